@@ -1,0 +1,164 @@
+//! Typed errors: every reachable failure says what was wrong and why.
+
+use thiserror::Error;
+
+/// Convenient result alias of the crate.
+pub type Result<T> = std::result::Result<T, Error>;
+
+/// Everything that can go wrong in the crate.
+///
+/// Every variant carries the offending values so a caller can report them or recover.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A length (block size, cell size, rod half-width, ...) is not finite and positive.
+    #[error("{name} = {value} m is invalid: it must be finite and > 0")]
+    InvalidLength {
+        /// Which length.
+        name: &'static str,
+        /// The value given (m).
+        value: f64,
+    },
+    /// A cell count is zero.
+    #[error("the grid needs at least one cell along {axis}, got 0")]
+    EmptyGrid {
+        /// `"x"` or `"y"`.
+        axis: &'static str,
+    },
+    /// The requested cell size does not divide the face into a whole number of cells.
+    #[error("cell size {cell} m does not divide L{axis} = {length} m (ratio {ratio}, not an integer)")]
+    GridDoesNotDivide {
+        /// `"x"` or `"y"`.
+        axis: &'static str,
+        /// Face length along that axis (m).
+        length: f64,
+        /// Requested cell size (m).
+        cell: f64,
+        /// `length / cell`.
+        ratio: f64,
+    },
+    /// A coordinate lies outside the block.
+    #[error("{name} = {value} m lies outside the block, which spans [0, {max}] m")]
+    OutsideBlock {
+        /// Which coordinate (`"x"`, `"xi"`, `"z"`, ...).
+        name: &'static str,
+        /// The value given (m).
+        value: f64,
+        /// The block length along that axis (m).
+        max: f64,
+    },
+    /// The rod band `[h - Δh, h + Δh]` is not inside the trailing face `[0, Lz]`.
+    #[error("rod band [h - dh, h + dh] = [{low}, {high}] m is not inside the trailing face [0, {lz}] m")]
+    RodBandOutsideFace {
+        /// `h - Δh` (m).
+        low: f64,
+        /// `h + Δh` (m).
+        high: f64,
+        /// Block height (m).
+        lz: f64,
+    },
+    /// A tolerance is not finite and positive.
+    #[error("tolerance {value} is invalid: it must be finite and > 0")]
+    InvalidTolerance {
+        /// The value given.
+        value: f64,
+    },
+    /// The target point coincides with the source point, where the Green function is infinite.
+    #[error("target and source coincide at ({x}, {y}, {z}) m: the Green function is singular there")]
+    SingularPoint {
+        /// x (m).
+        x: f64,
+        /// y (m).
+        y: f64,
+        /// z (m).
+        z: f64,
+    },
+    /// A series could not reach the requested tolerance within its term budget.
+    #[error(
+        "{what} did not reach tolerance {tolerance:e}: best value {value:e} with error estimate \
+         {error:e} after {terms} terms (raise the budget or the tolerance)"
+    )]
+    NotConverged {
+        /// Which series.
+        what: &'static str,
+        /// Best value reached.
+        value: f64,
+        /// Its error estimate (same units as `value`).
+        error: f64,
+        /// Requested tolerance.
+        tolerance: f64,
+        /// Terms summed.
+        terms: u64,
+    },
+    /// A slice has the wrong length for the grid.
+    #[error("{name} has {found} values, the grid needs {expected}")]
+    LengthMismatch {
+        /// Which argument.
+        name: &'static str,
+        /// Expected length.
+        expected: usize,
+        /// Length given.
+        found: usize,
+    },
+    /// A slice holds a NaN or an infinity.
+    #[error("{name}[{index}] = {value} is not finite")]
+    NonFinite {
+        /// Which argument.
+        name: &'static str,
+        /// First offending index.
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// A dense matrix was requested for a grid too large to hold one sensibly.
+    #[error("dense assembly of a {n} x {n} matrix refused: the limit is n <= {limit}; use the matrix-free operator")]
+    TooLargeForDense {
+        /// Number of cells.
+        n: usize,
+        /// The limit on the number of cells.
+        limit: usize,
+    },
+    /// A parameter outside the values the model accepts (a term budget of zero, ...).
+    #[error("{name} = {value} is invalid: {reason}")]
+    InvalidParameter {
+        /// Which parameter.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// Why it is refused.
+        reason: &'static str,
+    },
+}
+
+/// Checks that `value` is a finite, positive length.
+pub(crate) fn check_length(name: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::InvalidLength { name, value })
+    }
+}
+
+/// Checks that a tolerance is finite and positive.
+pub(crate) fn check_tolerance(value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::InvalidTolerance { value })
+    }
+}
+
+/// Checks a slice length and that every value is finite.
+pub(crate) fn check_slice(name: &'static str, values: &[f64], expected: usize) -> Result<()> {
+    if values.len() != expected {
+        return Err(Error::LengthMismatch {
+            name,
+            expected,
+            found: values.len(),
+        });
+    }
+    if let Some((index, &value)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(Error::NonFinite { name, index, value });
+    }
+    Ok(())
+}

@@ -1,0 +1,540 @@
+//! The Galerkin influence operator of the grid (MODEL.md section 2) and the transfer of
+//! bottom tractions to a plane at height `z`.
+//!
+//! `Ĝ_ij = (1/ΔA²) ∫_cell i ∫_cell j G(x,ξ;y,η;0,0) dA dA'` is diagonal in the 2-D DCT-II
+//! basis of the grid. With `θ = p'π/(2Nx)` the aliases of the mode `p'` are the
+//! wavenumbers `k = 2|θ + qπ|/Δx`, `q ∈ ℤ`, with cell-averaging weights
+//! `S² = sin²θ/(θ + qπ)²` (summing to 1), and
+//!
+//! `Ĝ_ij = Σ_{p',m'} λ(p',m') cos(p'π(ix_i+½)/Nx) cos(p'π(ix_j+½)/Nx) cos(m'π(iy_i+½)/Ny) cos(m'π(iy_j+½)/Ny)`,
+//! `λ(p',m') = (4/(Lx Ly)) Σ_{aliases} w_p w_m S_p² S_m² coth(κ Lz)/κ` (m⁻¹),
+//!
+//! `κ² = k_p² + k_m²`, `w_0 = ½`, and `Lz/3` in place of `coth(κLz)/κ` at `κ = 0`.
+//! The alias sum is truncated to `|q|, |r| ≤ Q` with the leading tail of both strips added
+//! in closed form (Euler–Maclaurin on `Σ 1/|θ + qπ|³`); `Q` doubles until two successive
+//! sums agree to the tolerance (see `docs/accuracy.md`).
+
+use crate::error::{check_slice, check_tolerance, Error, Result};
+use crate::geometry::Grid;
+use rustdct::{DctPlanner, TransformType2And3};
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+/// Largest alias box half-width `Q` before the alias sum reports [`Error::NotConverged`].
+const MAX_ALIAS: usize = 512;
+
+/// Largest grid for which [`InfluencePlan::dense`] assembles a matrix.
+pub const DENSE_LIMIT: usize = 20_000;
+
+/// Cell-averaging weights and wavenumbers of the aliases of one 1-D DCT mode.
+struct Aliases {
+    theta: f64,
+    /// `(weight w S², k)` for q = -Q..=Q, skipping zero weights.
+    terms: Vec<(f64, f64)>,
+    /// Sum of the weights in the box (½ for mode 0, whose only alias has `w_0 = ½`).
+    weight: f64,
+}
+
+fn aliases(mode: usize, n: usize, cell: f64, q_max: usize) -> Aliases {
+    let theta = mode as f64 * PI / (2.0 * n as f64);
+    let mut terms = Vec::with_capacity(2 * q_max + 1);
+    if mode == 0 {
+        // Only the q = 0 alias (p = 0) survives: sinc(qπ) = 0 otherwise; w_0 = ½.
+        terms.push((0.5, 0.0));
+        return Aliases {
+            theta,
+            terms,
+            weight: 0.5,
+        };
+    }
+    let s2 = theta.sin().powi(2);
+    let mut weight = 0.0;
+    for q in -(q_max as i64)..=(q_max as i64) {
+        let t = theta + q as f64 * PI;
+        let w = s2 / (t * t);
+        weight += w;
+        terms.push((w, 2.0 * t.abs() / cell));
+    }
+    Aliases {
+        theta,
+        terms,
+        weight,
+    }
+}
+
+/// `Σ_{|q|>Q} 1/|θ + qπ|³` by the Euler–Maclaurin midpoint rule (error O(Q⁻⁷)).
+fn tail_cubed(theta: f64, q: usize) -> f64 {
+    let mut total = 0.0;
+    for a in [theta / PI, -theta / PI] {
+        let b = q as f64 + 0.5 + a;
+        total += 1.0 / (2.0 * b * b) + 1.0 / (8.0 * b.powi(4)) - 7.0 / (96.0 * b.powi(6));
+    }
+    total / PI.powi(3)
+}
+
+/// `coth(κ Lz)/κ`, the depth-summed kernel of the bottom face; `Lz/3` at `κ = 0`.
+fn depth_kernel(kappa: f64, lz: f64) -> f64 {
+    if kappa == 0.0 {
+        lz / 3.0
+    } else {
+        1.0 / (kappa * (kappa * lz).tanh())
+    }
+}
+
+/// The alias sum of one eigenvalue with box `Q`, tail-corrected.
+fn lambda_box(grid: &Grid, p: usize, m: usize, q: usize) -> f64 {
+    let b = grid.block();
+    let ax = aliases(p, grid.nx(), grid.dx(), q);
+    let ay = aliases(m, grid.ny(), grid.dy(), q);
+    let lz = b.lz();
+    let mut sum = 0.0;
+    for &(wx, kx) in &ax.terms {
+        for &(wy, ky) in &ay.terms {
+            sum += wx * wy * depth_kernel((kx * kx + ky * ky).sqrt(), lz);
+        }
+    }
+    // Strips outside the box: κ ≈ k along the long side, coth = 1 there.
+    if p != 0 {
+        sum += ay.weight * ax.theta.sin().powi(2) * grid.dx() / 2.0 * tail_cubed(ax.theta, q);
+    }
+    if m != 0 {
+        sum += ax.weight * ay.theta.sin().powi(2) * grid.dy() / 2.0 * tail_cubed(ay.theta, q);
+    }
+    4.0 / (b.lx() * b.ly()) * sum
+}
+
+/// One eigenvalue with its error estimate, `Q` doubled until converged.
+fn lambda_adaptive(grid: &Grid, p: usize, m: usize, tol: f64) -> Result<(f64, f64)> {
+    if p == 0 && m == 0 {
+        let b = grid.block();
+        return Ok((b.lz() / (3.0 * b.lx() * b.ly()), 0.0));
+    }
+    let mut q = 2;
+    let mut previous = lambda_box(grid, p, m, 1);
+    loop {
+        let value = lambda_box(grid, p, m, q);
+        // Successive errors shrink ~14x per doubling: |Δ|/4 over-estimates the error.
+        let error = (value - previous).abs() / 4.0;
+        if error <= tol * value {
+            return Ok((value, error));
+        }
+        if q >= MAX_ALIAS {
+            return Err(Error::NotConverged {
+                what: "alias sum of the influence operator",
+                value,
+                error,
+                tolerance: tol,
+                terms: ((2 * q + 1) * (2 * q + 1)) as u64,
+            });
+        }
+        previous = value;
+        q *= 2;
+    }
+}
+
+/// Builder of an [`InfluencePlan`].
+#[derive(Debug, Clone)]
+#[must_use]
+pub struct InfluencePlanBuilder {
+    grid: Grid,
+    tolerance: f64,
+}
+
+impl InfluencePlanBuilder {
+    /// Relative tolerance on every eigenvalue's alias sum (default `1e-6`).
+    pub fn tolerance(mut self, tolerance: f64) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+
+    /// Computes the eigenvalues and plans the DCTs.
+    pub fn build(self) -> Result<InfluencePlan> {
+        let tol = check_tolerance(self.tolerance)?;
+        let grid = self.grid;
+        let (nx, ny) = (grid.nx(), grid.ny());
+        let mut lambda = vec![0.0; grid.len()];
+        let mut max_rel_error: f64 = 0.0;
+        // Modes with the same (p', m') appear once: O(N) alias sums.
+        for m in 0..ny {
+            for p in 0..nx {
+                let (value, error) = lambda_adaptive(&grid, p, m, tol)?;
+                lambda[m * nx + p] = value;
+                max_rel_error = max_rel_error.max(error / value);
+            }
+        }
+        Ok(InfluencePlan::from_eigenvalues(grid, tol, lambda, max_rel_error))
+    }
+}
+
+/// The Galerkin influence operator `Ĝ` of a grid, planned once and reused.
+///
+/// `Ĝ` maps cell-constant tractions on the bottom face (Pa) to cell-averaged
+/// displacements times `M/ΔA`: the displacement is `u = ⟨u⟩ + (ΔA/M) Ĝ φ`; its entries
+/// are in m⁻¹. It is applied matrix-free through the 2-D DCT in `O(N log N)`
+/// ([`InfluencePlan::apply`]) or assembled densely for small grids ([`InfluencePlan::dense`]).
+#[derive(Clone)]
+pub struct InfluencePlan {
+    grid: Grid,
+    tolerance: f64,
+    lambda: Vec<f64>,
+    /// λ scaled for unnormalised DCT-III: ×2 for p' = 0 and for m' = 0.
+    scaled: Vec<f64>,
+    max_rel_error: f64,
+    dct: Arc<Dct2d>,
+}
+
+impl std::fmt::Debug for InfluencePlan {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("InfluencePlan")
+            .field("grid", &self.grid)
+            .field("tolerance", &self.tolerance)
+            .field("max_rel_error", &self.max_rel_error)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Planned 1-D DCTs of both axes.
+pub(crate) struct Dct2d {
+    nx: usize,
+    ny: usize,
+    x: Arc<dyn TransformType2And3<f64>>,
+    y: Arc<dyn TransformType2And3<f64>>,
+    scratch_len: usize,
+}
+
+impl Dct2d {
+    pub(crate) fn new(nx: usize, ny: usize) -> Self {
+        let mut planner = DctPlanner::new();
+        let x = planner.plan_dct2(nx);
+        let y = planner.plan_dct2(ny);
+        let scratch_len = x.get_scratch_len().max(y.get_scratch_len());
+        Self {
+            nx,
+            ny,
+            x,
+            y,
+            scratch_len,
+        }
+    }
+
+    /// In place: forward (unnormalised DCT-II) on both axes, multiply by `diag`, then
+    /// unnormalised DCT-III on both axes.
+    pub(crate) fn filter(&self, buf: &mut [f64], diag: &[f64]) {
+        let mut scratch = vec![0.0; self.scratch_len];
+        let mut column = vec![0.0; self.ny];
+        for row in buf.chunks_exact_mut(self.nx) {
+            self.x.process_dct2_with_scratch(row, &mut scratch);
+        }
+        self.columns(buf, &mut column, &mut scratch, true);
+        for (b, d) in buf.iter_mut().zip(diag) {
+            *b *= d;
+        }
+        self.columns(buf, &mut column, &mut scratch, false);
+        for row in buf.chunks_exact_mut(self.nx) {
+            self.x.process_dct3_with_scratch(row, &mut scratch);
+        }
+    }
+
+    fn columns(&self, buf: &mut [f64], column: &mut [f64], scratch: &mut [f64], forward: bool) {
+        if self.ny == 1 {
+            return; // a length-1 DCT-II is the identity; DCT-III halves it, compensated in diag
+        }
+        for ix in 0..self.nx {
+            for (iy, c) in column.iter_mut().enumerate() {
+                *c = buf[iy * self.nx + ix];
+            }
+            if forward {
+                self.y.process_dct2_with_scratch(column, scratch);
+            } else {
+                self.y.process_dct3_with_scratch(column, scratch);
+            }
+            for (iy, c) in column.iter().enumerate() {
+                buf[iy * self.nx + ix] = *c;
+            }
+        }
+    }
+}
+
+/// Diagonal for [`Dct2d::filter`]: the eigenvalue table times the DCT-III scaling.
+fn dct_diagonal(grid: &Grid, values: &[f64]) -> Vec<f64> {
+    let (nx, ny) = (grid.nx(), grid.ny());
+    let mut out = values.to_vec();
+    for m in 0..ny {
+        for p in 0..nx {
+            let mut s = 1.0;
+            if p == 0 {
+                s *= 2.0;
+            }
+            if m == 0 && ny > 1 {
+                s *= 2.0;
+            }
+            out[m * nx + p] *= s;
+        }
+    }
+    out
+}
+
+/// `cos(π k (2i+1) / (2n))` for all `k, i < n`, with exact argument reduction.
+pub(crate) fn cosine_table(n: usize) -> Vec<f64> {
+    let base: Vec<f64> = (0..4 * n).map(|j| (PI * j as f64 / (2.0 * n as f64)).cos()).collect();
+    let mut t = vec![0.0; n * n];
+    for k in 0..n {
+        for i in 0..n {
+            t[k * n + i] = base[(k * (2 * i + 1)) % (4 * n)];
+        }
+    }
+    t
+}
+
+impl InfluencePlan {
+    /// A builder for the operator of `grid` with the default tolerance.
+    pub fn builder(grid: Grid) -> InfluencePlanBuilder {
+        InfluencePlanBuilder {
+            grid,
+            tolerance: 1e-6,
+        }
+    }
+
+    fn from_eigenvalues(grid: Grid, tolerance: f64, lambda: Vec<f64>, max_rel_error: f64) -> Self {
+        let scaled = dct_diagonal(&grid, &lambda);
+        Self {
+            dct: Arc::new(Dct2d::new(grid.nx(), grid.ny())),
+            grid,
+            tolerance,
+            lambda,
+            scaled,
+            max_rel_error,
+        }
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The relative tolerance the alias sums were computed to.
+    pub fn tolerance(&self) -> f64 {
+        self.tolerance
+    }
+
+    /// Largest estimated relative error of an eigenvalue.
+    pub fn max_relative_error(&self) -> f64 {
+        self.max_rel_error
+    }
+
+    /// `λ(p', m')` (m⁻¹), the coefficient of `cos(p'·)cos(p'·)cos(m'·)cos(m'·)` in `Ĝ`
+    /// (module docs); `p' < Nx`, `m' < Ny`. `None` outside the grid.
+    pub fn lambda(&self, p: usize, m: usize) -> Option<f64> {
+        (p < self.grid.nx() && m < self.grid.ny()).then(|| self.lambda[m * self.grid.nx() + p])
+    }
+
+    /// Eigenvalue of `Ĝ` (m⁻¹) for the orthonormal DCT-II mode `(p', m')`:
+    /// `λ / (α_p'² α_m'²)` with `α_0² = 1/N`, `α_{>0}² = 2/N`.
+    pub fn eigenvalue(&self, p: usize, m: usize) -> Option<f64> {
+        let (nx, ny) = (self.grid.nx() as f64, self.grid.ny() as f64);
+        let ax = if p == 0 { 1.0 / nx } else { 2.0 / nx };
+        let ay = if m == 0 { 1.0 / ny } else { 2.0 / ny };
+        self.lambda(p, m).map(|l| l / (ax * ay))
+    }
+
+    /// `out = Ĝ v` (m⁻¹ times the units of `v`), matrix-free in `O(N log N)`.
+    pub fn apply(&self, v: &[f64], out: &mut [f64]) -> Result<()> {
+        let n = self.grid.len();
+        check_slice("v", v, n)?;
+        if out.len() != n {
+            return Err(Error::LengthMismatch {
+                name: "out",
+                expected: n,
+                found: out.len(),
+            });
+        }
+        out.copy_from_slice(v);
+        self.dct.filter(out, &self.scaled);
+        Ok(())
+    }
+
+    /// The dense matrix `Ĝ` (m⁻¹), row-major `N x N`, assembled from the eigenvalue table
+    /// by explicit cosine sums (independent of the DCT path). Refused above
+    /// [`DENSE_LIMIT`] cells.
+    pub fn dense(&self) -> Result<Vec<f64>> {
+        let n = self.grid.len();
+        if n > DENSE_LIMIT {
+            return Err(Error::TooLargeForDense {
+                n,
+                limit: DENSE_LIMIT,
+            });
+        }
+        let (nx, ny) = (self.grid.nx(), self.grid.ny());
+        let cx = cosine_table(nx);
+        let cy = cosine_table(ny);
+        // B_m[a][b] = Σ_p λ(p,m) cx[p][a] cx[p][b], then Ĝ = Σ_m cy[m]⊗cy[m] ⊗ B_m.
+        let mut g = vec![0.0; n * n];
+        let mut bm = vec![0.0; nx * nx];
+        for m in 0..ny {
+            bm.iter_mut().for_each(|x| *x = 0.0);
+            for p in 0..nx {
+                let l = self.lambda[m * nx + p];
+                let row = &cx[p * nx..(p + 1) * nx];
+                for a in 0..nx {
+                    let la = l * row[a];
+                    for b in 0..nx {
+                        bm[a * nx + b] += la * row[b];
+                    }
+                }
+            }
+            let crow = &cy[m * ny..(m + 1) * ny];
+            for iy in 0..ny {
+                for jy in 0..ny {
+                    let c = crow[iy] * crow[jy];
+                    for a in 0..nx {
+                        let dst = &mut g[(iy * nx + a) * n + jy * nx..(iy * nx + a) * n + jy * nx + nx];
+                        let src = &bm[a * nx..(a + 1) * nx];
+                        for (d, s) in dst.iter_mut().zip(src) {
+                            *d += c * s;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(g)
+    }
+
+    /// The transfer of bottom tractions to the plane at height `z` (m), with the alias
+    /// sums converged to absolute tolerance `tol` (the factors are at most 1).
+    pub fn plane_transfer(&self, z: f64, tol: f64) -> Result<PlaneTransfer> {
+        PlaneTransfer::new(self, z, tol)
+    }
+}
+
+/// Cell-averaged stress on the plane `z` due to cell-constant bottom tractions.
+///
+/// A bottom traction mode `(p, m) ≠ 0` reaches height `z` multiplied by
+/// `sinh κ(Lz-z)/sinh κLz`, the mean by `(Lz-z)/Lz` (MODEL.md section 1); averaging over
+/// source and target cells makes the map diagonal in the DCT-II basis with factors
+/// `Σ_{aliases} (2w_p S_p²)(2w_m S_m²)·transfer(κ)`, which are exactly 1 at `z = 0`.
+#[derive(Clone)]
+pub struct PlaneTransfer {
+    grid: Grid,
+    z: f64,
+    factors: Vec<f64>,
+    scaled: Vec<f64>,
+    dct: Arc<Dct2d>,
+}
+
+impl std::fmt::Debug for PlaneTransfer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PlaneTransfer")
+            .field("grid", &self.grid)
+            .field("z", &self.z)
+            .finish_non_exhaustive()
+    }
+}
+
+/// `sinh κ(Lz - z)/sinh κLz` written with decaying exponentials; `(Lz - z)/Lz` at κ = 0.
+fn transfer(kappa: f64, z: f64, lz: f64) -> f64 {
+    if kappa == 0.0 {
+        return (lz - z) / lz;
+    }
+    ((-kappa * z).exp() - (-kappa * (2.0 * lz - z)).exp()) / (-(-2.0 * kappa * lz).exp_m1())
+}
+
+impl PlaneTransfer {
+    fn new(plan: &InfluencePlan, z: f64, tol: f64) -> Result<Self> {
+        let grid = plan.grid;
+        let lz = grid.block().lz();
+        let z = grid.block().check_height(z)?;
+        let tol = check_tolerance(tol)?;
+        let (nx, ny) = (grid.nx(), grid.ny());
+        let mut factors = vec![0.0; grid.len()];
+        for m in 0..ny {
+            for p in 0..nx {
+                factors[m * nx + p] = if z == 0.0 {
+                    1.0
+                } else {
+                    Self::factor(&grid, p, m, z, lz, tol)?
+                };
+            }
+        }
+        // Coefficient form for the DCT filter: factor × α_p'² α_m'² (inverse of the
+        // orthonormal scaling), then the DCT-III scaling.
+        let coef: Vec<f64> = (0..grid.len())
+            .map(|i| {
+                let (p, m) = (i % nx, i / nx);
+                let ax = if p == 0 { 1.0 / nx as f64 } else { 2.0 / nx as f64 };
+                let ay = if m == 0 { 1.0 / ny as f64 } else { 2.0 / ny as f64 };
+                factors[i] * ax * ay
+            })
+            .collect();
+        Ok(Self {
+            scaled: dct_diagonal(&grid, &coef),
+            dct: plan.dct.clone(),
+            grid,
+            z,
+            factors,
+        })
+    }
+
+    fn factor(grid: &Grid, p: usize, m: usize, z: f64, lz: f64, tol: f64) -> Result<f64> {
+        let mut q = 1;
+        loop {
+            let ax = aliases(p, grid.nx(), grid.dx(), q);
+            let ay = aliases(m, grid.ny(), grid.dy(), q);
+            // Weights normalised to sum to 1 over all aliases (2 w S²).
+            let (sx, sy) = (if p == 0 { 2.0 } else { 1.0 }, if m == 0 { 2.0 } else { 1.0 });
+            let mut sum = 0.0;
+            for &(wx, kx) in &ax.terms {
+                for &(wy, ky) in &ay.terms {
+                    sum += sx * wx * sy * wy * transfer((kx * kx + ky * ky).sqrt(), z, lz);
+                }
+            }
+            // Rigorous tail bound: the transfer decreases with κ and is below its value at
+            // the nearest alias outside the box; the weights outside sum to 1 - inside.
+            let inside = (sx * ax.weight * sy * ay.weight).min(1.0);
+            let out_weight = (1.0 - inside).max(0.0);
+            let k_out = 2.0 * (q as f64 + 0.5) * PI / grid.dx().max(grid.dy());
+            let bound = out_weight * transfer(k_out, z, lz);
+            if bound <= tol {
+                return Ok(sum);
+            }
+            if q >= MAX_ALIAS {
+                return Err(Error::NotConverged {
+                    what: "alias sum of the plane transfer (z too close to 0?)",
+                    value: sum,
+                    error: bound,
+                    tolerance: tol,
+                    terms: ((2 * q + 1) * (2 * q + 1)) as u64,
+                });
+            }
+            q *= 2;
+        }
+    }
+
+    /// Height of the plane (m).
+    pub fn z(&self) -> f64 {
+        self.z
+    }
+
+    /// Transfer factor of the orthonormal DCT-II mode `(p', m')` (dimensionless, in [0, 1]).
+    pub fn factor_of_mode(&self, p: usize, m: usize) -> Option<f64> {
+        (p < self.grid.nx() && m < self.grid.ny()).then(|| self.factors[m * self.grid.nx() + p])
+    }
+
+    /// Cell-averaged stress on the plane (Pa) due to the bottom tractions `traction` (Pa):
+    /// `σ(z) = -T(z) φ`, so that `σ_xz` follows from `φ_x` and `σ_zz` from `φ_z`; at
+    /// `z = 0` it is `-φ`. External load terms are not included (see [`crate::green::loads`]).
+    pub fn stress(&self, traction: &[f64], out: &mut [f64]) -> Result<()> {
+        let n = self.grid.len();
+        check_slice("traction", traction, n)?;
+        if out.len() != n {
+            return Err(Error::LengthMismatch {
+                name: "out",
+                expected: n,
+                found: out.len(),
+            });
+        }
+        out.copy_from_slice(traction);
+        self.dct.filter(out, &self.scaled);
+        out.iter_mut().for_each(|s| *s = -*s);
+        Ok(())
+    }
+}

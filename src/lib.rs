@@ -1,0 +1,39 @@
+//! # precursors
+//!
+//! The scalar elastic model of frictional precursors (Bonfanti, Taloni, Negri, Sellerio,
+//! Manini, Zapperi): a 3-D elastic block `[0,Lx] x [0,Ly] x [0,Lz]` on a rough rigid
+//! substrate, two decoupled scalar Laplace problems `M ∇²u_x = 0`, `M ∇²u_z = 0`
+//! (`M = E/(1+ν)`) solved with the box's Neumann Green function, and a grid of interfacial
+//! springs on the bottom face.
+//!
+//! Units are SI throughout: lengths in m, forces in N, tractions and stresses in Pa.
+//! Sign conventions are those of `MODEL.md` (shipped in `docs/model.md`): both shear loads
+//! point along +x, the normal load presses the block down, bottom tractions `φ_z ≥ 0`
+//! push up.
+//!
+//! This release provides the geometry and the [`green`] module: point evaluation of `G`
+//! and `∂G/∂z`, the analytic load terms, and the Galerkin influence operator of the grid,
+//! planned once per geometry and applied through the 2-D DCT.
+//!
+//! ```
+//! use precursors::{Block, Grid, green::InfluencePlan};
+//! let block = Block::new(0.14, 0.007, 0.075)?;          // 140 x 7 x 75 mm
+//! let grid = Grid::from_cell_size(block, 1e-3, 1e-3)?;   // 1 mm cells: 140 x 7
+//! let plan = InfluencePlan::builder(grid).tolerance(1e-8).build()?;
+//! let traction = vec![1.0; grid.len()];                  // 1 Pa everywhere
+//! let mut u = vec![0.0; grid.len()];
+//! plan.apply(&traction, &mut u)?;                        // Ĝ φ (m⁻¹ Pa)
+//! // A uniform traction only excites the mean mode: Σ_j Ĝ_ij = Lz / (3 ΔA).
+//! let expected = 0.075 / (3.0 * grid.cell_area());
+//! assert!((u[17] - expected).abs() < 1e-9 * expected);
+//! # Ok::<(), precursors::Error>(())
+//! ```
+#![deny(missing_docs)]
+#![forbid(unsafe_code)]
+
+pub mod error;
+pub mod geometry;
+pub mod green;
+
+pub use error::{Error, Result};
+pub use geometry::{Block, Grid, Point};

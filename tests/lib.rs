@@ -1,0 +1,8 @@
+//! One integration-test crate (one binary to link): each module tests one part of the
+//! public API against references computed independently of the code under test.
+
+mod common;
+mod errors;
+mod green_point;
+mod loads;
+mod operator;

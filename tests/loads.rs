@@ -1,0 +1,1 @@
+//! Analytic load terms against numerical quadrature of the point Green function.

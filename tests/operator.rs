@@ -1,0 +1,1 @@
+//! The Galerkin grid operator.
