@@ -26,7 +26,9 @@ pub enum Error {
         axis: &'static str,
     },
     /// The requested cell size does not divide the face into a whole number of cells.
-    #[error("cell size {cell} m does not divide L{axis} = {length} m (ratio {ratio}, not an integer)")]
+    #[error(
+        "cell size {cell} m does not divide L{axis} = {length} m (ratio {ratio}, not an integer)"
+    )]
     GridDoesNotDivide {
         /// `"x"` or `"y"`.
         axis: &'static str,
@@ -48,7 +50,9 @@ pub enum Error {
         max: f64,
     },
     /// The rod band `[h - Δh, h + Δh]` is not inside the trailing face `[0, Lz]`.
-    #[error("rod band [h - dh, h + dh] = [{low}, {high}] m is not inside the trailing face [0, {lz}] m")]
+    #[error(
+        "rod band [h - dh, h + dh] = [{low}, {high}] m is not inside the trailing face [0, {lz}] m"
+    )]
     RodBandOutsideFace {
         /// `h - Δh` (m).
         low: f64,
@@ -64,7 +68,9 @@ pub enum Error {
         value: f64,
     },
     /// The target point coincides with the source point, where the Green function is infinite.
-    #[error("target and source coincide at ({x}, {y}, {z}) m: the Green function is singular there")]
+    #[error(
+        "target and source coincide at ({x}, {y}, {z}) m: the Green function is singular there"
+    )]
     SingularPoint {
         /// x (m).
         x: f64,

@@ -36,4 +36,9 @@ pub mod geometry;
 pub mod green;
 
 pub use error::{Error, Result};
+
+/// The README's code blocks, compiled and run as doctests so they stay true.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
 pub use geometry::{Block, Grid, Point};

@@ -5,8 +5,16 @@ use precursors::{Block, Error, Grid, Point};
 
 #[test]
 fn block_sizes_must_be_finite_and_positive() {
-    for (lx, ly, lz) in [(0.0, 1.0, 1.0), (1.0, -1.0, 1.0), (1.0, 1.0, f64::NAN), (f64::INFINITY, 1.0, 1.0)] {
-        assert!(matches!(Block::new(lx, ly, lz), Err(Error::InvalidLength { .. })));
+    for (lx, ly, lz) in [
+        (0.0, 1.0, 1.0),
+        (1.0, -1.0, 1.0),
+        (1.0, 1.0, f64::NAN),
+        (f64::INFINITY, 1.0, 1.0),
+    ] {
+        assert!(matches!(
+            Block::new(lx, ly, lz),
+            Err(Error::InvalidLength { .. })
+        ));
     }
 }
 
@@ -14,9 +22,18 @@ fn block_sizes_must_be_finite_and_positive() {
 fn grid_must_divide_the_face() {
     let b = Block::new(0.14, 0.007, 0.075).unwrap();
     let e = Grid::from_cell_size(b, 0.003, 0.001).unwrap_err();
-    assert!(matches!(e, Error::GridDoesNotDivide { axis: "x", .. }), "{e}");
-    assert!(matches!(Grid::from_cell_size(b, 0.0, 0.001), Err(Error::InvalidLength { .. })));
-    assert!(matches!(Grid::new(b, 0, 3), Err(Error::EmptyGrid { axis: "x" })));
+    assert!(
+        matches!(e, Error::GridDoesNotDivide { axis: "x", .. }),
+        "{e}"
+    );
+    assert!(matches!(
+        Grid::from_cell_size(b, 0.0, 0.001),
+        Err(Error::InvalidLength { .. })
+    ));
+    assert!(matches!(
+        Grid::new(b, 0, 3),
+        Err(Error::EmptyGrid { axis: "x" })
+    ));
     let g = Grid::from_cell_size(b, 0.001, 0.001).unwrap();
     assert_eq!((g.nx(), g.ny()), (140, 7));
 }
@@ -26,9 +43,19 @@ fn points_outside_the_block_are_refused() {
     let b = Block::new(0.1, 0.01, 0.05).unwrap();
     let gf = GreenFunction::new(b);
     let inside = Point::new(0.05, 0.005, 0.01);
-    for bad in [Point::new(-1e-9, 0.005, 0.01), Point::new(0.05, 0.02, 0.01), Point::new(0.05, 0.005, f64::NAN)] {
-        assert!(matches!(gf.value(bad, inside, 1e-6), Err(Error::OutsideBlock { .. })));
-        assert!(matches!(gf.dz(inside, bad, 1e-6), Err(Error::OutsideBlock { .. })));
+    for bad in [
+        Point::new(-1e-9, 0.005, 0.01),
+        Point::new(0.05, 0.02, 0.01),
+        Point::new(0.05, 0.005, f64::NAN),
+    ] {
+        assert!(matches!(
+            gf.value(bad, inside, 1e-6),
+            Err(Error::OutsideBlock { .. })
+        ));
+        assert!(matches!(
+            gf.dz(inside, bad, 1e-6),
+            Err(Error::OutsideBlock { .. })
+        ));
     }
 }
 
@@ -38,7 +65,10 @@ fn tolerances_must_be_positive() {
     let gf = GreenFunction::new(b);
     let (r, s) = (Point::new(0.05, 0.005, 0.01), Point::new(0.02, 0.001, 0.0));
     for tol in [0.0, -1.0, f64::NAN] {
-        assert!(matches!(gf.value(r, s, tol), Err(Error::InvalidTolerance { .. })));
+        assert!(matches!(
+            gf.value(r, s, tol),
+            Err(Error::InvalidTolerance { .. })
+        ));
     }
     let grid = Grid::new(b, 10, 2).unwrap();
     assert!(matches!(
@@ -46,15 +76,27 @@ fn tolerances_must_be_positive() {
         Err(Error::InvalidTolerance { .. })
     ));
     let opts = SeriesOptions::with_tolerance(1e-6).max_terms(0);
-    assert!(matches!(gf.value_with(r, s, &opts), Err(Error::InvalidParameter { .. })));
+    assert!(matches!(
+        gf.value_with(r, s, &opts),
+        Err(Error::InvalidParameter { .. })
+    ));
 }
 
 #[test]
 fn rod_band_must_lie_on_the_face() {
     let b = Block::new(0.1, 0.01, 0.05).unwrap();
-    assert!(matches!(RodLoad::new(&b, 0.001, 0.002), Err(Error::RodBandOutsideFace { .. })));
-    assert!(matches!(RodLoad::new(&b, 0.049, 0.002), Err(Error::RodBandOutsideFace { .. })));
-    assert!(matches!(RodLoad::new(&b, 0.01, 0.0), Err(Error::InvalidLength { .. })));
+    assert!(matches!(
+        RodLoad::new(&b, 0.001, 0.002),
+        Err(Error::RodBandOutsideFace { .. })
+    ));
+    assert!(matches!(
+        RodLoad::new(&b, 0.049, 0.002),
+        Err(Error::RodBandOutsideFace { .. })
+    ));
+    assert!(matches!(
+        RodLoad::new(&b, 0.01, 0.0),
+        Err(Error::InvalidLength { .. })
+    ));
     assert!(RodLoad::new(&b, 0.025, 0.025).is_ok());
 }
 
@@ -63,9 +105,18 @@ fn heights_outside_the_block_are_refused() {
     let b = Block::new(0.1, 0.01, 0.05).unwrap();
     let grid = Grid::new(b, 10, 2).unwrap();
     let plan = InfluencePlan::builder(grid).build().unwrap();
-    assert!(matches!(plan.plane_transfer(0.06, 1e-8), Err(Error::OutsideBlock { .. })));
-    assert!(matches!(plan.plane_transfer(-0.001, 1e-8), Err(Error::OutsideBlock { .. })));
-    assert!(matches!(precursors::green::loads::top_stress_influence(&b, f64::NAN), Err(Error::OutsideBlock { .. })));
+    assert!(matches!(
+        plan.plane_transfer(0.06, 1e-8),
+        Err(Error::OutsideBlock { .. })
+    ));
+    assert!(matches!(
+        plan.plane_transfer(-0.001, 1e-8),
+        Err(Error::OutsideBlock { .. })
+    ));
+    assert!(matches!(
+        precursors::green::loads::top_stress_influence(&b, f64::NAN),
+        Err(Error::OutsideBlock { .. })
+    ));
 }
 
 #[test]
@@ -74,10 +125,16 @@ fn operator_inputs_are_checked() {
     let grid = Grid::new(b, 10, 2).unwrap();
     let plan = InfluencePlan::builder(grid).build().unwrap();
     let mut out = vec![0.0; 20];
-    assert!(matches!(plan.apply(&[1.0; 19], &mut out), Err(Error::LengthMismatch { .. })));
+    assert!(matches!(
+        plan.apply(&[1.0; 19], &mut out),
+        Err(Error::LengthMismatch { .. })
+    ));
     let mut v = vec![1.0; 20];
     v[3] = f64::NAN;
-    assert!(matches!(plan.apply(&v, &mut out), Err(Error::NonFinite { index: 3, .. })));
+    assert!(matches!(
+        plan.apply(&v, &mut out),
+        Err(Error::NonFinite { index: 3, .. })
+    ));
     let big = Grid::new(b, 200, 101).unwrap();
     let plan = InfluencePlan::builder(big).tolerance(1e-2).build().unwrap();
     assert!(matches!(plan.dense(), Err(Error::TooLargeForDense { .. })));

@@ -27,13 +27,26 @@ fn rapid_representation_matches_raw_triple_series() {
     // (face points are covered by the agreement of the three closed-form axes).
     let gf = GreenFunction::new(small_block());
     let pairs = [
-        (Point::new(0.007, 0.004, 0.003), Point::new(0.021, 0.013, 0.017)),
-        (Point::new(0.001, 0.019, 0.024), Point::new(0.029, 0.002, 0.009)),
-        (Point::new(0.016, 0.009, 0.012), Point::new(0.011, 0.003, 0.015)),
+        (
+            Point::new(0.007, 0.004, 0.003),
+            Point::new(0.021, 0.013, 0.017),
+        ),
+        (
+            Point::new(0.001, 0.019, 0.024),
+            Point::new(0.029, 0.002, 0.009),
+        ),
+        (
+            Point::new(0.016, 0.009, 0.012),
+            Point::new(0.011, 0.003, 0.015),
+        ),
     ];
     for (r, s) in pairs {
         let raw = gf
-            .raw_series(r, s, &SeriesOptions::with_tolerance(1e-3).max_terms(400_000_000))
+            .raw_series(
+                r,
+                s,
+                &SeriesOptions::with_tolerance(1e-3).max_terms(400_000_000),
+            )
             .unwrap();
         let rapid = gf.value(r, s, 1e-12).unwrap();
         let diff = (raw.value - rapid.value).abs();
@@ -67,7 +80,10 @@ fn error_estimate_bounds_the_actual_error() {
     for tol in [1e-2, 1e-4, 1e-6, 1e-8] {
         let e = gf.value(r, s, tol).unwrap();
         assert!(e.error <= tol);
-        assert!((e.value - reference).abs() <= e.error + 1e-13, "tol {tol}: {e:?} vs {reference}");
+        assert!(
+            (e.value - reference).abs() <= e.error + 1e-13,
+            "tol {tol}: {e:?} vs {reference}"
+        );
     }
 }
 
@@ -77,12 +93,27 @@ fn dz_matches_finite_differences_of_g() {
     let cases = [
         (Point::new(0.05, 0.003, 0.002), Point::new(0.06, 0.004, 0.0)),
         (Point::new(0.05, 0.003, 0.03), Point::new(0.07, 0.001, 0.01)),
-        (Point::new(0.01, 0.006, 0.07), Point::new(0.011, 0.006, 0.02)),
+        (
+            Point::new(0.01, 0.006, 0.07),
+            Point::new(0.011, 0.006, 0.02),
+        ),
     ];
     let h = 1e-6;
     for (r, s) in cases {
-        let up = g(&gf, Point::new(r.x, r.y, r.z + h), s, 1e-14, SummationAxis::Auto);
-        let down = g(&gf, Point::new(r.x, r.y, r.z - h), s, 1e-14, SummationAxis::Auto);
+        let up = g(
+            &gf,
+            Point::new(r.x, r.y, r.z + h),
+            s,
+            1e-14,
+            SummationAxis::Auto,
+        );
+        let down = g(
+            &gf,
+            Point::new(r.x, r.y, r.z - h),
+            s,
+            1e-14,
+            SummationAxis::Auto,
+        );
         let fd = (up - down) / (2.0 * h);
         let d = gf.dz(r, s, 1e-11).unwrap().value;
         assert!(rel(d, fd, 1.0) < 1e-5, "{r:?}: analytic {d} fd {fd}");
@@ -96,9 +127,18 @@ fn dz_axes_agree_including_the_papers_zeta_zero_form() {
     let r = Point::new(0.03, 0.002, 0.002);
     let s = Point::new(0.035, 0.005, 0.0);
     let opts = SeriesOptions::with_tolerance(1e-10);
-    let vz = gf.dz_with(r, s, &opts.axis(SummationAxis::Z)).unwrap().value;
-    let vx = gf.dz_with(r, s, &opts.axis(SummationAxis::X)).unwrap().value;
-    let vy = gf.dz_with(r, s, &opts.axis(SummationAxis::Y)).unwrap().value;
+    let vz = gf
+        .dz_with(r, s, &opts.axis(SummationAxis::Z))
+        .unwrap()
+        .value;
+    let vx = gf
+        .dz_with(r, s, &opts.axis(SummationAxis::X))
+        .unwrap()
+        .value;
+    let vy = gf
+        .dz_with(r, s, &opts.axis(SummationAxis::Y))
+        .unwrap()
+        .value;
     assert!(rel(vx, vz, 1.0) < 1e-9, "{vx} {vz}");
     assert!(rel(vy, vz, 1.0) < 1e-9, "{vy} {vz}");
 }
@@ -109,20 +149,38 @@ fn laplacian_is_one_over_volume_away_from_the_source() {
     let block = small_block();
     let gf = GreenFunction::new(block);
     let s = Point::new(0.011, 0.007, 0.009);
-    for r in [Point::new(0.02, 0.012, 0.015), Point::new(0.004, 0.015, 0.02)] {
+    for r in [
+        Point::new(0.02, 0.012, 0.015),
+        Point::new(0.004, 0.015, 0.02),
+    ] {
         let lap = |h: f64| {
             let c = g(&gf, r, s, 1e-13, SummationAxis::Auto);
             let mut sum = -6.0 * c;
             for (dx, dy, dz) in [(h, 0.0, 0.0), (0.0, h, 0.0), (0.0, 0.0, h)] {
-                sum += g(&gf, Point::new(r.x + dx, r.y + dy, r.z + dz), s, 1e-13, SummationAxis::Auto);
-                sum += g(&gf, Point::new(r.x - dx, r.y - dy, r.z - dz), s, 1e-13, SummationAxis::Auto);
+                sum += g(
+                    &gf,
+                    Point::new(r.x + dx, r.y + dy, r.z + dz),
+                    s,
+                    1e-13,
+                    SummationAxis::Auto,
+                );
+                sum += g(
+                    &gf,
+                    Point::new(r.x - dx, r.y - dy, r.z - dz),
+                    s,
+                    1e-13,
+                    SummationAxis::Auto,
+                );
             }
             sum / (h * h)
         };
         let (l1, l2) = (lap(4e-4), lap(2e-4));
         let extrapolated = (4.0 * l2 - l1) / 3.0;
         let expected = 1.0 / block.volume();
-        assert!(rel(extrapolated, expected, expected) < 1e-3, "{extrapolated} vs {expected}");
+        assert!(
+            rel(extrapolated, expected, expected) < 1e-3,
+            "{extrapolated} vs {expected}"
+        );
     }
 }
 
@@ -134,7 +192,9 @@ fn normal_derivative_vanishes_on_every_face() {
     let gf = GreenFunction::new(block);
     let s = Point::new(0.012, 0.008, 0.01);
     let h = 1e-5;
-    let one_sided = |f: &dyn Fn(f64) -> f64, sign: f64| (-3.0 * f(0.0) + 4.0 * f(sign * h) - f(2.0 * sign * h)) / (2.0 * h);
+    let one_sided = |f: &dyn Fn(f64) -> f64, sign: f64| {
+        (-3.0 * f(0.0) + 4.0 * f(sign * h) - f(2.0 * sign * h)) / (2.0 * h)
+    };
     let gv = |p: Point| g(&gf, p, s, 1e-14, SummationAxis::Auto);
     let scale = 1.0 / (4.0 * std::f64::consts::PI * 0.01f64.powi(2));
     let checks: Vec<f64> = vec![
@@ -157,7 +217,10 @@ fn normal_derivative_vanishes_on_every_face() {
 fn coincident_points_are_a_typed_error() {
     let gf = GreenFunction::new(small_block());
     let p = Point::new(0.01, 0.01, 0.01);
-    assert!(matches!(gf.value(p, p, 1e-8), Err(Error::SingularPoint { .. })));
+    assert!(matches!(
+        gf.value(p, p, 1e-8),
+        Err(Error::SingularPoint { .. })
+    ));
 }
 
 #[test]
@@ -166,7 +229,10 @@ fn forced_axis_without_separation_is_a_typed_error() {
     let r = Point::new(0.01, 0.01, 0.0);
     let s = Point::new(0.02, 0.012, 0.0);
     let opts = SeriesOptions::with_tolerance(1e-8).axis(SummationAxis::Z);
-    assert!(matches!(gf.value_with(r, s, &opts), Err(Error::InvalidParameter { .. })));
+    assert!(matches!(
+        gf.value_with(r, s, &opts),
+        Err(Error::InvalidParameter { .. })
+    ));
 }
 
 fn point_in(b: Block) -> impl Strategy<Value = Point> {
@@ -175,7 +241,9 @@ fn point_in(b: Block) -> impl Strategy<Value = Point> {
 }
 
 fn separated(r: Point, s: Point, b: Block) -> bool {
-    ((r.x - s.x) / b.lx()).abs() > 0.05 || ((r.y - s.y) / b.ly()).abs() > 0.05 || ((r.z - s.z) / b.lz()).abs() > 0.05
+    ((r.x - s.x) / b.lx()).abs() > 0.05
+        || ((r.y - s.y) / b.ly()).abs() > 0.05
+        || ((r.z - s.z) / b.lz()).abs() > 0.05
 }
 
 proptest! {

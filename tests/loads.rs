@@ -18,11 +18,19 @@ fn top_load_is_the_face_integral_of_g() {
         let mut q = 0.0;
         for (xi, wx) in rule(0.0, b.lx(), 10, 8) {
             for (eta, wy) in rule(0.0, b.ly(), 2, 8) {
-                q += wx * wy * gf.value(Point::new(x, y, 0.0), Point::new(xi, eta, b.lz()), 1e-12).unwrap().value;
+                q += wx
+                    * wy
+                    * gf.value(Point::new(x, y, 0.0), Point::new(xi, eta, b.lz()), 1e-12)
+                        .unwrap()
+                        .value;
             }
         }
         let q = q / (b.lx() * b.ly());
-        assert!(rel(top_influence(&b), q, 1e-300) < 1e-9, "{} vs {q}", top_influence(&b));
+        assert!(
+            rel(top_influence(&b), q, 1e-300) < 1e-9,
+            "{} vs {q}",
+            top_influence(&b)
+        );
     }
 }
 
@@ -34,7 +42,15 @@ fn top_stress_is_the_face_integral_of_dg_dz() {
         let mut q = 0.0;
         for (xi, wx) in rule(0.0, b.lx(), 10, 8) {
             for (eta, wy) in rule(0.0, b.ly(), 2, 8) {
-                q += wx * wy * gf.dz(Point::new(0.02, 0.003, z), Point::new(xi, eta, b.lz()), 1e-10).unwrap().value;
+                q += wx
+                    * wy
+                    * gf.dz(
+                        Point::new(0.02, 0.003, z),
+                        Point::new(xi, eta, b.lz()),
+                        1e-10,
+                    )
+                    .unwrap()
+                    .value;
             }
         }
         let q = q / (b.lx() * b.ly());
@@ -50,7 +66,11 @@ fn rod_quadrature(gf: &GreenFunction, rod: &RodLoad, x: f64, z: f64, dz: bool) -
     for (eta, we) in rule(0.0, b.ly(), 4, 10) {
         for (zeta, wz) in rule(lo, hi, 8, 10) {
             let (r, s) = (Point::new(x, 0.002, z), Point::new(0.0, eta, zeta));
-            let v = if dz { gf.dz(r, s, 1e-11) } else { gf.value(r, s, 1e-12) };
+            let v = if dz {
+                gf.dz(r, s, 1e-11)
+            } else {
+                gf.value(r, s, 1e-12)
+            };
             q += we * wz * v.unwrap().value;
         }
     }
@@ -62,7 +82,10 @@ fn rod_load_is_the_band_integral_of_g() {
     // Reference includes every constant of the closed form (paper Eq. G_x_lat).
     let b = block();
     let gf = GreenFunction::new(b);
-    for rod in [RodLoad::new(&b, 0.006, 0.002).unwrap(), RodLoad::new(&b, 0.02, 0.005).unwrap()] {
+    for rod in [
+        RodLoad::new(&b, 0.006, 0.002).unwrap(),
+        RodLoad::new(&b, 0.02, 0.005).unwrap(),
+    ] {
         for x in [0.008, 0.02, 0.045] {
             let q = rod_quadrature(&gf, &rod, x, 0.0, false);
             let v = rod.influence_at(x, 1e-12).unwrap();
@@ -79,7 +102,10 @@ fn rod_stress_is_the_band_integral_of_dg_dz() {
     for (x, z) in [(0.008, 0.002), (0.015, 0.007), (0.03, 0.02)] {
         let q = rod_quadrature(&gf, &rod, x, z, true);
         let v = rod.stress_influence_at(x, z, 1e-10).unwrap();
-        assert!((v.value - q).abs() < 1e-7 * q.abs().max(1.0), "({x},{z}): {v:?} vs {q}");
+        assert!(
+            (v.value - q).abs() < 1e-7 * q.abs().max(1.0),
+            "({x},{z}): {v:?} vs {q}"
+        );
     }
 }
 
@@ -96,10 +122,26 @@ fn cell_averages_equal_quadrature_of_the_point_formulas() {
     let dx = grid.dx();
     for ix in [0, 1, 2, 10, 24] {
         let (a, c) = (ix as f64 * dx, (ix + 1) as f64 * dx);
-        let q: f64 = rule(a, c, 4, 12).into_iter().map(|(x, w)| w * rod.influence_at(x, 1e-13).unwrap().value).sum::<f64>() / dx;
-        assert!(rel(cells[ix], q, 1.0) < 1e-9, "cell {ix}: {} vs {q}", cells[ix]);
-        let qs: f64 = rule(a, c, 4, 12).into_iter().map(|(x, w)| w * rod.stress_influence_at(x, z, 1e-12).unwrap().value).sum::<f64>() / dx;
-        assert!((stress[ix] - qs).abs() < 1e-6 * qs.abs().max(1.0), "stress cell {ix}: {} vs {qs}", stress[ix]);
+        let q: f64 = rule(a, c, 4, 12)
+            .into_iter()
+            .map(|(x, w)| w * rod.influence_at(x, 1e-13).unwrap().value)
+            .sum::<f64>()
+            / dx;
+        assert!(
+            rel(cells[ix], q, 1.0) < 1e-9,
+            "cell {ix}: {} vs {q}",
+            cells[ix]
+        );
+        let qs: f64 = rule(a, c, 4, 12)
+            .into_iter()
+            .map(|(x, w)| w * rod.stress_influence_at(x, z, 1e-12).unwrap().value)
+            .sum::<f64>()
+            / dx;
+        assert!(
+            (stress[ix] - qs).abs() < 1e-6 * qs.abs().max(1.0),
+            "stress cell {ix}: {} vs {qs}",
+            stress[ix]
+        );
     }
 }
 

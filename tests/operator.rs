@@ -7,7 +7,9 @@ use precursors::green::{GreenFunction, InfluencePlan};
 use precursors::{Block, Grid, Point};
 
 fn lcg(seed: &mut u64) -> f64 {
-    *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    *seed = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
     ((*seed >> 11) as f64) / (1u64 << 53) as f64 - 0.5
 }
 
@@ -35,7 +37,11 @@ fn matrix_free_apply_equals_dense_matvec() {
         let scale = dense.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         for i in 0..n {
             let slow: f64 = (0..n).map(|j| dense[i * n + j] * v[j]).sum();
-            assert!((fast[i] - slow).abs() <= 1e-12 * scale * n as f64, "{grid:?} row {i}: {} vs {slow}", fast[i]);
+            assert!(
+                (fast[i] - slow).abs() <= 1e-12 * scale * n as f64,
+                "{grid:?} row {i}: {} vs {slow}",
+                fast[i]
+            );
         }
     }
 }
@@ -73,12 +79,21 @@ fn entries_equal_cell_quadrature_of_the_point_function() {
     // do not touch, with G from the rapid point representation.
     let block = Block::new(0.016, 0.006, 0.01).unwrap();
     let grid = Grid::new(block, 16, 6).unwrap();
-    let plan = InfluencePlan::builder(grid).tolerance(1e-9).build().unwrap();
+    let plan = InfluencePlan::builder(grid)
+        .tolerance(1e-9)
+        .build()
+        .unwrap();
     let n = grid.len();
     let dense = plan.dense().unwrap();
     let gf = GreenFunction::new(block);
     let (dx, dy) = (grid.dx(), grid.dy());
-    let pairs = [((0, 0), (3, 2)), ((5, 1), (12, 4)), ((7, 3), (7, 5)), ((2, 5), (15, 0)), ((9, 2), (11, 2))];
+    let pairs = [
+        ((0, 0), (3, 2)),
+        ((5, 1), (12, 4)),
+        ((7, 3), (7, 5)),
+        ((2, 5), (15, 0)),
+        ((9, 2), (11, 2)),
+    ];
     for ((ix, iy), (jx, jy)) in pairs {
         let quad = |c: usize, d: f64| rule(c as f64 * d, (c + 1) as f64 * d, 1, 6);
         let (qx, qy, qxi, qeta) = (quad(ix, dx), quad(iy, dy), quad(jx, dx), quad(jy, dy));
@@ -87,7 +102,10 @@ fn entries_equal_cell_quadrature_of_the_point_function() {
             for &(y, wy) in &qy {
                 for &(xi, wxi) in &qxi {
                     for &(eta, weta) in &qeta {
-                        let v = gf.value(Point::new(x, y, 0.0), Point::new(xi, eta, 0.0), 1e-11).unwrap().value;
+                        let v = gf
+                            .value(Point::new(x, y, 0.0), Point::new(xi, eta, 0.0), 1e-11)
+                            .unwrap()
+                            .value;
                         sum += wx * wy * wxi * weta * v;
                     }
                 }
@@ -95,18 +113,28 @@ fn entries_equal_cell_quadrature_of_the_point_function() {
         }
         let reference = sum / (dx * dy).powi(2);
         let entry = dense[grid.index(ix, iy) * n + grid.index(jx, jy)];
-        assert!(rel(entry, reference, 1e-300) < 2e-7, "({ix},{iy})-({jx},{jy}): {entry} vs {reference}");
+        assert!(
+            rel(entry, reference, 1e-300) < 2e-7,
+            "({ix},{iy})-({jx},{jy}): {entry} vs {reference}"
+        );
         // Point value at the centres: within O(Δ²/r²) of the Galerkin entry.
         let (cx, cy) = grid.centre(ix, iy);
         let (sx, sy) = grid.centre(jx, jy);
         let r2 = (cx - sx).powi(2) + (cy - sy).powi(2);
-        let point = gf.value(Point::new(cx, cy, 0.0), Point::new(sx, sy, 0.0), 1e-11).unwrap().value;
+        let point = gf
+            .value(Point::new(cx, cy, 0.0), Point::new(sx, sy, 0.0), 1e-11)
+            .unwrap()
+            .value;
         // Averaging over two cells changes a smooth kernel by (Δ²/24)·(second derivatives):
         // O(Δ²/r²) relative to the 1/(2πr) face kernel, plus O(Δ²/V) from the smooth,
         // zero-mean part of the Neumann function (∇²G = 1/V), large for this small block.
         let r = r2.sqrt();
-        let bound = dx * dx * (1.0 / (2.0 * std::f64::consts::PI * r.powi(3)) + 1.0 / block.volume());
-        assert!((entry - point).abs() < bound, "point {point} vs entry {entry}, bound {bound}");
+        let bound =
+            dx * dx * (1.0 / (2.0 * std::f64::consts::PI * r.powi(3)) + 1.0 / block.volume());
+        assert!(
+            (entry - point).abs() < bound,
+            "point {point} vs entry {entry}, bound {bound}"
+        );
     }
 }
 
@@ -115,14 +143,20 @@ fn the_point_value_error_shrinks_like_delta_squared_over_r_squared() {
     // The paper's block, where the smooth O(Δ²/V) part is small.
     let block = Block::new(0.14, 0.007, 0.075).unwrap();
     let grid = Grid::new(block, 140, 7).unwrap();
-    let plan = InfluencePlan::builder(grid).tolerance(1e-8).build().unwrap();
+    let plan = InfluencePlan::builder(grid)
+        .tolerance(1e-8)
+        .build()
+        .unwrap();
     let n = grid.len();
     let dense = plan.dense().unwrap();
     let gf = GreenFunction::new(block);
     let ratio = |jx: usize| {
         let (cx, cy) = grid.centre(60, 3);
         let (sx, sy) = grid.centre(jx, 3);
-        let point = gf.value(Point::new(cx, cy, 0.0), Point::new(sx, sy, 0.0), 1e-12).unwrap().value;
+        let point = gf
+            .value(Point::new(cx, cy, 0.0), Point::new(sx, sy, 0.0), 1e-12)
+            .unwrap()
+            .value;
         let entry = dense[grid.index(60, 3) * n + grid.index(jx, 3)];
         let r = (cx - sx).abs();
         (entry - point).abs() * 4.0 * std::f64::consts::PI * r.powi(3) / grid.dx().powi(2)
@@ -138,14 +172,20 @@ fn the_point_value_error_shrinks_like_delta_squared_over_r_squared() {
 #[test]
 fn eigenvalue_error_estimates_are_honest() {
     let grid = Grid::new(Block::new(0.14, 0.007, 0.075).unwrap(), 140, 7).unwrap();
-    let tight = InfluencePlan::builder(grid).tolerance(1e-10).build().unwrap();
+    let tight = InfluencePlan::builder(grid)
+        .tolerance(1e-10)
+        .build()
+        .unwrap();
     for tol in [1e-3, 1e-5, 1e-7] {
         let loose = InfluencePlan::builder(grid).tolerance(tol).build().unwrap();
         assert!(loose.max_relative_error() <= tol);
         for m in 0..7 {
             for p in (0..140).step_by(7) {
                 let (a, b) = (loose.lambda(p, m).unwrap(), tight.lambda(p, m).unwrap());
-                assert!(rel(a, b, 1e-300) <= tol + 2e-10, "tol {tol} mode ({p},{m}): {a} vs {b}");
+                assert!(
+                    rel(a, b, 1e-300) <= tol + 2e-10,
+                    "tol {tol} mode ({p},{m}): {a} vs {b}"
+                );
             }
         }
     }
@@ -175,12 +215,18 @@ fn plane_transfer_is_identity_at_the_bottom_and_exact_for_the_mean() {
     let mut seed = 3u64;
     let phi: Vec<f64> = (0..n).map(|_| lcg(&mut seed)).collect();
     let mut out = vec![0.0; n];
-    plan.plane_transfer(0.0, 1e-12).unwrap().stress(&phi, &mut out).unwrap();
+    plan.plane_transfer(0.0, 1e-12)
+        .unwrap()
+        .stress(&phi, &mut out)
+        .unwrap();
     for (s, f) in out.iter().zip(&phi) {
         assert!((s + f).abs() < 1e-13);
     }
     let z = 0.004;
-    plan.plane_transfer(z, 1e-12).unwrap().stress(&vec![2.0; n], &mut out).unwrap();
+    plan.plane_transfer(z, 1e-12)
+        .unwrap()
+        .stress(&vec![2.0; n], &mut out)
+        .unwrap();
     for s in &out {
         assert!(rel(*s, -2.0 * (block.lz() - z) / block.lz(), 1.0) < 1e-13);
     }
@@ -210,7 +256,10 @@ fn plane_transfer_equals_quadrature_of_dg_dz() {
             for &(y, wy) in &q(iy, dy) {
                 for &(xi, wxi) in &q(5, dx) {
                     for &(eta, weta) in &q(2, dy) {
-                        let v = gf.dz(Point::new(x, y, z), Point::new(xi, eta, 0.0), 1e-9).unwrap().value;
+                        let v = gf
+                            .dz(Point::new(x, y, z), Point::new(xi, eta, 0.0), 1e-9)
+                            .unwrap()
+                            .value;
                         sum += wx * wy * wxi * weta * v;
                     }
                 }
@@ -218,6 +267,9 @@ fn plane_transfer_equals_quadrature_of_dg_dz() {
         }
         let reference = sum / (dx * dy);
         let got = out[grid.index(ix, iy)];
-        assert!((got - reference).abs() < 1e-6 * 0.1_f64.max(reference.abs()), "cell ({ix},{iy}): {got} vs {reference}");
+        assert!(
+            (got - reference).abs() < 1e-6 * 0.1_f64.max(reference.abs()),
+            "cell ({ix},{iy}): {got} vs {reference}"
+        );
     }
 }

@@ -156,7 +156,8 @@ impl RodLoad {
                 let gap = if first { dx } else { xa };
                 let series = self.sum_series(tol / pref * self.half_width, gap, |k| {
                     let avg = cell_average_cosh(k, xa, xb, lx, first);
-                    let bound = 2.0 * (-k * gap).exp() / (k * dx).max(1.0) / (-(-2.0 * k * lx).exp_m1());
+                    let bound =
+                        2.0 * (-k * gap).exp() / (k * dx).max(1.0) / (-(-2.0 * k * lx).exp_m1());
                     (self.band_moment(k) / k * avg, bound * 2.0 / (k * k))
                 })?;
                 Ok(pref * (poly + (closed + series.value) / self.half_width))
@@ -244,7 +245,8 @@ impl RodLoad {
                     let mut c = 0.0;
                     for (edge, sgn) in [(hi, 1.0), (lo, -1.0)] {
                         let theta = PI * edge / lz;
-                        c += sgn * 0.5 * (cos_sum_n2((phi - theta).abs()) - cos_sum_n2(phi + theta));
+                        c +=
+                            sgn * 0.5 * (cos_sum_n2((phi - theta).abs()) - cos_sum_n2(phi + theta));
                     }
                     c * (lz / PI).powi(2) / dx
                 } else {
@@ -253,7 +255,8 @@ impl RodLoad {
                 let gap = if first { dx } else { xa };
                 let series = self.sum_series(tol / pref.abs(), gap, |k| {
                     let avg = cell_average_cosh(k, xa, xb, lx, first);
-                    let bound = 2.0 * (-k * gap).exp() / (k * dx).max(1.0) / (-(-2.0 * k * lx).exp_m1());
+                    let bound =
+                        2.0 * (-k * gap).exp() / (k * dx).max(1.0) / (-(-2.0 * k * lx).exp_m1());
                     ((k * z).sin() * self.band_moment(k) * avg, 2.0 / k * bound)
                 })?;
                 Ok(pref * (closed + series.value))

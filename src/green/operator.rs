@@ -162,7 +162,12 @@ impl InfluencePlanBuilder {
                 max_rel_error = max_rel_error.max(error / value);
             }
         }
-        Ok(InfluencePlan::from_eigenvalues(grid, tol, lambda, max_rel_error))
+        Ok(InfluencePlan::from_eigenvalues(
+            grid,
+            tol,
+            lambda,
+            max_rel_error,
+        ))
     }
 }
 
@@ -276,7 +281,9 @@ fn dct_diagonal(grid: &Grid, values: &[f64]) -> Vec<f64> {
 
 /// `cos(π k (2i+1) / (2n))` for all `k, i < n`, with exact argument reduction.
 pub(crate) fn cosine_table(n: usize) -> Vec<f64> {
-    let base: Vec<f64> = (0..4 * n).map(|j| (PI * j as f64 / (2.0 * n as f64)).cos()).collect();
+    let base: Vec<f64> = (0..4 * n)
+        .map(|j| (PI * j as f64 / (2.0 * n as f64)).cos())
+        .collect();
     let mut t = vec![0.0; n * n];
     for k in 0..n {
         for i in 0..n {
@@ -387,7 +394,8 @@ impl InfluencePlan {
                 for jy in 0..ny {
                     let c = crow[iy] * crow[jy];
                     for a in 0..nx {
-                        let dst = &mut g[(iy * nx + a) * n + jy * nx..(iy * nx + a) * n + jy * nx + nx];
+                        let dst =
+                            &mut g[(iy * nx + a) * n + jy * nx..(iy * nx + a) * n + jy * nx + nx];
                         let src = &bm[a * nx..(a + 1) * nx];
                         for (d, s) in dst.iter_mut().zip(src) {
                             *d += c * s;
@@ -460,8 +468,16 @@ impl PlaneTransfer {
         let coef: Vec<f64> = (0..grid.len())
             .map(|i| {
                 let (p, m) = (i % nx, i / nx);
-                let ax = if p == 0 { 1.0 / nx as f64 } else { 2.0 / nx as f64 };
-                let ay = if m == 0 { 1.0 / ny as f64 } else { 2.0 / ny as f64 };
+                let ax = if p == 0 {
+                    1.0 / nx as f64
+                } else {
+                    2.0 / nx as f64
+                };
+                let ay = if m == 0 {
+                    1.0 / ny as f64
+                } else {
+                    2.0 / ny as f64
+                };
                 factors[i] * ax * ay
             })
             .collect();
@@ -480,7 +496,10 @@ impl PlaneTransfer {
             let ax = aliases(p, grid.nx(), grid.dx(), q);
             let ay = aliases(m, grid.ny(), grid.dy(), q);
             // Weights normalised to sum to 1 over all aliases (2 w S²).
-            let (sx, sy) = (if p == 0 { 2.0 } else { 1.0 }, if m == 0 { 2.0 } else { 1.0 });
+            let (sx, sy) = (
+                if p == 0 { 2.0 } else { 1.0 },
+                if m == 0 { 2.0 } else { 1.0 },
+            );
             let mut sum = 0.0;
             for &(wx, kx) in &ax.terms {
                 for &(wy, ky) in &ay.terms {

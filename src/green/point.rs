@@ -153,7 +153,12 @@ impl GreenFunction {
     }
 
     /// `G(r, r')` (m⁻¹) by the rapid representation with explicit options.
-    pub fn value_with(&self, target: Point, source: Point, opts: &SeriesOptions) -> Result<Estimate> {
+    pub fn value_with(
+        &self,
+        target: Point,
+        source: Point,
+        opts: &SeriesOptions,
+    ) -> Result<Estimate> {
         self.rapid(target, source, opts, false)
     }
 
@@ -172,7 +177,13 @@ impl GreenFunction {
         self.block.check_point(source, ["xi", "eta", "zeta"])
     }
 
-    fn rapid(&self, target: Point, source: Point, opts: &SeriesOptions, dz: bool) -> Result<Estimate> {
+    fn rapid(
+        &self,
+        target: Point,
+        source: Point,
+        opts: &SeriesOptions,
+        dz: bool,
+    ) -> Result<Estimate> {
         opts.check()?;
         self.check_points(target, source)?;
         let a = target.coords();
@@ -186,7 +197,9 @@ impl GreenFunction {
             SummationAxis::Auto => {
                 // Terms needed ~ L_u L_v / d_s² = V / (L_s d_s²): maximise L_s d_s².
                 let score = |k: usize| l[k] * d[k] * d[k];
-                (0..3).max_by(|&i, &j| score(i).total_cmp(&score(j))).unwrap_or(2)
+                (0..3)
+                    .max_by(|&i, &j| score(i).total_cmp(&score(j)))
+                    .unwrap_or(2)
             }
         };
         if d[axis] <= 0.0 {
@@ -214,7 +227,12 @@ impl GreenFunction {
     /// difference is the error estimate. It converges algebraically, and only where the
     /// target differs from the source in every coordinate; expect
     /// [`Error::NotConverged`] for tight tolerances.
-    pub fn raw_series(&self, target: Point, source: Point, opts: &SeriesOptions) -> Result<Estimate> {
+    pub fn raw_series(
+        &self,
+        target: Point,
+        source: Point,
+        opts: &SeriesOptions,
+    ) -> Result<Estimate> {
         opts.check()?;
         self.check_points(target, source)?;
         let a = target.coords();
@@ -333,7 +351,8 @@ fn partial_sum(
         k_cut *= 1.1;
         guard += 1;
     }
-    let est_terms = (l[u] * l[w] * k_cut * k_cut / (4.0 * PI) + k_cut * (l[u] + l[w]) / PI + 1.0) as u64;
+    let est_terms =
+        (l[u] * l[w] * k_cut * k_cut / (4.0 * PI) + k_cut * (l[u] + l[w]) / PI + 1.0) as u64;
     if est_terms > opts.max_terms || guard >= 400 {
         return Err(Error::NotConverged {
             what: "rapid representation of the Green function",

@@ -42,7 +42,10 @@ pub fn rule(a: f64, b: f64, panels: usize, n: usize) -> Vec<(f64, f64)> {
 
 /// Integral of `f` over [a, b].
 pub fn integrate(a: f64, b: f64, panels: usize, n: usize, mut f: impl FnMut(f64) -> f64) -> f64 {
-    rule(a, b, panels, n).into_iter().map(|(x, w)| w * f(x)).sum()
+    rule(a, b, panels, n)
+        .into_iter()
+        .map(|(x, w)| w * f(x))
+        .sum()
 }
 
 /// |a - b| / max(|b|, floor)
