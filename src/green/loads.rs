@@ -194,7 +194,8 @@ impl RodLoad {
                 1.0 - 2.0 * q * theta.cos() + q * q
             };
             if arg <= 0.0 {
-                return Err(Error::SingularPoint { x, y: f64::NAN, z });
+                // The rod stress does not depend on y; y = 0 labels the face.
+                return Err(Error::SingularPoint { x, y: 0.0, z });
             }
             Ok(-0.5 * arg.ln())
         };

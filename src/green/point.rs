@@ -246,7 +246,7 @@ impl GreenFunction {
             let counts: [usize; 3] = std::array::from_fn(|k| (k_cut * l[k] / PI).floor() as usize);
             let size = counts.iter().map(|&c| (c + 1) as u64).product::<u64>();
             if terms + size > opts.max_terms {
-                let value = previous.unwrap_or(f64::NAN);
+                let value = previous.unwrap_or(0.0);
                 return Err(Error::NotConverged {
                     what: "raw triple cosine series of G",
                     value,
@@ -355,8 +355,8 @@ fn partial_sum(
         (l[u] * l[w] * k_cut * k_cut / (4.0 * PI) + k_cut * (l[u] + l[w]) / PI + 1.0) as u64;
     if est_terms > opts.max_terms || guard >= 400 {
         return Err(Error::NotConverged {
-            what: "rapid representation of the Green function",
-            value: f64::NAN,
+            what: "rapid representation of the Green function (nothing summed)",
+            value: 0.0,
             error: tail(k_cut),
             tolerance: opts.tolerance,
             terms: est_terms,
