@@ -134,6 +134,53 @@ pub enum Error {
         /// Why it is refused.
         reason: &'static str,
     },
+    /// A spring height is zero or negative.
+    #[error("heights[{index}] = {value} m is invalid: spring heights must be > 0")]
+    NonPositiveHeight {
+        /// Cell index (paper order `iy * Nx + ix`).
+        index: usize,
+        /// The value given (m).
+        value: f64,
+    },
+    /// A site index beyond the grid.
+    #[error("site {index} does not exist: the interface has {sites} sites")]
+    SiteOutOfRange {
+        /// The index given.
+        index: usize,
+        /// Number of sites.
+        sites: usize,
+    },
+    /// No site can carry the load (every site broken), or the load itself is zero.
+    #[error("empty contact: {reason} ({available} sites can still carry force)")]
+    EmptyContact {
+        /// Sites neither broken nor excluded.
+        available: usize,
+        /// Why the contact is empty.
+        reason: &'static str,
+    },
+    /// An iterative solver stopped before reaching its tolerance.
+    #[error(
+        "{what} did not converge: relative residual {residual:e} > tolerance {tolerance:e} \
+         after {iterations} iterations"
+    )]
+    SolverNotConverged {
+        /// Which solver.
+        what: &'static str,
+        /// Iterations spent.
+        iterations: usize,
+        /// Best relative residual reached.
+        residual: f64,
+        /// Requested tolerance.
+        tolerance: f64,
+    },
+    /// A factorisation met a non-positive pivot (the system lost definiteness to rounding).
+    #[error("LDLT factorisation of the {n} x {n} attached-set matrix failed: {reason}")]
+    Factorization {
+        /// Size of the matrix.
+        n: usize,
+        /// What faer reported.
+        reason: String,
+    },
 }
 
 /// Checks that `value` is a finite, positive length.

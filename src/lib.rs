@@ -34,6 +34,8 @@
 pub mod error;
 pub mod geometry;
 pub mod green;
+pub mod interface;
+pub mod solver;
 
 pub use error::{Error, Result};
 
@@ -42,3 +44,7 @@ pub use error::{Error, Result};
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
 pub use geometry::{Block, Grid, Point};
+pub use interface::{HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw};
+pub use solver::{
+    Backend, EquilibriumSolver, NormalEquilibrium, SolveReport, SolverOptions, TangentialResponse,
+};

@@ -360,6 +360,11 @@ impl InfluencePlan {
         Ok(())
     }
 
+    /// `buf ← Ĝ buf` without validation (the solvers' inner loop).
+    pub(crate) fn apply_in_place(&self, buf: &mut [f64]) {
+        self.dct.filter(buf, &self.scaled);
+    }
+
     /// The dense matrix `Ĝ` (m⁻¹), row-major `N x N`, assembled from the eigenvalue table
     /// by explicit cosine sums (independent of the DCT path). Refused above
     /// [`DENSE_LIMIT`] cells.

@@ -1,0 +1,422 @@
+//! The interfacial springs of the bottom face (MODEL.md section 3).
+//!
+//! Each cell `i` of the grid holds one spring of rest height `u0_i > 0` (m), the local
+//! height of the rough substrate. Per unit area the springs have normal stiffness
+//! `k_z,i = c_z / u0_i` and tangential stiffness `k_x,i = c_x exp(-u_z,i / u0_i)` (N/m³).
+//! A site is [`SiteState::Attached`] while it pushes (`φ_z = k_z (u0 - u_z) ≥ 0`),
+//! [`SiteState::Detached`] when the block's bottom lies above it (`u_z > u0`, no force, it
+//! may re-attach), and [`SiteState::Broken`] once it slipped under the Coulomb rule (never
+//! re-attaches). The solvers ([`crate::solver`]) work with compliances `1/k` (m³/N),
+//! which stay finite when springs are stiff (`u0 → 0`).
+
+use crate::error::{check_slice, Error, Result};
+use crate::geometry::Grid;
+use rand::rngs::Xoshiro256PlusPlus;
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+
+/// Bulk and friction properties of the block. Defaults: the paper's PMMA.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct Material {
+    /// Young's modulus `E` (Pa). Default `3.833e9`.
+    pub young_modulus: f64,
+    /// Poisson's ratio `ν` (dimensionless, in `(-1, 0.5]`). Default `0.38`.
+    pub poisson_ratio: f64,
+    /// Static local friction coefficient `μ` (dimensionless, `≥ 0`). Default `0.5`.
+    pub friction_coefficient: f64,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Self {
+            young_modulus: 3.833e9,
+            poisson_ratio: 0.38,
+            friction_coefficient: 0.5,
+        }
+    }
+}
+
+impl Material {
+    /// A validated material: `E` (Pa) finite and > 0, `ν` in `(-1, 0.5]`, `μ` finite and `≥ 0`.
+    pub fn new(young_modulus: f64, poisson_ratio: f64, friction_coefficient: f64) -> Result<Self> {
+        let m = Self {
+            young_modulus,
+            poisson_ratio,
+            friction_coefficient,
+        };
+        m.validate()?;
+        Ok(m)
+    }
+
+    /// Checks the fields (they are public, so a struct literal may hold anything).
+    pub fn validate(&self) -> Result<()> {
+        if !(self.young_modulus.is_finite() && self.young_modulus > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "young_modulus",
+                value: self.young_modulus,
+                reason: "Young's modulus must be finite and > 0 Pa",
+            });
+        }
+        if !(self.poisson_ratio > -1.0 && self.poisson_ratio <= 0.5) {
+            return Err(Error::InvalidParameter {
+                name: "poisson_ratio",
+                value: self.poisson_ratio,
+                reason: "Poisson's ratio must lie in (-1, 0.5]",
+            });
+        }
+        if !(self.friction_coefficient.is_finite() && self.friction_coefficient >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "friction_coefficient",
+                value: self.friction_coefficient,
+                reason: "the friction coefficient must be finite and >= 0",
+            });
+        }
+        Ok(())
+    }
+
+    /// The scalar model's modulus `M = E / (1 + ν)` (Pa).
+    pub fn modulus(&self) -> f64 {
+        self.young_modulus / (1.0 + self.poisson_ratio)
+    }
+}
+
+/// The two constants of the spring laws. Defaults: the paper's calibrated PMMA values.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct SpringLaw {
+    /// `c_x` (N/m³): tangential stiffness per unit area of a site at `u_z = 0`. Default `1.65e12`.
+    pub c_x: f64,
+    /// `c_z` (N/m²): `k_z = c_z / u0`. Default `1.65e8`.
+    pub c_z: f64,
+}
+
+impl Default for SpringLaw {
+    fn default() -> Self {
+        Self {
+            c_x: 1.65e12,
+            c_z: 1.65e8,
+        }
+    }
+}
+
+impl SpringLaw {
+    /// A validated law: both constants finite and > 0.
+    pub fn new(c_x: f64, c_z: f64) -> Result<Self> {
+        let law = Self { c_x, c_z };
+        law.validate()?;
+        Ok(law)
+    }
+
+    /// Checks the fields.
+    pub fn validate(&self) -> Result<()> {
+        for (name, value) in [("c_x", self.c_x), ("c_z", self.c_z)] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value,
+                    reason: "spring constants must be finite and > 0",
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The Gaussian the heights are drawn from before truncation at 0. Defaults: the paper's
+/// mean 1 µm and standard deviation 1 µm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct HeightDistribution {
+    /// Mean of the untruncated Gaussian (m). Default `1e-6`.
+    pub mean: f64,
+    /// Standard deviation of the untruncated Gaussian (m, `≥ 0`). Default `1e-6`.
+    pub std_dev: f64,
+}
+
+impl Default for HeightDistribution {
+    fn default() -> Self {
+        Self {
+            mean: 1e-6,
+            std_dev: 1e-6,
+        }
+    }
+}
+
+impl HeightDistribution {
+    /// A distribution with the given mean and standard deviation (m).
+    pub fn new(mean: f64, std_dev: f64) -> Self {
+        Self { mean, std_dev }
+    }
+}
+
+/// Smallest `mean / std_dev` accepted: rejection sampling then keeps at least 0.1 % of draws.
+const MIN_MEAN_OVER_SD: f64 = -3.0;
+
+/// Rest heights `u0_i > 0` (m) of the springs, one per cell in the paper's order
+/// `i = iy * Nx + ix`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Heights {
+    values: Vec<f64>,
+}
+
+impl Heights {
+    /// Heights drawn from a Gaussian truncated at 0 (draws `≤ 0` are redrawn), seeded.
+    ///
+    /// The stream is fixed: `Xoshiro256PlusPlus::seed_from_u64(seed)` feeding
+    /// `rand_distr::Normal`, one height per cell in cell order. The same seed gives the
+    /// same heights on every platform (a value-stability test pins them).
+    pub fn truncated_gaussian(grid: &Grid, dist: HeightDistribution, seed: u64) -> Result<Self> {
+        let HeightDistribution { mean, std_dev } = dist;
+        if !mean.is_finite() {
+            return Err(Error::InvalidParameter {
+                name: "mean",
+                value: mean,
+                reason: "the mean height must be finite",
+            });
+        }
+        if !(std_dev.is_finite() && std_dev >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "std_dev",
+                value: std_dev,
+                reason: "the standard deviation must be finite and >= 0 m",
+            });
+        }
+        let ratio = if std_dev > 0.0 {
+            mean / std_dev
+        } else if mean > 0.0 {
+            f64::INFINITY
+        } else {
+            f64::NEG_INFINITY
+        };
+        if ratio < MIN_MEAN_OVER_SD {
+            return Err(Error::InvalidParameter {
+                name: "mean",
+                value: mean,
+                reason: "mean / std_dev must be >= -3 (and the mean > 0 when std_dev = 0): \
+                         almost every draw would be cut at 0",
+            });
+        }
+        let normal = Normal::new(mean, std_dev).map_err(|_| Error::InvalidParameter {
+            name: "std_dev",
+            value: std_dev,
+            reason: "rejected by rand_distr::Normal",
+        })?;
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let values = (0..grid.len())
+            .map(|_| loop {
+                let h = normal.sample(&mut rng);
+                if h > 0.0 {
+                    break h;
+                }
+            })
+            .collect();
+        Ok(Self { values })
+    }
+
+    /// User-supplied heights (a measured topography), in cell order `i = iy * Nx + ix`:
+    /// one finite value `> 0` (m) per cell.
+    pub fn from_values(grid: &Grid, values: Vec<f64>) -> Result<Self> {
+        check_slice("heights", &values, grid.len())?;
+        if let Some((index, &value)) = values.iter().enumerate().find(|(_, h)| **h <= 0.0) {
+            return Err(Error::NonPositiveHeight { index, value });
+        }
+        Ok(Self { values })
+    }
+
+    /// The heights (m), in cell order.
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// Number of sites.
+    pub fn len(&self) -> usize {
+        self.values.len()
+    }
+
+    /// Whether there is no site (never true for heights built on a grid).
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+}
+
+/// State of one interfacial spring.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum SiteState {
+    /// In contact: pushes with `φ_z = k_z (u0 - u_z) ≥ 0` and resists shear with `φ_x = -k_x u_x`.
+    Attached,
+    /// Out of contact (`u_z > u0`): no force; re-attaches when `u_z` falls below `u0`.
+    Detached,
+    /// Slipped under the Coulomb rule: no force, never re-attaches.
+    Broken,
+}
+
+/// The springs of the bottom face: heights, law and the state of every site.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Interface {
+    grid: Grid,
+    heights: Heights,
+    law: SpringLaw,
+    states: Vec<SiteState>,
+}
+
+impl Interface {
+    /// An interface on `grid` with every site attached (the solvers then detach what
+    /// must be). `heights` must have one value per cell.
+    pub fn new(grid: Grid, heights: Heights, law: SpringLaw) -> Result<Self> {
+        law.validate()?;
+        if heights.len() != grid.len() {
+            return Err(Error::LengthMismatch {
+                name: "heights",
+                expected: grid.len(),
+                found: heights.len(),
+            });
+        }
+        Ok(Self {
+            states: vec![SiteState::Attached; grid.len()],
+            grid,
+            heights,
+            law,
+        })
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The spring heights `u0` (m), in cell order.
+    pub fn heights(&self) -> &[f64] {
+        self.heights.values()
+    }
+
+    /// The spring law.
+    pub fn law(&self) -> SpringLaw {
+        self.law
+    }
+
+    /// State of every site, in cell order.
+    pub fn states(&self) -> &[SiteState] {
+        &self.states
+    }
+
+    /// Number of attached sites.
+    pub fn attached_count(&self) -> usize {
+        self.count(SiteState::Attached)
+    }
+
+    /// Number of broken sites.
+    pub fn broken_count(&self) -> usize {
+        self.count(SiteState::Broken)
+    }
+
+    fn count(&self, state: SiteState) -> usize {
+        self.states.iter().filter(|s| **s == state).count()
+    }
+
+    /// Breaks site `index` (Coulomb slip): it carries no force from now on.
+    pub fn break_site(&mut self, index: usize) -> Result<()> {
+        let n = self.states.len();
+        let state = self
+            .states
+            .get_mut(index)
+            .ok_or(Error::SiteOutOfRange { index, sites: n })?;
+        *state = SiteState::Broken;
+        Ok(())
+    }
+
+    /// Resets every site to attached (a fresh contact on the same substrate).
+    pub fn heal(&mut self) {
+        self.states.fill(SiteState::Attached);
+    }
+
+    pub(crate) fn set_state(&mut self, index: usize, state: SiteState) {
+        self.states[index] = state;
+    }
+
+    /// Normal stiffness per unit area `k_z = c_z / u0` (N/m³) of every site (the value
+    /// while attached; a detached or broken site exerts no force).
+    pub fn normal_stiffness(&self) -> Vec<f64> {
+        self.heights().iter().map(|h| self.law.c_z / h).collect()
+    }
+
+    /// Normal compliance `1 / k_z = u0 / c_z` (m³/N) of every site.
+    pub fn normal_compliance(&self) -> Vec<f64> {
+        self.heights().iter().map(|h| h / self.law.c_z).collect()
+    }
+
+    /// Tangential compliance `1 / k_x = exp(u_z / u0) / c_x` (m³/N) of attached site
+    /// `i` at normal displacement `u_z` (m). Finite whenever `u_z ≤ u0` (attached).
+    pub(crate) fn tangential_compliance_at(&self, index: usize, u_z: f64) -> Result<f64> {
+        let value = (u_z / self.heights()[index]).exp() / self.law.c_x;
+        if value.is_finite() {
+            Ok(value)
+        } else {
+            Err(Error::NonFinite {
+                name: "tangential compliance exp(u_z/u0)/c_x",
+                index,
+                value,
+            })
+        }
+    }
+
+    /// Tangential stiffness per unit area (N/m³) at the normal displacements `u_z` (m):
+    /// `k_x = c_x exp(-u_z / u0)` on attached sites, 0 on detached and broken ones (as in
+    /// the paper). An overflow (a huge penetration of a tiny asperity) is reported as
+    /// [`Error::NonFinite`].
+    pub fn tangential_stiffness(&self, u_z: &[f64]) -> Result<Vec<f64>> {
+        check_slice("u_z", u_z, self.grid.len())?;
+        self.heights()
+            .iter()
+            .zip(u_z)
+            .zip(&self.states)
+            .enumerate()
+            .map(|(index, ((h, u), state))| {
+                if *state != SiteState::Attached {
+                    return Ok(0.0);
+                }
+                let value = self.law.c_x * (-u / h).exp();
+                if value.is_finite() {
+                    Ok(value)
+                } else {
+                    Err(Error::NonFinite {
+                        name: "tangential stiffness c_x exp(-u_z/u0)",
+                        index,
+                        value,
+                    })
+                }
+            })
+            .collect()
+    }
+
+    /// Real contact area per cell (m²) at the normal displacements `u_z` (m):
+    /// `ΔA/(e-1) [exp(-(u_z - u0)/u0) - 1]` for attached sites, 0 otherwise. It equals
+    /// `ΔA` when `u_z = 0` and exceeds it when the block penetrates below the substrate
+    /// mean plane (`u_z < 0`). An overflow is reported as [`Error::NonFinite`].
+    pub fn real_contact_area(&self, u_z: &[f64]) -> Result<Vec<f64>> {
+        check_slice("u_z", u_z, self.grid.len())?;
+        let scale = self.grid.cell_area() / (std::f64::consts::E - 1.0);
+        self.heights()
+            .iter()
+            .zip(u_z)
+            .zip(&self.states)
+            .enumerate()
+            .map(|(index, ((h, u), state))| {
+                if *state != SiteState::Attached {
+                    return Ok(0.0);
+                }
+                let value = scale * ((-(u - h) / h).exp() - 1.0);
+                if value.is_finite() {
+                    Ok(value.max(0.0))
+                } else {
+                    Err(Error::NonFinite {
+                        name: "real contact area",
+                        index,
+                        value,
+                    })
+                }
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,344 @@
+//! Dense backend: the assembled matrix `C` and an LDLᵀ factor (faer) of
+//! `C_SS + diag(d_S)` on the attached set, kept across solves. When a few sites leave or
+//! join, the factor is updated (faer's row/column deletion; an appended row costs one
+//! triangular solve) instead of refactorised; the factor then preconditions projected
+//! CG, which converges in one or two iterations when it is exact and in a few when the
+//! diagonal changed since (the tangential compliances follow `u_z`).
+
+use super::pcg::SetSystem;
+use super::spectral::SpectralCore;
+use crate::error::{Error, Result};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt;
+use faer::linalg::matmul::matmul;
+use faer::linalg::triangular_solve::solve_unit_lower_triangular_in_place;
+use faer::{Accum, Mat, Par};
+
+/// Refactorise instead of updating when more than `n / UPDATE_FRACTION` sites change:
+/// an update costs `O(n²)` per site, a factorisation `O(n³/3)`.
+const UPDATE_FRACTION: usize = 8;
+/// Refactorise when the stale factor needed more PCG iterations than this last time.
+const STALE_ITERATIONS: usize = 6;
+/// Refactorise when a kept site's compliance changed by more than this fraction (the
+/// tangential compliance `exp(u_z/u0)/c_x` follows every normal re-equilibration).
+const DIAG_DRIFT: f64 = 0.05;
+
+/// An LDLᵀ factor of `C_SS + diag(d)` for the sites `order` (in factor order).
+#[derive(Debug, Clone)]
+pub(crate) struct FactorCache {
+    order: Vec<usize>,
+    diag: Vec<f64>,
+    ld: Mat<f64>,
+    last_iterations: usize,
+    /// Factorisations and updates performed (diagnostics).
+    pub(crate) factorisations: usize,
+    pub(crate) updates: usize,
+}
+
+impl Default for FactorCache {
+    fn default() -> Self {
+        Self {
+            order: Vec::new(),
+            diag: Vec::new(),
+            ld: Mat::new(),
+            last_iterations: 0,
+            factorisations: 0,
+            updates: 0,
+        }
+    }
+}
+
+impl FactorCache {
+    /// Brings the factor to the sites `set` with compliances `diag` (both in `set` order)
+    /// and returns the factor's site order (a permutation of `set`).
+    fn prepare(&mut self, c: &Mat<f64>, sub: &Mat<f64>, set: &[usize], diag: &[f64]) -> Result<()> {
+        let n_sites = c.nrows();
+        let mut in_new = vec![usize::MAX; n_sites];
+        for (a, &i) in set.iter().enumerate() {
+            in_new[i] = a;
+        }
+        let mut in_old = vec![false; n_sites];
+        let mut removed = Vec::new();
+        for (pos, &i) in self.order.iter().enumerate() {
+            in_old[i] = true;
+            if in_new[i] == usize::MAX {
+                removed.push(pos);
+            }
+        }
+        let added: Vec<usize> = set.iter().copied().filter(|&i| !in_old[i]).collect();
+        let changes = removed.len() + added.len();
+        let kept = self.order.len() - removed.len();
+        if self.order.is_empty()
+            || self.last_iterations > STALE_ITERATIONS
+            || changes * UPDATE_FRACTION > set.len()
+            || kept == 0
+            || self.diag_drift(set, diag, &in_new) > DIAG_DRIFT
+        {
+            return self.factorise(sub, set, diag);
+        }
+        if !removed.is_empty() {
+            let n = self.order.len();
+            let mut idx = removed.clone();
+            let mut mem = MemBuffer::new(
+                ldlt::update::delete_rows_and_cols_clobber_scratch::<f64>(n, idx.len()),
+            );
+            ldlt::update::delete_rows_and_cols_clobber(
+                self.ld.as_mut(),
+                &mut idx,
+                Par::Seq,
+                MemStack::new(&mut mem),
+            );
+            for &pos in removed.iter().rev() {
+                self.order.remove(pos);
+                self.diag.remove(pos);
+            }
+            let m = self.order.len();
+            self.ld.truncate(m, m);
+            self.updates += removed.len();
+        }
+        for &i in &added {
+            let a = in_new[i];
+            if !self.append(c, i, diag[a]) {
+                return self.factorise(sub, set, diag);
+            }
+            self.updates += 1;
+        }
+        // Kept sites keep their old compliance in the factor: it is a preconditioner.
+        Ok(())
+    }
+
+    /// Appends site `i`: `l = D⁻¹ L⁻¹ a`, `d = α - yᵀ D⁻¹ y` with `y = L⁻¹ a`.
+    /// Returns false when the new pivot is not positive (then refactorise).
+    fn append(&mut self, c: &Mat<f64>, i: usize, d_i: f64) -> bool {
+        let n = self.order.len();
+        let col = c.col_as_slice(i);
+        let mut y = Mat::<f64>::from_fn(n, 1, |a, _| col[self.order[a]]);
+        solve_unit_lower_triangular_in_place(self.ld.as_ref(), y.as_mut(), Par::Seq);
+        let mut pivot = c[(i, i)] + d_i;
+        for a in 0..n {
+            pivot -= y[(a, 0)] * y[(a, 0)] / self.ld[(a, a)];
+        }
+        if !(pivot > 0.0 && pivot.is_finite()) {
+            return false;
+        }
+        self.ld.resize_with(n + 1, n + 1, |_, _| 0.0);
+        for a in 0..n {
+            self.ld[(n, a)] = y[(a, 0)] / self.ld[(a, a)];
+            self.ld[(a, n)] = 0.0;
+        }
+        self.ld[(n, n)] = pivot;
+        self.order.push(i);
+        self.diag.push(d_i);
+        true
+    }
+
+    /// Whether bringing the factor to `set` would take a full factorisation.
+    pub(crate) fn needs_refactor(&self, set: &[usize], n_sites: usize) -> bool {
+        if self.order.is_empty() || self.last_iterations > STALE_ITERATIONS {
+            return true;
+        }
+        let mut in_new = vec![false; n_sites];
+        set.iter().for_each(|&i| in_new[i] = true);
+        let mut in_old = vec![false; n_sites];
+        let removed = self
+            .order
+            .iter()
+            .filter(|&&i| {
+                in_old[i] = true;
+                !in_new[i]
+            })
+            .count();
+        let added = set.iter().filter(|&&i| !in_old[i]).count();
+        (removed + added) * UPDATE_FRACTION > set.len()
+    }
+
+    /// Largest relative change of a kept site's compliance since the factorisation.
+    fn diag_drift(&self, set: &[usize], diag: &[f64], in_new: &[usize]) -> f64 {
+        let _ = set;
+        self.order
+            .iter()
+            .zip(&self.diag)
+            .filter(|(i, _)| in_new[**i] != usize::MAX)
+            .fold(0.0f64, |m, (i, old)| {
+                let new = diag[in_new[*i]];
+                m.max((new - old).abs() / new.abs().max(old.abs()).max(f64::MIN_POSITIVE))
+            })
+    }
+
+    /// Factorises `sub = C_SS + diag(d)` (already assembled, in `set` order).
+    fn factorise(&mut self, sub: &Mat<f64>, set: &[usize], diag: &[f64]) -> Result<()> {
+        let n = set.len();
+        self.order = set.to_vec();
+        self.diag = diag.to_vec();
+        self.ld = sub.clone();
+        let mut mem = MemBuffer::new(ldlt::factor::cholesky_in_place_scratch::<f64>(
+            n,
+            Par::Seq,
+            Default::default(),
+        ));
+        let result = ldlt::factor::cholesky_in_place(
+            self.ld.as_mut(),
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut mem),
+            Default::default(),
+        );
+        self.factorisations += 1;
+        self.last_iterations = 0;
+        let bad_pivot = (0..n).find(|&a| !(self.ld[(a, a)] > 0.0 && self.ld[(a, a)].is_finite()));
+        if let Err(e) = result {
+            self.order.clear();
+            return Err(Error::Factorization {
+                n,
+                reason: format!("{e:?}"),
+            });
+        }
+        if let Some(a) = bad_pivot {
+            let pivot = self.ld[(a, a)];
+            self.order.clear();
+            return Err(Error::Factorization {
+                n,
+                reason: format!(
+                    "pivot {a} is {pivot:e}: the matrix is not numerically positive definite"
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// Forgets the factor.
+    pub(crate) fn clear(&mut self) {
+        self.order.clear();
+        self.diag.clear();
+        self.ld = Mat::new();
+    }
+}
+
+/// The dense matrix `C_s` (m/Pa) of every site, column-major.
+#[derive(Debug, Clone)]
+pub(crate) struct DenseCore {
+    pub(crate) c: Mat<f64>,
+    pub(crate) normal: FactorCache,
+    pub(crate) tangential: FactorCache,
+    /// The DCT operator, to explore a cold attached set before factorising.
+    pub(crate) spectral: SpectralCore,
+    norm_c: f64,
+}
+
+impl DenseCore {
+    pub(crate) fn new(c: Mat<f64>, norm_c: f64, spectral: SpectralCore) -> Self {
+        Self {
+            c,
+            spectral,
+            normal: FactorCache::default(),
+            tangential: FactorCache::default(),
+            norm_c,
+        }
+    }
+
+    /// `out = C_s x` over every site, where `x` is given on `set`.
+    pub(crate) fn apply_full(&self, set: &[usize], x: &[f64], out: &mut [f64]) {
+        out.fill(0.0);
+        for (a, &j) in set.iter().enumerate() {
+            let col = self.c.col_as_slice(j);
+            let xa = x[a];
+            for (o, cij) in out.iter_mut().zip(col) {
+                *o += cij * xa;
+            }
+        }
+    }
+
+    /// A system on `set` with compliances `diag`, preconditioned by the chosen factor.
+    pub(crate) fn system<'a>(
+        &'a mut self,
+        tangential: bool,
+        set: &'a [usize],
+        diag: &'a [f64],
+    ) -> Result<DenseSystem<'a>> {
+        let cache = if tangential {
+            &mut self.tangential
+        } else {
+            &mut self.normal
+        };
+        let n = set.len();
+        let mut sub = Mat::<f64>::zeros(n, n);
+        for (b, &j) in set.iter().enumerate() {
+            let src = self.c.col_as_slice(j);
+            let dst = sub.col_as_slice_mut(b);
+            for (d, &i) in dst.iter_mut().zip(set) {
+                *d = src[i];
+            }
+            dst[b] += diag[b];
+        }
+        cache.prepare(&self.c, &sub, set, diag)?;
+        // Map from the factor order to positions in `set`.
+        let mut pos = vec![usize::MAX; self.c.nrows()];
+        for (a, &i) in set.iter().enumerate() {
+            pos[i] = a;
+        }
+        let perm: Vec<usize> = cache.order.iter().map(|&i| pos[i]).collect();
+        let norm = self.norm_c + diag.iter().fold(0.0f64, |m, d| m.max(*d));
+        Ok(DenseSystem {
+            sub,
+            cache,
+            perm,
+            norm,
+            work: Mat::zeros(set.len(), 1),
+        })
+    }
+}
+
+/// `A_SS = C_SS + diag(d)` assembled, with the cached factor as preconditioner.
+pub(crate) struct DenseSystem<'a> {
+    sub: Mat<f64>,
+    cache: &'a mut FactorCache,
+    perm: Vec<usize>,
+    norm: f64,
+    work: Mat<f64>,
+}
+
+impl DenseSystem<'_> {
+    /// Records how many PCG iterations the factor needed (a stale factor is replaced).
+    pub(crate) fn record(&mut self, iterations: usize) {
+        self.cache.last_iterations = iterations;
+    }
+}
+
+impl SetSystem for DenseSystem<'_> {
+    fn apply(&mut self, x: &[f64], y: &mut [f64]) {
+        let x = faer::ColRef::from_slice(x);
+        let y = faer::ColMut::from_slice_mut(y);
+        matmul(
+            y.as_mat_mut(),
+            Accum::Replace,
+            self.sub.as_ref(),
+            x.as_mat(),
+            1.0,
+            Par::Seq,
+        );
+    }
+
+    fn precondition(&mut self, r: &[f64], z: &mut [f64]) {
+        let n = r.len();
+        for (a, &p) in self.perm.iter().enumerate() {
+            self.work[(a, 0)] = r[p];
+        }
+        let ld = self.cache.ld.as_ref();
+        ldlt::solve::solve_in_place_with_conj(
+            ld,
+            ld.diagonal(),
+            faer::Conj::No,
+            self.work.as_mut(),
+            Par::Seq,
+            MemStack::new(&mut []),
+        );
+        for (a, &p) in self.perm.iter().enumerate() {
+            z[p] = self.work[(a, 0)];
+        }
+        debug_assert_eq!(n, self.perm.len());
+    }
+
+    fn norm_bound(&self) -> f64 {
+        self.norm
+    }
+}
