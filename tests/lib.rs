@@ -4,5 +4,7 @@
 mod common;
 mod errors;
 mod green_point;
+mod interface;
 mod loads;
 mod operator;
+mod solver;

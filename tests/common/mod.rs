@@ -59,3 +59,69 @@ fn gauss_legendre_integrates_polynomials_exactly() {
     let v = integrate(0.0, 2.0, 1, 5, |x| x.powi(9));
     assert!((v - 102.4).abs() < 1e-12);
 }
+
+/// A scene for the solver tests: a block with `nx x ny` cells of `cell` metres, height
+/// `lz`, seeded paper heights.
+pub struct Scene {
+    pub grid: precursors::Grid,
+    pub plan: precursors::green::InfluencePlan,
+    pub interface: precursors::Interface,
+}
+
+pub fn scene(nx: usize, ny: usize, cell: f64, lz: f64, seed: u64) -> Scene {
+    use precursors::*;
+    let block = Block::new(nx as f64 * cell, ny as f64 * cell, lz).unwrap();
+    let grid = Grid::new(block, nx, ny).unwrap();
+    let plan = green::InfluencePlan::builder(grid)
+        .tolerance(1e-9)
+        .build()
+        .unwrap();
+    let heights = Heights::truncated_gaussian(&grid, HeightDistribution::default(), seed).unwrap();
+    let interface = Interface::new(grid, heights, SpringLaw::default()).unwrap();
+    Scene {
+        grid,
+        plan,
+        interface,
+    }
+}
+
+/// `C = (ΔA/M) Ĝ` (m/Pa), row-major, from the naive dense assembly of the plan.
+pub fn compliance_matrix(plan: &precursors::green::InfluencePlan, modulus: f64) -> Vec<f64> {
+    let scale = plan.grid().cell_area() / modulus;
+    plan.dense()
+        .unwrap()
+        .into_iter()
+        .map(|g| g * scale)
+        .collect()
+}
+
+/// Solves the bordered system `[C_SS + diag(d), 1; 1ᵀ, 0] [f; U] = [b; total]` with faer's
+/// full-pivoting LU (a method the crate's solvers do not use).
+pub fn bordered_solve(
+    c: &[f64],
+    n: usize,
+    set: &[usize],
+    d: &[f64],
+    b: &[f64],
+    total: f64,
+) -> (Vec<f64>, f64) {
+    use faer::prelude::*;
+    let m = set.len();
+    let a = faer::Mat::<f64>::from_fn(m + 1, m + 1, |i, j| match (i < m, j < m) {
+        (true, true) => c[set[i] * n + set[j]] + if i == j { d[i] } else { 0.0 },
+        (true, false) | (false, true) => 1.0,
+        (false, false) => 0.0,
+    });
+    let rhs = faer::Mat::<f64>::from_fn(m + 1, 1, |i, _| if i < m { b[i] } else { total });
+    let x = a.full_piv_lu().solve(&rhs);
+    ((0..m).map(|i| x[(i, 0)]).collect(), x[(m, 0)])
+}
+
+/// Largest |a - b| over the largest |a|.
+pub fn max_rel_diff(a: &[f64], b: &[f64]) -> f64 {
+    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+        / scale
+}
