@@ -5,6 +5,8 @@ mod common;
 mod errors;
 mod green_point;
 mod interface;
+mod laws;
 mod loads;
 mod operator;
 mod solver;
+mod stability;
