@@ -11,9 +11,11 @@
 //! point along +x, the normal load presses the block down, bottom tractions `φ_z ≥ 0`
 //! push up.
 //!
-//! This release provides the geometry and the [`green`] module: point evaluation of `G`
-//! and `∂G/∂z`, the analytic load terms, and the Galerkin influence operator of the grid,
-//! planned once per geometry and applied through the 2-D DCT.
+//! This release provides the geometry, the [`green`] module (point evaluation of `G`
+//! and `∂G/∂z`, the analytic load terms, the Galerkin influence operator of the grid,
+//! planned once per geometry and applied through the 2-D DCT), the [`interface`] springs
+//! and the [`solver`] of the normal and tangential equilibria (dense and spectral
+//! backends).
 //!
 //! ```
 //! use precursors::{Block, Grid, green::InfluencePlan};

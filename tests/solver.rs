@@ -190,12 +190,12 @@ fn tangential_response_matches_bordered_lu() {
         let loads = t
             .breaking_loads(&eq.traction, m.friction_coefficient)
             .unwrap();
-        for i in 0..n {
-            if t.traction[i] != 0.0 {
-                let at_threshold = loads[i] * t.traction[i].abs();
-                assert!((at_threshold - 0.5 * eq.traction[i]).abs() <= 1e-12 * eq.traction[i]);
+        for ((load, g), f) in loads.iter().zip(&t.traction).zip(&eq.traction) {
+            if *g != 0.0 {
+                // At its breaking load a site sits on the Coulomb threshold |φ_x| = μ φ_z.
+                assert!((load * g.abs() - 0.5 * f).abs() <= 1e-12 * f);
             } else {
-                assert_eq!(loads[i], f64::INFINITY);
+                assert_eq!(*load, f64::INFINITY);
             }
         }
     }

@@ -1,0 +1,80 @@
+//! One normal and one tangential equilibrium per backend at N = 980 (140 x 7), 1e4
+//! (200 x 50) and 1e5 (1000 x 100), paper heights and 3.5 MPa; the dense backend at
+//! N = 980 only (its 1e4 one-shot timing is in docs/performance.md).
+//! `cold`: a fresh solver (all sites attached at the start; the dense factor built).
+//! `warm`: the solver re-equilibrates after one rupture (the driver's common step).
+//! Results: docs/performance.md.
+
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+use precursors::green::InfluencePlan;
+use precursors::*;
+use std::time::Duration;
+
+fn setup(nx: usize, ny: usize) -> (InfluencePlan, Interface, f64) {
+    let block = Block::new(nx as f64 * 1e-3, ny as f64 * 1e-3, 0.075).unwrap();
+    let grid = Grid::new(block, nx, ny).unwrap();
+    let plan = InfluencePlan::builder(grid).build().unwrap();
+    let heights = Heights::truncated_gaussian(&grid, HeightDistribution::default(), 1).unwrap();
+    let iface = Interface::new(grid, heights, SpringLaw::default()).unwrap();
+    (plan, iface, 3.5e6 * block.lx() * block.ly())
+}
+
+fn solver(plan: &InfluencePlan, backend: Backend) -> EquilibriumSolver {
+    EquilibriumSolver::builder(plan.clone())
+        .options(SolverOptions::default().with_backend(backend))
+        .build()
+        .unwrap()
+}
+
+fn bench(c: &mut Criterion) {
+    let mut group = c.benchmark_group("equilibrium");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(4));
+    for (nx, ny) in [(140, 7), (200, 50), (1000, 100)] {
+        let (plan, iface, load) = setup(nx, ny);
+        let n = nx * ny;
+        let zeros = vec![0.0; n];
+        for backend in [Backend::Dense, Backend::Spectral] {
+            if backend == Backend::Dense && n > 1_000 {
+                continue;
+            }
+            let tag = format!("{backend:?}/{n}");
+            // Cold normal: a fresh solver from an all-attached interface.
+            group.bench_function(format!("normal_cold/{tag}"), |b| {
+                b.iter_batched(
+                    || (solver(&plan, backend), iface.clone()),
+                    |(mut s, mut i)| s.solve_normal(&mut i, load).unwrap(),
+                    BatchSize::PerIteration,
+                )
+            });
+            // Warm: equilibrium known, one site breaks, normal + tangential again.
+            let mut s = solver(&plan, backend);
+            let mut i = iface.clone();
+            let eq = s.solve_normal(&mut i, load).unwrap();
+            s.solve_tangential(&i, &eq.displacement, &zeros).unwrap();
+            let attached: Vec<usize> = (0..n)
+                .filter(|&k| i.states()[k] == SiteState::Attached)
+                .collect();
+            let mut next = 0;
+            group.bench_function(format!("normal_warm/{tag}"), |b| {
+                b.iter(|| {
+                    if i.attached_count() < n / 4 {
+                        i.heal();
+                    }
+                    i.break_site(attached[next % attached.len()]).unwrap();
+                    next += 1;
+                    s.solve_normal(&mut i, load).unwrap()
+                })
+            });
+            let eq = s.solve_normal(&mut i, load).unwrap();
+            group.bench_function(format!("tangential/{tag}"), |b| {
+                b.iter(|| s.solve_tangential(&i, &eq.displacement, &zeros).unwrap())
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
