@@ -21,6 +21,9 @@ fn grids() -> Vec<Grid> {
         Grid::new(b, 1, 4).unwrap(),
         Grid::new(b, 1, 1).unwrap(),
         Grid::new(Block::new(0.14, 0.007, 0.075).unwrap(), 140, 7).unwrap(),
+        // Either side of the switch from direct y-products to rustdct columns (Ny = 16).
+        Grid::new(Block::new(0.02, 0.016, 0.01).unwrap(), 20, 16).unwrap(),
+        Grid::new(Block::new(0.02, 0.017, 0.01).unwrap(), 20, 17).unwrap(),
     ]
 }
 

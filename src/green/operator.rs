@@ -198,6 +198,10 @@ impl std::fmt::Debug for InfluencePlan {
     }
 }
 
+/// Below this many rows the y-axis transforms are done as a small dense product over
+/// whole rows (contiguous, vectorised) instead of strided length-`Ny` DCTs.
+const DIRECT_COLUMNS: usize = 16;
+
 /// Planned 1-D DCTs of both axes.
 pub(crate) struct Dct2d {
     nx: usize,
@@ -205,6 +209,8 @@ pub(crate) struct Dct2d {
     x: Arc<dyn TransformType2And3<f64>>,
     y: Arc<dyn TransformType2And3<f64>>,
     scratch_len: usize,
+    /// `cos(π m (2j+1) / (2Ny))`, row `m`, when `1 < Ny <= DIRECT_COLUMNS`.
+    direct: Option<Vec<f64>>,
 }
 
 impl Dct2d {
@@ -213,40 +219,80 @@ impl Dct2d {
         let x = planner.plan_dct2(nx);
         let y = planner.plan_dct2(ny);
         let scratch_len = x.get_scratch_len().max(y.get_scratch_len());
+        let direct = (ny > 1 && ny <= DIRECT_COLUMNS).then(|| cosine_table(ny));
         Self {
             nx,
             ny,
             x,
             y,
             scratch_len,
+            direct,
         }
     }
 
     /// In place: forward (unnormalised DCT-II) on both axes, multiply by `diag`, then
-    /// unnormalised DCT-III on both axes.
-    pub(crate) fn filter(&self, buf: &mut [f64], diag: &[f64]) {
-        let mut scratch = vec![0.0; self.scratch_len];
-        let mut column = vec![0.0; self.ny];
-        for row in buf.chunks_exact_mut(self.nx) {
-            self.x.process_dct2_with_scratch(row, &mut scratch);
+    /// unnormalised DCT-III on both axes. `work` is scratch (resized as needed), so that
+    /// iterative solvers do not allocate per product.
+    pub(crate) fn filter(&self, buf: &mut [f64], diag: &[f64], work: &mut Vec<f64>) {
+        let direct_len = if self.direct.is_some() { buf.len() } else { 0 };
+        let need = self.scratch_len + self.ny + direct_len;
+        if work.len() < need {
+            work.resize(need, 0.0);
         }
-        self.columns(buf, &mut column, &mut scratch, true);
+        let (scratch, rest) = work.split_at_mut(self.scratch_len);
+        let (column, tmp) = rest.split_at_mut(self.ny);
+        for row in buf.chunks_exact_mut(self.nx) {
+            self.x.process_dct2_with_scratch(row, scratch);
+        }
+        self.columns(buf, column, scratch, &mut tmp[..direct_len], true);
         for (b, d) in buf.iter_mut().zip(diag) {
             *b *= d;
         }
-        self.columns(buf, &mut column, &mut scratch, false);
+        self.columns(buf, column, scratch, &mut tmp[..direct_len], false);
         for row in buf.chunks_exact_mut(self.nx) {
-            self.x.process_dct3_with_scratch(row, &mut scratch);
+            self.x.process_dct3_with_scratch(row, scratch);
         }
     }
 
-    fn columns(&self, buf: &mut [f64], column: &mut [f64], scratch: &mut [f64], forward: bool) {
+    fn columns(
+        &self,
+        buf: &mut [f64],
+        column: &mut [f64],
+        scratch: &mut [f64],
+        tmp: &mut [f64],
+        forward: bool,
+    ) {
         if self.ny == 1 {
             return; // a length-1 DCT-II is the identity; DCT-III halves it, compensated in diag
         }
-        for ix in 0..self.nx {
+        let nx = self.nx;
+        if let Some(table) = &self.direct {
+            // DCT-II: out_m = Σ_j cos(π m (2j+1)/2Ny) in_j; DCT-III: out_j = in_0/2 +
+            // Σ_{m>0} cos(π m (2j+1)/2Ny) in_m (rustdct's unnormalised conventions).
+            let ny = self.ny;
+            tmp.fill(0.0);
+            for o in 0..ny {
+                let out = &mut tmp[o * nx..(o + 1) * nx];
+                for i in 0..ny {
+                    let w = if forward {
+                        table[o * ny + i]
+                    } else if i == 0 {
+                        0.5
+                    } else {
+                        table[i * ny + o]
+                    };
+                    let src = &buf[i * nx..(i + 1) * nx];
+                    for (d, s) in out.iter_mut().zip(src) {
+                        *d += w * s;
+                    }
+                }
+            }
+            buf.copy_from_slice(tmp);
+            return;
+        }
+        for ix in 0..nx {
             for (iy, c) in column.iter_mut().enumerate() {
-                *c = buf[iy * self.nx + ix];
+                *c = buf[iy * nx + ix];
             }
             if forward {
                 self.y.process_dct2_with_scratch(column, scratch);
@@ -254,7 +300,7 @@ impl Dct2d {
                 self.y.process_dct3_with_scratch(column, scratch);
             }
             for (iy, c) in column.iter().enumerate() {
-                buf[iy * self.nx + ix] = *c;
+                buf[iy * nx + ix] = *c;
             }
         }
     }
@@ -356,13 +402,35 @@ impl InfluencePlan {
             });
         }
         out.copy_from_slice(v);
-        self.dct.filter(out, &self.scaled);
+        self.dct.filter(out, &self.scaled, &mut Vec::new());
         Ok(())
     }
 
     /// `buf ← Ĝ buf` without validation (the solvers' inner loop).
-    pub(crate) fn apply_in_place(&self, buf: &mut [f64]) {
-        self.dct.filter(buf, &self.scaled);
+    pub(crate) fn apply_in_place(&self, buf: &mut [f64], work: &mut Vec<f64>) {
+        self.dct.filter(buf, &self.scaled, work);
+    }
+
+    /// The table for [`InfluencePlan::filter_in_place`] of the operator with the same
+    /// eigenvectors as `Ĝ` and eigenvalues `map(p', m', eigenvalue(p', m'))`.
+    pub(crate) fn spectral_table(&self, map: impl Fn(usize, usize, f64) -> f64) -> Vec<f64> {
+        let (nx, ny) = (self.grid.nx(), self.grid.ny());
+        let mut values = vec![0.0; nx * ny];
+        for m in 0..ny {
+            let ay = if m == 0 { 1.0 } else { 2.0 } / ny as f64;
+            for p in 0..nx {
+                let ax = if p == 0 { 1.0 } else { 2.0 } / nx as f64;
+                let k = m * nx + p;
+                let eigen = self.lambda[k] / (ax * ay);
+                values[k] = map(p, m, eigen) * (ax * ay);
+            }
+        }
+        dct_diagonal(&self.grid, &values)
+    }
+
+    /// Applies, in place, the operator whose table [`InfluencePlan::spectral_table`] built.
+    pub(crate) fn filter_in_place(&self, buf: &mut [f64], table: &[f64], work: &mut Vec<f64>) {
+        self.dct.filter(buf, table, work);
     }
 
     /// The dense matrix `Ĝ` (m⁻¹), row-major `N x N`, assembled from the eigenvalue table
@@ -557,7 +625,7 @@ impl PlaneTransfer {
             });
         }
         out.copy_from_slice(traction);
-        self.dct.filter(out, &self.scaled);
+        self.dct.filter(out, &self.scaled, &mut Vec::new());
         out.iter_mut().for_each(|s| *s = -*s);
         Ok(())
     }

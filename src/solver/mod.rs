@@ -37,6 +37,9 @@ use pcg::{projected_pcg, PcgOutcome};
 use spectral::SpectralCore;
 use std::collections::HashSet;
 
+/// Backward error of the linear solves while a cold attached set is explored.
+const EXPLORE_TOLERANCE: f64 = 1e-7;
+
 /// Largest grid the [`Backend::Auto`] choice solves densely.
 pub const AUTO_DENSE_LIMIT: usize = 2500;
 
@@ -291,6 +294,8 @@ impl std::fmt::Debug for EquilibriumSolver {
 struct SolveKind {
     explore: bool,
     tangential: bool,
+    /// A cold normal solve (spectral backend: use the spectral preconditioner).
+    cold: bool,
 }
 
 /// `(C_SS + diag(diag)) f + U 1 = b`, `Σ f = total` on the sites `set`.
@@ -368,6 +373,7 @@ impl EquilibriumSolver {
         let SolveKind {
             explore,
             tangential,
+            cold,
         } = kind;
         let SetProblem {
             set,
@@ -376,14 +382,20 @@ impl EquilibriumSolver {
             total,
         } = problem;
         let mut f = warm;
-        let tol = self.options.tolerance;
+        // Exploring a cold set only needs the signs of f and u0 - u_z right away from
+        // zero: a loose tolerance, the final set is confirmed at the user's one.
+        let tol = if explore {
+            self.options.tolerance.max(EXPLORE_TOLERANCE)
+        } else {
+            self.options.tolerance
+        };
         let max_it = self.options.max_linear_iterations;
-        let n_sites = self.grid.len();
+
         let outcome = match &mut self.core {
-            Core::Dense(core) if explore && core.normal.needs_refactor(set, n_sites) => {
+            Core::Dense(core) if explore => {
                 // A cold or much-changed set: find the attached set with the cheap
                 // spectral iteration first; the factor confirms the final set.
-                let mut sys = core.spectral.system(set, diag);
+                let mut sys = core.spectral.system(set, diag, true);
                 projected_pcg(&mut sys, b, total, &mut f, tol, max_it)
             }
             Core::Dense(core) => {
@@ -410,7 +422,7 @@ impl EquilibriumSolver {
                 outcome
             }
             Core::Spectral(core) => {
-                let mut sys = core.system(set, diag);
+                let mut sys = core.system(set, diag, cold);
                 projected_pcg(&mut sys, b, total, &mut f, tol, max_it)
             }
         };
@@ -484,7 +496,12 @@ impl EquilibriumSolver {
         let mut linear_iterations = 0;
         let mut u = vec![0.0; n];
         let mut iteration = 0;
-        let mut explore = true;
+        // Explore (loose tolerance; dense: spectral iteration) from a cold start only.
+        let cold = warm_full.iter().all(|x| *x == 0.0);
+        let mut explore = match &self.core {
+            Core::Dense(_) => true,
+            Core::Spectral(_) => cold,
+        };
         loop {
             iteration += 1;
             if iteration > self.options.max_active_set_iterations {
@@ -505,13 +522,17 @@ impl EquilibriumSolver {
                 b: &b,
                 total,
             };
+            let explored = explore
+                && match &self.core {
+                    Core::Dense(c) => c.normal.needs_refactor(&set, n),
+                    Core::Spectral(_) => true,
+                };
             let kind = SolveKind {
-                explore,
+                explore: explored,
                 tangential: false,
+                cold,
             };
             let solved = self.solve_set(kind, problem, warm)?;
-            let explored =
-                explore && matches!(&self.core, Core::Dense(c) if c.normal.needs_refactor(&set, n));
             linear_iterations += solved.outcome.iterations;
             let f = solved.f;
             let offset = solved.outcome.offset;
@@ -562,7 +583,7 @@ impl EquilibriumSolver {
                 warm_full[i] = f[a];
             }
             if negative.is_empty() && violated.is_empty() && explored {
-                explore = false; // confirm the set with the dense factor
+                explore = false; // confirm the set at full tolerance (dense: the factor)
                 continue;
             }
             if negative.is_empty() && violated.is_empty() {
@@ -613,6 +634,12 @@ impl EquilibriumSolver {
                 });
             }
             let key = set_key(&in_set);
+            if explore && seen.contains(&key) {
+                // Cycling at the loose tolerance: rounding noise, not the method. Go on at
+                // full tolerance from here.
+                explore = false;
+                seen.clear();
+            }
             if !fallback && !seen.insert(key) {
                 // The primal-dual iteration cycles: switch to the monotone method from a
                 // feasible point (uniform traction on the current set).
@@ -699,6 +726,7 @@ impl EquilibriumSolver {
         let kind = SolveKind {
             explore: false,
             tangential: true,
+            cold: false,
         };
         let solved = self.solve_set(kind, problem, warm)?;
         let offset = solved.outcome.offset;

@@ -16,6 +16,10 @@ pub(crate) struct SpectralCore {
     diag_c: f64,
     norm_c: f64,
     buf: Vec<f64>,
+    /// DCT scratch.
+    work: Vec<f64>,
+    /// Filter table of `(C_s + d̄ I)⁻¹` and the `d̄` it was built for.
+    inverse: Option<(f64, Vec<f64>)>,
 }
 
 impl SpectralCore {
@@ -37,6 +41,8 @@ impl SpectralCore {
             diag_c,
             norm_c,
             buf: vec![0.0; n],
+            work: Vec::new(),
+            inverse: None,
         }
     }
 
@@ -48,23 +54,67 @@ impl SpectralCore {
             out[i] = xi;
             sum += xi;
         }
-        self.plan.apply_in_place(out);
+        self.plan.apply_in_place(out, &mut self.work);
         let s = self.scale;
         let c = self.shift * sum;
         out.iter_mut().for_each(|o| *o = s * (*o - c));
     }
 
+    /// `y = (C_SS + diag(d)) x` on `set`.
+    pub(crate) fn apply_set(&mut self, set: &[usize], diag: &[f64], x: &[f64], y: &mut [f64]) {
+        let mut buf = std::mem::take(&mut self.buf);
+        self.apply_full(set, x, &mut buf);
+        for (a, &i) in set.iter().enumerate() {
+            y[a] = buf[i] + diag[a] * x[a];
+        }
+        self.buf = buf;
+    }
+
+    /// The system on `set` with compliances `diag`. Preconditioner: Jacobi (the mean
+    /// diagonal of `C` plus `d`), or with `spectral_preconditioner` the full-grid inverse
+    /// `(C_s + d̄ I)⁻¹` restricted to the set (`d̄` the mean compliance). `C` is diagonal in
+    /// the DCT basis, so the latter costs a second transform pair per iteration and
+    /// halves the iterations: it pays on cold, far-from-solution solves of large grids
+    /// (measured in docs/performance.md), Jacobi on warm ones.
     pub(crate) fn system<'a>(
         &'a mut self,
         set: &'a [usize],
         diag: &'a [f64],
+        spectral_preconditioner: bool,
     ) -> SpectralSystem<'a> {
         let norm = self.norm_c + diag.iter().fold(0.0f64, |m, d| m.max(*d));
+        if !spectral_preconditioner {
+            return SpectralSystem {
+                core: self,
+                set,
+                diag,
+                norm,
+                spectral_preconditioner,
+            };
+        }
+        let mean_d = diag.iter().sum::<f64>() / diag.len().max(1) as f64;
+        let stale = match &self.inverse {
+            Some((d, _)) => (d - mean_d).abs() > 0.05 * mean_d.abs().max(f64::MIN_POSITIVE),
+            None => true,
+        };
+        if stale {
+            let (scale, shift, n) = (self.scale, self.shift, self.buf.len() as f64);
+            let table = self.plan.spectral_table(|p, m, eigen| {
+                let e = if p == 0 && m == 0 {
+                    eigen - shift * n
+                } else {
+                    eigen
+                };
+                1.0 / (scale * e + mean_d)
+            });
+            self.inverse = Some((mean_d, table));
+        }
         SpectralSystem {
             core: self,
             set,
             diag,
             norm,
+            spectral_preconditioner,
         }
     }
 }
@@ -75,24 +125,35 @@ pub(crate) struct SpectralSystem<'a> {
     set: &'a [usize],
     diag: &'a [f64],
     norm: f64,
+    spectral_preconditioner: bool,
 }
 
 impl SetSystem for SpectralSystem<'_> {
     fn apply(&mut self, x: &[f64], y: &mut [f64]) {
-        let core = &mut *self.core;
-        let mut buf = std::mem::take(&mut core.buf);
-        core.apply_full(self.set, x, &mut buf);
-        for (a, &i) in self.set.iter().enumerate() {
-            y[a] = buf[i] + self.diag[a] * x[a];
-        }
-        core.buf = buf;
+        self.core.apply_set(self.set, self.diag, x, y);
     }
 
     fn precondition(&mut self, r: &[f64], z: &mut [f64]) {
-        let c = self.core.diag_c;
-        for ((zi, ri), d) in z.iter_mut().zip(r).zip(self.diag) {
-            *zi = ri / (c + d);
+        let core = &mut *self.core;
+        let mut buf = std::mem::take(&mut core.buf);
+        buf.fill(0.0);
+        for (&i, &ri) in self.set.iter().zip(r) {
+            buf[i] = ri;
         }
+        if !self.spectral_preconditioner {
+            for (zi, (ri, d)) in z.iter_mut().zip(r.iter().zip(self.diag)) {
+                *zi = ri / (core.diag_c + d);
+            }
+            core.buf = buf;
+            return;
+        }
+        if let Some((_, table)) = &core.inverse {
+            core.plan.filter_in_place(&mut buf, table, &mut core.work);
+        }
+        for (zi, &i) in z.iter_mut().zip(self.set) {
+            *zi = buf[i];
+        }
+        core.buf = buf;
     }
 
     fn norm_bound(&self) -> f64 {
@@ -111,7 +172,7 @@ mod tests {
         let mut core = SpectralCore::new(plan, 3.6e-16, 0.0, 1.0);
         let set: Vec<usize> = (0..980).filter(|i| i % 3 != 0).collect();
         let diag: Vec<f64> = set.iter().map(|i| 1e-15 * (*i as f64)).collect();
-        let mut sys = core.system(&set, &diag);
+        let mut sys = core.system(&set, &diag, false);
         let n = set.len();
         let x: Vec<f64> = (0..n).map(|i| ((i * 7919) % 101) as f64 - 50.0).collect();
         let y: Vec<f64> = (0..n).map(|i| ((i * 104729) % 97) as f64 - 48.0).collect();
