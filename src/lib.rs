@@ -14,8 +14,10 @@
 //! This release provides the geometry, the [`green`] module (point evaluation of `G`
 //! and `∂G/∂z`, the analytic load terms, the Galerkin influence operator of the grid,
 //! planned once per geometry and applied through the 2-D DCT), the [`interface`] springs
-//! and the [`solver`] of the normal and tangential equilibria (dense and spectral
-//! backends).
+//! the [`solver`] of the normal and tangential equilibria (dense and spectral
+//! backends), the [`scene`] builder and the quasi-static [`driver`], an iterator of
+//! [`Event`]s (ruptures, detachments, attachments, load steps, stable states, global
+//! slip).
 //!
 //! ```
 //! use precursors::{Block, Grid, green::InfluencePlan};
@@ -33,10 +35,12 @@
 #![deny(missing_docs)]
 #![forbid(unsafe_code)]
 
+pub mod driver;
 pub mod error;
 pub mod geometry;
 pub mod green;
 pub mod interface;
+pub mod scene;
 pub mod solver;
 
 pub use error::{Error, Result};
@@ -45,8 +49,10 @@ pub use error::{Error, Result};
 #[doc = include_str!("../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
+pub use driver::{Driver, Event, Load, Site};
 pub use geometry::{Block, Grid, Point};
 pub use interface::{HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw};
+pub use scene::{Drive, ForceLoad, HeightSource, Lateral, Scene, SceneBuilder};
 pub use solver::{
     Backend, EquilibriumSolver, NormalEquilibrium, SolveReport, SolverOptions, TangentialResponse,
 };

@@ -2,6 +2,7 @@
 //! public API against references computed independently of the code under test.
 
 mod common;
+mod driver;
 mod errors;
 mod green_point;
 mod interface;

@@ -62,13 +62,13 @@ fn gauss_legendre_integrates_polynomials_exactly() {
 
 /// A scene for the solver tests: a block with `nx x ny` cells of `cell` metres, height
 /// `lz`, seeded paper heights.
-pub struct Scene {
+pub struct TestScene {
     pub grid: precursors::Grid,
     pub plan: precursors::green::InfluencePlan,
     pub interface: precursors::Interface,
 }
 
-pub fn scene(nx: usize, ny: usize, cell: f64, lz: f64, seed: u64) -> Scene {
+pub fn scene(nx: usize, ny: usize, cell: f64, lz: f64, seed: u64) -> TestScene {
     use precursors::*;
     let block = Block::new(nx as f64 * cell, ny as f64 * cell, lz).unwrap();
     let grid = Grid::new(block, nx, ny).unwrap();
@@ -78,7 +78,7 @@ pub fn scene(nx: usize, ny: usize, cell: f64, lz: f64, seed: u64) -> Scene {
         .unwrap();
     let heights = Heights::truncated_gaussian(&grid, HeightDistribution::default(), seed).unwrap();
     let interface = Interface::new(grid, heights, SpringLaw::default()).unwrap();
-    Scene {
+    TestScene {
         grid,
         plan,
         interface,

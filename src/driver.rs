@@ -1,0 +1,509 @@
+//! The quasi-static protocol (paper Suppl. "Quasi-static dynamics", MODEL.md section 5)
+//! as an iterator of [`Event`]s.
+//!
+//! 1. Normal equilibrium at `F_N`, no shear: the first event is a [`Event::Stable`] state
+//!    at zero load.
+//! 2. The load is raised to the smallest breaking load `min_i λ_i` of the attached sites
+//!    ([`Event::LoadRaised`]); that site is over threshold.
+//! 3. At fixed load, the over-threshold site (`|φ_x| ≥ μ φ_z`) with the largest elastic
+//!    energy `½ k_x u_x² ΔA` breaks ([`Event::Rupture`]); the normal equilibrium is solved
+//!    again (sites [`Event::Detach`] and [`Event::Attach`]), then the tangential one; repeat
+//!    3 while a site is over threshold, then [`Event::Stable`] and back to 2.
+//! 4. When every site is broken the block slides: [`Event::GlobalSlip`], then the iterator
+//!    ends.
+//!
+//! Under displacement control the load is the drive displacement `U_S`; the spring force
+//! `F = K_S (U_S - ⟨u_x⟩)` follows from the state and drops at each rupture.
+//!
+//! ```
+//! use precursors::{Drive, Event, ForceLoad, Scene};
+//! let scene = Scene::builder()
+//!     .block(0.010, 0.002, 0.010)
+//!     .cell_size(1e-3, 1e-3)
+//!     .normal_load(40.0)
+//!     .drive(Drive::Force(ForceLoad::Top))
+//!     .seed(3)
+//!     .build()?;
+//! let mut driver = scene.driver()?;
+//! let mut slip = None;
+//! for event in &mut driver {
+//!     if let Event::GlobalSlip { load } = event? {
+//!         slip = Some(load.force);
+//!     }
+//! }
+//! // Amontons' first law: the block slides at μ F_N.
+//! let ratio = slip.unwrap() / (0.5 * 40.0);
+//! assert!((ratio - 1.0).abs() < 1e-9);
+//! # Ok::<(), precursors::Error>(())
+//! ```
+
+use crate::error::{Error, Result};
+use crate::geometry::Grid;
+use crate::interface::{Interface, SiteState};
+use crate::scene::{Drive, Scene};
+use crate::solver::{EquilibriumSolver, NormalEquilibrium, TangentialResponse};
+use std::collections::VecDeque;
+
+/// A site of the interface grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub struct Site {
+    /// Index `i = iy·Nx + ix` (the paper's order).
+    pub index: usize,
+    /// Column (along x, from the trailing edge).
+    pub ix: usize,
+    /// Row (along y).
+    pub iy: usize,
+}
+
+impl Site {
+    fn new(grid: &Grid, index: usize) -> Self {
+        Self {
+            index,
+            ix: index % grid.nx(),
+            iy: index / grid.nx(),
+        }
+    }
+}
+
+/// The applied load at an event.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct Load {
+    /// Total shear force `F = F_top + F_lat` (N): the control parameter under force
+    /// control, the spring force `K_S (U_S - ⟨u_x⟩)` under displacement control.
+    pub force: f64,
+    /// Drive displacement `U_S` (m) under displacement control, `None` under force
+    /// control.
+    pub drive_displacement: Option<f64>,
+}
+
+/// What happened.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum Event {
+    /// The load was raised to the next breaking threshold.
+    LoadRaised {
+        /// The new load.
+        load: Load,
+    },
+    /// A spring broke (irreversibly: the site slips).
+    Rupture {
+        /// Which site.
+        site: Site,
+        /// The load at the rupture (before the re-equilibration it triggers).
+        load: Load,
+        /// Elastic energy `½ k_x u_x² ΔA` of the spring when it broke (J).
+        energy: f64,
+    },
+    /// A site lost contact in the normal re-equilibration (it may attach again).
+    Detach {
+        /// Which site.
+        site: Site,
+    },
+    /// A detached site came back into contact.
+    Attach {
+        /// Which site.
+        site: Site,
+    },
+    /// No site is over threshold at the current load: the end of an avalanche (also the
+    /// initial state at zero shear).
+    Stable {
+        /// The load.
+        load: Load,
+        /// Ruptures in the avalanche that just ended.
+        ruptures: usize,
+    },
+    /// Every spring is broken: the block slides. The last event of a run.
+    GlobalSlip {
+        /// The load at which the last spring broke.
+        load: Load,
+    },
+}
+
+/// Where the protocol stands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Phase {
+    /// Before the first normal equilibrium.
+    Start,
+    /// Stable: the next step raises the load.
+    Stable,
+    /// At fixed load, possibly with sites over threshold (`forced`: the site that set
+    /// the threshold, over it by definition whatever the rounding).
+    Avalanche { forced: Option<usize> },
+    /// Global slip reported.
+    Done,
+    /// An error was returned; the run cannot go on.
+    Failed,
+}
+
+/// Runs a [`Scene`] quasi-statically; an iterator of [`Event`]s.
+#[derive(Debug)]
+pub struct Driver {
+    grid: Grid,
+    friction: f64,
+    normal_load: f64,
+    drive: Drive,
+    unit_load: Vec<f64>,
+    interface: Interface,
+    solver: EquilibriumSolver,
+    normal: Option<NormalEquilibrium>,
+    response: Option<TangentialResponse>,
+    /// Breaking load `λ_i` (N) of each site in the current state (`+∞` off contact).
+    breaking: Vec<f64>,
+    initial_columns: Vec<f64>,
+    /// Control parameter: `F` (N) under force control, `U_S` (m) under a spring.
+    control: f64,
+    pending: VecDeque<Event>,
+    phase: Phase,
+    avalanche_ruptures: usize,
+    events: usize,
+}
+
+impl Scene {
+    /// A driver at zero shear (the first [`Driver::step`] solves the normal equilibrium).
+    pub fn driver(&self) -> Result<Driver> {
+        let solver = EquilibriumSolver::builder(self.plan().clone())
+            .material(self.material())
+            .options(self.solver_options())
+            .build()?;
+        let n = self.grid().len();
+        Ok(Driver {
+            grid: *self.grid(),
+            friction: self.material().friction_coefficient,
+            normal_load: self.normal_load(),
+            drive: self.drive(),
+            unit_load: self.unit_load_displacement(),
+            interface: self.interface().clone(),
+            solver,
+            normal: None,
+            response: None,
+            breaking: vec![f64::INFINITY; n],
+            initial_columns: Vec::new(),
+            control: 0.0,
+            pending: VecDeque::new(),
+            phase: Phase::Start,
+            avalanche_ruptures: 0,
+            events: 0,
+        })
+    }
+}
+
+impl Driver {
+    /// The next event, `Ok(None)` after [`Event::GlobalSlip`]. After an error the driver
+    /// stays failed (every later call returns `Ok(None)`).
+    pub fn step(&mut self) -> Result<Option<Event>> {
+        loop {
+            if let Some(event) = self.pending.pop_front() {
+                self.events += 1;
+                return Ok(Some(event));
+            }
+            if matches!(self.phase, Phase::Done | Phase::Failed) {
+                return Ok(None);
+            }
+            if let Err(e) = self.advance() {
+                self.phase = Phase::Failed;
+                self.pending.clear();
+                return Err(e);
+            }
+        }
+    }
+
+    /// Runs to global slip (or the first error), calling `observe` after every event with
+    /// the driver in the state right after it.
+    pub fn run(&mut self, mut observe: impl FnMut(&Event, &Driver)) -> Result<()> {
+        while let Some(event) = self.step()? {
+            observe(&event, self);
+        }
+        Ok(())
+    }
+
+    /// One protocol move; queues its events.
+    fn advance(&mut self) -> Result<()> {
+        match self.phase {
+            Phase::Start => {
+                self.equilibrate()?;
+                self.initial_columns = self.column_contact_area()?;
+                self.pending.push_back(Event::Stable {
+                    load: self.load(),
+                    ruptures: 0,
+                });
+                self.phase = Phase::Stable;
+            }
+            Phase::Stable => {
+                let (site, threshold) = self.weakest()?;
+                self.control = match self.drive {
+                    Drive::Spring { stiffness, .. } => {
+                        // F = K_S U_S / (1 + K_S Û): invert for the U_S that makes F = λ.
+                        threshold * (1.0 + stiffness * self.response()?.offset) / stiffness
+                    }
+                    Drive::Force(_) => threshold,
+                };
+                self.pending
+                    .push_back(Event::LoadRaised { load: self.load() });
+                self.avalanche_ruptures = 0;
+                self.phase = Phase::Avalanche { forced: Some(site) };
+            }
+            Phase::Avalanche { forced } => {
+                let force = self.force();
+                let u_z = &self.normal()?.displacement;
+                let k_x = self.interface.tangential_stiffness(u_z)?;
+                let u_x = &self.response()?.displacement;
+                let cell = self.grid.cell_area();
+                let mut best: Option<(usize, f64)> = None;
+                for i in 0..self.grid.len() {
+                    if self.interface.states()[i] != SiteState::Attached {
+                        continue;
+                    }
+                    if self.breaking[i] <= force || forced == Some(i) {
+                        let u = force * u_x[i];
+                        let energy = 0.5 * k_x[i] * u * u * cell;
+                        if best.is_none_or(|(_, e)| energy > e) {
+                            best = Some((i, energy));
+                        }
+                    }
+                }
+                match best {
+                    None => {
+                        self.pending.push_back(Event::Stable {
+                            load: self.load(),
+                            ruptures: self.avalanche_ruptures,
+                        });
+                        self.phase = Phase::Stable;
+                    }
+                    Some((i, energy)) => {
+                        let load = self.load();
+                        self.pending.push_back(Event::Rupture {
+                            site: Site::new(&self.grid, i),
+                            load,
+                            energy,
+                        });
+                        self.avalanche_ruptures += 1;
+                        self.interface.break_site(i)?;
+                        if self.interface.broken_count() == self.grid.len() {
+                            self.pending.push_back(Event::GlobalSlip { load });
+                            self.phase = Phase::Done;
+                            return Ok(());
+                        }
+                        self.equilibrate()?;
+                        self.phase = Phase::Avalanche { forced: None };
+                    }
+                }
+            }
+            Phase::Done | Phase::Failed => {}
+        }
+        Ok(())
+    }
+
+    /// Normal then tangential equilibrium of the current site set; queues the sites that
+    /// detached or attached.
+    fn equilibrate(&mut self) -> Result<()> {
+        let before = self.interface.states().to_vec();
+        let normal = self
+            .solver
+            .solve_normal(&mut self.interface, self.normal_load)?;
+        if self.normal.is_some() {
+            for (i, (old, new)) in before.iter().zip(self.interface.states()).enumerate() {
+                let site = Site::new(&self.grid, i);
+                match (old, new) {
+                    (SiteState::Attached, SiteState::Detached) => {
+                        self.pending.push_back(Event::Detach { site })
+                    }
+                    (SiteState::Detached, SiteState::Attached) => {
+                        self.pending.push_back(Event::Attach { site })
+                    }
+                    _ => {}
+                }
+            }
+        }
+        let response =
+            self.solver
+                .solve_tangential(&self.interface, &normal.displacement, &self.unit_load)?;
+        if let Drive::Spring { stiffness, .. } = self.drive {
+            if !(1.0 + stiffness * response.offset > 0.0) {
+                return Err(Error::InvalidParameter {
+                    name: "mean shear compliance <u_x>/F (m/N)",
+                    value: response.offset,
+                    reason: "the block's mean displacement per newton must exceed -1/K_S for the \
+                             driving spring to load it",
+                });
+            }
+        }
+        self.breaking = response.breaking_loads(&normal.traction, self.friction)?;
+        self.normal = Some(normal);
+        self.response = Some(response);
+        Ok(())
+    }
+
+    /// The attached site with the smallest breaking load, and that load (N).
+    fn weakest(&self) -> Result<(usize, f64)> {
+        let mut best: Option<(usize, f64)> = None;
+        for (i, &b) in self.breaking.iter().enumerate() {
+            if self.interface.states()[i] == SiteState::Attached
+                && b.is_finite()
+                && best.is_none_or(|(_, v)| b < v)
+            {
+                best = Some((i, b));
+            }
+        }
+        best.ok_or(Error::EmptyContact {
+            available: self.interface.attached_count(),
+            reason: "no attached site carries shear: the next threshold is undefined",
+        })
+    }
+
+    fn normal(&self) -> Result<&NormalEquilibrium> {
+        self.normal.as_ref().ok_or(Error::EmptyContact {
+            available: 0,
+            reason: "the normal equilibrium has not been solved yet (call step first)",
+        })
+    }
+
+    fn response(&self) -> Result<&TangentialResponse> {
+        self.response.as_ref().ok_or(Error::EmptyContact {
+            available: 0,
+            reason: "the tangential equilibrium has not been solved yet (call step first)",
+        })
+    }
+
+    /// The shear force `F` (N) in the current state.
+    pub fn force(&self) -> f64 {
+        match self.drive {
+            Drive::Force(_) => self.control,
+            Drive::Spring { stiffness, .. } => match &self.response {
+                Some(r) => stiffness * self.control / (1.0 + stiffness * r.offset),
+                None => 0.0,
+            },
+        }
+    }
+
+    /// The applied load in the current state.
+    pub fn load(&self) -> Load {
+        Load {
+            force: self.force(),
+            drive_displacement: match self.drive {
+                Drive::Spring { .. } => Some(self.control),
+                Drive::Force(_) => None,
+            },
+        }
+    }
+
+    /// The spring force `K_S (U_S - ⟨u_x⟩)` (N) under displacement control, `None` under
+    /// force control.
+    pub fn spring_force(&self) -> Option<f64> {
+        matches!(self.drive, Drive::Spring { .. }).then(|| self.force())
+    }
+
+    /// The normal load `F_N` (N).
+    pub fn normal_load(&self) -> f64 {
+        self.normal_load
+    }
+
+    /// Events returned so far.
+    pub fn event_count(&self) -> usize {
+        self.events
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The interface (site states, heights, spring law).
+    pub fn interface(&self) -> &Interface {
+        &self.interface
+    }
+
+    /// Site states, in the paper's cell order.
+    pub fn site_states(&self) -> &[SiteState] {
+        self.interface.states()
+    }
+
+    /// Normal traction `φ_z` per cell (Pa).
+    pub fn normal_traction(&self) -> Result<&[f64]> {
+        Ok(&self.normal()?.traction)
+    }
+
+    /// Normal displacement `u_z` of the bottom face per cell (m).
+    pub fn normal_displacement(&self) -> Result<&[f64]> {
+        Ok(&self.normal()?.displacement)
+    }
+
+    /// Shear traction `φ_x` per cell (Pa; negative where the springs resist `+x`).
+    pub fn shear_traction(&self) -> Result<Vec<f64>> {
+        let f = self.force();
+        Ok(self.response()?.traction.iter().map(|g| f * g).collect())
+    }
+
+    /// Shear displacement `u_x` of the bottom face per cell (m).
+    pub fn shear_displacement(&self) -> Result<Vec<f64>> {
+        let f = self.force();
+        Ok(self
+            .response()?
+            .displacement
+            .iter()
+            .map(|u| f * u)
+            .collect())
+    }
+
+    /// Mean shear displacement `⟨u_x⟩` of the block (m) (plus the top load's constant
+    /// when a top shear acts).
+    pub fn mean_shear_displacement(&self) -> Result<f64> {
+        Ok(self.force() * self.response()?.offset)
+    }
+
+    /// Breaking load `λ_i` (N) of each site in the current state (`+∞` off contact).
+    pub fn breaking_loads(&self) -> &[f64] {
+        &self.breaking
+    }
+
+    /// Real contact area per cell (m²).
+    pub fn real_contact_area(&self) -> Result<Vec<f64>> {
+        self.interface
+            .real_contact_area(&self.normal()?.displacement)
+    }
+
+    /// Total real contact area (m²).
+    pub fn total_contact_area(&self) -> Result<f64> {
+        Ok(self.real_contact_area()?.iter().sum())
+    }
+
+    /// Real contact area per column `ix` (summed over `y`, m²).
+    pub fn column_contact_area(&self) -> Result<Vec<f64>> {
+        let area = self.real_contact_area()?;
+        let nx = self.grid.nx();
+        let mut columns = vec![0.0; nx];
+        for row in area.chunks_exact(nx) {
+            columns.iter_mut().zip(row).for_each(|(c, a)| *c += a);
+        }
+        Ok(columns)
+    }
+
+    /// Real contact area per column at zero shear (m²), the reference of the precursor.
+    pub fn initial_column_contact_area(&self) -> &[f64] {
+        &self.initial_columns
+    }
+
+    /// Precursor length `ℓ` (m): the extent, from the trailing edge `x = 0`, of the run of
+    /// columns whose real contact area is below its value at zero shear (MODEL.md
+    /// section 5; paper Fig. 2b). A multiple of `Δx`.
+    pub fn precursor_length(&self) -> Result<f64> {
+        let columns = self.column_contact_area()?;
+        let run = columns
+            .iter()
+            .zip(&self.initial_columns)
+            .take_while(|(now, then)| now < then)
+            .count();
+        Ok(run as f64 * self.grid.dx())
+    }
+}
+
+impl Iterator for Driver {
+    type Item = Result<Event>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        self.step().transpose()
+    }
+}
+
+impl std::iter::FusedIterator for Driver {}

@@ -1,0 +1,390 @@
+//! A complete simulation set-up: block, grid, material, interface springs, normal load
+//! and the shear drive, validated once by [`SceneBuilder::build`].
+//!
+//! A scene computes only what it needs: the lateral load table (paper Eq. `G_x_lat`) only
+//! for a drive with a lateral part, the dense matrix only when the solver backend is dense
+//! (by default: [`Backend::Auto`](crate::Backend::Auto) up to
+//! [`AUTO_DENSE_LIMIT`](crate::solver::AUTO_DENSE_LIMIT) cells).
+//!
+//! ```
+//! use precursors::{Drive, Lateral, Scene};
+//! // The paper's calibration scene (Fig. 2b): 140 x 7 x 75 mm, 1 mm cells, F_N = 3.5 kN,
+//! // rod at h = 6 mm with Δh = 2 mm.
+//! let scene = Scene::builder()
+//!     .block(0.140, 0.007, 0.075)
+//!     .cell_size(1e-3, 1e-3)
+//!     .normal_load(3.5e3)
+//!     .drive(Drive::Force(Lateral::Rod { height: 6e-3, half_width: 2e-3 }.into()))
+//!     .seed(1)
+//!     .build()?;
+//! assert_eq!(scene.grid().len(), 980);
+//! # Ok::<(), precursors::Error>(())
+//! ```
+
+use crate::error::{Error, Result};
+use crate::geometry::{Block, Grid};
+use crate::green::{InfluencePlan, RodLoad};
+use crate::interface::{HeightDistribution, Heights, Interface, Material, SpringLaw};
+use crate::solver::SolverOptions;
+
+/// Relative tolerance of the lateral load table.
+const LATERAL_TOLERANCE: f64 = 1e-12;
+
+/// Where a lateral shear acts on the trailing face `x = 0`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum Lateral {
+    /// The paper's rod: a band `z ∈ [height - half_width, height + half_width]` (m).
+    Rod {
+        /// Height `h` of the band's centre above the interface (m).
+        height: f64,
+        /// Half-width `Δh` of the band (m).
+        half_width: f64,
+    },
+    /// The whole trailing face (`h = Δh = Lz/2`).
+    Side,
+}
+
+/// How the total shear force `F = F_top + F_lat` is split under force control.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum ForceLoad {
+    /// Uniform shear on the top face only.
+    Top,
+    /// Lateral shear only.
+    Lateral(Lateral),
+    /// Both, with `F_top = ratio · F_lat` (the paper's `n`, dimensionless, ≥ 0).
+    Mixed {
+        /// `n = F_top / F_lat` (dimensionless).
+        ratio: f64,
+        /// Where the lateral part acts.
+        lateral: Lateral,
+    },
+}
+
+impl From<Lateral> for ForceLoad {
+    fn from(lateral: Lateral) -> Self {
+        ForceLoad::Lateral(lateral)
+    }
+}
+
+/// The shear drive: the quasi-static control parameter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum Drive {
+    /// Force control: the shear force `F` (N) is raised from threshold to threshold.
+    Force(ForceLoad),
+    /// Displacement control through a driving spring on the trailing face (paper Eq.
+    /// `spring_shear_force`): `F_lat = K_S (U_S - ⟨u_x⟩)`, with the drive displacement
+    /// `U_S` (m) raised from threshold to threshold.
+    Spring {
+        /// `K_S` (N/m, finite, > 0; the paper uses `4e6`).
+        stiffness: f64,
+        /// Where the spring acts.
+        lateral: Lateral,
+    },
+}
+
+impl Default for Drive {
+    /// The paper's rod at `h = 6 mm`, `Δh = 2 mm`, under force control.
+    fn default() -> Self {
+        Drive::Force(ForceLoad::Lateral(Lateral::Rod {
+            height: 6e-3,
+            half_width: 2e-3,
+        }))
+    }
+}
+
+/// Where the asperity heights come from.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum HeightSource {
+    /// Truncated Gaussian heights from a seed ([`Heights::truncated_gaussian`]).
+    Random {
+        /// Mean and standard deviation before truncation (m).
+        distribution: HeightDistribution,
+        /// Seed of the generator.
+        seed: u64,
+    },
+    /// Given heights (m), one per cell in the paper's order `i = iy·Nx + ix`.
+    Values(Vec<f64>),
+}
+
+impl Default for HeightSource {
+    fn default() -> Self {
+        HeightSource::Random {
+            distribution: HeightDistribution::default(),
+            seed: 0,
+        }
+    }
+}
+
+/// How the face is cut into cells.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Cells {
+    Size(f64, f64),
+    Count(usize, usize),
+}
+
+/// Builder of a [`Scene`]; every field has the paper's default (calibration scene,
+/// seed 0).
+#[derive(Debug, Clone)]
+#[must_use]
+pub struct SceneBuilder {
+    lengths: (f64, f64, f64),
+    cells: Cells,
+    material: Material,
+    law: SpringLaw,
+    heights: HeightSource,
+    normal_load: f64,
+    drive: Drive,
+    solver: SolverOptions,
+    plan_tolerance: f64,
+}
+
+impl Default for SceneBuilder {
+    fn default() -> Self {
+        Self {
+            lengths: (0.140, 0.007, 0.075),
+            cells: Cells::Size(1e-3, 1e-3),
+            material: Material::default(),
+            law: SpringLaw::default(),
+            heights: HeightSource::default(),
+            normal_load: 3.5e3,
+            drive: Drive::default(),
+            solver: SolverOptions::default(),
+            plan_tolerance: 1e-6,
+        }
+    }
+}
+
+impl SceneBuilder {
+    /// Block lengths `Lx, Ly, Lz` (m; default 140 x 7 x 75 mm).
+    pub fn block(mut self, lx: f64, ly: f64, lz: f64) -> Self {
+        self.lengths = (lx, ly, lz);
+        self
+    }
+
+    /// Cell size `Δx, Δy` (m; default 1 mm); must divide the face.
+    pub fn cell_size(mut self, dx: f64, dy: f64) -> Self {
+        self.cells = Cells::Size(dx, dy);
+        self
+    }
+
+    /// Cell counts `Nx, Ny` instead of a cell size.
+    pub fn cells(mut self, nx: usize, ny: usize) -> Self {
+        self.cells = Cells::Count(nx, ny);
+        self
+    }
+
+    /// Material (default PMMA, `μ = 0.5`).
+    pub fn material(mut self, material: Material) -> Self {
+        self.material = material;
+        self
+    }
+
+    /// Spring constants `c_x` (N/m³), `c_z` (N/m²) (default the paper's).
+    pub fn springs(mut self, law: SpringLaw) -> Self {
+        self.law = law;
+        self
+    }
+
+    /// Heights source (default: paper Gaussian, seed 0).
+    pub fn heights(mut self, heights: HeightSource) -> Self {
+        self.heights = heights;
+        self
+    }
+
+    /// Paper Gaussian heights (mean 1 µm, sd 1 µm, truncated at 0) from `seed`.
+    pub fn seed(mut self, seed: u64) -> Self {
+        self.heights = HeightSource::Random {
+            distribution: HeightDistribution::default(),
+            seed,
+        };
+        self
+    }
+
+    /// Normal load `F_N` (N, finite and > 0; default 3.5 kN).
+    pub fn normal_load(mut self, normal_load: f64) -> Self {
+        self.normal_load = normal_load;
+        self
+    }
+
+    /// The shear drive (default: rod at 6 mm, Δh = 2 mm, force control).
+    pub fn drive(mut self, drive: Drive) -> Self {
+        self.drive = drive;
+        self
+    }
+
+    /// Options of the equilibrium solvers.
+    pub fn solver(mut self, options: SolverOptions) -> Self {
+        self.solver = options;
+        self
+    }
+
+    /// Relative accuracy of the influence operator's eigenvalues (dimensionless, default
+    /// `1e-6`, as [`InfluencePlan::builder`]; see `docs/accuracy.md`). The lateral load
+    /// table is always summed to `1e-12` relative (closed forms, cheap).
+    pub fn plan_tolerance(mut self, tolerance: f64) -> Self {
+        self.plan_tolerance = tolerance;
+        self
+    }
+
+    /// Validates everything and plans the operator (`O(N)` eigenvalues).
+    pub fn build(self) -> Result<Scene> {
+        let (lx, ly, lz) = self.lengths;
+        let block = Block::new(lx, ly, lz)?;
+        let grid = match self.cells {
+            Cells::Size(dx, dy) => Grid::from_cell_size(block, dx, dy)?,
+            Cells::Count(nx, ny) => Grid::new(block, nx, ny)?,
+        };
+        self.material.validate()?;
+        self.law.validate()?;
+        if !(self.normal_load.is_finite() && self.normal_load > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "normal_load",
+                value: self.normal_load,
+                reason: "the normal load must be finite and > 0 N",
+            });
+        }
+        let heights = match &self.heights {
+            HeightSource::Random { distribution, seed } => {
+                Heights::truncated_gaussian(&grid, *distribution, *seed)?
+            }
+            HeightSource::Values(v) => Heights::from_values(&grid, v.clone())?,
+        };
+        let lateral = match self.drive {
+            Drive::Force(ForceLoad::Top) => None,
+            Drive::Force(ForceLoad::Lateral(l)) => Some(l),
+            Drive::Force(ForceLoad::Mixed { ratio, lateral }) => {
+                if !(ratio.is_finite() && ratio >= 0.0) {
+                    return Err(Error::InvalidParameter {
+                        name: "ratio (F_top / F_lat)",
+                        value: ratio,
+                        reason: "the mixed-load ratio n must be finite and >= 0",
+                    });
+                }
+                Some(lateral)
+            }
+            Drive::Spring { stiffness, lateral } => {
+                if !(stiffness.is_finite() && stiffness > 0.0) {
+                    return Err(Error::InvalidParameter {
+                        name: "stiffness (K_S)",
+                        value: stiffness,
+                        reason: "the driving spring's stiffness must be finite and > 0 N/m",
+                    });
+                }
+                Some(lateral)
+            }
+        };
+        let plan = InfluencePlan::builder(grid)
+            .tolerance(self.plan_tolerance)
+            .build()?;
+        // Displacement per newton of the lateral load, cell-averaged (m/N): only built
+        // when a lateral load exists.
+        let lateral_response = match lateral {
+            None => None,
+            Some(l) => {
+                let rod = match l {
+                    Lateral::Rod { height, half_width } => {
+                        RodLoad::new(&block, height, half_width)?
+                    }
+                    Lateral::Side => RodLoad::uniform_side(&block),
+                };
+                let scale = lx / (ly * lz);
+                let columns = rod.influence_cells(&grid, LATERAL_TOLERANCE * scale)?;
+                let m = self.material.modulus();
+                let mut cells = Vec::with_capacity(grid.len());
+                for _ in 0..grid.ny() {
+                    cells.extend(columns.iter().map(|v| v / m));
+                }
+                Some(cells)
+            }
+        };
+        let interface = Interface::new(grid, heights, self.law)?;
+        Ok(Scene {
+            grid,
+            material: self.material,
+            interface,
+            normal_load: self.normal_load,
+            drive: self.drive,
+            solver: self.solver,
+            plan,
+            lateral_response,
+        })
+    }
+}
+
+/// A validated simulation set-up; [`Scene::driver`] runs it.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    grid: Grid,
+    material: Material,
+    interface: Interface,
+    normal_load: f64,
+    drive: Drive,
+    solver: SolverOptions,
+    plan: InfluencePlan,
+    lateral_response: Option<Vec<f64>>,
+}
+
+impl Scene {
+    /// A builder with the paper's calibration scene as defaults.
+    pub fn builder() -> SceneBuilder {
+        SceneBuilder::default()
+    }
+
+    /// The grid (and through it the block).
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The material.
+    pub fn material(&self) -> Material {
+        self.material
+    }
+
+    /// The interface in its initial state (every site attached).
+    pub fn interface(&self) -> &Interface {
+        &self.interface
+    }
+
+    /// The normal load `F_N` (N).
+    pub fn normal_load(&self) -> f64 {
+        self.normal_load
+    }
+
+    /// The drive.
+    pub fn drive(&self) -> Drive {
+        self.drive
+    }
+
+    /// The solver options.
+    pub fn solver_options(&self) -> SolverOptions {
+        self.solver
+    }
+
+    /// The planned influence operator.
+    pub fn plan(&self) -> &InfluencePlan {
+        &self.plan
+    }
+
+    /// Whether the scene built the lateral load table (only drives with a lateral part).
+    pub fn has_lateral_table(&self) -> bool {
+        self.lateral_response.is_some()
+    }
+
+    /// Displacement `e` (m/N) of each cell per newton of the driven force in the absence
+    /// of interface tractions: per newton of total shear `F` under force control, per
+    /// newton of spring force under displacement control. `None` for a top shear (a
+    /// constant, absorbed by `⟨u_x⟩`).
+    pub(crate) fn unit_load_displacement(&self) -> Vec<f64> {
+        match (&self.lateral_response, self.drive) {
+            (Some(e), Drive::Force(ForceLoad::Mixed { ratio, .. })) => {
+                e.iter().map(|v| v / (1.0 + ratio)).collect()
+            }
+            (Some(e), _) => e.clone(),
+            (None, _) => vec![0.0; self.grid.len()],
+        }
+    }
+}
