@@ -320,7 +320,8 @@ impl Driver {
             self.solver
                 .solve_tangential(&self.interface, &normal.displacement, &self.unit_load)?;
         if let Drive::Spring { stiffness, .. } = self.drive {
-            if !(1.0 + stiffness * response.offset > 0.0) {
+            let denominator = 1.0 + stiffness * response.offset;
+            if denominator.is_nan() || denominator <= 0.0 {
                 return Err(Error::InvalidParameter {
                     name: "mean shear compliance <u_x>/F (m/N)",
                     value: response.offset,
