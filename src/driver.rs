@@ -40,12 +40,16 @@
 use crate::error::{Error, Result};
 use crate::geometry::Grid;
 use crate::interface::{Interface, SiteState};
-use crate::scene::{Drive, Scene};
+use crate::scene::{Drive, Scene, SceneBuilder};
 use crate::solver::{EquilibriumSolver, NormalEquilibrium, TangentialResponse};
 use std::collections::VecDeque;
 
+mod checkpoint;
+pub use checkpoint::Checkpoint;
+
 /// A site of the interface grid.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct Site {
     /// Index `i = iy·Nx + ix` (the paper's order).
@@ -68,6 +72,7 @@ impl Site {
 
 /// The applied load at an event.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct Load {
     /// Total shear force `F = F_top + F_lat` (N): the control parameter under force
@@ -80,6 +85,7 @@ pub struct Load {
 
 /// What happened.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub enum Event {
     /// The load was raised to the next breaking threshold.
@@ -123,6 +129,7 @@ pub enum Event {
 
 /// Where the protocol stands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 enum Phase {
     /// Before the first normal equilibrium.
     Start,
@@ -140,6 +147,8 @@ enum Phase {
 /// Runs a [`Scene`] quasi-statically; an iterator of [`Event`]s.
 #[derive(Debug)]
 pub struct Driver {
+    /// What the scene was built from (checkpoints record it).
+    scene: SceneBuilder,
     grid: Grid,
     friction: f64,
     normal_load: f64,
@@ -169,6 +178,7 @@ impl Scene {
             .build()?;
         let n = self.grid().len();
         Ok(Driver {
+            scene: self.to_builder(),
             grid: *self.grid(),
             friction: self.material().friction_coefficient,
             normal_load: self.normal_load(),

@@ -181,6 +181,36 @@ pub enum Error {
         /// What faer reported.
         reason: String,
     },
+    /// A file could not be read or written.
+    #[error("{path}: {reason}")]
+    Io {
+        /// The file.
+        path: String,
+        /// What the operating system reported.
+        reason: String,
+    },
+    /// A heights file has a line that is not a finite, positive height in metres.
+    #[error("{path}, line {line}: {reason}")]
+    HeightsFile {
+        /// The file.
+        path: String,
+        /// Line number (1-based).
+        line: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// A scene file is not valid JSON or does not follow `docs/scene-format.md`.
+    #[error("scene file: {reason}")]
+    SceneFile {
+        /// What the parser reported (with line and column).
+        reason: String,
+    },
+    /// A checkpoint does not fit the scene it is resumed on, or is inconsistent.
+    #[error("checkpoint refused: {reason}")]
+    InvalidCheckpoint {
+        /// Why.
+        reason: String,
+    },
 }
 
 /// Checks that `value` is a finite, positive length.

@@ -242,6 +242,7 @@ impl Heights {
 
 /// State of one interfacial spring.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub enum SiteState {
     /// In contact: pushes with `φ_z = k_z (u0 - u_z) ≥ 0` and resists shear with `φ_x = -k_x u_x`.

@@ -27,6 +27,9 @@ use crate::green::{InfluencePlan, RodLoad};
 use crate::interface::{HeightDistribution, Heights, Interface, Material, SpringLaw};
 use crate::solver::SolverOptions;
 
+#[cfg(feature = "serde")]
+mod file;
+
 /// Relative tolerance of the lateral load table.
 const LATERAL_TOLERANCE: f64 = 1e-12;
 
@@ -110,6 +113,50 @@ pub enum HeightSource {
     Values(Vec<f64>),
 }
 
+impl HeightSource {
+    /// Heights (m) read from a text file: one value per line in the paper's cell order
+    /// `i = iy·Nx + ix`; blank lines and lines starting with `#` are skipped. Each value
+    /// must be finite and `> 0`; the count is checked against the grid at
+    /// [`SceneBuilder::build`].
+    pub fn from_file(path: impl AsRef<std::path::Path>) -> Result<HeightSource> {
+        let path = path.as_ref();
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
+            path: name.clone(),
+            reason: e.to_string(),
+        })?;
+        let mut values = Vec::new();
+        for (number, line) in text.lines().enumerate() {
+            let line = line.trim();
+            if line.is_empty() || line.starts_with('#') {
+                continue;
+            }
+            let bad = |reason: String| Error::HeightsFile {
+                path: name.clone(),
+                line: number + 1,
+                reason,
+            };
+            let value: f64 = line
+                .parse()
+                .map_err(|e| bad(format!("{line:?} is not a number ({e})")))?;
+            if !(value.is_finite() && value > 0.0) {
+                return Err(bad(format!(
+                    "{value} m is not a height: heights must be finite and > 0"
+                )));
+            }
+            values.push(value);
+        }
+        if values.is_empty() {
+            return Err(Error::HeightsFile {
+                path: name,
+                line: 0,
+                reason: "the file holds no heights".into(),
+            });
+        }
+        Ok(HeightSource::Values(values))
+    }
+}
+
 impl Default for HeightSource {
     fn default() -> Self {
         HeightSource::Random {
@@ -127,8 +174,9 @@ enum Cells {
 }
 
 /// Builder of a [`Scene`]; every field has the paper's default (calibration scene,
-/// seed 0).
-#[derive(Debug, Clone)]
+/// seed 0). With the `serde` feature it reads and writes the JSON scene format
+/// (`docs/scene-format.md`): [`SceneBuilder::from_json_file`], [`SceneBuilder::to_json`].
+#[derive(Debug, Clone, PartialEq)]
 #[must_use]
 pub struct SceneBuilder {
     lengths: (f64, f64, f64),
@@ -232,6 +280,7 @@ impl SceneBuilder {
 
     /// Validates everything and plans the operator (`O(N)` eigenvalues).
     pub fn build(self) -> Result<Scene> {
+        let builder = self.clone();
         let (lx, ly, lz) = self.lengths;
         let block = Block::new(lx, ly, lz)?;
         let grid = match self.cells {
@@ -311,6 +360,7 @@ impl SceneBuilder {
             solver: self.solver,
             plan,
             lateral_response,
+            builder,
         })
     }
 }
@@ -326,12 +376,20 @@ pub struct Scene {
     solver: SolverOptions,
     plan: InfluencePlan,
     lateral_response: Option<Vec<f64>>,
+    /// What the scene was built from (a checkpoint records it).
+    builder: SceneBuilder,
 }
 
 impl Scene {
     /// A builder with the paper's calibration scene as defaults.
     pub fn builder() -> SceneBuilder {
         SceneBuilder::default()
+    }
+
+    /// The builder this scene was built from (for instance to write it as a scene file
+    /// with the `serde` feature, or to vary one parameter).
+    pub fn to_builder(&self) -> SceneBuilder {
+        self.builder.clone()
     }
 
     /// The grid (and through it the block).

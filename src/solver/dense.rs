@@ -22,6 +22,19 @@ const STALE_ITERATIONS: usize = 6;
 /// tangential compliance `exp(u_z/u0)/c_x` follows every normal re-equilibration).
 const DIAG_DRIFT: f64 = 0.05;
 
+/// Everything a [`FactorCache`] holds, for checkpoints.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub(crate) struct FactorState {
+    order: Vec<usize>,
+    diag: Vec<f64>,
+    /// `L` (unit diagonal implied) and `D` on the diagonal, row by row.
+    lower: Vec<f64>,
+    last_iterations: usize,
+    factorisations: usize,
+    updates: usize,
+}
+
 /// An LDLᵀ factor of `C_SS + diag(d)` for the sites `order` (in factor order).
 #[derive(Debug, Clone)]
 pub(crate) struct FactorCache {
@@ -210,6 +223,67 @@ impl FactorCache {
                 ),
             });
         }
+        Ok(())
+    }
+
+    /// The factor's full state, the lower triangle packed row by row.
+    pub(crate) fn state(&self) -> FactorState {
+        let m = self.order.len();
+        let mut lower = Vec::with_capacity(m * (m + 1) / 2);
+        for a in 0..m {
+            lower.extend((0..=a).map(|b| self.ld[(a, b)]));
+        }
+        FactorState {
+            order: self.order.clone(),
+            diag: self.diag.clone(),
+            lower,
+            last_iterations: self.last_iterations,
+            factorisations: self.factorisations,
+            updates: self.updates,
+        }
+    }
+
+    /// Restores a state taken by [`FactorCache::state`] on a grid of `n_sites` sites. The
+    /// upper triangle is never read (faer's LDLᵀ kernels use the lower one only).
+    pub(crate) fn restore(&mut self, state: FactorState, n_sites: usize) -> Result<()> {
+        let m = state.order.len();
+        let bad = |reason: String| Err(Error::InvalidCheckpoint { reason });
+        if state.diag.len() != m || state.lower.len() != m * (m + 1) / 2 {
+            return bad(format!(
+                "a dense factor of {m} sites needs {m} compliances and {} entries, found {} \
+                 and {}",
+                m * (m + 1) / 2,
+                state.diag.len(),
+                state.lower.len()
+            ));
+        }
+        let mut seen = vec![false; n_sites];
+        for &i in &state.order {
+            if i >= n_sites || std::mem::replace(&mut seen[i], true) {
+                return bad(format!(
+                    "the dense factor names site {i} twice or beyond the grid's {n_sites}"
+                ));
+            }
+        }
+        if !state.lower.iter().chain(&state.diag).all(|x| x.is_finite()) {
+            return bad("the dense factor holds a non-finite entry".into());
+        }
+        let mut ld = Mat::<f64>::zeros(m, m);
+        let mut k = 0;
+        for a in 0..m {
+            for b in 0..=a {
+                ld[(a, b)] = state.lower[k];
+                k += 1;
+            }
+        }
+        *self = FactorCache {
+            order: state.order,
+            diag: state.diag,
+            ld,
+            last_iterations: state.last_iterations,
+            factorisations: state.factorisations,
+            updates: state.updates,
+        };
         Ok(())
     }
 

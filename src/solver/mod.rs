@@ -32,7 +32,7 @@ use crate::error::{check_slice, check_tolerance, Error, Result};
 use crate::geometry::Grid;
 use crate::green::InfluencePlan;
 use crate::interface::{Interface, Material, SiteState};
-use dense::DenseCore;
+use dense::{DenseCore, FactorState};
 use pcg::{projected_pcg, PcgOutcome};
 use spectral::SpectralCore;
 use std::collections::HashSet;
@@ -45,6 +45,7 @@ pub const AUTO_DENSE_LIMIT: usize = 2500;
 
 /// Which linear-algebra backend solves the equilibria.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub enum Backend {
     /// Dense up to [`AUTO_DENSE_LIMIT`] cells, spectral above.
@@ -101,6 +102,7 @@ impl SolverOptions {
 
 /// How a solve went.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct SolveReport {
     /// The backend that ran (never `Auto`).
@@ -125,6 +127,7 @@ pub struct SolveReport {
 
 /// The normal equilibrium at a given normal load.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct NormalEquilibrium {
     /// Normal traction `φ_z` per cell (Pa, `≥ 0`; 0 on detached and broken sites).
@@ -141,6 +144,7 @@ pub struct NormalEquilibrium {
 
 /// The tangential response to one newton of shear at a fixed attached set.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct TangentialResponse {
     /// Shear traction `φ_x` per cell per newton of load (Pa/N, `≤ 0` mostly: it resists).
@@ -183,6 +187,20 @@ impl TangentialResponse {
             })
             .collect())
     }
+}
+
+/// Everything a solver carries from one solve to the next (warm starts, factors, the
+/// spectral preconditioner's `d̄`): with it a restored solver repeats the original's
+/// results bit for bit.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub(crate) struct SolverState {
+    backend: Backend,
+    warm_normal: Vec<f64>,
+    warm_tangential: Vec<f64>,
+    preconditioner_mean: Option<f64>,
+    /// Dense backend: the normal and tangential factors.
+    factors: Option<(FactorState, FactorState)>,
 }
 
 enum Core {
@@ -351,6 +369,67 @@ impl EquilibriumSolver {
             d.normal.clear();
             d.tangential.clear();
         }
+    }
+
+    /// The state carried between solves.
+    pub(crate) fn state(&self) -> SolverState {
+        let (preconditioner_mean, factors) = match &self.core {
+            Core::Dense(d) => (
+                d.spectral.preconditioner_mean(),
+                Some((d.normal.state(), d.tangential.state())),
+            ),
+            Core::Spectral(s) => (s.preconditioner_mean(), None),
+        };
+        SolverState {
+            backend: self.backend,
+            warm_normal: self.warm_normal.clone(),
+            warm_tangential: self.warm_tangential.clone(),
+            preconditioner_mean,
+            factors,
+        }
+    }
+
+    /// Restores a state taken by [`EquilibriumSolver::state`] on the same geometry.
+    pub(crate) fn restore(&mut self, state: SolverState) -> Result<()> {
+        let n = self.grid.len();
+        let bad = |reason: String| Err(Error::InvalidCheckpoint { reason });
+        if state.backend != self.backend {
+            return bad(format!(
+                "the checkpoint's solver ran the {:?} backend, this scene's runs {:?}",
+                state.backend, self.backend
+            ));
+        }
+        for (name, warm) in [
+            ("normal", &state.warm_normal),
+            ("tangential", &state.warm_tangential),
+        ] {
+            if !(warm.is_empty() || warm.len() == n) || !warm.iter().all(|x| x.is_finite()) {
+                return bad(format!(
+                    "the {name} warm start has {} values (expected 0 or {n}, all finite)",
+                    warm.len()
+                ));
+            }
+        }
+        if let Some(d) = state.preconditioner_mean {
+            if !(d.is_finite() && d >= 0.0) {
+                return bad(format!(
+                    "the preconditioner's mean compliance {d} is invalid"
+                ));
+            }
+        }
+        match (&mut self.core, state.factors) {
+            (Core::Dense(core), Some((normal, tangential))) => {
+                core.normal.restore(normal, n)?;
+                core.tangential.restore(tangential, n)?;
+                core.spectral
+                    .restore_preconditioner(state.preconditioner_mean);
+            }
+            (Core::Spectral(core), None) => core.restore_preconditioner(state.preconditioner_mean),
+            _ => return bad("the dense factors do not match the backend".into()),
+        }
+        self.warm_normal = state.warm_normal;
+        self.warm_tangential = state.warm_tangential;
+        Ok(())
     }
 
     fn check_interface(&self, interface: &Interface) -> Result<()> {

@@ -70,6 +70,34 @@ impl SpectralCore {
         self.buf = buf;
     }
 
+    /// Builds the filter table of `(C_s + d̄ I)⁻¹` for `d̄ = mean_d`.
+    fn build_inverse(&mut self, mean_d: f64) {
+        let (scale, shift, n) = (self.scale, self.shift, self.buf.len() as f64);
+        let table = self.plan.spectral_table(|p, m, eigen| {
+            let e = if p == 0 && m == 0 {
+                eigen - shift * n
+            } else {
+                eigen
+            };
+            1.0 / (scale * e + mean_d)
+        });
+        self.inverse = Some((mean_d, table));
+    }
+
+    /// The `d̄` of the spectral preconditioner's table, if one was built (checkpoints).
+    pub(crate) fn preconditioner_mean(&self) -> Option<f64> {
+        self.inverse.as_ref().map(|(d, _)| *d)
+    }
+
+    /// Rebuilds the spectral preconditioner's table for `d̄` (or drops it): the table is a
+    /// function of `d̄` alone, so a restored solver preconditions bit for bit as before.
+    pub(crate) fn restore_preconditioner(&mut self, mean: Option<f64>) {
+        match mean {
+            Some(d) => self.build_inverse(d),
+            None => self.inverse = None,
+        }
+    }
+
     /// The system on `set` with compliances `diag`. Preconditioner: Jacobi (the mean
     /// diagonal of `C` plus `d`), or with `spectral_preconditioner` the full-grid inverse
     /// `(C_s + d̄ I)⁻¹` restricted to the set (`d̄` the mean compliance). `C` is diagonal in
@@ -98,16 +126,7 @@ impl SpectralCore {
             None => true,
         };
         if stale {
-            let (scale, shift, n) = (self.scale, self.shift, self.buf.len() as f64);
-            let table = self.plan.spectral_table(|p, m, eigen| {
-                let e = if p == 0 && m == 0 {
-                    eigen - shift * n
-                } else {
-                    eigen
-                };
-                1.0 / (scale * e + mean_d)
-            });
-            self.inverse = Some((mean_d, table));
+            self.build_inverse(mean_d);
         }
         SpectralSystem {
             core: self,

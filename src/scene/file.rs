@@ -1,0 +1,346 @@
+//! The JSON scene format (feature `serde`; specification: `docs/scene-format.md`).
+//!
+//! The file's layout is a private mirror of [`SceneBuilder`], so the Rust API and the
+//! file format can evolve separately. Every key is optional (the paper's calibration
+//! scene fills the gaps) and unknown keys are refused: a misspelt key must not silently
+//! fall back to a default.
+
+use super::{Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder};
+use crate::error::{Error, Result};
+use crate::interface::{HeightDistribution, Material, SpringLaw};
+use crate::solver::{Backend, SolverOptions};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct SceneFile {
+    block: BlockSpec,
+    cells: CellsSpec,
+    material: MaterialSpec,
+    springs: SpringsSpec,
+    heights: HeightsSpec,
+    normal_load: f64,
+    drive: DriveSpec,
+    solver: SolverSpec,
+    plan_tolerance: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BlockSpec {
+    lx: f64,
+    ly: f64,
+    lz: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+enum CellsSpec {
+    Size { dx: f64, dy: f64 },
+    Count { nx: usize, ny: usize },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct MaterialSpec {
+    young_modulus: f64,
+    poisson_ratio: f64,
+    friction_coefficient: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct SpringsSpec {
+    c_x: f64,
+    c_z: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+enum HeightsSpec {
+    Gaussian {
+        #[serde(default = "default_mean")]
+        mean: f64,
+        #[serde(default = "default_std_dev")]
+        std_dev: f64,
+        #[serde(default)]
+        seed: u64,
+    },
+    Values {
+        values: Vec<f64>,
+    },
+    File {
+        path: PathBuf,
+    },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+enum LateralSpec {
+    Rod { height: f64, half_width: f64 },
+    Side,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+enum DriveSpec {
+    Top,
+    Rod {
+        height: f64,
+        half_width: f64,
+    },
+    Side,
+    Mixed {
+        ratio: f64,
+        lateral: LateralSpec,
+    },
+    Spring {
+        stiffness: f64,
+        lateral: LateralSpec,
+    },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum BackendSpec {
+    Auto,
+    Dense,
+    Spectral,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct SolverSpec {
+    backend: BackendSpec,
+    tolerance: f64,
+    max_active_set_iterations: usize,
+    max_linear_iterations: usize,
+}
+
+fn default_mean() -> f64 {
+    HeightDistribution::default().mean
+}
+
+fn default_std_dev() -> f64 {
+    HeightDistribution::default().std_dev
+}
+
+impl Default for SceneFile {
+    fn default() -> Self {
+        Self::from(&SceneBuilder::default())
+    }
+}
+
+macro_rules! default_from_builder {
+    ($spec:ty, $field:ident) => {
+        impl Default for $spec {
+            fn default() -> Self {
+                SceneFile::from(&SceneBuilder::default()).$field
+            }
+        }
+    };
+}
+default_from_builder!(MaterialSpec, material);
+default_from_builder!(SpringsSpec, springs);
+default_from_builder!(SolverSpec, solver);
+
+impl From<Lateral> for LateralSpec {
+    fn from(l: Lateral) -> Self {
+        match l {
+            Lateral::Rod { height, half_width } => LateralSpec::Rod { height, half_width },
+            Lateral::Side => LateralSpec::Side,
+        }
+    }
+}
+
+impl From<LateralSpec> for Lateral {
+    fn from(l: LateralSpec) -> Self {
+        match l {
+            LateralSpec::Rod { height, half_width } => Lateral::Rod { height, half_width },
+            LateralSpec::Side => Lateral::Side,
+        }
+    }
+}
+
+impl From<&SceneBuilder> for SceneFile {
+    fn from(b: &SceneBuilder) -> Self {
+        let (lx, ly, lz) = b.lengths;
+        let drive = match b.drive {
+            Drive::Force(ForceLoad::Top) => DriveSpec::Top,
+            Drive::Force(ForceLoad::Lateral(Lateral::Rod { height, half_width })) => {
+                DriveSpec::Rod { height, half_width }
+            }
+            Drive::Force(ForceLoad::Lateral(Lateral::Side)) => DriveSpec::Side,
+            Drive::Force(ForceLoad::Mixed { ratio, lateral }) => DriveSpec::Mixed {
+                ratio,
+                lateral: lateral.into(),
+            },
+            Drive::Spring { stiffness, lateral } => DriveSpec::Spring {
+                stiffness,
+                lateral: lateral.into(),
+            },
+        };
+        let heights = match &b.heights {
+            HeightSource::Random { distribution, seed } => HeightsSpec::Gaussian {
+                mean: distribution.mean,
+                std_dev: distribution.std_dev,
+                seed: *seed,
+            },
+            HeightSource::Values(values) => HeightsSpec::Values {
+                values: values.clone(),
+            },
+        };
+        let backend = match b.solver.backend {
+            Backend::Dense => BackendSpec::Dense,
+            Backend::Spectral => BackendSpec::Spectral,
+            _ => BackendSpec::Auto,
+        };
+        SceneFile {
+            block: BlockSpec { lx, ly, lz },
+            cells: match b.cells {
+                Cells::Size(dx, dy) => CellsSpec::Size { dx, dy },
+                Cells::Count(nx, ny) => CellsSpec::Count { nx, ny },
+            },
+            material: MaterialSpec {
+                young_modulus: b.material.young_modulus,
+                poisson_ratio: b.material.poisson_ratio,
+                friction_coefficient: b.material.friction_coefficient,
+            },
+            springs: SpringsSpec {
+                c_x: b.law.c_x,
+                c_z: b.law.c_z,
+            },
+            heights,
+            normal_load: b.normal_load,
+            drive,
+            solver: SolverSpec {
+                backend,
+                tolerance: b.solver.tolerance,
+                max_active_set_iterations: b.solver.max_active_set_iterations,
+                max_linear_iterations: b.solver.max_linear_iterations,
+            },
+            plan_tolerance: b.plan_tolerance,
+        }
+    }
+}
+
+impl SceneFile {
+    /// The builder; a heights file is read relative to `base`.
+    fn into_builder(self, base: &Path) -> Result<SceneBuilder> {
+        let mut material = Material::default();
+        material.young_modulus = self.material.young_modulus;
+        material.poisson_ratio = self.material.poisson_ratio;
+        material.friction_coefficient = self.material.friction_coefficient;
+        let law = SpringLaw {
+            c_x: self.springs.c_x,
+            c_z: self.springs.c_z,
+        };
+        let heights = match self.heights {
+            HeightsSpec::Gaussian {
+                mean,
+                std_dev,
+                seed,
+            } => HeightSource::Random {
+                distribution: HeightDistribution::new(mean, std_dev),
+                seed,
+            },
+            HeightsSpec::Values { values } => HeightSource::Values(values),
+            HeightsSpec::File { path } => HeightSource::from_file(base.join(path))?,
+        };
+        let drive = match self.drive {
+            DriveSpec::Top => Drive::Force(ForceLoad::Top),
+            DriveSpec::Rod { height, half_width } => {
+                Drive::Force(ForceLoad::Lateral(Lateral::Rod { height, half_width }))
+            }
+            DriveSpec::Side => Drive::Force(ForceLoad::Lateral(Lateral::Side)),
+            DriveSpec::Mixed { ratio, lateral } => Drive::Force(ForceLoad::Mixed {
+                ratio,
+                lateral: lateral.into(),
+            }),
+            DriveSpec::Spring { stiffness, lateral } => Drive::Spring {
+                stiffness,
+                lateral: lateral.into(),
+            },
+        };
+        let mut solver = SolverOptions::default().with_backend(match self.solver.backend {
+            BackendSpec::Auto => Backend::Auto,
+            BackendSpec::Dense => Backend::Dense,
+            BackendSpec::Spectral => Backend::Spectral,
+        });
+        solver.tolerance = self.solver.tolerance;
+        solver.max_active_set_iterations = self.solver.max_active_set_iterations;
+        solver.max_linear_iterations = self.solver.max_linear_iterations;
+        Ok(SceneBuilder {
+            lengths: (self.block.lx, self.block.ly, self.block.lz),
+            cells: match self.cells {
+                CellsSpec::Size { dx, dy } => Cells::Size(dx, dy),
+                CellsSpec::Count { nx, ny } => Cells::Count(nx, ny),
+            },
+            material,
+            law,
+            heights,
+            normal_load: self.normal_load,
+            drive,
+            solver,
+            plan_tolerance: self.plan_tolerance,
+        })
+    }
+}
+
+fn json_error(e: serde_json::Error) -> Error {
+    Error::SceneFile {
+        reason: e.to_string(),
+    }
+}
+
+impl SceneBuilder {
+    /// Reads a scene from JSON text (`docs/scene-format.md`; feature `serde`). A heights
+    /// file named in it is read relative to the current directory. Nothing is validated
+    /// beyond the format until [`SceneBuilder::build`].
+    pub fn from_json_str(text: &str) -> Result<SceneBuilder> {
+        let file: SceneFile = serde_json::from_str(text).map_err(json_error)?;
+        file.into_builder(Path::new("."))
+    }
+
+    /// Reads a scene file (`docs/scene-format.md`; feature `serde`). A heights file named
+    /// in it is read relative to the scene file's directory.
+    pub fn from_json_file(path: impl AsRef<Path>) -> Result<SceneBuilder> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
+            path: path.display().to_string(),
+            reason: e.to_string(),
+        })?;
+        let file: SceneFile = serde_json::from_str(&text).map_err(|e| Error::SceneFile {
+            reason: format!("{}: {e}", path.display()),
+        })?;
+        file.into_builder(path.parent().unwrap_or(Path::new(".")))
+    }
+
+    /// The scene as JSON (`docs/scene-format.md`; feature `serde`), every key written.
+    /// Heights read from a file are written as values. Reading it back gives an equal
+    /// builder: floats round-trip exactly.
+    pub fn to_json(&self) -> Result<String> {
+        serde_json::to_string_pretty(&SceneFile::from(self)).map_err(json_error)
+    }
+}
+
+impl Serialize for SceneBuilder {
+    fn serialize<S: serde::Serializer>(
+        &self,
+        serializer: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        SceneFile::from(self).serialize(serializer)
+    }
+}
+
+impl<'de> Deserialize<'de> for SceneBuilder {
+    /// Heights files are read relative to the current directory.
+    fn deserialize<D: serde::Deserializer<'de>>(
+        deserializer: D,
+    ) -> std::result::Result<Self, D::Error> {
+        SceneFile::deserialize(deserializer)?
+            .into_builder(Path::new("."))
+            .map_err(serde::de::Error::custom)
+    }
+}

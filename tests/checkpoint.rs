@@ -1,0 +1,187 @@
+//! Checkpoint and resume: a resumed run returns exactly (bit for bit) the events and the
+//! states of the uninterrupted run, on both backends, wherever the checkpoint falls
+//! (at a stable state, inside an avalanche, with events still queued). The reference is
+//! the uninterrupted run itself.
+
+use precursors::*;
+
+/// Every remaining event of `driver`, and its normal tractions at the end.
+fn finish(mut driver: Driver) -> (Vec<Event>, Vec<f64>) {
+    let events = driver.by_ref().collect::<Result<Vec<_>>>().unwrap();
+    (events, driver.normal_traction().unwrap().to_vec())
+}
+
+/// Checkpoints taken after events `at` of an uninterrupted run, each resumed and run to
+/// the end, must return the uninterrupted run's events.
+fn check_resume(scene: &Scene, at: &[usize], through: impl Fn(Checkpoint) -> Checkpoint) {
+    let mut driver = scene.driver().unwrap();
+    let mut checkpoints = Vec::new();
+    let mut events = Vec::new();
+    while let Some(event) = driver.step().unwrap() {
+        events.push(event);
+        if at.contains(&events.len()) {
+            checkpoints.push((events.len(), driver.checkpoint()));
+        }
+    }
+    let end = driver.normal_traction().unwrap().to_vec();
+    assert!(matches!(events.last(), Some(Event::GlobalSlip { .. })));
+    assert_eq!(
+        checkpoints.len(),
+        at.len(),
+        "the run has {} events",
+        events.len()
+    );
+    for (k, checkpoint) in checkpoints {
+        assert_eq!(checkpoint.event_count(), k);
+        let resumed = scene.resume(&through(checkpoint)).unwrap();
+        assert_eq!(resumed.event_count(), k);
+        let (rest, traction) = finish(resumed);
+        assert_eq!(rest.len(), events.len() - k, "checkpoint after event {k}");
+        assert!(
+            rest == events[k..],
+            "checkpoint after event {k}: events differ"
+        );
+        assert!(
+            traction == end,
+            "checkpoint after event {k}: final tractions differ"
+        );
+    }
+}
+
+/// The index (1-based count) of a rupture whose re-equilibration queued attachments:
+/// a checkpoint there holds pending events.
+fn rupture_with_queue(scene: &Scene) -> usize {
+    let events = scene.driver().unwrap().collect::<Result<Vec<_>>>().unwrap();
+    events
+        .windows(2)
+        .position(|w| {
+            matches!(w[0], Event::Rupture { .. })
+                && matches!(w[1], Event::Attach { .. } | Event::Detach { .. })
+        })
+        .map(|i| i + 1)
+        .expect("a rupture followed by a state change")
+}
+
+#[test]
+fn resumed_runs_repeat_the_uninterrupted_one_dense() {
+    // The calibration scene (dense backend, factor updates and refactorisations).
+    let scene = Scene::builder().seed(1).build().unwrap();
+    let queued = rupture_with_queue(&scene);
+    check_resume(&scene, &[1, 2, queued, 1200], |c| c);
+}
+
+#[test]
+fn resumed_runs_repeat_the_uninterrupted_one_spectral() {
+    let scene = Scene::builder()
+        .block(0.060, 0.010, 0.030)
+        .normal_load(1.5e3)
+        .solver(SolverOptions::default().with_backend(Backend::Spectral))
+        .seed(4)
+        .build()
+        .unwrap();
+    let queued = rupture_with_queue(&scene);
+    check_resume(&scene, &[1, queued, 300], |c| c);
+}
+
+#[test]
+fn resume_under_displacement_control() {
+    let scene = Scene::builder()
+        .block(0.040, 0.004, 0.020)
+        .normal_load(400.0)
+        .drive(Drive::Spring {
+            stiffness: 4e6,
+            lateral: Lateral::Side,
+        })
+        .seed(7)
+        .build()
+        .unwrap();
+    check_resume(&scene, &[3, 50], |c| c);
+}
+
+#[test]
+fn a_checkpoint_is_refused_on_another_scene() {
+    let scene = Scene::builder()
+        .block(0.020, 0.004, 0.020)
+        .normal_load(200.0)
+        .seed(1)
+        .build()
+        .unwrap();
+    let mut driver = scene.driver().unwrap();
+    driver.step().unwrap();
+    let checkpoint = driver.checkpoint();
+    let other = scene.to_builder().seed(2).build().unwrap();
+    assert!(matches!(
+        other.resume(&checkpoint),
+        Err(Error::InvalidCheckpoint { .. })
+    ));
+    let other = scene.to_builder().normal_load(201.0).build().unwrap();
+    assert!(matches!(
+        other.resume(&checkpoint),
+        Err(Error::InvalidCheckpoint { .. })
+    ));
+    // The checkpoint names its scene: building that resumes.
+    let rebuilt = checkpoint.scene().clone().build().unwrap();
+    assert!(rebuilt.resume(&checkpoint).is_ok());
+}
+
+#[cfg(feature = "serde")]
+mod json {
+    use super::*;
+
+    fn round_trip(c: Checkpoint) -> Checkpoint {
+        let text = c.to_json().unwrap();
+        let back = Checkpoint::from_json_str(&text).unwrap();
+        assert!(back == c, "the checkpoint changed through JSON");
+        back
+    }
+
+    #[test]
+    fn resume_through_json_is_exact() {
+        let scene = Scene::builder().seed(1).build().unwrap();
+        let queued = rupture_with_queue(&scene);
+        check_resume(&scene, &[queued, 1800], round_trip);
+        let spectral = Scene::builder()
+            .block(0.040, 0.010, 0.030)
+            .normal_load(1.0e3)
+            .solver(SolverOptions::default().with_backend(Backend::Spectral))
+            .seed(5)
+            .build()
+            .unwrap();
+        check_resume(&spectral, &[100], round_trip);
+    }
+
+    #[test]
+    fn damaged_checkpoints_are_refused_with_typed_errors() {
+        let scene = Scene::builder()
+            .block(0.020, 0.004, 0.020)
+            .normal_load(200.0)
+            .seed(1)
+            .build()
+            .unwrap();
+        let mut driver = scene.driver().unwrap();
+        for _ in 0..5 {
+            driver.step().unwrap();
+        }
+        let text = driver.checkpoint().to_json().unwrap();
+        assert!(matches!(
+            Checkpoint::from_json_str(&text[..text.len() / 2]),
+            Err(Error::InvalidCheckpoint { .. })
+        ));
+        let newer = text.replacen("\"format\":1", "\"format\":2", 1);
+        assert_ne!(newer, text);
+        let c = Checkpoint::from_json_str(&newer).unwrap();
+        assert!(matches!(
+            scene.resume(&c),
+            Err(Error::InvalidCheckpoint { .. })
+        ));
+        // A warm start of the wrong length.
+        let key = "\"warm_normal\":[";
+        let at = text.find(key).unwrap() + key.len();
+        let short = format!("{}0.0,{}", &text[..at], &text[at..]);
+        let c = Checkpoint::from_json_str(&short).unwrap();
+        assert!(matches!(
+            scene.resume(&c),
+            Err(Error::InvalidCheckpoint { .. })
+        ));
+    }
+}
