@@ -405,6 +405,11 @@ impl Driver {
         matches!(self.drive, Drive::Spring { .. }).then(|| self.force())
     }
 
+    /// The backend solving the equilibria (`Dense` or `Spectral`, never `Auto`).
+    pub fn backend(&self) -> crate::solver::Backend {
+        self.solver.backend()
+    }
+
     /// The normal load `F_N` (N).
     pub fn normal_load(&self) -> f64 {
         self.normal_load

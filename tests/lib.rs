@@ -10,5 +10,7 @@ mod interface;
 mod laws;
 mod loads;
 mod operator;
+#[cfg(feature = "serde")]
+mod scene_file;
 mod solver;
 mod stability;

@@ -1,0 +1,231 @@
+//! The JSON scene format (feature `serde`, docs/scene-format.md): every builder option
+//! round-trips, hand-written files give the builder the Rust API gives, defaults are the
+//! calibration scene's, mistakes are typed errors, and the documented examples and the
+//! files in `examples/scenes/` stay valid.
+
+use precursors::*;
+use std::path::{Path, PathBuf};
+
+/// A fresh directory under the system's temporary one.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("precursors-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A builder with every option away from its default.
+fn everything() -> SceneBuilder {
+    let mut material = Material::default();
+    material.young_modulus = 2.5e9;
+    material.poisson_ratio = 0.3;
+    material.friction_coefficient = 0.7;
+    let mut law = SpringLaw::default();
+    law.c_x = 1.1e12;
+    law.c_z = 2.2e8;
+    let mut solver = SolverOptions::default()
+        .with_backend(Backend::Spectral)
+        .with_tolerance(1e-11);
+    solver.max_active_set_iterations = 77;
+    solver.max_linear_iterations = 999;
+    Scene::builder()
+        .block(0.030, 0.006, 0.020)
+        .cells(15, 3)
+        .material(material)
+        .springs(law)
+        .heights(HeightSource::Values(
+            (0..45).map(|i| 1e-7 * (1.0 + i as f64) / 3.0).collect(),
+        ))
+        .normal_load(123.456)
+        .drive(Drive::Spring {
+            stiffness: 3.3e6,
+            lateral: Lateral::Rod {
+                height: 4e-3,
+                half_width: 1.5e-3,
+            },
+        })
+        .solver(solver)
+        .plan_tolerance(1e-7)
+}
+
+#[test]
+fn every_option_round_trips_exactly() {
+    let drives = [
+        Drive::Force(ForceLoad::Top),
+        Drive::Force(ForceLoad::Lateral(Lateral::Side)),
+        Drive::Force(ForceLoad::Lateral(Lateral::Rod {
+            height: 0.1 + 0.2, // not representable exactly: the round trip must still be
+            half_width: 1e-3,
+        })),
+        Drive::Force(ForceLoad::Mixed {
+            ratio: 1.0 / 3.0,
+            lateral: Lateral::Side,
+        }),
+    ];
+    let builders = std::iter::once(everything())
+        .chain(drives.into_iter().map(|d| everything().drive(d)))
+        .chain([
+            everything().cell_size(2e-3, 2e-3),
+            everything().heights(HeightSource::Random {
+                distribution: HeightDistribution::new(2e-6, 0.5e-6),
+                seed: u64::MAX,
+            }),
+            Scene::builder(),
+        ]);
+    for b in builders {
+        let text = b.to_json().unwrap();
+        let back = SceneBuilder::from_json_str(&text).unwrap();
+        assert_eq!(back, b, "{text}");
+    }
+}
+
+#[test]
+fn a_hand_written_file_gives_the_rust_builder() {
+    let text = r#"{
+        "block": {"lx": 0.030, "ly": 0.006, "lz": 0.020},
+        "cells": {"kind": "count", "nx": 15, "ny": 3},
+        "material": {"young_modulus": 2.5e9, "poisson_ratio": 0.3, "friction_coefficient": 0.7},
+        "springs": {"c_x": 1.1e12, "c_z": 2.2e8},
+        "heights": {"kind": "values", "values": [VALUES]},
+        "normal_load": 123.456,
+        "drive": {"kind": "spring", "stiffness": 3.3e6,
+                  "lateral": {"kind": "rod", "height": 0.004, "half_width": 0.0015}},
+        "solver": {"backend": "spectral", "tolerance": 1e-11,
+                   "max_active_set_iterations": 77, "max_linear_iterations": 999},
+        "plan_tolerance": 1e-7
+    }"#;
+    let values: Vec<String> = (0..45)
+        .map(|i| format!("{:e}", 1e-7 * (1.0 + i as f64) / 3.0))
+        .collect();
+    let text = text.replace("VALUES", &values.join(", "));
+    assert_eq!(SceneBuilder::from_json_str(&text).unwrap(), everything());
+}
+
+#[test]
+fn missing_keys_take_the_calibration_defaults() {
+    assert_eq!(SceneBuilder::from_json_str("{}").unwrap(), Scene::builder());
+    let partial = SceneBuilder::from_json_str(
+        r#"{"material": {"friction_coefficient": 0.6}, "heights": {"kind": "gaussian", "seed": 9}}"#,
+    )
+    .unwrap();
+    let mut material = Material::default();
+    material.friction_coefficient = 0.6;
+    assert_eq!(partial, Scene::builder().material(material).seed(9));
+}
+
+#[test]
+fn mistakes_are_typed_errors() {
+    let cases = [
+        r#"{"normal_lod": 10}"#,                              // misspelt key
+        r#"{"material": {"mu": 0.5}}"#,                       // unknown nested key
+        r#"{"block": {"lx": 0.1, "ly": 0.01}}"#,              // incomplete block
+        r#"{"drive": {"kind": "rod", "height": 0.006}}"#,     // incomplete drive
+        r#"{"drive": {"kind": "sled"}}"#,                     // unknown kind
+        r#"{"cells": {"kind": "count", "nx": -3, "ny": 2}}"#, // negative count
+        r#"{"solver": {"backend": "gpu"}}"#,                  // unknown backend
+        r#"{"normal_load": "3.5 kN"}"#,                       // wrong type
+        r#"{"block": {"lx": 0.1, "ly": 0.01, "lz": 0.05}"#,   // truncated
+    ];
+    for text in cases {
+        match SceneBuilder::from_json_str(text) {
+            Err(Error::SceneFile { reason }) => assert!(reason.contains("line"), "{reason}"),
+            other => panic!("{text}: {other:?}"),
+        }
+    }
+    // Valid JSON, invalid physics: refused when built, with the builder's errors.
+    let b = SceneBuilder::from_json_str(r#"{"normal_load": -1.0}"#).unwrap();
+    assert!(matches!(b.build(), Err(Error::InvalidParameter { .. })));
+}
+
+#[test]
+fn heights_file_is_read_relative_to_the_scene_file() {
+    let dir = scratch("heights");
+    std::fs::create_dir_all(dir.join("maps")).unwrap();
+    let values: Vec<f64> = (0..20).map(|i| 1e-6 * (0.5 + 0.1 * i as f64)).collect();
+    let mut text = String::from("# a measured map\n\n");
+    for v in &values {
+        text.push_str(&format!("  {v:e}\n"));
+    }
+    std::fs::write(dir.join("maps/h.txt"), text).unwrap();
+    let scene_path = dir.join("scene.json");
+    std::fs::write(
+        &scene_path,
+        r#"{"block": {"lx": 0.010, "ly": 0.002, "lz": 0.010},
+            "cells": {"kind": "count", "nx": 10, "ny": 2},
+            "heights": {"kind": "file", "path": "maps/h.txt"}, "normal_load": 20.0}"#,
+    )
+    .unwrap();
+    let scene = SceneBuilder::from_json_file(&scene_path)
+        .unwrap()
+        .build()
+        .unwrap();
+    assert_eq!(scene.interface().heights(), &values[..]);
+    // Written back, the heights are values: the file is no longer needed.
+    let again = SceneBuilder::from_json_str(&scene.to_builder().to_json().unwrap()).unwrap();
+    assert_eq!(again, scene.to_builder());
+}
+
+#[test]
+fn bad_heights_files_name_the_line() {
+    let dir = scratch("bad-heights");
+    let cases = [
+        ("1e-6\n2e-6\nabc\n", 3),
+        ("1e-6\n\n# c\n-2e-6\n", 4),
+        ("1e-6\ninf\n", 2),
+        ("# only a comment\n", 0),
+    ];
+    for (k, (text, line)) in cases.iter().enumerate() {
+        let path = dir.join(format!("h{k}.txt"));
+        std::fs::write(&path, text).unwrap();
+        match HeightSource::from_file(&path) {
+            Err(Error::HeightsFile { line: l, .. }) => assert_eq!(l, *line, "{text:?}"),
+            other => panic!("{text:?}: {other:?}"),
+        }
+    }
+    assert!(matches!(
+        HeightSource::from_file(dir.join("missing.txt")),
+        Err(Error::Io { .. })
+    ));
+    // Too few values for the grid: refused at build with the sizes.
+    let path = dir.join("short.txt");
+    std::fs::write(&path, "1e-6\n2e-6\n").unwrap();
+    let b = Scene::builder()
+        .cells(10, 2)
+        .block(0.01, 0.002, 0.01)
+        .heights(HeightSource::from_file(&path).unwrap());
+    assert!(matches!(b.build(), Err(Error::LengthMismatch { .. })));
+}
+
+/// The JSON blocks of docs/scene-format.md and the files of examples/scenes/ parse and
+/// build (heights files resolved against examples/scenes/).
+#[test]
+fn documented_scenes_are_valid() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let doc = std::fs::read_to_string(root.join("docs/scene-format.md")).unwrap();
+    let mut blocks = 0;
+    for chunk in doc.split("```json").skip(1) {
+        let text = chunk.split("```").next().unwrap();
+        let dir = scratch("doc");
+        std::fs::copy(
+            root.join("examples/scenes/heights_10x2.txt"),
+            dir.join("heights_10x2.txt"),
+        )
+        .unwrap();
+        std::fs::write(dir.join("scene.json"), text).unwrap();
+        let b = SceneBuilder::from_json_file(dir.join("scene.json"))
+            .unwrap_or_else(|e| panic!("{e}\n{text}"));
+        b.build().unwrap_or_else(|e| panic!("{e}\n{text}"));
+        blocks += 1;
+    }
+    assert_eq!(blocks, 3);
+    let mut files = 0;
+    for entry in std::fs::read_dir(root.join("examples/scenes")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "json") {
+            let b = SceneBuilder::from_json_file(&path).unwrap_or_else(|e| panic!("{e}"));
+            b.build()
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            files += 1;
+        }
+    }
+    assert!(files >= 3);
+}
