@@ -40,6 +40,7 @@
 use crate::error::{Error, Result};
 use crate::geometry::Grid;
 use crate::interface::{Interface, SiteState};
+use crate::probe::{ProbeInput, StressProbe, Stresses};
 use crate::scene::{Drive, Scene, SceneBuilder};
 use crate::solver::{EquilibriumSolver, NormalEquilibrium, TangentialResponse};
 use std::collections::VecDeque;
@@ -154,6 +155,9 @@ pub struct Driver {
     normal_load: f64,
     drive: Drive,
     unit_load: Vec<f64>,
+    /// `(F_top, F_lat)` per newton of `F`.
+    split: (f64, f64),
+    probe: Option<StressProbe>,
     interface: Interface,
     solver: EquilibriumSolver,
     normal: Option<NormalEquilibrium>,
@@ -184,6 +188,8 @@ impl Scene {
             normal_load: self.normal_load(),
             drive: self.drive(),
             unit_load: self.unit_load_displacement(),
+            split: self.load_split(),
+            probe: self.stress_probe().cloned(),
             interface: self.interface().clone(),
             solver,
             normal: None,
@@ -471,6 +477,26 @@ impl Driver {
     /// Breaking load `λ_i` (N) of each site in the current state (`+∞` off contact).
     pub fn breaking_loads(&self) -> &[f64] {
         &self.breaking
+    }
+
+    /// Shear, normal and Coulomb stresses (Pa) at the scene's probes
+    /// ([`crate::SceneBuilder::probes`]) in the current state, with every load term. Call
+    /// it at the states you want: after the [`Event::LoadRaised`] that precedes the first
+    /// [`Event::Rupture`] for "just before the first rupture", at each [`Event::Stable`]
+    /// for the quasi-static evolution. Errors: [`Error::InvalidParameter`] when the scene
+    /// has no probes.
+    pub fn stresses(&self) -> Result<Stresses> {
+        let probe = self.probe.as_ref().ok_or(Error::InvalidParameter {
+            name: "probes",
+            value: 0.0,
+            reason: "the scene was built without stress probes (SceneBuilder::probes)",
+        })?;
+        let shear = self.shear_traction()?;
+        let force = self.force();
+        let input = ProbeInput::new(&shear, self.normal_traction()?)
+            .loads(force * self.split.0, force * self.split.1, self.normal_load)
+            .friction(self.friction);
+        probe.evaluate(&input)
     }
 
     /// Real contact area per cell (m²).

@@ -40,6 +40,7 @@ pub mod error;
 pub mod geometry;
 pub mod green;
 pub mod interface;
+pub mod probe;
 pub mod scene;
 pub mod solver;
 

@@ -25,6 +25,7 @@ use crate::error::{Error, Result};
 use crate::geometry::{Block, Grid};
 use crate::green::{InfluencePlan, RodLoad};
 use crate::interface::{HeightDistribution, Heights, Interface, Material, SpringLaw};
+use crate::probe::{ProbeSpec, StressProbe};
 use crate::solver::SolverOptions;
 
 #[cfg(feature = "serde")]
@@ -188,6 +189,7 @@ pub struct SceneBuilder {
     drive: Drive,
     solver: SolverOptions,
     plan_tolerance: f64,
+    probes: ProbeSpec,
 }
 
 impl Default for SceneBuilder {
@@ -202,6 +204,7 @@ impl Default for SceneBuilder {
             drive: Drive::default(),
             solver: SolverOptions::default(),
             plan_tolerance: 1e-6,
+            probes: ProbeSpec::default(),
         }
     }
 }
@@ -278,6 +281,13 @@ impl SceneBuilder {
         self
     }
 
+    /// Stress probes (planes and points, default none): planned at build, read with
+    /// [`crate::Driver::stresses`]. Without probes no probe operator is built.
+    pub fn probes(mut self, probes: ProbeSpec) -> Self {
+        self.probes = probes;
+        self
+    }
+
     /// Validates everything and plans the operator (`O(N)` eigenvalues).
     pub fn build(self) -> Result<Scene> {
         let builder = self.clone();
@@ -331,15 +341,16 @@ impl SceneBuilder {
             .build()?;
         // Displacement per newton of the lateral load, cell-averaged (m/N): only built
         // when a lateral load exists.
-        let lateral_response = match lateral {
+        let rod = match lateral {
             None => None,
-            Some(l) => {
-                let rod = match l {
-                    Lateral::Rod { height, half_width } => {
-                        RodLoad::new(&block, height, half_width)?
-                    }
-                    Lateral::Side => RodLoad::uniform_side(&block),
-                };
+            Some(Lateral::Rod { height, half_width }) => {
+                Some(RodLoad::new(&block, height, half_width)?)
+            }
+            Some(Lateral::Side) => Some(RodLoad::uniform_side(&block)),
+        };
+        let lateral_response = match &rod {
+            None => None,
+            Some(rod) => {
                 let scale = lx / (ly * lz);
                 let columns = rod.influence_cells(&grid, LATERAL_TOLERANCE * scale)?;
                 let m = self.material.modulus();
@@ -351,7 +362,13 @@ impl SceneBuilder {
             }
         };
         let interface = Interface::new(grid, heights, self.law)?;
+        let probe = if self.probes.is_empty() {
+            None
+        } else {
+            Some(StressProbe::new(&plan, &self.probes, rod.as_ref())?)
+        };
         Ok(Scene {
+            probe,
             grid,
             material: self.material,
             interface,
@@ -376,6 +393,7 @@ pub struct Scene {
     solver: SolverOptions,
     plan: InfluencePlan,
     lateral_response: Option<Vec<f64>>,
+    probe: Option<StressProbe>,
     /// What the scene was built from (a checkpoint records it).
     builder: SceneBuilder,
 }
@@ -425,6 +443,22 @@ impl Scene {
     /// The planned influence operator.
     pub fn plan(&self) -> &InfluencePlan {
         &self.plan
+    }
+
+    /// The planned stress probes (`None` when the builder requested none).
+    pub fn stress_probe(&self) -> Option<&StressProbe> {
+        self.probe.as_ref()
+    }
+
+    /// `(F_top, F_lat)` (N) per newton of the driven force `F`.
+    pub(crate) fn load_split(&self) -> (f64, f64) {
+        match self.drive {
+            Drive::Force(ForceLoad::Top) => (1.0, 0.0),
+            Drive::Force(ForceLoad::Mixed { ratio, .. }) => {
+                (ratio / (1.0 + ratio), 1.0 / (1.0 + ratio))
+            }
+            _ => (0.0, 1.0),
+        }
     }
 
     /// Whether the scene built the lateral load table (only drives with a lateral part).

@@ -10,6 +10,7 @@ mod interface;
 mod laws;
 mod loads;
 mod operator;
+mod probe;
 #[cfg(feature = "serde")]
 mod scene_file;
 mod solver;

@@ -45,6 +45,13 @@ fn everything() -> SceneBuilder {
         })
         .solver(solver)
         .plan_tolerance(1e-7)
+        .probes(
+            probe::ProbeSpec::default()
+                .plane(2e-3)
+                .plane(0.0)
+                .point(Point::new(0.01, 0.003, 0.001))
+                .tolerance(1e-9),
+        )
 }
 
 #[test]
@@ -91,7 +98,8 @@ fn a_hand_written_file_gives_the_rust_builder() {
                   "lateral": {"kind": "rod", "height": 0.004, "half_width": 0.0015}},
         "solver": {"backend": "spectral", "tolerance": 1e-11,
                    "max_active_set_iterations": 77, "max_linear_iterations": 999},
-        "plan_tolerance": 1e-7
+        "plan_tolerance": 1e-7,
+        "probes": {"planes": [0.002, 0], "points": [[0.01, 0.003, 0.001]], "tolerance": 1e-9}
     }"#;
     let values: Vec<String> = (0..45)
         .map(|i| format!("{:e}", 1e-7 * (1.0 + i as f64) / 3.0))

@@ -7,7 +7,9 @@
 
 use super::{Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder};
 use crate::error::{Error, Result};
+use crate::geometry::Point;
 use crate::interface::{HeightDistribution, Material, SpringLaw};
+use crate::probe::ProbeSpec;
 use crate::solver::{Backend, SolverOptions};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -24,6 +26,15 @@ struct SceneFile {
     drive: DriveSpec,
     solver: SolverSpec,
     plan_tolerance: f64,
+    probes: ProbesSpec,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct ProbesSpec {
+    planes: Vec<f64>,
+    points: Vec<[f64; 3]>,
+    tolerance: f64,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -144,6 +155,7 @@ macro_rules! default_from_builder {
 default_from_builder!(MaterialSpec, material);
 default_from_builder!(SpringsSpec, springs);
 default_from_builder!(SolverSpec, solver);
+default_from_builder!(ProbesSpec, probes);
 
 impl From<Lateral> for LateralSpec {
     fn from(l: Lateral) -> Self {
@@ -221,6 +233,11 @@ impl From<&SceneBuilder> for SceneFile {
                 max_linear_iterations: b.solver.max_linear_iterations,
             },
             plan_tolerance: b.plan_tolerance,
+            probes: ProbesSpec {
+                planes: b.probes.planes.clone(),
+                points: b.probes.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
+                tolerance: b.probes.tolerance,
+            },
         }
     }
 }
@@ -284,6 +301,17 @@ impl SceneFile {
             drive,
             solver,
             plan_tolerance: self.plan_tolerance,
+            probes: {
+                let mut probes = ProbeSpec::default().tolerance(self.probes.tolerance);
+                probes.planes = self.probes.planes;
+                probes.points = self
+                    .probes
+                    .points
+                    .iter()
+                    .map(|[x, y, z]| Point::new(*x, *y, *z))
+                    .collect();
+                probes
+            },
         })
     }
 }

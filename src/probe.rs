@@ -1,0 +1,556 @@
+//! Stresses inside the block: the shear stress `τ = σ_xz`, the normal stress `σ = σ_zz`
+//! and the Coulomb stress `τ_C = |τ| - μ|σ|` (paper Suppl. "Calculation of Coulomb
+//! stress"), on planes `z = const` (every cell, through the DCT) and at points `(x, y, z)`
+//! (a mode series), with the top, lateral and normal load terms.
+//!
+//! With cell-constant bottom tractions `φ` (Pa) and the loads, MODEL.md section 1 gives
+//!
+//! ```text
+//! τ(x,y,z) = -T_z[φ_x] + F_top z/(Lz Lx Ly) + F_lat s_lat(x, z)
+//! σ(x,y,z) = -T_z[φ_z] - F_N z/(Lz Lx Ly)
+//! ```
+//!
+//! where `T_z` multiplies each cosine mode of the bottom traction by
+//! `sinh κ(Lz-z)/sinh κLz` (the mean by `(Lz-z)/Lz`) and `s_lat` is the rod's stress per
+//! newton ([`RodLoad::stress_influence_at`]). At `z = 0` the stresses are `τ = -φ_x`,
+//! `σ = -φ_z` (the interface tractions, with the sign of a stress on the face of outward
+//! normal `-z`); at `z = Lz` they are the top tractions.
+//!
+//! On a plane the result is cell-averaged (the Galerkin convention of MODEL.md section 2,
+//! [`PlaneTransfer`]); at a point it is the exact value for cell-constant tractions:
+//! a cell-constant field has the cosine coefficients `(2w_p/N) S_p D(p')` with the
+//! aliases `p = 2Nq ± p'` of the DCT-II coefficient `D(p')` (sign `(-1)^q`), so a point
+//! probe is a fixed kernel `K` over the cells, built once: `T_z[φ](P) = Σ_j K_j φ_j`.
+//!
+//! ```
+//! use precursors::{Point, Scene};
+//! use precursors::probe::ProbeSpec;
+//! let scene = Scene::builder()
+//!     .block(0.020, 0.004, 0.010)
+//!     .normal_load(80.0)
+//!     .probes(ProbeSpec::default().plane(2e-3).point(Point::new(0.005, 0.002, 2e-3)))
+//!     .build()?;
+//! let mut driver = scene.driver()?;
+//! driver.step()?; // the normal equilibrium at zero shear
+//! let stresses = driver.stresses()?;
+//! let plane = &stresses.planes[0];
+//! // Force balance through the plane: ∫ σ_zz dA = -F_N.
+//! let total: f64 = plane.normal.iter().sum::<f64>() * scene.grid().cell_area();
+//! assert!((total + 80.0).abs() < 1e-9 * 80.0);
+//! # Ok::<(), precursors::Error>(())
+//! ```
+
+use crate::error::{check_slice, check_tolerance, Error, Result};
+use crate::geometry::{Grid, Point};
+use crate::green::loads::top_stress_influence;
+use crate::green::{InfluencePlan, PlaneTransfer, RodLoad};
+use rustdct::DctPlanner;
+use std::f64::consts::PI;
+
+/// Largest alias shell of a point kernel (the sum converges like `e^{-2π q z/Δ}`).
+const MAX_SHELLS: usize = 64;
+
+/// Where stresses are wanted: planes `z = const` and points. Requested on a scene
+/// ([`crate::SceneBuilder::probes`]); nothing is built without them.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct ProbeSpec {
+    /// Heights `z ∈ [0, Lz]` (m) of the planes.
+    pub planes: Vec<f64>,
+    /// Points inside the block (m).
+    pub points: Vec<Point>,
+    /// Absolute accuracy of the transfer factors (dimensionless, `≤ 1`; default `1e-10`):
+    /// the stresses are accurate to this times the largest traction. The lateral load's
+    /// series is summed to this relative to the load's scale.
+    pub tolerance: f64,
+}
+
+impl Default for ProbeSpec {
+    fn default() -> Self {
+        Self {
+            planes: Vec::new(),
+            points: Vec::new(),
+            tolerance: 1e-10,
+        }
+    }
+}
+
+impl ProbeSpec {
+    /// With a plane at height `z` (m).
+    #[must_use]
+    pub fn plane(mut self, z: f64) -> Self {
+        self.planes.push(z);
+        self
+    }
+
+    /// With a point probe (m).
+    #[must_use]
+    pub fn point(mut self, point: Point) -> Self {
+        self.points.push(point);
+        self
+    }
+
+    /// With the given accuracy (dimensionless).
+    #[must_use]
+    pub fn tolerance(mut self, tolerance: f64) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+
+    /// Whether nothing is requested.
+    pub fn is_empty(&self) -> bool {
+        self.planes.is_empty() && self.points.is_empty()
+    }
+}
+
+/// The loads and interface tractions a stress evaluation needs.
+#[derive(Debug, Clone, Copy)]
+#[non_exhaustive]
+pub struct ProbeInput<'a> {
+    /// Bottom shear traction `φ_x` per cell (Pa).
+    pub shear_traction: &'a [f64],
+    /// Bottom normal traction `φ_z` per cell (Pa).
+    pub normal_traction: &'a [f64],
+    /// Top shear force `F_top` (N, along +x).
+    pub top_force: f64,
+    /// Lateral shear force `F_lat` (N, along +x) on the trailing face.
+    pub lateral_force: f64,
+    /// Normal load `F_N` (N, pressing down).
+    pub normal_load: f64,
+    /// Friction coefficient `μ` of the Coulomb stress (dimensionless).
+    pub friction_coefficient: f64,
+}
+
+impl<'a> ProbeInput<'a> {
+    /// Tractions only (no external load): `F_top = F_lat = F_N = 0`, `μ = 0.5`.
+    pub fn new(shear_traction: &'a [f64], normal_traction: &'a [f64]) -> Self {
+        Self {
+            shear_traction,
+            normal_traction,
+            top_force: 0.0,
+            lateral_force: 0.0,
+            normal_load: 0.0,
+            friction_coefficient: 0.5,
+        }
+    }
+
+    /// With the external loads (N).
+    #[must_use]
+    pub fn loads(mut self, top_force: f64, lateral_force: f64, normal_load: f64) -> Self {
+        self.top_force = top_force;
+        self.lateral_force = lateral_force;
+        self.normal_load = normal_load;
+        self
+    }
+
+    /// With the friction coefficient (dimensionless).
+    #[must_use]
+    pub fn friction(mut self, friction_coefficient: f64) -> Self {
+        self.friction_coefficient = friction_coefficient;
+        self
+    }
+}
+
+/// Stresses on one plane, per cell in the paper's order (Pa).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct PlaneStress {
+    /// Height of the plane (m).
+    pub z: f64,
+    /// Cells along x (to read the rows).
+    pub nx: usize,
+    /// Shear stress `τ = σ_xz` (Pa), cell averages.
+    pub shear: Vec<f64>,
+    /// Normal stress `σ = σ_zz` (Pa, negative in compression), cell averages.
+    pub normal: Vec<f64>,
+    /// Coulomb stress `τ_C = |τ| - μ|σ|` (Pa) of the cell averages.
+    pub coulomb: Vec<f64>,
+}
+
+/// Profiles along x, averaged over y (one value per column, Pa).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct Profile {
+    /// `τ(x, z) = (1/Ly) ∫ τ dy` (Pa).
+    pub shear: Vec<f64>,
+    /// `σ(x, z) = (1/Ly) ∫ σ dy` (Pa).
+    pub normal: Vec<f64>,
+    /// `|τ(x,z)| - μ|σ(x,z)|` of the averages (Pa): the paper's `τ_C(x, z_P)`.
+    pub coulomb_of_means: Vec<f64>,
+    /// `(1/Ly) ∫ (|τ| - μ|σ|) dy` (Pa): the paper's interface `τ_C(x)`.
+    pub mean_coulomb: Vec<f64>,
+}
+
+impl PlaneStress {
+    /// The y-averaged profiles along x (Pa), with the friction coefficient `μ` used for
+    /// the Coulomb stress of the averages.
+    pub fn profile(&self, friction_coefficient: f64) -> Profile {
+        let nx = self.nx;
+        let ny = self.shear.len() / nx.max(1);
+        let mean = |v: &[f64]| -> Vec<f64> {
+            let mut out = vec![0.0; nx];
+            for row in v.chunks_exact(nx) {
+                out.iter_mut()
+                    .zip(row)
+                    .for_each(|(o, x)| *o += x / ny as f64);
+            }
+            out
+        };
+        let shear = mean(&self.shear);
+        let normal = mean(&self.normal);
+        let coulomb_of_means = shear
+            .iter()
+            .zip(&normal)
+            .map(|(t, s)| t.abs() - friction_coefficient * s.abs())
+            .collect();
+        Profile {
+            mean_coulomb: mean(&self.coulomb),
+            shear,
+            normal,
+            coulomb_of_means,
+        }
+    }
+}
+
+/// Stresses at one point (Pa).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct PointStress {
+    /// Where (m).
+    pub point: Point,
+    /// Shear stress `τ = σ_xz` (Pa).
+    pub shear: f64,
+    /// Normal stress `σ = σ_zz` (Pa).
+    pub normal: f64,
+    /// Coulomb stress `|τ| - μ|σ|` (Pa).
+    pub coulomb: f64,
+}
+
+/// Everything the probes measured in one state.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct Stresses {
+    /// One per requested plane, in request order.
+    pub planes: Vec<PlaneStress>,
+    /// One per requested point, in request order.
+    pub points: Vec<PointStress>,
+}
+
+#[derive(Debug, Clone)]
+struct PlaneProbe {
+    transfer: PlaneTransfer,
+    /// Lateral stress per newton, per column (m⁻²).
+    lateral: Option<Vec<f64>>,
+    /// Top load's stress per newton (m⁻²).
+    top: f64,
+}
+
+#[derive(Debug, Clone)]
+struct PointProbe {
+    point: Point,
+    /// `T_z[φ](P) = Σ_j kernel_j φ_j` (dimensionless).
+    kernel: Vec<f64>,
+    lateral: Option<f64>,
+    top: f64,
+}
+
+/// Stress probes planned once for a geometry (and a lateral load, if any); evaluated on
+/// any state by [`StressProbe::evaluate`].
+#[derive(Debug, Clone)]
+pub struct StressProbe {
+    grid: Grid,
+    planes: Vec<PlaneProbe>,
+    points: Vec<PointProbe>,
+}
+
+impl StressProbe {
+    /// Plans the probes of `spec` on `plan`'s grid; `lateral` is the trailing-face load
+    /// (if the scene has one), whose stress term is tabulated now.
+    pub fn new(plan: &InfluencePlan, spec: &ProbeSpec, lateral: Option<&RodLoad>) -> Result<Self> {
+        let grid = *plan.grid();
+        let block = *grid.block();
+        let tol = check_tolerance(spec.tolerance)?;
+        // The lateral series' natural scale is 1/(Ly Lz) per newton.
+        let lateral_tol = tol / (block.ly() * block.lz());
+        let planes = spec
+            .planes
+            .iter()
+            .map(|&z| {
+                Ok(PlaneProbe {
+                    transfer: plan.plane_transfer(z, tol)?,
+                    lateral: lateral
+                        .map(|r| r.stress_influence_cells(&grid, z, lateral_tol))
+                        .transpose()?,
+                    top: top_stress_influence(&block, z)?,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let mut planner = DctPlanner::new();
+        let points = spec
+            .points
+            .iter()
+            .map(|&point| {
+                let kernel = point_kernel(&grid, point, tol, &mut planner)?;
+                Ok(PointProbe {
+                    point,
+                    kernel,
+                    lateral: lateral
+                        .map(|r| r.stress_influence_at(point.x, point.z, lateral_tol))
+                        .transpose()?
+                        .map(|e| e.value),
+                    top: top_stress_influence(&block, point.z)?,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Self {
+            grid,
+            planes,
+            points,
+        })
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The stresses of a state. A lateral force needs a probe planned with a lateral
+    /// load ([`Error::InvalidParameter`] otherwise).
+    pub fn evaluate(&self, input: &ProbeInput<'_>) -> Result<Stresses> {
+        let n = self.grid.len();
+        check_slice("shear_traction", input.shear_traction, n)?;
+        check_slice("normal_traction", input.normal_traction, n)?;
+        for (name, value) in [
+            ("top_force", input.top_force),
+            ("lateral_force", input.lateral_force),
+            ("normal_load", input.normal_load),
+        ] {
+            if !value.is_finite() {
+                return Err(Error::NonFinite {
+                    name,
+                    index: 0,
+                    value,
+                });
+            }
+        }
+        let mu = input.friction_coefficient;
+        if !(mu.is_finite() && mu >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "friction_coefficient",
+                value: mu,
+                reason: "the friction coefficient must be finite and >= 0",
+            });
+        }
+        let lateral_missing = input.lateral_force != 0.0
+            && (self.planes.iter().any(|p| p.lateral.is_none())
+                || self.points.iter().any(|p| p.lateral.is_none()));
+        if lateral_missing {
+            return Err(Error::InvalidParameter {
+                name: "lateral_force",
+                value: input.lateral_force,
+                reason: "the probes were planned without a lateral load",
+            });
+        }
+        let nx = self.grid.nx();
+        let coulomb = |t: f64, s: f64| t.abs() - mu * s.abs();
+        let mut planes = Vec::with_capacity(self.planes.len());
+        for p in &self.planes {
+            let mut shear = vec![0.0; n];
+            let mut normal = vec![0.0; n];
+            if p.transfer.z() == 0.0 {
+                // The interface itself: the tractions, exactly (no transform rounding).
+                shear
+                    .iter_mut()
+                    .zip(input.shear_traction)
+                    .for_each(|(s, f)| *s = -f);
+                normal
+                    .iter_mut()
+                    .zip(input.normal_traction)
+                    .for_each(|(s, f)| *s = -f);
+            } else {
+                p.transfer.stress(input.shear_traction, &mut shear)?;
+                p.transfer.stress(input.normal_traction, &mut normal)?;
+            }
+            for (i, (t, s)) in shear.iter_mut().zip(normal.iter_mut()).enumerate() {
+                *t += input.top_force * p.top;
+                if let Some(l) = &p.lateral {
+                    *t += input.lateral_force * l[i % nx];
+                }
+                *s -= input.normal_load * p.top;
+            }
+            let coulomb = shear
+                .iter()
+                .zip(&normal)
+                .map(|(t, s)| coulomb(*t, *s))
+                .collect();
+            planes.push(PlaneStress {
+                z: p.transfer.z(),
+                nx,
+                shear,
+                normal,
+                coulomb,
+            });
+        }
+        let dot = |k: &[f64], v: &[f64]| k.iter().zip(v).map(|(a, b)| a * b).sum::<f64>();
+        let points = self
+            .points
+            .iter()
+            .map(|p| {
+                let shear = -dot(&p.kernel, input.shear_traction)
+                    + input.top_force * p.top
+                    + p.lateral.map_or(0.0, |l| input.lateral_force * l);
+                let normal = -dot(&p.kernel, input.normal_traction) - input.normal_load * p.top;
+                PointStress {
+                    point: p.point,
+                    shear,
+                    normal,
+                    coulomb: coulomb(shear, normal),
+                }
+            })
+            .collect();
+        Ok(Stresses { planes, points })
+    }
+}
+
+/// `sinh κ(Lz - z)/sinh κLz` with decaying exponentials; `(Lz - z)/Lz` at κ = 0.
+fn transfer(kappa: f64, z: f64, lz: f64) -> f64 {
+    if kappa == 0.0 {
+        return (lz - z) / lz;
+    }
+    ((-kappa * z).exp() - (-kappa * (2.0 * lz - z)).exp()) / (-(-2.0 * kappa * lz).exp_m1())
+}
+
+/// The aliases `(sign (-1)^q · 2w_p S_p/N · cos(k_p x), k_p)` of the 1-D DCT mode `mode`
+/// with `|q| = shell`.
+fn shell_terms(mode: usize, n: usize, length: f64, x: f64, shell: usize) -> Vec<(f64, f64)> {
+    let cell = length / n as f64;
+    let term = |p: f64, q: usize| {
+        let k = p * PI / length;
+        let w = if p == 0.0 { 0.5 } else { 1.0 };
+        let half = 0.5 * k * cell;
+        let s = if half == 0.0 { 1.0 } else { half.sin() / half };
+        let sign = if q % 2 == 0 { 1.0 } else { -1.0 };
+        (sign * 2.0 * w * s / n as f64 * (k * x).cos(), k)
+    };
+    let base = 2 * n * shell;
+    if shell == 0 {
+        vec![term(mode as f64, 0)]
+    } else if mode == 0 {
+        vec![term(base as f64, shell)]
+    } else {
+        vec![
+            term((base - mode) as f64, shell),
+            term((base + mode) as f64, shell),
+        ]
+    }
+}
+
+/// The kernel `K` with `T_z[φ](P) = Σ_j K_j φ_j` for cell-constant `φ`:
+/// `K_ij = Σ_{p',m'} W(p',m') cos(k_p' x_i) cos(k_m' y_j)` (a 2-D DCT-III of the alias
+/// sums `W`). At `z = 0` it is the indicator of the cell holding `P` (averaged over the
+/// cells sharing an edge or corner with it, the limit of the series there).
+fn point_kernel(
+    grid: &Grid,
+    point: Point,
+    tol: f64,
+    planner: &mut DctPlanner<f64>,
+) -> Result<Vec<f64>> {
+    let block = grid.block();
+    let (lx, ly, lz) = (block.lx(), block.ly(), block.lz());
+    for (name, value, max) in [("x", point.x, lx), ("y", point.y, ly)] {
+        if !(value.is_finite() && (0.0..=max).contains(&value)) {
+            return Err(Error::OutsideBlock { name, value, max });
+        }
+    }
+    let z = block.check_height(point.z)?;
+    let (nx, ny) = (grid.nx(), grid.ny());
+    if z == 0.0 {
+        return Ok(cell_indicator(grid, point));
+    }
+    let mut w = vec![0.0; nx * ny];
+    for m in 0..ny {
+        for p in 0..nx {
+            let mut sum = 0.0;
+            let mut shell = 0;
+            loop {
+                // Terms with max(|q_x|, |q_y|) = shell.
+                let mut shell_sum = 0.0;
+                let mut shell_bound = 0.0;
+                for qx in 0..=shell {
+                    for qy in 0..=shell {
+                        if qx.max(qy) != shell {
+                            continue;
+                        }
+                        for (ax, kx) in shell_terms(p, nx, lx, point.x, qx) {
+                            for (ay, ky) in shell_terms(m, ny, ly, point.y, qy) {
+                                let t = ax * ay * transfer((kx * kx + ky * ky).sqrt(), z, lz);
+                                shell_sum += t;
+                                shell_bound += t.abs();
+                            }
+                        }
+                    }
+                }
+                sum += shell_sum;
+                // The shells decay like e^{-2π z/Δ} each: the next is below this bound.
+                let ratio = (-2.0 * PI * z / grid.dx().max(grid.dy())).exp();
+                if shell > 0 && shell_bound * ratio / (1.0 - ratio) <= tol {
+                    break;
+                }
+                if shell >= MAX_SHELLS {
+                    return Err(Error::NotConverged {
+                        what: "alias sum of a point stress probe (z too close to 0?)",
+                        value: sum,
+                        error: shell_bound,
+                        tolerance: tol,
+                        terms: (shell * shell) as u64,
+                    });
+                }
+                shell += 1;
+            }
+            w[m * nx + p] = sum;
+        }
+    }
+    // K = DCT-III over x then y; rustdct's DCT-III halves the first entry: double it.
+    let dct_x = planner.plan_dct3(nx);
+    let dct_y = planner.plan_dct3(ny);
+    for row in w.chunks_exact_mut(nx) {
+        row[0] *= 2.0;
+        dct_x.process_dct3(row);
+    }
+    let mut column = vec![0.0; ny];
+    for ix in 0..nx {
+        for (iy, c) in column.iter_mut().enumerate() {
+            *c = w[iy * nx + ix];
+        }
+        column[0] *= 2.0;
+        dct_y.process_dct3(&mut column);
+        for (iy, c) in column.iter().enumerate() {
+            w[iy * nx + ix] = *c;
+        }
+    }
+    Ok(w)
+}
+
+/// The cells holding `P` on the bottom face, weighted equally (1 inside a cell, ½ each on
+/// an edge, ¼ each at a corner).
+fn cell_indicator(grid: &Grid, point: Point) -> Vec<f64> {
+    let near = |v: f64, d: f64, n: usize| -> Vec<usize> {
+        let s = v / d;
+        let r = s.round();
+        if (s - r).abs() < 1e-12 && r > 0.0 && (r as usize) < n {
+            vec![r as usize - 1, r as usize]
+        } else {
+            vec![(s.floor() as usize).min(n - 1)]
+        }
+    };
+    let xs = near(point.x, grid.dx(), grid.nx());
+    let ys = near(point.y, grid.dy(), grid.ny());
+    let mut k = vec![0.0; grid.len()];
+    let share = 1.0 / (xs.len() * ys.len()) as f64;
+    for &iy in &ys {
+        for &ix in &xs {
+            k[grid.index(ix, iy)] = share;
+        }
+    }
+    k
+}
