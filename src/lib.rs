@@ -35,6 +35,7 @@
 #![deny(missing_docs)]
 #![forbid(unsafe_code)]
 
+pub mod calibration;
 pub mod driver;
 pub mod error;
 pub mod geometry;

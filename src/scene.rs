@@ -288,6 +288,16 @@ impl SceneBuilder {
         self
     }
 
+    /// The spring constants set so far.
+    pub fn spring_law(&self) -> SpringLaw {
+        self.law
+    }
+
+    /// The heights source set so far.
+    pub fn height_source(&self) -> &HeightSource {
+        &self.heights
+    }
+
     /// Validates everything and plans the operator (`O(N)` eigenvalues).
     pub fn build(self) -> Result<Scene> {
         let builder = self.clone();

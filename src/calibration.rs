@@ -1,0 +1,345 @@
+//! Fitting the model's two adjustable constants to measurements (paper Suppl. "Model
+//! calibration"):
+//!
+//! * [`fit_normal_stiffness`]: `c_z` (N/m²) such that the real contact area at zero shear,
+//!   averaged over height realizations, equals a target `A_R = α F_N` (a bracketing root
+//!   search in `ln c_z`: the area falls monotonically as the springs stiffen);
+//! * [`fit_tangential_stiffness`]: `c_x` (N/m³) minimising the squared misfit between the
+//!   precursor curve `ℓ(F)` averaged over realizations and target points (a scan of a
+//!   logarithmic grid refined by golden sections: `ℓ` is a multiple of `Δx`, so the
+//!   misfit is piecewise constant and a derivative-based method would stall).
+//!
+//! ```
+//! use precursors::calibration::{fit_normal_stiffness, normal_contact_area, FitOptions};
+//! use precursors::{Scene, SpringLaw};
+//! let base = Scene::builder().block(0.020, 0.004, 0.010).normal_load(100.0);
+//! let options = FitOptions::default().seeds(&[1, 2]);
+//! // A target made with c_z = 3e8 N/m² is recovered.
+//! let mut law = SpringLaw::default();
+//! law.c_z = 3e8;
+//! let target = normal_contact_area(&base.clone().springs(law), &options)?;
+//! let fit = fit_normal_stiffness(&base, target, (1e7, 1e10), &options)?;
+//! assert!((fit.value / 3e8 - 1.0).abs() < 1e-6);
+//! # Ok::<(), precursors::Error>(())
+//! ```
+
+use crate::driver::Event;
+use crate::error::{Error, Result};
+use crate::interface::HeightDistribution;
+use crate::scene::{HeightSource, SceneBuilder};
+
+/// Options of the fits.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct FitOptions {
+    /// Seeds of the height realizations averaged over (paper Gaussian heights with the
+    /// builder's distribution); empty: the builder's own heights only (default).
+    pub seeds: Vec<u64>,
+    /// Relative accuracy of the fitted constant (dimensionless, default `1e-8`).
+    pub tolerance: f64,
+    /// Largest number of model evaluations (default `200`).
+    pub max_evaluations: usize,
+    /// Points of the logarithmic scan of [`fit_tangential_stiffness`] (default `17`).
+    pub scan_points: usize,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        Self {
+            seeds: Vec::new(),
+            tolerance: 1e-8,
+            max_evaluations: 200,
+            scan_points: 17,
+        }
+    }
+}
+
+impl FitOptions {
+    /// With these realizations.
+    #[must_use]
+    pub fn seeds(mut self, seeds: &[u64]) -> Self {
+        self.seeds = seeds.to_vec();
+        self
+    }
+
+    /// With this relative accuracy of the constant.
+    #[must_use]
+    pub fn tolerance(mut self, tolerance: f64) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+}
+
+/// A fitted constant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct Fit {
+    /// The constant (N/m² for `c_z`, N/m³ for `c_x`).
+    pub value: f64,
+    /// The misfit there: area minus target (m²) for `c_z`; mean squared length misfit
+    /// (m²) for `c_x`.
+    pub misfit: f64,
+    /// Model evaluations spent (each over every realization).
+    pub evaluations: usize,
+}
+
+/// The builders of the realizations.
+fn realizations(builder: &SceneBuilder, options: &FitOptions) -> Vec<SceneBuilder> {
+    if options.seeds.is_empty() {
+        return vec![builder.clone()];
+    }
+    let distribution = match builder.height_source() {
+        HeightSource::Random { distribution, .. } => *distribution,
+        _ => HeightDistribution::default(),
+    };
+    options
+        .seeds
+        .iter()
+        .map(|&seed| {
+            builder
+                .clone()
+                .heights(HeightSource::Random { distribution, seed })
+        })
+        .collect()
+}
+
+fn check_options(options: &FitOptions) -> Result<()> {
+    if !(options.tolerance.is_finite() && options.tolerance > 0.0) {
+        return Err(Error::InvalidTolerance {
+            value: options.tolerance,
+        });
+    }
+    Ok(())
+}
+
+fn check_bracket(name: &'static str, bracket: (f64, f64)) -> Result<()> {
+    let (lo, hi) = bracket;
+    if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo) {
+        return Err(Error::InvalidParameter {
+            name,
+            value: lo,
+            reason: "the bracket must be finite with 0 < low < high",
+        });
+    }
+    Ok(())
+}
+
+/// The real contact area at zero shear (m²), averaged over the realizations of
+/// `options`.
+pub fn normal_contact_area(builder: &SceneBuilder, options: &FitOptions) -> Result<f64> {
+    let scenes = realizations(builder, options);
+    let mut total = 0.0;
+    for b in &scenes {
+        let scene = b.clone().build()?;
+        let mut driver = scene.driver()?;
+        driver.step()?;
+        total += driver.total_contact_area()?;
+    }
+    Ok(total / scenes.len() as f64)
+}
+
+/// `c_z` (N/m²) in `bracket` such that the mean real contact area at zero shear is
+/// `target_area` (m², the paper's `α F_N`). Errors: [`Error::InvalidParameter`] when the
+/// bracket does not enclose the target (with the areas at its ends in the message's
+/// value), [`Error::NotConverged`] past `max_evaluations`.
+pub fn fit_normal_stiffness(
+    builder: &SceneBuilder,
+    target_area: f64,
+    bracket: (f64, f64),
+    options: &FitOptions,
+) -> Result<Fit> {
+    check_options(options)?;
+    check_bracket("c_z bracket (N/m²)", bracket)?;
+    if !(target_area.is_finite() && target_area > 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "target_area (m²)",
+            value: target_area,
+            reason: "the target real contact area must be finite and > 0",
+        });
+    }
+    let mut evaluations = 0;
+    let misfit = |ln_cz: f64, evaluations: &mut usize| -> Result<f64> {
+        *evaluations += 1;
+        let mut law = builder.spring_law();
+        law.c_z = ln_cz.exp();
+        Ok(normal_contact_area(&builder.clone().springs(law), options)? - target_area)
+    };
+    let (mut a, mut b) = (bracket.0.ln(), bracket.1.ln());
+    let mut fa = misfit(a, &mut evaluations)?;
+    let mut fb = misfit(b, &mut evaluations)?;
+    for (x, f) in [(a, fa), (b, fb)] {
+        if f == 0.0 {
+            return Ok(Fit {
+                value: x.exp(),
+                misfit: 0.0,
+                evaluations,
+            });
+        }
+    }
+    if fa.signum() == fb.signum() {
+        return Err(Error::InvalidParameter {
+            name: "c_z bracket: area misfit at its low end (m²)",
+            value: fa,
+            reason: "the target area is not between the areas at the bracket's ends",
+        });
+    }
+    // Illinois regula falsi in ln c_z: superlinear on this smooth monotone misfit, never
+    // leaves the bracket, and shrinks it from both sides.
+    let mut side = 0i8;
+    loop {
+        let c = (a * fb - b * fa) / (fb - fa);
+        let fc = misfit(c, &mut evaluations)?;
+        if fc.signum() == fb.signum() {
+            b = c;
+            fb = fc;
+            if side == -1 {
+                fa /= 2.0;
+            }
+            side = -1;
+        } else {
+            a = c;
+            fa = fc;
+            if side == 1 {
+                fb /= 2.0;
+            }
+            side = 1;
+        }
+        if fc == 0.0 || (b - a).abs() <= options.tolerance {
+            return Ok(Fit {
+                value: c.exp(),
+                misfit: fc,
+                evaluations,
+            });
+        }
+        if evaluations >= options.max_evaluations {
+            return Err(Error::NotConverged {
+                what: "c_z fit (regula falsi in ln c_z)",
+                value: c.exp(),
+                error: (b - a).abs(),
+                tolerance: options.tolerance,
+                terms: evaluations as u64,
+            });
+        }
+    }
+}
+
+/// The precursor curve of one scene: `(F, ℓ)` (N, m) at every stable state up to global
+/// slip.
+pub fn precursor_curve(builder: &SceneBuilder) -> Result<Vec<(f64, f64)>> {
+    let scene = builder.clone().build()?;
+    let mut driver = scene.driver()?;
+    let mut curve = Vec::new();
+    while let Some(event) = driver.step()? {
+        if let Event::Stable { load, .. } = event {
+            curve.push((load.force, driver.precursor_length()?));
+        }
+    }
+    Ok(curve)
+}
+
+/// `ℓ` (m) at force `force` (N) on a curve from [`precursor_curve`]: the value of the last
+/// stable state at or below the force (the state holds until the next threshold).
+pub fn length_at(curve: &[(f64, f64)], force: f64) -> f64 {
+    curve
+        .iter()
+        .take_while(|(f, _)| *f <= force)
+        .last()
+        .map_or(0.0, |(_, l)| *l)
+}
+
+/// Mean squared misfit (m²) of the realization-averaged precursor curve against the
+/// target points `(F, ℓ)` (N, m).
+pub fn precursor_misfit(
+    builder: &SceneBuilder,
+    targets: &[(f64, f64)],
+    options: &FitOptions,
+) -> Result<f64> {
+    let scenes = realizations(builder, options);
+    let curves = scenes
+        .iter()
+        .map(precursor_curve)
+        .collect::<Result<Vec<_>>>()?;
+    let mut sum = 0.0;
+    for &(force, ell) in targets {
+        let model = curves.iter().map(|c| length_at(c, force)).sum::<f64>() / curves.len() as f64;
+        sum += (model - ell).powi(2);
+    }
+    Ok(sum / targets.len() as f64)
+}
+
+/// `c_x` (N/m³) in `bracket` minimising [`precursor_misfit`] against `targets` (points
+/// `(F, ℓ)` in N and m, read off a measured precursor curve). A logarithmic scan of
+/// `scan_points` values, then golden sections around the best one down to the relative
+/// `tolerance` (or `max_evaluations`). Among equally good values (the misfit is piecewise
+/// constant) the one found first is kept.
+pub fn fit_tangential_stiffness(
+    builder: &SceneBuilder,
+    targets: &[(f64, f64)],
+    bracket: (f64, f64),
+    options: &FitOptions,
+) -> Result<Fit> {
+    check_options(options)?;
+    check_bracket("c_x bracket (N/m³)", bracket)?;
+    if targets.is_empty() {
+        return Err(Error::EmptyContact {
+            available: 0,
+            reason: "no target point to fit the precursor curve to",
+        });
+    }
+    for (i, &(f, l)) in targets.iter().enumerate() {
+        if !(f.is_finite() && l.is_finite() && f >= 0.0 && l >= 0.0) {
+            return Err(Error::NonFinite {
+                name: "targets (F in N, ℓ in m: finite and >= 0)",
+                index: i,
+                value: if f.is_finite() { l } else { f },
+            });
+        }
+    }
+    let mut evaluations = 0;
+    let misfit = |ln_cx: f64, evaluations: &mut usize| -> Result<f64> {
+        *evaluations += 1;
+        let mut law = builder.spring_law();
+        law.c_x = ln_cx.exp();
+        precursor_misfit(&builder.clone().springs(law), targets, options)
+    };
+    let (lo, hi) = (bracket.0.ln(), bracket.1.ln());
+    let k = options.scan_points.max(3);
+    let grid: Vec<f64> = (0..k)
+        .map(|i| lo + (hi - lo) * i as f64 / (k - 1) as f64)
+        .collect();
+    let mut values = Vec::with_capacity(k);
+    for &x in &grid {
+        values.push(misfit(x, &mut evaluations)?);
+    }
+    let best = (0..k)
+        .min_by(|&i, &j| values[i].total_cmp(&values[j]))
+        .unwrap_or(0);
+    let (mut best_x, mut best_f) = (grid[best], values[best]);
+    let (mut a, mut b) = (grid[best.saturating_sub(1)], grid[(best + 1).min(k - 1)]);
+    let ratio = 0.5 * (5f64.sqrt() - 1.0);
+    while b - a > options.tolerance && best_f > 0.0 {
+        if evaluations >= options.max_evaluations {
+            break;
+        }
+        // Probe both golden points of [a, b]; keep the sub-interval around the better.
+        let c = b - ratio * (b - a);
+        let d = a + ratio * (b - a);
+        let (fc, fd) = (misfit(c, &mut evaluations)?, misfit(d, &mut evaluations)?);
+        for (x, f) in [(c, fc), (d, fd)] {
+            if f < best_f {
+                best_x = x;
+                best_f = f;
+            }
+        }
+        if fc <= fd {
+            b = d;
+        } else {
+            a = c;
+        }
+    }
+    Ok(Fit {
+        value: best_x.exp(),
+        misfit: best_f,
+        evaluations,
+    })
+}

@@ -1,0 +1,94 @@
+//! Calibration: the fits recover constants from data the crate generated with known
+//! constants (the reference is the generating value), and refuse bad input.
+
+use precursors::calibration::*;
+use precursors::*;
+
+fn base() -> SceneBuilder {
+    Scene::builder()
+        .block(0.040, 0.004, 0.020)
+        .cells(40, 4)
+        .normal_load(400.0)
+        .drive(Drive::Force(ForceLoad::Lateral(Lateral::Rod {
+            height: 3e-3,
+            half_width: 1e-3,
+        })))
+}
+
+fn with_law(c_x: f64, c_z: f64) -> SceneBuilder {
+    let mut law = SpringLaw::default();
+    law.c_x = c_x;
+    law.c_z = c_z;
+    base().springs(law)
+}
+
+#[test]
+fn normal_stiffness_is_recovered_over_realizations() {
+    let options = FitOptions::default().seeds(&[3, 4, 5]);
+    let truth = 4.2e8;
+    let target = normal_contact_area(&with_law(1.65e12, truth), &options).unwrap();
+    let fit = fit_normal_stiffness(&base(), target, (1e6, 1e11), &options).unwrap();
+    assert!((fit.value / truth - 1.0).abs() < 1e-6, "{fit:?}");
+    assert!(fit.misfit.abs() < 1e-9 * target);
+    eprintln!("c_z fit: {fit:?}");
+    // The area falls as the springs stiffen (why the bracketing search is safe).
+    let soft = normal_contact_area(&with_law(1.65e12, 1e8), &options).unwrap();
+    let stiff = normal_contact_area(&with_law(1.65e12, 1e9), &options).unwrap();
+    assert!(soft > target && target > stiff);
+}
+
+#[test]
+fn tangential_stiffness_is_recovered_from_a_generated_curve() {
+    let options = FitOptions::default().seeds(&[1, 2]).tolerance(1e-3);
+    let truth = 1.65e12;
+    let generating = with_law(truth, 1.65e8);
+    // Target points: the generated, realization-averaged curve at a few forces.
+    let curves: Vec<_> = [1u64, 2]
+        .iter()
+        .map(|&s| precursor_curve(&generating.clone().seed(s)).unwrap())
+        .collect();
+    let mu_fn = 0.5 * 400.0;
+    let targets: Vec<(f64, f64)> = [0.3, 0.5, 0.7, 0.85, 0.95]
+        .iter()
+        .map(|r| {
+            let f = r * mu_fn;
+            (f, curves.iter().map(|c| length_at(c, f)).sum::<f64>() / 2.0)
+        })
+        .collect();
+    assert!(targets.iter().any(|t| t.1 > 0.0), "{targets:?}");
+    let fit = fit_tangential_stiffness(&with_law(1.0e12, 1.65e8), &targets, (1e11, 1e13), &options)
+        .unwrap();
+    eprintln!("c_x fit: {fit:?}, targets {targets:?}");
+    assert_eq!(fit.misfit, 0.0);
+    assert!((fit.value / truth).ln().abs() < 0.1, "{fit:?}");
+}
+
+#[test]
+fn bad_calibration_input_is_refused() {
+    let options = FitOptions::default();
+    assert!(matches!(
+        fit_normal_stiffness(&base(), 1e-6, (1e9, 1e8), &options),
+        Err(Error::InvalidParameter { .. })
+    ));
+    assert!(matches!(
+        fit_normal_stiffness(&base(), -1.0, (1e7, 1e9), &options),
+        Err(Error::InvalidParameter { .. })
+    ));
+    // A target no c_z in the bracket reaches.
+    assert!(matches!(
+        fit_normal_stiffness(&base(), 1.0, (1e7, 1e9), &options),
+        Err(Error::InvalidParameter { .. })
+    ));
+    assert!(matches!(
+        fit_tangential_stiffness(&base(), &[], (1e11, 1e13), &options),
+        Err(Error::EmptyContact { .. })
+    ));
+    assert!(matches!(
+        fit_tangential_stiffness(&base(), &[(f64::NAN, 0.0)], (1e11, 1e13), &options),
+        Err(Error::NonFinite { .. })
+    ));
+    assert!(matches!(
+        fit_normal_stiffness(&base(), 1e-6, (1e7, 1e9), &options.clone().tolerance(0.0)),
+        Err(Error::InvalidTolerance { .. })
+    ));
+}
