@@ -158,6 +158,28 @@ pub struct Driver {
     phase: Phase,
     avalanche_ruptures: usize,
     events: usize,
+    stats: SolveStats,
+}
+
+/// Cumulative solver work of a run (diagnostics for performance work; not part of the
+/// stable API).
+#[doc(hidden)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SolveStats {
+    /// Normal equilibria solved.
+    pub normal_solves: usize,
+    /// Active-set iterations, summed over the normal solves.
+    pub normal_active_set_iterations: usize,
+    /// CG iterations, summed over the normal solves.
+    pub normal_iterations: usize,
+    /// Wall time in normal solves (s).
+    pub normal_seconds: f64,
+    /// Tangential responses solved.
+    pub tangential_solves: usize,
+    /// CG iterations, summed over the tangential solves.
+    pub tangential_iterations: usize,
+    /// Wall time in tangential solves (s).
+    pub tangential_seconds: f64,
 }
 
 impl Scene {
@@ -185,6 +207,7 @@ impl Scene {
             phase: Phase::Start,
             avalanche_ruptures: 0,
             events: 0,
+            stats: SolveStats::default(),
         })
     }
 }
@@ -299,9 +322,14 @@ impl Driver {
     /// detached or attached.
     fn equilibrate(&mut self) -> Result<()> {
         let before = self.interface.states().to_vec();
+        let clock = std::time::Instant::now();
         let normal = self
             .solver
             .solve_normal(&mut self.interface, self.normal_load)?;
+        self.stats.normal_seconds += clock.elapsed().as_secs_f64();
+        self.stats.normal_solves += 1;
+        self.stats.normal_active_set_iterations += normal.report.active_set_iterations;
+        self.stats.normal_iterations += normal.report.linear_iterations;
         if self.normal.is_some() {
             for (i, (old, new)) in before.iter().zip(self.interface.states()).enumerate() {
                 let site = Site::new(&self.grid, i);
@@ -316,9 +344,13 @@ impl Driver {
                 }
             }
         }
+        let clock = std::time::Instant::now();
         let response =
             self.solver
                 .solve_tangential(&self.interface, &normal.displacement, &self.unit_load)?;
+        self.stats.tangential_seconds += clock.elapsed().as_secs_f64();
+        self.stats.tangential_solves += 1;
+        self.stats.tangential_iterations += response.report.linear_iterations;
         if let Drive::Spring { stiffness, .. } = self.drive {
             let denominator = 1.0 + stiffness * response.offset;
             if denominator.is_nan() || denominator <= 0.0 {
@@ -398,6 +430,12 @@ impl Driver {
     /// The normal load `F_N` (N).
     pub fn normal_load(&self) -> f64 {
         self.normal_load
+    }
+
+    /// Cumulative solver work so far (diagnostics; not part of the stable API).
+    #[doc(hidden)]
+    pub fn solve_stats(&self) -> SolveStats {
+        self.stats
     }
 
     /// Events returned so far.

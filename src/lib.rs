@@ -49,6 +49,8 @@ pub use error::{Error, Result};
 #[doc = include_str!("../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
+#[doc(hidden)]
+pub use driver::SolveStats;
 pub use driver::{Driver, Event, Load, Site};
 pub use geometry::{Block, Grid, Point};
 pub use interface::{HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw};
