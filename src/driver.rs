@@ -171,6 +171,28 @@ pub struct Driver {
     phase: Phase,
     avalanche_ruptures: usize,
     events: usize,
+    stats: SolveStats,
+}
+
+/// Cumulative solver work of a driver since it was created or resumed
+/// ([`Driver::solve_stats`]): where a run spends its time.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[non_exhaustive]
+pub struct SolveStats {
+    /// Normal equilibria solved.
+    pub normal_solves: usize,
+    /// Active-set iterations, summed over the normal solves.
+    pub normal_active_set_iterations: usize,
+    /// CG iterations, summed over the normal solves.
+    pub normal_iterations: usize,
+    /// Wall time in normal solves (s).
+    pub normal_seconds: f64,
+    /// Tangential responses solved.
+    pub tangential_solves: usize,
+    /// CG iterations, summed over the tangential solves.
+    pub tangential_iterations: usize,
+    /// Wall time in tangential solves (s).
+    pub tangential_seconds: f64,
 }
 
 impl Scene {
@@ -201,6 +223,7 @@ impl Scene {
             phase: Phase::Start,
             avalanche_ruptures: 0,
             events: 0,
+            stats: SolveStats::default(),
         })
     }
 }
@@ -315,9 +338,14 @@ impl Driver {
     /// detached or attached.
     fn equilibrate(&mut self) -> Result<()> {
         let before = self.interface.states().to_vec();
+        let clock = std::time::Instant::now();
         let normal = self
             .solver
             .solve_normal(&mut self.interface, self.normal_load)?;
+        self.stats.normal_seconds += clock.elapsed().as_secs_f64();
+        self.stats.normal_solves += 1;
+        self.stats.normal_active_set_iterations += normal.report.active_set_iterations;
+        self.stats.normal_iterations += normal.report.linear_iterations;
         if self.normal.is_some() {
             for (i, (old, new)) in before.iter().zip(self.interface.states()).enumerate() {
                 let site = Site::new(&self.grid, i);
@@ -332,9 +360,13 @@ impl Driver {
                 }
             }
         }
+        let clock = std::time::Instant::now();
         let response =
             self.solver
                 .solve_tangential(&self.interface, &normal.displacement, &self.unit_load)?;
+        self.stats.tangential_seconds += clock.elapsed().as_secs_f64();
+        self.stats.tangential_solves += 1;
+        self.stats.tangential_iterations += response.report.linear_iterations;
         if let Drive::Spring { stiffness, .. } = self.drive {
             let denominator = 1.0 + stiffness * response.offset;
             if denominator.is_nan() || denominator <= 0.0 {
@@ -419,6 +451,12 @@ impl Driver {
     /// The normal load `F_N` (N).
     pub fn normal_load(&self) -> f64 {
         self.normal_load
+    }
+
+    /// Cumulative solver work since this driver was created or resumed (counts and wall
+    /// times; not part of a checkpoint).
+    pub fn solve_stats(&self) -> SolveStats {
+        self.stats
     }
 
     /// Events returned so far.

@@ -51,7 +51,7 @@ pub use error::{Error, Result};
 #[doc = include_str!("../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
-pub use driver::{Checkpoint, Driver, Event, Load, Site};
+pub use driver::{Checkpoint, Driver, Event, Load, Site, SolveStats};
 pub use geometry::{Block, Grid, Point};
 pub use interface::{HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw};
 pub use scene::{Drive, ForceLoad, HeightSource, Lateral, Scene, SceneBuilder};

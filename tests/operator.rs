@@ -24,6 +24,8 @@ fn grids() -> Vec<Grid> {
         // Either side of the switch from direct y-products to rustdct columns (Ny = 16).
         Grid::new(Block::new(0.02, 0.016, 0.01).unwrap(), 20, 16).unwrap(),
         Grid::new(Block::new(0.02, 0.017, 0.01).unwrap(), 20, 17).unwrap(),
+        // Both sides even, Ny > 16: the paired-FFT transforms.
+        Grid::new(Block::new(0.02, 0.018, 0.01).unwrap(), 20, 18).unwrap(),
     ]
 }
 

@@ -104,7 +104,9 @@ pub(crate) fn projected_pcg<S: SetSystem>(
     }
     p.iter_mut().zip(&z).for_each(|(pi, zi)| *pi = -zi);
     let mut rz = dot(&r, &z);
+    // The best iterate so far, kept in one buffer (no allocation per iteration).
     let mut best = (residual, f.to_vec(), offset);
+    let mut confirmed = false;
     while iterations < max_iterations {
         iterations += 1;
         sys.apply(&p, &mut q);
@@ -123,7 +125,9 @@ pub(crate) fn projected_pcg<S: SetSystem>(
         project(sys, &mut r, &mut z, &mut offset);
         residual = backward(&r, f, offset);
         if residual < best.0 {
-            best = (residual, f.to_vec(), offset);
+            best.0 = residual;
+            best.1.copy_from_slice(f);
+            best.2 = offset;
         }
         if residual <= tol {
             // Confirm with the true residual; rounding in the recurrence can flatter it.
@@ -132,9 +136,12 @@ pub(crate) fn projected_pcg<S: SetSystem>(
             project(sys, &mut r, &mut z, &mut offset);
             residual = backward(&r, f, offset);
             if residual < best.0 {
-                best = (residual, f.to_vec(), offset);
+                best.0 = residual;
+                best.1.copy_from_slice(f);
+                best.2 = offset;
             }
             if residual <= tol {
+                confirmed = true;
                 break;
             }
             // Restart from the true residual.
@@ -148,6 +155,15 @@ pub(crate) fn projected_pcg<S: SetSystem>(
         p.iter_mut()
             .zip(&z)
             .for_each(|(pi, zi)| *pi = beta * *pi - zi);
+    }
+    if confirmed {
+        // The true residual of f was just computed: another product would only repeat it.
+        return PcgOutcome {
+            offset,
+            iterations,
+            residual,
+            converged: true,
+        };
     }
     // Report the true residual of the returned iterate, not the recurrence's.
     if best.0 < residual {
