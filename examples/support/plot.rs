@@ -1,6 +1,30 @@
-//! A minimal line plot written as PNG (the `png` crate encodes; this only rasterises):
-//! a frame, tick marks every tenth of each axis range, and polylines. No text: the
-//! examples write the numbers as CSV next to the picture.
+//! A minimal plot written as PNG (the `png` crate encodes; this only rasterises): a
+//! frame, tick marks every tenth of each axis range, polylines and colour maps. No text:
+//! the examples write the numbers as CSV next to the picture.
+#![allow(dead_code)] // each example uses its own part
+
+/// Distinct line colours.
+pub const COLOURS: [[u8; 3]; 8] = [
+    [20, 60, 200],
+    [200, 30, 30],
+    [20, 150, 60],
+    [200, 120, 0],
+    [140, 40, 170],
+    [0, 150, 170],
+    [120, 120, 120],
+    [0, 0, 0],
+];
+
+/// Diverging colour of `t ∈ [-1, 1]`: blue (−1), white (0), red (+1).
+pub fn diverging(t: f64) -> [u8; 3] {
+    let t = if t.is_nan() { 0.0 } else { t.clamp(-1.0, 1.0) };
+    let fade = |c: f64| (255.0 * (1.0 - t.abs()) + c * t.abs()).round() as u8;
+    if t < 0.0 {
+        [fade(20.0), fade(60.0), fade(200.0)]
+    } else {
+        [fade(200.0), fade(30.0), fade(30.0)]
+    }
+}
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -86,6 +110,28 @@ impl Plot {
         for w in points.windows(2) {
             let (a, b) = (self.to_pixel(w[0].0, w[0].1), self.to_pixel(w[1].0, w[1].1));
             self.segment(a, b, rgb);
+        }
+    }
+
+    /// Fills the data area with `values` (`columns x rows`, row-major, row 0 at the bottom
+    /// of the y range) through `colour`.
+    pub fn heatmap(
+        &mut self,
+        values: &[f64],
+        columns: usize,
+        rows: usize,
+        colour: impl Fn(f64) -> [u8; 3],
+    ) {
+        let (x0, y0) = self.to_pixel(self.x_range.0, self.y_range.0);
+        let (x1, y1) = self.to_pixel(self.x_range.1, self.y_range.1);
+        for py in (y1.ceil() as i64)..(y0.floor() as i64) {
+            for px in (x0.ceil() as i64 + 1)..(x1.floor() as i64) {
+                let fx = (px as f64 - x0) / (x1 - x0);
+                let fy = (y0 - py as f64) / (y0 - y1);
+                let c = ((fx * columns as f64) as usize).min(columns - 1);
+                let r = ((fy * rows as f64) as usize).min(rows - 1);
+                self.put(px, py, colour(values[r * columns + c]));
+            }
         }
     }
 

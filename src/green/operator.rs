@@ -219,9 +219,12 @@ pub(crate) struct Dct2d {
     pairs: Option<(PairDct, PairDct)>,
 }
 
+/// Complex buffers of [`PairDct`]: the lines' data and the FFT's scratch.
+type PairBuffers = (Vec<Complex<f64>>, Vec<Complex<f64>>);
+
 thread_local! {
     /// Complex scratch of [`PairDct`] (one per thread: the plan is shared between clones).
-    static PAIR_SCRATCH: RefCell<(Vec<Complex<f64>>, Vec<Complex<f64>>)> =
+    static PAIR_SCRATCH: RefCell<PairBuffers> =
         const { RefCell::new((Vec::new(), Vec::new())) };
 }
 

@@ -1,0 +1,75 @@
+//! Paper Fig. 2a (Archard / Amontons' second law): the real contact area at zero shear in
+//! % of the nominal area `A0 = Lx Ly` against the normal load, for a 30 x 6 x 150 mm block
+//! (1 mm cells), averaged over 10 height realizations. The model's `A_R` grows linearly
+//! with `F_N` (`A_R = α F_N`); the least-squares slope and intercept are printed.
+//!
+//! Writes `fig2a.csv` (normal_load_N, area_percent_mean, area_percent_sd, alpha_m2_per_N)
+//! and `fig2a.png` (A_R/A0 in % against F_N from 0 to 4 kN).
+//! Run: `cargo run --release --example fig2a_archard [output directory]`.
+
+#[path = "support/figures.rs"]
+mod figures;
+#[path = "support/plot.rs"]
+mod plot;
+
+use precursors::Scene;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let dir = figures::out_dir();
+    let loads: Vec<f64> = (1..=8).map(|k| 500.0 * k as f64).collect();
+    let seeds: Vec<u64> = (1..=10).collect();
+    let a0 = 0.030 * 0.006;
+    let mut rows = Vec::new();
+    let mut points = Vec::new();
+    for &f_n in &loads {
+        let mut values = Vec::new();
+        for &seed in &seeds {
+            let scene = Scene::builder()
+                .block(0.030, 0.006, 0.150)
+                .normal_load(f_n)
+                .seed(seed)
+                .build()?;
+            let mut driver = scene.driver()?;
+            driver.step()?; // the normal equilibrium at zero shear
+            values.push(100.0 * driver.total_contact_area()? / a0);
+        }
+        let mean = values.iter().sum::<f64>() / values.len() as f64;
+        let sd = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>()
+            / (values.len() - 1) as f64)
+            .sqrt();
+        rows.push(format!(
+            "{f_n},{mean:.6},{sd:.6},{:.6e}",
+            mean / 100.0 * a0 / f_n
+        ));
+        points.push((f_n, mean));
+        println!("F_N = {f_n:6.0} N: A_R/A0 = {mean:.4} % (sd {sd:.4} %)");
+    }
+    // Least squares A = a F_N + b.
+    let n = points.len() as f64;
+    let (sx, sy) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y));
+    let sxx: f64 = points.iter().map(|(x, _)| x * x).sum();
+    let sxy: f64 = points.iter().map(|(x, y)| x * y).sum();
+    let slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+    let intercept = (sy - slope * sx) / n;
+    println!(
+        "linear fit: A_R/A0 = {slope:.4e} %/N · F_N + {intercept:.4} %  (α = {:.4e} m²/N)",
+        slope / 100.0 * a0
+    );
+    figures::write_csv(
+        &format!("{dir}/fig2a.csv"),
+        "normal_load_N,area_percent_mean,area_percent_sd,alpha_m2_per_N",
+        &rows,
+    )?;
+    let top = points.iter().fold(0.0f64, |m, p| m.max(p.1)) * 1.2;
+    let mut canvas = plot::Plot::new(640, 480, (0.0, 4000.0), (0.0, top));
+    canvas.line(&points, plot::COLOURS[0]);
+    canvas.line(
+        &[(0.0, intercept), (4000.0, intercept + slope * 4000.0)],
+        plot::COLOURS[6],
+    );
+    canvas.save(&format!("{dir}/fig2a.png"))?;
+    println!("wrote {dir}/fig2a.csv and {dir}/fig2a.png");
+    Ok(())
+}

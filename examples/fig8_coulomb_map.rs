@@ -1,0 +1,106 @@
+//! Paper Fig. 8: the y-averaged Coulomb stress τ_C(x, z) = |τ(x,z)| - μ|σ(x,z)| in the
+//! x-z plane of the Fig. 7 block (200 x 7 x 100 mm, F_N = 6.25 kN, top and rod shear with
+//! F_top = F_lat, seed 1) at four stages: just before the first precursor (the last
+//! stable state before ℓ exceeds 5 mm, as in fig7_stresses) and at the stable states
+//! reached at F/(μF_N) = 0.6, 0.8 and 0.95. Planes every 1 mm from z = 0.5 mm to 99.5 mm.
+//!
+//! Writes `fig8.csv` (stage, force_over_mu_FN, precursor_m, x_m, z_m, coulomb_Pa) and
+//! `fig8_<stage>.png`: x right, z up (the interface at the bottom); red where τ_C > 0,
+//! blue where τ_C < 0 (scaled by 1 MPa, saturating).
+//! Run: `cargo run --release --example fig8_coulomb_map [output directory]`.
+
+#[path = "support/figures.rs"]
+mod figures;
+#[path = "support/plot.rs"]
+mod plot;
+
+use precursors::probe::ProbeSpec;
+use precursors::{Drive, Event, ForceLoad, Lateral, Scene};
+
+const THRESHOLD: f64 = 5e-3;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let dir = figures::out_dir();
+    let heights: Vec<f64> = (0..100).map(|k| (k as f64 + 0.5) * 1e-3).collect();
+    let mut spec = ProbeSpec::default();
+    for &z in &heights {
+        spec = spec.plane(z);
+    }
+    let scene = Scene::builder()
+        .block(0.200, 0.007, 0.100)
+        .normal_load(6.25e3)
+        .drive(Drive::Force(ForceLoad::Mixed {
+            ratio: 1.0,
+            lateral: Lateral::Rod {
+                height: 6e-3,
+                half_width: 2e-3,
+            },
+        }))
+        .probes(spec)
+        .seed(1)
+        .build()?;
+    let mu = scene.material().friction_coefficient;
+    let mu_fn = mu * scene.normal_load();
+    let nx = scene.grid().nx();
+    // τ_C(x, z) of the y-averages, rows = planes.
+    let map = |d: &precursors::Driver| -> precursors::Result<Vec<f64>> {
+        let s = d.stresses()?;
+        Ok(s.planes
+            .iter()
+            .flat_map(|p| p.profile(mu).coulomb_of_means)
+            .collect())
+    };
+    let mut stages: Vec<(String, f64, f64, Vec<f64>)> = Vec::new();
+    let mut before: Option<(f64, f64, Vec<f64>)> = None;
+    let mut targets = vec![0.6, 0.8, 0.95].into_iter().peekable();
+    let mut driver = scene.driver()?;
+    while let Some(event) = driver.step()? {
+        let Event::Stable { load, .. } = event else {
+            continue;
+        };
+        let f = load.force / mu_fn;
+        let ell = driver.precursor_length()?;
+        if stages.is_empty() {
+            if ell > THRESHOLD {
+                let (bf, bl, m) = before.take().ok_or("no state before the precursor")?;
+                stages.push(("before".into(), bf, bl, m));
+            } else {
+                before = Some((f, ell, map(&driver)?));
+            }
+        }
+        if let Some(&t) = targets.peek() {
+            if f >= t && !stages.is_empty() {
+                stages.push((format!("{t}"), f, ell, map(&driver)?));
+                targets.next();
+            }
+        }
+    }
+    let mut rows = Vec::new();
+    for (name, f, ell, values) in &stages {
+        for (k, z) in heights.iter().enumerate() {
+            for ix in 0..nx {
+                rows.push(format!(
+                    "{name},{f:.6},{ell:.4e},{:.4e},{z:.4e},{:.6e}",
+                    (ix as f64 + 0.5) * 1e-3,
+                    values[k * nx + ix]
+                ));
+            }
+        }
+        let mut canvas = plot::Plot::new(800, 480, (0.0, 0.2), (0.0, 0.1));
+        canvas.heatmap(values, nx, heights.len(), |v| plot::diverging(v / 1e6));
+        canvas.save(&format!("{dir}/fig8_{name}.png"))?;
+        let positive = values.iter().filter(|v| **v > 0.0).count();
+        println!(
+            "stage {name:>6}: F/(μF_N) = {f:.3}, ℓ = {:.0} mm, τ_C > 0 on {:.1} % of the x-z plane",
+            ell * 1e3,
+            100.0 * positive as f64 / values.len() as f64
+        );
+    }
+    figures::write_csv(
+        &format!("{dir}/fig8.csv"),
+        "stage,force_over_mu_FN,precursor_m,x_m,z_m,coulomb_Pa",
+        &rows,
+    )?;
+    println!("wrote {dir}/fig8.csv and {dir}/fig8_<stage>.png");
+    Ok(())
+}
