@@ -9,9 +9,8 @@
 
 #[path = "support/figures.rs"]
 mod figures;
-#[path = "support/plot.rs"]
-mod plot;
 
+use figures::plot;
 use precursors::Scene;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

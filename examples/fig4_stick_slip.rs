@@ -11,9 +11,8 @@
 
 #[path = "support/figures.rs"]
 mod figures;
-#[path = "support/plot.rs"]
-mod plot;
 
+use figures::plot;
 use precursors::{Drive, Event, Lateral, Scene};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

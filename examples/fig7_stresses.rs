@@ -16,9 +16,8 @@
 
 #[path = "support/figures.rs"]
 mod figures;
-#[path = "support/plot.rs"]
-mod plot;
 
+use figures::plot;
 use precursors::probe::{ProbeSpec, Profile};
 use precursors::{Drive, Event, ForceLoad, Lateral, Scene};
 

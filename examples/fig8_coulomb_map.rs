@@ -11,9 +11,8 @@
 
 #[path = "support/figures.rs"]
 mod figures;
-#[path = "support/plot.rs"]
-mod plot;
 
+use figures::plot;
 use precursors::probe::ProbeSpec;
 use precursors::{Drive, Event, ForceLoad, Lateral, Scene};
 

@@ -3,6 +3,9 @@
 #![allow(dead_code)] // each example uses its own part
 
 use precursors::calibration::{length_at, precursor_curve};
+#[path = "plot.rs"]
+pub mod plot;
+
 use precursors::{Result, SceneBuilder};
 use std::io::Write;
 
@@ -38,6 +41,65 @@ pub fn mean_precursor_curve(
         }
     }
     Ok(mean)
+}
+
+/// Realization-averaged precursor curves `ℓ/Lx` of several scenes on one grid of
+/// `F/(μF_N)`: writes `<name>.csv` (one column per curve) and `<name>.png` (one colour per
+/// curve, in column order) and prints where each curve reaches ℓ/Lx = 0.1 and 0.5.
+pub fn precursor_panel(
+    dir: &str,
+    name: &str,
+    curves: &[(String, SceneBuilder)],
+    seeds: &[u64],
+) -> std::result::Result<(), Box<dyn std::error::Error>> {
+    let grid = unit_grid(0.005);
+    let mut columns = Vec::new();
+    for (label, builder) in curves {
+        let mean = mean_precursor_curve(builder, seeds, &grid)?;
+        let reach = |level: f64| {
+            grid.iter()
+                .zip(&mean)
+                .find(|(_, l)| **l >= level)
+                .map_or(f64::NAN, |(f, _)| *f)
+        };
+        println!(
+            "{name} {label:>10}: ℓ/Lx reaches 0.1 at F/(μF_N) = {:.3}, 0.5 at {:.3}",
+            reach(0.1),
+            reach(0.5)
+        );
+        columns.push(mean);
+    }
+    let header = std::iter::once("force_over_mu_FN".to_string())
+        .chain(curves.iter().map(|(l, _)| format!("ell_over_Lx_{l}")))
+        .collect::<Vec<_>>()
+        .join(",");
+    let rows: Vec<String> = grid
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            std::iter::once(format!("{f:.3}"))
+                .chain(columns.iter().map(|c| format!("{:.5}", c[i])))
+                .collect::<Vec<_>>()
+                .join(",")
+        })
+        .collect();
+    write_csv(&format!("{dir}/{name}.csv"), &header, &rows)?;
+    let mut canvas = plot::Plot::new(640, 480, (0.0, 1.0), (0.0, 1.0));
+    for (k, c) in columns.iter().enumerate() {
+        let points: Vec<(f64, f64)> = grid.iter().copied().zip(c.iter().copied()).collect();
+        canvas.line(&points, plot::COLOURS[k % plot::COLOURS.len()]);
+    }
+    canvas.save(&format!("{dir}/{name}.png"))?;
+    Ok(())
+}
+
+/// Seeds 1..=k, k the second command-line argument (default 10, the paper's count).
+pub fn seeds() -> Vec<u64> {
+    let k = std::env::args()
+        .nth(2)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(10u64);
+    (1..=k).collect()
 }
 
 /// `0, step, 2 step, ..., 1`.

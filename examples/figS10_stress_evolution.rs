@@ -1,0 +1,103 @@
+//! Paper Fig. S10: the quasi-static evolution of the y-averaged normal and shear stresses
+//! |σ(x, z_P)| and |τ(x, z_P)| on the plane z_P = 2 mm, block 200 x 7 x 100 mm, F_N =
+//! 6.25 kN, rod (h = 6 mm, Δh = 2 mm) plus top shear with F_top = F_lat (as in
+//! fig7_stresses), averaged over 10 realizations, at F/(μF_N) = 0, 0.1, ..., 0.9 (the
+//! stable state reached at each load).
+//!
+//! Writes `figS10.csv` (force_over_mu_FN, x_m, abs_sigma_Pa, abs_tau_Pa) and
+//! `figS10_sigma.png`, `figS10_tau.png` (x/Lx right, stress up in MPa, one colour per
+//! load, blue to red as the load grows).
+//! Run: `cargo run --release --example figS10_stress_evolution [output directory] [realizations]`.
+
+#[path = "support/figures.rs"]
+mod figures;
+
+use figures::plot;
+use precursors::probe::ProbeSpec;
+use precursors::{Drive, Event, ForceLoad, Lateral, Scene};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let dir = figures::out_dir();
+    let seeds = figures::seeds();
+    let levels: Vec<f64> = (0..10).map(|k| 0.1 * k as f64).collect();
+    let nx = 200;
+    let mut sigma = vec![vec![0.0; nx]; levels.len()];
+    let mut tau = vec![vec![0.0; nx]; levels.len()];
+    for &seed in &seeds {
+        let scene = Scene::builder()
+            .block(0.200, 0.007, 0.100)
+            .normal_load(6.25e3)
+            .drive(Drive::Force(ForceLoad::Mixed {
+                ratio: 1.0,
+                lateral: Lateral::Rod {
+                    height: 6e-3,
+                    half_width: 2e-3,
+                },
+            }))
+            .probes(ProbeSpec::default().plane(2e-3))
+            .seed(seed)
+            .build()?;
+        let mu = scene.material().friction_coefficient;
+        let mu_fn = mu * scene.normal_load();
+        let mut driver = scene.driver()?;
+        let mut next = 0;
+        while let Some(event) = driver.step()? {
+            let Event::Stable { load, .. } = event else {
+                continue;
+            };
+            while next < levels.len() && load.force / mu_fn >= levels[next] {
+                let p = driver.stresses()?.planes[0].profile(mu);
+                for ix in 0..nx {
+                    sigma[next][ix] += p.normal[ix].abs() / seeds.len() as f64;
+                    tau[next][ix] += p.shear[ix].abs() / seeds.len() as f64;
+                }
+                next += 1;
+            }
+            if next == levels.len() {
+                break;
+            }
+        }
+    }
+    let mut rows = Vec::new();
+    for (k, f) in levels.iter().enumerate() {
+        for ix in 0..nx {
+            rows.push(format!(
+                "{f:.1},{:.4e},{:.6e},{:.6e}",
+                (ix as f64 + 0.5) * 1e-3,
+                sigma[k][ix],
+                tau[k][ix]
+            ));
+        }
+    }
+    figures::write_csv(
+        &format!("{dir}/figS10.csv"),
+        "force_over_mu_FN,x_m,abs_sigma_Pa,abs_tau_Pa",
+        &rows,
+    )?;
+    for (name, data) in [("sigma", &sigma), ("tau", &tau)] {
+        let top = data.iter().flatten().fold(0.0f64, |m, v| m.max(*v)) / 1e6 * 1.1;
+        let mut canvas = plot::Plot::new(800, 480, (0.0, 1.0), (0.0, top));
+        for (k, profile) in data.iter().enumerate() {
+            let t = k as f64 / (levels.len() - 1) as f64;
+            let colour = plot::diverging(2.0 * t - 1.0);
+            let points: Vec<(f64, f64)> = profile
+                .iter()
+                .enumerate()
+                .map(|(ix, v)| ((ix as f64 + 0.5) / nx as f64, v / 1e6))
+                .collect();
+            canvas.line(&points, colour);
+        }
+        canvas.save(&format!("{dir}/figS10_{name}.png"))?;
+    }
+    let edge = |d: &Vec<Vec<f64>>, k: usize| d[k][0] / 1e6;
+    println!(
+        "|τ(0, z_P)| grows from {:.3} to {:.3} MPa and |σ(0, z_P)| goes from {:.3} to {:.3} MPa \
+         between F/(μF_N) = 0 and 0.9",
+        edge(&tau, 0),
+        edge(&tau, levels.len() - 1),
+        edge(&sigma, 0),
+        edge(&sigma, levels.len() - 1)
+    );
+    println!("wrote {dir}/figS10.csv and the PNGs");
+    Ok(())
+}

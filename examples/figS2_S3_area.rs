@@ -1,0 +1,171 @@
+//! Paper Figs. S2 and S3: the real contact area during shearing.
+//!
+//! * S2: A_R(F)/A_R(0) against F/(μF_N) under uniform top shear, 100 x 7 x 75 mm,
+//!   F_N = 4 kN, seed 1 (total area, one row per stable state).
+//! * S3 (Amontons' first and second laws): A_R against F/(μF_N) at F_N = 4 kN for blocks
+//!   of very different nominal areas: Lx x Ly = 50 x 7, 100 x 7, 140 x 14, 200 x 20 mm
+//!   (Lz = 75 mm), uniform side shear and rod (h = 6 mm, Δh = 2 mm), averaged over 10
+//!   realizations. A_R depends on F_N only, not on A0; every run slides at F = μF_N.
+//!
+//! Writes `figS2.csv` (force_over_mu_FN, area_ratio) + `figS2.png`, and `figS3.csv`
+//! (force_over_mu_FN, then A_R in mm² per sample and drive) + `figS3.png` (side: solid
+//! colours, rod: the next colours). Prints, per sample, A_R(0), the spread of A_R(0)
+//! across samples relative to its mean, and the slip load.
+//! Run: `cargo run --release --example figS2_S3_area [output directory] [realizations]`.
+
+#[path = "support/figures.rs"]
+mod figures;
+
+use figures::plot;
+use precursors::{Drive, Event, ForceLoad, Lateral, Scene, SceneBuilder};
+
+/// `(F/(μF_N), A_R)` at every stable state, and the slip load F/(μF_N).
+fn area_curve(builder: &SceneBuilder) -> precursors::Result<(Vec<(f64, f64)>, f64)> {
+    let scene = builder.clone().build()?;
+    let mu_fn = scene.material().friction_coefficient * scene.normal_load();
+    let mut driver = scene.driver()?;
+    let mut curve = Vec::new();
+    let mut slip = f64::NAN;
+    while let Some(event) = driver.step()? {
+        match event {
+            Event::Stable { load, .. } => {
+                curve.push((load.force / mu_fn, driver.total_contact_area()?))
+            }
+            Event::GlobalSlip { load } => slip = load.force / mu_fn,
+            _ => {}
+        }
+    }
+    Ok((curve, slip))
+}
+
+fn at(curve: &[(f64, f64)], f: f64) -> f64 {
+    curve
+        .iter()
+        .take_while(|p| p.0 <= f)
+        .last()
+        .map_or(f64::NAN, |p| p.1)
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let dir = figures::out_dir();
+    let seeds = figures::seeds();
+    // S2.
+    let (curve, slip) = area_curve(
+        &Scene::builder()
+            .block(0.100, 0.007, 0.075)
+            .normal_load(4e3)
+            .drive(Drive::Force(ForceLoad::Top))
+            .seed(1),
+    )?;
+    let a0 = curve[0].1;
+    let rows: Vec<String> = curve
+        .iter()
+        .map(|(f, a)| format!("{f:.9},{:.9}", a / a0))
+        .collect();
+    figures::write_csv(
+        &format!("{dir}/figS2.csv"),
+        "force_over_mu_FN,area_ratio",
+        &rows,
+    )?;
+    let points: Vec<(f64, f64)> = curve.iter().map(|(f, a)| (*f, a / a0)).collect();
+    let top = points.iter().fold(1.0f64, |m, p| m.max(p.1)) * 1.05;
+    let low = points.iter().fold(1.0f64, |m, p| m.min(p.1)) * 0.95;
+    let mut canvas = plot::Plot::new(640, 480, (0.0, 1.0), (low, top));
+    canvas.line(&points, plot::COLOURS[0]);
+    canvas.save(&format!("{dir}/figS2.png"))?;
+    println!(
+        "S2: A_R/A_R(0) from {:.4} to {:.4} under top shear; slip at F/(μF_N) = {slip:.9}",
+        low / 0.95,
+        top / 1.05
+    );
+
+    // S3.
+    let grid = figures::unit_grid(0.01);
+    let samples = [
+        (0.050, 0.007),
+        (0.100, 0.007),
+        (0.140, 0.014),
+        (0.200, 0.020),
+    ];
+    let drives = [
+        ("side", Drive::Force(ForceLoad::Lateral(Lateral::Side))),
+        (
+            "rod",
+            Drive::Force(ForceLoad::Lateral(Lateral::Rod {
+                height: 6e-3,
+                half_width: 2e-3,
+            })),
+        ),
+    ];
+    let mut columns = Vec::new();
+    let mut header = vec!["force_over_mu_FN".to_string()];
+    let mut initial = Vec::new();
+    for (drive_name, drive) in drives {
+        for &(lx, ly) in &samples {
+            let mut mean = vec![0.0; grid.len()];
+            let mut worst_slip: f64 = 0.0;
+            for &seed in &seeds {
+                let b = Scene::builder()
+                    .block(lx, ly, 0.075)
+                    .normal_load(4e3)
+                    .drive(drive)
+                    .seed(seed);
+                let (curve, slip) = area_curve(&b)?;
+                worst_slip = worst_slip.max((slip - 1.0).abs());
+                for (m, f) in mean.iter_mut().zip(&grid) {
+                    *m += at(&curve, *f) * 1e6 / seeds.len() as f64;
+                }
+            }
+            println!(
+                "S3 {drive_name:>4} {:>3.0} x {:>2.0} mm (A0 = {:>5.0} mm²): A_R(0) = {:.3} mm², \
+                 max |F_slip/(μF_N) - 1| = {worst_slip:.1e}",
+                lx * 1e3,
+                ly * 1e3,
+                lx * ly * 1e6,
+                mean[0]
+            );
+            initial.push(mean[0]);
+            header.push(format!(
+                "area_mm2_{drive_name}_{:.0}x{:.0}",
+                lx * 1e3,
+                ly * 1e3
+            ));
+            columns.push(mean);
+        }
+    }
+    let avg = initial.iter().sum::<f64>() / initial.len() as f64;
+    let spread = initial.iter().fold(0.0f64, |m, a| m.max((a - avg).abs())) / avg;
+    println!(
+        "S3: A_R(0) across samples: mean {avg:.3} mm², largest deviation {:.2} %",
+        100.0 * spread
+    );
+    let rows: Vec<String> = grid
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            std::iter::once(format!("{f:.2}"))
+                .chain(columns.iter().map(|c| format!("{:.6}", c[i])))
+                .collect::<Vec<_>>()
+                .join(",")
+        })
+        .collect();
+    figures::write_csv(&format!("{dir}/figS3.csv"), &header.join(","), &rows)?;
+    let top = columns
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, v| if v.is_finite() { m.max(*v) } else { m })
+        * 1.1;
+    let mut canvas = plot::Plot::new(640, 480, (0.0, 1.0), (0.0, top));
+    for (k, c) in columns.iter().enumerate() {
+        let points: Vec<(f64, f64)> = grid
+            .iter()
+            .copied()
+            .zip(c.iter().copied())
+            .filter(|p| p.1.is_finite())
+            .collect();
+        canvas.line(&points, plot::COLOURS[k % plot::COLOURS.len()]);
+    }
+    canvas.save(&format!("{dir}/figS3.png"))?;
+    println!("wrote {dir}/figS2.csv, {dir}/figS3.csv and the PNGs");
+    Ok(())
+}
