@@ -6,9 +6,10 @@
 //! the wall time, the event counts and the solver work split between the normal and the
 //! tangential equilibria.
 //!
-//! Run: `cargo run --release --example large_run [seed]`.
+//! Run: `cargo run --release --example large_run [seed] [solver tolerance]` (the
+//! tolerance defaults to the solver's, `1e-13`).
 
-use precursors::{Event, Scene};
+use precursors::{Event, Scene, SolverOptions};
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -17,8 +18,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|s| s.parse())
         .transpose()?
         .unwrap_or(1);
+    let tolerance: f64 = std::env::args()
+        .nth(2)
+        .map(|s| s.parse())
+        .transpose()?
+        .unwrap_or(SolverOptions::default().tolerance);
     let start = Instant::now();
     let scene = Scene::builder()
+        .solver(SolverOptions::default().with_tolerance(tolerance))
         .block(0.200, 0.050, 0.075)
         .cell_size(1e-3, 1e-3)
         .seed(seed)
