@@ -57,7 +57,10 @@ const MAX_SHELLS: usize = 64;
 pub struct ProbeSpec {
     /// Heights `z ∈ [0, Lz]` (m) of the planes.
     pub planes: Vec<f64>,
-    /// Points inside the block (m).
+    /// Points inside the block (m). Each costs a kernel of `N` values, built once from
+    /// alias sums over every mode (`O(N)` times the alias shells, which grow like
+    /// `Δ/z` for points close to the interface) and one 2-D DCT: use planes for fields,
+    /// points for a few probes.
     pub points: Vec<Point>,
     /// Absolute accuracy of the transfer factors (dimensionless, `≤ 1`; default `1e-10`):
     /// the stresses are accurate to this times the largest traction. The lateral load's

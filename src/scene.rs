@@ -176,7 +176,7 @@ enum Cells {
 
 /// Builder of a [`Scene`]; every field has the paper's default (calibration scene,
 /// seed 0). With the `serde` feature it reads and writes the JSON scene format
-/// (`docs/scene-format.md`): [`SceneBuilder::from_json_file`], [`SceneBuilder::to_json`].
+/// (`docs/scene-format.md`): `SceneBuilder::from_json_file`, `SceneBuilder::to_json`.
 #[derive(Debug, Clone, PartialEq)]
 #[must_use]
 pub struct SceneBuilder {

@@ -20,7 +20,7 @@ const FORMAT: u32 = 1;
 
 /// A snapshot of a [`Driver`] between two events ([`Driver::checkpoint`]), resumed by
 /// [`Scene::resume`]. With the `serde` feature it serialises in any serde format
-/// ([`Checkpoint::to_json`] for JSON); floats must round-trip exactly (they do in JSON
+/// (`Checkpoint::to_json` for JSON); floats must round-trip exactly (they do in JSON
 /// through this crate, which enables `serde_json`'s `float_roundtrip`).
 ///
 /// ```
