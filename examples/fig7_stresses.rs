@@ -19,7 +19,7 @@ mod figures;
 
 use figures::plot;
 use precursors::probe::{ProbeSpec, Profile};
-use precursors::{Drive, Event, ForceLoad, Lateral, Scene};
+use precursors::Event;
 
 /// The precursor length (m) taken as the first front (see the module docs).
 const THRESHOLD: f64 = 5e-3;
@@ -31,16 +31,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut sums: Option<[Vec<f64>; 4]> = None;
     let mut loads = Vec::new();
     for &seed in &seeds {
-        let scene = Scene::builder()
-            .block(0.200, 0.007, 0.100)
-            .normal_load(6.25e3)
-            .drive(Drive::Force(ForceLoad::Mixed {
-                ratio: 1.0,
-                lateral: Lateral::Rod {
-                    height: 6e-3,
-                    half_width: 2e-3,
-                },
-            }))
+        let scene = figures::stress_block()
             .probes(ProbeSpec::default().plane(z_p).plane(0.0))
             .seed(seed)
             .build()?;

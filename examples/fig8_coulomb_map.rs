@@ -14,7 +14,7 @@ mod figures;
 
 use figures::plot;
 use precursors::probe::ProbeSpec;
-use precursors::{Drive, Event, ForceLoad, Lateral, Scene};
+use precursors::Event;
 
 const THRESHOLD: f64 = 5e-3;
 
@@ -25,19 +25,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for &z in &heights {
         spec = spec.plane(z);
     }
-    let scene = Scene::builder()
-        .block(0.200, 0.007, 0.100)
-        .normal_load(6.25e3)
-        .drive(Drive::Force(ForceLoad::Mixed {
-            ratio: 1.0,
-            lateral: Lateral::Rod {
-                height: 6e-3,
-                half_width: 2e-3,
-            },
-        }))
-        .probes(spec)
-        .seed(1)
-        .build()?;
+    let scene = figures::stress_block().probes(spec).seed(1).build()?;
     let mu = scene.material().friction_coefficient;
     let mu_fn = mu * scene.normal_load();
     let nx = scene.grid().nx();

@@ -14,7 +14,7 @@ mod figures;
 
 use figures::plot;
 use precursors::probe::ProbeSpec;
-use precursors::{Drive, Event, ForceLoad, Lateral, Scene};
+use precursors::Event;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dir = figures::out_dir();
@@ -24,16 +24,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut sigma = vec![vec![0.0; nx]; levels.len()];
     let mut tau = vec![vec![0.0; nx]; levels.len()];
     for &seed in &seeds {
-        let scene = Scene::builder()
-            .block(0.200, 0.007, 0.100)
-            .normal_load(6.25e3)
-            .drive(Drive::Force(ForceLoad::Mixed {
-                ratio: 1.0,
-                lateral: Lateral::Rod {
-                    height: 6e-3,
-                    half_width: 2e-3,
-                },
-            }))
+        let scene = figures::stress_block()
             .probes(ProbeSpec::default().plane(2e-3))
             .seed(seed)
             .build()?;

@@ -6,7 +6,22 @@ use precursors::calibration::{length_at, precursor_curve};
 #[path = "plot.rs"]
 pub mod plot;
 
-use precursors::{Result, SceneBuilder};
+use precursors::{Drive, ForceLoad, Lateral, Result, Scene, SceneBuilder};
+
+/// The block of Figs. 7, 8 and S10: 200 x 7 x 100 mm, F_N = 6.25 kN, rod (h = 6 mm,
+/// Δh = 2 mm) plus top shear with F_top = F_lat (the paper does not give the split).
+pub fn stress_block() -> SceneBuilder {
+    Scene::builder()
+        .block(0.200, 0.007, 0.100)
+        .normal_load(6.25e3)
+        .drive(Drive::Force(ForceLoad::Mixed {
+            ratio: 1.0,
+            lateral: Lateral::Rod {
+                height: 6e-3,
+                half_width: 2e-3,
+            },
+        }))
+}
 use std::io::Write;
 
 /// The output directory: the first command-line argument, or `.`.
