@@ -351,7 +351,8 @@ impl PairDct {
             for k in 0..n {
                 // Z(k) = V_a(k) + i V_b(k) with V_a, V_b Hermitian: separate them.
                 let zk = zc[k];
-                let zm = zc[(n - k) % n].conj();
+                // (n - k) mod n without a division per element (hot loop).
+                let zm = zc[if k == 0 { 0 } else { n - k }].conj();
                 let va = (zk + zm) * 0.5;
                 let vb = (zk - zm) * Complex::new(0.0, -0.5);
                 let t = self.twiddle[k];
