@@ -25,6 +25,7 @@
 //! drown `u0` in a huge common displacement.
 
 mod dense;
+mod fsai;
 mod pcg;
 mod spectral;
 
@@ -34,7 +35,7 @@ use crate::green::InfluencePlan;
 use crate::interface::{Interface, Material, SiteState};
 use dense::{DenseCore, FactorState};
 use pcg::{projected_pcg, PcgOutcome};
-use spectral::SpectralCore;
+use spectral::{Precond, SpectralCore};
 use std::collections::HashSet;
 
 /// Backward error of the linear solves while a cold attached set is explored.
@@ -474,7 +475,7 @@ impl EquilibriumSolver {
             Core::Dense(core) if explore => {
                 // A cold or much-changed set: find the attached set with the cheap
                 // spectral iteration first; the factor confirms the final set.
-                let mut sys = core.spectral.system(set, diag, true);
+                let mut sys = core.spectral.system(set, diag, Precond::Spectral);
                 projected_pcg(&mut sys, b, total, &mut f, tol, max_it)
             }
             Core::Dense(core) => {
@@ -501,7 +502,12 @@ impl EquilibriumSolver {
                 outcome
             }
             Core::Spectral(core) => {
-                let mut sys = core.system(set, diag, cold);
+                let precond = if cold {
+                    Precond::Spectral
+                } else {
+                    spectral::warm_precond(tangential)
+                };
+                let mut sys = core.system(set, diag, precond);
                 projected_pcg(&mut sys, b, total, &mut f, tol, max_it)
             }
         };

@@ -1,0 +1,385 @@
+//! Factorised sparse approximate inverse (FSAI) of `A = C_SS + diag(d)` on an attached
+//! set: `M⁻¹ = Gᵀ G`, `G` lower triangular in site order on a local pattern (the site and
+//! its attached neighbours of smaller index within `radius` cells). Row `i` of `G` solves
+//! the small SPD system `A[P_i, P_i] g = e_i` and is scaled by `1/√g_i`, so `M⁻¹` is
+//! symmetric positive definite by construction (projected CG stays valid).
+//!
+//! Why: `A` is an order −1 operator on a porous set, badly conditioned for Jacobi; a
+//! local approximate inverse captures the strong coupling of neighbouring sites at the
+//! cost of two sparse products per iteration, far less than the DCT product.
+//!
+//! The entries of `C` between nearby sites are exact: with the cosine basis of the plan,
+//! `Ĝ[(a,i),(b,j)] = Σ K(s, t)` over `s ∈ {|a-b|, a+b+1}`, `t ∈ {|i-j|, i+j+1}` (the
+//! image sums of the even reflection), `K(s,t) = ¼ Σ λ(p,m) cos(πps/Nx) cos(πmt/Ny)`,
+//! tabulated once (`O(Nx Ny (Nx + Ny))`).
+//!
+//! Rows are cached per site with the pattern and compliances they were built from and
+//! rebuilt only when these change: every row is a pure function of its own inputs, so
+//! the preconditioner is a deterministic function of the set and the compliances (no
+//! history; checkpoints resume bit for bit).
+
+use crate::green::InfluencePlan;
+use std::f64::consts::PI;
+
+/// The exact entries of `C_s = scale (Ĝ - shift 11ᵀ)`.
+#[derive(Debug, Clone)]
+pub(crate) struct Entries {
+    nx: usize,
+    ny: usize,
+    /// `K(s, t)`, row-major `2Ny x 2Nx`.
+    k: Vec<f64>,
+    scale: f64,
+    shift: f64,
+}
+
+impl Entries {
+    pub(crate) fn new(plan: &InfluencePlan, scale: f64, shift: f64) -> Self {
+        let (nx, ny) = (plan.grid().nx(), plan.grid().ny());
+        // cos(π k / N) for k mod 2N, exact multiples.
+        let cos_table = |n: usize| -> Vec<f64> {
+            (0..2 * n)
+                .map(|k| (PI * k as f64 / n as f64).cos())
+                .collect()
+        };
+        let (cx, cy) = (cos_table(nx), cos_table(ny));
+        // H(p, t) = Σ_m λ(p,m) cos(πmt/Ny), t < 2Ny.
+        let mut h = vec![0.0; nx * 2 * ny];
+        for p in 0..nx {
+            for t in 0..2 * ny {
+                let mut s = 0.0;
+                for m in 0..ny {
+                    s += plan.lambda(p, m).unwrap_or(0.0) * cy[(m * t) % (2 * ny)];
+                }
+                h[p * 2 * ny + t] = s;
+            }
+        }
+        let mut k = vec![0.0; 4 * nx * ny];
+        for t in 0..2 * ny {
+            for s in 0..2 * nx {
+                let mut acc = 0.0;
+                for p in 0..nx {
+                    acc += h[p * 2 * ny + t] * cx[(p * s) % (2 * nx)];
+                }
+                k[t * 2 * nx + s] = 0.25 * acc;
+            }
+        }
+        Self {
+            nx,
+            ny,
+            k,
+            scale,
+            shift,
+        }
+    }
+
+    /// `C_s[i, j]` for sites `i`, `j`.
+    pub(crate) fn get(&self, i: usize, j: usize) -> f64 {
+        let (a, y) = (i % self.nx, i / self.nx);
+        let (b, z) = (j % self.nx, j / self.nx);
+        let s = [a.abs_diff(b), a + b + 1];
+        let t = [y.abs_diff(z), y + z + 1];
+        let w = 2 * self.nx;
+        let mut g = 0.0;
+        for tt in t {
+            for ss in s {
+                g += self.k[tt * w + ss];
+            }
+        }
+        self.scale * (g - self.shift)
+    }
+}
+
+/// Sites per block of the fused `Gᵀ G` product.
+const FUSED_BLOCK: usize = 256;
+
+/// The cached factor `G` (rows per site) of one system kind (normal or tangential).
+#[derive(Debug, Clone)]
+pub(crate) struct Fsai {
+    radius: usize,
+    /// Pattern slots per row: the site and its lower neighbours in a `(2r+1)²` box.
+    stride: usize,
+    /// Site offset of each slot (`dy Nx + dx ≤ 0`; the last slot is the site itself).
+    offsets: Vec<usize>,
+    /// Per site: pattern length (0: no row cached).
+    len: Vec<usize>,
+    /// Per site, `stride` slots: pattern sites (ascending, the site last), their slots,
+    /// the compliances they were built with and the row of `G`.
+    cols: Vec<usize>,
+    slots: Vec<usize>,
+    diag: Vec<f64>,
+    g: Vec<f64>,
+    /// Per site: the position in the current set (`usize::MAX` off the set).
+    position: Vec<usize>,
+    /// The current set (ascending sites).
+    sites: Vec<usize>,
+    /// `G` of the current set on the full grid as one weight plane per slot: `(G r)_i =
+    /// Σ_k w_k[i] r[i - offset_k]` (zero weight where a neighbour is missing). Why: the
+    /// products become shifted, contiguous, vectorised passes instead of gathers.
+    planes: Vec<f64>,
+    /// Full-grid scratch: `r`, `G r`, `Gᵀ G r`.
+    rf: Vec<f64>,
+    yf: Vec<f64>,
+    zf: Vec<f64>,
+    /// The small matrix.
+    small: Vec<f64>,
+}
+
+impl Fsai {
+    pub(crate) fn new(nx: usize, n: usize, radius: usize) -> Self {
+        let r = radius as isize;
+        let mut offsets = Vec::new();
+        for dy in -r..=0 {
+            let hi = if dy == 0 { -1 } else { r };
+            for dx in -r..=hi {
+                offsets.push((-(dy * nx as isize + dx)) as usize);
+            }
+        }
+        offsets.push(0);
+        let stride = offsets.len();
+        Self {
+            radius,
+            stride,
+            offsets,
+            len: vec![0; n],
+            cols: vec![0; n * stride],
+            slots: vec![0; n * stride],
+            diag: vec![0.0; n * stride],
+            g: vec![0.0; n * stride],
+            position: vec![usize::MAX; n],
+            sites: Vec::new(),
+            planes: vec![0.0; n * stride],
+            rf: vec![0.0; n],
+            yf: vec![0.0; n],
+            zf: vec![0.0; n],
+            small: vec![0.0; stride * stride],
+        }
+    }
+
+    /// Updates the factor for `set` (ascending sites) with compliances `d`.
+    pub(crate) fn update(&mut self, entries: &Entries, set: &[usize], d: &[f64]) {
+        let (nx, ny) = (entries.nx, entries.ny);
+        let n = nx * ny;
+        for &i in &self.sites {
+            self.position[i] = usize::MAX;
+        }
+        for (a, &i) in set.iter().enumerate() {
+            self.position[i] = a;
+        }
+        self.sites.clear();
+        self.sites.extend_from_slice(set);
+        self.planes.fill(0.0);
+        let r = self.radius as isize;
+        let mut pattern = Vec::with_capacity(self.stride);
+        let mut slots = Vec::with_capacity(self.stride);
+        for &i in set {
+            let (x, y) = ((i % nx) as isize, (i / nx) as isize);
+            pattern.clear();
+            slots.clear();
+            // Lower neighbours in site order: rows y - r..=y, and on row y only x' < x.
+            let mut slot = 0;
+            for dy in -r..=0 {
+                let hi = if dy == 0 { -1 } else { r };
+                for dx in -r..=hi {
+                    let (xx, yy) = (x + dx, y + dy);
+                    if xx >= 0 && xx < nx as isize && yy >= 0 && yy < ny as isize {
+                        let j = yy as usize * nx + xx as usize;
+                        if self.position[j] != usize::MAX {
+                            pattern.push(j);
+                            slots.push(slot);
+                        }
+                    }
+                    slot += 1;
+                }
+            }
+            pattern.push(i);
+            slots.push(slot);
+            let base = i * self.stride;
+            let k = pattern.len();
+            let same = self.len[i] == k
+                && self.cols[base..base + k] == pattern[..]
+                && pattern
+                    .iter()
+                    .zip(&self.diag[base..base + k])
+                    .all(|(&j, &dj)| d[self.position[j]].to_bits() == dj.to_bits());
+            if !same {
+                self.len[i] = k;
+                self.cols[base..base + k].copy_from_slice(&pattern);
+                self.slots[base..base + k].copy_from_slice(&slots);
+                for (slot, &j) in pattern.iter().enumerate() {
+                    self.diag[base + slot] = d[self.position[j]];
+                }
+                build_row(
+                    entries,
+                    &pattern,
+                    &self.diag[base..base + k],
+                    &mut self.small,
+                    &mut self.g[base..base + k],
+                );
+            }
+            for q in 0..k {
+                self.planes[self.slots[base + q] * n + i] = self.g[base + q];
+            }
+        }
+    }
+
+    /// `z = Gᵀ G r` on the current set.
+    pub(crate) fn apply(&mut self, r: &[f64], z: &mut [f64]) {
+        let n = self.rf.len();
+        self.rf.fill(0.0);
+        for (&i, &ri) in self.sites.iter().zip(r) {
+            self.rf[i] = ri;
+        }
+        self.zf.fill(0.0);
+        // Blocks of sites: both products per block while its weights are in L1 (the
+        // planes are read once per application; `Gᵀ` only writes below the block).
+        let mut b0 = 0;
+        while b0 < n {
+            let b1 = (b0 + FUSED_BLOCK).min(n);
+            self.yf[b0..b1].fill(0.0);
+            for (w, &o) in self.planes.chunks_exact(n).zip(&self.offsets) {
+                let lo = b0.max(o);
+                if lo >= b1 {
+                    continue;
+                }
+                // y[i] += w[i] r[i - o]
+                for ((y, w), x) in self.yf[lo..b1]
+                    .iter_mut()
+                    .zip(&w[lo..b1])
+                    .zip(&self.rf[lo - o..b1 - o])
+                {
+                    *y += w * x;
+                }
+            }
+            for (w, &o) in self.planes.chunks_exact(n).zip(&self.offsets) {
+                let lo = b0.max(o);
+                if lo >= b1 {
+                    continue;
+                }
+                // z[i - o] += w[i] y[i]
+                for ((z, w), y) in self.zf[lo - o..b1 - o]
+                    .iter_mut()
+                    .zip(&w[lo..b1])
+                    .zip(&self.yf[lo..b1])
+                {
+                    *z += w * y;
+                }
+            }
+            b0 = b1;
+        }
+        for (zi, &i) in z.iter_mut().zip(&self.sites) {
+            *zi = self.zf[i];
+        }
+    }
+}
+
+/// Row of `G` on `pattern` (the site last): `A[P, P] g = e_last`, `g /= √g_last`.
+fn build_row(entries: &Entries, pattern: &[usize], d: &[f64], small: &mut [f64], g: &mut [f64]) {
+    let k = pattern.len();
+    let l = &mut small[..k * k];
+    for (r, &i) in pattern.iter().enumerate() {
+        for (c, &j) in pattern.iter().enumerate().take(r + 1) {
+            let mut v = entries.get(i, j);
+            if r == c {
+                v += d[r];
+            }
+            l[r * k + c] = v;
+        }
+    }
+    // In-place Cholesky (lower).
+    for c in 0..k {
+        let mut piv = l[c * k + c];
+        for q in 0..c {
+            piv -= l[c * k + q] * l[c * k + q];
+        }
+        if piv.is_nan() || piv <= 0.0 {
+            // Not SPD (cannot happen with exact entries): fall back to the Jacobi row.
+            g.fill(0.0);
+            g[k - 1] = 1.0 / (entries.get(pattern[k - 1], pattern[k - 1]) + d[k - 1]).sqrt();
+            return;
+        }
+        let piv = piv.sqrt();
+        l[c * k + c] = piv;
+        for r in c + 1..k {
+            let mut v = l[r * k + c];
+            for q in 0..c {
+                v -= l[r * k + q] * l[c * k + q];
+            }
+            l[r * k + c] = v / piv;
+        }
+    }
+    // L y = e_last → y = e_last / L_kk; Lᵀ x = y; g = x / √x_last with x_last = 1/L_kk².
+    // So g = L_kk x, i.e. solve Lᵀ g = e_last.
+    g.fill(0.0);
+    g[k - 1] = 1.0;
+    for r in (0..k).rev() {
+        let mut v = g[r];
+        for q in r + 1..k {
+            v -= l[q * k + r] * g[q];
+        }
+        g[r] = v / l[r * k + r];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Block, Grid};
+
+    #[test]
+    fn entries_match_operator_columns() {
+        let grid = Grid::new(Block::new(0.012, 0.010, 0.075).unwrap(), 12, 10).unwrap();
+        let plan = InfluencePlan::builder(grid).build().unwrap();
+        let n = 120;
+        let (scale, shift) = (2.0, 0.1);
+        let e = Entries::new(&plan, scale, shift);
+        for j in [0, 5, 13, 57, 119] {
+            let mut v = vec![0.0; n];
+            v[j] = 1.0;
+            let mut out = vec![0.0; n];
+            plan.apply(&v, &mut out).unwrap();
+            for (i, o) in out.iter().enumerate() {
+                let want = scale * (o - shift);
+                let got = e.get(i, j);
+                assert!(
+                    (want - got).abs() <= 1e-12 * want.abs().max(1.0),
+                    "{i} {j}: {want} {got}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn factor_is_spd_and_history_free() {
+        let grid = Grid::new(Block::new(0.016, 0.012, 0.075).unwrap(), 16, 12).unwrap();
+        let plan = InfluencePlan::builder(grid).build().unwrap();
+        let e = Entries::new(&plan, 3.6e-16, 0.0);
+        let set_a: Vec<usize> = (0..192).filter(|i| (i * 7919) % 10 < 6).collect();
+        let set_b: Vec<usize> = (0..192)
+            .filter(|i| (i * 7919) % 10 < 6 && i % 17 != 3)
+            .collect();
+        let d = |set: &[usize]| -> Vec<f64> {
+            set.iter()
+                .map(|&i| 1e-14 * (1.0 + (i % 5) as f64))
+                .collect()
+        };
+        for radius in [1, 2] {
+            // Updated through set A, then set B, against a fresh factor of set B.
+            let mut warm = Fsai::new(16, 192, radius);
+            warm.update(&e, &set_a, &d(&set_a));
+            warm.update(&e, &set_b, &d(&set_b));
+            let mut fresh = Fsai::new(16, 192, radius);
+            fresh.update(&e, &set_b, &d(&set_b));
+            assert_eq!(warm.planes, fresh.planes);
+            let m = set_b.len();
+            let x: Vec<f64> = (0..m).map(|i| ((i * 31) % 7) as f64 - 3.0).collect();
+            let y: Vec<f64> = (0..m).map(|i| ((i * 17) % 5) as f64 - 2.0).collect();
+            let (mut mx, mut my) = (vec![0.0; m], vec![0.0; m]);
+            fresh.apply(&x, &mut mx);
+            fresh.apply(&y, &mut my);
+            let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();
+            let (xy, yx, xx) = (dot(&y, &mx), dot(&x, &my), dot(&x, &mx));
+            assert!((xy - yx).abs() <= 1e-12 * xx, "{xy} {yx}");
+            assert!(xx > 0.0);
+        }
+    }
+}
