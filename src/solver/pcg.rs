@@ -124,22 +124,14 @@ pub(crate) fn projected_pcg<S: SetSystem>(
         }
         project(sys, &mut r, &mut z, &mut offset);
         residual = backward(&r, f, offset);
-        if residual < best.0 {
-            best.0 = residual;
-            best.1.copy_from_slice(f);
-            best.2 = offset;
-        }
+        keep_best(&mut best, residual, f, offset);
         if residual <= tol {
             // Confirm with the true residual; rounding in the recurrence can flatter it.
             fix_sum(f);
             residual_of(sys, f, offset, &mut r);
             project(sys, &mut r, &mut z, &mut offset);
             residual = backward(&r, f, offset);
-            if residual < best.0 {
-                best.0 = residual;
-                best.1.copy_from_slice(f);
-                best.2 = offset;
-            }
+            keep_best(&mut best, residual, f, offset);
             if residual <= tol {
                 confirmed = true;
                 break;
@@ -179,6 +171,15 @@ pub(crate) fn projected_pcg<S: SetSystem>(
         iterations,
         residual,
         converged: residual <= tol,
+    }
+}
+
+/// Keeps the iterate with the smallest backward error (CG residuals are not monotone).
+fn keep_best(best: &mut (f64, Vec<f64>, f64), residual: f64, f: &[f64], offset: f64) {
+    if residual < best.0 {
+        best.0 = residual;
+        best.1.copy_from_slice(f);
+        best.2 = offset;
     }
 }
 
