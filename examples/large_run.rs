@@ -6,8 +6,9 @@
 //! the wall time, the event counts and the solver work split between the normal and the
 //! tangential equilibria.
 //!
-//! Run: `cargo run --release --example large_run [seed] [solver tolerance]` (the
-//! tolerance defaults to the solver's, `1e-13`).
+//! Run: `cargo run --release --example large_run [seed] [solver tolerance] [threads]`
+//! (the tolerance defaults to the solver's, `1e-13`; threads to 1, see
+//! `SolverOptions::threads`: the events are the same for every thread count).
 
 use precursors::{Event, Scene, SolverOptions};
 use std::time::Instant;
@@ -23,9 +24,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|s| s.parse())
         .transpose()?
         .unwrap_or(SolverOptions::default().tolerance);
+    let threads: usize = std::env::args()
+        .nth(3)
+        .map(|s| s.parse())
+        .transpose()?
+        .unwrap_or(1);
     let start = Instant::now();
     let scene = Scene::builder()
-        .solver(SolverOptions::default().with_tolerance(tolerance))
+        .solver(
+            SolverOptions::default()
+                .with_tolerance(tolerance)
+                .with_threads(threads),
+        )
         .block(0.200, 0.050, 0.075)
         .cell_size(1e-3, 1e-3)
         .seed(seed)

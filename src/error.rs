@@ -134,6 +134,14 @@ pub enum Error {
         /// Why it is refused.
         reason: &'static str,
     },
+    /// The operating system refused the solver's threads.
+    #[error("could not start a pool of {threads} solver threads: {reason}")]
+    ThreadPool {
+        /// Threads requested ([`crate::SolverOptions::threads`]).
+        threads: usize,
+        /// What the thread pool reported.
+        reason: String,
+    },
     /// A spring height is zero or negative.
     #[error("heights[{index}] = {value} m is invalid: spring heights must be > 0")]
     NonPositiveHeight {

@@ -13,5 +13,6 @@ mod operator;
 mod point;
 
 pub use loads::RodLoad;
+pub(crate) use operator::Dct2d;
 pub use operator::{InfluencePlan, InfluencePlanBuilder, PlaneTransfer, DENSE_LIMIT};
 pub use point::{Estimate, GreenFunction, SeriesOptions, SummationAxis};

@@ -213,11 +213,11 @@ const DIRECT_COLUMNS: usize = 16;
 const MATMUL_COLUMNS: usize = 64;
 
 /// The y-axis DCT-II and DCT-III as dense matrices (rustdct's unnormalised conventions).
-struct ColumnMatrices {
+pub(crate) struct ColumnMatrices {
     /// `D2[m][j] = cos(π m (2j+1) / (2Ny))`.
-    forward: faer::Mat<f64>,
+    pub(crate) forward: faer::Mat<f64>,
     /// `D3[j][m] = D2[m][j]`, and `1/2` for `m = 0`.
-    inverse: faer::Mat<f64>,
+    pub(crate) inverse: faer::Mat<f64>,
 }
 
 impl ColumnMatrices {
@@ -229,30 +229,27 @@ impl ColumnMatrices {
         }
     }
 
-    /// `buf ← D3 (diag ⊙ (D2 buf))`, `buf` the row-major `Ny x Nx` block; `tmp` holds
-    /// at least `Ny Nx` values.
-    fn filter(&self, buf: &mut [f64], diag: &[f64], tmp: &mut [f64], nx: usize) {
+    /// `block ← D3 (diag ⊙ (D2 block))`, `block` and `diag` row-major `Ny x width`;
+    /// `tmp` holds at least `Ny width` values.
+    fn filter(&self, block: &mut [f64], width: usize, diag: &[f64], tmp: &mut [f64]) {
         use faer::linalg::matmul::matmul;
         use faer::{Accum, MatMut, MatRef, Par};
         let ny = self.forward.nrows();
-        let n = nx * ny;
-        let tmp = &mut tmp[..n];
+        let tmp = &mut tmp[..ny * width];
         matmul(
-            MatMut::from_row_major_slice_mut(tmp, ny, nx),
+            MatMut::from_row_major_slice_mut(tmp, ny, width),
             Accum::Replace,
             self.forward.as_ref(),
-            MatRef::from_row_major_slice(buf, ny, nx),
+            MatRef::from_row_major_slice(block, ny, width),
             1.0,
             Par::Seq,
         );
-        for (t, d) in tmp.iter_mut().zip(diag) {
-            *t *= d;
-        }
+        tmp.iter_mut().zip(diag).for_each(|(t, d)| *t *= d);
         matmul(
-            MatMut::from_row_major_slice_mut(buf, ny, nx),
+            MatMut::from_row_major_slice_mut(block, ny, width),
             Accum::Replace,
             self.inverse.as_ref(),
-            MatRef::from_row_major_slice(tmp, ny, nx),
+            MatRef::from_row_major_slice(tmp, ny, width),
             1.0,
             Par::Seq,
         );
@@ -293,20 +290,22 @@ struct PairDct {
     n: usize,
     forward: Arc<dyn Fft<f64>>,
     inverse: Arc<dyn Fft<f64>>,
-    /// `exp(-iπk/(2n))`.
-    twiddle: Vec<Complex<f64>>,
+    /// `cos(πk/(2n))/2` and `sin(πk/(2n))/2`: the twiddle `exp(-iπk/(2n))` split into
+    /// real factors, so that the pre- and post-processing only forms the real parts it
+    /// keeps (a third of the flops of complex products; these passes were 19 % of a run).
+    half_cos: Vec<f64>,
+    half_sin: Vec<f64>,
 }
 
 impl PairDct {
     fn new(planner: &mut FftPlanner<f64>, n: usize) -> Self {
-        let twiddle = (0..n)
-            .map(|k| Complex::from_polar(1.0, -PI * k as f64 / (2.0 * n as f64)))
-            .collect();
+        let angle = |k: usize| PI * k as f64 / (2.0 * n as f64);
         Self {
             n,
             forward: planner.plan_fft_forward(n),
             inverse: planner.plan_fft_inverse(n),
-            twiddle,
+            half_cos: (0..n).map(|k| 0.5 * angle(k).cos()).collect(),
+            half_sin: (0..n).map(|k| 0.5 * angle(k).sin()).collect(),
         }
     }
 
@@ -316,15 +315,35 @@ impl PairDct {
             .max(self.inverse.get_inplace_scratch_len())
     }
 
-    /// Loads line pair `c` (lines `2c` and `2c+1`, element `j` of line `l` at
-    /// `data[l * line + j * step]`) into `z` in Makhoul's order.
-    fn load(&self, data: &[f64], line: usize, step: usize, c: usize, z: &mut [Complex<f64>]) {
+    /// Runs `body` on line pair `c` (lines `2c` and `2c+1`, element `j` of line `l` at
+    /// `data[l * line + j * step]`) as two contiguous slices: the lines themselves when
+    /// `step = 1` (the rows), else copies written back afterwards.
+    fn with_lines(
+        &self,
+        data: &mut [f64],
+        line: usize,
+        step: usize,
+        c: usize,
+        copies: &mut Vec<f64>,
+        body: impl FnOnce(&mut [f64], &mut [f64]),
+    ) {
         let n = self.n;
-        let (a, b) = (2 * c * line, (2 * c + 1) * line);
-        for j in 0..n / 2 {
-            let (e, o) = (2 * j * step, (2 * j + 1) * step);
-            z[j] = Complex::new(data[a + e], data[b + e]);
-            z[n - 1 - j] = Complex::new(data[a + o], data[b + o]);
+        if step == 1 {
+            let (a, b) = data[2 * c * line..].split_at_mut(line);
+            body(&mut a[..n], &mut b[..n]);
+            return;
+        }
+        copies.resize(2 * n, 0.0);
+        let (a, b) = copies.split_at_mut(n);
+        let (sa, sb) = (2 * c * line, (2 * c + 1) * line);
+        for j in 0..n {
+            a[j] = data[sa + j * step];
+            b[j] = data[sb + j * step];
+        }
+        body(a, b);
+        for j in 0..n {
+            data[sa + j * step] = a[j];
+            data[sb + j * step] = b[j];
         }
     }
 
@@ -339,26 +358,36 @@ impl PairDct {
         scratch: &mut Vec<Complex<f64>>,
     ) {
         let n = self.n;
-        let pairs = lines / 2;
-        z.resize(pairs * n, Complex::new(0.0, 0.0));
+        z.resize(lines / 2 * n, Complex::new(0.0, 0.0));
         scratch.resize(self.scratch_len(), Complex::new(0.0, 0.0));
+        let mut copies = Vec::new();
         for (c, zc) in z.chunks_exact_mut(n).enumerate() {
-            self.load(data, line, step, c, zc);
+            // Makhoul's order: z[j] = (a[2j], b[2j]), z[n-1-j] = (a[2j+1], b[2j+1]).
+            self.with_lines(data, line, step, c, &mut copies, |a, b| {
+                let (lo, hi) = zc.split_at_mut(n / 2);
+                let pairs = a.chunks_exact(2).zip(b.chunks_exact(2));
+                for ((zl, zh), (pa, pb)) in lo.iter_mut().zip(hi.iter_mut().rev()).zip(pairs) {
+                    *zl = Complex::new(pa[0], pb[0]);
+                    *zh = Complex::new(pa[1], pb[1]);
+                }
+            });
         }
         self.forward.process_with_scratch(z, scratch);
         for (c, zc) in z.chunks_exact(n).enumerate() {
-            let (a, b) = (2 * c * line, (2 * c + 1) * line);
-            for k in 0..n {
-                // Z(k) = V_a(k) + i V_b(k) with V_a, V_b Hermitian: separate them.
-                let zk = zc[k];
-                // (n - k) mod n without a division per element (hot loop).
-                let zm = zc[if k == 0 { 0 } else { n - k }].conj();
-                let va = (zk + zm) * 0.5;
-                let vb = (zk - zm) * Complex::new(0.0, -0.5);
-                let t = self.twiddle[k];
-                data[a + k * step] = (t * va).re;
-                data[b + k * step] = (t * vb).re;
-            }
+            // Z(k) = V_a(k) + i V_b(k) with V_a, V_b Hermitian: with Z(k) = X + iY and
+            // Z(n-k) = P + iQ, V_a(k) = (X+P + i(Y-Q))/2 and V_b(k) = (Y+Q - i(X-P))/2;
+            // the DCT-II is Re(exp(-iπk/(2n)) V(k)). At k = 0: V_a = X, V_b = Y.
+            self.with_lines(data, line, step, c, &mut copies, |a, b| {
+                a[0] = zc[0].re;
+                b[0] = zc[0].im;
+                let twiddles = self.half_cos[1..].iter().zip(&self.half_sin[1..]);
+                let outputs = a[1..].iter_mut().zip(b[1..].iter_mut());
+                let inputs = zc[1..].iter().zip(zc[1..].iter().rev());
+                for (((z, w), (oa, ob)), (hc, hs)) in inputs.zip(outputs).zip(twiddles) {
+                    *oa = hc * (z.re + w.re) + hs * (z.im - w.im);
+                    *ob = hc * (z.im + w.im) + hs * (w.re - z.re);
+                }
+            });
         }
     }
 
@@ -373,35 +402,40 @@ impl PairDct {
         scratch: &mut Vec<Complex<f64>>,
     ) {
         let n = self.n;
-        let pairs = lines / 2;
-        z.resize(pairs * n, Complex::new(0.0, 0.0));
+        z.resize(lines / 2 * n, Complex::new(0.0, 0.0));
         scratch.resize(self.scratch_len(), Complex::new(0.0, 0.0));
+        let mut copies = Vec::new();
         for (c, zc) in z.chunks_exact_mut(n).enumerate() {
-            let (a, b) = (2 * c * line, (2 * c + 1) * line);
-            for k in 0..n {
-                // W(k) = (X(k) - i X(n-k)) exp(iπk/(2n)) / 2 per line (X(n) = 0); the
-                // inverse FFT of W_a + i W_b is v_a + i v_b (both real).
-                let (xa_m, xb_m) = if k == 0 {
-                    (0.0, 0.0)
-                } else {
-                    (data[a + (n - k) * step], data[b + (n - k) * step])
-                };
-                let wa = Complex::new(data[a + k * step], -xa_m);
-                let wb = Complex::new(data[b + k * step], -xb_m);
-                let t = self.twiddle[k].conj() * 0.5;
-                zc[k] = (wa + Complex::new(0.0, 1.0) * wb) * t;
-            }
+            // W(k) = (X(k) - i X(n-k)) exp(iπk/(2n)) / 2 per line (X(n) = 0); the inverse
+            // FFT of W_a + i W_b is v_a + i v_b (both real). In real parts, with A = X_a(k),
+            // Ā = X_a(n-k) and B, B̄ alike: Re = c(A + B̄) + s(Ā - B), Im = s(A + B̄) + c(B - Ā).
+            self.with_lines(data, line, step, c, &mut copies, |a, b| {
+                zc[0] = Complex::new(self.half_cos[0] * a[0], self.half_cos[0] * b[0]);
+                let twiddles = self.half_cos[1..].iter().zip(&self.half_sin[1..]);
+                let ahead = a[1..].iter().zip(&b[1..]);
+                let behind = a[1..].iter().rev().zip(b[1..].iter().rev());
+                for ((zk, ((xa, xb), (ya, yb))), (hc, hs)) in
+                    zc[1..].iter_mut().zip(ahead.zip(behind)).zip(twiddles)
+                {
+                    *zk = Complex::new(
+                        hc * (xa + yb) + hs * (ya - xb),
+                        hs * (xa + yb) + hc * (xb - ya),
+                    );
+                }
+            });
         }
         self.inverse.process_with_scratch(z, scratch);
         for (c, zc) in z.chunks_exact(n).enumerate() {
-            let (a, b) = (2 * c * line, (2 * c + 1) * line);
-            for j in 0..n / 2 {
-                let (e, o) = (2 * j * step, (2 * j + 1) * step);
-                data[a + e] = zc[j].re;
-                data[b + e] = zc[j].im;
-                data[a + o] = zc[n - 1 - j].re;
-                data[b + o] = zc[n - 1 - j].im;
-            }
+            self.with_lines(data, line, step, c, &mut copies, |a, b| {
+                let (lo, hi) = zc.split_at(n / 2);
+                let pairs = a.chunks_exact_mut(2).zip(b.chunks_exact_mut(2));
+                for ((zl, zh), (pa, pb)) in lo.iter().zip(hi.iter().rev()).zip(pairs) {
+                    pa[0] = zl.re;
+                    pb[0] = zl.im;
+                    pa[1] = zh.re;
+                    pb[1] = zh.im;
+                }
+            });
         }
     }
 }
@@ -446,104 +480,141 @@ impl Dct2d {
     /// unnormalised DCT-III on both axes. `work` is scratch (resized as needed), so that
     /// iterative solvers do not allocate per product.
     pub(crate) fn filter(&self, buf: &mut [f64], diag: &[f64], work: &mut Vec<f64>) {
-        if let Some((px, py)) = &self.pairs {
-            let (nx, ny) = (self.nx, self.ny);
-            if self.columns_matmul.is_some() && work.len() < buf.len() {
-                work.resize(buf.len(), 0.0);
-            }
-            PAIR_SCRATCH.with_borrow_mut(|(z, scratch)| {
-                px.dct2(buf, ny, nx, 1, z, scratch); // rows
-                if let Some(columns) = &self.columns_matmul {
-                    columns.filter(buf, diag, work, nx);
-                } else {
-                    py.dct2(buf, nx, 1, nx, z, scratch); // columns
-                    for (b, d) in buf.iter_mut().zip(diag) {
-                        *b *= d;
-                    }
-                    py.dct3(buf, nx, 1, nx, z, scratch);
-                }
-                px.dct3(buf, ny, nx, 1, z, scratch);
-            });
+        self.rows(buf, true, work);
+        self.columns(buf, self.nx, diag, work);
+        self.rows(buf, false, work);
+    }
+
+    /// The y-transforms as matrices, when they run as matrix products.
+    pub(crate) fn column_matrices(&self) -> Option<&ColumnMatrices> {
+        self.columns_matmul.as_ref()
+    }
+
+    /// Whether [`Dct2d::rows`] transforms `lines` rows as pairs (then any even split of the
+    /// rows gives the same values as the whole block).
+    pub(crate) fn pairs_rows(&self) -> bool {
+        self.pairs.is_some()
+    }
+
+    /// Unnormalised DCT-II (`forward`) or DCT-III of every row of `rows`, a whole number
+    /// of rows of the grid (an even number on the paired path), in place.
+    pub(crate) fn rows(&self, rows: &mut [f64], forward: bool, work: &mut Vec<f64>) {
+        let nx = self.nx;
+        let lines = rows.len() / nx;
+        if lines == 0 {
             return;
         }
-        let direct_len = if self.direct.is_some() || self.columns_matmul.is_some() {
-            buf.len()
-        } else {
-            0
-        };
-        let need = self.scratch_len + self.ny + direct_len;
-        if work.len() < need {
-            work.resize(need, 0.0);
+        if let Some((px, _)) = &self.pairs {
+            if lines % 2 == 0 {
+                PAIR_SCRATCH.with_borrow_mut(|(z, scratch)| {
+                    if forward {
+                        px.dct2(rows, lines, nx, 1, z, scratch);
+                    } else {
+                        px.dct3(rows, lines, nx, 1, z, scratch);
+                    }
+                });
+                return;
+            }
         }
-        let (scratch, rest) = work.split_at_mut(self.scratch_len);
-        let (column, tmp) = rest.split_at_mut(self.ny);
-        for row in buf.chunks_exact_mut(self.nx) {
-            self.x.process_dct2_with_scratch(row, scratch);
+        if work.len() < self.scratch_len {
+            work.resize(self.scratch_len, 0.0);
         }
-        if let Some(columns) = &self.columns_matmul {
-            columns.filter(buf, diag, tmp, self.nx);
-            for row in buf.chunks_exact_mut(self.nx) {
+        let scratch = &mut work[..self.scratch_len];
+        for row in rows.chunks_exact_mut(nx) {
+            if forward {
+                self.x.process_dct2_with_scratch(row, scratch);
+            } else {
                 self.x.process_dct3_with_scratch(row, scratch);
             }
-            return;
-        }
-        self.columns(buf, column, scratch, &mut tmp[..direct_len], true);
-        for (b, d) in buf.iter_mut().zip(diag) {
-            *b *= d;
-        }
-        self.columns(buf, column, scratch, &mut tmp[..direct_len], false);
-        for row in buf.chunks_exact_mut(self.nx) {
-            self.x.process_dct3_with_scratch(row, scratch);
         }
     }
 
-    fn columns(
+    /// `block ← DCT-III_y (diag ⊙ DCT-II_y block)` on a row-major `Ny x width` block of
+    /// columns (`diag` the same block of the table), in place.
+    pub(crate) fn columns(
         &self,
-        buf: &mut [f64],
-        column: &mut [f64],
-        scratch: &mut [f64],
-        tmp: &mut [f64],
-        forward: bool,
+        block: &mut [f64],
+        width: usize,
+        diag: &[f64],
+        work: &mut Vec<f64>,
     ) {
-        if self.ny == 1 {
-            return; // a length-1 DCT-II is the identity; DCT-III halves it, compensated in diag
-        }
-        let nx = self.nx;
-        if let Some(table) = &self.direct {
-            // DCT-II: out_m = Σ_j cos(π m (2j+1)/2Ny) in_j; DCT-III: out_j = in_0/2 +
-            // Σ_{m>0} cos(π m (2j+1)/2Ny) in_m (rustdct's unnormalised conventions).
-            let ny = self.ny;
-            tmp.fill(0.0);
-            for o in 0..ny {
-                let out = &mut tmp[o * nx..(o + 1) * nx];
-                for i in 0..ny {
-                    let w = if forward {
-                        table[o * ny + i]
-                    } else if i == 0 {
-                        0.5
-                    } else {
-                        table[i * ny + o]
-                    };
-                    let src = &buf[i * nx..(i + 1) * nx];
-                    for (d, s) in out.iter_mut().zip(src) {
-                        *d += w * s;
-                    }
-                }
-            }
-            buf.copy_from_slice(tmp);
+        let ny = self.ny;
+        let n = ny * width;
+        if ny == 1 {
+            // A length-1 DCT-II is the identity; DCT-III halves it, compensated in diag.
+            block.iter_mut().zip(diag).for_each(|(b, d)| *b *= d);
             return;
         }
-        for ix in 0..nx {
-            for (iy, c) in column.iter_mut().enumerate() {
-                *c = buf[iy * nx + ix];
+        if let Some(columns) = &self.columns_matmul {
+            if work.len() < n {
+                work.resize(n, 0.0);
+            }
+            columns.filter(block, width, diag, work);
+            return;
+        }
+        if let Some(table) = &self.direct {
+            if work.len() < n {
+                work.resize(n, 0.0);
+            }
+            let tmp = &mut work[..n];
+            for forward in [true, false] {
+                // DCT-II: out_m = Σ_j cos(π m (2j+1)/2Ny) in_j; DCT-III: out_j = in_0/2 +
+                // Σ_{m>0} cos(π m (2j+1)/2Ny) in_m (rustdct's unnormalised conventions).
+                tmp.fill(0.0);
+                for o in 0..ny {
+                    let out = &mut tmp[o * width..(o + 1) * width];
+                    for i in 0..ny {
+                        let w = if forward {
+                            table[o * ny + i]
+                        } else if i == 0 {
+                            0.5
+                        } else {
+                            table[i * ny + o]
+                        };
+                        let src = &block[i * width..(i + 1) * width];
+                        for (d, s) in out.iter_mut().zip(src) {
+                            *d += w * s;
+                        }
+                    }
+                }
+                block.copy_from_slice(tmp);
+                if forward {
+                    block.iter_mut().zip(diag).for_each(|(b, d)| *b *= d);
+                }
+            }
+            return;
+        }
+        if let Some((_, py)) = &self.pairs {
+            if width % 2 == 0 {
+                PAIR_SCRATCH.with_borrow_mut(|(z, scratch)| {
+                    py.dct2(block, width, 1, width, z, scratch);
+                    block.iter_mut().zip(diag).for_each(|(b, d)| *b *= d);
+                    py.dct3(block, width, 1, width, z, scratch);
+                });
+                return;
+            }
+        }
+        let need = self.scratch_len + ny;
+        if work.len() < need {
+            work.resize(need, 0.0);
+        }
+        let (scratch, column) = work[..need].split_at_mut(self.scratch_len);
+        for forward in [true, false] {
+            for ix in 0..width {
+                for (iy, c) in column.iter_mut().enumerate() {
+                    *c = block[iy * width + ix];
+                }
+                if forward {
+                    self.y.process_dct2_with_scratch(column, scratch);
+                } else {
+                    self.y.process_dct3_with_scratch(column, scratch);
+                }
+                for (iy, c) in column.iter().enumerate() {
+                    block[iy * width + ix] = *c;
+                }
             }
             if forward {
-                self.y.process_dct2_with_scratch(column, scratch);
-            } else {
-                self.y.process_dct3_with_scratch(column, scratch);
-            }
-            for (iy, c) in column.iter().enumerate() {
-                buf[iy * nx + ix] = *c;
+                block.iter_mut().zip(diag).for_each(|(b, d)| *b *= d);
             }
         }
     }
@@ -649,9 +720,14 @@ impl InfluencePlan {
         Ok(())
     }
 
-    /// `buf ← Ĝ buf` without validation (the solvers' inner loop).
+    /// `buf ← Ĝ buf` in place (`work`: scratch).
     pub(crate) fn apply_in_place(&self, buf: &mut [f64], work: &mut Vec<f64>) {
         self.dct.filter(buf, &self.scaled, work);
+    }
+
+    /// The planned transforms and the operator's table (the solver's split products).
+    pub(crate) fn transforms(&self) -> (&Dct2d, &[f64]) {
+        (&self.dct, &self.scaled)
     }
 
     /// The table for [`InfluencePlan::filter_in_place`] of the operator with the same
@@ -669,11 +745,6 @@ impl InfluencePlan {
             }
         }
         dct_diagonal(&self.grid, &values)
-    }
-
-    /// Applies, in place, the operator whose table [`InfluencePlan::spectral_table`] built.
-    pub(crate) fn filter_in_place(&self, buf: &mut [f64], table: &[f64], work: &mut Vec<f64>) {
-        self.dct.filter(buf, table, work);
     }
 
     /// The dense matrix `Ĝ` (m⁻¹), row-major `N x N`, assembled from the eigenvalue table

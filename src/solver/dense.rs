@@ -296,7 +296,7 @@ impl FactorCache {
 }
 
 /// The dense matrix `C_s` (m/Pa) of every site, column-major.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub(crate) struct DenseCore {
     pub(crate) c: Mat<f64>,
     pub(crate) normal: FactorCache,

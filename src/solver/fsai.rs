@@ -90,6 +90,7 @@ impl Entries {
 }
 
 /// Sites per block of the fused `Gᵀ G` product.
+#[cfg(test)]
 const FUSED_BLOCK: usize = 256;
 
 /// The cached factor `G` (rows per site) of one system kind (normal or tangential).
@@ -116,10 +117,6 @@ pub(crate) struct Fsai {
     /// Σ_k w_k[i] r[i - offset_k]` (zero weight where a neighbour is missing). Why: the
     /// products become shifted, contiguous, vectorised passes instead of gathers.
     planes: Vec<f64>,
-    /// Full-grid scratch: `r`, `G r`, `Gᵀ G r`.
-    rf: Vec<f64>,
-    yf: Vec<f64>,
-    zf: Vec<f64>,
     /// The small matrix.
     small: Vec<f64>,
 }
@@ -148,9 +145,6 @@ impl Fsai {
             position: vec![usize::MAX; n],
             sites: Vec::new(),
             planes: vec![0.0; n * stride],
-            rf: vec![0.0; n],
-            yf: vec![0.0; n],
-            zf: vec![0.0; n],
             small: vec![0.0; stride * stride],
         }
     }
@@ -222,30 +216,37 @@ impl Fsai {
         }
     }
 
-    /// `z = Gᵀ G r` on the current set.
+    /// `G` of the current set as weight planes (`N` values per slot, slot-major) and the
+    /// slots' site offsets: `(G r)_i = Σ_k w_k[i] r[i - o_k]`.
+    pub(crate) fn weights(&self) -> (&[f64], &[usize]) {
+        (&self.planes, &self.offsets)
+    }
+
+    /// `z = Gᵀ G r` on the current set (the solver applies it split, in `team.rs`).
+    #[cfg(test)]
     pub(crate) fn apply(&mut self, r: &[f64], z: &mut [f64]) {
-        let n = self.rf.len();
-        self.rf.fill(0.0);
+        let n = self.position.len();
+        let (mut rf, mut yf, mut zf) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         for (&i, &ri) in self.sites.iter().zip(r) {
-            self.rf[i] = ri;
+            rf[i] = ri;
         }
-        self.zf.fill(0.0);
+        zf.fill(0.0);
         // Blocks of sites: both products per block while its weights are in L1 (the
         // planes are read once per application; `Gᵀ` only writes below the block).
         let mut b0 = 0;
         while b0 < n {
             let b1 = (b0 + FUSED_BLOCK).min(n);
-            self.yf[b0..b1].fill(0.0);
+            yf[b0..b1].fill(0.0);
             for (w, &o) in self.planes.chunks_exact(n).zip(&self.offsets) {
                 let lo = b0.max(o);
                 if lo >= b1 {
                     continue;
                 }
                 // y[i] += w[i] r[i - o]
-                for ((y, w), x) in self.yf[lo..b1]
+                for ((y, w), x) in yf[lo..b1]
                     .iter_mut()
                     .zip(&w[lo..b1])
-                    .zip(&self.rf[lo - o..b1 - o])
+                    .zip(&rf[lo - o..b1 - o])
                 {
                     *y += w * x;
                 }
@@ -256,10 +257,10 @@ impl Fsai {
                     continue;
                 }
                 // z[i - o] += w[i] y[i]
-                for ((z, w), y) in self.zf[lo - o..b1 - o]
+                for ((z, w), y) in zf[lo - o..b1 - o]
                     .iter_mut()
                     .zip(&w[lo..b1])
-                    .zip(&self.yf[lo..b1])
+                    .zip(&yf[lo..b1])
                 {
                     *z += w * y;
                 }
@@ -267,7 +268,7 @@ impl Fsai {
             b0 = b1;
         }
         for (zi, &i) in z.iter_mut().zip(&self.sites) {
-            *zi = self.zf[i];
+            *zi = zf[i];
         }
     }
 }

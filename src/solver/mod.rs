@@ -28,6 +28,7 @@ mod dense;
 mod fsai;
 mod pcg;
 mod spectral;
+mod team;
 
 use crate::error::{check_slice, check_tolerance, Error, Result};
 use crate::geometry::Grid;
@@ -37,6 +38,7 @@ use dense::{DenseCore, FactorState};
 use pcg::{projected_pcg, PcgOutcome};
 use spectral::{Precond, SpectralCore};
 use std::collections::HashSet;
+use std::sync::Arc;
 
 /// Backward error of the linear solves while a cold attached set is explored.
 const EXPLORE_TOLERANCE: f64 = 1e-7;
@@ -59,6 +61,9 @@ pub enum Backend {
     Spectral,
 }
 
+/// Most threads a solver uses ([`SolverOptions::threads`]).
+pub const MAX_THREADS: usize = 2;
+
 /// Options of the equilibrium solvers.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
@@ -72,6 +77,13 @@ pub struct SolverOptions {
     pub max_active_set_iterations: usize,
     /// Conjugate-gradient iterations allowed per linear solve (default `20000`).
     pub max_linear_iterations: usize,
+    /// Threads of the spectral backend's conjugate gradients, `1` (default: no thread is
+    /// started) or `2`. The spectral CG always splits the grid in two fixed halves
+    /// (`solver/team.rs`); with two threads the solver owns a pool of two and runs one
+    /// half on each, in step. The arithmetic is the same either way: results are bit for
+    /// bit those of one thread (tested), only the wall time changes (docs/performance.md).
+    /// The dense backend's factor solves stay on one thread.
+    pub threads: usize,
 }
 
 impl Default for SolverOptions {
@@ -81,6 +93,7 @@ impl Default for SolverOptions {
             tolerance: 1e-13,
             max_active_set_iterations: 1000,
             max_linear_iterations: 20000,
+            threads: 1,
         }
     }
 }
@@ -97,6 +110,13 @@ impl SolverOptions {
     #[must_use]
     pub fn with_tolerance(mut self, tolerance: f64) -> Self {
         self.tolerance = tolerance;
+        self
+    }
+
+    /// With the given number of threads, 1 or 2 (see [`SolverOptions::threads`]).
+    #[must_use]
+    pub fn with_threads(mut self, threads: usize) -> Self {
+        self.threads = threads;
         self
     }
 }
@@ -235,6 +255,27 @@ impl EquilibriumSolverBuilder {
     pub fn build(self) -> Result<EquilibriumSolver> {
         self.material.validate()?;
         check_tolerance(self.options.tolerance)?;
+        let threads = self.options.threads;
+        if !(1..=MAX_THREADS).contains(&threads) {
+            return Err(Error::InvalidParameter {
+                name: "threads",
+                value: threads as f64,
+                reason: "the spectral solver splits its work in two halves: 1 or 2 threads",
+            });
+        }
+        let pool = if threads > 1 {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .thread_name(|i| format!("precursors-solver-{i}"))
+                .build()
+                .map_err(|e| Error::ThreadPool {
+                    threads,
+                    reason: e.to_string(),
+                })?;
+            Some(Arc::new(pool))
+        } else {
+            None
+        };
         let grid = *self.plan.grid();
         let n = grid.len();
         let backend = match self.options.backend {
@@ -261,10 +302,16 @@ impl EquilibriumSolverBuilder {
             Backend::Dense => {
                 let g = self.plan.dense()?;
                 let c = faer::Mat::from_fn(n, n, |i, j| scale * (g[i * n + j] - shift));
-                let spectral = SpectralCore::new(self.plan, scale, shift, norm_c);
+                let spectral = SpectralCore::new(self.plan, scale, shift, norm_c, pool.clone());
                 Core::Dense(Box::new(DenseCore::new(c, norm_c, spectral)))
             }
-            _ => Core::Spectral(Box::new(SpectralCore::new(self.plan, scale, shift, norm_c))),
+            _ => Core::Spectral(Box::new(SpectralCore::new(
+                self.plan,
+                scale,
+                shift,
+                norm_c,
+                pool.clone(),
+            ))),
         };
         Ok(EquilibriumSolver {
             grid,
@@ -275,6 +322,7 @@ impl EquilibriumSolverBuilder {
             shift,
             norm_c,
             core,
+            pool,
             warm_normal: Vec::new(),
             warm_tangential: Vec::new(),
         })
@@ -292,6 +340,8 @@ pub struct EquilibriumSolver {
     shift: f64,
     norm_c: f64,
     core: Core,
+    /// The threads of [`SolverOptions::threads`] (`None` for one thread).
+    pool: Option<Arc<rayon::ThreadPool>>,
     warm_normal: Vec<f64>,
     warm_tangential: Vec<f64>,
 }
@@ -475,8 +525,9 @@ impl EquilibriumSolver {
             Core::Dense(core) if explore => {
                 // A cold or much-changed set: find the attached set with the cheap
                 // spectral iteration first; the factor confirms the final set.
-                let mut sys = core.spectral.system(set, diag, Precond::Spectral);
-                projected_pcg(&mut sys, b, total, &mut f, tol, max_it)
+                let precond = Precond::Spectral;
+                core.spectral
+                    .solve(set, diag, precond, b, total, &mut f, tol, max_it)
             }
             Core::Dense(core) => {
                 let mut sys = core.system(tangential, set, diag)?;
@@ -507,8 +558,7 @@ impl EquilibriumSolver {
                 } else {
                     spectral::warm_precond(tangential)
                 };
-                let mut sys = core.system(set, diag, precond);
-                projected_pcg(&mut sys, b, total, &mut f, tol, max_it)
+                core.solve(set, diag, precond, b, total, &mut f, tol, max_it)
             }
         };
         if !outcome.converged {
@@ -541,6 +591,18 @@ impl EquilibriumSolver {
     /// broken, [`Error::SolverNotConverged`] / [`Error::Factorization`] when the linear
     /// algebra fails (with its diagnostics).
     pub fn solve_normal(
+        &mut self,
+        interface: &mut Interface,
+        normal_load: f64,
+    ) -> Result<NormalEquilibrium> {
+        match self.pool.clone() {
+            Some(pool) => pool.install(|| self.normal_here(interface, normal_load)),
+            None => self.normal_here(interface, normal_load),
+        }
+    }
+
+    /// [`EquilibriumSolver::solve_normal`] on the calling thread (inside the pool if any).
+    fn normal_here(
         &mut self,
         interface: &mut Interface,
         normal_load: f64,
@@ -773,6 +835,21 @@ impl EquilibriumSolver {
     /// shear (a constant), `RodLoad::influence_cells / M` for a rod or side load. The
     /// response to a load `F` is `F` times the returned one.
     pub fn solve_tangential(
+        &mut self,
+        interface: &Interface,
+        normal_displacement: &[f64],
+        unit_load_displacement: &[f64],
+    ) -> Result<TangentialResponse> {
+        let (u_z, e) = (normal_displacement, unit_load_displacement);
+        match self.pool.clone() {
+            Some(pool) => pool.install(|| self.tangential_here(interface, u_z, e)),
+            None => self.tangential_here(interface, u_z, e),
+        }
+    }
+
+    /// [`EquilibriumSolver::solve_tangential`] on the calling thread (inside the pool if
+    /// any).
+    fn tangential_here(
         &mut self,
         interface: &Interface,
         normal_displacement: &[f64],

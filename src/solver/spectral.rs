@@ -3,8 +3,10 @@
 //! no `N x N` matrix is ever formed.
 
 use super::fsai::{Entries, Fsai};
-use super::pcg::SetSystem;
+use super::pcg::PcgOutcome;
+use super::team::{SplitPrecond, Team};
 use crate::green::InfluencePlan;
+use std::sync::Arc;
 
 /// Pattern radius (cells) of the FSAI preconditioner. Measured on the N = 1e4 run (first
 /// 1000 ruptures, warm normal solves): Jacobi 68.3 CG iterations, 13.3 ms per solve;
@@ -36,7 +38,7 @@ pub(crate) enum Precond {
 }
 
 /// Scratch and constants of the spectral backend.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub(crate) struct SpectralCore {
     plan: InfluencePlan,
     /// `C_s = scale (Ĝ - shift 11ᵀ)`.
@@ -53,10 +55,18 @@ pub(crate) struct SpectralCore {
     /// Exact local entries of `C_s` (built on first use) and the FSAI factors.
     entries: Option<Entries>,
     fsai: Option<Fsai>,
+    /// The split CG (one or two threads, the same results).
+    team: Team,
 }
 
 impl SpectralCore {
-    pub(crate) fn new(plan: InfluencePlan, scale: f64, shift: f64, norm_c: f64) -> Self {
+    pub(crate) fn new(
+        plan: InfluencePlan,
+        scale: f64,
+        shift: f64,
+        norm_c: f64,
+        pool: Option<Arc<rayon::ThreadPool>>,
+    ) -> Self {
         let n = plan.grid().len();
         let (nx, ny) = (plan.grid().nx(), plan.grid().ny());
         // trace(Ĝ) = Σ eigenvalues; the diagonal varies only near the edges.
@@ -68,7 +78,6 @@ impl SpectralCore {
         }
         let diag_c = scale * (trace / n as f64 - shift);
         Self {
-            plan,
             scale,
             shift,
             diag_c,
@@ -78,18 +87,28 @@ impl SpectralCore {
             inverse: None,
             entries: None,
             fsai: None,
+            team: Team::new(&plan, pool),
+            plan,
         }
     }
 
     /// `out = C_s x` over every site, `x` given on `set`.
+    /// After a solve, `x` its solution, the transform is the one of the solve's last
+    /// product (no product of its own).
     pub(crate) fn apply_full(&mut self, set: &[usize], x: &[f64], out: &mut [f64]) {
-        out.fill(0.0);
-        let mut sum = 0.0;
-        for (&i, &xi) in set.iter().zip(x) {
-            out[i] = xi;
-            sum += xi;
-        }
-        self.plan.apply_in_place(out, &mut self.work);
+        let sum = match self.team.last_transform(set, x, out) {
+            Some(sum) => sum,
+            None => {
+                out.fill(0.0);
+                let mut sum = 0.0;
+                for (&i, &xi) in set.iter().zip(x) {
+                    out[i] = xi;
+                    sum += xi;
+                }
+                self.plan.apply_in_place(out, &mut self.work);
+                sum
+            }
+        };
         let s = self.scale;
         let c = self.shift * sum;
         out.iter_mut().for_each(|o| *o = s * (*o - c));
@@ -133,18 +152,13 @@ impl SpectralCore {
         }
     }
 
-    /// The system on `set` with compliances `diag`. Preconditioner: Jacobi (the mean
-    /// diagonal of `C` plus `d`), FSAI (updated here for the set), or the full-grid inverse
-    /// `(C_s + d̄ I)⁻¹` restricted to the set (`d̄` the mean compliance). `C` is diagonal in
-    /// the DCT basis, so the latter costs a second transform pair per iteration and
-    /// halves the iterations: it pays on cold, far-from-solution solves of large grids
-    /// (measured in docs/performance.md), Jacobi on warm ones.
-    pub(crate) fn system<'a>(
-        &'a mut self,
-        set: &'a [usize],
-        diag: &'a [f64],
-        precond: Precond,
-    ) -> SpectralSystem<'a> {
+    /// Prepares the preconditioner of a solve on `set` with compliances `diag` and returns
+    /// `‖A‖`'s bound. Jacobi (the mean diagonal of `C` plus `d`), FSAI (updated here for
+    /// the set), or the full-grid inverse `(C_s + d̄ I)⁻¹` restricted to the set (`d̄` the
+    /// mean compliance). `C` is diagonal in the DCT basis, so the latter costs a second
+    /// transform pair per iteration and halves the iterations: it pays on cold,
+    /// far-from-solution solves of large grids (measured in docs/performance.md).
+    fn prepare(&mut self, set: &[usize], diag: &[f64], precond: Precond) -> f64 {
         let norm = self.norm_c + diag.iter().fold(0.0f64, |m, d| m.max(*d));
         if precond == Precond::Fsai {
             if self.entries.is_none() {
@@ -158,78 +172,55 @@ impl SpectralCore {
                 fsai.update(entries, set, diag);
             }
         }
-        if precond != Precond::Spectral {
-            return SpectralSystem {
-                core: self,
-                set,
-                diag,
-                norm,
-                precond,
+        if precond == Precond::Spectral {
+            let mean_d = diag.iter().sum::<f64>() / diag.len().max(1) as f64;
+            let stale = match &self.inverse {
+                Some((d, _)) => (d - mean_d).abs() > 0.05 * mean_d.abs().max(f64::MIN_POSITIVE),
+                None => true,
             };
+            if stale {
+                self.build_inverse(mean_d);
+            }
         }
-        let mean_d = diag.iter().sum::<f64>() / diag.len().max(1) as f64;
-        let stale = match &self.inverse {
-            Some((d, _)) => (d - mean_d).abs() > 0.05 * mean_d.abs().max(f64::MIN_POSITIVE),
-            None => true,
+        norm
+    }
+
+    /// Solves `A f + U 1 = b`, `1ᵀ f = total` on `set` with `A = C_SS + diag(diag)` by
+    /// the split projected CG ([`Team`]); `f` holds the warm start on entry. The
+    /// preconditioner is prepared by [`SpectralCore::prepare`].
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn solve(
+        &mut self,
+        set: &[usize],
+        diag: &[f64],
+        precond: Precond,
+        b: &[f64],
+        total: f64,
+        f: &mut [f64],
+        tol: f64,
+        max_iterations: usize,
+    ) -> PcgOutcome {
+        let norm = self.prepare(set, diag, precond);
+        let split = match (precond, &self.fsai, &self.inverse) {
+            (Precond::Fsai, Some(fsai), _) => SplitPrecond::Fsai(fsai),
+            (Precond::Spectral, _, Some((_, table))) => SplitPrecond::Spectral(table),
+            _ => SplitPrecond::Jacobi {
+                diag_c: self.diag_c,
+            },
         };
-        if stale {
-            self.build_inverse(mean_d);
-        }
-        SpectralSystem {
-            core: self,
+        let constants = (self.scale, self.shift, norm);
+        self.team.solve(
+            &self.plan,
+            constants,
+            split,
             set,
             diag,
-            norm,
-            precond,
-        }
-    }
-}
-
-/// `A_SS = C_SS + diag(d)` applied matrix-free.
-pub(crate) struct SpectralSystem<'a> {
-    core: &'a mut SpectralCore,
-    set: &'a [usize],
-    diag: &'a [f64],
-    norm: f64,
-    precond: Precond,
-}
-
-impl SetSystem for SpectralSystem<'_> {
-    fn apply(&mut self, x: &[f64], y: &mut [f64]) {
-        self.core.apply_set(self.set, self.diag, x, y);
-    }
-
-    fn precondition(&mut self, r: &[f64], z: &mut [f64]) {
-        let core = &mut *self.core;
-        match (self.precond, &mut core.fsai) {
-            (Precond::Fsai, Some(fsai)) => {
-                fsai.apply(r, z);
-                return;
-            }
-            (Precond::Jacobi, _) => {
-                for (zi, (ri, d)) in z.iter_mut().zip(r.iter().zip(self.diag)) {
-                    *zi = ri / (core.diag_c + d);
-                }
-                return;
-            }
-            _ => {}
-        }
-        let mut buf = std::mem::take(&mut core.buf);
-        buf.fill(0.0);
-        for (&i, &ri) in self.set.iter().zip(r) {
-            buf[i] = ri;
-        }
-        if let Some((_, table)) = &core.inverse {
-            core.plan.filter_in_place(&mut buf, table, &mut core.work);
-        }
-        for (zi, &i) in z.iter_mut().zip(self.set) {
-            *zi = buf[i];
-        }
-        core.buf = buf;
-    }
-
-    fn norm_bound(&self) -> f64 {
-        self.norm
+            b,
+            total,
+            f,
+            tol,
+            max_iterations,
+        )
     }
 }
 
@@ -241,21 +232,88 @@ mod tests {
     fn restricted_operator_is_symmetric() {
         let grid = Grid::new(Block::new(0.14, 0.007, 0.075).unwrap(), 140, 7).unwrap();
         let plan = InfluencePlan::builder(grid).build().unwrap();
-        let mut core = SpectralCore::new(plan, 3.6e-16, 0.0, 1.0);
+        let mut core = SpectralCore::new(plan, 3.6e-16, 0.0, 1.0, None);
         let set: Vec<usize> = (0..980).filter(|i| i % 3 != 0).collect();
         let diag: Vec<f64> = set.iter().map(|i| 1e-15 * (*i as f64)).collect();
-        let mut sys = core.system(&set, &diag, Precond::Jacobi);
         let n = set.len();
         let x: Vec<f64> = (0..n).map(|i| ((i * 7919) % 101) as f64 - 50.0).collect();
         let y: Vec<f64> = (0..n).map(|i| ((i * 104729) % 97) as f64 - 48.0).collect();
         let mut ax = vec![0.0; n];
         let mut ay = vec![0.0; n];
-        sys.apply(&x, &mut ax);
-        sys.apply(&y, &mut ay);
+        core.apply_set(&set, &diag, &x, &mut ax);
+        core.apply_set(&set, &diag, &y, &mut ay);
         let a: f64 = y.iter().zip(&ax).map(|(p, q)| p * q).sum();
         let b: f64 = x.iter().zip(&ay).map(|(p, q)| p * q).sum();
         let xx: f64 = x.iter().zip(&ax).map(|(p, q)| p * q).sum();
         eprintln!("{a:e} {b:e} {xx:e}");
         assert!((a - b).abs() < 1e-12 * a.abs());
+    }
+
+    /// The split CG gives the same bits on one thread and on two, on every transform path
+    /// (paired rows with matrix-product, paired-FFT and direct columns; rustdct rows), for
+    /// every preconditioner; and its solution satisfies the equations when the residual is
+    /// recomputed with the unsplit product (`apply_full`, an independent path).
+    #[test]
+    fn split_solve_is_thread_count_independent_and_solves() {
+        let pool = Some(Arc::new(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(2)
+                .build()
+                .unwrap(),
+        ));
+        for (nx, ny) in [(60, 40), (24, 70), (21, 30), (30, 10), (15, 67)] {
+            let block = Block::new(nx as f64 * 1e-3, ny as f64 * 1e-3, 0.075).unwrap();
+            let plan = InfluencePlan::builder(Grid::new(block, nx, ny).unwrap())
+                .build()
+                .unwrap();
+            let n = nx * ny;
+            let scale = 3.6e-16;
+            let mut top = 0.0f64;
+            for m in 0..ny {
+                for q in 0..nx {
+                    top = top.max(plan.eigenvalue(q, m).unwrap());
+                }
+            }
+            let set: Vec<usize> = (0..n).filter(|i| (i * 7919 + 3) % 10 < 6).collect();
+            let b: Vec<f64> = set.iter().map(|i| 1e-6 * (1.0 + (i % 7) as f64)).collect();
+            for precond in [Precond::Jacobi, Precond::Fsai, Precond::Spectral] {
+                let mut results = Vec::new();
+                for pool in [None, pool.clone()] {
+                    let mut core = SpectralCore::new(plan.clone(), scale, 0.0, scale * top, pool);
+                    let d: Vec<f64> = set
+                        .iter()
+                        .map(|i| 0.05 * core.diag_c * (1.0 + (i % 3) as f64))
+                        .collect();
+                    let mut f = vec![0.0; set.len()];
+                    let out = core.solve(&set, &d, precond, &b, 1e-3, &mut f, 1e-13, 5000);
+                    assert!(out.converged, "{nx}x{ny} {precond:?}: {out:?}");
+                    // Independent residual: the unsplit product.
+                    let mut u = vec![0.0; n];
+                    core.team.forget_last(); // the unsplit product, not the reuse
+                    core.apply_full(&set, &f, &mut u);
+                    let norm = core.norm_c + d.iter().fold(0.0f64, |m, x| m.max(*x));
+                    let fmax = f.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                    let bmax = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                    let r = set
+                        .iter()
+                        .enumerate()
+                        .map(|(a, &i)| (u[i] + d[a] * f[a] + out.offset - b[a]).abs())
+                        .fold(0.0f64, f64::max);
+                    let backward = r / (norm * fmax + bmax + out.offset.abs());
+                    assert!(backward < 1e-12, "{nx}x{ny} {precond:?}: {backward:e}");
+                    let mass: f64 = f.iter().map(|x| x.abs()).sum();
+                    assert!((f.iter().sum::<f64>() - 1e-3).abs() < 1e-13 * mass);
+                    results.push((out.iterations, out.offset.to_bits(), f));
+                }
+                let bits = |f: &[f64]| f.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(results[0].0, results[1].0, "{nx}x{ny} {precond:?}");
+                assert_eq!(results[0].1, results[1].1, "{nx}x{ny} {precond:?}");
+                assert_eq!(
+                    bits(&results[0].2),
+                    bits(&results[1].2),
+                    "{nx}x{ny} {precond:?}"
+                );
+            }
+        }
     }
 }
