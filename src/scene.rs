@@ -273,6 +273,14 @@ impl SceneBuilder {
         self
     }
 
+    /// Whether `other` describes the same run: every option equal but the solver's thread
+    /// count, which does not change results (checkpoints resume across it).
+    pub(crate) fn same_run(&self, other: &SceneBuilder) -> bool {
+        let mut mine = self.clone();
+        mine.solver.threads = other.solver.threads;
+        mine == *other
+    }
+
     /// Relative accuracy of the influence operator's eigenvalues (dimensionless, default
     /// `1e-6`, as [`InfluencePlan::builder`]; see `docs/accuracy.md`). The lateral load
     /// table is always summed to `1e-12` relative (closed forms, cheap).

@@ -83,6 +83,45 @@ fn resumed_runs_repeat_the_uninterrupted_one_spectral() {
     check_resume(&scene, &[1, queued, 300], |c| c);
 }
 
+/// Two solver threads give the one-thread run bit for bit (events, final tractions), and a
+/// checkpoint taken on one thread resumes on two (the reference: the one-thread run).
+#[test]
+fn two_threads_repeat_the_one_thread_run_and_resume_it() {
+    let builder = |threads| {
+        Scene::builder()
+            .block(0.040, 0.020, 0.030)
+            .normal_load(2.8e3)
+            .solver(
+                SolverOptions::default()
+                    .with_backend(Backend::Spectral)
+                    .with_threads(threads),
+            )
+            .seed(5)
+    };
+    let one = builder(1).build().unwrap();
+    let two = builder(2).build().unwrap();
+    let (events, traction) = finish(one.driver().unwrap());
+    assert!(events.len() > 1000, "{} events", events.len());
+    let (events2, traction2) = finish(two.driver().unwrap());
+    assert!(events2 == events, "two threads: events differ");
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(
+        bits(&traction2),
+        bits(&traction),
+        "two threads: tractions differ"
+    );
+    let mut driver = one.driver().unwrap();
+    for _ in 0..400 {
+        driver.step().unwrap();
+    }
+    let (rest, traction3) = finish(two.resume(&driver.checkpoint()).unwrap());
+    assert!(
+        rest == events[400..],
+        "resumed on two threads: events differ"
+    );
+    assert_eq!(bits(&traction3), bits(&traction));
+}
+
 #[test]
 fn resume_under_displacement_control() {
     let scene = Scene::builder()

@@ -139,3 +139,20 @@ fn operator_inputs_are_checked() {
     let plan = InfluencePlan::builder(big).tolerance(1e-2).build().unwrap();
     assert!(matches!(plan.dense(), Err(Error::TooLargeForDense { .. })));
 }
+
+#[test]
+fn solver_threads_must_be_one_or_two() {
+    for threads in [0, 3, 64] {
+        let built = precursors::Scene::builder()
+            .solver(precursors::SolverOptions::default().with_threads(threads))
+            .build()
+            .and_then(|scene| scene.driver());
+        match built {
+            Err(Error::InvalidParameter { name, value, .. }) => {
+                assert_eq!(name, "threads");
+                assert_eq!(value, threads as f64);
+            }
+            other => panic!("threads = {threads}: {other:?}"),
+        }
+    }
+}

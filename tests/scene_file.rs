@@ -24,7 +24,8 @@ fn everything() -> SceneBuilder {
     law.c_z = 2.2e8;
     let mut solver = SolverOptions::default()
         .with_backend(Backend::Spectral)
-        .with_tolerance(1e-11);
+        .with_tolerance(1e-11)
+        .with_threads(2);
     solver.max_active_set_iterations = 77;
     solver.max_linear_iterations = 999;
     Scene::builder()
@@ -97,7 +98,8 @@ fn a_hand_written_file_gives_the_rust_builder() {
         "drive": {"kind": "spring", "stiffness": 3.3e6,
                   "lateral": {"kind": "rod", "height": 0.004, "half_width": 0.0015}},
         "solver": {"backend": "spectral", "tolerance": 1e-11,
-                   "max_active_set_iterations": 77, "max_linear_iterations": 999},
+                   "max_active_set_iterations": 77, "max_linear_iterations": 999,
+                   "threads": 2},
         "plan_tolerance": 1e-7,
         "probes": {"planes": [0.002, 0], "points": [[0.01, 0.003, 0.001]], "tolerance": 1e-9}
     }"#;

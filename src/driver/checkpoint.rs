@@ -104,7 +104,8 @@ impl Driver {
 
 impl Scene {
     /// A driver continuing from `checkpoint`, which must have been taken on this scene
-    /// (same builder: block, grid, material, springs, heights, loads, solver options).
+    /// (same builder: block, grid, material, springs, heights, loads, solver options; the
+    /// thread count may differ, results do not depend on it).
     /// Errors: [`Error::InvalidCheckpoint`] when it was not, or when it is inconsistent.
     pub fn resume(&self, checkpoint: &Checkpoint) -> Result<Driver> {
         let bad = |reason: String| Err(Error::InvalidCheckpoint { reason });
@@ -114,7 +115,7 @@ impl Scene {
                 checkpoint.format
             ));
         }
-        if checkpoint.scene != self.to_builder() {
+        if !checkpoint.scene.same_run(&self.to_builder()) {
             return bad("it was taken on another scene (the builders differ)".into());
         }
         let mut driver = self.driver()?;

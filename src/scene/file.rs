@@ -127,6 +127,7 @@ struct SolverSpec {
     tolerance: f64,
     max_active_set_iterations: usize,
     max_linear_iterations: usize,
+    threads: usize,
 }
 
 fn default_mean() -> f64 {
@@ -231,6 +232,7 @@ impl From<&SceneBuilder> for SceneFile {
                 tolerance: b.solver.tolerance,
                 max_active_set_iterations: b.solver.max_active_set_iterations,
                 max_linear_iterations: b.solver.max_linear_iterations,
+                threads: b.solver.threads,
             },
             plan_tolerance: b.plan_tolerance,
             probes: ProbesSpec {
@@ -288,6 +290,7 @@ impl SceneFile {
         solver.tolerance = self.solver.tolerance;
         solver.max_active_set_iterations = self.solver.max_active_set_iterations;
         solver.max_linear_iterations = self.solver.max_linear_iterations;
+        solver.threads = self.solver.threads;
         Ok(SceneBuilder {
             lengths: (self.block.lx, self.block.ly, self.block.lz),
             cells: match self.cells {
