@@ -3,7 +3,9 @@
 //! N = 980 only (its 1e4 one-shot timing is in docs/performance.md).
 //! `cold`: a fresh solver (all sites attached at the start; the dense factor built).
 //! `warm`: the solver re-equilibrates after one rupture (the driver's common step);
-//! `tangential_warm` times the tangential solve that follows it.
+//! `tangential_warm` times the tangential solve that follows it. At N >= 1e4 the spectral
+//! backend also runs with two threads (`Spectral2`, `SolverOptions::threads = 2`: the same
+//! results; compare the ratio, the machine has two cores).
 //! Results: docs/performance.md.
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
@@ -20,9 +22,13 @@ fn setup(nx: usize, ny: usize) -> (InfluencePlan, Interface, f64) {
     (plan, iface, 3.5e6 * block.lx() * block.ly())
 }
 
-fn solver(plan: &InfluencePlan, backend: Backend) -> EquilibriumSolver {
+fn solver(plan: &InfluencePlan, (backend, threads): (Backend, usize)) -> EquilibriumSolver {
     EquilibriumSolver::builder(plan.clone())
-        .options(SolverOptions::default().with_backend(backend))
+        .options(
+            SolverOptions::default()
+                .with_backend(backend)
+                .with_threads(threads),
+        )
         .build()
         .unwrap()
 }
@@ -36,11 +42,20 @@ fn bench(c: &mut Criterion) {
         let (plan, iface, load) = setup(nx, ny);
         let n = nx * ny;
         let zeros = vec![0.0; n];
-        for backend in [Backend::Dense, Backend::Spectral] {
-            if backend == Backend::Dense && n > 1_000 {
+        for (backend, threads) in [
+            (Backend::Dense, 1),
+            (Backend::Spectral, 1),
+            (Backend::Spectral, 2),
+        ] {
+            if (backend == Backend::Dense && n > 1_000) || (threads > 1 && n < 10_000) {
                 continue;
             }
-            let tag = format!("{backend:?}/{n}");
+            let backend = (backend, threads);
+            let name = match backend {
+                (b, 1) => format!("{b:?}"),
+                (b, t) => format!("{b:?}{t}"),
+            };
+            let tag = format!("{name}/{n}");
             // Cold normal: a fresh solver from an all-attached interface.
             group.bench_function(format!("normal_cold/{tag}"), |b| {
                 b.iter_batched(

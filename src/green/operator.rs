@@ -490,37 +490,45 @@ impl Dct2d {
         self.columns_matmul.as_ref()
     }
 
-    /// Whether [`Dct2d::rows`] transforms `lines` rows as pairs (then any even split of the
-    /// rows gives the same values as the whole block).
+    /// Whether [`Dct2d::rows`] and [`Dct2d::columns`] pair their lines (the paired FFT
+    /// path: both lengths even).
     pub(crate) fn pairs_rows(&self) -> bool {
         self.pairs.is_some()
     }
 
     /// Unnormalised DCT-II (`forward`) or DCT-III of every row of `rows`, a whole number
-    /// of rows of the grid (an even number on the paired path), in place.
+    /// of rows of the grid, in place (on the paired path, an odd last row runs alone:
+    /// rounding then depends on where a block of rows starts, fixed by the caller).
     pub(crate) fn rows(&self, rows: &mut [f64], forward: bool, work: &mut Vec<f64>) {
         let nx = self.nx;
         let lines = rows.len() / nx;
         if lines == 0 {
             return;
         }
+        // Pairs of rows through the paired FFT; an odd last row alone (rustdct).
+        let mut single = rows;
         if let Some((px, _)) = &self.pairs {
-            if lines % 2 == 0 {
+            let paired = lines & !1;
+            let (head, tail) = single.split_at_mut(paired * nx);
+            if paired > 0 {
                 PAIR_SCRATCH.with_borrow_mut(|(z, scratch)| {
                     if forward {
-                        px.dct2(rows, lines, nx, 1, z, scratch);
+                        px.dct2(head, paired, nx, 1, z, scratch);
                     } else {
-                        px.dct3(rows, lines, nx, 1, z, scratch);
+                        px.dct3(head, paired, nx, 1, z, scratch);
                     }
                 });
-                return;
             }
+            single = tail;
+        }
+        if single.is_empty() {
+            return;
         }
         if work.len() < self.scratch_len {
             work.resize(self.scratch_len, 0.0);
         }
         let scratch = &mut work[..self.scratch_len];
-        for row in rows.chunks_exact_mut(nx) {
+        for row in single.chunks_exact_mut(nx) {
             if forward {
                 self.x.process_dct2_with_scratch(row, scratch);
             } else {

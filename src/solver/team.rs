@@ -1,7 +1,6 @@
 //! The spectral backend's projected CG, split in two fixed halves of the grid.
 //!
-//! The grid is cut between two rows (an even number of rows per half on the paired DCT
-//! path) and the attached set with it: part `h` owns the set's sites in its rows and the
+//! The grid is cut between two rows (at `Ny / 2`) and the attached set with it: part `h` owns the set's sites in its rows and the
 //! slices of every set vector on them. One CG iteration is a sequence of phases; in each
 //! phase every part works on its own data (reading the other part's grid buffers where
 //! the phase needs them), and the phases are separated by barriers:
@@ -54,12 +53,14 @@ struct Layout {
 
 impl Layout {
     fn new(nx: usize, ny: usize, pairs: bool) -> Self {
-        // Even counts of rows and columns per half on the paired path (pairs of lines).
+        // Halves of rows (an odd half runs its last row alone: about half a pair more, far
+        // less than the pair of rows an even split would move); even column blocks on the
+        // paired path (the y-transforms pair columns).
         let even = |k: usize| if pairs { (k / 2) & !1 } else { k / 2 };
         Self {
             nx,
             ny,
-            rows: even(ny),
+            rows: ny / 2,
             cols: even(nx),
         }
     }
