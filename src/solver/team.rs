@@ -656,40 +656,44 @@ impl Context<'_> {
         let layout = self.layout;
         let total = layout.nx * layout.ny;
         let halo = offsets.iter().copied().max().unwrap_or(0);
+        // rf[h]: the halo cells before the part (zeros before the grid), then its cells.
         for p in parts.iter() {
             let (base, cells) = layout.cells(p.h);
             let mut rf = write(&shared.rf[p.h]);
             rf.clear();
-            rf.resize(cells, 0.0);
+            rf.resize(halo + cells, 0.0);
             for (&i, &v) in p.sites.iter().zip(&p.r) {
-                rf[i - base] = v;
+                rf[halo + i - base] = v;
             }
         }
         self.barrier.wait();
+        // The slots with the site itself first (offset 0, never clipped): it assigns, the
+        // others add, so no buffer needs zeroing.
+        let slots = || planes.chunks_exact(total).zip(offsets).rev();
         for p in parts.iter_mut() {
             let (base, cells) = layout.cells(p.h);
-            // local = cells base - halo .. base + cells (zeros before the grid).
-            let local = &mut p.work;
-            local.clear();
-            local.resize(halo, 0.0);
             if p.h == 1 {
+                // Part 1 copies its halo from part 0 (which only reads its own buffer now:
+                // no lock here may be held for writing across the phase).
                 let r0 = read(&shared.rf[0]);
-                let take = halo.min(r0.len());
-                local[halo - take..].copy_from_slice(&r0[r0.len() - take..]);
+                let take = halo.min(r0.len() - halo);
+                write(&shared.rf[1])[halo - take..halo].copy_from_slice(&r0[r0.len() - take..]);
             }
-            local.extend_from_slice(&read(&shared.rf[p.h]));
+            let rf = read(&shared.rf[p.h]);
+            // yf[h]: the part's cells, then the halo cells after it (zeros past the grid).
             let mut yf = write(&shared.yf[p.h]);
-            yf.clear();
-            yf.resize(cells, 0.0);
-            for (b, y) in yf.chunks_mut(BLOCK).enumerate() {
+            yf.resize(cells + halo, 0.0);
+            for (b, y) in yf[..cells].chunks_mut(BLOCK).enumerate() {
                 let lo = b * BLOCK; // local cell index of the block
                 let hi = lo + y.len();
-                for (w, &o) in planes.chunks_exact(total).zip(offsets) {
+                for (k, (w, &o)) in slots().enumerate() {
                     let terms = w[base + lo..base + hi]
                         .iter()
-                        .zip(&local[halo + lo - o..halo + hi - o]);
-                    for (y, (w, x)) in y.iter_mut().zip(terms) {
-                        *y += w * x;
+                        .zip(&rf[halo + lo - o..halo + hi - o]);
+                    if k == 0 {
+                        y.iter_mut().zip(terms).for_each(|(y, (w, x))| *y = w * x);
+                    } else {
+                        y.iter_mut().zip(terms).for_each(|(y, (w, x))| *y += w * x);
                     }
                 }
             }
@@ -697,20 +701,16 @@ impl Context<'_> {
         self.barrier.wait();
         for p in parts.iter_mut() {
             let (base, cells) = layout.cells(p.h);
-            // local = y on cells base .. base + cells + halo (zeros past the grid).
-            let local = &mut p.work;
-            local.clear();
-            local.extend_from_slice(&read(&shared.yf[p.h]));
             if p.h == 0 {
                 let y1 = read(&shared.yf[1]);
-                local.extend_from_slice(&y1[..halo.min(y1.len())]);
+                let take = halo.min(y1.len() - halo);
+                write(&shared.yf[0])[cells..cells + take].copy_from_slice(&y1[..take]);
             }
-            local.resize(cells + halo, 0.0);
-            p.zf.clear();
+            let yf = read(&shared.yf[p.h]);
             p.zf.resize(cells, 0.0);
             for (b, z) in p.zf.chunks_mut(BLOCK).enumerate() {
                 let lo = b * BLOCK;
-                for (w, &o) in planes.chunks_exact(total).zip(offsets) {
+                for (k, (w, &o)) in slots().enumerate() {
                     // Cells j + o past the grid carry no weight.
                     let hi = (lo + z.len()).min(total.saturating_sub(base + o));
                     if hi <= lo {
@@ -718,9 +718,14 @@ impl Context<'_> {
                     }
                     let terms = w[base + lo + o..base + hi + o]
                         .iter()
-                        .zip(&local[lo + o..hi + o]);
-                    for (z, (w, y)) in z[..hi - lo].iter_mut().zip(terms) {
-                        *z += w * y;
+                        .zip(&yf[lo + o..hi + o]);
+                    if k == 0 {
+                        z.iter_mut().zip(terms).for_each(|(z, (w, y))| *z = w * y);
+                    } else {
+                        z[..hi - lo]
+                            .iter_mut()
+                            .zip(terms)
+                            .for_each(|(z, (w, y))| *z += w * y);
                     }
                 }
             }
@@ -768,10 +773,10 @@ impl Context<'_> {
             let (c0, width) = layout.block(p.h);
             let (r0, r1) = (read(&shared.rows[0]), read(&shared.rows[1]));
             let mut block = write(&shared.blocks[p.h]);
-            block.clear();
             if let Some(m) = matrices {
                 // Matrix products read the rows in place: block = diag ⊙ (D2 X) with the
-                // sum over y split at the rows' cut; D3 waits for phase 3.
+                // sum over y split at the rows' cut; D3 waits for phase 3. (The first
+                // product replaces the block: no zeroing.)
                 block.resize(layout.ny * width, 0.0);
                 let split = layout.rows;
                 let mut out = MatMut::from_row_major_slice_mut(&mut block, layout.ny, width);
@@ -788,6 +793,7 @@ impl Context<'_> {
                 }
                 block.iter_mut().zip(&table[p.h]).for_each(|(b, d)| *b *= d);
             } else {
+                block.clear();
                 for row in r0.chunks_exact(nx).chain(r1.chunks_exact(nx)) {
                     block.extend_from_slice(&row[c0..c0 + width]);
                 }
