@@ -286,7 +286,6 @@ impl Driver {
             Phase::Avalanche { forced } => {
                 let force = self.force();
                 let u_z = &self.normal()?.displacement;
-                let k_x = self.interface.tangential_stiffness(u_z)?;
                 let u_x = &self.response()?.displacement;
                 let cell = self.grid.cell_area();
                 let mut best: Option<(usize, f64)> = None;
@@ -295,8 +294,10 @@ impl Driver {
                         continue;
                     }
                     if self.breaking[i] <= force || forced == Some(i) {
+                        // k_x of the candidates only (an exponential per site).
+                        let k_x = self.interface.tangential_stiffness_at(i, u_z[i])?;
                         let u = force * u_x[i];
-                        let energy = 0.5 * k_x[i] * u * u * cell;
+                        let energy = 0.5 * k_x * u * u * cell;
                         if best.is_none_or(|(_, e)| energy > e) {
                             best = Some((i, energy));
                         }

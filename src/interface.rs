@@ -368,27 +368,27 @@ impl Interface {
     /// [`Error::NonFinite`].
     pub fn tangential_stiffness(&self, u_z: &[f64]) -> Result<Vec<f64>> {
         check_slice("u_z", u_z, self.grid.len())?;
-        self.heights()
-            .iter()
-            .zip(u_z)
-            .zip(&self.states)
+        u_z.iter()
             .enumerate()
-            .map(|(index, ((h, u), state))| {
-                if *state != SiteState::Attached {
-                    return Ok(0.0);
-                }
-                let value = self.law.c_x * (-u / h).exp();
-                if value.is_finite() {
-                    Ok(value)
-                } else {
-                    Err(Error::NonFinite {
-                        name: "tangential stiffness c_x exp(-u_z/u0)",
-                        index,
-                        value,
-                    })
-                }
-            })
+            .map(|(index, u)| self.tangential_stiffness_at(index, *u))
             .collect()
+    }
+
+    /// [`Interface::tangential_stiffness`] of one site (N/m³).
+    pub(crate) fn tangential_stiffness_at(&self, index: usize, u_z: f64) -> Result<f64> {
+        if self.states[index] != SiteState::Attached {
+            return Ok(0.0);
+        }
+        let value = self.law.c_x * (-u_z / self.heights()[index]).exp();
+        if value.is_finite() {
+            Ok(value)
+        } else {
+            Err(Error::NonFinite {
+                name: "tangential stiffness c_x exp(-u_z/u0)",
+                index,
+                value,
+            })
+        }
     }
 
     /// Real contact area per cell (m²) at the normal displacements `u_z` (m):
