@@ -2,10 +2,12 @@
 //! Δh = 2 mm, seed 1) driven from zero shear to global slip: scene build (operator plan,
 //! lateral table) and the whole run, with the default backend (dense at this size) and
 //! with each backend forced, to compare them on the driver's real sequence of solves.
-//! Results: docs/performance.md.
+//! And the N = 1e4 scene of `examples/large_run.rs` (200 x 50 x 75 mm, seed 1) through
+//! its first 300 ruptures on one and on two solver threads (the whole run takes about a
+//! minute: the example times it). Results: docs/performance.md.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use precursors::{Backend, Scene, SolverOptions};
+use precursors::{Backend, Event, Scene, SolverOptions};
 use std::time::Duration;
 
 fn bench(c: &mut Criterion) {
@@ -34,6 +36,28 @@ fn bench(c: &mut Criterion) {
             b.iter(|| {
                 let mut d = scene.driver().unwrap();
                 d.run(|_, _| {}).unwrap();
+                d.event_count()
+            })
+        });
+    }
+    for threads in [1, 2] {
+        let scene = Scene::builder()
+            .block(0.200, 0.050, 0.075)
+            .cell_size(1e-3, 1e-3)
+            .seed(1)
+            .normal_load(3.5e6 * 0.200 * 0.050)
+            .solver(SolverOptions::default().with_threads(threads))
+            .build()
+            .unwrap();
+        group.bench_function(format!("n1e4_first_300_ruptures/threads{threads}"), |b| {
+            b.iter(|| {
+                let mut d = scene.driver().unwrap();
+                let mut ruptures = 0;
+                while ruptures < 300 {
+                    if let Some(Event::Rupture { .. }) = d.step().unwrap() {
+                        ruptures += 1;
+                    }
+                }
                 d.event_count()
             })
         });
