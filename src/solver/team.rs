@@ -1,7 +1,8 @@
 //! The spectral backend's projected CG, split in two fixed halves of the grid.
 //!
-//! The grid is cut between two rows (at `Ny / 2`) and the attached set with it: part `h` owns the set's sites in its rows and the
-//! slices of every set vector on them. One CG iteration is a sequence of phases; in each
+//! The grid is cut between two rows (at `Ny / 2`) and the attached set with it: part `h`
+//! owns the set's sites in its rows and the slices of every set vector on them. One CG
+//! iteration is a sequence of phases; in each
 //! phase every part works on its own data (reading the other part's grid buffers where
 //! the phase needs them), and the phases are separated by barriers:
 //!
@@ -152,7 +153,9 @@ struct Shared {
     rows: [RwLock<Vec<f64>>; 2],
     /// The part's column block after the y-filter (row-major, `Ny x width`).
     blocks: [RwLock<Vec<f64>>; 2],
-    /// FSAI: the residual on the part's cells, then `G r` on them.
+    /// FSAI: the residual on the halo cells before the part (copied from part 0 by part
+    /// 1, zeros before the grid) and on its cells; then `G r` on its cells and the halo
+    /// after them (copied from part 1 by part 0, zeros past the grid).
     rf: [RwLock<Vec<f64>>; 2],
     yf: [RwLock<Vec<f64>>; 2],
 }
