@@ -402,3 +402,34 @@ fn driver_follows_the_naive_protocol() {
         assert!((a - b).abs() < 1e-8 * b, "{a} vs {b}");
     }
 }
+
+#[test]
+fn drivers_and_solvers_can_move_between_threads() {
+    // Users run seeds in parallel: the driver, the scene and the solver are Send, the
+    // scene and its plan are Sync (shared read-only between runs).
+    fn send<T: Send>() {}
+    fn sync<T: Sync>() {}
+    send::<Driver>();
+    send::<EquilibriumSolver>();
+    send::<Scene>();
+    sync::<Scene>();
+    sync::<precursors::green::InfluencePlan>();
+    // And a driver with a pool of its own moves and runs on another thread.
+    let scene = Scene::builder()
+        .block(0.030, 0.020, 0.030)
+        .normal_load(2.1e3)
+        .solver(
+            SolverOptions::default()
+                .with_backend(Backend::Spectral)
+                .with_threads(2),
+        )
+        .seed(2)
+        .build()
+        .unwrap();
+    let driver = scene.driver().unwrap();
+    let events = std::thread::spawn(move || driver.collect::<Result<Vec<_>>>().unwrap())
+        .join()
+        .unwrap();
+    assert!(matches!(events.last(), Some(Event::GlobalSlip { .. })));
+    assert!(events == run(&scene));
+}

@@ -261,7 +261,16 @@ mod tests {
                 .build()
                 .unwrap(),
         ));
-        for (nx, ny) in [(60, 40), (24, 70), (21, 30), (30, 10), (15, 67), (1, 20), (20, 1), (3, 3)] {
+        for (nx, ny) in [
+            (60, 40),
+            (24, 70),
+            (21, 30),
+            (30, 10),
+            (15, 67),
+            (1, 20),
+            (20, 1),
+            (3, 3),
+        ] {
             let block = Block::new(nx as f64 * 1e-3, ny as f64 * 1e-3, 0.075).unwrap();
             let plan = InfluencePlan::builder(Grid::new(block, nx, ny).unwrap())
                 .build()
