@@ -82,7 +82,8 @@ pub struct SolverOptions {
     /// (`solver/team.rs`); with two threads the solver owns a pool of two and runs one
     /// half on each, in step. The arithmetic is the same either way: results are bit for
     /// bit those of one thread (tested), only the wall time changes (docs/performance.md).
-    /// The dense backend's factor solves stay on one thread.
+    /// The dense backend's factor solves stay on one thread. Two threads pay when two
+    /// cores are free: to run several scenes at once (seeds), give each one thread.
     pub threads: usize,
 }
 
