@@ -568,19 +568,20 @@ impl Context<'_> {
             }
         };
 
+        let tol = self.tol;
+        let outcome = |offset, iterations, residual: f64| PcgOutcome {
+            offset,
+            iterations,
+            residual,
+            converged: residual <= tol,
+        };
         let mut offset = 0.0;
         let mut last_sum = residual_of(&mut red, parts, offset);
         project(&mut red, parts, &mut offset);
         let (mut residual, mut rz) = measure(&mut red, parts, offset);
         let mut iterations = 0;
         if residual <= self.tol {
-            let outcome = PcgOutcome {
-                offset,
-                iterations,
-                residual,
-                converged: true,
-            };
-            return (outcome, last_sum);
+            return (outcome(offset, iterations, residual), last_sum);
         }
         for p in parts.iter_mut() {
             p.p.iter_mut().zip(&p.z).for_each(|(pi, zi)| *pi = -zi);
@@ -645,13 +646,7 @@ impl Context<'_> {
             }
         }
         if confirmed {
-            let outcome = PcgOutcome {
-                offset,
-                iterations,
-                residual,
-                converged: true,
-            };
-            return (outcome, last_sum);
+            return (outcome(offset, iterations, residual), last_sum);
         }
         // Report the true residual of the returned iterate, not the recurrence's.
         if best.0 < residual {
@@ -664,13 +659,7 @@ impl Context<'_> {
         last_sum = residual_of(&mut red, parts, offset);
         project(&mut red, parts, &mut offset);
         residual = measure(&mut red, parts, offset).0;
-        let outcome = PcgOutcome {
-            offset,
-            iterations,
-            residual,
-            converged: residual <= self.tol,
-        };
-        (outcome, last_sum)
+        (outcome(offset, iterations, residual), last_sum)
     }
 
     /// `z = M⁻¹ r` on every part.
