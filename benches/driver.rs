@@ -7,7 +7,7 @@
 //! minute: the example times it). Results: docs/performance.md.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use precursors::{Backend, Event, Scene, SolverOptions};
+use precursors::{Backend, Event, Parallelism, Scene, SolverOptions};
 use std::time::Duration;
 
 fn bench(c: &mut Criterion) {
@@ -46,7 +46,11 @@ fn bench(c: &mut Criterion) {
             .cell_size(1e-3, 1e-3)
             .seed(1)
             .normal_load(3.5e6 * 0.200 * 0.050)
-            .solver(SolverOptions::default().with_threads(threads))
+            .solver(SolverOptions::default().with_parallelism(if threads > 1 {
+                Parallelism::Threads(threads)
+            } else {
+                Parallelism::Sequential
+            }))
             .build()
             .unwrap();
         group.bench_function(format!("n1e4_first_300_ruptures/threads{threads}"), |b| {

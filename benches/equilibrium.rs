@@ -4,7 +4,7 @@
 //! `cold`: a fresh solver (all sites attached at the start; the dense factor built).
 //! `warm`: the solver re-equilibrates after one rupture (the driver's common step);
 //! `tangential_warm` times the tangential solve that follows it. At N >= 1e4 the spectral
-//! backend also runs with two threads (`Spectral2`, `SolverOptions::threads = 2`: the same
+//! backend also runs with two threads (`Spectral2`, `Parallelism::Threads(2)`: the same
 //! results; compare the ratio, the machine has two cores).
 //! Results: docs/performance.md.
 
@@ -27,7 +27,11 @@ fn solver(plan: &InfluencePlan, (backend, threads): (Backend, usize)) -> Equilib
         .options(
             SolverOptions::default()
                 .with_backend(backend)
-                .with_threads(threads),
+                .with_parallelism(if threads > 1 {
+                    Parallelism::Threads(threads)
+                } else {
+                    Parallelism::Sequential
+                }),
         )
         .build()
         .unwrap()
@@ -60,7 +64,7 @@ fn bench(c: &mut Criterion) {
             group.bench_function(format!("normal_cold/{tag}"), |b| {
                 b.iter_batched(
                     || (solver(&plan, backend), iface.clone()),
-                    |(mut s, mut i)| s.solve_normal(&mut i, load).unwrap(),
+                    |(mut s, i)| s.solve_normal(&i, load).unwrap(),
                     BatchSize::PerIteration,
                 )
             });
@@ -68,12 +72,14 @@ fn bench(c: &mut Criterion) {
             // solved again (the driver's common step); heal when a quarter is left.
             let mut s = solver(&plan, backend);
             let mut i = iface.clone();
-            let mut eq = s.solve_normal(&mut i, load).unwrap();
+            let mut eq = s.solve_normal(&i, load).unwrap();
+            i.set_states(&eq.states).unwrap();
             s.solve_tangential(&i, &eq.displacement, &zeros).unwrap();
             let rupture = |s: &mut EquilibriumSolver, i: &mut Interface| {
                 if i.attached_count() < n / 4 {
                     i.heal();
-                    s.solve_normal(i, load).unwrap();
+                    let eq = s.solve_normal(i, load).unwrap();
+                    i.set_states(&eq.states).unwrap();
                 }
                 let site = (0..n)
                     .find(|&k| i.states()[k] == SiteState::Attached)
@@ -86,8 +92,9 @@ fn bench(c: &mut Criterion) {
                     for _ in 0..iters {
                         rupture(&mut s, &mut i);
                         let t = Instant::now();
-                        eq = s.solve_normal(&mut i, load).unwrap();
+                        eq = s.solve_normal(&i, load).unwrap();
                         spent += t.elapsed();
+                        i.set_states(&eq.states).unwrap();
                     }
                     spent
                 })
@@ -98,7 +105,8 @@ fn bench(c: &mut Criterion) {
                     let mut spent = Duration::ZERO;
                     for _ in 0..iters {
                         rupture(&mut s, &mut i);
-                        eq = s.solve_normal(&mut i, load).unwrap();
+                        eq = s.solve_normal(&i, load).unwrap();
+                        i.set_states(&eq.states).unwrap();
                         let t = Instant::now();
                         s.solve_tangential(&i, &eq.displacement, &zeros).unwrap();
                         spent += t.elapsed();

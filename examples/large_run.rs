@@ -8,10 +8,10 @@
 //! tangential equilibria.
 //!
 //! Run: `cargo run --release --example large_run [seed] [solver tolerance] [threads]`
-//! (the tolerance defaults to the solver's, `1e-13`; threads to 1, see
-//! `SolverOptions::threads`: the events are the same for every thread count).
+//! (the tolerance defaults to the solver's, `1e-13`; threads to 1, `0` for every core,
+//! see `SolverOptions::parallelism`: the events are the same for every thread count).
 
-use precursors::{Event, Scene, SolverOptions};
+use precursors::{Event, Parallelism, Scene, SolverOptions};
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -35,7 +35,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .solver(
             SolverOptions::default()
                 .with_tolerance(tolerance)
-                .with_threads(threads),
+                .with_parallelism(match threads {
+                    0 => Parallelism::all_cores(),
+                    1 => Parallelism::Sequential,
+                    n => Parallelism::Threads(n),
+                }),
         )
         .block(0.200, 0.050, 0.075)
         .cell_size(1e-3, 1e-3)

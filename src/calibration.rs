@@ -25,6 +25,7 @@
 
 use crate::driver::Event;
 use crate::error::{Error, Result};
+use crate::green::Planner;
 use crate::interface::HeightDistribution;
 use crate::scene::{HeightSource, SceneBuilder};
 
@@ -127,10 +128,19 @@ fn check_bracket(name: &'static str, bracket: (f64, f64)) -> Result<()> {
 /// The real contact area at zero shear (m²), averaged over the realizations of
 /// `options`.
 pub fn normal_contact_area(builder: &SceneBuilder, options: &FitOptions) -> Result<f64> {
+    normal_area_with(builder, options, &Planner::new())
+}
+
+/// [`normal_contact_area`] with plans from `planner` (a fit plans its geometry once).
+fn normal_area_with(
+    builder: &SceneBuilder,
+    options: &FitOptions,
+    planner: &Planner,
+) -> Result<f64> {
     let scenes = realizations(builder, options);
     let mut total = 0.0;
     for b in &scenes {
-        let scene = b.clone().build()?;
+        let scene = b.clone().build_with(planner)?;
         let mut driver = scene.driver()?;
         driver.step()?;
         total += driver.total_contact_area()?;
@@ -158,11 +168,12 @@ pub fn fit_normal_stiffness(
         });
     }
     let mut evaluations = 0;
+    let planner = Planner::new(); // every evaluation shares the geometry's plan
     let misfit = |ln_cz: f64, evaluations: &mut usize| -> Result<f64> {
         *evaluations += 1;
         let mut law = builder.spring_law();
         law.c_z = ln_cz.exp();
-        Ok(normal_contact_area(&builder.clone().springs(law), options)? - target_area)
+        Ok(normal_area_with(&builder.clone().springs(law), options, &planner)? - target_area)
     };
     let (mut a, mut b) = (bracket.0.ln(), bracket.1.ln());
     let mut fa = misfit(a, &mut evaluations)?;
@@ -226,7 +237,12 @@ pub fn fit_normal_stiffness(
 /// The precursor curve of one scene: `(F, ℓ)` (N, m) at every stable state up to global
 /// slip.
 pub fn precursor_curve(builder: &SceneBuilder) -> Result<Vec<(f64, f64)>> {
-    let scene = builder.clone().build()?;
+    curve_with(builder, &Planner::new())
+}
+
+/// [`precursor_curve`] with the plan from `planner`.
+fn curve_with(builder: &SceneBuilder, planner: &Planner) -> Result<Vec<(f64, f64)>> {
+    let scene = builder.clone().build_with(planner)?;
     let mut driver = scene.driver()?;
     let mut curve = Vec::new();
     while let Some(event) = driver.step()? {
@@ -254,10 +270,20 @@ pub fn precursor_misfit(
     targets: &[(f64, f64)],
     options: &FitOptions,
 ) -> Result<f64> {
+    misfit_with(builder, targets, options, &Planner::new())
+}
+
+/// [`precursor_misfit`] with plans from `planner`.
+fn misfit_with(
+    builder: &SceneBuilder,
+    targets: &[(f64, f64)],
+    options: &FitOptions,
+    planner: &Planner,
+) -> Result<f64> {
     let scenes = realizations(builder, options);
     let curves = scenes
         .iter()
-        .map(precursor_curve)
+        .map(|b| curve_with(b, planner))
         .collect::<Result<Vec<_>>>()?;
     let mut sum = 0.0;
     for &(force, ell) in targets {
@@ -296,11 +322,12 @@ pub fn fit_tangential_stiffness(
         }
     }
     let mut evaluations = 0;
+    let planner = Planner::new(); // every evaluation shares the geometry's plan
     let misfit = |ln_cx: f64, evaluations: &mut usize| -> Result<f64> {
         *evaluations += 1;
         let mut law = builder.spring_law();
         law.c_x = ln_cx.exp();
-        precursor_misfit(&builder.clone().springs(law), targets, options)
+        misfit_with(&builder.clone().springs(law), targets, options, &planner)
     };
     let (lo, hi) = (bracket.0.ln(), bracket.1.ln());
     let k = options.scan_points.max(3);
@@ -317,24 +344,42 @@ pub fn fit_tangential_stiffness(
     let (mut best_x, mut best_f) = (grid[best], values[best]);
     let (mut a, mut b) = (grid[best.saturating_sub(1)], grid[(best + 1).min(k - 1)]);
     let ratio = 0.5 * (5f64.sqrt() - 1.0);
+    // Golden sections: the interior point kept from the last step is reused, so each
+    // step evaluates one new point.
+    let mut c = b - ratio * (b - a);
+    let mut d = a + ratio * (b - a);
+    let mut fc = None;
+    let mut fd = None;
     while b - a > options.tolerance && best_f > 0.0 {
         if evaluations >= options.max_evaluations {
             break;
         }
-        // Probe both golden points of [a, b]; keep the sub-interval around the better.
-        let c = b - ratio * (b - a);
-        let d = a + ratio * (b - a);
-        let (fc, fd) = (misfit(c, &mut evaluations)?, misfit(d, &mut evaluations)?);
-        for (x, f) in [(c, fc), (d, fd)] {
+        let (vc, vd) = match (fc, fd) {
+            (Some(vc), Some(vd)) => (vc, vd),
+            (Some(vc), None) => (vc, misfit(d, &mut evaluations)?),
+            (None, Some(vd)) => (misfit(c, &mut evaluations)?, vd),
+            (None, None) => (misfit(c, &mut evaluations)?, misfit(d, &mut evaluations)?),
+        };
+        for (x, f) in [(c, vc), (d, vd)] {
             if f < best_f {
                 best_x = x;
                 best_f = f;
             }
         }
-        if fc <= fd {
+        if vc <= vd {
+            // Keep [a, d]: the old c becomes the new d.
             b = d;
+            d = c;
+            fd = Some(vc);
+            c = b - ratio * (b - a);
+            fc = None;
         } else {
+            // Keep [c, b]: the old d becomes the new c.
             a = c;
+            c = d;
+            fc = Some(vd);
+            d = a + ratio * (b - a);
+            fd = None;
         }
     }
     Ok(Fit {

@@ -342,7 +342,8 @@ impl Driver {
         let clock = std::time::Instant::now();
         let normal = self
             .solver
-            .solve_normal(&mut self.interface, self.normal_load)?;
+            .solve_normal(&self.interface, self.normal_load)?;
+        self.interface.set_states(&normal.states)?;
         self.stats.normal_seconds += clock.elapsed().as_secs_f64();
         self.stats.normal_solves += 1;
         self.stats.normal_active_set_iterations += normal.report.active_set_iterations;
@@ -379,7 +380,9 @@ impl Driver {
                 });
             }
         }
-        self.breaking = response.breaking_loads(&normal.traction, self.friction)?;
+        self.breaking =
+            self.interface
+                .breaking_loads(&normal.traction, &response.traction, self.friction)?;
         self.normal = Some(normal);
         self.response = Some(response);
         Ok(())

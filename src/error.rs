@@ -137,7 +137,7 @@ pub enum Error {
     /// The operating system refused the solver's threads.
     #[error("could not start a pool of {threads} solver threads: {reason}")]
     ThreadPool {
-        /// Threads requested ([`crate::SolverOptions::threads`]).
+        /// Threads requested ([`crate::SolverOptions::parallelism`]).
         threads: usize,
         /// What the thread pool reported.
         reason: String,

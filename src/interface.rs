@@ -336,6 +336,73 @@ impl Interface {
         self.states[index] = state;
     }
 
+    /// Sets every site's state, e.g. to those of a normal equilibrium
+    /// ([`crate::NormalEquilibrium::states`]).
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] when `states` does not hold one state per site;
+    /// [`Error::InvalidParameter`] when a broken site would be revived (only
+    /// [`Interface::heal`] does that).
+    pub fn set_states(&mut self, states: &[SiteState]) -> Result<()> {
+        if states.len() != self.states.len() {
+            return Err(Error::LengthMismatch {
+                name: "states",
+                expected: self.states.len(),
+                found: states.len(),
+            });
+        }
+        if let Some(i) = (0..states.len())
+            .find(|&i| self.states[i] == SiteState::Broken && states[i] != SiteState::Broken)
+        {
+            return Err(Error::InvalidParameter {
+                name: "states (a broken site)",
+                value: i as f64,
+                reason: "a broken site stays broken until the interface is healed",
+            });
+        }
+        self.states.copy_from_slice(states);
+        Ok(())
+    }
+
+    /// The Coulomb rule: the shear load (N) at which each site reaches the threshold
+    /// `|φ_x| = μ φ_z`, `λ_i = μ φ_z,i / |φ_x,i(1)|` (paper Eq. lambda_Amonton_dscrt), from
+    /// the normal tractions (Pa) and the shear tractions per newton of load (Pa/N,
+    /// [`crate::TangentialResponse::traction`]). `+∞` for sites that carry no shear
+    /// (detached, broken, or exactly unloaded).
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] for slices of the wrong length;
+    /// [`Error::InvalidParameter`] for a friction coefficient that is negative or not
+    /// finite.
+    pub fn breaking_loads(
+        &self,
+        normal_traction: &[f64],
+        shear_per_newton: &[f64],
+        friction_coefficient: f64,
+    ) -> Result<Vec<f64>> {
+        let n = self.states.len();
+        check_slice("normal_traction", normal_traction, n)?;
+        check_slice("shear_per_newton", shear_per_newton, n)?;
+        if !(friction_coefficient.is_finite() && friction_coefficient >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "friction_coefficient",
+                value: friction_coefficient,
+                reason: "the friction coefficient must be finite and >= 0",
+            });
+        }
+        Ok(shear_per_newton
+            .iter()
+            .zip(normal_traction)
+            .map(|(g, f)| {
+                if *g == 0.0 {
+                    f64::INFINITY
+                } else {
+                    friction_coefficient * f / g.abs()
+                }
+            })
+            .collect())
+    }
+
     /// Normal stiffness per unit area `k_z = c_z / u0` (N/m³) of every site (the value
     /// while attached; a detached or broken site exerts no force).
     pub fn normal_stiffness(&self) -> Vec<f64> {

@@ -56,5 +56,6 @@ pub use geometry::{Block, Grid, Point};
 pub use interface::{HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw};
 pub use scene::{Drive, ForceLoad, HeightSource, Lateral, Scene, SceneBuilder};
 pub use solver::{
-    Backend, EquilibriumSolver, NormalEquilibrium, SolveReport, SolverOptions, TangentialResponse,
+    Backend, EquilibriumSolver, NormalEquilibrium, Parallelism, SolveReport, SolverOptions,
+    TangentialResponse,
 };

@@ -23,7 +23,7 @@
 
 use crate::error::{Error, Result};
 use crate::geometry::{Block, Grid};
-use crate::green::{InfluencePlan, RodLoad};
+use crate::green::{InfluencePlan, Planner, RodLoad};
 use crate::interface::{HeightDistribution, Heights, Interface, Material, SpringLaw};
 use crate::probe::{ProbeSpec, StressProbe};
 use crate::solver::SolverOptions;
@@ -273,11 +273,11 @@ impl SceneBuilder {
         self
     }
 
-    /// Whether `other` describes the same run: every option equal but the solver's thread
-    /// count, which does not change results (checkpoints resume across it).
+    /// Whether `other` describes the same run: every option equal but the solver's
+    /// parallelism, which does not change results (checkpoints resume across it).
     pub(crate) fn same_run(&self, other: &SceneBuilder) -> bool {
         let mut mine = self.clone();
-        mine.solver.threads = other.solver.threads;
+        mine.solver.parallelism = other.solver.parallelism;
         mine == *other
     }
 
@@ -307,7 +307,20 @@ impl SceneBuilder {
     }
 
     /// Validates everything and plans the operator (`O(N)` eigenvalues).
+    ///
+    /// # Errors
+    /// The first invalid option, as a typed [`Error`] naming it.
     pub fn build(self) -> Result<Scene> {
+        self.build_with(&Planner::new())
+    }
+
+    /// [`SceneBuilder::build`] with the operator from `planner`: scenes of one geometry
+    /// (block, cells, plan tolerance) share one plan, planned once, e.g. realizations of
+    /// the heights or sweeps over loads and drives.
+    ///
+    /// # Errors
+    /// As [`SceneBuilder::build`].
+    pub fn build_with(self, planner: &Planner) -> Result<Scene> {
         let builder = self.clone();
         let (lx, ly, lz) = self.lengths;
         let block = Block::new(lx, ly, lz)?;
@@ -354,9 +367,7 @@ impl SceneBuilder {
                 Some(lateral)
             }
         };
-        let plan = InfluencePlan::builder(grid)
-            .tolerance(self.plan_tolerance)
-            .build()?;
+        let plan = planner.plan(grid, self.plan_tolerance)?;
         // Displacement per newton of the lateral load, cell-averaged (m/N): only built
         // when a lateral load exists.
         let rod = match lateral {

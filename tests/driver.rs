@@ -414,14 +414,14 @@ fn drivers_and_solvers_can_move_between_threads() {
     send::<Scene>();
     sync::<Scene>();
     sync::<precursors::green::InfluencePlan>();
-    // And a driver with a pool of its own moves and runs on another thread.
+    // And a driver with helper threads moves and runs on another thread.
     let scene = Scene::builder()
         .block(0.030, 0.020, 0.030)
         .normal_load(2.1e3)
         .solver(
             SolverOptions::default()
                 .with_backend(Backend::Spectral)
-                .with_threads(2),
+                .with_parallelism(Parallelism::Threads(2)),
         )
         .seed(2)
         .build()

@@ -141,18 +141,31 @@ fn operator_inputs_are_checked() {
 }
 
 #[test]
-fn solver_threads_must_be_one_or_two() {
-    for threads in [0, 3, 64] {
-        let built = precursors::Scene::builder()
-            .solver(precursors::SolverOptions::default().with_threads(threads))
-            .build()
-            .and_then(|scene| scene.driver());
-        match built {
-            Err(Error::InvalidParameter { name, value, .. }) => {
-                assert_eq!(name, "threads");
-                assert_eq!(value, threads as f64);
-            }
-            other => panic!("threads = {threads}: {other:?}"),
+fn zero_solver_threads_are_refused() {
+    let built = precursors::Scene::builder()
+        .solver(
+            precursors::SolverOptions::default()
+                .with_parallelism(precursors::Parallelism::Threads(0)),
+        )
+        .build()
+        .and_then(|scene| scene.driver());
+    match built {
+        Err(Error::InvalidParameter { name, value, .. }) => {
+            assert_eq!(name, "threads");
+            assert_eq!(value, 0.0);
         }
+        other => panic!("threads = 0: {other:?}"),
+    }
+    // Any other count is valid, beyond the machine's cores too.
+    for threads in [1, 3, 64] {
+        let scene = precursors::Scene::builder()
+            .block(0.010, 0.005, 0.010)
+            .solver(
+                precursors::SolverOptions::default()
+                    .with_parallelism(precursors::Parallelism::Threads(threads)),
+            )
+            .build()
+            .unwrap();
+        assert!(scene.driver().is_ok(), "threads = {threads}");
     }
 }

@@ -17,7 +17,8 @@ fn real_area(lx: f64, ly: f64, lz: f64, loads: &[f64], seeds: u64) -> Vec<f64> {
             Heights::truncated_gaussian(&grid, HeightDistribution::default(), seed).unwrap();
         let mut iface = Interface::new(grid, heights, SpringLaw::default()).unwrap();
         for (k, &load) in loads.iter().enumerate() {
-            let eq = solver.solve_normal(&mut iface, load).unwrap();
+            let eq = solver.solve_normal(&iface, load).unwrap();
+            iface.set_states(&eq.states).unwrap();
             let area: f64 = iface
                 .real_contact_area(&eq.displacement)
                 .unwrap()

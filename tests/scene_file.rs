@@ -25,7 +25,7 @@ fn everything() -> SceneBuilder {
     let mut solver = SolverOptions::default()
         .with_backend(Backend::Spectral)
         .with_tolerance(1e-11)
-        .with_threads(2);
+        .with_parallelism(Parallelism::Threads(2));
     solver.max_active_set_iterations = 77;
     solver.max_linear_iterations = 999;
     Scene::builder()

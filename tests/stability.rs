@@ -61,7 +61,8 @@ fn run(case: Case) {
             .options(SolverOptions::default().with_backend(backend))
             .build()
             .unwrap();
-        let eq = solver.solve_normal(&mut iface, case.normal_load).unwrap();
+        let eq = solver.solve_normal(&iface, case.normal_load).unwrap();
+        iface.set_states(&eq.states).unwrap();
         assert!(eq
             .traction
             .iter()
@@ -218,7 +219,8 @@ fn stability_penetration_below_the_substrate() {
     let mut iface = Interface::new(g, heights, SpringLaw::default()).unwrap();
     let plan = InfluencePlan::builder(g).build().unwrap();
     let mut solver = EquilibriumSolver::builder(plan).build().unwrap();
-    let eq = solver.solve_normal(&mut iface, case.normal_load).unwrap();
+    let eq = solver.solve_normal(&iface, case.normal_load).unwrap();
+    iface.set_states(&eq.states).unwrap();
     assert!(
         eq.displacement.iter().all(|u| *u < 0.0),
         "every site below the substrate plane"

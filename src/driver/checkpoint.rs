@@ -163,7 +163,11 @@ impl Scene {
         // λ is a function of the two equilibria: recomputed rather than stored (it holds
         // infinities, which JSON cannot).
         if let (Some(normal), Some(response)) = (&checkpoint.normal, &checkpoint.response) {
-            driver.breaking = response.breaking_loads(&normal.traction, driver.friction)?;
+            driver.breaking = driver.interface.breaking_loads(
+                &normal.traction,
+                &response.traction,
+                driver.friction,
+            )?;
         }
         driver.normal = checkpoint.normal.clone();
         driver.response = checkpoint.response.clone();

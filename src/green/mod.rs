@@ -1,18 +1,29 @@
 //! The box's Neumann Green function: point series, analytic load terms and the grid
 //! operator.
 //!
-//! * [`GreenFunction`]: `G` and `∂G/∂z` at points (raw triple series and the paper's
-//!   rapidly converging representation), each with a truncation-error estimate.
+//! * [`GreenFunction`] (`point.rs`): `G` and `∂G/∂z` at points (raw triple series and the
+//!   paper's rapidly converging representation), each with a truncation-error estimate.
 //! * [`loads`]: the top, rod and uniform-side load terms and their transfer to height `z`.
-//! * [`InfluencePlan`]: the Galerkin influence operator of a grid (MODEL.md section 2),
-//!   planned once per geometry and applied matrix-free through the DCT, plus the
-//!   [`PlaneTransfer`] of bottom tractions to a plane at height `z`.
+//! * [`InfluencePlan`] (`plan.rs`): the Galerkin influence operator of a grid
+//!   (docs/model.md section 2), planned once per geometry ([`Planner`] shares plans) and
+//!   applied matrix-free; its eigenvalues come from `spectrum.rs`, its transforms from
+//!   the DCT engine `dct.rs`, and `staged.rs` applies it part by part for parallel
+//!   solvers.
+//! * [`PlaneTransfer`] (`transfer.rs`): bottom tractions carried to a plane at height `z`.
 
+mod dct;
 pub mod loads;
-mod operator;
+mod plan;
+mod planner;
 mod point;
+mod spectrum;
+mod staged;
+mod transfer;
 
 pub use loads::RodLoad;
-pub(crate) use operator::Dct2d;
-pub use operator::{InfluencePlan, InfluencePlanBuilder, PlaneTransfer, DENSE_LIMIT};
+pub(crate) use plan::SpectralTable;
+pub use plan::{InfluencePlan, InfluencePlanBuilder, DENSE_LIMIT};
+pub use planner::Planner;
 pub use point::{Estimate, GreenFunction, SeriesOptions, SummationAxis};
+pub(crate) use staged::{Partition, Staging};
+pub use transfer::PlaneTransfer;

@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use crate::geometry::Point;
 use crate::interface::{HeightDistribution, Material, SpringLaw};
 use crate::probe::ProbeSpec;
-use crate::solver::{Backend, SolverOptions};
+use crate::solver::{Backend, Parallelism, SolverOptions};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -127,7 +127,44 @@ struct SolverSpec {
     tolerance: f64,
     max_active_set_iterations: usize,
     max_linear_iterations: usize,
-    threads: usize,
+    threads: ThreadsSpec,
+}
+
+/// `solver.threads`: a count (`1`: the calling thread only; `0`: every core), `"all"`
+/// (every core) or `"current"` (the caller's rayon pool).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+enum ThreadsSpec {
+    Count(usize),
+    Name(ThreadsName),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum ThreadsName {
+    All,
+    Current,
+}
+
+impl From<Parallelism> for ThreadsSpec {
+    fn from(p: Parallelism) -> Self {
+        match p {
+            Parallelism::Threads(n) => ThreadsSpec::Count(n),
+            Parallelism::CurrentPool => ThreadsSpec::Name(ThreadsName::Current),
+            _ => ThreadsSpec::Count(1),
+        }
+    }
+}
+
+impl From<ThreadsSpec> for Parallelism {
+    fn from(t: ThreadsSpec) -> Self {
+        match t {
+            ThreadsSpec::Count(0) | ThreadsSpec::Name(ThreadsName::All) => Parallelism::all_cores(),
+            ThreadsSpec::Count(1) => Parallelism::Sequential,
+            ThreadsSpec::Count(n) => Parallelism::Threads(n),
+            ThreadsSpec::Name(ThreadsName::Current) => Parallelism::CurrentPool,
+        }
+    }
 }
 
 fn default_mean() -> f64 {
@@ -232,7 +269,7 @@ impl From<&SceneBuilder> for SceneFile {
                 tolerance: b.solver.tolerance,
                 max_active_set_iterations: b.solver.max_active_set_iterations,
                 max_linear_iterations: b.solver.max_linear_iterations,
-                threads: b.solver.threads,
+                threads: b.solver.parallelism.into(),
             },
             plan_tolerance: b.plan_tolerance,
             probes: ProbesSpec {
@@ -290,7 +327,7 @@ impl SceneFile {
         solver.tolerance = self.solver.tolerance;
         solver.max_active_set_iterations = self.solver.max_active_set_iterations;
         solver.max_linear_iterations = self.solver.max_linear_iterations;
-        solver.threads = self.solver.threads;
+        solver.parallelism = self.solver.threads.into();
         Ok(SceneBuilder {
             lengths: (self.block.lx, self.block.ly, self.block.lz),
             cells: match self.cells {

@@ -5,13 +5,14 @@
 //! CG, which converges in one or two iterations when it is exact and in a few when the
 //! diagonal changed since (the tangential compliances follow `u_z`).
 
-use super::pcg::SetSystem;
-use super::spectral::SpectralCore;
+use super::spectral::{Effort, SetProblem, SetSolve, SpectralCore};
+use super::system::Preconditioner;
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt;
 use faer::linalg::triangular_solve::solve_unit_lower_triangular_in_place;
 use faer::{Mat, Par};
+use std::sync::Mutex;
 
 /// Refactorise instead of updating when more than `n / UPDATE_FRACTION` sites change:
 /// an update costs `O(n²)` per site, a factorisation `O(n³/3)`.
@@ -295,114 +296,126 @@ impl FactorCache {
     }
 }
 
-/// The dense matrix `C_s` (m/Pa) of every site, column-major.
+/// The dense matrix `C_s` (m/Pa) of every site, column-major, and the factors of the
+/// normal and tangential systems.
 #[derive(Debug)]
 pub(crate) struct DenseCore {
     pub(crate) c: Mat<f64>,
     pub(crate) normal: FactorCache,
     pub(crate) tangential: FactorCache,
-    /// The DCT operator, to explore a cold attached set before factorising.
+    /// The DCT product (one part), and the spectral iteration that explores a cold
+    /// attached set before the factor is built.
     pub(crate) spectral: SpectralCore,
-    norm_c: f64,
 }
 
 impl DenseCore {
-    pub(crate) fn new(c: Mat<f64>, norm_c: f64, spectral: SpectralCore) -> Self {
+    pub(crate) fn new(c: Mat<f64>, spectral: SpectralCore) -> Self {
         Self {
             c,
             spectral,
             normal: FactorCache::default(),
             tangential: FactorCache::default(),
-            norm_c,
         }
     }
 
-    /// `out = C_s x` over every site, where `x` is given on `set`: through the DCT, which
-    /// is cheaper than the assembled matrix (`O(N log N)` against `O(N n)`) and agrees
-    /// with it to rounding.
-    pub(crate) fn apply_full(&mut self, set: &[usize], x: &[f64], out: &mut [f64]) {
-        self.spectral.apply_full(set, x, out);
+    /// Solves `problem` preconditioned by the normal or the tangential factor, brought up
+    /// to date for the set first. The product goes through the DCT operator (`O(N log N)`,
+    /// in cache) rather than the assembled `n x n` submatrix (`O(n²)`, memory bound): the
+    /// factor is only the preconditioner. A stale factor gets 50 iterations, then is
+    /// refactorised.
+    pub(crate) fn solve(
+        &mut self,
+        tangential: bool,
+        problem: SetProblem<'_>,
+        f: Vec<f64>,
+        effort: Effort,
+    ) -> Result<SetSolve> {
+        let first = Effort {
+            max_iterations: effort.max_iterations.min(50),
+            ..effort
+        };
+        let mut solved = self.solve_once(tangential, problem, f, first)?;
+        if !solved.outcome.converged {
+            self.cache(tangential).clear();
+            let spent = solved.outcome.iterations;
+            solved = self.solve_once(tangential, problem, solved.f, effort)?;
+            solved.outcome.iterations += spent;
+        }
+        Ok(solved)
     }
 
-    /// A system on `set` with compliances `diag`, preconditioned by the chosen factor.
-    pub(crate) fn system<'a>(
-        &'a mut self,
+    fn cache(&mut self, tangential: bool) -> &mut FactorCache {
+        if tangential {
+            &mut self.tangential
+        } else {
+            &mut self.normal
+        }
+    }
+
+    fn solve_once(
+        &mut self,
         tangential: bool,
-        set: &'a [usize],
-        diag: &'a [f64],
-    ) -> Result<DenseSystem<'a>> {
+        problem: SetProblem<'_>,
+        f: Vec<f64>,
+        effort: Effort,
+    ) -> Result<SetSolve> {
+        let c = &self.c;
         let cache = if tangential {
             &mut self.tangential
         } else {
             &mut self.normal
         };
-        cache.prepare(&self.c, set, diag)?;
+        cache.prepare(c, problem.set, problem.d)?;
         // Map from the factor order to positions in `set`.
-        let mut pos = vec![usize::MAX; self.c.nrows()];
-        for (a, &i) in set.iter().enumerate() {
+        let mut pos = vec![usize::MAX; c.nrows()];
+        for (a, &i) in problem.set.iter().enumerate() {
             pos[i] = a;
         }
         let perm: Vec<usize> = cache.order.iter().map(|&i| pos[i]).collect();
-        let norm = self.norm_c + diag.iter().fold(0.0f64, |m, d| m.max(*d));
-        Ok(DenseSystem {
-            spectral: &mut self.spectral,
-            set,
-            diag,
+        let factor = FactorSolve {
             cache,
+            work: Mutex::new(Mat::zeros(perm.len(), 1)),
             perm,
-            norm,
-            work: Mat::zeros(set.len(), 1),
-        })
+        };
+        let solved =
+            self.spectral
+                .solve_with(problem, Preconditioner::Factor(factor), f, effort)?;
+        let cache = if tangential {
+            &mut self.tangential
+        } else {
+            &mut self.normal
+        };
+        // How many iterations the factor needed (a stale factor is replaced).
+        cache.last_iterations = solved.outcome.iterations;
+        Ok(solved)
     }
 }
 
-/// `A_SS = C_SS + diag(d)` assembled, with the cached factor as preconditioner.
-/// The product goes through the DCT operator (`O(N log N)`, in cache) rather than the
-/// assembled `n x n` submatrix (`O(n²)`, memory bound): the factor is only the
-/// preconditioner.
-pub(crate) struct DenseSystem<'a> {
-    spectral: &'a mut SpectralCore,
-    set: &'a [usize],
-    diag: &'a [f64],
-    cache: &'a mut FactorCache,
+/// `z = (L D Lᵀ)⁻¹ r` with the cached factor, in the factor's site order.
+pub(crate) struct FactorSolve<'a> {
+    cache: &'a FactorCache,
+    /// Positions in the set of the factor's sites.
     perm: Vec<usize>,
-    norm: f64,
-    work: Mat<f64>,
+    work: Mutex<Mat<f64>>,
 }
 
-impl DenseSystem<'_> {
-    /// Records how many PCG iterations the factor needed (a stale factor is replaced).
-    pub(crate) fn record(&mut self, iterations: usize) {
-        self.cache.last_iterations = iterations;
-    }
-}
-
-impl SetSystem for DenseSystem<'_> {
-    fn apply(&mut self, x: &[f64], y: &mut [f64]) {
-        self.spectral.apply_set(self.set, self.diag, x, y);
-    }
-
-    fn precondition(&mut self, r: &[f64], z: &mut [f64]) {
-        let n = r.len();
+impl FactorSolve<'_> {
+    pub(crate) fn solve(&self, r: &[f64], z: &mut [f64]) {
+        let mut work = self.work.lock().unwrap_or_else(|e| e.into_inner());
         for (a, &p) in self.perm.iter().enumerate() {
-            self.work[(a, 0)] = r[p];
+            work[(a, 0)] = r[p];
         }
         let ld = self.cache.ld.as_ref();
         ldlt::solve::solve_in_place_with_conj(
             ld,
             ld.diagonal(),
             faer::Conj::No,
-            self.work.as_mut(),
+            work.as_mut(),
             Par::Seq,
             MemStack::new(&mut []),
         );
         for (a, &p) in self.perm.iter().enumerate() {
-            z[p] = self.work[(a, 0)];
+            z[p] = work[(a, 0)];
         }
-        debug_assert_eq!(n, self.perm.len());
-    }
-
-    fn norm_bound(&self) -> f64 {
-        self.norm
     }
 }

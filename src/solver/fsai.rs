@@ -89,9 +89,8 @@ impl Entries {
     }
 }
 
-/// Sites per block of the fused `Gᵀ G` product.
-#[cfg(test)]
-const FUSED_BLOCK: usize = 256;
+/// Cells per block of the products (a block's values stay in L1 across the slots).
+const BLOCK: usize = 256;
 
 /// The cached factor `G` (rows per site) of one system kind (normal or tangential).
 #[derive(Debug, Clone)]
@@ -280,57 +279,78 @@ impl Fsai {
         self.dirty = dirty;
     }
 
-    /// `G` of the current set as weight planes (`N` values per slot, slot-major) and the
-    /// slots' site offsets: `(G r)_i = Σ_k w_k[i] r[i - o_k]`.
-    pub(crate) fn weights(&self) -> (&[f64], &[usize]) {
-        (&self.planes, &self.offsets)
+    /// Cells `G` reaches back (and `Gᵀ` forward): the largest slot offset.
+    pub(crate) fn halo(&self) -> usize {
+        self.offsets.iter().copied().max().unwrap_or(0)
     }
 
-    /// `z = Gᵀ G r` on the current set (the solver applies it split, in `team.rs`).
-    #[cfg(test)]
-    pub(crate) fn apply(&mut self, r: &[f64], z: &mut [f64]) {
+    /// `y = G r` on the cells `lo .. lo + y.len()`: `y_i = Σ_k w_k[i] r[i - o_k]`.
+    /// `r_ext[halo + c - lo]` holds `r` at cell `c` for `c` in `lo - halo .. lo + y.len()`
+    /// (zeros before the grid). Runs blocks of cells with all the slots while the block
+    /// stays in L1 (a pass per slot over a whole part streams the weight planes: 2.5x
+    /// slower).
+    pub(crate) fn g(&self, lo: usize, r_ext: &[f64], y: &mut [f64]) {
         let n = self.member.len();
-        let (mut rf, mut yf, mut zf) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let halo = self.halo();
+        // The slot of the site itself first (offset 0, never clipped): it assigns, the
+        // others add, so no buffer needs zeroing.
+        let slots = || self.planes.chunks_exact(n).zip(&self.offsets).rev();
+        for (b, y) in y.chunks_mut(BLOCK).enumerate() {
+            let a = b * BLOCK; // local cell index of the block
+            let e = a + y.len();
+            for (k, (w, &o)) in slots().enumerate() {
+                let terms = w[lo + a..lo + e]
+                    .iter()
+                    .zip(&r_ext[halo + a - o..halo + e - o]);
+                if k == 0 {
+                    y.iter_mut().zip(terms).for_each(|(y, (w, x))| *y = w * x);
+                } else {
+                    y.iter_mut().zip(terms).for_each(|(y, (w, x))| *y += w * x);
+                }
+            }
+        }
+    }
+
+    /// `z = Gᵀ y` on the cells `lo .. lo + z.len()`: `z_j = Σ_k w_k[j + o_k] y[j + o_k]`.
+    /// `y_ext[c - lo]` holds `y` at cell `c` for `c` in `lo .. lo + z.len() + halo` (cells
+    /// past the grid carry no weight and are not read).
+    pub(crate) fn gt(&self, lo: usize, y_ext: &[f64], z: &mut [f64]) {
+        let n = self.member.len();
+        let slots = || self.planes.chunks_exact(n).zip(&self.offsets).rev();
+        for (b, z) in z.chunks_mut(BLOCK).enumerate() {
+            let a = b * BLOCK;
+            for (k, (w, &o)) in slots().enumerate() {
+                let e = (a + z.len()).min(n.saturating_sub(lo + o));
+                if e <= a {
+                    continue;
+                }
+                let terms = w[lo + a + o..lo + e + o].iter().zip(&y_ext[a + o..e + o]);
+                if k == 0 {
+                    z.iter_mut().zip(terms).for_each(|(z, (w, y))| *z = w * y);
+                } else {
+                    z[..e - a]
+                        .iter_mut()
+                        .zip(terms)
+                        .for_each(|(z, (w, y))| *z += w * y);
+                }
+            }
+        }
+    }
+
+    /// `z = Gᵀ G r` on the current set through [`Fsai::g`] and [`Fsai::gt`] over the whole
+    /// grid as one part (the solver runs the same functions part by part).
+    #[cfg(test)]
+    pub(crate) fn apply(&self, r: &[f64], z: &mut [f64]) {
+        let n = self.member.len();
+        let halo = self.halo();
+        let mut r_ext = vec![0.0; halo + n];
         for (&i, &ri) in self.sites.iter().zip(r) {
-            rf[i] = ri;
+            r_ext[halo + i] = ri;
         }
-        zf.fill(0.0);
-        // Blocks of sites: both products per block while its weights are in L1 (the
-        // planes are read once per application; `Gᵀ` only writes below the block).
-        let mut b0 = 0;
-        while b0 < n {
-            let b1 = (b0 + FUSED_BLOCK).min(n);
-            yf[b0..b1].fill(0.0);
-            for (w, &o) in self.planes.chunks_exact(n).zip(&self.offsets) {
-                let lo = b0.max(o);
-                if lo >= b1 {
-                    continue;
-                }
-                // y[i] += w[i] r[i - o]
-                for ((y, w), x) in yf[lo..b1]
-                    .iter_mut()
-                    .zip(&w[lo..b1])
-                    .zip(&rf[lo - o..b1 - o])
-                {
-                    *y += w * x;
-                }
-            }
-            for (w, &o) in self.planes.chunks_exact(n).zip(&self.offsets) {
-                let lo = b0.max(o);
-                if lo >= b1 {
-                    continue;
-                }
-                // z[i - o] += w[i] y[i]
-                for ((z, w), y) in zf[lo - o..b1 - o]
-                    .iter_mut()
-                    .zip(&w[lo..b1])
-                    .zip(&yf[lo..b1])
-                {
-                    *z += w * y;
-                }
-            }
-            b0 = b1;
-        }
+        let mut y_ext = vec![0.0; n + halo];
+        self.g(0, &r_ext, &mut y_ext[..n]);
+        let mut zf = vec![0.0; n];
+        self.gt(0, &y_ext, &mut zf);
         for (zi, &i) in z.iter_mut().zip(&self.sites) {
             *zi = zf[i];
         }

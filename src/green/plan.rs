@@ -1,0 +1,304 @@
+//! The Galerkin influence operator of the grid (MODEL.md section 2) and the transfer of
+//! bottom tractions to a plane at height `z`.
+//!
+//! `Ĝ_ij = (1/ΔA²) ∫_cell i ∫_cell j G(x,ξ;y,η;0,0) dA dA'` is diagonal in the 2-D DCT-II
+//! basis of the grid. With `θ = p'π/(2Nx)` the aliases of the mode `p'` are the
+//! wavenumbers `k = 2|θ + qπ|/Δx`, `q ∈ ℤ`, with cell-averaging weights
+//! `S² = sin²θ/(θ + qπ)²` (summing to 1), and
+//!
+//! `Ĝ_ij = Σ_{p',m'} λ(p',m') cos(p'π(ix_i+½)/Nx) cos(p'π(ix_j+½)/Nx) cos(m'π(iy_i+½)/Ny) cos(m'π(iy_j+½)/Ny)`,
+//! `λ(p',m') = (4/(Lx Ly)) Σ_{aliases} w_p w_m S_p² S_m² coth(κ Lz)/κ` (m⁻¹),
+//!
+//! `κ² = k_p² + k_m²`, `w_0 = ½`, and `Lz/3` in place of `coth(κLz)/κ` at `κ = 0`.
+//! The alias sum is truncated to `|q|, |r| ≤ Q` with the leading tail of both strips added
+//! in closed form (Euler–Maclaurin on `Σ 1/|θ + qπ|³`); `Q` doubles until two successive
+//! sums agree to the tolerance (see `docs/accuracy.md`).
+
+use super::dct::{cosine_table, Dct2d};
+use super::spectrum::lambda_adaptive;
+use super::transfer::PlaneTransfer;
+use crate::error::{check_slice, check_tolerance, Error, Result};
+use crate::geometry::Grid;
+use std::sync::Arc;
+
+/// Largest grid for which [`InfluencePlan::dense`] assembles a matrix.
+pub const DENSE_LIMIT: usize = 20_000;
+
+/// Builder of an [`InfluencePlan`].
+#[derive(Debug, Clone)]
+#[must_use]
+pub struct InfluencePlanBuilder {
+    grid: Grid,
+    tolerance: f64,
+}
+
+impl InfluencePlanBuilder {
+    /// Relative tolerance on every eigenvalue's alias sum (default `1e-6`).
+    pub fn tolerance(mut self, tolerance: f64) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+
+    /// Computes the eigenvalues and plans the DCTs.
+    pub fn build(self) -> Result<InfluencePlan> {
+        let tol = check_tolerance(self.tolerance)?;
+        let grid = self.grid;
+        let (nx, ny) = (grid.nx(), grid.ny());
+        let mut lambda = vec![0.0; grid.len()];
+        let mut max_rel_error: f64 = 0.0;
+        // Modes with the same (p', m') appear once: O(N) alias sums.
+        for m in 0..ny {
+            for p in 0..nx {
+                let (value, error) = lambda_adaptive(&grid, p, m, tol)?;
+                lambda[m * nx + p] = value;
+                max_rel_error = max_rel_error.max(error / value);
+            }
+        }
+        Ok(InfluencePlan::from_eigenvalues(
+            grid,
+            tol,
+            lambda,
+            max_rel_error,
+        ))
+    }
+}
+
+/// The Galerkin influence operator `Ĝ` of a grid, planned once and reused.
+///
+/// `Ĝ` maps cell-constant tractions on the bottom face (Pa) to cell-averaged
+/// displacements times `M/ΔA`: the displacement is `u = ⟨u⟩ + (ΔA/M) Ĝ φ`; its entries
+/// are in m⁻¹. It is applied matrix-free through the 2-D DCT in `O(N log N)`
+/// ([`InfluencePlan::apply`]) or assembled densely for small grids ([`InfluencePlan::dense`]).
+///
+/// A plan is cheap to clone: clones share the eigenvalues and the planned transforms
+/// (`Arc`), so one plan serves every scene, solver and probe of its geometry
+/// ([`crate::Scene::builder`]'s `plan`, [`Planner`](super::Planner)).
+#[derive(Clone)]
+pub struct InfluencePlan {
+    inner: Arc<PlanData>,
+}
+
+struct PlanData {
+    grid: Grid,
+    tolerance: f64,
+    lambda: Vec<f64>,
+    /// The operator's table: λ scaled for unnormalised DCT-III (×2 for p' = 0 and for
+    /// m' = 0).
+    table: SpectralTable,
+    max_rel_error: f64,
+    dct: Arc<Dct2d>,
+}
+
+/// The diagonal of an operator with the eigenvectors of `Ĝ` (the 2-D DCT-II modes of the
+/// grid), in the form the plan's transforms apply ([`InfluencePlan::spectral_table`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct SpectralTable(Vec<f64>);
+
+impl SpectralTable {
+    /// Row-major `Ny x Nx`, in the scaling of the unnormalised transforms.
+    pub(super) fn values(&self) -> &[f64] {
+        &self.0
+    }
+}
+
+impl std::fmt::Debug for InfluencePlan {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("InfluencePlan")
+            .field("grid", &self.inner.grid)
+            .field("tolerance", &self.inner.tolerance)
+            .field("max_rel_error", &self.inner.max_rel_error)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Diagonal for [`Dct2d::filter`]: the eigenvalue table times the DCT-III scaling.
+pub(super) fn dct_diagonal(grid: &Grid, values: &[f64]) -> Vec<f64> {
+    let (nx, ny) = (grid.nx(), grid.ny());
+    let mut out = values.to_vec();
+    for m in 0..ny {
+        for p in 0..nx {
+            let mut s = 1.0;
+            if p == 0 {
+                s *= 2.0;
+            }
+            if m == 0 && ny > 1 {
+                s *= 2.0;
+            }
+            out[m * nx + p] *= s;
+        }
+    }
+    out
+}
+
+impl InfluencePlan {
+    /// A builder for the operator of `grid` with the default tolerance.
+    pub fn builder(grid: Grid) -> InfluencePlanBuilder {
+        InfluencePlanBuilder {
+            grid,
+            tolerance: 1e-6,
+        }
+    }
+
+    fn from_eigenvalues(grid: Grid, tolerance: f64, lambda: Vec<f64>, max_rel_error: f64) -> Self {
+        let table = SpectralTable(dct_diagonal(&grid, &lambda));
+        Self {
+            inner: Arc::new(PlanData {
+                dct: Arc::new(Dct2d::new(grid.nx(), grid.ny())),
+                grid,
+                tolerance,
+                lambda,
+                table,
+                max_rel_error,
+            }),
+        }
+    }
+
+    /// Whether `self` and `other` share one planned operator (clones of one plan).
+    pub fn same_plan(&self, other: &InfluencePlan) -> bool {
+        Arc::ptr_eq(&self.inner, &other.inner)
+    }
+
+    /// The planned transforms (the plane transfer shares them).
+    pub(super) fn dct(&self) -> &Arc<Dct2d> {
+        &self.inner.dct
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &Grid {
+        &self.inner.grid
+    }
+
+    /// The relative tolerance the alias sums were computed to.
+    pub fn tolerance(&self) -> f64 {
+        self.inner.tolerance
+    }
+
+    /// Largest estimated relative error of an eigenvalue.
+    pub fn max_relative_error(&self) -> f64 {
+        self.inner.max_rel_error
+    }
+
+    /// `λ(p', m')` (m⁻¹), the coefficient of `cos(p'·)cos(p'·)cos(m'·)cos(m'·)` in `Ĝ`
+    /// (module docs); `p' < Nx`, `m' < Ny`. `None` outside the grid.
+    pub fn lambda(&self, p: usize, m: usize) -> Option<f64> {
+        (p < self.inner.grid.nx() && m < self.inner.grid.ny())
+            .then(|| self.inner.lambda[m * self.inner.grid.nx() + p])
+    }
+
+    /// Eigenvalue of `Ĝ` (m⁻¹) for the orthonormal DCT-II mode `(p', m')`:
+    /// `λ / (α_p'² α_m'²)` with `α_0² = 1/N`, `α_{>0}² = 2/N`.
+    pub fn eigenvalue(&self, p: usize, m: usize) -> Option<f64> {
+        let (nx, ny) = (self.inner.grid.nx() as f64, self.inner.grid.ny() as f64);
+        let ax = if p == 0 { 1.0 / nx } else { 2.0 / nx };
+        let ay = if m == 0 { 1.0 / ny } else { 2.0 / ny };
+        self.lambda(p, m).map(|l| l / (ax * ay))
+    }
+
+    /// `out = Ĝ v` (m⁻¹ times the units of `v`), matrix-free in `O(N log N)`.
+    pub fn apply(&self, v: &[f64], out: &mut [f64]) -> Result<()> {
+        let n = self.inner.grid.len();
+        check_slice("v", v, n)?;
+        if out.len() != n {
+            return Err(Error::LengthMismatch {
+                name: "out",
+                expected: n,
+                found: out.len(),
+            });
+        }
+        out.copy_from_slice(v);
+        self.apply_in_place(out, &mut Vec::new());
+        Ok(())
+    }
+
+    /// `buf ← Ĝ buf` in place (`work`: scratch).
+    pub(crate) fn apply_in_place(&self, buf: &mut [f64], work: &mut Vec<f64>) {
+        self.filter_in_place(&self.inner.table, buf, work);
+    }
+
+    /// `buf ← T buf` in place for an operator `T` with `Ĝ`'s eigenvectors, given by its
+    /// table (`work`: scratch).
+    pub(crate) fn filter_in_place(
+        &self,
+        table: &SpectralTable,
+        buf: &mut [f64],
+        work: &mut Vec<f64>,
+    ) {
+        let nx = self.inner.grid.nx();
+        self.inner.dct.filter(buf, &table.0, nx, work);
+    }
+
+    /// The operator's own table.
+    pub(crate) fn operator_table(&self) -> &SpectralTable {
+        &self.inner.table
+    }
+
+    /// The table of the operator with the same eigenvectors as `Ĝ` and eigenvalues
+    /// `map(p', m', eigenvalue(p', m'))`.
+    pub(crate) fn spectral_table(&self, map: impl Fn(usize, usize, f64) -> f64) -> SpectralTable {
+        let (nx, ny) = (self.inner.grid.nx(), self.inner.grid.ny());
+        let mut values = vec![0.0; nx * ny];
+        for m in 0..ny {
+            let ay = if m == 0 { 1.0 } else { 2.0 } / ny as f64;
+            for p in 0..nx {
+                let ax = if p == 0 { 1.0 } else { 2.0 } / nx as f64;
+                let k = m * nx + p;
+                let eigen = self.inner.lambda[k] / (ax * ay);
+                values[k] = map(p, m, eigen) * (ax * ay);
+            }
+        }
+        SpectralTable(dct_diagonal(&self.inner.grid, &values))
+    }
+
+    /// The dense matrix `Ĝ` (m⁻¹), row-major `N x N`, assembled from the eigenvalue table
+    /// by explicit cosine sums (independent of the DCT path). Refused above
+    /// [`DENSE_LIMIT`] cells.
+    pub fn dense(&self) -> Result<Vec<f64>> {
+        let n = self.inner.grid.len();
+        if n > DENSE_LIMIT {
+            return Err(Error::TooLargeForDense {
+                n,
+                limit: DENSE_LIMIT,
+            });
+        }
+        let (nx, ny) = (self.inner.grid.nx(), self.inner.grid.ny());
+        let cx = cosine_table(nx);
+        let cy = cosine_table(ny);
+        // B_m[a][b] = Σ_p λ(p,m) cx[p][a] cx[p][b], then Ĝ = Σ_m cy[m]⊗cy[m] ⊗ B_m.
+        let mut g = vec![0.0; n * n];
+        let mut bm = vec![0.0; nx * nx];
+        for m in 0..ny {
+            bm.iter_mut().for_each(|x| *x = 0.0);
+            for p in 0..nx {
+                let l = self.inner.lambda[m * nx + p];
+                let row = &cx[p * nx..(p + 1) * nx];
+                for a in 0..nx {
+                    let la = l * row[a];
+                    for b in 0..nx {
+                        bm[a * nx + b] += la * row[b];
+                    }
+                }
+            }
+            let crow = &cy[m * ny..(m + 1) * ny];
+            for iy in 0..ny {
+                for jy in 0..ny {
+                    let c = crow[iy] * crow[jy];
+                    for a in 0..nx {
+                        let dst =
+                            &mut g[(iy * nx + a) * n + jy * nx..(iy * nx + a) * n + jy * nx + nx];
+                        let src = &bm[a * nx..(a + 1) * nx];
+                        for (d, s) in dst.iter_mut().zip(src) {
+                            *d += c * s;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(g)
+    }
+
+    /// The transfer of bottom tractions to the plane at height `z` (m), with the alias
+    /// sums converged to absolute tolerance `tol` (the factors are at most 1).
+    pub fn plane_transfer(&self, z: f64, tol: f64) -> Result<PlaneTransfer> {
+        PlaneTransfer::new(self, z, tol)
+    }
+}

@@ -1,0 +1,70 @@
+//! A cache of influence plans: one plan per geometry and tolerance, shared.
+
+use super::plan::InfluencePlan;
+use crate::error::Result;
+use crate::geometry::Grid;
+use std::sync::{Arc, Mutex};
+
+/// Plans influence operators once per grid and tolerance and hands out shared clones.
+///
+/// Planning a grid costs `O(N)` alias sums (78 ms for the paper's 140 x 7 calibration
+/// grid, seconds at `N = 1e5`); every scene, solver and probe of one geometry can share
+/// one plan. A `Planner` is cheap to clone (clones share the cache) and may be used from
+/// several threads. Plans stay cached while the planner lives.
+///
+/// ```
+/// use precursors::{green::Planner, Scene};
+/// let planner = Planner::new();
+/// let a = Scene::builder().seed(1).build_with(&planner)?;
+/// let b = Scene::builder().seed(2).build_with(&planner)?;   // same geometry: no new plan
+/// assert!(a.plan().same_plan(b.plan()) && planner.len() == 1);
+/// # Ok::<(), precursors::Error>(())
+/// ```
+#[derive(Debug, Clone, Default)]
+pub struct Planner {
+    plans: Arc<Mutex<Vec<InfluencePlan>>>,
+}
+
+impl Planner {
+    /// An empty cache.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The plan of `grid` with relative tolerance `tolerance` ([`InfluencePlan::builder`]),
+    /// planned on the first request and shared afterwards.
+    ///
+    /// # Errors
+    /// Those of [`crate::green::InfluencePlanBuilder::build`] (invalid tolerance, an alias
+    /// sum that does not converge).
+    pub fn plan(&self, grid: Grid, tolerance: f64) -> Result<InfluencePlan> {
+        let same =
+            |p: &InfluencePlan| *p.grid() == grid && p.tolerance().to_bits() == tolerance.to_bits();
+        if let Some(plan) = self.lock().iter().find(|p| same(p)) {
+            return Ok(plan.clone());
+        }
+        // Planned outside the lock (other geometries stay available meanwhile); a plan
+        // of the same geometry planned meanwhile by another thread wins.
+        let plan = InfluencePlan::builder(grid).tolerance(tolerance).build()?;
+        let mut plans = self.lock();
+        if let Some(existing) = plans.iter().find(|p| same(p)) {
+            return Ok(existing.clone());
+        }
+        plans.push(plan.clone());
+        Ok(plan)
+    }
+
+    /// Plans in the cache.
+    pub fn len(&self) -> usize {
+        self.lock().len()
+    }
+
+    /// Whether the cache is empty.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<InfluencePlan>> {
+        self.plans.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}

@@ -1,0 +1,142 @@
+//! What the solvers take and return: the backend, the options, the equilibria and the
+//! report of a solve.
+
+use super::parallel::Parallelism;
+use crate::interface::SiteState;
+
+/// Largest grid the [`Backend::Auto`] choice solves densely.
+pub const AUTO_DENSE_LIMIT: usize = 2500;
+
+/// Which linear-algebra backend solves the equilibria.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[non_exhaustive]
+pub enum Backend {
+    /// Dense up to [`AUTO_DENSE_LIMIT`] cells, spectral above.
+    #[default]
+    Auto,
+    /// Assembled `C` (`N²` memory, up to [`crate::green::DENSE_LIMIT`] cells) and an LDLᵀ
+    /// factor of the attached set, updated when sites leave or join.
+    Dense,
+    /// Matrix-free: the DCT operator in projected conjugate gradients, memory `O(N)`.
+    Spectral,
+}
+
+/// Options of the equilibrium solvers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct SolverOptions {
+    /// Backend (default [`Backend::Auto`]).
+    pub backend: Backend,
+    /// Normwise backward error `‖A f + U 1 - b‖∞ / (‖A‖ ‖f‖∞ + ‖b‖∞ + |U|)` at which a
+    /// linear solve stops (default `1e-13`).
+    pub tolerance: f64,
+    /// Active-set iterations allowed per normal equilibrium (default `1000`).
+    pub max_active_set_iterations: usize,
+    /// Conjugate-gradient iterations allowed per linear solve (default `20000`).
+    pub max_linear_iterations: usize,
+    /// The threads a solve may use (default [`Parallelism::Sequential`]). The spectral
+    /// backend shares each solve's work over the parts of the grid (fixed by the grid);
+    /// the results are the same bit for bit for every choice (tested), only the wall time
+    /// changes (docs/performance.md). The dense backend's factor solves run on the
+    /// calling thread whatever the choice. To run several scenes at once (seeds), give
+    /// each [`Parallelism::Sequential`] and one scene per core.
+    pub parallelism: Parallelism,
+}
+
+impl Default for SolverOptions {
+    fn default() -> Self {
+        Self {
+            backend: Backend::Auto,
+            tolerance: 1e-13,
+            max_active_set_iterations: 1000,
+            max_linear_iterations: 20000,
+            parallelism: Parallelism::Sequential,
+        }
+    }
+}
+
+impl SolverOptions {
+    /// With the given backend.
+    #[must_use]
+    pub fn with_backend(mut self, backend: Backend) -> Self {
+        self.backend = backend;
+        self
+    }
+
+    /// With the given linear tolerance (dimensionless).
+    #[must_use]
+    pub fn with_tolerance(mut self, tolerance: f64) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+
+    /// With the given parallelism (see [`SolverOptions::parallelism`]).
+    #[must_use]
+    pub fn with_parallelism(mut self, parallelism: Parallelism) -> Self {
+        self.parallelism = parallelism;
+        self
+    }
+}
+
+/// How a solve went.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[non_exhaustive]
+pub struct SolveReport {
+    /// The backend that ran (never `Auto`).
+    pub backend: Backend,
+    /// Active-set iterations (1 for the tangential solve).
+    pub active_set_iterations: usize,
+    /// Conjugate-gradient iterations, summed over the active-set iterations.
+    pub linear_iterations: usize,
+    /// Sites whose state changed between attached and detached.
+    pub flips: usize,
+    /// Normwise backward error of the last linear solve (dimensionless).
+    pub residual: f64,
+    /// `|ΔA Σ φ - F| / |F|` (dimensionless).
+    pub force_balance_error: f64,
+    /// Largest violation of the unilateral conditions, relative to the largest height:
+    /// `max(-f_i)/max f` on attached sites and `max(u0_i - u_z,i)/max u0` on detached ones
+    /// (0 for the tangential solve).
+    pub complementarity: f64,
+    /// Whether the monotone fallback ran (the primal-dual iteration revisited a set).
+    pub fallback: bool,
+}
+
+/// The normal equilibrium at a given normal load.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[non_exhaustive]
+pub struct NormalEquilibrium {
+    /// Normal traction `φ_z` per cell (Pa, `≥ 0`; 0 on detached and broken sites).
+    pub traction: Vec<f64>,
+    /// Normal displacement `u_z` of the bottom face per cell (m, cell averages).
+    pub displacement: Vec<f64>,
+    /// `U` (m): `u_z = U + (ΔA/M) Ĝ φ_z`, i.e. `⟨u_z⟩` plus the top load's constant.
+    pub offset: f64,
+    /// The state of every site at this equilibrium: attached or detached (broken sites
+    /// stay broken). The solver does not change the interface: apply these with
+    /// [`Interface::set_states`](crate::Interface::set_states).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub states: Vec<SiteState>,
+    /// The normal load `F_N` (N).
+    pub normal_load: f64,
+    /// How the solve went.
+    pub report: SolveReport,
+}
+
+/// The tangential response to one newton of shear at a fixed attached set.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[non_exhaustive]
+pub struct TangentialResponse {
+    /// Shear traction `φ_x` per cell per newton of load (Pa/N, `≤ 0` mostly: it resists).
+    pub traction: Vec<f64>,
+    /// Shear displacement `u_x` of the bottom face per cell per newton of load (m/N).
+    pub displacement: Vec<f64>,
+    /// `U` (m/N): `u_x = U + e + (ΔA/M) Ĝ φ_x`.
+    pub offset: f64,
+    /// How the solve went.
+    pub report: SolveReport,
+}

@@ -1,0 +1,311 @@
+//! The set system both backends solve: `A = C_SS + diag(d)` on an attached set, with
+//! `C_s = scale (Ĝ - shift 11ᵀ)` applied through the plan's staged product (part by
+//! part, [`crate::green::Staging`]) and one of the preconditioners.
+
+use super::dense::FactorSolve;
+use super::fsai::Fsai;
+use super::pcg::{sum, SetSystem};
+use crate::green::{Partition, SpectralTable, Staging};
+use std::ops::Range;
+use std::sync::{Mutex, RwLock};
+
+/// The preconditioner of a set system.
+pub(crate) enum Preconditioner<'a> {
+    /// `z = r / (diag_c + d)`: the mean diagonal of `C_s` plus the compliance.
+    Jacobi { diag_c: f64 },
+    /// `z = Gᵀ G r` ([`Fsai`]), part by part with the buffers of `buffers`.
+    Fsai {
+        fsai: &'a Fsai,
+        buffers: &'a FsaiBuffers,
+    },
+    /// The full-grid inverse `(C_s + d̄ I)⁻¹` restricted to the set: a staged product with
+    /// another table (and buffers of its own, so the operator's last product stays).
+    Spectral {
+        staging: &'a Staging,
+        table: &'a SpectralTable,
+    },
+    /// The dense backend's LDLᵀ factor (a system of one part).
+    Factor(FactorSolve<'a>),
+}
+
+/// `A = C_SS + diag(d)` on `set` (ascending sites), part by part.
+pub(crate) struct StagedSystem<'a> {
+    staging: &'a Staging,
+    table: &'a SpectralTable,
+    set: &'a [usize],
+    d: &'a [f64],
+    /// Set positions of each part.
+    ranges: Vec<Range<usize>>,
+    scale: f64,
+    shift: f64,
+    norm: f64,
+    precond: Preconditioner<'a>,
+}
+
+/// The constants of `C_s`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Compliance {
+    /// `ΔA/M` (m/Pa per m⁻¹).
+    pub scale: f64,
+    /// The mean mode's lowering (module docs of [`super`]).
+    pub shift: f64,
+    /// `‖C_s‖₂` (m/Pa).
+    pub norm: f64,
+}
+
+impl<'a> StagedSystem<'a> {
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn new(
+        staging: &'a Staging,
+        table: &'a SpectralTable,
+        compliance: Compliance,
+        set: &'a [usize],
+        d: &'a [f64],
+        precond: Preconditioner<'a>,
+    ) -> Self {
+        let partition = staging.partition();
+        let ranges = (0..partition.parts())
+            .scan(0, |start, k| {
+                let end = partition.cells(k).end;
+                let stop = *start + set[*start..].partition_point(|&i| i < end);
+                let range = *start..stop;
+                *start = stop;
+                Some(range)
+            })
+            .collect();
+        let norm = compliance.norm + d.iter().fold(0.0f64, |m, x| m.max(*x));
+        Self {
+            staging,
+            table,
+            set,
+            d,
+            ranges,
+            scale: compliance.scale,
+            shift: compliance.shift,
+            norm,
+            precond,
+        }
+    }
+
+    fn partition(&self) -> &Partition {
+        self.staging.partition()
+    }
+
+    /// `Σ x` as the product's first stage adds it (part by part, in part order).
+    pub(crate) fn input_sum(&self, x: &[f64]) -> f64 {
+        self.ranges.iter().fold(0.0, |s, r| s + sum(&x[r.clone()]))
+    }
+
+    /// `C_s x` on every cell, `x` the input of the last operator product and `sum_x` its
+    /// sum ([`StagedSystem::input_sum`]).
+    pub(crate) fn grid_product(&self, sum_x: f64, out: &mut [f64]) {
+        self.staging.result(out);
+        let (s, c) = (self.scale, self.shift * sum_x);
+        out.iter_mut().for_each(|o| *o = s * (*o - c));
+    }
+
+    /// Stages 0 and 1 of a staged product of `x` (part `k`'s slice) with `table`.
+    fn staged_head(
+        &self,
+        staging: &Staging,
+        table: &SpectralTable,
+        stage: usize,
+        k: usize,
+        x: &[f64],
+        carry: f64,
+    ) -> f64 {
+        match stage {
+            0 => {
+                let base = self.partition().cells(k).start;
+                let sites = &self.set[self.ranges[k].clone()];
+                staging.forward_rows(k, |rows| {
+                    for (&i, &v) in sites.iter().zip(x) {
+                        rows[i - base] = v;
+                    }
+                });
+                sum(x)
+            }
+            _ => {
+                staging.filter_columns(k, table);
+                // Pass the input's sum on to the last stage (part 0 carries it, exactly).
+                if k == 0 {
+                    carry
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+}
+
+impl SetSystem for StagedSystem<'_> {
+    fn parts(&self) -> usize {
+        self.ranges.len()
+    }
+
+    fn range(&self, k: usize) -> Range<usize> {
+        self.ranges[k].clone()
+    }
+
+    fn product_stages(&self) -> usize {
+        3
+    }
+
+    fn product(&self, stage: usize, k: usize, x: &[f64], y: &mut [f64], carry: f64) -> f64 {
+        if stage < 2 {
+            return self.staged_head(self.staging, self.table, stage, k, x, carry);
+        }
+        let base = self.partition().cells(k).start;
+        let range = self.ranges[k].clone();
+        let (sites, d) = (&self.set[range.clone()], &self.d[range]);
+        let (s, c) = (self.scale, self.shift * carry);
+        self.staging.inverse_rows(k, |rows| {
+            for (((ya, &i), da), xa) in y.iter_mut().zip(sites).zip(d).zip(x) {
+                *ya = s * (rows[i - base] - c) + da * xa;
+            }
+        });
+        carry
+    }
+
+    fn precondition_stages(&self) -> usize {
+        match self.precond {
+            Preconditioner::Jacobi { .. } | Preconditioner::Factor(_) => 1,
+            Preconditioner::Fsai { .. } | Preconditioner::Spectral { .. } => 3,
+        }
+    }
+
+    fn precondition(&self, stage: usize, k: usize, r: &[f64], z: &mut [f64], carry: f64) -> f64 {
+        let range = self.ranges[k].clone();
+        match &self.precond {
+            Preconditioner::Jacobi { diag_c } => {
+                for (zi, (ri, d)) in z.iter_mut().zip(r.iter().zip(&self.d[range])) {
+                    *zi = ri / (diag_c + d);
+                }
+            }
+            Preconditioner::Factor(factor) => factor.solve(r, z),
+            Preconditioner::Spectral { staging, table } => {
+                if stage < 2 {
+                    self.staged_head(staging, table, stage, k, r, carry);
+                } else {
+                    let base = self.partition().cells(k).start;
+                    let sites = &self.set[range];
+                    staging.inverse_rows(k, |rows| {
+                        for (za, &i) in z.iter_mut().zip(sites) {
+                            *za = rows[i - base];
+                        }
+                    });
+                }
+            }
+            Preconditioner::Fsai { fsai, buffers } => {
+                let cells = self.partition().cells(k);
+                let sites = &self.set[range];
+                buffers.stage(fsai, self.partition(), stage, k, cells, sites, r, z);
+            }
+        }
+        0.0
+    }
+
+    fn norm_bound(&self) -> f64 {
+        self.norm
+    }
+}
+
+/// Grid buffers of the FSAI product, per part: `r` and `G r` on the part's cells, and
+/// scratch (the halo-extended input of each pass, `Gᵀ G r` on the cells).
+#[derive(Debug)]
+pub(crate) struct FsaiBuffers {
+    r: Vec<RwLock<Vec<f64>>>,
+    y: Vec<RwLock<Vec<f64>>>,
+    scratch: Vec<Mutex<(Vec<f64>, Vec<f64>)>>,
+}
+
+impl FsaiBuffers {
+    pub(crate) fn new(partition: &Partition) -> Self {
+        let parts = partition.parts();
+        let cells = |k: usize| partition.cells(k).len();
+        Self {
+            r: (0..parts)
+                .map(|k| RwLock::new(vec![0.0; cells(k)]))
+                .collect(),
+            y: (0..parts)
+                .map(|k| RwLock::new(vec![0.0; cells(k)]))
+                .collect(),
+            scratch: (0..parts).map(|_| Mutex::default()).collect(),
+        }
+    }
+
+    /// Stage 0: `r` on the part's cells; 1: `y = G r` there (the halo before the part read
+    /// from the parts before it); 2: `z = Gᵀ y` there (the halo after it from the parts
+    /// after it), gathered on the part's sites.
+    #[allow(clippy::too_many_arguments)]
+    fn stage(
+        &self,
+        fsai: &Fsai,
+        partition: &Partition,
+        stage: usize,
+        k: usize,
+        cells: Range<usize>,
+        sites: &[usize],
+        r: &[f64],
+        z: &mut [f64],
+    ) {
+        let halo = fsai.halo();
+        let base = cells.start;
+        match stage {
+            0 => {
+                let mut buf = super::write(&self.r[k]);
+                buf.fill(0.0);
+                for (&i, &v) in sites.iter().zip(r) {
+                    buf[i - base] = v;
+                }
+            }
+            1 => {
+                let mut scratch = super::lock(&self.scratch[k]);
+                let ext = &mut scratch.0;
+                ext.clear();
+                ext.resize(halo + cells.len(), 0.0);
+                gather(
+                    &self.r,
+                    partition,
+                    base.saturating_sub(halo),
+                    cells.end,
+                    ext,
+                    halo - halo.min(base),
+                );
+                fsai.g(base, ext, &mut super::write(&self.y[k]));
+            }
+            _ => {
+                let mut scratch = super::lock(&self.scratch[k]);
+                let (ext, zc) = &mut *scratch;
+                ext.clear();
+                ext.resize(cells.len() + halo, 0.0);
+                let end = (cells.end + halo).min(partition.len());
+                gather(&self.y, partition, base, end, ext, 0);
+                zc.resize(cells.len(), 0.0);
+                fsai.gt(base, ext, zc);
+                for (za, &i) in z.iter_mut().zip(sites) {
+                    *za = zc[i - base];
+                }
+            }
+        }
+    }
+}
+
+/// Copies the cells `lo..hi` of per-part buffers into `out[at..]`.
+fn gather(
+    buffers: &[RwLock<Vec<f64>>],
+    partition: &Partition,
+    lo: usize,
+    hi: usize,
+    out: &mut [f64],
+    at: usize,
+) {
+    for (j, buffer) in buffers.iter().enumerate() {
+        let cells = partition.cells(j);
+        let (a, b) = (cells.start.max(lo), cells.end.min(hi));
+        if a < b {
+            let buf = super::read(buffer);
+            out[at + a - lo..at + b - lo].copy_from_slice(&buf[a - cells.start..b - cells.start]);
+        }
+    }
+}
