@@ -176,10 +176,9 @@ impl SpectralCore {
                 let grid = self.plan.grid();
                 let partition = self.staging.partition();
                 let (fsai, _) = self.fsai.get_or_insert_with(|| {
-                    (
-                        Fsai::new(grid.nx(), grid.len(), FSAI_RADIUS),
-                        FsaiBuffers::new(partition),
-                    )
+                    let fsai = Fsai::new(grid.nx(), grid.len(), FSAI_RADIUS);
+                    let buffers = FsaiBuffers::new(partition, fsai.halo());
+                    (fsai, buffers)
                 });
                 fsai.update(entries, set, d);
             }

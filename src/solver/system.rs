@@ -210,33 +210,37 @@ impl SetSystem for StagedSystem<'_> {
     }
 }
 
-/// Grid buffers of the FSAI product, per part: `r` and `G r` on the part's cells, and
-/// scratch (the halo-extended input of each pass, `Gᵀ G r` on the cells).
+/// Grid buffers of the FSAI product, per part: `r` on the halo before the part and on its
+/// cells; `G r` on its cells and the halo after them; `Gᵀ G r` on its cells. Each stage
+/// copies only the halo from its neighbours.
 #[derive(Debug)]
 pub(crate) struct FsaiBuffers {
     r: Vec<RwLock<Vec<f64>>>,
     y: Vec<RwLock<Vec<f64>>>,
-    scratch: Vec<Mutex<(Vec<f64>, Vec<f64>)>>,
+    /// Per part: `Gᵀ G r` on its cells, and the halo values on their way in.
+    z: Vec<Mutex<(Vec<f64>, Vec<f64>)>>,
 }
 
 impl FsaiBuffers {
-    pub(crate) fn new(partition: &Partition) -> Self {
+    pub(crate) fn new(partition: &Partition, halo: usize) -> Self {
         let parts = partition.parts();
         let cells = |k: usize| partition.cells(k).len();
         Self {
             r: (0..parts)
-                .map(|k| RwLock::new(vec![0.0; cells(k)]))
+                .map(|k| RwLock::new(vec![0.0; halo + cells(k)]))
                 .collect(),
             y: (0..parts)
-                .map(|k| RwLock::new(vec![0.0; cells(k)]))
+                .map(|k| RwLock::new(vec![0.0; cells(k) + halo]))
                 .collect(),
-            scratch: (0..parts).map(|_| Mutex::default()).collect(),
+            z: (0..parts)
+                .map(|k| Mutex::new((vec![0.0; cells(k)], vec![0.0; halo])))
+                .collect(),
         }
     }
 
-    /// Stage 0: `r` on the part's cells; 1: `y = G r` there (the halo before the part read
-    /// from the parts before it); 2: `z = Gᵀ y` there (the halo after it from the parts
-    /// after it), gathered on the part's sites.
+    /// Stage 0: `r` on the part's cells; 1: the halo before the part from the parts before
+    /// it, then `y = G r` on the part's cells; 2: the halo after the part from the parts
+    /// after it, then `z = Gᵀ y` on its cells, gathered on its sites.
     #[allow(clippy::too_many_arguments)]
     fn stage(
         &self,
@@ -251,38 +255,36 @@ impl FsaiBuffers {
     ) {
         let halo = fsai.halo();
         let base = cells.start;
+        let n = cells.len();
         match stage {
             0 => {
                 let mut buf = super::write(&self.r[k]);
-                buf.fill(0.0);
+                buf[halo..].fill(0.0);
                 for (&i, &v) in sites.iter().zip(r) {
-                    buf[i - base] = v;
+                    buf[halo + i - base] = v;
                 }
             }
             1 => {
-                let mut scratch = super::lock(&self.scratch[k]);
-                let ext = &mut scratch.0;
-                ext.clear();
-                ext.resize(halo + cells.len(), 0.0);
-                gather(
-                    &self.r,
-                    partition,
-                    base.saturating_sub(halo),
-                    cells.end,
-                    ext,
-                    halo - halo.min(base),
-                );
-                fsai.g(base, ext, &mut super::write(&self.y[k]));
+                // The halo first (read locks on the parts before, no lock of our own held
+                // meanwhile: they read ours at the same time), then our own buffer.
+                let mut scratch = super::lock(&self.z[k]);
+                let temp = &mut scratch.1;
+                temp.fill(0.0); // cells before the grid
+                let lo = base.saturating_sub(halo);
+                gather(&self.r, partition, lo, base, temp, halo - (base - lo), halo);
+                super::write(&self.r[k])[..halo].copy_from_slice(temp);
+                let buf = super::read(&self.r[k]);
+                fsai.g(base, &buf, &mut super::write(&self.y[k])[..n]);
             }
             _ => {
-                let mut scratch = super::lock(&self.scratch[k]);
-                let (ext, zc) = &mut *scratch;
-                ext.clear();
-                ext.resize(cells.len() + halo, 0.0);
-                let end = (cells.end + halo).min(partition.len());
-                gather(&self.y, partition, base, end, ext, 0);
-                zc.resize(cells.len(), 0.0);
-                fsai.gt(base, ext, zc);
+                let mut scratch = super::lock(&self.z[k]);
+                let (zc, temp) = &mut *scratch;
+                temp.fill(0.0); // cells past the grid
+                let hi = (cells.end + halo).min(partition.len());
+                gather(&self.y, partition, cells.end, hi, temp, 0, 0);
+                super::write(&self.y[k])[n..].copy_from_slice(temp);
+                let y = super::read(&self.y[k]);
+                fsai.gt(base, &y, zc);
                 for (za, &i) in z.iter_mut().zip(sites) {
                     *za = zc[i - base];
                 }
@@ -291,7 +293,8 @@ impl FsaiBuffers {
     }
 }
 
-/// Copies the cells `lo..hi` of per-part buffers into `out[at..]`.
+/// Copies the cells `lo..hi` of other parts' buffers into `out[at..]`; a part's cells
+/// start at `offset` in its buffer.
 fn gather(
     buffers: &[RwLock<Vec<f64>>],
     partition: &Partition,
@@ -299,13 +302,15 @@ fn gather(
     hi: usize,
     out: &mut [f64],
     at: usize,
+    offset: usize,
 ) {
     for (j, buffer) in buffers.iter().enumerate() {
         let cells = partition.cells(j);
         let (a, b) = (cells.start.max(lo), cells.end.min(hi));
         if a < b {
             let buf = super::read(buffer);
-            out[at + a - lo..at + b - lo].copy_from_slice(&buf[a - cells.start..b - cells.start]);
+            let src = &buf[offset + a - cells.start..offset + b - cells.start];
+            out[at + a - lo..at + b - lo].copy_from_slice(src);
         }
     }
 }
