@@ -239,3 +239,37 @@ fn documented_scenes_are_valid() {
     }
     assert!(files >= 3);
 }
+
+/// `solver.threads`: a count, `0` or `"all"` (every core), `"current"` (the caller's pool);
+/// the same parallelism comes back out of `to_json`.
+#[test]
+fn solver_threads_take_counts_and_names() {
+    let cores = Parallelism::all_cores();
+    for (value, want) in [
+        ("1", Parallelism::Sequential),
+        ("3", Parallelism::Threads(3)),
+        ("0", cores),
+        ("\"all\"", cores),
+        ("\"current\"", Parallelism::CurrentPool),
+    ] {
+        let text = format!(
+            r#"{{"block": {{"lx": 0.01, "ly": 0.004, "lz": 0.01}}, "solver": {{"threads": {value}}}}}"#
+        );
+        let builder = SceneBuilder::from_json_str(&text).unwrap();
+        let scene = builder.clone().build().unwrap();
+        assert_eq!(
+            scene.solver_options().parallelism,
+            want,
+            "threads = {value}"
+        );
+        let again = SceneBuilder::from_json_str(&builder.to_json().unwrap()).unwrap();
+        assert_eq!(again, builder, "threads = {value}");
+    }
+    for bad in ["-1", "\"some\"", "2.5"] {
+        let text = format!(r#"{{"solver": {{"threads": {bad}}}}}"#);
+        assert!(
+            SceneBuilder::from_json_str(&text).is_err(),
+            "threads = {bad}"
+        );
+    }
+}
