@@ -336,20 +336,16 @@ impl DenseCore {
         };
         let mut solved = self.solve_once(tangential, problem, f, first)?;
         if !solved.outcome.converged {
-            self.cache(tangential).clear();
+            if tangential {
+                self.tangential.clear();
+            } else {
+                self.normal.clear();
+            }
             let spent = solved.outcome.iterations;
             solved = self.solve_once(tangential, problem, solved.f, effort)?;
             solved.outcome.iterations += spent;
         }
         Ok(solved)
-    }
-
-    fn cache(&mut self, tangential: bool) -> &mut FactorCache {
-        if tangential {
-            &mut self.tangential
-        } else {
-            &mut self.normal
-        }
     }
 
     fn solve_once(
@@ -359,12 +355,13 @@ impl DenseCore {
         f: Vec<f64>,
         effort: Effort,
     ) -> Result<SetSolve> {
-        let c = &self.c;
-        let cache = if tangential {
-            &mut self.tangential
-        } else {
-            &mut self.normal
-        };
+        let DenseCore {
+            c,
+            normal,
+            tangential: shear,
+            spectral,
+        } = self;
+        let cache = if tangential { shear } else { normal };
         cache.prepare(c, problem.set, problem.d)?;
         // Map from the factor order to positions in `set`.
         let mut pos = vec![usize::MAX; c.nrows()];
@@ -377,14 +374,7 @@ impl DenseCore {
             work: Mutex::new(Mat::zeros(perm.len(), 1)),
             perm,
         };
-        let solved =
-            self.spectral
-                .solve_with(problem, Preconditioner::Factor(factor), f, effort)?;
-        let cache = if tangential {
-            &mut self.tangential
-        } else {
-            &mut self.normal
-        };
+        let solved = spectral.solve_with(problem, Preconditioner::Factor(factor), f, effort)?;
         // How many iterations the factor needed (a stale factor is replaced).
         cache.last_iterations = solved.outcome.iterations;
         Ok(solved)
