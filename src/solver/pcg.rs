@@ -59,6 +59,12 @@ pub(crate) struct PcgSettings {
     pub parallelism: Parallelism,
 }
 
+/// The CG's vectors, part by part, kept between solves (no allocation and no zeroing of
+/// `O(N)` memory on the calling thread per solve: every vector is written before it is
+/// read).
+#[derive(Debug, Default)]
+pub(crate) struct PcgVectors(Vec<Mutex<Vectors>>);
+
 /// Solves in place: `f` holds the warm start on entry and the solution on exit. The last
 /// operator product the system ran is `A f` of the returned `f` (a spectral system keeps
 /// `C f` on the grid: the displacements need no product of their own).
@@ -67,26 +73,34 @@ pub(crate) fn projected_pcg<S: SetSystem>(
     b: &[f64],
     f: &mut [f64],
     settings: PcgSettings,
+    vectors: &mut PcgVectors,
 ) -> Result<PcgOutcome> {
     let n = f.len();
     debug_assert_eq!(b.len(), n);
     let parts = sys.parts();
-    let vectors = (0..parts)
-        .map(|k| {
-            let range = sys.range(k);
-            let m = range.len();
-            Mutex::new(Vectors {
-                f: f[range].to_vec(),
-                r: vec![0.0; m],
-                z: vec![0.0; m],
-                p: vec![0.0; m],
-                q: vec![0.0; m],
-                w: vec![0.0; m],
-                best: vec![0.0; m],
-            })
-        })
-        .collect();
-    let work = Work { sys, b, vectors };
+    vectors.0.resize_with(parts, Default::default);
+    for (k, v) in vectors.0.iter_mut().enumerate() {
+        let v = v.get_mut().unwrap_or_else(|e| e.into_inner());
+        let range = sys.range(k);
+        let m = range.len();
+        v.f.clear();
+        v.f.extend_from_slice(&f[range]);
+        for x in [
+            &mut v.r,
+            &mut v.z,
+            &mut v.p,
+            &mut v.q,
+            &mut v.w,
+            &mut v.best,
+        ] {
+            x.resize(m, 0.0);
+        }
+    }
+    let work = Work {
+        sys,
+        b,
+        vectors: &vectors.0,
+    };
     let norm_b = max_abs(b);
     let outcome = with_crew(settings.parallelism, parts, &work, |crew| {
         Leader {
@@ -109,6 +123,7 @@ pub(crate) fn projected_pcg<S: SetSystem>(
 }
 
 /// One part's slices of the CG vectors.
+#[derive(Debug, Default)]
 struct Vectors {
     f: Vec<f64>,
     r: Vec<f64>,
@@ -223,7 +238,7 @@ struct Phase {
 struct Work<'a, S> {
     sys: &'a S,
     b: &'a [f64],
-    vectors: Vec<Mutex<Vectors>>,
+    vectors: &'a [Mutex<Vectors>],
 }
 
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {

@@ -4,7 +4,7 @@
 
 use super::fsai::{Entries, Fsai};
 use super::parallel::Parallelism;
-use super::pcg::{projected_pcg, PcgOutcome, PcgSettings};
+use super::pcg::{projected_pcg, PcgOutcome, PcgSettings, PcgVectors};
 use super::system::{Compliance, FsaiBuffers, Preconditioner, StagedSystem};
 use crate::error::Result;
 use crate::green::{InfluencePlan, Partition, SpectralTable, Staging};
@@ -87,6 +87,8 @@ pub(crate) struct SpectralCore {
     /// Exact local entries of `C_s` (built on first use), the FSAI factor and buffers.
     entries: Option<Entries>,
     fsai: Option<(Fsai, FsaiBuffers)>,
+    /// The CG's vectors (a lock: the dense backend solves through `&self`).
+    vectors: std::sync::Mutex<PcgVectors>,
 }
 
 impl SpectralCore {
@@ -110,6 +112,7 @@ impl SpectralCore {
             inverse: None,
             entries: None,
             fsai: None,
+            vectors: Default::default(),
         }
     }
 
@@ -235,7 +238,9 @@ impl SpectralCore {
             problem.d,
             precond,
         );
-        let outcome = projected_pcg(&system, problem.b, &mut f, effort.settings(problem.total))?;
+        let mut vectors = super::lock(&self.vectors);
+        let settings = effort.settings(problem.total);
+        let outcome = projected_pcg(&system, problem.b, &mut f, settings, &mut vectors)?;
         let mut grid_product = vec![0.0; self.plan.grid().len()];
         system.grid_product(system.input_sum(&f), &mut grid_product);
         Ok(SetSolve {
