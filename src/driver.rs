@@ -452,6 +452,15 @@ impl Driver {
         self.solver.backend()
     }
 
+    /// Runs the next solves with `parallelism`; the events do not change (the parts of
+    /// the grid are fixed by the grid).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for `Parallelism::Threads(0)`.
+    pub fn set_parallelism(&mut self, parallelism: crate::solver::Parallelism) -> Result<()> {
+        self.solver.set_parallelism(parallelism)
+    }
+
     /// The normal load `F_N` (N).
     pub fn normal_load(&self) -> f64 {
         self.normal_load

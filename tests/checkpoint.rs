@@ -131,6 +131,20 @@ fn any_thread_count_repeats_the_sequential_run_and_resumes_it() {
         assert!(got == events, "{par:?}: events differ");
         assert_eq!(bits(&t), bits(&traction), "{par:?}: tractions differ");
     }
+    // One driver switching counts between events.
+    let mut driver = one.driver().unwrap();
+    let mut switched = Vec::new();
+    for k in 0..count {
+        let par = [
+            Parallelism::Threads(4),
+            Parallelism::Sequential,
+            Parallelism::Threads(3),
+        ][k % 3];
+        driver.set_parallelism(par).unwrap();
+        switched.push(driver.step().unwrap().unwrap());
+    }
+    assert!(switched == events, "switching counts: events differ");
+    assert!(driver.set_parallelism(Parallelism::Threads(0)).is_err());
     // Checkpoints: taken on 3 threads, resumed on 1 and on 8; taken on 1, resumed on 2.
     for (from, to) in [
         (Parallelism::Threads(3), Parallelism::Sequential),
