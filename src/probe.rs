@@ -3,7 +3,7 @@
 //! stress"), on planes `z = const` (every cell, through the DCT) and at points `(x, y, z)`
 //! (a mode series), with the top, lateral and normal load terms.
 //!
-//! With cell-constant bottom tractions `φ` (Pa) and the loads, MODEL.md section 1 gives
+//! With cell-constant bottom tractions `φ` (Pa) and the loads, docs/model.md section 1 gives
 //!
 //! ```text
 //! τ(x,y,z) = -T_z[φ_x] + F_top z/(Lz Lx Ly) + F_lat s_lat(x, z)
@@ -16,7 +16,7 @@
 //! `σ = -φ_z` (the interface tractions, with the sign of a stress on the face of outward
 //! normal `-z`); at `z = Lz` they are the top tractions.
 //!
-//! On a plane the result is cell-averaged (the Galerkin convention of MODEL.md section 2,
+//! On a plane the result is cell-averaged (the Galerkin convention of docs/model.md section 2,
 //! [`PlaneTransfer`]); at a point it is the exact value for cell-constant tractions:
 //! a cell-constant field has the cosine coefficients `(2w_p/N) S_p D(p')` with the
 //! aliases `p = 2Nq ± p'` of the DCT-II coefficient `D(p')` (sign `(-1)^q`), so a point

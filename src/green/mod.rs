@@ -4,7 +4,7 @@
 //! * [`GreenFunction`]: `G` and `∂G/∂z` at points (raw triple series and the paper's
 //!   rapidly converging representation), each with a truncation-error estimate.
 //! * [`loads`]: the top, rod and uniform-side load terms and their transfer to height `z`.
-//! * [`InfluencePlan`]: the Galerkin influence operator of a grid (MODEL.md section 2),
+//! * [`InfluencePlan`]: the Galerkin influence operator of a grid (docs/model.md section 2),
 //!   planned once per geometry and applied matrix-free through the DCT, plus the
 //!   [`PlaneTransfer`] of bottom tractions to a plane at height `z`.
 
