@@ -136,7 +136,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                 ell / grid.block().lx(),
             )?;
             if let Some(path) = &args.checkpoint {
-                if stable_states % args.every == 0 {
+                if stable_states.is_multiple_of(args.every) {
                     events.flush()?;
                     curve.flush()?;
                     write_checkpoint(path, &driver)?;

@@ -33,6 +33,10 @@
 //! ```
 #![deny(missing_docs)]
 #![forbid(unsafe_code)]
+// `is_multiple_of` is stable from 1.87; under rust-version 1.88 clippy asks for it in
+// src/green/operator.rs and src/solver/team.rs, which are being rewritten: drop this
+// once they use it.
+#![allow(clippy::manual_is_multiple_of)]
 
 pub mod calibration;
 pub mod driver;

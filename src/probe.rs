@@ -432,7 +432,7 @@ fn shell_terms(mode: usize, n: usize, length: f64, x: f64, shell: usize) -> Vec<
         let w = if p == 0.0 { 0.5 } else { 1.0 };
         let half = 0.5 * k * cell;
         let s = if half == 0.0 { 1.0 } else { half.sin() / half };
-        let sign = if q % 2 == 0 { 1.0 } else { -1.0 };
+        let sign = if q.is_multiple_of(2) { 1.0 } else { -1.0 };
         (sign * 2.0 * w * s / n as f64 * (k * x).cos(), k)
     };
     let base = 2 * n * shell;
