@@ -3,10 +3,18 @@
 //!
 //! Run: `cargo run --release --example green`
 
+#[path = "support/report.rs"]
+mod report;
+
 use precursors::green::{InfluencePlan, RodLoad};
 use precursors::{Block, Grid};
+use std::process::ExitCode;
 
-fn main() -> Result<(), precursors::Error> {
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
     let block = Block::new(0.140, 0.007, 0.075)?;
     let grid = Grid::from_cell_size(block, 1e-3, 1e-3)?;
     let t = std::time::Instant::now();
