@@ -552,7 +552,8 @@ fn cell_indicator(grid: &Grid, point: Point) -> Vec<f64> {
     let share = 1.0 / (xs.len() * ys.len()) as f64;
     for &iy in &ys {
         for &ix in &xs {
-            k[grid.index(ix, iy)] = share;
+            // `near` clamps to the grid: the flat index is in range.
+            k[iy * grid.nx() + ix] = share;
         }
     }
     k
