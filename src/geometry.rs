@@ -134,7 +134,7 @@ impl Grid {
             });
         }
         let grid = Self { block, nx, ny };
-        // Sizes of at least one cell: lx / nx may round to zero for absurdly fine grids.
+        // lx / nx rounds to zero when nx is huge against a tiny block.
         check_length("dx", grid.dx())?;
         check_length("dy", grid.dy())?;
         let area = grid.cell_area();
@@ -149,7 +149,7 @@ impl Grid {
     }
 
     /// Cells of size `dx x dy` (m), which must divide `Lx` and `Ly` into whole numbers
-    /// (to 1e-9 relative).
+    /// (to 1e-9 relative) of at most `2^53` cells each, then as [`Grid::new`].
     pub fn from_cell_size(block: Block, dx: f64, dy: f64) -> Result<Self> {
         let count = |axis, length: f64, cell: f64| -> Result<usize> {
             check_length(if axis == "x" { "dx" } else { "dy" }, cell)?;
