@@ -3,10 +3,18 @@
 //!
 //! Run: `cargo run --release --example accuracy`
 
+#[path = "support/report.rs"]
+mod report;
+
 use precursors::green::{GreenFunction, InfluencePlan, SeriesOptions};
 use precursors::{Block, Grid, Point};
+use std::process::ExitCode;
 
-fn main() -> Result<(), precursors::Error> {
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
     let block = Block::new(0.14, 0.007, 0.075)?;
     let gf = GreenFunction::new(block);
     let (r, s) = (

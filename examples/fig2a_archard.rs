@@ -1,22 +1,31 @@
 //! Paper Fig. 2a (Archard / Amontons' second law): the real contact area at zero shear in
 //! % of the nominal area `A0 = Lx Ly` against the normal load, for a 30 x 6 x 150 mm block
-//! (1 mm cells), averaged over 10 height realizations. The model's `A_R` grows linearly
+//! (1 mm cells), averaged over height realizations (seeds 1-10; the second argument
+//! changes the count, at least 2). The model's `A_R` grows linearly
 //! with `F_N` (`A_R = α F_N`); the least-squares slope and intercept are printed.
 //!
 //! Writes `fig2a.csv` (normal_load_N, area_percent_mean, area_percent_sd, alpha_m2_per_N)
 //! and `fig2a.png` (A_R/A0 in % against F_N from 0 to 4 kN).
-//! Run: `cargo run --release --example fig2a_archard [output directory]`.
+//! Run: `cargo run --release --example fig2a_archard [output directory] [realizations]`.
+
+#[path = "support/report.rs"]
+mod report;
 
 #[path = "support/figures.rs"]
 mod figures;
 
 use figures::plot;
 use precursors::Scene;
+use std::process::ExitCode;
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let dir = figures::out_dir();
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
+    // The sample standard deviation needs two realizations.
+    let figures::Args { dir, seeds } = figures::args(Some(2))?;
     let loads: Vec<f64> = (1..=8).map(|k| 500.0 * k as f64).collect();
-    let seeds: Vec<u64> = (1..=10).collect();
     let a0 = 0.030 * 0.006;
     let mut rows = Vec::new();
     let mut points = Vec::new();

@@ -9,14 +9,22 @@
 //! the precursor length ℓ/Lx at a few loads.
 //! Run: `cargo run --release --example fig3_contact_maps [output directory]`.
 
+#[path = "support/report.rs"]
+mod report;
+
 #[path = "support/figures.rs"]
 mod figures;
 
 use figures::plot;
 use precursors::{Drive, Event, ForceLoad, Lateral, Scene};
+use std::process::ExitCode;
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let dir = figures::out_dir();
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
+    let dir = figures::args(None)?.dir;
     let drives = [
         (
             "rod",

@@ -9,14 +9,22 @@
 //! Prints the number of drops and the largest one.
 //! Run: `cargo run --release --example fig4_stick_slip [output directory]`.
 
+#[path = "support/report.rs"]
+mod report;
+
 #[path = "support/figures.rs"]
 mod figures;
 
 use figures::plot;
 use precursors::{Drive, Event, Lateral, Scene};
+use std::process::ExitCode;
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let dir = figures::out_dir();
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
+    let dir = figures::args(None)?.dir;
     let scene = Scene::builder()
         .drive(Drive::Spring {
             stiffness: 4e6,

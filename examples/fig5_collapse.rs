@@ -14,10 +14,14 @@
 //! Run: `cargo run --release --example fig5_collapse [output directory] [realizations]`
 //! (about 10 minutes with 10 realizations).
 
+#[path = "support/report.rs"]
+mod report;
+
 #[path = "support/figures.rs"]
 mod figures;
 
 use precursors::{Drive, Lateral, Scene, SceneBuilder};
+use std::process::ExitCode;
 
 fn rod(height: f64) -> Drive {
     Drive::Force(
@@ -29,9 +33,12 @@ fn rod(height: f64) -> Drive {
     )
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let dir = figures::out_dir();
-    let seeds = figures::seeds();
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
+    let figures::Args { dir, seeds } = figures::args(Some(1))?;
     let pressure = 3.5e3 / (0.140 * 0.007);
     let a: Vec<(String, SceneBuilder)> = [0.100, 0.140, 0.200, 0.280, 0.350]
         .iter()

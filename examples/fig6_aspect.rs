@@ -19,10 +19,14 @@
 //! Writes `fig6{a,b,c,d}.csv` and `.png` (see `figures::precursor_panel`).
 //! Run: `cargo run --release --example fig6_aspect [output directory] [realizations]`.
 
+#[path = "support/report.rs"]
+mod report;
+
 #[path = "support/figures.rs"]
 mod figures;
 
 use precursors::{Drive, ForceLoad, Lateral, Scene, SceneBuilder};
+use std::process::ExitCode;
 
 fn side(lx: f64, ly: f64, lz: f64, f_n: f64) -> SceneBuilder {
     Scene::builder()
@@ -35,9 +39,12 @@ fn mm(v: f64) -> f64 {
     v * 1e-3
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let dir = figures::out_dir();
-    let seeds = figures::seeds();
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
+    let figures::Args { dir, seeds } = figures::args(Some(1))?;
     let a: Vec<_> = [(43.0, 7.0), (61.0, 10.0), (92.0, 15.0), (122.0, 20.0)]
         .iter()
         .map(|&(lx, ly)| (format!("Lx{lx}Ly{ly}"), side(mm(lx), mm(ly), mm(10.0), 4e3)))

@@ -7,12 +7,15 @@
 //! `THRESHOLD` = 5 mm: single ruptures at the trailing edge make ℓ flicker between 0 and
 //! 2 cells from the smallest loads on, long before the first front (the leap of several
 //! cells the paper calls a precursor; see docs/validation.md). The profiles are averaged
-//! over 10 height realizations.
+//! over height realizations (seeds 1-10; the second argument changes the count).
 //!
 //! Writes `fig7.csv` (x_m, abs_tau_zP_Pa, abs_sigma_zP_Pa, coulomb_zP_Pa (|τ| - μ|σ| of
 //! the y-averages), coulomb_interface_Pa (y-average of τ_C at z = 0)) and `fig7.png`
 //! (|τ| blue, |σ| red, τ_C(z_P) green, τ_C(0) purple, in MPa, against x/Lx).
-//! Run: `cargo run --release --example fig7_stresses [output directory]`.
+//! Run: `cargo run --release --example fig7_stresses [output directory] [realizations]`.
+
+#[path = "support/report.rs"]
+mod report;
 
 #[path = "support/figures.rs"]
 mod figures;
@@ -20,14 +23,18 @@ mod figures;
 use figures::plot;
 use precursors::probe::{ProbeSpec, Profile};
 use precursors::Event;
+use std::process::ExitCode;
 
 /// The precursor length (m) taken as the first front (see the module docs).
 const THRESHOLD: f64 = 5e-3;
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let dir = figures::out_dir();
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
+    let figures::Args { dir, seeds } = figures::args(Some(1))?;
     let z_p = 2e-3;
-    let seeds: Vec<u64> = (1..=10).collect();
     let mut sums: Option<[Vec<f64>; 4]> = None;
     let mut loads = Vec::new();
     for &seed in &seeds {

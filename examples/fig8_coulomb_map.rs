@@ -9,17 +9,25 @@
 //! blue where τ_C < 0 (scaled by 1 MPa, saturating).
 //! Run: `cargo run --release --example fig8_coulomb_map [output directory]`.
 
+#[path = "support/report.rs"]
+mod report;
+
 #[path = "support/figures.rs"]
 mod figures;
 
 use figures::plot;
 use precursors::probe::ProbeSpec;
 use precursors::Event;
+use std::process::ExitCode;
 
 const THRESHOLD: f64 = 5e-3;
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let dir = figures::out_dir();
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
+    let dir = figures::args(None)?.dir;
     let heights: Vec<f64> = (0..100).map(|k| (k as f64 + 0.5) * 1e-3).collect();
     let mut spec = ProbeSpec::default();
     for &z in &heights {

@@ -9,16 +9,23 @@
 //! load, blue to red as the load grows).
 //! Run: `cargo run --release --example figS10_stress_evolution [output directory] [realizations]`.
 
+#[path = "support/report.rs"]
+mod report;
+
 #[path = "support/figures.rs"]
 mod figures;
 
 use figures::plot;
 use precursors::probe::ProbeSpec;
 use precursors::Event;
+use std::process::ExitCode;
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let dir = figures::out_dir();
-    let seeds = figures::seeds();
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
+    let figures::Args { dir, seeds } = figures::args(Some(1))?;
     let levels: Vec<f64> = (0..10).map(|k| 0.1 * k as f64).collect();
     let nx = 200;
     let mut sigma = vec![vec![0.0; nx]; levels.len()];

@@ -13,11 +13,15 @@
 //! across samples relative to its mean, and the slip load.
 //! Run: `cargo run --release --example figS2_S3_area [output directory] [realizations]`.
 
+#[path = "support/report.rs"]
+mod report;
+
 #[path = "support/figures.rs"]
 mod figures;
 
 use figures::plot;
 use precursors::{Drive, Event, ForceLoad, Lateral, Scene, SceneBuilder};
+use std::process::ExitCode;
 
 /// `(F/(μF_N), A_R)` at every stable state, and the slip load F/(μF_N).
 fn area_curve(builder: &SceneBuilder) -> precursors::Result<(Vec<(f64, f64)>, f64)> {
@@ -46,9 +50,12 @@ fn at(curve: &[(f64, f64)], f: f64) -> f64 {
         .map_or(f64::NAN, |p| p.1)
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let dir = figures::out_dir();
-    let seeds = figures::seeds();
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
+    let figures::Args { dir, seeds } = figures::args(Some(1))?;
     // S2.
     let (curve, slip) = area_curve(
         &Scene::builder()

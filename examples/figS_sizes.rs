@@ -15,10 +15,14 @@
 //! Writes `figS4.csv` ... `figS9.csv` and `.png` (see `figures::precursor_panel`).
 //! Run: `cargo run --release --example figS_sizes [output directory] [realizations]`.
 
+#[path = "support/report.rs"]
+mod report;
+
 #[path = "support/figures.rs"]
 mod figures;
 
 use precursors::{Drive, Lateral, Scene, SceneBuilder};
+use std::process::ExitCode;
 
 fn rod(lx: f64, ly: f64, lz: f64, h: f64) -> SceneBuilder {
     Scene::builder()
@@ -33,9 +37,12 @@ fn rod(lx: f64, ly: f64, lz: f64, h: f64) -> SceneBuilder {
         ))
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let dir = figures::out_dir();
-    let seeds = figures::seeds();
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
+    let figures::Args { dir, seeds } = figures::args(Some(1))?;
     let panels: Vec<(&str, Vec<(String, SceneBuilder)>)> = vec![
         (
             "figS4",

@@ -3,10 +3,18 @@
 //!
 //! Run: `cargo run --release --example green`
 
+#[path = "support/report.rs"]
+mod report;
+
 use precursors::green::{InfluencePlan, RodLoad};
 use precursors::{Block, Grid};
+use std::process::ExitCode;
 
-fn main() -> Result<(), precursors::Error> {
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
     let block = Block::new(0.140, 0.007, 0.075)?;
     let grid = Grid::from_cell_size(block, 1e-3, 1e-3)?;
     let t = std::time::Instant::now();
@@ -20,16 +28,20 @@ fn main() -> Result<(), precursors::Error> {
     );
 
     // A 1 MPa traction on the cell (20, 3): displacement times M (m·Pa) along the row iy = 3.
+    let cell = |ix, iy| {
+        grid.index(ix, iy)
+            .ok_or(format!("no cell ({ix}, {iy}) in the grid"))
+    };
     let mut phi = vec![0.0; grid.len()];
-    phi[grid.index(20, 3)] = 1e6;
+    phi[cell(20, 3)?] = 1e6;
     let mut u = vec![0.0; grid.len()];
     plan.apply(&phi, &mut u)?;
     println!(
         "\nM·u (N/m) along y = 3.5 mm from a 1 MPa load on cell (20, 3), relative to the far end:"
     );
-    let far = u[grid.index(139, 3)] * grid.cell_area();
+    let far = u[cell(139, 3)?] * grid.cell_area();
     for ix in [18, 19, 20, 21, 22, 25, 30, 40, 60, 100] {
-        let v = u[grid.index(ix, 3)] * grid.cell_area() - far;
+        let v = u[cell(ix, 3)?] * grid.cell_area() - far;
         println!("  x = {:5.1} mm   {:10.4}", (ix as f64 + 0.5), v);
     }
 

@@ -11,25 +11,41 @@
 //! (the tolerance defaults to the solver's, `1e-13`; threads to 1, `0` for every core,
 //! see `SolverOptions::parallelism`: the events are the same for every thread count).
 
+#[path = "support/report.rs"]
+mod report;
+
 use precursors::{Event, Parallelism, Scene, SolverOptions};
+use std::process::ExitCode;
 use std::time::Instant;
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let seed: u64 = std::env::args()
-        .nth(1)
-        .map(|s| s.parse())
-        .transpose()?
-        .unwrap_or(1);
-    let tolerance: f64 = std::env::args()
-        .nth(2)
-        .map(|s| s.parse())
-        .transpose()?
-        .unwrap_or(SolverOptions::default().tolerance);
-    let threads: usize = std::env::args()
-        .nth(3)
-        .map(|s| s.parse())
-        .transpose()?
-        .unwrap_or(1);
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    const USAGE: &str = "the arguments are [seed] [solver tolerance] [threads]";
+    if args.len() > 3 {
+        return Err(format!("unexpected argument '{}': {USAGE}", args[3]).into());
+    }
+    // A bad argument is refused by name rather than replaced by its default.
+    fn parse<T: std::str::FromStr>(
+        arg: Option<&String>,
+        name: &str,
+        default: T,
+    ) -> Result<T, String> {
+        arg.map_or(Ok(default), |text| {
+            text.parse()
+                .map_err(|_| format!("invalid {name} '{text}' ({USAGE})"))
+        })
+    }
+    let seed: u64 = parse(args.first(), "seed", 1)?;
+    let tolerance: f64 = parse(
+        args.get(1),
+        "solver tolerance",
+        SolverOptions::default().tolerance,
+    )?;
+    let threads: usize = parse(args.get(2), "thread count", 1)?;
     let start = Instant::now();
     let scene = Scene::builder()
         .solver(

@@ -8,17 +8,39 @@
 //!
 //! Run: `cargo run --release --example quickstart [seed] [output directory]`.
 
+#[path = "support/report.rs"]
+mod report;
+
 #[path = "support/plot.rs"]
 mod plot;
 
 use precursors::{Event, Scene};
+use report::AtPath;
 use std::io::Write;
+use std::process::ExitCode;
 use std::time::Instant;
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let mut args = std::env::args().skip(1);
-    let seed: u64 = args.next().map(|s| s.parse()).transpose()?.unwrap_or(1);
-    let dir = args.next().unwrap_or_else(|| ".".into());
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.len() > 2 {
+        return Err(format!(
+            "unexpected argument '{}': the arguments are [seed] [output directory]",
+            args[2]
+        )
+        .into());
+    }
+    let seed: u64 = match args.first() {
+        None => 1,
+        Some(text) => text
+            .parse()
+            .map_err(|_| format!("the seed must be a whole number >= 0, got '{text}'"))?,
+    };
+    let dir = args.get(1).cloned().unwrap_or_else(|| ".".into());
+    report::writable_dir(&dir)?;
     let start = Instant::now();
     // The builder's defaults are the calibration scene; only the seed is chosen here.
     let scene = Scene::builder().seed(seed).build()?;
@@ -40,15 +62,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let elapsed = start.elapsed();
 
     let csv = format!("{dir}/quickstart.csv");
-    let mut out = std::io::BufWriter::new(std::fs::File::create(&csv)?);
-    writeln!(
-        out,
-        "force_over_mu_fn,precursor_over_lx,real_contact_area_m2,ruptures"
-    )?;
-    for (f, l, a, r) in &rows {
-        writeln!(out, "{f:.9},{l:.6},{a:.9e},{r}")?;
-    }
-    out.flush()?;
+    let write = || -> std::io::Result<()> {
+        let mut out = std::io::BufWriter::new(std::fs::File::create(&csv)?);
+        writeln!(
+            out,
+            "force_over_mu_fn,precursor_over_lx,real_contact_area_m2,ruptures"
+        )?;
+        for (f, l, a, r) in &rows {
+            writeln!(out, "{f:.9},{l:.6},{a:.9e},{r}")?;
+        }
+        out.flush()
+    };
+    write().at("write", &csv)?;
 
     // The envelope as the paper draws it: ℓ at each stable state, as a staircase.
     let mut points = Vec::new();

@@ -16,11 +16,16 @@
 //! cargo run --release --features serde --example run_scene -- --resume out/checkpoint.json --out out
 //! ```
 
+#[path = "support/report.rs"]
+mod report;
+
 use precursors::{Checkpoint, Driver, Event, SceneBuilder, SiteState};
+use report::AtPath;
 use std::error::Error;
 use std::fs::{self, File, OpenOptions};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 use std::time::Instant;
 
 const EVENTS_HEADER: &str = "index,kind,ix,iy,force_N,drive_displacement_m,energy_J,ruptures";
@@ -69,7 +74,11 @@ fn parse_args() -> Result<Args, String> {
     Ok(args)
 }
 
-fn main() -> Result<(), Box<dyn Error>> {
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
     let args = match parse_args() {
         Ok(a) => a,
         Err(e) => {
@@ -80,7 +89,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             std::process::exit(2);
         }
     };
-    fs::create_dir_all(&args.out)?;
+    report::writable_dir(&args.out)?;
     let events_path = args.out.join("events.csv");
     let curve_path = args.out.join("curve.csv");
     let started = Instant::now();
@@ -95,7 +104,8 @@ fn main() -> Result<(), Box<dyn Error>> {
             (scene, driver, events, curve)
         }
         Some(path) => {
-            let checkpoint = Checkpoint::from_json_str(&fs::read_to_string(path)?)?;
+            let text = fs::read_to_string(path).at("read the checkpoint", path)?;
+            let checkpoint = Checkpoint::from_json_str(&text).at("read the checkpoint", path)?;
             let scene = checkpoint.scene().clone().build()?;
             let driver = scene.resume(&checkpoint)?;
             // Keep the rows up to the checkpoint (a crashed run may have written more).
@@ -120,7 +130,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     let mut last_progress = Instant::now();
     while let Some(event) = driver.step()? {
         let index = driver.event_count();
-        write_event(&mut events, index, &event)?;
+        write_event(&mut events, index, &event).at("write", &events_path)?;
         if let Event::Stable { load, .. } = event {
             stable_states += 1;
             let (broken, attached) = counts(driver.site_states());
@@ -134,11 +144,12 @@ fn main() -> Result<(), Box<dyn Error>> {
                 driver.total_contact_area()?,
                 ell,
                 ell / grid.block().lx(),
-            )?;
+            )
+            .at("write", &curve_path)?;
             if let Some(path) = &args.checkpoint {
-                if stable_states % args.every == 0 {
-                    events.flush()?;
-                    curve.flush()?;
+                if stable_states.is_multiple_of(args.every) {
+                    events.flush().at("write", &events_path)?;
+                    curve.flush().at("write", &curve_path)?;
                     write_checkpoint(path, &driver)?;
                 }
             }
@@ -148,8 +159,8 @@ fn main() -> Result<(), Box<dyn Error>> {
             last_progress = Instant::now();
         }
     }
-    events.flush()?;
-    curve.flush()?;
+    events.flush().at("write", &events_path)?;
+    curve.flush().at("write", &curve_path)?;
     progress(&driver, mu_fn, started);
     eprintln!(
         "\nglobal slip after {} events; wrote {} and {}",
@@ -171,7 +182,12 @@ fn table(
     if let Some(k) = keep {
         if let Ok(old) = fs::read_to_string(path) {
             for line in old.lines().skip(1) {
-                let index: usize = line.split(',').next().unwrap_or("").parse()?;
+                let index: usize = line
+                    .split(',')
+                    .next()
+                    .unwrap_or("")
+                    .parse()
+                    .at("read the rows to keep from", path)?;
                 if index <= k {
                     text.push_str(line);
                     text.push('\n');
@@ -179,8 +195,12 @@ fn table(
             }
         }
     }
-    fs::write(path, text)?;
-    Ok(BufWriter::new(OpenOptions::new().append(true).open(path)?))
+    fs::write(path, text).at("write", path)?;
+    let file = OpenOptions::new()
+        .append(true)
+        .open(path)
+        .at("open", path)?;
+    Ok(BufWriter::new(file))
 }
 
 fn optional(x: Option<f64>) -> String {
@@ -222,8 +242,8 @@ fn counts(states: &[SiteState]) -> (usize, usize) {
 /// checkpoint.
 fn write_checkpoint(path: &Path, driver: &Driver) -> Result<(), Box<dyn Error>> {
     let tmp = path.with_extension("tmp");
-    fs::write(&tmp, driver.checkpoint().to_json()?)?;
-    fs::rename(&tmp, path)?;
+    fs::write(&tmp, driver.checkpoint().to_json()?).at("write", &tmp)?;
+    fs::rename(&tmp, path).at("write the checkpoint", path)?;
     Ok(())
 }
 

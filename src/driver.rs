@@ -1,4 +1,4 @@
-//! The quasi-static protocol (paper Suppl. "Quasi-static dynamics", MODEL.md section 5)
+//! The quasi-static protocol (paper Suppl. "Quasi-static dynamics", docs/model.md section 5)
 //! as an iterator of [`Event`]s.
 //!
 //! 1. Normal equilibrium at `F_N`, no shear: the first event is a [`Event::Stable`] state
@@ -578,7 +578,7 @@ impl Driver {
     }
 
     /// Precursor length `ℓ` (m): the extent, from the trailing edge `x = 0`, of the run of
-    /// columns whose real contact area is below its value at zero shear (MODEL.md
+    /// columns whose real contact area is below its value at zero shear (docs/model.md
     /// section 5; paper Fig. 2b). A multiple of `Δx`.
     pub fn precursor_length(&self) -> Result<f64> {
         let columns = self.column_contact_area()?;

@@ -11,13 +11,23 @@ pub struct Block {
 }
 
 impl Block {
-    /// A block of sides `lx`, `ly`, `lz` (m); each must be finite and > 0.
+    /// A block of sides `lx`, `ly`, `lz` (m); each must be finite and > 0, and so must
+    /// the volume `Lx Ly Lz` (the Green function divides by it).
     pub fn new(lx: f64, ly: f64, lz: f64) -> Result<Self> {
-        Ok(Self {
+        let block = Self {
             lx: check_length("Lx", lx)?,
             ly: check_length("Ly", ly)?,
             lz: check_length("Lz", lz)?,
-        })
+        };
+        let volume = block.volume();
+        if !(volume.is_finite() && volume > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "Lx Ly Lz",
+                value: volume,
+                reason: "the block's volume (m³) overflows or underflows f64",
+            });
+        }
+        Ok(block)
     }
 
     /// Length along x, the shear direction (m).
@@ -97,8 +107,18 @@ pub struct Grid {
     ny: usize,
 }
 
+/// Most cells a grid may have: a vector of one `f64` per cell, the smallest thing the API
+/// exchanges, must fit in the address space (`isize::MAX` bytes), so that `len()` and the
+/// buffers sized by it cannot overflow.
+const MAX_CELLS: usize = isize::MAX as usize / std::mem::size_of::<f64>();
+
+/// Largest count along one axis: above `2^53` a count is not exactly an `f64`, and
+/// [`Grid::from_cell_size`] could not tell whether the cell divides the face.
+const MAX_AXIS_CELLS: f64 = 9_007_199_254_740_992.0;
+
 impl Grid {
-    /// `nx x ny` cells on the bottom face of `block`; both counts must be >= 1.
+    /// `nx x ny` cells on the bottom face of `block`; both counts must be >= 1, the cell
+    /// area `ΔA` must not underflow to zero, and `Nx Ny` f64 values must fit in memory.
     pub fn new(block: Block, nx: usize, ny: usize) -> Result<Self> {
         if nx == 0 {
             return Err(Error::EmptyGrid { axis: "x" });
@@ -106,15 +126,43 @@ impl Grid {
         if ny == 0 {
             return Err(Error::EmptyGrid { axis: "y" });
         }
-        Ok(Self { block, nx, ny })
+        if nx.checked_mul(ny).is_none_or(|n| n > MAX_CELLS) {
+            return Err(Error::InvalidParameter {
+                name: "Nx Ny",
+                value: nx as f64 * ny as f64,
+                reason: "more cells than a vector of one f64 per cell can hold",
+            });
+        }
+        let grid = Self { block, nx, ny };
+        // lx / nx rounds to zero when nx is huge against a tiny block.
+        check_length("dx", grid.dx())?;
+        check_length("dy", grid.dy())?;
+        let area = grid.cell_area();
+        if area <= 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "ΔA",
+                value: area,
+                reason: "the cell area (m²) underflows to zero",
+            });
+        }
+        Ok(grid)
     }
 
     /// Cells of size `dx x dy` (m), which must divide `Lx` and `Ly` into whole numbers
-    /// (to 1e-9 relative).
+    /// (to 1e-9 relative) of at most `2^53` cells each, then as [`Grid::new`].
     pub fn from_cell_size(block: Block, dx: f64, dy: f64) -> Result<Self> {
         let count = |axis, length: f64, cell: f64| -> Result<usize> {
             check_length(if axis == "x" { "dx" } else { "dy" }, cell)?;
             let ratio = length / cell;
+            if ratio > MAX_AXIS_CELLS {
+                // Any cell this small "divides" the face in f64 (the ratio is an integer),
+                // and the count would saturate `usize`: refuse it before rounding.
+                return Err(Error::InvalidParameter {
+                    name: if axis == "x" { "dx" } else { "dy" },
+                    value: cell,
+                    reason: "the cell is so small that L / cell exceeds 2^53 cells",
+                });
+            }
             let n = ratio.round();
             if n < 1.0 || (ratio - n).abs() > 1e-9 * ratio.max(1.0) {
                 return Err(Error::GridDoesNotDivide {
@@ -163,12 +211,14 @@ impl Grid {
     pub fn cell_area(&self) -> f64 {
         self.dx() * self.dy()
     }
-    /// Flat index of cell `(ix, iy)`: `iy * Nx + ix`.
-    pub fn index(&self, ix: usize, iy: usize) -> usize {
-        iy * self.nx + ix
+    /// Flat index `iy * Nx + ix` of cell `(ix, iy)`; `None` unless `ix < Nx` and
+    /// `iy < Ny` (an `ix` past the row would otherwise name a cell of the next row).
+    pub fn index(&self, ix: usize, iy: usize) -> Option<usize> {
+        (ix < self.nx && iy < self.ny).then(|| iy * self.nx + ix)
     }
-    /// Centre `(x, y)` of cell `(ix, iy)` (m).
-    pub fn centre(&self, ix: usize, iy: usize) -> (f64, f64) {
-        ((ix as f64 + 0.5) * self.dx(), (iy as f64 + 0.5) * self.dy())
+    /// Centre `(x, y)` of cell `(ix, iy)` (m); `None` unless `ix < Nx` and `iy < Ny`.
+    pub fn centre(&self, ix: usize, iy: usize) -> Option<(f64, f64)> {
+        (ix < self.nx && iy < self.ny)
+            .then(|| ((ix as f64 + 0.5) * self.dx(), (iy as f64 + 0.5) * self.dy()))
     }
 }

@@ -1,4 +1,4 @@
-//! The interfacial springs of the bottom face (MODEL.md section 3).
+//! The interfacial springs of the bottom face (docs/model.md section 3).
 //!
 //! Each cell `i` of the grid holds one spring of rest height `u0_i > 0` (m), the local
 //! height of the rough substrate. Per unit area the springs have normal stiffness

@@ -1,15 +1,14 @@
 //! # precursors
 //!
-//! The scalar elastic model of frictional precursors (Bonfanti, Taloni, Negri, Sellerio,
-//! Manini, Zapperi): a 3-D elastic block `[0,Lx] x [0,Ly] x [0,Lz]` on a rough rigid
-//! substrate, two decoupled scalar Laplace problems `M ∇²u_x = 0`, `M ∇²u_z = 0`
-//! (`M = E/(1+ν)`) solved with the box's Neumann Green function, and a grid of interfacial
-//! springs on the bottom face.
+//! The scalar elastic model of frictional precursors of A. Taloni, A. Benassi, S. Sandfeld
+//! and S. Zapperi, "Scalar model for frictional precursors dynamics": a 3-D elastic block
+//! `[0,Lx] x [0,Ly] x [0,Lz]` on a rough rigid substrate, two decoupled scalar Laplace
+//! problems `M ∇²u_x = 0`, `M ∇²u_z = 0` (`M = E/(1+ν)`) solved with the box's Neumann
+//! Green function, and a grid of interfacial springs on the bottom face.
 //!
 //! Units are SI throughout: lengths in m, forces in N, tractions and stresses in Pa.
-//! Sign conventions are those of `MODEL.md` (shipped in `docs/model.md`): both shear loads
-//! point along +x, the normal load presses the block down, bottom tractions `φ_z ≥ 0`
-//! push up.
+//! Sign conventions are those of `docs/model.md` section 1: both shear loads point along
+//! +x, the normal load presses the block down, bottom tractions `φ_z ≥ 0` push up.
 //!
 //! This release provides the geometry, the [`green`] module (point evaluation of `G`
 //! and `∂G/∂z`, the analytic load terms, the Galerkin influence operator of the grid,

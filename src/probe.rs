@@ -3,7 +3,7 @@
 //! stress"), on planes `z = const` (every cell, through the DCT) and at points `(x, y, z)`
 //! (a mode series), with the top, lateral and normal load terms.
 //!
-//! With cell-constant bottom tractions `φ` (Pa) and the loads, MODEL.md section 1 gives
+//! With cell-constant bottom tractions `φ` (Pa) and the loads, docs/model.md section 1 gives
 //!
 //! ```text
 //! τ(x,y,z) = -T_z[φ_x] + F_top z/(Lz Lx Ly) + F_lat s_lat(x, z)
@@ -16,7 +16,7 @@
 //! `σ = -φ_z` (the interface tractions, with the sign of a stress on the face of outward
 //! normal `-z`); at `z = Lz` they are the top tractions.
 //!
-//! On a plane the result is cell-averaged (the Galerkin convention of MODEL.md section 2,
+//! On a plane the result is cell-averaged (the Galerkin convention of docs/model.md section 2,
 //! [`PlaneTransfer`]); at a point it is the exact value for cell-constant tractions:
 //! a cell-constant field has the cosine coefficients `(2w_p/N) S_p D(p')` with the
 //! aliases `p = 2Nq ± p'` of the DCT-II coefficient `D(p')` (sign `(-1)^q`), so a point
@@ -432,7 +432,7 @@ fn shell_terms(mode: usize, n: usize, length: f64, x: f64, shell: usize) -> Vec<
         let w = if p == 0.0 { 0.5 } else { 1.0 };
         let half = 0.5 * k * cell;
         let s = if half == 0.0 { 1.0 } else { half.sin() / half };
-        let sign = if q % 2 == 0 { 1.0 } else { -1.0 };
+        let sign = if q.is_multiple_of(2) { 1.0 } else { -1.0 };
         (sign * 2.0 * w * s / n as f64 * (k * x).cos(), k)
     };
     let base = 2 * n * shell;
@@ -552,7 +552,8 @@ fn cell_indicator(grid: &Grid, point: Point) -> Vec<f64> {
     let share = 1.0 / (xs.len() * ys.len()) as f64;
     for &iy in &ys {
         for &ix in &xs {
-            k[grid.index(ix, iy)] = share;
+            // `near` clamps to the grid: the flat index is in range.
+            k[iy * grid.nx() + ix] = share;
         }
     }
     k

@@ -169,3 +169,74 @@ fn zero_solver_threads_are_refused() {
         assert!(scene.driver().is_ok(), "threads = {threads}");
     }
 }
+
+#[test]
+fn cell_indices_past_the_grid_are_refused() {
+    let b = Block::new(0.14, 0.007, 0.075).unwrap();
+    let g = Grid::from_cell_size(b, 1e-3, 1e-3).unwrap();
+    // Without the check, (140, 0) aliased cell (0, 1).
+    assert_eq!(g.index(140, 0), None);
+    assert_eq!(g.index(0, 7), None);
+    assert_eq!(g.index(usize::MAX, usize::MAX), None);
+    assert_eq!(g.index(139, 6), Some(6 * 140 + 139));
+    assert_eq!(g.index(0, 1), Some(140));
+    assert_eq!(g.centre(140, 0), None);
+    assert_eq!(g.centre(0, 7), None);
+    let (x, y) = g.centre(139, 6).unwrap();
+    assert!((x - 0.1395).abs() < 1e-15 && (y - 0.0065).abs() < 1e-15);
+}
+
+#[test]
+fn absurdly_fine_cells_get_a_typed_error_not_a_panic() {
+    let b = Block::new(0.14, 0.007, 0.075).unwrap();
+    // Each of these once gave a grid whose `len()` overflowed or whose count saturated
+    // `usize` (any cell below 2^-53 L "divides" the face in f64).
+    for (dx, dy) in [
+        (1e-300, 1e-3),
+        (1e-3, 1e-300),
+        (5e-324, 5e-324),
+        (1e-17, 1e-3),
+    ] {
+        let e = Grid::from_cell_size(b, dx, dy).unwrap_err();
+        assert!(matches!(e, Error::InvalidParameter { .. }), "{e}");
+    }
+    // L / cell = inf passed the divisibility test (inf - inf is NaN, never > tolerance).
+    let huge = Block::new(1e300, 1.0, 1.0).unwrap();
+    let e = Grid::from_cell_size(huge, 1e-300, 1.0).unwrap_err();
+    assert!(
+        matches!(e, Error::InvalidParameter { name: "dx", .. }),
+        "{e}"
+    );
+    for (nx, ny) in [(usize::MAX, 2), (2, usize::MAX), (1 << 32, 1 << 32)] {
+        let e = Grid::new(b, nx, ny).unwrap_err();
+        assert!(
+            matches!(e, Error::InvalidParameter { name: "Nx Ny", .. }),
+            "{e}"
+        );
+    }
+    // The largest counts that are still accepted keep `len()` exact.
+    let g = Grid::new(b, 1 << 40, 1 << 19).unwrap();
+    assert_eq!(g.len(), 1 << 59);
+}
+
+#[test]
+fn cells_and_blocks_that_underflow_or_overflow_are_refused() {
+    // Each side is a valid length, the volume is not (inf / 0).
+    let e = Block::new(1e200, 1e200, 1e200).unwrap_err();
+    assert!(matches!(e, Error::InvalidParameter { .. }), "{e}");
+    let e = Block::new(1e-200, 1e-200, 1e-200).unwrap_err();
+    assert!(matches!(e, Error::InvalidParameter { .. }), "{e}");
+    // A cell of 5e-324 / 2 m rounds to zero; a cell area of 1e-326 m² underflows.
+    let tiny = Block::new(5e-324, 1.0, 1.0).unwrap();
+    assert!(matches!(
+        Grid::new(tiny, 2, 1),
+        Err(Error::InvalidLength { name: "dx", .. })
+    ));
+    let thin = Block::new(1e-160, 1e-160, 1e300).unwrap();
+    assert!(Grid::new(thin, 1, 1).is_ok());
+    let e = Grid::new(thin, 1000, 1000).unwrap_err();
+    assert!(
+        matches!(e, Error::InvalidParameter { name: "ΔA", .. }),
+        "{e}"
+    );
+}

@@ -147,7 +147,7 @@ fn cell_averages_equal_quadrature_of_the_point_formulas() {
 
 #[test]
 fn uniform_side_load_is_the_polynomial_of_model_md() {
-    // MODEL.md: for the uniform side load only Lx(x²/(2Lx²) - x/Lx + 1/3)/(Ly Lz) remains,
+    // docs/model.md: for the uniform side load only Lx(x²/(2Lx²) - x/Lx + 1/3)/(Ly Lz) remains,
     // and the stress it adds inside the block vanishes.
     let b = block();
     let grid = Grid::new(b, 10, 2).unwrap();

@@ -117,14 +117,14 @@ fn entries_equal_cell_quadrature_of_the_point_function() {
             }
         }
         let reference = sum / (dx * dy).powi(2);
-        let entry = dense[grid.index(ix, iy) * n + grid.index(jx, jy)];
+        let entry = dense[grid.index(ix, iy).unwrap() * n + grid.index(jx, jy).unwrap()];
         assert!(
             rel(entry, reference, 1e-300) < 2e-7,
             "({ix},{iy})-({jx},{jy}): {entry} vs {reference}"
         );
         // Point value at the centres: within O(Δ²/r²) of the Galerkin entry.
-        let (cx, cy) = grid.centre(ix, iy);
-        let (sx, sy) = grid.centre(jx, jy);
+        let (cx, cy) = grid.centre(ix, iy).unwrap();
+        let (sx, sy) = grid.centre(jx, jy).unwrap();
         let r2 = (cx - sx).powi(2) + (cy - sy).powi(2);
         let point = gf
             .value(Point::new(cx, cy, 0.0), Point::new(sx, sy, 0.0), 1e-11)
@@ -156,13 +156,13 @@ fn the_point_value_error_shrinks_like_delta_squared_over_r_squared() {
     let dense = plan.dense().unwrap();
     let gf = GreenFunction::new(block);
     let ratio = |jx: usize| {
-        let (cx, cy) = grid.centre(60, 3);
-        let (sx, sy) = grid.centre(jx, 3);
+        let (cx, cy) = grid.centre(60, 3).unwrap();
+        let (sx, sy) = grid.centre(jx, 3).unwrap();
         let point = gf
             .value(Point::new(cx, cy, 0.0), Point::new(sx, sy, 0.0), 1e-12)
             .unwrap()
             .value;
-        let entry = dense[grid.index(60, 3) * n + grid.index(jx, 3)];
+        let entry = dense[grid.index(60, 3).unwrap() * n + grid.index(jx, 3).unwrap()];
         let r = (cx - sx).abs();
         (entry - point).abs() * 4.0 * std::f64::consts::PI * r.powi(3) / grid.dx().powi(2)
     };
@@ -248,7 +248,7 @@ fn plane_transfer_equals_quadrature_of_dg_dz() {
     let n = grid.len();
     let z = 0.002;
     let transfer = plan.plane_transfer(z, 1e-12).unwrap();
-    let j = grid.index(5, 2);
+    let j = grid.index(5, 2).unwrap();
     let mut unit = vec![0.0; n];
     unit[j] = 1.0;
     let mut out = vec![0.0; n];
@@ -271,7 +271,7 @@ fn plane_transfer_equals_quadrature_of_dg_dz() {
             }
         }
         let reference = sum / (dx * dy);
-        let got = out[grid.index(ix, iy)];
+        let got = out[grid.index(ix, iy).unwrap()];
         assert!(
             (got - reference).abs() < 1e-6 * 0.1_f64.max(reference.abs()),
             "cell ({ix},{iy}): {got} vs {reference}"

@@ -149,7 +149,7 @@ impl Fv {
         let mut out = vec![0.0; grid.len()];
         for i in 0..nx {
             for j in 0..ny {
-                let c = grid.index(i / fx, j / fy);
+                let c = grid.index(i / fx, j / fy).unwrap();
                 let v = self.u[(i * ny + j) * nz] + 0.5 * self.h * traction[c] / modulus;
                 out[c] += v / (fx * fy) as f64;
             }
@@ -167,7 +167,7 @@ impl Fv {
             for j in 0..ny {
                 let base = (i * ny + j) * nz;
                 let d = modulus * (self.u[base + k] - self.u[base + k - 1]) / self.h;
-                out[grid.index(i / fx, j / fy)] += d / (fx * fy) as f64;
+                out[grid.index(i / fx, j / fy).unwrap()] += d / (fx * fy) as f64;
             }
         }
         out
@@ -227,7 +227,10 @@ fn probes_and_displacements_match_a_finite_volume_solve() {
     remove_mean(&mut ux);
     remove_mean(&mut uz);
 
-    let cell = |x: f64, y: f64| grid.index((x / grid.dx()) as usize, (y / grid.dy()) as usize);
+    let cell = |x: f64, y: f64| {
+        grid.index((x / grid.dx()) as usize, (y / grid.dy()) as usize)
+            .unwrap()
+    };
     let band = |z: f64| {
         if (2e-3..4e-3).contains(&z) {
             f_lat / (block.ly() * 2e-3)
@@ -312,9 +315,9 @@ fn planes_at_the_interface_and_the_top_give_the_tractions() {
         assert!((out.planes[1].shear[i] - f_top / area).abs() < 1e-9 * f_top / area);
         assert!((out.planes[1].normal[i] + f_n / area).abs() < 1e-9 * f_n / area);
     }
-    let c = grid.index(1, 0);
+    let c = grid.index(1, 0).unwrap();
     assert!((out.points[0].shear + phi_x[c]).abs() < 1e-12 * phi_x[c].abs());
-    let edge = 0.5 * (phi_z[grid.index(1, 0)] + phi_z[grid.index(2, 0)]);
+    let edge = 0.5 * (phi_z[grid.index(1, 0).unwrap()] + phi_z[grid.index(2, 0).unwrap()]);
     assert!((out.points[1].normal + edge).abs() < 1e-12 * edge);
     assert!((out.points[2].normal + f_n / area).abs() < 1e-9 * f_n / area);
 }
@@ -350,7 +353,7 @@ fn point_probes_averaged_over_a_cell_give_the_plane() {
         }
     }
     let cell_area = grid.cell_area();
-    let c = grid.index(2, 1);
+    let c = grid.index(2, 1).unwrap();
     let plane = &out.planes[0];
     // The stress is smooth at z = 1.5 mm: 6-point rules integrate it to ~1e-10.
     assert!((shear / cell_area - plane.shear[c]).abs() < 1e-8 * plane.shear[c].abs());

@@ -22,21 +22,67 @@ pub fn stress_block() -> SceneBuilder {
             },
         }))
 }
+use crate::report::{AtPath, FileError};
 use std::io::Write;
 
-/// The output directory: the first command-line argument, or `.`.
-pub fn out_dir() -> String {
-    std::env::args().nth(1).unwrap_or_else(|| ".".into())
+/// The command line of a figure example: `[output directory] [realizations]`.
+pub struct Args {
+    /// The output directory (default `.`), created and found writable.
+    pub dir: String,
+    /// Seeds `1..=k`, `k` the realizations (default 10, the paper's count); `[1]` for the
+    /// single-realization figures.
+    pub seeds: Vec<u64>,
+}
+
+/// Reads the command line, then creates the output directory and checks that it takes a
+/// file, all before any computing: a figure can take minutes, and a typo should not cost
+/// them. `realizations` is `Some(minimum)` for figures averaged over realizations (which
+/// take the count as second argument), `None` for single-realization figures (which
+/// refuse a second argument rather than ignore it).
+pub fn args(realizations: Option<u64>) -> std::result::Result<Args, Box<dyn std::error::Error>> {
+    let argv: Vec<String> = std::env::args().skip(1).collect();
+    let usage = match realizations {
+        Some(_) => "[output directory] [realizations]",
+        None => "[output directory]",
+    };
+    let most = if realizations.is_some() { 2 } else { 1 };
+    if argv.len() > most {
+        return Err(format!(
+            "unexpected argument '{}': the arguments are {usage}",
+            argv[most]
+        )
+        .into());
+    }
+    let seeds = match (realizations, argv.get(1)) {
+        (None, _) => vec![1],
+        (Some(_), None) => (1..=10).collect(),
+        (Some(min), Some(text)) => match text.parse::<u64>() {
+            Ok(k) if k >= min => (1..=k).collect(),
+            _ => {
+                return Err(format!(
+                    "realizations must be a whole number >= {min}, got '{text}' \
+                     (the arguments are {usage})"
+                )
+                .into())
+            }
+        },
+    };
+    let dir = argv.first().cloned().unwrap_or_else(|| ".".into());
+    crate::report::writable_dir(&dir)?;
+    Ok(Args { dir, seeds })
 }
 
 /// Writes `rows` under `header` to `path`.
-pub fn write_csv(path: &str, header: &str, rows: &[String]) -> std::io::Result<()> {
-    let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(out, "{header}")?;
-    for r in rows {
-        writeln!(out, "{r}")?;
-    }
-    out.flush()
+pub fn write_csv(path: &str, header: &str, rows: &[String]) -> std::result::Result<(), FileError> {
+    let write = || -> std::io::Result<()> {
+        let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+        writeln!(out, "{header}")?;
+        for r in rows {
+            writeln!(out, "{r}")?;
+        }
+        out.flush()
+    };
+    write().at("write", path)
 }
 
 /// `ℓ/Lx` averaged over the seeds at each `F/(μF_N)` of `grid`.
@@ -106,15 +152,6 @@ pub fn precursor_panel(
     }
     canvas.save(&format!("{dir}/{name}.png"))?;
     Ok(())
-}
-
-/// Seeds 1..=k, k the second command-line argument (default 10, the paper's count).
-pub fn seeds() -> Vec<u64> {
-    let k = std::env::args()
-        .nth(2)
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(10u64);
-    (1..=k).collect()
 }
 
 /// `0, step, 2 step, ..., 1`.

@@ -136,12 +136,15 @@ impl Plot {
     }
 
     /// Writes the canvas as an 8-bit RGB PNG.
-    pub fn save(&self, path: &str) -> Result<(), Box<dyn std::error::Error>> {
-        let file = BufWriter::new(File::create(path)?);
+    pub fn save(&self, path: &str) -> Result<(), crate::report::FileError> {
+        use crate::report::AtPath;
+        let file = BufWriter::new(File::create(path).at("create", path)?);
         let mut encoder = png::Encoder::new(file, self.width as u32, self.height as u32);
         encoder.set_color(png::ColorType::Rgb);
         encoder.set_depth(png::BitDepth::Eight);
-        encoder.write_header()?.write_image_data(&self.pixels)?;
-        Ok(())
+        let mut writer = encoder.write_header().at("write", path)?;
+        writer.write_image_data(&self.pixels).at("write", path)?;
+        // Dropping the writer would finish the file and swallow an error.
+        writer.finish().at("write", path)
     }
 }

@@ -287,7 +287,12 @@ impl Dct2d {
         let y = planner.plan_dct2(ny);
         let scratch_len = x.get_scratch_len().max(y.get_scratch_len());
         let direct = (ny > 1 && ny <= DIRECT_COLUMNS).then(|| cosine_table(ny));
-        let pairs = (pairs && direct.is_none() && nx % 2 == 0 && ny % 2 == 0 && nx >= 4 && ny >= 4)
+        let pairs = (pairs
+            && direct.is_none()
+            && nx.is_multiple_of(2)
+            && ny.is_multiple_of(2)
+            && nx >= 4
+            && ny >= 4)
             .then(|| {
                 let mut fft = FftPlanner::new();
                 (PairDct::new(&mut fft, nx), PairDct::new(&mut fft, ny))
@@ -426,7 +431,7 @@ impl Dct2d {
             return;
         }
         if let Some((_, py)) = &self.pairs {
-            if width % 2 == 0 {
+            if width.is_multiple_of(2) {
                 PAIR_SCRATCH.with_borrow_mut(|(z, scratch)| {
                     py.dct2(block, width, 1, width, z, scratch);
                     diag.scale(block, width);

@@ -2,12 +2,12 @@
 //! displacements and to the stresses at height `z`, per unit force.
 //!
 //! A load of force `F` (N) spread as a uniform traction `t = F / area` over a face adds
-//! `u = (F/M) · influence` to the displacement of the bottom face (MODEL.md section 1,
+//! `u = (F/M) · influence` to the displacement of the bottom face (docs/model.md section 1,
 //! `u = ⟨u⟩ + (1/M) ∮ G t dS`), where `influence = (1/area) ∫_face G dS` (m⁻¹), and adds
 //! `F · stress_influence` to the stress `M ∂u/∂z` at height `z`, where
 //! `stress_influence = (1/area) ∫_face ∂G/∂z dS` (m⁻²).
 //!
-//! On the grid the terms enter cell-averaged over x (MODEL.md section 2): every function
+//! On the grid the terms enter cell-averaged over x (docs/model.md section 2): every function
 //! `*_cells` returns one value per column `ix` (they do not depend on y).
 
 use super::point::{cos_sum_n2, sin_sum_n3, Estimate};
@@ -104,7 +104,7 @@ impl RodLoad {
 
     /// Rod load per unit force at the point `x` of the bottom face:
     /// `(1/(2Δh Ly)) ∫_0^Ly dη ∫_band dζ G(x,0;y,η;0,ζ)` (m⁻¹), to absolute tolerance
-    /// `tol` (m⁻¹). Closed form (MODEL.md section 1, paper Eq. `G_x_lat` with all its
+    /// `tol` (m⁻¹). Closed form (docs/model.md section 1, paper Eq. `G_x_lat` with all its
     /// constants):
     /// `(1/(Ly Lz)) [Lx(x²/2Lx² - x/Lx + 1/3) + (1/Δh) Σ_n (I_n/k_n) cosh k_n(Lx-x)/sinh k_nLx]`.
     pub fn influence_at(&self, x: f64, tol: f64) -> Result<Estimate> {

@@ -1,5 +1,5 @@
-//! The Galerkin influence operator of the grid (MODEL.md section 2) and the transfer of
-//! bottom tractions to a plane at height `z`.
+//! The Galerkin influence operator of the grid (docs/model.md section 2), planned once
+//! per geometry and shared.
 //!
 //! `Ĝ_ij = (1/ΔA²) ∫_cell i ∫_cell j G(x,ξ;y,η;0,0) dA dA'` is diagonal in the 2-D DCT-II
 //! basis of the grid. With `θ = p'π/(2Nx)` the aliases of the mode `p'` are the

@@ -195,7 +195,7 @@ impl<P: Copy> Board<P> {
                 continue;
             }
             spins += 1;
-            if spins % 64 == 0 && idle.elapsed() > SPIN {
+            if spins.is_multiple_of(64) && idle.elapsed() > SPIN {
                 let guard = self.lock.lock().unwrap_or_else(|e| e.into_inner());
                 self.sleepers.fetch_add(1, Ordering::SeqCst);
                 let stale = self.ticket.load(Ordering::SeqCst) >> 32 == seen
@@ -260,7 +260,7 @@ impl<T: Tasks> Crew<'_, T> {
                 "a solver thread panicked"
             );
             spins += 1;
-            if spins % 1024 == 0 {
+            if spins.is_multiple_of(1024) {
                 // A helper holding a task was descheduled (more threads than cores): let
                 // it run.
                 std::thread::yield_now();
