@@ -109,12 +109,16 @@ const SPIN: Duration = Duration::from_micros(20);
 
 /// The shared state of one solve's phases.
 struct Board<P> {
-    /// `generation << 32 | next unclaimed part` of the current phase.
-    ticket: AtomicU64,
+    /// The generation of the current phase.
+    generation: AtomicU64,
     /// The current phase (read by a helper before it claims a task of it).
     phase: Mutex<Option<P>>,
+    /// Per part: the generation it was last claimed in.
+    claims: Vec<AtomicU64>,
     /// Tasks of the current phase finished.
     done: AtomicUsize,
+    /// Workers: the leader and its helpers.
+    workers: usize,
     partials: Vec<[AtomicU64; SLOTS]>,
     finished: AtomicBool,
     poisoned: AtomicBool,
@@ -124,11 +128,13 @@ struct Board<P> {
 }
 
 impl<P: Copy> Board<P> {
-    fn new(parts: usize) -> Self {
+    fn new(parts: usize, workers: usize) -> Self {
         Self {
-            ticket: AtomicU64::new(0),
+            generation: AtomicU64::new(0),
             phase: Mutex::new(None),
+            claims: (0..parts).map(|_| AtomicU64::new(0)).collect(),
             done: AtomicUsize::new(0),
+            workers,
             partials: (0..parts).map(|_| Default::default()).collect(),
             finished: AtomicBool::new(false),
             poisoned: AtomicBool::new(false),
@@ -142,37 +148,36 @@ impl<P: Copy> Board<P> {
         self.partials.len()
     }
 
-    /// Claims and runs tasks of generation `generation` until none is left.
-    fn work<T: Tasks<Phase = P>>(&self, tasks: &T, generation: u64, phase: P) {
+    /// Runs the tasks of generation `generation` that worker `worker` can claim: its own
+    /// block of parts first (each part stays with one thread from phase to phase while
+    /// every worker keeps up: its data stays in that core's cache), then, from the far
+    /// end, the parts of workers that have not started theirs.
+    fn work<T: Tasks<Phase = P>>(&self, tasks: &T, worker: usize, generation: u64, phase: P) {
         let _guard = PoisonOnPanic(&self.poisoned);
-        let parts = self.parts() as u64;
-        let mut ticket = self.ticket.load(Ordering::Acquire);
-        loop {
-            if ticket >> 32 != generation || ticket & 0xffff_ffff >= parts {
-                return;
+        let parts = self.parts();
+        let block = |w: usize| w * parts / self.workers..(w + 1) * parts / self.workers;
+        let mine = block(worker);
+        let others = (0..parts).rev().filter(|k| !mine.contains(k));
+        for part in mine.clone().chain(others) {
+            let claimed = &self.claims[part];
+            let old = claimed.load(Ordering::Acquire);
+            if old >= generation
+                || claimed
+                    .compare_exchange(old, generation, Ordering::AcqRel, Ordering::Acquire)
+                    .is_err()
+            {
+                continue;
             }
-            match self.ticket.compare_exchange_weak(
-                ticket,
-                ticket + 1,
-                Ordering::AcqRel,
-                Ordering::Acquire,
-            ) {
-                Ok(_) => {
-                    let part = (ticket & 0xffff_ffff) as usize;
-                    let values = tasks.run(phase, part);
-                    for (slot, v) in self.partials[part].iter().zip(values) {
-                        slot.store(v.to_bits(), Ordering::Relaxed);
-                    }
-                    self.done.fetch_add(1, Ordering::Release);
-                    ticket = self.ticket.load(Ordering::Acquire);
-                }
-                Err(now) => ticket = now,
+            let values = tasks.run(phase, part);
+            for (slot, v) in self.partials[part].iter().zip(values) {
+                slot.store(v.to_bits(), Ordering::Relaxed);
             }
+            self.done.fetch_add(1, Ordering::Release);
         }
     }
 
-    /// A helper: takes tasks of every phase it sees until the solve is finished.
-    fn help<T: Tasks<Phase = P>>(&self, tasks: &T) {
+    /// Helper `worker`: takes tasks of every phase it sees until the solve is finished.
+    fn help<T: Tasks<Phase = P>>(&self, tasks: &T, worker: usize) {
         let mut seen = 0;
         let mut idle = Instant::now();
         let mut spins = 0u32;
@@ -180,14 +185,13 @@ impl<P: Copy> Board<P> {
             if self.finished.load(Ordering::Acquire) || self.poisoned.load(Ordering::Relaxed) {
                 return;
             }
-            let ticket = self.ticket.load(Ordering::Acquire);
-            let generation = ticket >> 32;
-            if generation != seen && ticket & 0xffff_ffff < self.parts() as u64 {
+            let generation = self.generation.load(Ordering::Acquire);
+            if generation != seen {
                 // The phase read here belongs to `generation` if a claim of it succeeds
                 // (the leader publishes the next phase only once every task is done).
                 let phase = *self.phase.lock().unwrap_or_else(|e| e.into_inner());
                 if let Some(phase) = phase {
-                    self.work(tasks, generation, phase);
+                    self.work(tasks, worker, generation, phase);
                 }
                 seen = generation;
                 idle = Instant::now();
@@ -198,7 +202,7 @@ impl<P: Copy> Board<P> {
             if spins.is_multiple_of(64) && idle.elapsed() > SPIN {
                 let guard = self.lock.lock().unwrap_or_else(|e| e.into_inner());
                 self.sleepers.fetch_add(1, Ordering::SeqCst);
-                let stale = self.ticket.load(Ordering::SeqCst) >> 32 == seen
+                let stale = self.generation.load(Ordering::SeqCst) == seen
                     && !self.finished.load(Ordering::SeqCst);
                 if stale {
                     // The timeout only bounds a missed wake-up's cost.
@@ -249,9 +253,9 @@ impl<T: Tasks> Crew<'_, T> {
         self.generation.set(generation);
         *board.phase.lock().unwrap_or_else(|e| e.into_inner()) = Some(phase);
         board.done.store(0, Ordering::Relaxed);
-        board.ticket.store(generation << 32, Ordering::SeqCst);
+        board.generation.store(generation, Ordering::SeqCst);
         board.notify();
-        board.work(self.tasks, generation, phase);
+        board.work(self.tasks, 0, generation, phase);
         let parts = board.parts();
         let mut spins = 0u32;
         while board.done.load(Ordering::Acquire) < parts {
@@ -279,8 +283,8 @@ pub(crate) fn with_crew<T: Tasks, R>(
     tasks: &T,
     leader: impl FnOnce(&Crew<'_, T>) -> R,
 ) -> Result<R> {
-    let board = Board::new(parts);
     let helpers = parallelism.threads().min(parts).saturating_sub(1);
+    let board = Board::new(parts, helpers + 1);
     if helpers == 0 {
         return Ok(lead(None, &board, tasks, 0, leader));
     }
@@ -301,8 +305,8 @@ fn lead<'s, T: Tasks, R>(
     leader: impl FnOnce(&Crew<'_, T>) -> R,
 ) -> R {
     if let Some(scope) = scope {
-        for _ in 0..helpers {
-            scope.spawn(move |_| board.help(tasks));
+        for worker in 1..=helpers {
+            scope.spawn(move |_| board.help(tasks, worker));
         }
     }
     let crew = Crew {
