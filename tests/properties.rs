@@ -16,7 +16,8 @@
 //! messages and CHANGELOG list the breakages).
 
 use crate::common::rule;
-use precursors::green::{GreenFunction, InfluencePlan};
+use precursors::green::{GreenFunction, InfluencePlan, RodLoad};
+use precursors::probe::{ProbeInput, ProbeSpec, StressProbe};
 use precursors::*;
 use proptest::prelude::*;
 use std::f64::consts::PI;
@@ -257,6 +258,78 @@ proptest! {
                 prop_assert!((entry - quad).abs() <= 1e-7 * kernel,
                     "{} of {:?}-{:?}: {} vs quadrature {}", name, ci, cj, entry, quad);
             }
+        }
+    }
+}
+
+/// Random cell tractions (Pa) with the total `ΔA Σ φ = total` (N): the mean plus a
+/// zero-sum perturbation of the same size.
+fn tractions(grid: &Grid, total: f64, rng: &mut u64) -> Vec<f64> {
+    let n = grid.len();
+    let mean = total / (grid.block().lx() * grid.block().ly());
+    let mut noise: Vec<f64> = (0..n).map(|_| uniform(rng) - 0.5).collect();
+    let avg = noise.iter().sum::<f64>() / n as f64;
+    noise.iter_mut().for_each(|x| *x -= avg);
+    let amplitude = 2.0 * mean.abs().max(1.0);
+    noise.iter().map(|x| mean + amplitude * x).collect()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Force balance through random planes: for random blocks, grids, rod bands (or the
+    /// uniform side load), loads and tractions that balance them, the integrals of the
+    /// plane probes' stresses equal the flux of the loads above the plane (closed form):
+    /// `∫ τ dA = F_top + F_lat · (part of the band above z)`, `∫ σ dA = -F_N`.
+    #[test]
+    fn plane_probes_carry_the_loads_above_them(
+        grid in grids(12, 6),
+        band in (0.0f64..1.0, 0.0f64..1.0),
+        side in any::<bool>(),
+        (f_top, f_lat, f_n) in (0.0f64..50.0, 0.0f64..50.0, 1.0f64..500.0),
+        planes in proptest::collection::vec(0.0f64..=1.0, 1..4),
+        seed in any::<u64>(),
+    ) {
+        let block = *grid.block();
+        let lz = block.lz();
+        let (lo, hi) = if side {
+            (0.0, lz)
+        } else {
+            let (a, b) = (band.0.min(band.1), band.0.max(band.1));
+            (a * lz, (b * lz).max(a * lz + 1e-3 * lz).min(lz))
+        };
+        let rod = if side {
+            RodLoad::uniform_side(&block)
+        } else {
+            RodLoad::new(&block, 0.5 * (lo + hi), 0.5 * (hi - lo)).unwrap()
+        };
+        let plan = InfluencePlan::builder(grid).build().unwrap();
+        // Planes from z_min = Δ/20 to Lz: the transfer's alias sums need `z ≳ Δ/100` to
+        // converge (`e^{-2π q z/Δ}`, q ≤ 512); z = 0 copies the tractions, balanced here
+        // by construction.
+        let z_min = (0.05 * grid.dx().max(grid.dy())).min(lz);
+        let heights: Vec<f64> = planes.iter().map(|t| z_min + t * (lz - z_min)).collect();
+        let spec = heights.iter().fold(ProbeSpec::default(), |s, z| s.plane(*z));
+        let probe = StressProbe::new(&plan, &spec, Some(&rod)).unwrap();
+        let mut rng = seed;
+        let phi_x = tractions(&grid, -(f_top + f_lat), &mut rng);
+        let phi_z = tractions(&grid, f_n, &mut rng);
+        let out = probe
+            .evaluate(&ProbeInput::new(&phi_x, &phi_z).loads(f_top, f_lat, f_n))
+            .unwrap();
+        let area = grid.cell_area();
+        // Probe accuracy (ProbeSpec::tolerance = 1e-10): transfer factors to 1e-10 times
+        // the largest traction over the face, the lateral term to 1e-10/(Ly Lz) per
+        // newton per cell, i.e. 1e-10 F_lat Lx/Lz over the face; 10x margin.
+        let face = block.lx() * block.ly();
+        let tol = 1e-9 * (face * (max_abs(&phi_x) + max_abs(&phi_z)) + f_lat * (1.0 + block.lx() / lz) + f_top + f_n);
+        for (plane, z) in out.planes.iter().zip(&heights) {
+            let above = ((hi - z) / (hi - lo)).clamp(0.0, 1.0);
+            let shear: f64 = plane.shear.iter().sum::<f64>() * area;
+            let normal: f64 = plane.normal.iter().sum::<f64>() * area;
+            let expected = f_top + f_lat * above;
+            prop_assert!((shear - expected).abs() <= tol, "z = {}: ∫τ = {} vs {}", z, shear, expected);
+            prop_assert!((normal + f_n).abs() <= tol, "z = {}: ∫σ = {} vs {}", z, normal, -f_n);
         }
     }
 }
