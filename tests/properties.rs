@@ -616,3 +616,130 @@ fn former_solver_regressions_satisfy_the_equilibria() {
     )
     .unwrap();
 }
+
+/// `(1/(Lx Ly)) ∫_face G(x,y,0; 0,η,ζ) dx dy = (2/V) (Lz²/6 - Lz ζ/2 + ζ²/4)` (only the
+/// `p = m = 0` terms survive, then `Σ_n cos(k_n ζ)/k_n²` in closed form), averaged over
+/// the band `[lo, hi]`: the bottom-face mean of a lateral load's displacement per newton
+/// times `M` (m⁻¹).
+fn face_mean_of_lateral_influence(block: &Block, lo: f64, hi: f64) -> f64 {
+    let lz = block.lz();
+    let primitive = |t: f64| lz * lz * t / 6.0 - lz * t * t / 4.0 + t.powi(3) / 12.0;
+    2.0 / block.volume() * (primitive(hi) - primitive(lo)) / (hi - lo)
+}
+
+#[derive(Debug, Clone, Copy)]
+enum TestDrive {
+    Spring { stiffness: f64 },
+    Mixed { ratio: f64 },
+    Top,
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+
+    /// The driver's states on random scenes and drives (a driving spring, mixed or top
+    /// force control), through ruptures up to global slip (or 60 events): the shear
+    /// tractions and displacements satisfy the tangential equations with the reference
+    /// `C`, and under displacement control the spring force is `K_S (U_S - ⟨u_x⟩)` with
+    /// `⟨u_x⟩` recomputed from the displacements: the face mean of `u_x` minus the face
+    /// means of the lateral load (closed form) and of the traction term (`Σ_j Ĝ_ij ΔA =
+    /// Lz/3`, closed form). Under a spring the offset of the tangential check is
+    /// `U_S - F/K_S`, not the driver's.
+    #[test]
+    fn driver_states_satisfy_the_equilibria_and_the_spring_law(
+        (nx, ny) in (2usize..=10, 1usize..=4),
+        lz in 2e-3f64..0.05,
+        seed in 0u64..100_000,
+        pressure in 1e6f64..1e7,
+        band in (0.1f64..0.9, 0.05f64..0.5),
+        side in any::<bool>(),
+        drive in prop_oneof![
+            ((1e5f64).ln()..(1e8f64).ln()).prop_map(|k| TestDrive::Spring { stiffness: k.exp() }),
+            (0.0f64..3.0).prop_map(|ratio| TestDrive::Mixed { ratio }),
+            Just(TestDrive::Top),
+        ],
+    ) {
+        let (dx, dy) = (1e-3, 1e-3);
+        let (lx, ly) = (nx as f64 * dx, ny as f64 * dy);
+        let half = (band.1 * lz * band.0.min(1.0 - band.0) / 0.5).max(1e-3 * lz);
+        let lateral = if side {
+            Lateral::Side
+        } else {
+            Lateral::Rod { height: band.0 * lz, half_width: half }
+        };
+        let scene_drive = match drive {
+            TestDrive::Spring { stiffness } => Drive::Spring { stiffness, lateral },
+            TestDrive::Mixed { ratio } => Drive::Force(ForceLoad::Mixed { ratio, lateral }),
+            TestDrive::Top => Drive::Force(ForceLoad::Top),
+        };
+        let scene = Scene::builder()
+            .block(lx, ly, lz)
+            .cells(nx, ny)
+            .normal_load(pressure * lx * ly)
+            .drive(scene_drive)
+            .seed(seed)
+            .plan_tolerance(PLAN_TOL)
+            .build()
+            .unwrap();
+        let grid = *scene.grid();
+        let n = grid.len();
+        let block = *grid.block();
+        let modulus = scene.material().modulus();
+        let c = reference_compliance(&grid, modulus);
+        let rod = match lateral {
+            Lateral::Side => RodLoad::uniform_side(&block),
+            _ => RodLoad::new(&block, band.0 * lz, half).unwrap(),
+        };
+        let (lo, hi) = (rod.h() - rod.half_width(), rod.h() + rod.half_width());
+        // Lateral part of the driven force F, and the displacement per newton of F.
+        let lateral_share = match drive {
+            TestDrive::Spring { .. } => 1.0,
+            TestDrive::Mixed { ratio } => 1.0 / (1.0 + ratio),
+            TestDrive::Top => 0.0,
+        };
+        let e: Vec<f64> = unit_load(&grid, &rod, modulus).iter().map(|v| v * lateral_share).collect();
+        let e_mean = lateral_share * face_mean_of_lateral_influence(&block, lo, hi) / modulus;
+        let tol = equilibrium_tolerance(n);
+        let mut driver = scene.driver().unwrap();
+        let mut checked = 0;
+        for _ in 0..60 {
+            let Some(event) = driver.step().unwrap() else { break };
+            if matches!(event, Event::GlobalSlip { .. }) {
+                break;
+            }
+            // Equilibrium states only: the last rupture leaves the broken state unsolved.
+            if !matches!(event, Event::Stable { .. } | Event::LoadRaised { .. }) {
+                continue;
+            }
+            let force = driver.force();
+            let phi = driver.shear_traction().unwrap();
+            let u_x = driver.shear_displacement().unwrap();
+            let u_z = driver.normal_displacement().unwrap().to_vec();
+            let e_f: Vec<f64> = e.iter().map(|v| force * v).collect();
+            let offset = match (drive, driver.load().drive_displacement) {
+                (TestDrive::Spring { stiffness }, Some(u_s)) => {
+                    // ⟨u_x⟩ from the displacements: face mean of u_x minus the load's and
+                    // the tractions' face means (closed forms).
+                    let face_mean = u_x.iter().sum::<f64>() / n as f64;
+                    let traction_mean = block.lz() / (3.0 * modulus * n as f64) * phi.iter().sum::<f64>();
+                    let mean = face_mean - force * e_mean - traction_mean;
+                    let spring = stiffness * (u_s - mean);
+                    let scale = max_abs(&u_x) + force * max_abs(&e) + mean.abs();
+                    prop_assert!((spring - force).abs() <= stiffness * 1e-11 * scale,
+                        "K_S (U_S - <u_x>) = {} vs F = {}", spring, force);
+                    u_s - force / stiffness
+                }
+                (TestDrive::Spring { .. }, None) => {
+                    return Err(TestCaseError::fail("a spring drive without U_S"));
+                }
+                _ => driver.mean_shear_displacement().unwrap(),
+            };
+            if force > 0.0 {
+                let shear = Shear { u_z: &u_z, e: &e_f, traction: &phi, displacement: &u_x, offset };
+                check_tangential(&c, driver.interface(), &shear, tol)?;
+                checked += 1;
+            }
+        }
+        prop_assert!(checked > 0);
+    }
+}
