@@ -13,7 +13,7 @@
 //!   after random ruptures) and the driver's states.
 //!
 //! Each test was seen to fail once with the code under test broken by hand (the commit
-//! messages and CHANGELOG list the breakages).
+//! messages list the breakages).
 
 use crate::common::rule;
 use precursors::green::{GreenFunction, InfluencePlan, RodLoad};
