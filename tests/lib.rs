@@ -12,6 +12,7 @@ mod laws;
 mod loads;
 mod operator;
 mod probe;
+mod properties;
 #[cfg(feature = "serde")]
 mod scene_file;
 mod solver;
