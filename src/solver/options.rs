@@ -38,7 +38,8 @@ pub struct SolverOptions {
     /// The threads a solve may use (default [`Parallelism::Sequential`]). The spectral
     /// backend shares each solve's work over the parts of the grid (fixed by the grid);
     /// the results are the same bit for bit for every choice (tested), only the wall time
-    /// changes (docs/performance.md). The dense backend's factor solves run on the
+    /// changes (docs/performance.md). The dense backend (grids up to
+    /// [`AUTO_DENSE_LIMIT`] cells under [`Backend::Auto`]) is one part: it runs on the
     /// calling thread whatever the choice. To run several scenes at once (seeds), give
     /// each [`Parallelism::Sequential`] and one scene per core.
     pub parallelism: Parallelism,
