@@ -265,12 +265,37 @@ pub fn length_at(curve: &[(f64, f64)], force: f64) -> f64 {
 
 /// Mean squared misfit (m²) of the realization-averaged precursor curve against the
 /// target points `(F, ℓ)` (N, m).
+///
+/// # Errors
+/// [`Error::EmptyInput`] with no target point; [`Error::NonFinite`] for a target point
+/// that is not finite and `>= 0`; those of building and running the scenes.
 pub fn precursor_misfit(
     builder: &SceneBuilder,
     targets: &[(f64, f64)],
     options: &FitOptions,
 ) -> Result<f64> {
+    check_targets(targets)?;
     misfit_with(builder, targets, options, &Planner::new())
+}
+
+/// At least one target point, each finite and `>= 0`.
+fn check_targets(targets: &[(f64, f64)]) -> Result<()> {
+    if targets.is_empty() {
+        return Err(Error::EmptyInput {
+            what: "targets (points (F, ℓ) of a precursor curve)",
+            reason: "the misfit is a mean over the target points: give at least one",
+        });
+    }
+    for (i, &(f, l)) in targets.iter().enumerate() {
+        if !(f.is_finite() && l.is_finite() && f >= 0.0 && l >= 0.0) {
+            return Err(Error::NonFinite {
+                name: "targets (F in N, ℓ in m: finite and >= 0)",
+                index: i,
+                value: if f.is_finite() { l } else { f },
+            });
+        }
+    }
+    Ok(())
 }
 
 /// [`precursor_misfit`] with plans from `planner`.
@@ -306,21 +331,7 @@ pub fn fit_tangential_stiffness(
 ) -> Result<Fit> {
     check_options(options)?;
     check_bracket("c_x bracket (N/m³)", bracket)?;
-    if targets.is_empty() {
-        return Err(Error::EmptyContact {
-            available: 0,
-            reason: "no target point to fit the precursor curve to",
-        });
-    }
-    for (i, &(f, l)) in targets.iter().enumerate() {
-        if !(f.is_finite() && l.is_finite() && f >= 0.0 && l >= 0.0) {
-            return Err(Error::NonFinite {
-                name: "targets (F in N, ℓ in m: finite and >= 0)",
-                index: i,
-                value: if f.is_finite() { l } else { f },
-            });
-        }
-    }
+    check_targets(targets)?;
     let mut evaluations = 0;
     let planner = Planner::new(); // every evaluation shares the geometry's plan
     let misfit = |ln_cx: f64, evaluations: &mut usize| -> Result<f64> {

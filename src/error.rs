@@ -2,8 +2,9 @@
 
 use thiserror::Error;
 
-/// Convenient result alias of the crate.
-pub type Result<T> = std::result::Result<T, Error>;
+/// Convenient result alias of the crate. The error type defaults to [`Error`] and can be
+/// named, so `use precursors::*` leaves `Result<T, E>` usable for other errors.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// Everything that can go wrong in the crate.
 ///
@@ -157,6 +158,15 @@ pub enum Error {
         index: usize,
         /// Number of sites.
         sites: usize,
+    },
+    /// An input that must hold at least one item holds none (e.g. the target points of a
+    /// fit).
+    #[error("{what} is empty: {reason}")]
+    EmptyInput {
+        /// Which input.
+        what: &'static str,
+        /// Why it needs at least one item.
+        reason: &'static str,
     },
     /// No site can carry the load (every site broken), or the load itself is zero.
     #[error("empty contact: {reason} ({available} sites can still carry force)")]

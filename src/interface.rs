@@ -23,7 +23,7 @@ pub struct Material {
     pub young_modulus: f64,
     /// Poisson's ratio `ν` (dimensionless, in `(-1, 0.5]`). Default `0.38`.
     pub poisson_ratio: f64,
-    /// Static local friction coefficient `μ` (dimensionless, `≥ 0`). Default `0.5`.
+    /// Static local friction coefficient `μ` (dimensionless, `> 0`). Default `0.5`.
     pub friction_coefficient: f64,
 }
 
@@ -65,11 +65,12 @@ impl Material {
                 reason: "Poisson's ratio must lie in (-1, 0.5]",
             });
         }
-        if !(self.friction_coefficient.is_finite() && self.friction_coefficient >= 0.0) {
+        if !(self.friction_coefficient.is_finite() && self.friction_coefficient > 0.0) {
             return Err(Error::InvalidParameter {
                 name: "friction_coefficient",
                 value: self.friction_coefficient,
-                reason: "the friction coefficient must be finite and >= 0",
+                reason: "the friction coefficient must be finite and > 0 (with μ = 0 every \
+                         site slips at zero shear and the loads F/(μF_N) are undefined)",
             });
         }
         Ok(())

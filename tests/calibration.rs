@@ -81,7 +81,16 @@ fn bad_calibration_input_is_refused() {
     ));
     assert!(matches!(
         fit_tangential_stiffness(&base(), &[], (1e11, 1e13), &options),
-        Err(Error::EmptyContact { .. })
+        Err(Error::EmptyInput { .. })
+    ));
+    // The misfit of no target point is refused, not NaN (0/0).
+    assert!(matches!(
+        precursor_misfit(&base(), &[], &options),
+        Err(Error::EmptyInput { .. })
+    ));
+    assert!(matches!(
+        precursor_misfit(&base(), &[(1.0, f64::INFINITY)], &options),
+        Err(Error::NonFinite { .. })
     ));
     assert!(matches!(
         fit_tangential_stiffness(&base(), &[(f64::NAN, 0.0)], (1e11, 1e13), &options),

@@ -240,3 +240,48 @@ fn cells_and_blocks_that_underflow_or_overflow_are_refused() {
         "{e}"
     );
 }
+
+/// `μ = 0` is refused where it would make every load ratio `F/(μF_N)` NaN.
+#[test]
+fn zero_friction_is_refused() {
+    for mu in [0.0, -0.1, f64::NAN] {
+        assert!(
+            matches!(
+                precursors::Material::new(3e9, 0.38, mu),
+                Err(Error::InvalidParameter {
+                    name: "friction_coefficient",
+                    ..
+                })
+            ),
+            "μ = {mu}"
+        );
+        let mut material = precursors::Material::default();
+        material.friction_coefficient = mu;
+        let built = precursors::Scene::builder().material(material).build();
+        assert!(
+            matches!(
+                built,
+                Err(Error::InvalidParameter {
+                    name: "friction_coefficient",
+                    ..
+                })
+            ),
+            "μ = {mu}"
+        );
+    }
+}
+
+/// `use precursors::*` brings `Result` with a default error type: naming another error
+/// still works.
+#[test]
+fn result_alias_takes_another_error_type() {
+    use precursors::*;
+    fn parse(text: &str) -> Result<u32, std::num::ParseIntError> {
+        text.parse()
+    }
+    fn build() -> Result<Grid> {
+        Grid::from_cell_size(Block::new(0.01, 0.01, 0.01)?, 1e-3, 1e-3)
+    }
+    assert!(parse("x").is_err() && parse("7") == Ok(7));
+    assert_eq!(build().unwrap().len(), 100);
+}
