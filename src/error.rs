@@ -2,7 +2,7 @@
 
 use thiserror::Error;
 
-/// Convenient result alias of the crate. The error type defaults to [`Error`] and can be
+/// Convenient result alias of the crate. The error type defaults to [`enum@Error`] and can be
 /// named, so `use precursors::*` leaves `Result<T, E>` usable for other errors.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
