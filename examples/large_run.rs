@@ -7,9 +7,12 @@
 //! the wall time, the event counts and the solver work split between the normal and the
 //! tangential equilibria.
 //!
-//! Run: `cargo run --release --example large_run [seed] [solver tolerance] [threads]`
+//! Run: `cargo run --release --example large_run [seed] [solver tolerance] [threads] [size]`
 //! (the tolerance defaults to the solver's, `1e-13`; threads to 1, `0` for every core,
-//! see `SolverOptions::parallelism`: the events are the same for every thread count).
+//! see `SolverOptions::parallelism`: the events are the same for every thread count;
+//! size `1e4`, the default, or `1e5`: the N = 1e5 scene of issue 13, a 1000 x 100 x 75 mm
+//! block on 1 mm cells at the same pressure). `LARGE_RUN_MAX_RUPTURES=k` stops after `k`
+//! ruptures.
 
 #[path = "support/report.rs"]
 mod report;
@@ -24,9 +27,9 @@ fn main() -> ExitCode {
 
 fn run() -> report::Outcome {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    const USAGE: &str = "the arguments are [seed] [solver tolerance] [threads]";
-    if args.len() > 3 {
-        return Err(format!("unexpected argument '{}': {USAGE}", args[3]).into());
+    const USAGE: &str = "the arguments are [seed] [solver tolerance] [threads] [size: 1e4 or 1e5]";
+    if args.len() > 4 {
+        return Err(format!("unexpected argument '{}': {USAGE}", args[4]).into());
     }
     // A bad argument is refused by name rather than replaced by its default.
     fn parse<T: std::str::FromStr>(
@@ -46,6 +49,11 @@ fn run() -> report::Outcome {
         SolverOptions::default().tolerance,
     )?;
     let threads: usize = parse(args.get(2), "thread count", 1)?;
+    let (lx, ly) = match args.get(3).map(String::as_str) {
+        None | Some("1e4") => (0.200, 0.050),
+        Some("1e5") => (1.000, 0.100),
+        Some(other) => return Err(format!("invalid size '{other}' ({USAGE})").into()),
+    };
     let start = Instant::now();
     let scene = Scene::builder()
         .solver(
@@ -57,10 +65,10 @@ fn run() -> report::Outcome {
                     n => Parallelism::Threads(n),
                 }),
         )
-        .block(0.200, 0.050, 0.075)
+        .block(lx, ly, 0.075)
         .cell_size(1e-3, 1e-3)
         .seed(seed)
-        .normal_load(3.5e6 * 0.200 * 0.050)
+        .normal_load(3.5e6 * lx * ly)
         .build()?;
     let built = start.elapsed();
     let scale = scene.material().friction_coefficient * scene.normal_load();

@@ -257,7 +257,7 @@ mod json {
             Checkpoint::from_json_str(&text[..text.len() / 2]),
             Err(Error::InvalidCheckpoint { .. })
         ));
-        let newer = text.replacen("\"format\":1", "\"format\":2", 1);
+        let newer = text.replacen("\"format\":2", "\"format\":3", 1);
         assert_ne!(newer, text);
         let c = Checkpoint::from_json_str(&newer).unwrap();
         assert!(matches!(

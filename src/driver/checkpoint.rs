@@ -1,7 +1,7 @@
 //! Checkpoints: a [`Driver`] frozen between two events, resumable on its scene.
 //!
 //! A checkpoint holds everything the protocol and the solvers carry from one event to the
-//! next, including the solvers' warm starts, the dense backend's LDLᵀ factors and the
+//! next, including the solvers' warm starts, the dense backend's LDLᵀ factor and the
 //! spectral preconditioner's `d̄`: iterative solves stop at a tolerance, so their results
 //! depend on where they start and how they are preconditioned at the rounding level, and
 //! a near-tie between two sites would otherwise let a resumed run pick another rupture.
@@ -16,7 +16,7 @@ use crate::solver::{NormalEquilibrium, SolverState, TangentialResponse};
 use crate::Event;
 
 /// Version of the checkpoint layout; a checkpoint of another version is refused.
-const FORMAT: u32 = 1;
+const FORMAT: u32 = 2;
 
 /// A snapshot of a [`Driver`] between two events ([`Driver::checkpoint`]), resumed by
 /// [`Scene::resume`]. With the `serde` feature it serialises in any serde format

@@ -1,9 +1,13 @@
 //! Dense backend: the assembled matrix `C` and an LDLᵀ factor (faer) of
-//! `C_SS + diag(d_S)` on the attached set, kept across solves. When a few sites leave or
-//! join, the factor is updated (faer's row/column deletion; an appended row costs one
-//! triangular solve) instead of refactorised; the factor then preconditions projected
-//! CG, which converges in one or two iterations when it is exact and in a few when the
-//! diagonal changed since (the tangential compliances follow `u_z`).
+//! `C_SS + diag(1/k_z)` on the attached set, kept across normal solves. When a few sites
+//! leave or join, the factor is updated (faer's row/column deletion; an appended row costs
+//! one triangular solve) instead of refactorised; the factor then preconditions projected
+//! CG, which converges in one or two iterations.
+//!
+//! The tangential system has no factor: its compliances `1/k_x = exp(u_z/u0)/c_x` change on
+//! every site at every normal re-equilibration and dominate `C`'s diagonal, so Jacobi CG
+//! from the last response (the spectral backend's path) costs less than keeping a second
+//! factor up to date (docs/performance.md, "The cost of one event").
 
 use super::spectral::{Effort, SetProblem, SetSolve, SpectralCore};
 use super::system::Preconditioner;
@@ -19,8 +23,7 @@ use std::sync::Mutex;
 const UPDATE_FRACTION: usize = 8;
 /// Refactorise when the stale factor needed more PCG iterations than this last time.
 const STALE_ITERATIONS: usize = 6;
-/// Refactorise when a kept site's compliance changed by more than this fraction (the
-/// tangential compliance `exp(u_z/u0)/c_x` follows every normal re-equilibration).
+/// Refactorise when a kept site's compliance changed by more than this fraction.
 const DIAG_DRIFT: f64 = 0.05;
 
 /// Everything a [`FactorCache`] holds, for checkpoints.
@@ -296,13 +299,12 @@ impl FactorCache {
     }
 }
 
-/// The dense matrix `C_s` (m/Pa) of every site, column-major, and the factors of the
-/// normal and tangential systems.
+/// The dense matrix `C_s` (m/Pa) of every site, column-major, and the factor of the
+/// normal system.
 #[derive(Debug)]
 pub(crate) struct DenseCore {
     pub(crate) c: Mat<f64>,
     pub(crate) normal: FactorCache,
-    pub(crate) tangential: FactorCache,
     /// The DCT product (one part), and the spectral iteration that explores a cold
     /// attached set before the factor is built.
     pub(crate) spectral: SpectralCore,
@@ -314,18 +316,15 @@ impl DenseCore {
             c,
             spectral,
             normal: FactorCache::default(),
-            tangential: FactorCache::default(),
         }
     }
 
-    /// Solves `problem` preconditioned by the normal or the tangential factor, brought up
-    /// to date for the set first. The product goes through the DCT operator (`O(N log N)`,
-    /// in cache) rather than the assembled `n x n` submatrix (`O(n²)`, memory bound): the
-    /// factor is only the preconditioner. A stale factor gets 50 iterations, then is
-    /// refactorised.
+    /// Solves the normal `problem` preconditioned by the factor, brought up to date for the
+    /// set first. The product goes through the DCT operator (`O(N log N)`, in cache) rather
+    /// than the assembled `n x n` submatrix (`O(n²)`, memory bound): the factor is only the
+    /// preconditioner. A stale factor gets 50 iterations, then is refactorised.
     pub(crate) fn solve(
         &mut self,
-        tangential: bool,
         problem: SetProblem<'_>,
         f: Vec<f64>,
         effort: Effort,
@@ -334,15 +333,11 @@ impl DenseCore {
             max_iterations: effort.max_iterations.min(50),
             ..effort
         };
-        let mut solved = self.solve_once(tangential, problem, f, first)?;
+        let mut solved = self.solve_once(problem, f, first)?;
         if !solved.outcome.converged {
-            if tangential {
-                self.tangential.clear();
-            } else {
-                self.normal.clear();
-            }
+            self.normal.clear();
             let spent = solved.outcome.iterations;
-            solved = self.solve_once(tangential, problem, solved.f, effort)?;
+            solved = self.solve_once(problem, solved.f, effort)?;
             solved.outcome.iterations += spent;
         }
         Ok(solved)
@@ -350,18 +345,15 @@ impl DenseCore {
 
     fn solve_once(
         &mut self,
-        tangential: bool,
         problem: SetProblem<'_>,
         f: Vec<f64>,
         effort: Effort,
     ) -> Result<SetSolve> {
         let DenseCore {
             c,
-            normal,
-            tangential: shear,
+            normal: cache,
             spectral,
         } = self;
-        let cache = if tangential { shear } else { normal };
         cache.prepare(c, problem.set, problem.d)?;
         // Map from the factor order to positions in `set`.
         let mut pos = vec![usize::MAX; c.nrows()];

@@ -64,8 +64,8 @@ pub(crate) struct SolverState {
     warm_normal: Vec<f64>,
     warm_tangential: Vec<f64>,
     preconditioner_mean: Option<f64>,
-    /// Dense backend: the normal and tangential factors.
-    factors: Option<(FactorState, FactorState)>,
+    /// Dense backend: the normal factor.
+    factor: Option<FactorState>,
 }
 
 enum Core {
@@ -238,17 +238,13 @@ impl EquilibriumSolver {
         self.warm_tangential.clear();
         if let Core::Dense(d) = &mut self.core {
             d.normal.clear();
-            d.tangential.clear();
         }
     }
 
     /// The state carried between solves.
     pub(crate) fn state(&self) -> SolverState {
-        let (preconditioner_mean, factors) = match &self.core {
-            Core::Dense(d) => (
-                d.spectral.preconditioner_mean(),
-                Some((d.normal.state(), d.tangential.state())),
-            ),
+        let (preconditioner_mean, factor) = match &self.core {
+            Core::Dense(d) => (d.spectral.preconditioner_mean(), Some(d.normal.state())),
             Core::Spectral(s) => (s.preconditioner_mean(), None),
         };
         SolverState {
@@ -256,7 +252,7 @@ impl EquilibriumSolver {
             warm_normal: self.warm_normal.clone(),
             warm_tangential: self.warm_tangential.clone(),
             preconditioner_mean,
-            factors,
+            factor,
         }
     }
 
@@ -288,15 +284,14 @@ impl EquilibriumSolver {
                 ));
             }
         }
-        match (&mut self.core, state.factors) {
-            (Core::Dense(core), Some((normal, tangential))) => {
+        match (&mut self.core, state.factor) {
+            (Core::Dense(core), Some(normal)) => {
                 core.normal.restore(normal, n)?;
-                core.tangential.restore(tangential, n)?;
                 core.spectral
                     .restore_preconditioner(state.preconditioner_mean);
             }
             (Core::Spectral(core), None) => core.restore_preconditioner(state.preconditioner_mean),
-            _ => return bad("the dense factors do not match the backend".into()),
+            _ => return bad("the dense factor does not match the backend".into()),
         }
         self.warm_normal = state.warm_normal;
         self.warm_tangential = state.warm_tangential;
@@ -359,7 +354,12 @@ impl EquilibriumSolver {
                 core.spectral
                     .solve(problem, Precond::Spectral, warm, effort)?
             }
-            Core::Dense(core) => core.solve(tangential, problem, warm, effort)?,
+            // The tangential system goes the spectral way on both backends (dense.rs).
+            Core::Dense(core) if tangential => {
+                core.spectral
+                    .solve(problem, spectral::warm_precond(true), warm, effort)?
+            }
+            Core::Dense(core) => core.solve(problem, warm, effort)?,
             Core::Spectral(core) => {
                 let precond = if cold {
                     Precond::Spectral
