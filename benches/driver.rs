@@ -8,6 +8,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use precursors::{Backend, Event, Parallelism, Scene, SolverOptions};
+use std::ops::ControlFlow;
 use std::time::Duration;
 
 fn bench(c: &mut Criterion) {
@@ -22,7 +23,7 @@ fn bench(c: &mut Criterion) {
     group.bench_function("calibration_scene_to_global_slip", |b| {
         b.iter(|| {
             let mut d = scene.driver().unwrap();
-            d.run(|_, _| {}).unwrap();
+            d.run(|_, _| ControlFlow::<()>::Continue(())).unwrap();
             d.event_count()
         })
     });
@@ -35,7 +36,7 @@ fn bench(c: &mut Criterion) {
         group.bench_function(format!("calibration_scene_to_global_slip_{name}"), |b| {
             b.iter(|| {
                 let mut d = scene.driver().unwrap();
-                d.run(|_, _| {}).unwrap();
+                d.run(|_, _| ControlFlow::<()>::Continue(())).unwrap();
                 d.event_count()
             })
         });

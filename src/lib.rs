@@ -18,6 +18,8 @@
 //! [`Event`]s (ruptures, detachments, attachments, load steps, stable states, global
 //! slip).
 //!
+//! Features: `serde` (JSON scene files and checkpoints).
+//!
 //! ```
 //! use precursors::{Block, Grid, green::InfluencePlan};
 //! let block = Block::new(0.14, 0.007, 0.075)?;          // 140 x 7 x 75 mm
@@ -53,6 +55,9 @@ pub struct ReadmeDoctests;
 pub use driver::{Checkpoint, Driver, Event, Load, Site, SolveStats};
 pub use geometry::{Block, Grid, Point};
 pub use interface::{HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw};
+pub use probe::{
+    CellStress, PlaneStress, PointStress, ProbeInput, ProbeSpec, Profile, StressProbe, Stresses,
+};
 pub use scene::{Drive, ForceLoad, HeightSource, Lateral, Scene, SceneBuilder};
 pub use solver::{
     Backend, EquilibriumSolver, NormalEquilibrium, Parallelism, SolveReport, SolverOptions,

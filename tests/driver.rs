@@ -6,6 +6,7 @@
 use crate::common::{bordered_solve, compliance_matrix};
 use precursors::green::RodLoad;
 use precursors::*;
+use std::ops::ControlFlow;
 
 fn small(drive: Drive, seed: u64) -> Scene {
     Scene::builder()
@@ -43,6 +44,7 @@ fn precursor_curve(scene: &Scene) -> Vec<(f64, f64)> {
         if let Event::Stable { load, .. } = e {
             out.push((load.force / scale, d.precursor_length().unwrap()));
         }
+        ControlFlow::<()>::Continue(())
     })
     .unwrap();
     out
@@ -204,6 +206,7 @@ fn stable_states_balance_forces_and_respect_the_coulomb_threshold() {
             }
             checked += 1;
         }
+        ControlFlow::<()>::Continue(())
     })
     .unwrap();
     assert!(checked > 10);

@@ -1,6 +1,7 @@
 //! One integration-test crate (one binary to link): each module tests one part of the
 //! public API against references computed independently of the code under test.
 
+mod api;
 mod calibration;
 mod checkpoint;
 mod common;
