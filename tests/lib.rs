@@ -11,6 +11,8 @@ mod green_point;
 mod interface;
 mod laws;
 mod loads;
+#[cfg(feature = "nalgebra")]
+mod matrix;
 mod operator;
 mod probe;
 mod properties;
