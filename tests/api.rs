@@ -268,7 +268,7 @@ fn heights_convert_from_vectors_and_slices() {
 #[test]
 fn getters_are_named_as_their_setters() {
     let law = SpringLaw::new(1.0e12, 2.0e8).unwrap();
-    let options = SolverOptions::default().with_backend(Backend::Spectral);
+    let options = SolverOptions::default().backend(Backend::Spectral);
     let probes = ProbeSpec::default().plane(1e-3);
     let material = Material::new(3.0e9, 0.3, 0.6).unwrap();
     let heights = HeightSource::Values(vec![2e-6; 24]);

@@ -423,8 +423,8 @@ fn drivers_and_solvers_can_move_between_threads() {
         .normal_load(2.1e3)
         .solver(
             SolverOptions::default()
-                .with_backend(Backend::Spectral)
-                .with_parallelism(Parallelism::Threads(2)),
+                .backend(Backend::Spectral)
+                .parallelism(Parallelism::Threads(2)),
         )
         .seed(2)
         .build()

@@ -562,7 +562,7 @@ fn check_equilibria(
         let mut iface = fresh.clone();
         let mut solver = EquilibriumSolver::builder(plan.clone())
             .material(material)
-            .options(SolverOptions::default().with_backend(backend))
+            .options(SolverOptions::default().backend(backend))
             .build()
             .unwrap();
         let mut history = Vec::new();

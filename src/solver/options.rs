@@ -60,21 +60,21 @@ impl Default for SolverOptions {
 impl SolverOptions {
     /// With the given backend.
     #[must_use]
-    pub fn with_backend(mut self, backend: Backend) -> Self {
+    pub fn backend(mut self, backend: Backend) -> Self {
         self.backend = backend;
         self
     }
 
     /// With the given linear tolerance (dimensionless).
     #[must_use]
-    pub fn with_tolerance(mut self, tolerance: f64) -> Self {
+    pub fn tolerance(mut self, tolerance: f64) -> Self {
         self.tolerance = tolerance;
         self
     }
 
-    /// With the given parallelism (see [`SolverOptions::parallelism`]).
+    /// With the given parallelism (see the field `parallelism`).
     #[must_use]
-    pub fn with_parallelism(mut self, parallelism: Parallelism) -> Self {
+    pub fn parallelism(mut self, parallelism: Parallelism) -> Self {
         self.parallelism = parallelism;
         self
     }
