@@ -8,6 +8,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use precursors::{Backend, Event, Parallelism, Scene, SolverOptions};
+use std::ops::ControlFlow;
 use std::time::Duration;
 
 fn bench(c: &mut Criterion) {
@@ -22,20 +23,20 @@ fn bench(c: &mut Criterion) {
     group.bench_function("calibration_scene_to_global_slip", |b| {
         b.iter(|| {
             let mut d = scene.driver().unwrap();
-            d.run(|_, _| {}).unwrap();
+            d.run(|_, _| ControlFlow::<()>::Continue(())).unwrap();
             d.event_count()
         })
     });
     for (name, backend) in [("dense", Backend::Dense), ("spectral", Backend::Spectral)] {
         let scene = Scene::builder()
             .seed(1)
-            .solver(SolverOptions::default().with_backend(backend))
+            .solver(SolverOptions::default().backend(backend))
             .build()
             .unwrap();
         group.bench_function(format!("calibration_scene_to_global_slip_{name}"), |b| {
             b.iter(|| {
                 let mut d = scene.driver().unwrap();
-                d.run(|_, _| {}).unwrap();
+                d.run(|_, _| ControlFlow::<()>::Continue(())).unwrap();
                 d.event_count()
             })
         });
@@ -46,7 +47,7 @@ fn bench(c: &mut Criterion) {
             .cell_size(1e-3, 1e-3)
             .seed(1)
             .normal_load(3.5e6 * 0.200 * 0.050)
-            .solver(SolverOptions::default().with_parallelism(if threads > 1 {
+            .solver(SolverOptions::default().parallelism(if threads > 1 {
                 Parallelism::Threads(threads)
             } else {
                 Parallelism::Sequential

@@ -26,8 +26,8 @@ fn solver(plan: &InfluencePlan, (backend, threads): (Backend, usize)) -> Equilib
     EquilibriumSolver::builder(plan.clone())
         .options(
             SolverOptions::default()
-                .with_backend(backend)
-                .with_parallelism(if threads > 1 {
+                .backend(backend)
+                .parallelism(if threads > 1 {
                     Parallelism::Threads(threads)
                 } else {
                     Parallelism::Sequential

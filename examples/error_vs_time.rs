@@ -77,8 +77,8 @@ fn one(
         .plan_tolerance(plan)
         .solver(
             SolverOptions::default()
-                .with_tolerance(solver)
-                .with_parallelism(threads),
+                .tolerance(solver)
+                .parallelism(threads),
         )
         .build()?;
     let mu_fn = scene.material().friction_coefficient * scene.normal_load();

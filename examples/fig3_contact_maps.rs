@@ -17,6 +17,7 @@ mod figures;
 
 use figures::plot;
 use precursors::{Drive, Event, ForceLoad, Lateral, Scene};
+use std::ops::ControlFlow;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -62,6 +63,7 @@ fn run() -> report::Outcome {
                     d.precursor_length().unwrap_or(0.0),
                 ));
             }
+            ControlFlow::<()>::Continue(())
         })?;
         let mut rows = Vec::new();
         for (f, ratio, _) in &states {

@@ -17,6 +17,7 @@ mod figures;
 
 use figures::plot;
 use precursors::{Drive, Event, Lateral, Scene};
+use std::ops::ControlFlow;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -44,13 +45,14 @@ fn run() -> report::Outcome {
             Event::LoadRaised { load } => ("load_raised", *load),
             Event::Stable { load, .. } => ("stable", *load),
             Event::GlobalSlip { load } => ("global_slip", *load),
-            _ => return,
+            _ => return ControlFlow::Continue(()),
         };
         // After the event: the spring force of the current state.
         let u = load.drive_displacement.unwrap_or(f64::NAN);
         let f = d.spring_force().unwrap_or(f64::NAN);
         rows.push(format!("{kind},{u:.9e},{f:.9e},{:.9e}", f / mu_fn));
         points.push((u, f / mu_fn));
+        ControlFlow::<()>::Continue(())
     })?;
     figures::write_csv(
         &format!("{dir}/fig4.csv"),

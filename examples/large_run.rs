@@ -58,8 +58,8 @@ fn run() -> report::Outcome {
     let scene = Scene::builder()
         .solver(
             SolverOptions::default()
-                .with_tolerance(tolerance)
-                .with_parallelism(match threads {
+                .tolerance(tolerance)
+                .parallelism(match threads {
                     0 => Parallelism::all_cores(),
                     1 => Parallelism::Sequential,
                     n => Parallelism::Threads(n),

@@ -17,6 +17,7 @@ mod plot;
 use precursors::{Event, Scene};
 use report::AtPath;
 use std::io::Write;
+use std::ops::ControlFlow;
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -49,15 +50,18 @@ fn run() -> report::Outcome {
     let mut driver = scene.driver()?;
     let mut rows = Vec::new();
     let mut slip = None;
-    driver.run(|event, d| match event {
-        Event::Stable { load, ruptures } => rows.push((
-            load.force / scale,
-            d.precursor_length().unwrap_or(f64::NAN) / lx,
-            d.total_contact_area().unwrap_or(f64::NAN),
-            *ruptures,
-        )),
-        Event::GlobalSlip { load } => slip = Some(load.force / scale),
-        _ => {}
+    driver.run(|event, d| {
+        match event {
+            Event::Stable { load, ruptures } => rows.push((
+                load.force / scale,
+                d.precursor_length().unwrap_or(f64::NAN) / lx,
+                d.total_contact_area().unwrap_or(f64::NAN),
+                *ruptures,
+            )),
+            Event::GlobalSlip { load } => slip = Some(load.force / scale),
+            _ => {}
+        }
+        ControlFlow::<()>::Continue(())
     })?;
     let elapsed = start.elapsed();
 

@@ -89,7 +89,7 @@ fn realizations(builder: &SceneBuilder, options: &FitOptions) -> Vec<SceneBuilde
     if options.seeds.is_empty() {
         return vec![builder.clone()];
     }
-    let distribution = match builder.height_source() {
+    let distribution = match builder.current_heights() {
         HeightSource::Random { distribution, .. } => *distribution,
         _ => HeightDistribution::default(),
     };
@@ -171,7 +171,7 @@ pub fn fit_normal_stiffness(
     let planner = Planner::new(); // every evaluation shares the geometry's plan
     let misfit = |ln_cz: f64, evaluations: &mut usize| -> Result<f64> {
         *evaluations += 1;
-        let mut law = builder.spring_law();
+        let mut law = builder.current_springs();
         law.c_z = ln_cz.exp();
         Ok(normal_area_with(&builder.clone().springs(law), options, &planner)? - target_area)
     };
@@ -336,7 +336,7 @@ pub fn fit_tangential_stiffness(
     let planner = Planner::new(); // every evaluation shares the geometry's plan
     let misfit = |ln_cx: f64, evaluations: &mut usize| -> Result<f64> {
         *evaluations += 1;
-        let mut law = builder.spring_law();
+        let mut law = builder.current_springs();
         law.c_x = ln_cx.exp();
         misfit_with(&builder.clone().springs(law), targets, options, &planner)
     };

@@ -39,11 +39,12 @@
 
 use crate::error::{Error, Result};
 use crate::geometry::Grid;
-use crate::interface::{Interface, SiteState};
-use crate::probe::{ProbeInput, StressProbe, Stresses};
-use crate::scene::{Drive, Scene, SceneBuilder};
+use crate::interface::{Interface, Material, SiteState};
+use crate::probe::{ProbeInput, ProbeSpec, StressProbe, Stresses};
+use crate::scene::{Drive, Scene};
 use crate::solver::{EquilibriumSolver, NormalEquilibrium, TangentialResponse};
 use std::collections::VecDeque;
+use std::ops::ControlFlow;
 
 mod checkpoint;
 pub use checkpoint::Checkpoint;
@@ -148,8 +149,8 @@ enum Phase {
 /// Runs a [`Scene`] quasi-statically; an iterator of [`Event`]s.
 #[derive(Debug)]
 pub struct Driver {
-    /// What the scene was built from (checkpoints record it).
-    scene: SceneBuilder,
+    /// The scene it runs (checkpoints record its builder).
+    scene: Scene,
     grid: Grid,
     friction: f64,
     normal_load: f64,
@@ -157,11 +158,16 @@ pub struct Driver {
     unit_load: Vec<f64>,
     /// `(F_top, F_lat)` per newton of `F`.
     split: (f64, f64),
-    probe: Option<StressProbe>,
+    /// The scene's probes, then those added by [`Driver::add_probes`], in order.
+    probes: Vec<StressProbe>,
     interface: Interface,
     solver: EquilibriumSolver,
     normal: Option<NormalEquilibrium>,
     response: Option<TangentialResponse>,
+    /// `φ_x = F g` (Pa) of the current state (empty before the first equilibrium).
+    shear_traction: Vec<f64>,
+    /// `u_x = F u_x/F` (m) of the current state (empty before the first equilibrium).
+    shear_displacement: Vec<f64>,
     /// Breaking load `λ_i` (N) of each site in the current state (`+∞` off contact).
     breaking: Vec<f64>,
     initial_columns: Vec<f64>,
@@ -200,22 +206,24 @@ impl Scene {
     pub fn driver(&self) -> Result<Driver> {
         let solver = EquilibriumSolver::builder(self.plan().clone())
             .material(self.material())
-            .options(self.solver_options())
+            .options(self.solver())
             .build()?;
         let n = self.grid().len();
         Ok(Driver {
-            scene: self.to_builder(),
+            scene: self.clone(),
             grid: *self.grid(),
             friction: self.material().friction_coefficient,
             normal_load: self.normal_load(),
             drive: self.drive(),
             unit_load: self.unit_load_displacement(),
             split: self.load_split(),
-            probe: self.stress_probe().cloned(),
+            probes: self.stress_probe().into_iter().cloned().collect(),
             interface: self.interface().clone(),
             solver,
             normal: None,
             response: None,
+            shear_traction: Vec::new(),
+            shear_displacement: Vec::new(),
             breaking: vec![f64::INFINITY; n],
             initial_columns: Vec::new(),
             control: 0.0,
@@ -240,7 +248,9 @@ impl Driver {
             if matches!(self.phase, Phase::Done | Phase::Failed) {
                 return Ok(None);
             }
-            if let Err(e) = self.advance() {
+            let advanced = self.advance();
+            self.refresh_shear();
+            if let Err(e) = advanced {
                 self.phase = Phase::Failed;
                 self.pending.clear();
                 return Err(e);
@@ -249,12 +259,63 @@ impl Driver {
     }
 
     /// Runs to global slip (or the first error), calling `observe` after every event with
-    /// the driver in the state right after it.
-    pub fn run(&mut self, mut observe: impl FnMut(&Event, &Driver)) -> Result<()> {
+    /// the driver in the state right after it; `observe` stops the run early by returning
+    /// [`ControlFlow::Break`]. Returns the break's value, `None` when the run reached
+    /// global slip. The driver stays usable after a break: a later `run` or
+    /// [`Driver::step`] continues with the next event.
+    ///
+    /// ```
+    /// use precursors::{Event, Scene};
+    /// use std::ops::ControlFlow;
+    /// let scene = Scene::builder().block(0.012, 0.002, 0.010).normal_load(50.0).build()?;
+    /// let mut driver = scene.driver()?;
+    /// // Stop at the first rupture and report its site.
+    /// let first = driver.run(|event, _| match event {
+    ///     Event::Rupture { site, .. } => ControlFlow::Break(*site),
+    ///     _ => ControlFlow::Continue(()),
+    /// })?;
+    /// assert!(first.is_some_and(|site| site.ix < 12));
+    /// // To the end: no break value.
+    /// let mut stable = 0;
+    /// let end = driver.run(|event, _| {
+    ///     stable += matches!(event, Event::Stable { .. }) as usize;
+    ///     ControlFlow::<()>::Continue(())
+    /// })?;
+    /// assert!(end.is_none() && stable > 0);
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// The first error of [`Driver::step`].
+    pub fn run<B>(
+        &mut self,
+        mut observe: impl FnMut(&Event, &Driver) -> ControlFlow<B>,
+    ) -> Result<Option<B>> {
         while let Some(event) = self.step()? {
-            observe(&event, self);
+            if let ControlFlow::Break(value) = observe(&event, self) {
+                return Ok(Some(value));
+            }
         }
-        Ok(())
+        Ok(None)
+    }
+
+    /// Recomputes the shear fields of the current state (`F` times the response per
+    /// newton) after the load or the response changed.
+    pub(crate) fn refresh_shear(&mut self) {
+        let f = self.force();
+        match &self.response {
+            Some(r) => {
+                self.shear_traction.clear();
+                self.shear_traction.extend(r.traction.iter().map(|g| f * g));
+                self.shear_displacement.clear();
+                self.shear_displacement
+                    .extend(r.displacement.iter().map(|u| f * u));
+            }
+            None => {
+                self.shear_traction.clear();
+                self.shear_displacement.clear();
+            }
+        }
     }
 
     /// One protocol move; queues its events.
@@ -274,7 +335,8 @@ impl Driver {
                 self.control = match self.drive {
                     Drive::Spring { stiffness, .. } => {
                         // F = K_S U_S / (1 + K_S Û): invert for the U_S that makes F = λ.
-                        threshold * (1.0 + stiffness * self.response()?.offset) / stiffness
+                        threshold * (1.0 + stiffness * self.response()?.offset_per_newton)
+                            / stiffness
                     }
                     Drive::Force(_) => threshold,
                 };
@@ -370,11 +432,11 @@ impl Driver {
         self.stats.tangential_solves += 1;
         self.stats.tangential_iterations += response.report.linear_iterations;
         if let Drive::Spring { stiffness, .. } = self.drive {
-            let denominator = 1.0 + stiffness * response.offset;
+            let denominator = 1.0 + stiffness * response.offset_per_newton;
             if denominator.is_nan() || denominator <= 0.0 {
                 return Err(Error::InvalidParameter {
                     name: "mean shear compliance <u_x>/F (m/N)",
-                    value: response.offset,
+                    value: response.offset_per_newton,
                     reason: "the block's mean displacement per newton must exceed -1/K_S for the \
                              driving spring to load it",
                 });
@@ -424,7 +486,7 @@ impl Driver {
         match self.drive {
             Drive::Force(_) => self.control,
             Drive::Spring { stiffness, .. } => match &self.response {
-                Some(r) => stiffness * self.control / (1.0 + stiffness * r.offset),
+                Some(r) => stiffness * self.control / (1.0 + stiffness * r.offset_per_newton),
                 None => 0.0,
             },
         }
@@ -466,6 +528,23 @@ impl Driver {
         self.normal_load
     }
 
+    /// The scene this driver runs (its set-up, not the current state: see
+    /// [`Driver::interface`] for the site states).
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// The block's material (of the scene).
+    pub fn material(&self) -> Material {
+        self.scene.material()
+    }
+
+    /// The local friction coefficient `μ` (dimensionless) of the Coulomb rule, for
+    /// instance for [`crate::PlaneStress::profile`].
+    pub fn friction_coefficient(&self) -> f64 {
+        self.friction
+    }
+
     /// Cumulative solver work since this driver was created or resumed (counts and wall
     /// times; not part of a checkpoint).
     pub fn solve_stats(&self) -> SolveStats {
@@ -503,26 +582,21 @@ impl Driver {
     }
 
     /// Shear traction `φ_x` per cell (Pa; negative where the springs resist `+x`).
-    pub fn shear_traction(&self) -> Result<Vec<f64>> {
-        let f = self.force();
-        Ok(self.response()?.traction.iter().map(|g| f * g).collect())
+    pub fn shear_traction(&self) -> Result<&[f64]> {
+        self.response()?;
+        Ok(&self.shear_traction)
     }
 
     /// Shear displacement `u_x` of the bottom face per cell (m).
-    pub fn shear_displacement(&self) -> Result<Vec<f64>> {
-        let f = self.force();
-        Ok(self
-            .response()?
-            .displacement
-            .iter()
-            .map(|u| f * u)
-            .collect())
+    pub fn shear_displacement(&self) -> Result<&[f64]> {
+        self.response()?;
+        Ok(&self.shear_displacement)
     }
 
     /// Mean shear displacement `⟨u_x⟩` of the block (m) (plus the top load's constant
     /// when a top shear acts).
     pub fn mean_shear_displacement(&self) -> Result<f64> {
-        Ok(self.force() * self.response()?.offset)
+        Ok(self.force() * self.response()?.offset_per_newton)
     }
 
     /// Breaking load `λ_i` (N) of each site in the current state (`+∞` off contact).
@@ -530,24 +604,65 @@ impl Driver {
         &self.breaking
     }
 
-    /// Shear, normal and Coulomb stresses (Pa) at the scene's probes
-    /// ([`crate::SceneBuilder::probes`]) in the current state, with every load term. Call
+    /// Adds stress probes (planes and points), planned now on the scene's operator and
+    /// read by [`Driver::stresses`] after the scene's own ([`crate::SceneBuilder::probes`]),
+    /// in the order they were added. Probes observe: they change neither the events nor
+    /// the scene's identity, so they may be added at any time, and a
+    /// [`Checkpoint`] resumes whatever probes either driver has (a checkpoint does not
+    /// hold them: add them again to the resumed driver). An empty `spec` adds nothing.
+    ///
+    /// ```
+    /// use precursors::{ProbeSpec, Scene};
+    /// let scene = Scene::builder().block(0.020, 0.004, 0.010).normal_load(80.0).build()?;
+    /// let mut driver = scene.driver()?;
+    /// driver.step()?;
+    /// driver.add_probes(&ProbeSpec::default().plane(2e-3))?;
+    /// let plane = &driver.stresses()?.planes[0];
+    /// assert_eq!((plane.nx, plane.ny), (20, 4));
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`StressProbe::new`]: a plane or point outside the block, a bad tolerance.
+    pub fn add_probes(&mut self, spec: &ProbeSpec) -> Result<()> {
+        if spec.is_empty() {
+            return Ok(());
+        }
+        let probe = StressProbe::new(self.scene.plan(), spec, self.scene.lateral_load())?;
+        self.probes.push(probe);
+        Ok(())
+    }
+
+    /// Shear, normal and Coulomb stresses (Pa) at the probes (the scene's,
+    /// [`crate::SceneBuilder::probes`], then those of [`Driver::add_probes`], planes and
+    /// points each in request order) in the current state, with every load term. Call
     /// it at the states you want: after the [`Event::LoadRaised`] that precedes the first
     /// [`Event::Rupture`] for "just before the first rupture", at each [`Event::Stable`]
-    /// for the quasi-static evolution. Errors: [`Error::InvalidParameter`] when the scene
+    /// for the quasi-static evolution. Errors: [`Error::InvalidParameter`] when the driver
     /// has no probes.
     pub fn stresses(&self) -> Result<Stresses> {
-        let probe = self.probe.as_ref().ok_or(Error::InvalidParameter {
-            name: "probes",
-            value: 0.0,
-            reason: "the scene was built without stress probes (SceneBuilder::probes)",
-        })?;
-        let shear = self.shear_traction()?;
+        if self.probes.is_empty() {
+            return Err(Error::InvalidParameter {
+                name: "probes",
+                value: 0.0,
+                reason: "the driver has no stress probes (SceneBuilder::probes, \
+                         Driver::add_probes)",
+            });
+        }
         let force = self.force();
-        let input = ProbeInput::new(&shear, self.normal_traction()?)
+        let input = ProbeInput::new(self.shear_traction()?, self.normal_traction()?)
             .loads(force * self.split.0, force * self.split.1, self.normal_load)
-            .friction(self.friction);
-        probe.evaluate(&input)
+            .friction_coefficient(self.friction);
+        let mut all = Stresses {
+            planes: Vec::new(),
+            points: Vec::new(),
+        };
+        for probe in &self.probes {
+            let stresses = probe.evaluate(&input)?;
+            all.planes.extend(stresses.planes);
+            all.points.extend(stresses.points);
+        }
+        Ok(all)
     }
 
     /// Real contact area per cell (m²).

@@ -229,6 +229,24 @@ pub enum Error {
         /// Why.
         reason: String,
     },
+    /// A matrix has the wrong shape for the grid: a field on the grid is an `Ny x Nx`
+    /// matrix (row `iy`, column `ix`); a transposed one is refused, not read sideways.
+    #[error(
+        "{name} is a {rows} x {columns} matrix, the grid needs {expected_rows} x \
+         {expected_columns} (Ny rows by Nx columns: row iy, column ix)"
+    )]
+    ShapeMismatch {
+        /// Which argument.
+        name: &'static str,
+        /// Rows given.
+        rows: usize,
+        /// Columns given.
+        columns: usize,
+        /// Rows needed (`Ny`).
+        expected_rows: usize,
+        /// Columns needed (`Nx`).
+        expected_columns: usize,
+    },
 }
 
 /// Checks that `value` is a finite, positive length.

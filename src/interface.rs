@@ -241,6 +241,61 @@ impl Heights {
     }
 }
 
+impl TryFrom<Vec<f64>> for Heights {
+    type Error = Error;
+
+    /// Heights (m) in cell order `i = iy·Nx + ix`, validated: at least one, each finite
+    /// and `> 0`. The count is checked against the grid where they are used
+    /// ([`Interface::new`], [`crate::SceneBuilder::build`]); [`Heights::from_values`]
+    /// checks it at once.
+    ///
+    /// ```
+    /// use precursors::Heights;
+    /// let heights = Heights::try_from(vec![1e-6, 2e-6, 0.5e-6])?;
+    /// assert_eq!(heights.values(), &[1e-6, 2e-6, 0.5e-6]);
+    /// assert!(Heights::try_from(vec![1e-6, 0.0]).is_err());
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::EmptyInput`] for no value, [`Error::NonFinite`] for a NaN or an infinity,
+    /// [`Error::NonPositiveHeight`] for a value `≤ 0`.
+    fn try_from(values: Vec<f64>) -> Result<Self> {
+        check_heights(&values)?;
+        Ok(Self { values })
+    }
+}
+
+impl TryFrom<&[f64]> for Heights {
+    type Error = Error;
+
+    /// As `TryFrom<Vec<f64>>` (copies the values).
+    ///
+    /// # Errors
+    /// As `TryFrom<Vec<f64>>`.
+    fn try_from(values: &[f64]) -> Result<Self> {
+        check_heights(values)?;
+        Ok(Self {
+            values: values.to_vec(),
+        })
+    }
+}
+
+/// At least one height, each finite and `> 0` (m).
+fn check_heights(values: &[f64]) -> Result<()> {
+    if values.is_empty() {
+        return Err(Error::EmptyInput {
+            what: "heights",
+            reason: "an interface needs one height per cell",
+        });
+    }
+    check_slice("heights", values, values.len())?;
+    if let Some((index, &value)) = values.iter().enumerate().find(|(_, h)| **h <= 0.0) {
+        return Err(Error::NonPositiveHeight { index, value });
+    }
+    Ok(())
+}
+
 /// State of one interfacial spring.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]

@@ -18,6 +18,9 @@
 //! [`Event`]s (ruptures, detachments, attachments, load steps, stable states, global
 //! slip).
 //!
+//! Features: `serde` (JSON scene files and checkpoints), `nalgebra` (heights from and
+//! fields to `nalgebra` matrices and vectors, row `iy` and column `ix`).
+//!
 //! ```
 //! use precursors::{Block, Grid, green::InfluencePlan};
 //! let block = Block::new(0.14, 0.007, 0.075)?;          // 140 x 7 x 75 mm
@@ -40,11 +43,19 @@ pub mod error;
 pub mod geometry;
 pub mod green;
 pub mod interface;
+#[cfg(feature = "nalgebra")]
+mod matrix;
 pub mod probe;
 pub mod scene;
 pub mod solver;
 
 pub use error::{Error, Result};
+/// The `nalgebra` this crate converts to and from (feature `nalgebra`): heights from an
+/// `Ny x Nx` `DMatrix` (row `iy`, column `ix`: [`Heights::from_dmatrix`]), fields to a
+/// `DMatrix` ([`Grid::field_to_dmatrix`]) or to a `DVector` in the cell order
+/// `i = iy·Nx + ix` ([`Grid::field_to_dvector`]).
+#[cfg(feature = "nalgebra")]
+pub use nalgebra;
 
 /// The README's code blocks, compiled and run as doctests so they stay true.
 #[doc = include_str!("../README.md")]
@@ -53,6 +64,9 @@ pub struct ReadmeDoctests;
 pub use driver::{Checkpoint, Driver, Event, Load, Site, SolveStats};
 pub use geometry::{Block, Grid, Point};
 pub use interface::{HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw};
+pub use probe::{
+    CellStress, PlaneStress, PointStress, ProbeInput, ProbeSpec, Profile, StressProbe, Stresses,
+};
 pub use scene::{Drive, ForceLoad, HeightSource, Lateral, Scene, SceneBuilder};
 pub use solver::{
     Backend, EquilibriumSolver, NormalEquilibrium, Parallelism, SolveReport, SolverOptions,

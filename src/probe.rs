@@ -50,8 +50,10 @@ use std::f64::consts::PI;
 /// Largest alias shell of a point kernel (the sum converges like `e^{-2π q z/Δ}`).
 const MAX_SHELLS: usize = 64;
 
-/// Where stresses are wanted: planes `z = const` and points. Requested on a scene
-/// ([`crate::SceneBuilder::probes`]); nothing is built without them.
+/// Where stresses are wanted: planes `z = const` and points. Requested on a driver at
+/// any time ([`crate::Driver::add_probes`]), or on a scene ([`crate::SceneBuilder::probes`])
+/// as the set every driver of the scene starts with; neither changes the scene's
+/// identity (checkpoints resume across them). Nothing is planned without them.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct ProbeSpec {
@@ -146,22 +148,27 @@ impl<'a> ProbeInput<'a> {
         self
     }
 
-    /// With the friction coefficient (dimensionless).
+    /// With the friction coefficient `μ` (dimensionless).
     #[must_use]
-    pub fn friction(mut self, friction_coefficient: f64) -> Self {
+    pub fn friction_coefficient(mut self, friction_coefficient: f64) -> Self {
         self.friction_coefficient = friction_coefficient;
         self
     }
 }
 
-/// Stresses on one plane, per cell in the paper's order (Pa).
+/// Stresses on one plane, per cell in the paper's order `i = iy·Nx + ix` (Pa).
+///
+/// Read a cell with [`PlaneStress::at`] (`None` out of range); with the `nalgebra`
+/// feature, a field as an `Ny x Nx` matrix with `Grid::field_to_dmatrix`.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct PlaneStress {
     /// Height of the plane (m).
     pub z: f64,
-    /// Cells along x (to read the rows).
+    /// Cells along x `Nx` (the length of a row).
     pub nx: usize,
+    /// Cells along y `Ny` (the number of rows).
+    pub ny: usize,
     /// Shear stress `τ = σ_xz` (Pa), cell averages.
     pub shear: Vec<f64>,
     /// Normal stress `σ = σ_zz` (Pa, negative in compression), cell averages.
@@ -184,12 +191,41 @@ pub struct Profile {
     pub mean_coulomb: Vec<f64>,
 }
 
+/// The stresses of one cell of a plane (Pa, cell averages).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct CellStress {
+    /// Shear stress `τ = σ_xz` (Pa).
+    pub shear: f64,
+    /// Normal stress `σ = σ_zz` (Pa, negative in compression).
+    pub normal: f64,
+    /// Coulomb stress `|τ| - μ|σ|` (Pa).
+    pub coulomb: f64,
+}
+
 impl PlaneStress {
-    /// The y-averaged profiles along x (Pa), with the friction coefficient `μ` used for
+    /// The index `i = iy·Nx + ix` of cell `(ix, iy)`, `None` unless `ix < Nx` and
+    /// `iy < Ny`.
+    pub fn index(&self, ix: usize, iy: usize) -> Option<usize> {
+        (ix < self.nx && iy < self.ny).then(|| iy * self.nx + ix)
+    }
+
+    /// The stresses of cell `(ix, iy)` (column `ix` along x, row `iy` along y), `None`
+    /// unless `ix < Nx` and `iy < Ny`.
+    pub fn at(&self, ix: usize, iy: usize) -> Option<CellStress> {
+        let i = self.index(ix, iy)?;
+        Some(CellStress {
+            shear: *self.shear.get(i)?,
+            normal: *self.normal.get(i)?,
+            coulomb: *self.coulomb.get(i)?,
+        })
+    }
+
+    /// The y-averaged profiles along x (Pa), with the friction coefficient `μ`
+    /// (dimensionless; a driver's is [`crate::Driver::friction_coefficient`]) used for
     /// the Coulomb stress of the averages.
     pub fn profile(&self, friction_coefficient: f64) -> Profile {
-        let nx = self.nx;
-        let ny = self.shear.len() / nx.max(1);
+        let (nx, ny) = (self.nx, self.ny);
         let mean = |v: &[f64]| -> Vec<f64> {
             let mut out = vec![0.0; nx];
             for row in v.chunks_exact(nx) {
@@ -389,6 +425,7 @@ impl StressProbe {
             planes.push(PlaneStress {
                 z: p.transfer.z(),
                 nx,
+                ny: self.grid.ny(),
                 shear,
                 normal,
                 coulomb,

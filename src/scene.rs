@@ -158,6 +158,22 @@ impl HeightSource {
     }
 }
 
+impl From<Vec<f64>> for HeightSource {
+    /// Given heights (m) in cell order `i = iy·Nx + ix`
+    /// ([`HeightSource::Values`]), validated at [`SceneBuilder::build`].
+    fn from(values: Vec<f64>) -> Self {
+        HeightSource::Values(values)
+    }
+}
+
+impl From<Heights> for HeightSource {
+    /// Heights already validated ([`Heights::try_from`], [`Heights::from_values`]); the
+    /// count is checked against the grid at [`SceneBuilder::build`].
+    fn from(heights: Heights) -> Self {
+        HeightSource::Values(heights.values().to_vec())
+    }
+}
+
 impl Default for HeightSource {
     fn default() -> Self {
         HeightSource::Random {
@@ -273,12 +289,20 @@ impl SceneBuilder {
         self
     }
 
-    /// Whether `other` describes the same run: every option equal but the solver's
-    /// parallelism, which does not change results (checkpoints resume across it).
+    /// Whether `other` describes the same run: every option equal but those that do not
+    /// change the events ([`SceneBuilder::identity`]); checkpoints resume across them.
     pub(crate) fn same_run(&self, other: &SceneBuilder) -> bool {
-        let mut mine = self.clone();
-        mine.solver.parallelism = other.solver.parallelism;
-        mine == *other
+        self.identity() == other.identity()
+    }
+
+    /// The scene's identity: this builder without the options that do not change the
+    /// events, the solver's parallelism (results are bit for bit the same for every
+    /// choice) and the probes (observers, which a driver may add at any time).
+    pub(crate) fn identity(&self) -> SceneBuilder {
+        let mut identity = self.clone();
+        identity.solver.parallelism = SolverOptions::default().parallelism;
+        identity.probes = ProbeSpec::default();
+        identity
     }
 
     /// Relative accuracy of the influence operator's eigenvalues (dimensionless, default
@@ -289,20 +313,25 @@ impl SceneBuilder {
         self
     }
 
-    /// Stress probes (planes and points, default none): planned at build, read with
-    /// [`crate::Driver::stresses`]. Without probes no probe operator is built.
+    /// The stress probes every driver of the scene starts with (planes and points,
+    /// default none): planned and validated at build, read with
+    /// [`crate::Driver::stresses`]. A driver adds more at any time with
+    /// [`crate::Driver::add_probes`]. The probes are not part of the scene's identity: a
+    /// checkpoint resumes on the scene with other probes.
     pub fn probes(mut self, probes: ProbeSpec) -> Self {
         self.probes = probes;
         self
     }
 
-    /// The spring constants set so far.
-    pub fn spring_law(&self) -> SpringLaw {
+    /// The spring constants set so far (the builder's getters are the crate's; users
+    /// read them from the built [`Scene::springs`]: a getter cannot share its setter's
+    /// name on the builder).
+    pub(crate) fn current_springs(&self) -> SpringLaw {
         self.law
     }
 
-    /// The heights source set so far.
-    pub fn height_source(&self) -> &HeightSource {
+    /// The heights source set so far (see [`SceneBuilder::current_springs`]).
+    pub(crate) fn current_heights(&self) -> &HeightSource {
         &self.heights
     }
 
@@ -398,6 +427,7 @@ impl SceneBuilder {
         };
         Ok(Scene {
             probe,
+            rod,
             grid,
             material: self.material,
             interface,
@@ -422,6 +452,9 @@ pub struct Scene {
     solver: SolverOptions,
     plan: InfluencePlan,
     lateral_response: Option<Vec<f64>>,
+    /// The lateral load, if the drive has one (the probes' lateral term).
+    rod: Option<RodLoad>,
+    /// The default probes, planned at build.
     probe: Option<StressProbe>,
     /// What the scene was built from (a checkpoint records it).
     builder: SceneBuilder,
@@ -464,9 +497,20 @@ impl Scene {
         self.drive
     }
 
-    /// The solver options.
-    pub fn solver_options(&self) -> SolverOptions {
+    /// The solver options ([`SceneBuilder::solver`]).
+    pub fn solver(&self) -> SolverOptions {
         self.solver
+    }
+
+    /// The spring constants ([`SceneBuilder::springs`]).
+    pub fn springs(&self) -> SpringLaw {
+        self.interface.law()
+    }
+
+    /// Where the heights came from ([`SceneBuilder::heights`], [`SceneBuilder::seed`]);
+    /// the heights themselves are [`Interface::heights`] of [`Scene::interface`].
+    pub fn heights(&self) -> &HeightSource {
+        &self.builder.heights
     }
 
     /// The planned influence operator.
@@ -474,9 +518,20 @@ impl Scene {
         &self.plan
     }
 
-    /// The planned stress probes (`None` when the builder requested none).
-    pub fn stress_probe(&self) -> Option<&StressProbe> {
+    /// The stress probes every driver of the scene starts with ([`SceneBuilder::probes`];
+    /// empty by default).
+    pub fn probes(&self) -> &ProbeSpec {
+        &self.builder.probes
+    }
+
+    /// The default probes as planned at build (`None` when there are none).
+    pub(crate) fn stress_probe(&self) -> Option<&StressProbe> {
         self.probe.as_ref()
+    }
+
+    /// The lateral load of the drive, if any (the probes' lateral stress term).
+    pub(crate) fn lateral_load(&self) -> Option<&RodLoad> {
+        self.rod.as_ref()
     }
 
     /// `(F_top, F_lat)` (N) per newton of the driven force `F`.

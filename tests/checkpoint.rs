@@ -75,7 +75,7 @@ fn resumed_runs_repeat_the_uninterrupted_one_spectral() {
     let scene = Scene::builder()
         .block(0.060, 0.010, 0.030)
         .normal_load(1.5e3)
-        .solver(SolverOptions::default().with_backend(Backend::Spectral))
+        .solver(SolverOptions::default().backend(Backend::Spectral))
         .seed(4)
         .build()
         .unwrap();
@@ -95,8 +95,8 @@ fn any_thread_count_repeats_the_sequential_run_and_resumes_it() {
             .normal_load(3.5e6 * 0.128 * 0.064)
             .solver(
                 SolverOptions::default()
-                    .with_backend(Backend::Spectral)
-                    .with_parallelism(parallelism),
+                    .backend(Backend::Spectral)
+                    .parallelism(parallelism),
             )
             .seed(5)
     };
@@ -233,7 +233,7 @@ mod json {
         let spectral = Scene::builder()
             .block(0.040, 0.010, 0.030)
             .normal_load(1.0e3)
-            .solver(SolverOptions::default().with_backend(Backend::Spectral))
+            .solver(SolverOptions::default().backend(Backend::Spectral))
             .seed(5)
             .build()
             .unwrap();

@@ -6,6 +6,7 @@
 use crate::common::{bordered_solve, compliance_matrix};
 use precursors::green::RodLoad;
 use precursors::*;
+use std::ops::ControlFlow;
 
 fn small(drive: Drive, seed: u64) -> Scene {
     Scene::builder()
@@ -43,6 +44,7 @@ fn precursor_curve(scene: &Scene) -> Vec<(f64, f64)> {
         if let Event::Stable { load, .. } = e {
             out.push((load.force / scale, d.precursor_length().unwrap()));
         }
+        ControlFlow::<()>::Continue(())
     })
     .unwrap();
     out
@@ -204,6 +206,7 @@ fn stable_states_balance_forces_and_respect_the_coulomb_threshold() {
             }
             checked += 1;
         }
+        ControlFlow::<()>::Continue(())
     })
     .unwrap();
     assert!(checked > 10);
@@ -420,8 +423,8 @@ fn drivers_and_solvers_can_move_between_threads() {
         .normal_load(2.1e3)
         .solver(
             SolverOptions::default()
-                .with_backend(Backend::Spectral)
-                .with_parallelism(Parallelism::Threads(2)),
+                .backend(Backend::Spectral)
+                .parallelism(Parallelism::Threads(2)),
         )
         .seed(2)
         .build()

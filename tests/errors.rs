@@ -144,8 +144,7 @@ fn operator_inputs_are_checked() {
 fn zero_solver_threads_are_refused() {
     let built = precursors::Scene::builder()
         .solver(
-            precursors::SolverOptions::default()
-                .with_parallelism(precursors::Parallelism::Threads(0)),
+            precursors::SolverOptions::default().parallelism(precursors::Parallelism::Threads(0)),
         )
         .build()
         .and_then(|scene| scene.driver());
@@ -162,7 +161,7 @@ fn zero_solver_threads_are_refused() {
             .block(0.010, 0.005, 0.010)
             .solver(
                 precursors::SolverOptions::default()
-                    .with_parallelism(precursors::Parallelism::Threads(threads)),
+                    .parallelism(precursors::Parallelism::Threads(threads)),
             )
             .build()
             .unwrap();

@@ -1,6 +1,7 @@
 //! One integration-test crate (one binary to link): each module tests one part of the
 //! public API against references computed independently of the code under test.
 
+mod api;
 mod calibration;
 mod checkpoint;
 mod common;
@@ -10,6 +11,8 @@ mod green_point;
 mod interface;
 mod laws;
 mod loads;
+#[cfg(feature = "nalgebra")]
+mod matrix;
 mod operator;
 mod probe;
 mod properties;

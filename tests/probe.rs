@@ -403,7 +403,7 @@ fn probe_errors_are_typed() {
         Err(Error::NonFinite { .. })
     ));
     assert!(matches!(
-        probe.evaluate(&ProbeInput::new(&phi, &phi).friction(-0.1)),
+        probe.evaluate(&ProbeInput::new(&phi, &phi).friction_coefficient(-0.1)),
         Err(Error::InvalidParameter { .. })
     ));
 }
@@ -415,7 +415,7 @@ fn the_driver_reports_probes_only_when_requested() {
         .normal_load(60.0)
         .seed(3);
     let plain = base.clone().build().unwrap();
-    assert!(plain.stress_probe().is_none());
+    assert!(plain.probes().is_empty());
     let mut d = plain.driver().unwrap();
     d.step().unwrap();
     assert!(matches!(d.stresses(), Err(Error::InvalidParameter { .. })));

@@ -562,7 +562,7 @@ fn check_equilibria(
         let mut iface = fresh.clone();
         let mut solver = EquilibriumSolver::builder(plan.clone())
             .material(material)
-            .options(SolverOptions::default().with_backend(backend))
+            .options(SolverOptions::default().backend(backend))
             .build()
             .unwrap();
         let mut history = Vec::new();
@@ -586,7 +586,7 @@ fn check_equilibria(
                 e: &e,
                 traction: &t.traction,
                 displacement: &t.displacement,
-                offset: t.offset,
+                offset: t.offset_per_newton,
             };
             check_tangential(&c, &iface, &shear, tol)?;
             history.push(iface.states().to_vec());
@@ -728,7 +728,7 @@ proptest! {
                     let traction_mean = block.lz() / (3.0 * modulus * n as f64) * phi.iter().sum::<f64>();
                     let mean = face_mean - force * e_mean - traction_mean;
                     let spring = stiffness * (u_s - mean);
-                    let scale = max_abs(&u_x) + force * max_abs(&e) + mean.abs();
+                    let scale = max_abs(u_x) + force * max_abs(&e) + mean.abs();
                     prop_assert!((spring - force).abs() <= stiffness * 1e-11 * scale,
                         "K_S (U_S - <u_x>) = {} vs F = {}", spring, force);
                     u_s - force / stiffness
@@ -739,7 +739,7 @@ proptest! {
                 _ => driver.mean_shear_displacement().unwrap(),
             };
             if force > 0.0 {
-                let shear = Shear { u_z: &u_z, e: &e_f, traction: &phi, displacement: &u_x, offset };
+                let shear = Shear { u_z: &u_z, e: &e_f, traction: phi, displacement: u_x, offset };
                 check_tangential(&c, driver.interface(), &shear, tol)?;
                 checked += 1;
             }

@@ -23,9 +23,9 @@ fn everything() -> SceneBuilder {
     law.c_x = 1.1e12;
     law.c_z = 2.2e8;
     let mut solver = SolverOptions::default()
-        .with_backend(Backend::Spectral)
-        .with_tolerance(1e-11)
-        .with_parallelism(Parallelism::Threads(2));
+        .backend(Backend::Spectral)
+        .tolerance(1e-11)
+        .parallelism(Parallelism::Threads(2));
     solver.max_active_set_iterations = 77;
     solver.max_linear_iterations = 999;
     Scene::builder()
@@ -257,11 +257,7 @@ fn solver_threads_take_counts_and_names() {
         );
         let builder = SceneBuilder::from_json_str(&text).unwrap();
         let scene = builder.clone().build().unwrap();
-        assert_eq!(
-            scene.solver_options().parallelism,
-            want,
-            "threads = {value}"
-        );
+        assert_eq!(scene.solver().parallelism, want, "threads = {value}");
         let again = SceneBuilder::from_json_str(&builder.to_json().unwrap()).unwrap();
         assert_eq!(again, builder, "threads = {value}");
     }

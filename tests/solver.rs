@@ -9,7 +9,7 @@ use precursors::*;
 
 fn solver(plan: &green::InfluencePlan, backend: Backend) -> EquilibriumSolver {
     EquilibriumSolver::builder(plan.clone())
-        .options(SolverOptions::default().with_backend(backend))
+        .options(SolverOptions::default().backend(backend))
         .build()
         .unwrap()
 }
@@ -242,12 +242,12 @@ fn solver_errors_are_typed() {
     let big = scene(150, 150, 1e-4, 0.01, 1);
     assert!(matches!(
         EquilibriumSolver::builder(big.plan)
-            .options(SolverOptions::default().with_backend(Backend::Dense))
+            .options(SolverOptions::default().backend(Backend::Dense))
             .build(),
         Err(Error::TooLargeForDense { .. })
     ));
     assert!(EquilibriumSolver::builder(s.plan.clone())
-        .options(SolverOptions::default().with_tolerance(-1.0))
+        .options(SolverOptions::default().tolerance(-1.0))
         .build()
         .is_err());
 }

@@ -58,7 +58,7 @@ fn run(case: Case) {
                 .for_each(|i| iface.break_site(i).unwrap());
         }
         let mut solver = EquilibriumSolver::builder(plan.clone())
-            .options(SolverOptions::default().with_backend(backend))
+            .options(SolverOptions::default().backend(backend))
             .build()
             .unwrap();
         let eq = solver.solve_normal(&iface, case.normal_load).unwrap();

@@ -87,7 +87,7 @@ impl Driver {
     pub fn checkpoint(&self) -> Checkpoint {
         Checkpoint {
             format: FORMAT,
-            scene: self.scene.clone(),
+            scene: self.scene.to_builder(),
             states: self.interface.states().to_vec(),
             normal: self.normal.clone(),
             response: self.response.clone(),
@@ -105,7 +105,9 @@ impl Driver {
 impl Scene {
     /// A driver continuing from `checkpoint`, which must have been taken on this scene
     /// (same builder: block, grid, material, springs, heights, loads, solver options; the
-    /// thread count may differ, results do not depend on it).
+    /// thread count may differ, results do not depend on it; so may the probes, which
+    /// observe: the resumed driver has this scene's, add others with
+    /// [`Driver::add_probes`]).
     /// Errors: [`Error::InvalidCheckpoint`] when it was not, or when it is inconsistent.
     pub fn resume(&self, checkpoint: &Checkpoint) -> Result<Driver> {
         let bad = |reason: String| Err(Error::InvalidCheckpoint { reason });
@@ -177,6 +179,7 @@ impl Scene {
         driver.phase = checkpoint.phase;
         driver.avalanche_ruptures = checkpoint.avalanche_ruptures;
         driver.events = checkpoint.events;
+        driver.refresh_shear();
         Ok(driver)
     }
 }

@@ -319,7 +319,7 @@ impl SceneFile {
                 lateral: lateral.into(),
             },
         };
-        let mut solver = SolverOptions::default().with_backend(match self.solver.backend {
+        let mut solver = SolverOptions::default().backend(match self.solver.backend {
             BackendSpec::Auto => Backend::Auto,
             BackendSpec::Dense => Backend::Dense,
             BackendSpec::Spectral => Backend::Spectral,

@@ -60,21 +60,21 @@ impl Default for SolverOptions {
 impl SolverOptions {
     /// With the given backend.
     #[must_use]
-    pub fn with_backend(mut self, backend: Backend) -> Self {
+    pub fn backend(mut self, backend: Backend) -> Self {
         self.backend = backend;
         self
     }
 
     /// With the given linear tolerance (dimensionless).
     #[must_use]
-    pub fn with_tolerance(mut self, tolerance: f64) -> Self {
+    pub fn tolerance(mut self, tolerance: f64) -> Self {
         self.tolerance = tolerance;
         self
     }
 
-    /// With the given parallelism (see [`SolverOptions::parallelism`]).
+    /// With the given parallelism (see the field `parallelism`).
     #[must_use]
-    pub fn with_parallelism(mut self, parallelism: Parallelism) -> Self {
+    pub fn parallelism(mut self, parallelism: Parallelism) -> Self {
         self.parallelism = parallelism;
         self
     }
@@ -114,7 +114,8 @@ pub struct NormalEquilibrium {
     pub traction: Vec<f64>,
     /// Normal displacement `u_z` of the bottom face per cell (m, cell averages).
     pub displacement: Vec<f64>,
-    /// `U` (m): `u_z = U + (ΔA/M) Ĝ φ_z`, i.e. `⟨u_z⟩` plus the top load's constant.
+    /// `U` (m): `u_z = U + (ΔA/M) Ĝ φ_z`, i.e. `⟨u_z⟩` plus the top load's constant. (The
+    /// tangential response's is per newton: [`TangentialResponse::offset_per_newton`].)
     pub offset: f64,
     /// The state of every site at this equilibrium: attached or detached (broken sites
     /// stay broken). The solver does not change the interface: apply these with
@@ -136,8 +137,10 @@ pub struct TangentialResponse {
     pub traction: Vec<f64>,
     /// Shear displacement `u_x` of the bottom face per cell per newton of load (m/N).
     pub displacement: Vec<f64>,
-    /// `U` (m/N): `u_x = U + e + (ΔA/M) Ĝ φ_x`.
-    pub offset: f64,
+    /// `U` per newton of load (m/N): `u_x = U + e + (ΔA/M) Ĝ φ_x`, all per newton. (The
+    /// normal equilibrium's [`NormalEquilibrium::offset`] is in m.)
+    #[cfg_attr(feature = "serde", serde(alias = "offset"))]
+    pub offset_per_newton: f64,
     /// How the solve went.
     pub report: SolveReport,
 }

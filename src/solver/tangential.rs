@@ -79,7 +79,7 @@ impl EquilibriumSolver {
         Ok(TangentialResponse {
             traction,
             displacement,
-            offset: offset - self.compliance.scale * self.compliance.shift * sum,
+            offset_per_newton: offset - self.compliance.scale * self.compliance.shift * sum,
             report: SolveReport {
                 backend: self.backend,
                 active_set_iterations: 1,
