@@ -24,7 +24,7 @@
 use crate::error::{Error, Result};
 use crate::geometry::{Block, Grid};
 use crate::green::{InfluencePlan, Planner, RodLoad};
-use crate::interface::{HeightDistribution, Heights, Interface, Material, SpringLaw};
+use crate::interface::{AreaLaw, HeightDistribution, Heights, Interface, Material, SpringLaw};
 use crate::probe::{ProbeSpec, StressProbe};
 use crate::solver::SolverOptions;
 
@@ -234,9 +234,17 @@ impl SceneBuilder {
         self
     }
 
-    /// Spring constants `c_x` (N/m³), `c_z` (N/m²) (default the paper's).
+    /// Spring constants `c_x` (N/m³), `c_z` (N/m²) and the area law (default the paper's).
     pub fn springs(mut self, law: SpringLaw) -> Self {
         self.law = law;
+        self
+    }
+
+    /// The real-contact-area law of the springs (default [`AreaLaw::Paper`]); the
+    /// constants set by [`SceneBuilder::springs`] stay. It changes the outputs (areas,
+    /// precursor lengths), not the events.
+    pub fn area_law(mut self, area_law: AreaLaw) -> Self {
+        self.law.area_law = area_law;
         self
     }
 
