@@ -429,3 +429,83 @@ mod json {
         ));
     }
 }
+
+/// The tables of `examples/run_scene.rs` on resume (`examples/support/table.rs`).
+mod tables {
+    use crate::table::{open, rows_to_keep};
+    use std::io::Write;
+
+    const HEADER: &str = "index,kind,force_N";
+
+    #[test]
+    fn rows_after_the_checkpoint_and_a_cut_last_row_are_dropped() {
+        let rows = "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n3,rupture,1.5\n";
+        // Rows up to the checkpoint's event are kept, later ones dropped.
+        assert_eq!(
+            rows_to_keep(rows, HEADER, 2).unwrap(),
+            "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n"
+        );
+        assert_eq!(rows_to_keep(rows, HEADER, 9).unwrap(), rows);
+        // A crash cut the last row: within its index ("12" of "1234"), within a field,
+        // or after the last field but before the newline. Each is dropped.
+        let kept = "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n";
+        for cut in ["2", "2,load_r", "3,rupture,1.5", "3,rupture"] {
+            let damaged = format!("{kept}{cut}");
+            assert_eq!(
+                rows_to_keep(&damaged, HEADER, 1000).unwrap(),
+                kept,
+                "cut {cut:?}"
+            );
+        }
+        // A complete last line with too few fields (a crash between two writes of a row).
+        assert_eq!(
+            rows_to_keep(&format!("{kept}3,rupture\n"), HEADER, 1000).unwrap(),
+            kept
+        );
+        // The same damage before the last row, another header, a bad index: refused.
+        assert!(rows_to_keep("index,kind,force_N\n1,stable\n2,stable,1.0\n", HEADER, 9).is_err());
+        assert!(rows_to_keep("event,force_N\n1,0.0\n", HEADER, 9).is_err());
+        assert!(rows_to_keep(
+            "index,kind,force_N\nx,stable,0.0\n2,stable,1.0\n",
+            HEADER,
+            9
+        )
+        .is_err());
+        // An empty file starts with the header.
+        assert_eq!(rows_to_keep("", HEADER, 3).unwrap(), "index,kind,force_N\n");
+    }
+
+    #[test]
+    fn a_resumed_table_continues_where_the_checkpoint_was() {
+        let dir = std::env::temp_dir().join(format!("precursors-{}-tables", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("events.csv");
+        // A run that crashed while writing row 4, after a checkpoint at event 2.
+        std::fs::write(
+            &path,
+            "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n3,rupture,1.5\n4,st",
+        )
+        .unwrap();
+        let mut table = open(&path, HEADER, Some(2)).unwrap();
+        writeln!(table, "3,rupture,1.5").unwrap();
+        drop(table);
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n3,rupture,1.5\n"
+        );
+        // Resumed into an empty directory: the header only; a new run: the header only.
+        std::fs::remove_file(&path).unwrap();
+        drop(open(&path, HEADER, Some(2)).unwrap());
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            "index,kind,force_N\n"
+        );
+        std::fs::write(&path, "junk").unwrap();
+        drop(open(&path, HEADER, None).unwrap());
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            "index,kind,force_N\n"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
