@@ -575,12 +575,21 @@ impl Driver {
     /// area `Lx·Ly` ([`Driver::nominal_area`]) by more than `1e-9` relative (the rounding
     /// of the sum): a state the paper's unbounded area law ([`crate::AreaLaw::Paper`])
     /// reaches when asperities are pressed below the substrate's mean plane, physically
-    /// meaningless as an area. Never true under [`crate::AreaLaw::Capped`].
+    /// meaningless as an area. An area whose exponential overflows
+    /// ([`Error::NonFinite`] from [`Driver::real_contact_area`]) exceeds it too. Never
+    /// true under [`crate::AreaLaw::Capped`].
     ///
     /// # Errors
-    /// As [`Driver::real_contact_area`].
+    /// As [`Driver::real_contact_area`] before the first event.
     pub fn area_exceeds_nominal(&self) -> Result<bool> {
-        Ok(self.total_contact_area()? > self.nominal_area() * (1.0 + NOMINAL_AREA_SLACK))
+        match self.total_contact_area() {
+            Ok(total) => Ok(total > self.nominal_area() * (1.0 + NOMINAL_AREA_SLACK)),
+            Err(Error::NonFinite {
+                name: "real contact area",
+                ..
+            }) => Ok(true),
+            Err(e) => Err(e),
+        }
     }
 
     /// Real contact area per column `ix` (summed over `y`, m²).

@@ -151,7 +151,10 @@ impl Checkpoint {
         };
         let mut tmp_name = std::ffi::OsString::from(".");
         tmp_name.push(name);
-        tmp_name.push(format!(".tmp{}", std::process::id()));
+        // Unique per process and call: concurrent writers never share a temporary file.
+        static CALLS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        tmp_name.push(format!(".tmp{}-{call}", std::process::id()));
         let tmp = dir.join(tmp_name);
         let written = (|| {
             let mut file = std::fs::File::create(&tmp)?;
