@@ -1,15 +1,19 @@
 //! Runs a scene file (docs/scene-format.md) to global slip and writes two tables:
 //!
 //! * `events.csv`: one row per event: `index,kind,ix,iy,force_N,drive_displacement_m,
-//!   energy_J,ruptures` (empty cells where a column does not apply);
+//!   energy_J,ruptures,area_exceeds_nominal` (empty cells where a column does not apply);
 //! * `curve.csv`: one row per stable state: `event,force_N,force_over_mu_FN,
 //!   drive_displacement_m,real_contact_area_m2,precursor_length_m,precursor_over_Lx,
-//!   broken,attached`.
+//!   broken,attached,area_exceeds_nominal`.
+//!
+//! `area_exceeds_nominal` is 1 when the total real contact area of the state after the
+//! event exceeds the nominal area `Lx·Ly` (the paper's unbounded area law), 0 otherwise.
 //!
 //! A progress line goes to stderr about once a second. With `--checkpoint FILE` a
 //! checkpoint is written every `--every K` stable states (default 100); `--resume FILE`
-//! continues from one (the scene comes from the checkpoint) and the tables end exactly as
-//! those of an uninterrupted run.
+//! continues from one (the scene comes from the checkpoint, whose digest must match it)
+//! and the tables end exactly as those of an uninterrupted run (rows after the
+//! checkpoint, and a last row cut by a crash, are dropped).
 //!
 //! ```sh
 //! cargo run --release --features serde --example run_scene -- examples/scenes/calibration.json --out out
@@ -19,18 +23,22 @@
 #[path = "support/report.rs"]
 mod report;
 
+#[path = "support/table.rs"]
+mod table;
+
 use precursors::{Checkpoint, Driver, Event, SceneBuilder, SiteState};
 use report::AtPath;
-use std::error::Error;
-use std::fs::{self, File, OpenOptions};
+use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-const EVENTS_HEADER: &str = "index,kind,ix,iy,force_N,drive_displacement_m,energy_J,ruptures";
+const EVENTS_HEADER: &str =
+    "index,kind,ix,iy,force_N,drive_displacement_m,energy_J,ruptures,area_exceeds_nominal";
 const CURVE_HEADER: &str = "event,force_N,force_over_mu_FN,drive_displacement_m,\
-                            real_contact_area_m2,precursor_length_m,precursor_over_Lx,broken,attached";
+                            real_contact_area_m2,precursor_length_m,precursor_over_Lx,broken,\
+                            attached,area_exceeds_nominal";
 
 struct Args {
     scene: Option<PathBuf>,
@@ -104,8 +112,7 @@ fn run() -> report::Outcome {
             (scene, driver, events, curve)
         }
         Some(path) => {
-            let text = fs::read_to_string(path).at("read the checkpoint", path)?;
-            let checkpoint = Checkpoint::from_json_str(&text).at("read the checkpoint", path)?;
+            let checkpoint = Checkpoint::read_from(path)?;
             let scene = checkpoint.scene().clone().build()?;
             let driver = scene.resume(&checkpoint)?;
             // Keep the rows up to the checkpoint (a crashed run may have written more).
@@ -130,27 +137,29 @@ fn run() -> report::Outcome {
     let mut last_progress = Instant::now();
     while let Some(event) = driver.step()? {
         let index = driver.event_count();
-        write_event(&mut events, index, &event).at("write", &events_path)?;
+        let exceeds = driver.area_exceeds_nominal()?;
+        write_event(&mut events, index, &event, exceeds).at("write", &events_path)?;
         if let Event::Stable { load, .. } = event {
             stable_states += 1;
             let (broken, attached) = counts(driver.site_states());
             let ell = driver.precursor_length()?;
             writeln!(
                 curve,
-                "{index},{:.12e},{:.12e},{},{:.12e},{:.12e},{:.12e},{broken},{attached}",
+                "{index},{:.12e},{:.12e},{},{:.12e},{:.12e},{:.12e},{broken},{attached},{}",
                 load.force,
                 load.force / mu_fn,
                 optional(load.drive_displacement),
                 driver.total_contact_area()?,
                 ell,
                 ell / grid.block().lx(),
+                u8::from(exceeds),
             )
             .at("write", &curve_path)?;
             if let Some(path) = &args.checkpoint {
                 if stable_states.is_multiple_of(args.every) {
                     events.flush().at("write", &events_path)?;
                     curve.flush().at("write", &curve_path)?;
-                    write_checkpoint(path, &driver)?;
+                    driver.checkpoint().write_to(path)?;
                 }
             }
         }
@@ -172,42 +181,25 @@ fn run() -> report::Outcome {
 }
 
 /// A CSV table: new (header only), or an existing one cut after the rows whose first
-/// column (an event index) is at most `keep`.
+/// column (an event index) is at most `keep` (`support/table.rs`).
 fn table(
     path: &Path,
     header: &str,
     keep: Option<usize>,
-) -> Result<BufWriter<File>, Box<dyn Error>> {
-    let mut text = format!("{header}\n");
-    if let Some(k) = keep {
-        if let Ok(old) = fs::read_to_string(path) {
-            for line in old.lines().skip(1) {
-                let index: usize = line
-                    .split(',')
-                    .next()
-                    .unwrap_or("")
-                    .parse()
-                    .at("read the rows to keep from", path)?;
-                if index <= k {
-                    text.push_str(line);
-                    text.push('\n');
-                }
-            }
-        }
-    }
-    fs::write(path, text).at("write", path)?;
-    let file = OpenOptions::new()
-        .append(true)
-        .open(path)
-        .at("open", path)?;
-    Ok(BufWriter::new(file))
+) -> Result<BufWriter<File>, report::FileError> {
+    table::open(path, header, keep).at("resume the table", path)
 }
 
 fn optional(x: Option<f64>) -> String {
     x.map(|v| format!("{v:.12e}")).unwrap_or_default()
 }
 
-fn write_event(out: &mut impl Write, index: usize, event: &Event) -> std::io::Result<()> {
+fn write_event(
+    out: &mut impl Write,
+    index: usize,
+    event: &Event,
+    exceeds: bool,
+) -> std::io::Result<()> {
     let (kind, site, load, energy, ruptures) = match *event {
         Event::LoadRaised { load } => ("load_raised", None, Some(load), None, None),
         Event::Rupture { site, load, energy } => {
@@ -224,11 +216,12 @@ fn write_event(out: &mut impl Write, index: usize, event: &Event) -> std::io::Re
     });
     writeln!(
         out,
-        "{index},{kind},{ix},{iy},{},{},{},{}",
+        "{index},{kind},{ix},{iy},{},{},{},{},{}",
         optional(load.map(|l| l.force)),
         optional(load.and_then(|l| l.drive_displacement)),
         optional(energy),
-        ruptures.map(|r| r.to_string()).unwrap_or_default()
+        ruptures.map(|r| r.to_string()).unwrap_or_default(),
+        u8::from(exceeds)
     )
 }
 
@@ -236,15 +229,6 @@ fn counts(states: &[SiteState]) -> (usize, usize) {
     let broken = states.iter().filter(|s| **s == SiteState::Broken).count();
     let attached = states.iter().filter(|s| **s == SiteState::Attached).count();
     (broken, attached)
-}
-
-/// Written to a temporary file first, then renamed: a crash never leaves half a
-/// checkpoint.
-fn write_checkpoint(path: &Path, driver: &Driver) -> Result<(), Box<dyn Error>> {
-    let tmp = path.with_extension("tmp");
-    fs::write(&tmp, driver.checkpoint().to_json()?).at("write", &tmp)?;
-    fs::rename(&tmp, path).at("write the checkpoint", path)?;
-    Ok(())
 }
 
 fn progress(driver: &Driver, mu_fn: f64, started: Instant) {

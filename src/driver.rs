@@ -46,6 +46,10 @@ use crate::solver::{EquilibriumSolver, NormalEquilibrium, TangentialResponse};
 use std::collections::VecDeque;
 use std::ops::ControlFlow;
 
+/// Relative slack of [`Driver::area_exceeds_nominal`]: the rounding of a sum of cell
+/// areas, so a capped area of `ΔA` on every cell is not flagged.
+const NOMINAL_AREA_SLACK: f64 = 1e-9;
+
 mod checkpoint;
 pub use checkpoint::Checkpoint;
 
@@ -676,6 +680,33 @@ impl Driver {
         Ok(self.real_contact_area()?.iter().sum())
     }
 
+    /// The nominal area `Lx·Ly` of the interface (m²).
+    pub fn nominal_area(&self) -> f64 {
+        let block = self.grid.block();
+        block.lx() * block.ly()
+    }
+
+    /// Whether the total real contact area of the current state exceeds the nominal
+    /// area `Lx·Ly` ([`Driver::nominal_area`]) by more than `1e-9` relative (the rounding
+    /// of the sum): a state the paper's unbounded area law ([`crate::AreaLaw::Paper`])
+    /// reaches when asperities are pressed below the substrate's mean plane, physically
+    /// meaningless as an area. An area whose exponential overflows
+    /// ([`Error::NonFinite`] from [`Driver::real_contact_area`]) exceeds it too. Never
+    /// true under [`crate::AreaLaw::Capped`].
+    ///
+    /// # Errors
+    /// As [`Driver::real_contact_area`] before the first event.
+    pub fn area_exceeds_nominal(&self) -> Result<bool> {
+        match self.total_contact_area() {
+            Ok(total) => Ok(total > self.nominal_area() * (1.0 + NOMINAL_AREA_SLACK)),
+            Err(Error::NonFinite {
+                name: "real contact area",
+                ..
+            }) => Ok(true),
+            Err(e) => Err(e),
+        }
+    }
+
     /// Real contact area per column `ix` (summed over `y`, m²).
     pub fn column_contact_area(&self) -> Result<Vec<f64>> {
         let area = self.real_contact_area()?;
@@ -701,6 +732,35 @@ impl Driver {
             .iter()
             .zip(&self.initial_columns)
             .take_while(|(now, then)| now < then)
+            .count();
+        Ok(run as f64 * self.grid.dx())
+    }
+
+    /// A noise-robust precursor length (m): the extent, from the trailing edge, of the
+    /// run of columns whose real contact area fell below `(1 - drop)` times its value at
+    /// zero shear. `drop` (dimensionless, in `[0, 1)`) is the relative fall that counts;
+    /// `drop = 0` is the paper's definition ([`Driver::precursor_length`]) exactly; a
+    /// larger `drop` never gives a longer front: a column counts only once it lost that
+    /// fraction of its area, so smaller fluctuations do not extend the front. A multiple
+    /// of `Δx`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a `drop` outside `[0, 1)` (or NaN); as
+    /// [`Driver::real_contact_area`] before the first event.
+    pub fn precursor_length_with(&self, drop: f64) -> Result<f64> {
+        if !(0.0..1.0).contains(&drop) {
+            return Err(Error::InvalidParameter {
+                name: "drop",
+                value: drop,
+                reason: "the relative drop of a column's contact area must lie in [0, 1)",
+            });
+        }
+        let keep = 1.0 - drop;
+        let columns = self.column_contact_area()?;
+        let run = columns
+            .iter()
+            .zip(&self.initial_columns)
+            .take_while(|(now, then)| **now < keep * **then)
             .count();
         Ok(run as f64 * self.grid.dx())
     }

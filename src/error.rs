@@ -247,6 +247,26 @@ pub enum Error {
         /// Columns needed (`Nx`).
         expected_columns: usize,
     },
+    /// A checkpoint belongs to another scene: the scene it is resumed on differs from the
+    /// checkpoint's, or the scene stored in the checkpoint was edited after it was taken
+    /// (its digest no longer matches).
+    #[error("checkpoint refused: the scenes differ at `{key}`: {reason}")]
+    CheckpointSceneMismatch {
+        /// The first differing option, by its scene-file key path (`block.lx`,
+        /// `normal_load`, `drive.lateral.height`, ...).
+        key: String,
+        /// Which scenes differ, and the values when they are known.
+        reason: String,
+    },
+    /// A checkpoint file holds no valid checkpoint (a read or write failure of the file
+    /// itself is [`Error::Io`]).
+    #[error("{path}: not a checkpoint: {reason}")]
+    CheckpointFile {
+        /// The file.
+        path: String,
+        /// What the parser reported.
+        reason: String,
+    },
 }
 
 /// Checks that `value` is a finite, positive length.

@@ -82,7 +82,26 @@ impl Material {
     }
 }
 
-/// The two constants of the spring laws. Defaults: the paper's calibrated PMMA values.
+/// The real contact area of an attached site (docs/model.md section 3). It enters the
+/// outputs only (total area, precursor length), never the equilibria or the events.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
+pub enum AreaLaw {
+    /// The paper's law `A_R,i = ΔA/(e-1) [exp(-(u_z,i - u0_i)/u0_i) - 1]` (m²), unbounded:
+    /// a site pressed below the substrate's mean plane (`u_z < 0`) has more real contact
+    /// area than its cell, and the total may exceed the nominal area `Lx·Ly`
+    /// ([`crate::Driver::area_exceeds_nominal`]). The default.
+    #[default]
+    Paper,
+    /// The paper's law capped at the cell area: `min(A_R,i, ΔA)` (m²), so the total never
+    /// exceeds the nominal area `Lx·Ly`.
+    Capped,
+}
+
+/// The constants of the spring laws and the real-contact-area law. Defaults: the paper's
+/// calibrated PMMA values and its area law.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct SpringLaw {
@@ -90,6 +109,9 @@ pub struct SpringLaw {
     pub c_x: f64,
     /// `c_z` (N/m²): `k_z = c_z / u0`. Default `1.65e8`.
     pub c_z: f64,
+    /// The real contact area of an attached site (m², outputs only). Default
+    /// [`AreaLaw::Paper`].
+    pub area_law: AreaLaw,
 }
 
 impl Default for SpringLaw {
@@ -97,16 +119,28 @@ impl Default for SpringLaw {
         Self {
             c_x: 1.65e12,
             c_z: 1.65e8,
+            area_law: AreaLaw::Paper,
         }
     }
 }
 
 impl SpringLaw {
-    /// A validated law: both constants finite and > 0.
+    /// A validated law: both constants finite and > 0; the paper's area law.
     pub fn new(c_x: f64, c_z: f64) -> Result<Self> {
-        let law = Self { c_x, c_z };
+        let law = Self {
+            c_x,
+            c_z,
+            area_law: AreaLaw::Paper,
+        };
         law.validate()?;
         Ok(law)
+    }
+
+    /// The same constants with another real-contact-area law.
+    #[must_use]
+    pub fn with_area_law(mut self, area_law: AreaLaw) -> Self {
+        self.area_law = area_law;
+        self
     }
 
     /// Checks the fields.
@@ -516,11 +550,18 @@ impl Interface {
 
     /// Real contact area per cell (m²) at the normal displacements `u_z` (m):
     /// `ΔA/(e-1) [exp(-(u_z - u0)/u0) - 1]` for attached sites, 0 otherwise. It equals
-    /// `ΔA` when `u_z = 0` and exceeds it when the block penetrates below the substrate
-    /// mean plane (`u_z < 0`). An overflow is reported as [`Error::NonFinite`].
+    /// `ΔA` when `u_z = 0` and, under the paper's [`AreaLaw::Paper`], exceeds it when the
+    /// block penetrates below the substrate mean plane (`u_z < 0`); [`AreaLaw::Capped`]
+    /// caps it at `ΔA`. Under the paper's law an overflow of the exponential is
+    /// reported as [`Error::NonFinite`] (the capped law gives `ΔA`).
     pub fn real_contact_area(&self, u_z: &[f64]) -> Result<Vec<f64>> {
         check_slice("u_z", u_z, self.grid.len())?;
-        let scale = self.grid.cell_area() / (std::f64::consts::E - 1.0);
+        let cell = self.grid.cell_area();
+        let cap = match self.law.area_law {
+            AreaLaw::Capped => cell,
+            _ => f64::INFINITY,
+        };
+        let scale = cell / (std::f64::consts::E - 1.0);
         self.heights()
             .iter()
             .zip(u_z)
@@ -531,7 +572,10 @@ impl Interface {
                     return Ok(0.0);
                 }
                 let value = scale * ((-(u - h) / h).exp() - 1.0);
-                if value.is_finite() {
+                if value > cap {
+                    // Also an overflow to +∞ under the capped law.
+                    Ok(cap)
+                } else if value.is_finite() {
                     Ok(value.max(0.0))
                 } else {
                     Err(Error::NonFinite {

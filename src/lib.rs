@@ -63,7 +63,9 @@ pub use nalgebra;
 pub struct ReadmeDoctests;
 pub use driver::{Checkpoint, Driver, Event, Load, Site, SolveStats};
 pub use geometry::{Block, Grid, Point};
-pub use interface::{HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw};
+pub use interface::{
+    AreaLaw, HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw,
+};
 pub use probe::{
     CellStress, PlaneStress, PointStress, ProbeInput, ProbeSpec, Profile, StressProbe, Stresses,
 };

@@ -199,16 +199,53 @@ fn a_checkpoint_is_refused_on_another_scene() {
     let mut driver = scene.driver().unwrap();
     driver.step().unwrap();
     let checkpoint = driver.checkpoint();
-    let other = scene.to_builder().seed(2).build().unwrap();
-    assert!(matches!(
-        other.resume(&checkpoint),
-        Err(Error::InvalidCheckpoint { .. })
-    ));
-    let other = scene.to_builder().normal_load(201.0).build().unwrap();
-    assert!(matches!(
-        other.resume(&checkpoint),
-        Err(Error::InvalidCheckpoint { .. })
-    ));
+    // Each refusal names the first differing option by its scene-file key.
+    let key_of = |other: SceneBuilder| match other.build().unwrap().resume(&checkpoint) {
+        Err(Error::CheckpointSceneMismatch { key, reason }) => {
+            eprintln!("{key}: {reason}");
+            key
+        }
+        other => panic!("not refused with a key: {other:?}"),
+    };
+    let b = scene.to_builder();
+    assert_eq!(key_of(b.clone().seed(2)), "heights.seed");
+    assert_eq!(key_of(b.clone().normal_load(201.0)), "normal_load");
+    assert_eq!(key_of(b.clone().block(0.024, 0.004, 0.020)), "block.lx");
+    assert_eq!(
+        key_of(b.clone().area_law(AreaLaw::Capped)),
+        "springs.area_law"
+    );
+    assert_eq!(
+        key_of(b.clone().drive(Drive::Force(Lateral::Side.into()))),
+        "drive.kind"
+    );
+    assert_eq!(
+        key_of(
+            b.clone().drive(Drive::Force(
+                Lateral::Rod {
+                    height: 7e-3,
+                    half_width: 2e-3
+                }
+                .into()
+            ))
+        ),
+        "drive.height"
+    );
+    let message = b
+        .clone()
+        .normal_load(201.0)
+        .build()
+        .unwrap()
+        .resume(&checkpoint)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("normal_load") && message.contains("200.0") && message.contains("201.0"),
+        "{message}"
+    );
+    // The thread count is not part of the run's identity.
+    let threads = b.solver(SolverOptions::default().parallelism(Parallelism::Threads(2)));
+    assert!(threads.build().unwrap().resume(&checkpoint).is_ok());
     // The checkpoint names its scene: building that resumes.
     let rebuilt = checkpoint.scene().clone().build().unwrap();
     assert!(rebuilt.resume(&checkpoint).is_ok());
@@ -238,6 +275,123 @@ mod json {
             .build()
             .unwrap();
         check_resume(&spectral, &[100], round_trip);
+    }
+
+    #[test]
+    fn a_checkpoint_whose_scene_was_edited_is_refused_naming_the_key() {
+        let scene = Scene::builder()
+            .block(0.020, 0.004, 0.020)
+            .normal_load(200.0)
+            .seed(1)
+            .build()
+            .unwrap();
+        let mut driver = scene.driver().unwrap();
+        for _ in 0..5 {
+            driver.step().unwrap();
+        }
+        let text = driver.checkpoint().to_json().unwrap();
+        for (from, to, key) in [
+            (
+                "\"normal_load\":200.0",
+                "\"normal_load\":210.0",
+                "normal_load",
+            ),
+            (
+                "\"friction_coefficient\":0.5",
+                "\"friction_coefficient\":0.6",
+                "material.friction_coefficient",
+            ),
+            ("\"seed\":1", "\"seed\":3", "heights.seed"),
+            (
+                "\"area_law\":\"paper\"",
+                "\"area_law\":\"capped\"",
+                "springs.area_law",
+            ),
+        ] {
+            // The first occurrence is in the scene (the solver reports repeat F_N).
+            let digest = text.find("\"scene_digest\"").unwrap();
+            assert!(text.find(from).unwrap() < digest, "{from}");
+            let edited = Checkpoint::from_json_str(&text.replacen(from, to, 1)).unwrap();
+            // Resumed on its own (edited) scene, or on the original one: refused.
+            let own = edited.scene().clone().build().unwrap();
+            for target in [&own, &scene] {
+                match target.resume(&edited) {
+                    Err(Error::CheckpointSceneMismatch { key: k, reason }) => {
+                        assert_eq!(k, key, "{reason}");
+                        assert!(reason.contains("edited"), "{reason}");
+                    }
+                    other => panic!("{key}: not refused: {other:?}"),
+                }
+            }
+        }
+        // Unedited, it resumes.
+        let c = Checkpoint::from_json_str(&text).unwrap();
+        assert!(c.scene().clone().build().unwrap().resume(&c).is_ok());
+    }
+
+    /// A fresh directory under the system's temporary directory.
+    fn scratch(name: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("precursors-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[test]
+    fn checkpoint_files_are_written_atomically_and_read_back() {
+        let scene = Scene::builder()
+            .block(0.020, 0.004, 0.020)
+            .normal_load(200.0)
+            .seed(1)
+            .build()
+            .unwrap();
+        let mut driver = scene.driver().unwrap();
+        let dir = scratch("checkpoint-files");
+        let path = dir.join("cp.json");
+        // Written twice (the second replaces the first), read back equal.
+        for _ in 0..2 {
+            for _ in 0..7 {
+                driver.step().unwrap();
+            }
+            let c = driver.checkpoint();
+            c.write_to(&path).unwrap();
+            assert!(Checkpoint::read_from(&path).unwrap() == c);
+            assert_eq!(
+                std::fs::read_to_string(&path).unwrap(),
+                c.to_json().unwrap()
+            );
+        }
+        let names: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, ["cp.json"], "no temporary file is left behind");
+        // A resumed run from the file repeats the rest of the run.
+        let resumed = scene
+            .resume(&Checkpoint::read_from(&path).unwrap())
+            .unwrap();
+        let (rest, _) = finish(resumed);
+        let (expected, _) = finish(driver);
+        assert!(rest == expected);
+        // Typed errors carrying the path.
+        let missing = dir.join("missing.json");
+        match Checkpoint::read_from(&missing) {
+            Err(Error::Io { path, .. }) => assert_eq!(path, missing.display().to_string()),
+            other => panic!("{other:?}"),
+        }
+        let cut = dir.join("cut.json");
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::write(&cut, &text[..text.len() / 3]).unwrap();
+        match Checkpoint::read_from(&cut) {
+            Err(Error::CheckpointFile { path, .. }) => assert_eq!(path, cut.display().to_string()),
+            other => panic!("{other:?}"),
+        }
+        let nowhere = dir.join("no-such-dir").join("cp.json");
+        assert!(matches!(
+            scene.driver().unwrap().checkpoint().write_to(&nowhere),
+            Err(Error::Io { .. })
+        ));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
@@ -273,5 +427,85 @@ mod json {
             scene.resume(&c),
             Err(Error::InvalidCheckpoint { .. })
         ));
+    }
+}
+
+/// The tables of `examples/run_scene.rs` on resume (`examples/support/table.rs`).
+mod tables {
+    use crate::table::{open, rows_to_keep};
+    use std::io::Write;
+
+    const HEADER: &str = "index,kind,force_N";
+
+    #[test]
+    fn rows_after_the_checkpoint_and_a_cut_last_row_are_dropped() {
+        let rows = "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n3,rupture,1.5\n";
+        // Rows up to the checkpoint's event are kept, later ones dropped.
+        assert_eq!(
+            rows_to_keep(rows, HEADER, 2).unwrap(),
+            "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n"
+        );
+        assert_eq!(rows_to_keep(rows, HEADER, 9).unwrap(), rows);
+        // A crash cut the last row: within its index ("12" of "1234"), within a field,
+        // or after the last field but before the newline. Each is dropped.
+        let kept = "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n";
+        for cut in ["2", "2,load_r", "3,rupture,1.5", "3,rupture"] {
+            let damaged = format!("{kept}{cut}");
+            assert_eq!(
+                rows_to_keep(&damaged, HEADER, 1000).unwrap(),
+                kept,
+                "cut {cut:?}"
+            );
+        }
+        // A complete last line with too few fields (a crash between two writes of a row).
+        assert_eq!(
+            rows_to_keep(&format!("{kept}3,rupture\n"), HEADER, 1000).unwrap(),
+            kept
+        );
+        // The same damage before the last row, another header, a bad index: refused.
+        assert!(rows_to_keep("index,kind,force_N\n1,stable\n2,stable,1.0\n", HEADER, 9).is_err());
+        assert!(rows_to_keep("event,force_N\n1,0.0\n", HEADER, 9).is_err());
+        assert!(rows_to_keep(
+            "index,kind,force_N\nx,stable,0.0\n2,stable,1.0\n",
+            HEADER,
+            9
+        )
+        .is_err());
+        // An empty file starts with the header.
+        assert_eq!(rows_to_keep("", HEADER, 3).unwrap(), "index,kind,force_N\n");
+    }
+
+    #[test]
+    fn a_resumed_table_continues_where_the_checkpoint_was() {
+        let dir = std::env::temp_dir().join(format!("precursors-{}-tables", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("events.csv");
+        // A run that crashed while writing row 4, after a checkpoint at event 2.
+        std::fs::write(
+            &path,
+            "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n3,rupture,1.5\n4,st",
+        )
+        .unwrap();
+        let mut table = open(&path, HEADER, Some(2)).unwrap();
+        writeln!(table, "3,rupture,1.5").unwrap();
+        drop(table);
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n3,rupture,1.5\n"
+        );
+        // Resumed into an empty directory: the header only; a new run: the header only.
+        std::fs::remove_file(&path).unwrap();
+        drop(open(&path, HEADER, Some(2)).unwrap());
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            "index,kind,force_N\n"
+        );
+        std::fs::write(&path, "junk").unwrap();
+        drop(open(&path, HEADER, None).unwrap());
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            "index,kind,force_N\n"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -2,7 +2,7 @@
 //! closed form), validation, the spring laws and the real contact area.
 
 use precursors::interface::{
-    HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw,
+    AreaLaw, HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw,
 };
 use precursors::{Block, Error, Grid};
 
@@ -170,4 +170,44 @@ fn spring_laws_and_real_contact_area() {
     ));
     iface.heal();
     assert_eq!(iface.broken_count(), 0);
+}
+
+#[test]
+fn capped_area_law_caps_each_site_at_its_cell() {
+    // References: the paper's formula A = ΔA/(e-1) (exp(-(u-u0)/u0) - 1) written out here,
+    // and its cap min(A, ΔA).
+    let g = grid(4, 1);
+    let u0 = vec![1e-6, 2e-6, 4e-6, 1e-12];
+    let heights = Heights::from_values(&g, u0.clone()).unwrap();
+    let paper = SpringLaw::new(2e12, 3e8).unwrap();
+    assert_eq!(
+        paper.area_law,
+        AreaLaw::Paper,
+        "the paper's law is the default"
+    );
+    assert_eq!(SpringLaw::default().area_law, AreaLaw::Paper);
+    let capped = paper.with_area_law(AreaLaw::Capped);
+    let p = Interface::new(g, heights.clone(), paper).unwrap();
+    let c = Interface::new(g, heights, capped).unwrap();
+    let e = std::f64::consts::E;
+    let da = g.cell_area();
+    // Half-way up the asperity, the mean plane, a penetration of u0, a huge one.
+    let uz = vec![0.5e-6, 0.0, -4e-6, -1e-9];
+    let formula = |i: usize| da / (e - 1.0) * ((-(uz[i] - u0[i]) / u0[i]).exp() - 1.0);
+    let a = c.real_contact_area(&uz).unwrap();
+    assert!((a[0] - formula(0)).abs() <= 1e-15 * da && a[0] < da);
+    assert!((a[1] - da).abs() <= 1e-15 * da);
+    assert!(
+        formula(2) > 2.0 * da,
+        "the paper's law exceeds the cell here"
+    );
+    assert_eq!(a[2], da);
+    assert_eq!(a[3], da, "an overflow is capped, not an error");
+    let b = p.real_contact_area(&uz[..3].iter().chain([&0.0]).copied().collect::<Vec<_>>());
+    let b = b.unwrap();
+    assert!((b[2] - formula(2)).abs() <= 1e-12 * formula(2));
+    assert!(matches!(
+        p.real_contact_area(&uz),
+        Err(Error::NonFinite { index: 3, .. })
+    ));
 }

@@ -20,3 +20,6 @@ mod properties;
 mod scene_file;
 mod solver;
 mod stability;
+/// The crash-safe CSV tables of `examples/run_scene.rs`.
+#[path = "../examples/support/table.rs"]
+mod table;

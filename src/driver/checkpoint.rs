@@ -16,12 +16,54 @@ use crate::solver::{NormalEquilibrium, SolverState, TangentialResponse};
 use crate::Event;
 
 /// Version of the checkpoint layout; a checkpoint of another version is refused.
+/// Version 2: the scene digest; the dense backend's one factor.
 const FORMAT: u32 = 2;
+
+/// FNV-1a (64 bits) of a text: a digest that is the same on every platform and build.
+fn fnv1a(text: &str) -> u64 {
+    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// The digest of a scene: each option's key path and a hash of its exact value.
+fn digest(scene: &SceneBuilder) -> Vec<(String, u64)> {
+    scene
+        .run_keys()
+        .into_iter()
+        .map(|(key, value)| (key, fnv1a(&value)))
+        .collect()
+}
+
+/// The first key whose hash differs between two digests (or that only one holds).
+fn first_difference(a: &[(String, u64)], b: &[(String, u64)]) -> Option<String> {
+    a.iter()
+        .find(|(key, hash)| !b.iter().any(|(k, h)| k == key && h == hash))
+        .or_else(|| b.iter().find(|(key, _)| !a.iter().any(|(k, _)| k == key)))
+        .map(|(key, _)| key.clone())
+}
+
+/// The value of `key` in `scene`, shortened for a message.
+fn value_of(scene: &SceneBuilder, key: &str) -> String {
+    match scene.run_keys().into_iter().find(|(k, _)| k == key) {
+        None => "no such key".into(),
+        Some((_, v)) if v.chars().count() > 48 => {
+            format!("{}...", v.chars().take(45).collect::<String>())
+        }
+        Some((_, v)) => v,
+    }
+}
 
 /// A snapshot of a [`Driver`] between two events ([`Driver::checkpoint`]), resumed by
 /// [`Scene::resume`]. With the `serde` feature it serialises in any serde format
-/// (`Checkpoint::to_json` for JSON); floats must round-trip exactly (they do in JSON
-/// through this crate, which enables `serde_json`'s `float_roundtrip`).
+/// (`Checkpoint::to_json` for JSON, `Checkpoint::write_to` and `Checkpoint::read_from`
+/// for files); floats must round-trip exactly (they do in JSON through this crate, which
+/// enables `serde_json`'s `float_roundtrip`).
+///
+/// A checkpoint holds its scene and a digest of it (a hash of every option by its
+/// scene-file key): [`Scene::resume`] refuses, naming the first differing key, a scene
+/// that differs from the checkpoint's and a checkpoint whose stored scene was edited
+/// after it was taken ([`Error::CheckpointSceneMismatch`]).
 ///
 /// ```
 /// use precursors::{Event, Scene};
@@ -41,6 +83,7 @@ const FORMAT: u32 = 2;
 pub struct Checkpoint {
     format: u32,
     scene: SceneBuilder,
+    scene_digest: Vec<(String, u64)>,
     states: Vec<SiteState>,
     normal: Option<NormalEquilibrium>,
     response: Option<TangentialResponse>,
@@ -79,6 +122,78 @@ impl Checkpoint {
             reason: format!("not a checkpoint: {e}"),
         })
     }
+
+    /// Writes the checkpoint as JSON to `path` atomically (feature `serde`): to a
+    /// temporary file in the same directory, synced to disk, then renamed over `path`
+    /// (and the directory synced on Unix). A crash leaves the old file or the new one,
+    /// never half of one.
+    ///
+    /// # Errors
+    /// [`Error::Io`] with the path of the file that could not be written, synced or
+    /// renamed (the temporary file is removed); [`Error::InvalidCheckpoint`] when the
+    /// checkpoint cannot be written as JSON.
+    #[cfg(feature = "serde")]
+    pub fn write_to(&self, path: impl AsRef<std::path::Path>) -> Result<()> {
+        use std::io::Write;
+        let path = path.as_ref();
+        let io = |p: &std::path::Path, e: std::io::Error| Error::Io {
+            path: p.display().to_string(),
+            reason: e.to_string(),
+        };
+        let text = self.to_json()?;
+        let name = path.file_name().ok_or_else(|| Error::Io {
+            path: path.display().to_string(),
+            reason: "not a file name".into(),
+        })?;
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => std::path::Path::new("."),
+        };
+        let mut tmp_name = std::ffi::OsString::from(".");
+        tmp_name.push(name);
+        // Unique per process and call: concurrent writers never share a temporary file.
+        static CALLS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        tmp_name.push(format!(".tmp{}-{call}", std::process::id()));
+        let tmp = dir.join(tmp_name);
+        let written = (|| {
+            let mut file = std::fs::File::create(&tmp)?;
+            file.write_all(text.as_bytes())?;
+            file.sync_all()
+        })();
+        if let Err(e) = written {
+            let _ = std::fs::remove_file(&tmp);
+            return Err(io(&tmp, e));
+        }
+        if let Err(e) = std::fs::rename(&tmp, path) {
+            let _ = std::fs::remove_file(&tmp);
+            return Err(io(path, e));
+        }
+        #[cfg(unix)]
+        std::fs::File::open(dir)
+            .and_then(|d| d.sync_all())
+            .map_err(|e| io(dir, e))?;
+        Ok(())
+    }
+
+    /// Reads a checkpoint file written by [`Checkpoint::write_to`] (or holding
+    /// [`Checkpoint::to_json`]'s text; feature `serde`).
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be read; [`Error::CheckpointFile`], with the
+    /// path, when it holds no checkpoint (not JSON, cut short, another layout).
+    #[cfg(feature = "serde")]
+    pub fn read_from(path: impl AsRef<std::path::Path>) -> Result<Checkpoint> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
+            path: path.display().to_string(),
+            reason: e.to_string(),
+        })?;
+        serde_json::from_str(&text).map_err(|e| Error::CheckpointFile {
+            path: path.display().to_string(),
+            reason: e.to_string(),
+        })
+    }
 }
 
 impl Driver {
@@ -88,6 +203,7 @@ impl Driver {
         Checkpoint {
             format: FORMAT,
             scene: self.scene.to_builder(),
+            scene_digest: digest(&self.scene.to_builder()),
             states: self.interface.states().to_vec(),
             normal: self.normal.clone(),
             response: self.response.clone(),
@@ -108,7 +224,12 @@ impl Scene {
     /// thread count may differ, results do not depend on it; so may the probes, which
     /// observe: the resumed driver has this scene's, add others with
     /// [`Driver::add_probes`]).
-    /// Errors: [`Error::InvalidCheckpoint`] when it was not, or when it is inconsistent.
+    ///
+    /// # Errors
+    /// [`Error::CheckpointSceneMismatch`], naming the first differing option by its
+    /// scene-file key, when the checkpoint was taken on another scene or its stored
+    /// scene was edited since (the digest differs); [`Error::InvalidCheckpoint`] when it
+    /// is of another layout version or inconsistent.
     pub fn resume(&self, checkpoint: &Checkpoint) -> Result<Driver> {
         let bad = |reason: String| Err(Error::InvalidCheckpoint { reason });
         if checkpoint.format != FORMAT {
@@ -117,8 +238,26 @@ impl Scene {
                 checkpoint.format
             ));
         }
-        if !checkpoint.scene.same_run(&self.to_builder()) {
-            return bad("it was taken on another scene (the builders differ)".into());
+        if let Some(key) = first_difference(&checkpoint.scene_digest, &digest(&checkpoint.scene)) {
+            return Err(Error::CheckpointSceneMismatch {
+                reason: format!(
+                    "the scene stored in the checkpoint was edited after the checkpoint was \
+                     taken (its digest differs; it now holds {})",
+                    value_of(&checkpoint.scene, &key)
+                ),
+                key,
+            });
+        }
+        let mine = self.to_builder();
+        if let Some(key) = checkpoint.scene.run_difference(&mine) {
+            return Err(Error::CheckpointSceneMismatch {
+                reason: format!(
+                    "the checkpoint's scene has {}, the scene resumed on has {}",
+                    value_of(&checkpoint.scene, &key),
+                    value_of(&mine, &key)
+                ),
+                key,
+            });
         }
         let mut driver = self.driver()?;
         let n = self.grid().len();

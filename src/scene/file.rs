@@ -8,7 +8,7 @@
 use super::{Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder};
 use crate::error::{Error, Result};
 use crate::geometry::Point;
-use crate::interface::{HeightDistribution, Material, SpringLaw};
+use crate::interface::{AreaLaw, HeightDistribution, Material, SpringLaw};
 use crate::probe::ProbeSpec;
 use crate::solver::{Backend, Parallelism, SolverOptions};
 use serde::{Deserialize, Serialize};
@@ -65,6 +65,7 @@ struct MaterialSpec {
 struct SpringsSpec {
     c_x: f64,
     c_z: f64,
+    area_law: AreaLaw,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -260,6 +261,7 @@ impl From<&SceneBuilder> for SceneFile {
             springs: SpringsSpec {
                 c_x: b.law.c_x,
                 c_z: b.law.c_z,
+                area_law: b.law.area_law,
             },
             heights,
             normal_load: b.normal_load,
@@ -291,6 +293,7 @@ impl SceneFile {
         let law = SpringLaw {
             c_x: self.springs.c_x,
             c_z: self.springs.c_z,
+            area_law: self.springs.area_law,
         };
         let heights = match self.heights {
             HeightsSpec::Gaussian {
