@@ -406,16 +406,14 @@ impl Driver {
     }
 
     fn normal(&self) -> Result<&NormalEquilibrium> {
-        self.normal.as_ref().ok_or(Error::EmptyContact {
-            available: 0,
-            reason: "the normal equilibrium has not been solved yet (call step first)",
+        self.normal.as_ref().ok_or(Error::NotSolved {
+            what: "the normal equilibrium",
         })
     }
 
     fn response(&self) -> Result<&TangentialResponse> {
-        self.response.as_ref().ok_or(Error::EmptyContact {
-            available: 0,
-            reason: "the tangential equilibrium has not been solved yet (call step first)",
+        self.response.as_ref().ok_or(Error::NotSolved {
+            what: "the tangential equilibrium",
         })
     }
 
@@ -452,11 +450,18 @@ impl Driver {
         self.solver.backend()
     }
 
+    /// The threads a solve actually uses ([`EquilibriumSolver::threads`]: 1 on the
+    /// dense backend).
+    pub fn threads(&self) -> usize {
+        self.solver.threads()
+    }
+
     /// Runs the next solves with `parallelism`; the events do not change (the parts of
     /// the grid are fixed by the grid).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for `Parallelism::Threads(0)`.
+    /// As [`EquilibriumSolver::set_parallelism`]: [`Error::InvalidCount`] for
+    /// `Parallelism::Threads(0)`, [`Error::DenseThreads`] with an explicit dense backend.
     pub fn set_parallelism(&mut self, parallelism: crate::solver::Parallelism) -> Result<()> {
         self.solver.set_parallelism(parallelism)
     }
@@ -534,14 +539,13 @@ impl Driver {
     /// ([`crate::SceneBuilder::probes`]) in the current state, with every load term. Call
     /// it at the states you want: after the [`Event::LoadRaised`] that precedes the first
     /// [`Event::Rupture`] for "just before the first rupture", at each [`Event::Stable`]
-    /// for the quasi-static evolution. Errors: [`Error::InvalidParameter`] when the scene
-    /// has no probes.
+    /// for the quasi-static evolution.
+    ///
+    /// # Errors
+    /// [`Error::NoProbes`] when the scene has no probes; [`Error::NotSolved`] before the
+    /// first equilibrium (call [`Driver::step`] first).
     pub fn stresses(&self) -> Result<Stresses> {
-        let probe = self.probe.as_ref().ok_or(Error::InvalidParameter {
-            name: "probes",
-            value: 0.0,
-            reason: "the scene was built without stress probes (SceneBuilder::probes)",
-        })?;
+        let probe = self.probe.as_ref().ok_or(Error::NoProbes)?;
         let shear = self.shear_traction()?;
         let force = self.force();
         let input = ProbeInput::new(&shear, self.normal_traction()?)

@@ -126,13 +126,8 @@ impl Grid {
         if ny == 0 {
             return Err(Error::EmptyGrid { axis: "y" });
         }
-        if nx.checked_mul(ny).is_none_or(|n| n > MAX_CELLS) {
-            return Err(Error::InvalidParameter {
-                name: "Nx Ny",
-                value: nx as f64 * ny as f64,
-                reason: "more cells than a vector of one f64 per cell can hold",
-            });
-        }
+        // More cells than a vector of one f64 per cell can hold.
+        crate::green::check_cells(nx, ny, MAX_CELLS)?;
         let grid = Self { block, nx, ny };
         // lx / nx rounds to zero when nx is huge against a tiny block.
         check_length("dx", grid.dx())?;

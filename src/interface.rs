@@ -355,11 +355,7 @@ impl Interface {
         if let Some(i) = (0..states.len())
             .find(|&i| self.states[i] == SiteState::Broken && states[i] != SiteState::Broken)
         {
-            return Err(Error::InvalidParameter {
-                name: "states (a broken site)",
-                value: i as f64,
-                reason: "a broken site stays broken until the interface is healed",
-            });
+            return Err(Error::BrokenSite { index: i });
         }
         self.states.copy_from_slice(states);
         Ok(())

@@ -52,6 +52,7 @@ pub use error::{Error, Result};
 pub struct ReadmeDoctests;
 pub use driver::{Checkpoint, Driver, Event, Load, Site, SolveStats};
 pub use geometry::{Block, Grid, Point};
+pub use green::GridCost;
 pub use interface::{HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw};
 pub use scene::{Drive, ForceLoad, HeightSource, Lateral, Scene, SceneBuilder};
 pub use solver::{

@@ -122,10 +122,8 @@ impl HeightSource {
     pub fn from_file(path: impl AsRef<std::path::Path>) -> Result<HeightSource> {
         let path = path.as_ref();
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-            path: name.clone(),
-            reason: e.to_string(),
-        })?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| Error::io("reading heights file", path, e))?;
         let mut values = Vec::new();
         for (number, line) in text.lines().enumerate() {
             let line = line.trim();
@@ -190,6 +188,7 @@ pub struct SceneBuilder {
     solver: SolverOptions,
     plan_tolerance: f64,
     probes: ProbeSpec,
+    max_cells: usize,
 }
 
 impl Default for SceneBuilder {
@@ -205,6 +204,7 @@ impl Default for SceneBuilder {
             solver: SolverOptions::default(),
             plan_tolerance: 1e-6,
             probes: ProbeSpec::default(),
+            max_cells: crate::green::DEFAULT_MAX_CELLS,
         }
     }
 }
@@ -273,11 +273,23 @@ impl SceneBuilder {
         self
     }
 
+    /// The most cells [`SceneBuilder::build`] accepts (default
+    /// [`DEFAULT_MAX_CELLS`](crate::green::DEFAULT_MAX_CELLS) = `1e6`; scene-file key
+    /// `max_cells`): a larger grid is refused with [`Error::GridTooLarge`] and its
+    /// estimated memory and time ([`crate::GridCost`]) before anything is allocated.
+    /// Raise it for a grid whose cost you accept; it does not change results.
+    pub fn max_cells(mut self, max_cells: usize) -> Self {
+        self.max_cells = max_cells;
+        self
+    }
+
     /// Whether `other` describes the same run: every option equal but the solver's
-    /// parallelism, which does not change results (checkpoints resume across it).
+    /// parallelism and the cell limit, which do not change results (checkpoints resume
+    /// across them).
     pub(crate) fn same_run(&self, other: &SceneBuilder) -> bool {
         let mut mine = self.clone();
         mine.solver.parallelism = other.solver.parallelism;
+        mine.max_cells = other.max_cells;
         mine == *other
     }
 
@@ -328,8 +340,10 @@ impl SceneBuilder {
             Cells::Size(dx, dy) => Grid::from_cell_size(block, dx, dy)?,
             Cells::Count(nx, ny) => Grid::new(block, nx, ny)?,
         };
+        crate::green::check_cells(grid.nx(), grid.ny(), self.max_cells)?;
         self.material.validate()?;
         self.law.validate()?;
+        self.solver.validate()?;
         if !(self.normal_load.is_finite() && self.normal_load > 0.0) {
             return Err(Error::InvalidParameter {
                 name: "normal_load",
@@ -367,7 +381,7 @@ impl SceneBuilder {
                 Some(lateral)
             }
         };
-        let plan = planner.plan(grid, self.plan_tolerance)?;
+        let plan = planner.plan_with_max_cells(grid, self.plan_tolerance, self.max_cells)?;
         // Displacement per newton of the lateral load, cell-averaged (m/N): only built
         // when a lateral load exists.
         let rod = match lateral {

@@ -94,9 +94,9 @@ impl SeriesOptions {
     fn check(&self) -> Result<()> {
         check_tolerance(self.tolerance)?;
         if self.max_terms == 0 {
-            return Err(Error::InvalidParameter {
+            return Err(Error::InvalidCount {
                 name: "max_terms",
-                value: 0.0,
+                value: 0,
                 reason: "a series needs at least one term",
             });
         }
@@ -210,9 +210,9 @@ impl GreenFunction {
                     z: a[2],
                 });
             }
-            return Err(Error::InvalidParameter {
-                name: "axis",
-                value: axis as f64,
+            return Err(Error::InvalidChoice {
+                name: "summation axis",
+                value: ["x", "y", "z"][axis],
                 reason: "the target has the source's coordinate along the summed axis, \
                          where that representation does not converge; use SummationAxis::Auto",
             });

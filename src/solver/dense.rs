@@ -211,7 +211,8 @@ impl FactorCache {
             self.order.clear();
             return Err(Error::Factorization {
                 n,
-                reason: format!("{e:?}"),
+                reason: format!("faer reported {e}"),
+                source: Some(Box::new(e)),
             });
         }
         if let Some(a) = bad_pivot {
@@ -222,6 +223,7 @@ impl FactorCache {
                 reason: format!(
                     "pivot {a} is {pivot:e}: the matrix is not numerically positive definite"
                 ),
+                source: None,
             });
         }
         Ok(())
