@@ -197,6 +197,11 @@ pub struct SolveStats {
 
 impl Scene {
     /// A driver at zero shear (the first [`Driver::step`] solves the normal equilibrium).
+    ///
+    /// # Errors
+    /// Those of
+    /// [`EquilibriumSolverBuilder::build`](crate::solver::EquilibriumSolverBuilder::build)
+    /// ([`Error::TooLargeForDense`], [`Error::DenseThreads`], ...).
     pub fn driver(&self) -> Result<Driver> {
         let solver = EquilibriumSolver::builder(self.plan().clone())
             .material(self.material())
@@ -231,6 +236,11 @@ impl Scene {
 impl Driver {
     /// The next event, `Ok(None)` after [`Event::GlobalSlip`]. After an error the driver
     /// stays failed (every later call returns `Ok(None)`).
+    ///
+    /// # Errors
+    /// The first failure of a solve ([`Error::SolverNotConverged`],
+    /// [`Error::Factorization`], [`Error::EmptyContact`], [`Error::NonFinite`],
+    /// [`Error::ThreadPool`], ...); the driver then stays failed.
     pub fn step(&mut self) -> Result<Option<Event>> {
         loop {
             if let Some(event) = self.pending.pop_front() {
@@ -250,6 +260,9 @@ impl Driver {
 
     /// Runs to global slip (or the first error), calling `observe` after every event with
     /// the driver in the state right after it.
+    ///
+    /// # Errors
+    /// As [`Driver::step`].
     pub fn run(&mut self, mut observe: impl FnMut(&Event, &Driver)) -> Result<()> {
         while let Some(event) = self.step()? {
             observe(&event, self);
@@ -498,22 +511,34 @@ impl Driver {
     }
 
     /// Normal traction `φ_z` per cell (Pa).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
     pub fn normal_traction(&self) -> Result<&[f64]> {
         Ok(&self.normal()?.traction)
     }
 
     /// Normal displacement `u_z` of the bottom face per cell (m).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
     pub fn normal_displacement(&self) -> Result<&[f64]> {
         Ok(&self.normal()?.displacement)
     }
 
     /// Shear traction `φ_x` per cell (Pa; negative where the springs resist `+x`).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
     pub fn shear_traction(&self) -> Result<Vec<f64>> {
         let f = self.force();
         Ok(self.response()?.traction.iter().map(|g| f * g).collect())
     }
 
     /// Shear displacement `u_x` of the bottom face per cell (m).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
     pub fn shear_displacement(&self) -> Result<Vec<f64>> {
         let f = self.force();
         Ok(self
@@ -526,6 +551,9 @@ impl Driver {
 
     /// Mean shear displacement `⟨u_x⟩` of the block (m) (plus the top load's constant
     /// when a top shear acts).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
     pub fn mean_shear_displacement(&self) -> Result<f64> {
         Ok(self.force() * self.response()?.offset)
     }
@@ -555,17 +583,27 @@ impl Driver {
     }
 
     /// Real contact area per cell (m²).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`]; [`Error::NonFinite`] on
+    /// overflow.
     pub fn real_contact_area(&self) -> Result<Vec<f64>> {
         self.interface
             .real_contact_area(&self.normal()?.displacement)
     }
 
     /// Total real contact area (m²).
+    ///
+    /// # Errors
+    /// As [`Driver::real_contact_area`].
     pub fn total_contact_area(&self) -> Result<f64> {
         Ok(self.real_contact_area()?.iter().sum())
     }
 
     /// Real contact area per column `ix` (summed over `y`, m²).
+    ///
+    /// # Errors
+    /// As [`Driver::real_contact_area`].
     pub fn column_contact_area(&self) -> Result<Vec<f64>> {
         let area = self.real_contact_area()?;
         let nx = self.grid.nx();
@@ -584,6 +622,9 @@ impl Driver {
     /// Precursor length `ℓ` (m): the extent, from the trailing edge `x = 0`, of the run of
     /// columns whose real contact area is below its value at zero shear (docs/model.md
     /// section 5; paper Fig. 2b). A multiple of `Δx`.
+    ///
+    /// # Errors
+    /// As [`Driver::real_contact_area`].
     pub fn precursor_length(&self) -> Result<f64> {
         let columns = self.column_contact_area()?;
         let run = columns

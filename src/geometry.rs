@@ -13,6 +13,10 @@ pub struct Block {
 impl Block {
     /// A block of sides `lx`, `ly`, `lz` (m); each must be finite and > 0, and so must
     /// the volume `Lx Ly Lz` (the Green function divides by it).
+    ///
+    /// # Errors
+    /// [`Error::InvalidLength`] for a side that is not finite and `> 0`;
+    /// [`Error::InvalidParameter`] when the volume overflows or underflows.
     pub fn new(lx: f64, ly: f64, lz: f64) -> Result<Self> {
         let block = Self {
             lx: check_length("Lx", lx)?,
@@ -119,6 +123,11 @@ const MAX_AXIS_CELLS: f64 = 9_007_199_254_740_992.0;
 impl Grid {
     /// `nx x ny` cells on the bottom face of `block`; both counts must be >= 1, the cell
     /// area `ΔA` must not underflow to zero, and `Nx Ny` f64 values must fit in memory.
+    ///
+    /// # Errors
+    /// [`Error::EmptyGrid`] for a zero count; [`Error::GridTooLarge`] when `Nx Ny`
+    /// overflows the address space; [`Error::InvalidLength`] when `Δx` or `Δy` rounds to
+    /// zero; [`Error::InvalidParameter`] when `ΔA` underflows.
     pub fn new(block: Block, nx: usize, ny: usize) -> Result<Self> {
         if nx == 0 {
             return Err(Error::EmptyGrid { axis: "x" });
@@ -145,6 +154,11 @@ impl Grid {
 
     /// Cells of size `dx x dy` (m), which must divide `Lx` and `Ly` into whole numbers
     /// (to 1e-9 relative) of at most `2^53` cells each, then as [`Grid::new`].
+    ///
+    /// # Errors
+    /// [`Error::InvalidLength`] for a size that is not finite and `> 0`;
+    /// [`Error::InvalidParameter`] when `L / cell` exceeds `2^53`;
+    /// [`Error::GridDoesNotDivide`]; those of [`Grid::new`].
     pub fn from_cell_size(block: Block, dx: f64, dy: f64) -> Result<Self> {
         let count = |axis, length: f64, cell: f64| -> Result<usize> {
             check_length(if axis == "x" { "dx" } else { "dy" }, cell)?;

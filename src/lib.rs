@@ -32,6 +32,7 @@
 //! # Ok::<(), precursors::Error>(())
 //! ```
 #![deny(missing_docs)]
+#![warn(clippy::missing_errors_doc)]
 #![forbid(unsafe_code)]
 
 pub mod calibration;

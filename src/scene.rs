@@ -119,6 +119,10 @@ impl HeightSource {
     /// `i = iy·Nx + ix`; blank lines and lines starting with `#` are skipped. Each value
     /// must be finite and `> 0`; the count is checked against the grid at
     /// [`SceneBuilder::build`].
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be read (with its path); [`Error::HeightsFile`]
+    /// for a line that is not a finite height `> 0`, or no height at all.
     pub fn from_file(path: impl AsRef<std::path::Path>) -> Result<HeightSource> {
         let path = path.as_ref();
         let name = path.display().to_string();

@@ -65,6 +65,10 @@ impl Checkpoint {
     }
 
     /// The checkpoint as compact JSON (feature `serde`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidCheckpoint`] if serialisation fails (it does not for a checkpoint
+    /// taken by [`Driver::checkpoint`]).
     #[cfg(feature = "serde")]
     pub fn to_json(&self) -> Result<String> {
         serde_json::to_string(self).map_err(|e| Error::InvalidCheckpoint {
@@ -73,6 +77,9 @@ impl Checkpoint {
     }
 
     /// Reads a checkpoint written by [`Checkpoint::to_json`] (feature `serde`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidCheckpoint`] when `text` is not a checkpoint.
     #[cfg(feature = "serde")]
     pub fn from_json_str(text: &str) -> Result<Checkpoint> {
         serde_json::from_str(text).map_err(|e| Error::InvalidCheckpoint {
@@ -107,6 +114,10 @@ impl Scene {
     /// (same builder: block, grid, material, springs, heights, loads, solver options; the
     /// thread count may differ, results do not depend on it).
     /// Errors: [`Error::InvalidCheckpoint`] when it was not, or when it is inconsistent.
+    ///
+    /// # Errors
+    /// [`Error::InvalidCheckpoint`] when the checkpoint was not taken on this scene or is
+    /// inconsistent; those of [`Scene::driver`].
     pub fn resume(&self, checkpoint: &Checkpoint) -> Result<Driver> {
         let bad = |reason: String| Err(Error::InvalidCheckpoint { reason });
         if checkpoint.format != FORMAT {

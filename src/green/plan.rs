@@ -212,6 +212,10 @@ impl InfluencePlan {
     }
 
     /// `out = Ĝ v` (m⁻¹ times the units of `v`), matrix-free in `O(N log N)`.
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] when `v` or `out` does not hold one value per cell;
+    /// [`Error::NonFinite`] for a NaN or infinite input.
     pub fn apply(&self, v: &[f64], out: &mut [f64]) -> Result<()> {
         let n = self.inner.grid.len();
         check_slice("v", v, n)?;
@@ -269,6 +273,9 @@ impl InfluencePlan {
     /// The dense matrix `Ĝ` (m⁻¹), row-major `N x N`, assembled from the eigenvalue table
     /// by explicit cosine sums (independent of the DCT path). Refused above
     /// [`DENSE_LIMIT`] cells.
+    ///
+    /// # Errors
+    /// [`Error::TooLargeForDense`] above [`DENSE_LIMIT`] cells.
     pub fn dense(&self) -> Result<Vec<f64>> {
         let n = self.inner.grid.len();
         if n > DENSE_LIMIT {
@@ -315,6 +322,10 @@ impl InfluencePlan {
 
     /// The transfer of bottom tractions to the plane at height `z` (m), with the alias
     /// sums converged to absolute tolerance `tol` (the factors are at most 1).
+    ///
+    /// # Errors
+    /// [`Error::InvalidTolerance`],
+    /// [`Error::OutsideBlock`] for `z` outside `[0, Lz]`, [`Error::NotConverged`].
     pub fn plane_transfer(&self, z: f64, tol: f64) -> Result<PlaneTransfer> {
         PlaneTransfer::new(self, z, tol)
     }

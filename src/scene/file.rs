@@ -380,6 +380,10 @@ impl SceneBuilder {
     /// Reads a scene from JSON text (`docs/scene-format.md`; feature `serde`). A heights
     /// file named in it is read relative to the current directory. Nothing is validated
     /// beyond the format until [`SceneBuilder::build`].
+    ///
+    /// # Errors
+    /// [`Error::SceneFile`] for invalid JSON or a key outside the format; those of
+    /// [`HeightSource::from_file`] for a heights file.
     pub fn from_json_str(text: &str) -> Result<SceneBuilder> {
         let file: SceneFile = serde_json::from_str(text).map_err(|e| json_error(None, e))?;
         file.into_builder(Path::new("."))
@@ -387,6 +391,11 @@ impl SceneBuilder {
 
     /// Reads a scene file (`docs/scene-format.md`; feature `serde`). A heights file named
     /// in it is read relative to the scene file's directory.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be read; [`Error::SceneFile`] (with the path,
+    /// line and column) for invalid JSON or a key outside the format; those of
+    /// [`HeightSource::from_file`] for a heights file.
     pub fn from_json_file(path: impl AsRef<Path>) -> Result<SceneBuilder> {
         let path = path.as_ref();
         let text =
@@ -398,6 +407,9 @@ impl SceneBuilder {
     /// The scene as JSON (`docs/scene-format.md`; feature `serde`), every key written.
     /// Heights read from a file are written as values. Reading it back gives an equal
     /// builder: floats round-trip exactly.
+    ///
+    /// # Errors
+    /// [`Error::SceneFile`] if serialisation fails (it does not for a builder's values).
     pub fn to_json(&self) -> Result<String> {
         serde_json::to_string_pretty(&SceneFile::from(self)).map_err(|e| json_error(None, e))
     }
