@@ -26,7 +26,7 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 #[non_exhaustive]
 pub enum Error {
     /// A length (block size, cell size, rod half-width, ...) is not finite and positive.
-    #[error("{name} = {value} m is invalid: it must be finite and > 0")]
+    #[error("{name} = {} m is invalid: it must be finite and > 0", Num(*value))]
     InvalidLength {
         /// Which length.
         name: &'static str,
@@ -41,7 +41,10 @@ pub enum Error {
     },
     /// The requested cell size does not divide the face into a whole number of cells.
     #[error(
-        "cell size {cell} m does not divide L{axis} = {length} m (ratio {ratio}, not an integer)"
+        "cell size {} m does not divide L{axis} = {} m (ratio {}, not an integer)",
+        Num(*cell),
+        Num(*length),
+        Num(*ratio)
     )]
     GridDoesNotDivide {
         /// `"x"` or `"y"`.
@@ -54,7 +57,7 @@ pub enum Error {
         ratio: f64,
     },
     /// A coordinate lies outside the block.
-    #[error("{name} = {value} m lies outside the block, which spans [0, {max}] m")]
+    #[error("{name} = {} m lies outside the block, which spans [0, {}] m", Num(*value), Num(*max))]
     OutsideBlock {
         /// Which coordinate (`"x"`, `"xi"`, `"z"`, ...).
         name: &'static str,
@@ -65,7 +68,10 @@ pub enum Error {
     },
     /// The rod band `[h - Δh, h + Δh]` is not inside the trailing face `[0, Lz]`.
     #[error(
-        "rod band [h - dh, h + dh] = [{low}, {high}] m is not inside the trailing face [0, {lz}] m"
+        "rod band [h - dh, h + dh] = [{}, {}] m is not inside the trailing face [0, {}] m",
+        Num(*low),
+        Num(*high),
+        Num(*lz)
     )]
     RodBandOutsideFace {
         /// `h - Δh` (m).
@@ -76,14 +82,17 @@ pub enum Error {
         lz: f64,
     },
     /// A tolerance is not finite and positive.
-    #[error("tolerance {value} is invalid: it must be finite and > 0")]
+    #[error("tolerance {} is invalid: it must be finite and > 0", Num(*value))]
     InvalidTolerance {
         /// The value given.
         value: f64,
     },
     /// The target point coincides with the source point, where the Green function is infinite.
     #[error(
-        "target and source coincide at ({x}, {y}, {z}) m: the Green function is singular there"
+        "target and source coincide at ({}, {}, {}) m: the Green function is singular there",
+        Num(*x),
+        Num(*y),
+        Num(*z)
     )]
     SingularPoint {
         /// x (m).
@@ -141,7 +150,7 @@ pub enum Error {
     /// A real-valued parameter outside the values the model accepts (a normal load of
     /// zero, a negative stiffness, ...). Integer parameters are reported by
     /// [`Error::InvalidCount`].
-    #[error("{name} = {value} is invalid: {reason}")]
+    #[error("{name} = {} is invalid: {reason}", Num(*value))]
     InvalidParameter {
         /// Which parameter.
         name: &'static str,
@@ -223,7 +232,7 @@ pub enum Error {
         source: Cause,
     },
     /// A spring height is zero or negative.
-    #[error("heights[{index}] = {value} m is invalid: spring heights must be > 0")]
+    #[error("heights[{index}] = {} m is invalid: spring heights must be > 0", Num(*value))]
     NonPositiveHeight {
         /// Cell index (paper order `iy * Nx + ix`).
         index: usize,
@@ -353,6 +362,21 @@ impl Error {
             operation,
             path: path.into(),
             source,
+        }
+    }
+}
+
+/// A number in a message: plain from `1e-4` to `1e6` in magnitude (and 0, NaN, ±inf),
+/// scientific otherwise, so that `1e-300` does not print as 300 zeros.
+pub(crate) struct Num(pub(crate) f64);
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if a == 0.0 || !a.is_finite() || (1e-4..1e6).contains(&a) {
+            write!(f, "{}", self.0)
+        } else {
+            write!(f, "{:e}", self.0)
         }
     }
 }

@@ -13,6 +13,7 @@ mod loads;
 mod operator;
 mod probe;
 mod properties;
+mod robustness;
 #[cfg(feature = "serde")]
 mod scene_file;
 mod solver;
