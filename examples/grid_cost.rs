@@ -4,8 +4,9 @@
 //! 3.5 MPa normal pressure, rod drive, seed 1, one thread. The numbers behind
 //! [`precursors::GridCost`]'s estimates (docs/performance.md, "Grid-size guard").
 //!
-//! Run: `cargo run --release --example grid_cost [Nx] [Ny]` (default 1000 x 100); the
-//! peak memory is read from `/proc/self/status` (Linux; `n/a` elsewhere).
+//! Run: `cargo run --release --example grid_cost [Nx] [Ny] [max_cells]` (default 1000 x
+//! 100 and the default limit, `1e6` cells: 10000 x 10000 is refused at once with the
+//! estimates); the peak memory is read from `/proc/self/status` (Linux; `n/a` elsewhere).
 
 #[path = "support/report.rs"]
 mod report;
@@ -28,9 +29,9 @@ fn peak_memory() -> Option<f64> {
 
 fn run() -> report::Outcome {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    const USAGE: &str = "the arguments are [Nx] [Ny]";
-    if args.len() > 2 {
-        return Err(format!("unexpected argument '{}': {USAGE}", args[2]).into());
+    const USAGE: &str = "the arguments are [Nx] [Ny] [max_cells]";
+    if args.len() > 3 {
+        return Err(format!("unexpected argument '{}': {USAGE}", args[3]).into());
     }
     let parse = |i: usize, default: usize| -> Result<usize, String> {
         args.get(i).map_or(Ok(default), |t| {
@@ -39,6 +40,7 @@ fn run() -> report::Outcome {
         })
     };
     let (nx, ny) = (parse(0, 1000)?, parse(1, 100)?);
+    let max_cells = parse(2, precursors::green::DEFAULT_MAX_CELLS)?;
     let (lx, ly) = (nx as f64 * 1e-3, ny as f64 * 1e-3);
     let base = peak_memory();
     let start = Instant::now();
@@ -47,7 +49,7 @@ fn run() -> report::Outcome {
         .cells(nx, ny)
         .normal_load(3.5e6 * lx * ly)
         .seed(1)
-        .max_cells(usize::MAX)
+        .max_cells(max_cells)
         .build()?;
     let built = start.elapsed().as_secs_f64();
     let mut driver = scene.driver()?;
