@@ -40,7 +40,8 @@ pub struct FitOptions {
     pub tolerance: f64,
     /// Largest number of model evaluations (default `200`).
     pub max_evaluations: usize,
-    /// Points of the logarithmic scan of [`fit_tangential_stiffness`] (default `17`).
+    /// Points of the logarithmic scan of [`fit_tangential_stiffness`] (default `17`, at
+    /// least 3).
     pub scan_points: usize,
 }
 
@@ -127,6 +128,11 @@ fn check_bracket(name: &'static str, bracket: (f64, f64)) -> Result<()> {
 
 /// The real contact area at zero shear (m²), averaged over the realizations of
 /// `options`.
+///
+/// # Errors
+/// [`Error::InvalidTolerance`] for invalid `options`; those of
+/// [`SceneBuilder::build`](crate::SceneBuilder::build) and of the normal solve
+/// ([`Error::SolverNotConverged`], [`Error::EmptyContact`], ...).
 pub fn normal_contact_area(builder: &SceneBuilder, options: &FitOptions) -> Result<f64> {
     normal_area_with(builder, options, &Planner::new())
 }
@@ -152,6 +158,12 @@ fn normal_area_with(
 /// `target_area` (m², the paper's `α F_N`). Errors: [`Error::InvalidParameter`] when the
 /// bracket does not enclose the target (with the areas at its ends in the message's
 /// value), [`Error::NotConverged`] past `max_evaluations`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a target area that is not finite and `> 0`, a bracket
+/// that is not `0 < low < high` or does not enclose the target; [`Error::InvalidTolerance`]
+/// for invalid `options`; [`Error::NotConverged`] past `max_evaluations`; those of
+/// [`normal_contact_area`].
 pub fn fit_normal_stiffness(
     builder: &SceneBuilder,
     target_area: f64,
@@ -236,6 +248,10 @@ pub fn fit_normal_stiffness(
 
 /// The precursor curve of one scene: `(F, ℓ)` (N, m) at every stable state up to global
 /// slip.
+///
+/// # Errors
+/// Those of [`SceneBuilder::build`](crate::SceneBuilder::build) and of the run
+/// ([`Driver::step`](crate::Driver::step)).
 pub fn precursor_curve(builder: &SceneBuilder) -> Result<Vec<(f64, f64)>> {
     curve_with(builder, &Planner::new())
 }
@@ -323,6 +339,11 @@ fn misfit_with(
 /// `scan_points` values, then golden sections around the best one down to the relative
 /// `tolerance` (or `max_evaluations`). Among equally good values (the misfit is piecewise
 /// constant) the one found first is kept.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a bracket that is not `0 < low < high`;
+/// [`Error::InvalidTolerance`] for invalid `options`; [`Error::InvalidCount`] for fewer
+/// than three `scan_points`; those of [`precursor_misfit`].
 pub fn fit_tangential_stiffness(
     builder: &SceneBuilder,
     targets: &[(f64, f64)],
@@ -332,6 +353,13 @@ pub fn fit_tangential_stiffness(
     check_options(options)?;
     check_bracket("c_x bracket (N/m³)", bracket)?;
     check_targets(targets)?;
+    if options.scan_points < 3 {
+        return Err(Error::InvalidCount {
+            name: "scan_points",
+            value: options.scan_points as u64,
+            reason: "the scan needs at least 3 points to bracket a minimum",
+        });
+    }
     let mut evaluations = 0;
     let planner = Planner::new(); // every evaluation shares the geometry's plan
     let misfit = |ln_cx: f64, evaluations: &mut usize| -> Result<f64> {
@@ -341,7 +369,7 @@ pub fn fit_tangential_stiffness(
         misfit_with(&builder.clone().springs(law), targets, options, &planner)
     };
     let (lo, hi) = (bracket.0.ln(), bracket.1.ln());
-    let k = options.scan_points.max(3);
+    let k = options.scan_points;
     let grid: Vec<f64> = (0..k)
         .map(|i| lo + (hi - lo) * i as f64 / (k - 1) as f64)
         .collect();

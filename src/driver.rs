@@ -207,6 +207,11 @@ pub struct SolveStats {
 
 impl Scene {
     /// A driver at zero shear (the first [`Driver::step`] solves the normal equilibrium).
+    ///
+    /// # Errors
+    /// Those of
+    /// [`EquilibriumSolverBuilder::build`](crate::solver::EquilibriumSolverBuilder::build)
+    /// ([`Error::TooLargeForDense`], [`Error::DenseThreads`], ...).
     pub fn driver(&self) -> Result<Driver> {
         let solver = EquilibriumSolver::builder(self.plan().clone())
             .material(self.material())
@@ -243,6 +248,11 @@ impl Scene {
 impl Driver {
     /// The next event, `Ok(None)` after [`Event::GlobalSlip`]. After an error the driver
     /// stays failed (every later call returns `Ok(None)`).
+    ///
+    /// # Errors
+    /// The first failure of a solve ([`Error::SolverNotConverged`],
+    /// [`Error::Factorization`], [`Error::EmptyContact`], [`Error::NonFinite`],
+    /// [`Error::ThreadPool`], ...); the driver then stays failed.
     pub fn step(&mut self) -> Result<Option<Event>> {
         loop {
             if let Some(event) = self.pending.pop_front() {
@@ -472,16 +482,14 @@ impl Driver {
     }
 
     fn normal(&self) -> Result<&NormalEquilibrium> {
-        self.normal.as_ref().ok_or(Error::EmptyContact {
-            available: 0,
-            reason: "the normal equilibrium has not been solved yet (call step first)",
+        self.normal.as_ref().ok_or(Error::NotSolved {
+            what: "the normal equilibrium",
         })
     }
 
     fn response(&self) -> Result<&TangentialResponse> {
-        self.response.as_ref().ok_or(Error::EmptyContact {
-            available: 0,
-            reason: "the tangential equilibrium has not been solved yet (call step first)",
+        self.response.as_ref().ok_or(Error::NotSolved {
+            what: "the tangential equilibrium",
         })
     }
 
@@ -518,11 +526,18 @@ impl Driver {
         self.solver.backend()
     }
 
+    /// The threads a solve actually uses ([`EquilibriumSolver::threads`]: 1 on the
+    /// dense backend).
+    pub fn threads(&self) -> usize {
+        self.solver.threads()
+    }
+
     /// Runs the next solves with `parallelism`; the events do not change (the parts of
     /// the grid are fixed by the grid).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for `Parallelism::Threads(0)`.
+    /// As [`EquilibriumSolver::set_parallelism`]: [`Error::InvalidCount`] for
+    /// `Parallelism::Threads(0)`, [`Error::DenseThreads`] with an explicit dense backend.
     pub fn set_parallelism(&mut self, parallelism: crate::solver::Parallelism) -> Result<()> {
         self.solver.set_parallelism(parallelism)
     }
@@ -576,22 +591,34 @@ impl Driver {
     }
 
     /// Normal traction `φ_z` per cell (Pa).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
     pub fn normal_traction(&self) -> Result<&[f64]> {
         Ok(&self.normal()?.traction)
     }
 
     /// Normal displacement `u_z` of the bottom face per cell (m).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
     pub fn normal_displacement(&self) -> Result<&[f64]> {
         Ok(&self.normal()?.displacement)
     }
 
     /// Shear traction `φ_x` per cell (Pa; negative where the springs resist `+x`).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
     pub fn shear_traction(&self) -> Result<&[f64]> {
         self.response()?;
         Ok(&self.shear_traction)
     }
 
     /// Shear displacement `u_x` of the bottom face per cell (m).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
     pub fn shear_displacement(&self) -> Result<&[f64]> {
         self.response()?;
         Ok(&self.shear_displacement)
@@ -599,6 +626,9 @@ impl Driver {
 
     /// Mean shear displacement `⟨u_x⟩` of the block (m) (plus the top load's constant
     /// when a top shear acts).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
     pub fn mean_shear_displacement(&self) -> Result<f64> {
         Ok(self.force() * self.response()?.offset_per_newton)
     }
@@ -642,16 +672,15 @@ impl Driver {
     /// points each in request order) in the current state, with every load term. Call
     /// it at the states you want: after the [`Event::LoadRaised`] that precedes the first
     /// [`Event::Rupture`] for "just before the first rupture", at each [`Event::Stable`]
-    /// for the quasi-static evolution. Errors: [`Error::InvalidParameter`] when the driver
-    /// has no probes.
+    /// for the quasi-static evolution.
+    ///
+    /// # Errors
+    /// [`Error::NoProbes`] when the driver has no probes ([`crate::SceneBuilder::probes`],
+    /// [`Driver::add_probes`]); [`Error::NotSolved`] before the first equilibrium (call
+    /// [`Driver::step`] first).
     pub fn stresses(&self) -> Result<Stresses> {
         if self.probes.is_empty() {
-            return Err(Error::InvalidParameter {
-                name: "probes",
-                value: 0.0,
-                reason: "the driver has no stress probes (SceneBuilder::probes, \
-                         Driver::add_probes)",
-            });
+            return Err(Error::NoProbes);
         }
         let force = self.force();
         let input = ProbeInput::new(self.shear_traction()?, self.normal_traction()?)
@@ -670,12 +699,19 @@ impl Driver {
     }
 
     /// Real contact area per cell (m²).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`]; [`Error::NonFinite`] on
+    /// overflow.
     pub fn real_contact_area(&self) -> Result<Vec<f64>> {
         self.interface
             .real_contact_area(&self.normal()?.displacement)
     }
 
     /// Total real contact area (m²).
+    ///
+    /// # Errors
+    /// As [`Driver::real_contact_area`].
     pub fn total_contact_area(&self) -> Result<f64> {
         Ok(self.real_contact_area()?.iter().sum())
     }
@@ -708,6 +744,9 @@ impl Driver {
     }
 
     /// Real contact area per column `ix` (summed over `y`, m²).
+    ///
+    /// # Errors
+    /// As [`Driver::real_contact_area`].
     pub fn column_contact_area(&self) -> Result<Vec<f64>> {
         let area = self.real_contact_area()?;
         let nx = self.grid.nx();
@@ -726,6 +765,9 @@ impl Driver {
     /// Precursor length `ℓ` (m): the extent, from the trailing edge `x = 0`, of the run of
     /// columns whose real contact area is below its value at zero shear (docs/model.md
     /// section 5; paper Fig. 2b). A multiple of `Δx`.
+    ///
+    /// # Errors
+    /// As [`Driver::real_contact_area`].
     pub fn precursor_length(&self) -> Result<f64> {
         let columns = self.column_contact_area()?;
         let run = columns

@@ -1,6 +1,13 @@
 //! Typed errors: every reachable failure says what was wrong and why.
 
+use std::path::PathBuf;
 use thiserror::Error;
+
+/// The cause of an [`enum@Error`] that wraps another library's error (a JSON parser's, a
+/// factorisation's, the thread pool's), type-erased so that no dependency's type enters
+/// the crate's API. [`std::error::Error::source`] returns the cause itself, so
+/// `downcast_ref` reaches its concrete type.
+pub type Cause = Box<dyn std::error::Error + Send + Sync + 'static>;
 
 /// Convenient result alias of the crate. The error type defaults to [`enum@Error`] and can be
 /// named, so `use precursors::*` leaves `Result<T, E>` usable for other errors.
@@ -9,11 +16,17 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 /// Everything that can go wrong in the crate.
 ///
 /// Every variant carries the offending values so a caller can report them or recover.
-#[derive(Debug, Clone, PartialEq, Error)]
+/// Variants that wrap another error (I/O, JSON, factorisation, thread pool) return it from
+/// [`std::error::Error::source`], so a report can print the whole cause chain; their
+/// `Display` already names the cause's message, with the file and the operation.
+///
+/// `Error` is neither `Clone` nor `PartialEq`, as the `std::io::Error` it keeps: match on
+/// the variant, e.g. `matches!(e, Error::GridDoesNotDivide { axis: "x", .. })`.
+#[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum Error {
     /// A length (block size, cell size, rod half-width, ...) is not finite and positive.
-    #[error("{name} = {value} m is invalid: it must be finite and > 0")]
+    #[error("{name} = {} m is invalid: it must be finite and > 0", Num(*value))]
     InvalidLength {
         /// Which length.
         name: &'static str,
@@ -28,7 +41,10 @@ pub enum Error {
     },
     /// The requested cell size does not divide the face into a whole number of cells.
     #[error(
-        "cell size {cell} m does not divide L{axis} = {length} m (ratio {ratio}, not an integer)"
+        "cell size {} m does not divide L{axis} = {} m (ratio {}, not an integer)",
+        Num(*cell),
+        Num(*length),
+        Num(*ratio)
     )]
     GridDoesNotDivide {
         /// `"x"` or `"y"`.
@@ -41,7 +57,7 @@ pub enum Error {
         ratio: f64,
     },
     /// A coordinate lies outside the block.
-    #[error("{name} = {value} m lies outside the block, which spans [0, {max}] m")]
+    #[error("{name} = {} m lies outside the block, which spans [0, {}] m", Num(*value), Num(*max))]
     OutsideBlock {
         /// Which coordinate (`"x"`, `"xi"`, `"z"`, ...).
         name: &'static str,
@@ -52,7 +68,10 @@ pub enum Error {
     },
     /// The rod band `[h - Δh, h + Δh]` is not inside the trailing face `[0, Lz]`.
     #[error(
-        "rod band [h - dh, h + dh] = [{low}, {high}] m is not inside the trailing face [0, {lz}] m"
+        "rod band [h - dh, h + dh] = [{}, {}] m is not inside the trailing face [0, {}] m",
+        Num(*low),
+        Num(*high),
+        Num(*lz)
     )]
     RodBandOutsideFace {
         /// `h - Δh` (m).
@@ -63,14 +82,17 @@ pub enum Error {
         lz: f64,
     },
     /// A tolerance is not finite and positive.
-    #[error("tolerance {value} is invalid: it must be finite and > 0")]
+    #[error("tolerance {} is invalid: it must be finite and > 0", Num(*value))]
     InvalidTolerance {
         /// The value given.
         value: f64,
     },
     /// The target point coincides with the source point, where the Green function is infinite.
     #[error(
-        "target and source coincide at ({x}, {y}, {z}) m: the Green function is singular there"
+        "target and source coincide at ({}, {}, {}) m: the Green function is singular there",
+        Num(*x),
+        Num(*y),
+        Num(*z)
     )]
     SingularPoint {
         /// x (m).
@@ -125,8 +147,10 @@ pub enum Error {
         /// The limit on the number of cells.
         limit: usize,
     },
-    /// A parameter outside the values the model accepts (a term budget of zero, ...).
-    #[error("{name} = {value} is invalid: {reason}")]
+    /// A real-valued parameter outside the values the model accepts (a normal load of
+    /// zero, a negative stiffness, ...). Integer parameters are reported by
+    /// [`Error::InvalidCount`].
+    #[error("{name} = {} is invalid: {reason}", Num(*value))]
     InvalidParameter {
         /// Which parameter.
         name: &'static str,
@@ -135,22 +159,106 @@ pub enum Error {
         /// Why it is refused.
         reason: &'static str,
     },
+    /// An integer parameter (a count of cells, threads, terms, ...) outside the values the
+    /// model accepts.
+    #[error("{name} = {value} is invalid: {reason}")]
+    InvalidCount {
+        /// Which parameter.
+        name: &'static str,
+        /// The value given.
+        value: u64,
+        /// Why it is refused.
+        reason: &'static str,
+    },
+    /// A choice among named options that does not apply here (e.g. a summation axis).
+    #[error("{name} = {value} is invalid: {reason}")]
+    InvalidChoice {
+        /// Which parameter.
+        name: &'static str,
+        /// The option given.
+        value: &'static str,
+        /// Why it is refused and what to choose instead.
+        reason: &'static str,
+    },
+    /// The grid has more cells than the limit a plan or scene is built with
+    /// ([`crate::green::InfluencePlanBuilder::max_cells`], [`crate::SceneBuilder::max_cells`],
+    /// default [`crate::green::DEFAULT_MAX_CELLS`]): refused before anything is allocated,
+    /// with the estimated cost ([`crate::GridCost`], docs/performance.md).
+    #[error(
+        "a grid of {nx} x {ny} = {cells} cells exceeds the limit of {limit} cells: it would \
+         need about {memory} of memory, about {plan} to plan and about {solve} per cold \
+         equilibrium (estimates, docs/performance.md); raise the limit with max_cells(n) \
+         (\"max_cells\" in a scene file) if that is intended",
+        memory = crate::green::format_bytes(*memory_bytes),
+        plan = crate::green::format_seconds(*plan_seconds),
+        solve = crate::green::format_seconds(*solve_seconds)
+    )]
+    GridTooLarge {
+        /// Cells along x.
+        nx: usize,
+        /// Cells along y.
+        ny: usize,
+        /// `Nx·Ny` (exact, even when it overflows `usize`).
+        cells: u128,
+        /// The limit on the number of cells.
+        limit: usize,
+        /// Estimated peak memory of a scene and its driver (bytes).
+        memory_bytes: f64,
+        /// Estimated time to plan the operator (s, one thread, release build).
+        plan_seconds: f64,
+        /// Estimated time of one cold normal and tangential equilibrium (s, one thread,
+        /// release build).
+        solve_seconds: f64,
+    },
+    /// An explicit thread count above one with the dense backend, which runs on one
+    /// thread (its factor solve needs the whole attached set).
+    #[error(
+        "Backend::Dense runs on one thread, but Parallelism::Threads({threads}) was asked for: \
+         use Backend::Spectral (or Backend::Auto above {auto_limit} cells) to solve on several \
+         threads, or Parallelism::Sequential with the dense backend",
+        auto_limit = crate::solver::AUTO_DENSE_LIMIT
+    )]
+    DenseThreads {
+        /// Threads asked for.
+        threads: usize,
+    },
     /// The operating system refused the solver's threads.
-    #[error("could not start a pool of {threads} solver threads: {reason}")]
+    #[error("could not start a pool of {threads} solver threads: {source}")]
     ThreadPool {
         /// Threads requested ([`crate::SolverOptions::parallelism`]).
         threads: usize,
         /// What the thread pool reported.
-        reason: String,
+        #[source]
+        source: Cause,
     },
     /// A spring height is zero or negative.
-    #[error("heights[{index}] = {value} m is invalid: spring heights must be > 0")]
+    #[error("heights[{index}] = {} m is invalid: spring heights must be > 0", Num(*value))]
     NonPositiveHeight {
         /// Cell index (paper order `iy * Nx + ix`).
         index: usize,
         /// The value given (m).
         value: f64,
     },
+    /// A broken site was given another state: broken sites stay broken until the
+    /// interface is healed.
+    #[error(
+        "site {index} is broken and cannot be set to another state (heal the interface first)"
+    )]
+    BrokenSite {
+        /// Cell index (paper order `iy * Nx + ix`).
+        index: usize,
+    },
+    /// A driver was asked for a field of its equilibrium before it solved one.
+    #[error("the driver has not solved {what} yet: call step() first")]
+    NotSolved {
+        /// Which equilibrium (`"the normal equilibrium"`, `"the tangential equilibrium"`).
+        what: &'static str,
+    },
+    /// Stresses were asked of a driver whose scene has no stress probes.
+    #[error(
+        "no stress probes: the scene was built without them (add them with SceneBuilder::probes)"
+    )]
+    NoProbes,
     /// A site index beyond the grid.
     #[error("site {index} does not exist: the interface has {sites} sites")]
     SiteOutOfRange {
@@ -168,7 +276,8 @@ pub enum Error {
         /// Why it needs at least one item.
         reason: &'static str,
     },
-    /// No site can carry the load (every site broken), or the load itself is zero.
+    /// No site can carry the load: every site broken, or none attached. A physical state
+    /// of the interface, not a misuse (see [`Error::NotSolved`]).
     #[error("empty contact: {reason} ({available} sites can still carry force)")]
     EmptyContact {
         /// Sites neither broken nor excluded.
@@ -196,16 +305,24 @@ pub enum Error {
     Factorization {
         /// Size of the matrix.
         n: usize,
-        /// What faer reported.
+        /// What went wrong (the pivot and its value, or faer's error).
         reason: String,
+        /// faer's error, when faer reported one (a pivot found non-positive afterwards
+        /// has none).
+        #[source]
+        source: Option<Cause>,
     },
-    /// A file could not be read or written.
-    #[error("{path}: {reason}")]
+    /// A file could not be read or written: the operation, the file and the operating
+    /// system's error (its [`std::io::ErrorKind`] through `source.kind()`).
+    #[error("{operation} {}: {source}", path.display())]
     Io {
+        /// What was being done (`"reading scene file"`, `"reading heights file"`, ...).
+        operation: &'static str,
         /// The file.
-        path: String,
+        path: PathBuf,
         /// What the operating system reported.
-        reason: String,
+        #[source]
+        source: std::io::Error,
     },
     /// A heights file has a line that is not a finite, positive height in metres.
     #[error("{path}, line {line}: {reason}")]
@@ -218,10 +335,17 @@ pub enum Error {
         reason: String,
     },
     /// A scene file is not valid JSON or does not follow `docs/scene-format.md`.
-    #[error("scene file: {reason}")]
+    #[error("scene file{}: {source}", path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default())]
     SceneFile {
-        /// What the parser reported (with line and column).
-        reason: String,
+        /// The file (`None` for JSON text given directly).
+        path: Option<PathBuf>,
+        /// Line of the error (1-based; 0 when the parser gave none).
+        line: usize,
+        /// Column of the error (1-based; 0 when the parser gave none).
+        column: usize,
+        /// What the parser reported (its message names the line and column).
+        #[source]
+        source: Cause,
     },
     /// A checkpoint does not fit the scene it is resumed on, or is inconsistent.
     #[error("checkpoint refused: {reason}")]
@@ -267,6 +391,32 @@ pub enum Error {
         /// What the parser reported.
         reason: String,
     },
+}
+
+impl Error {
+    /// An [`Error::Io`] for `operation` (`"reading scene file"`, ...) on `path`.
+    pub fn io(operation: &'static str, path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            operation,
+            path: path.into(),
+            source,
+        }
+    }
+}
+
+/// A number in a message: plain from `1e-4` to `1e6` in magnitude (and 0, NaN, ±inf),
+/// scientific otherwise, so that `1e-300` does not print as 300 zeros.
+pub(crate) struct Num(pub(crate) f64);
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if a == 0.0 || !a.is_finite() || (1e-4..1e6).contains(&a) {
+            write!(f, "{}", self.0)
+        } else {
+            write!(f, "{:e}", self.0)
+        }
+    }
 }
 
 /// Checks that `value` is a finite, positive length.

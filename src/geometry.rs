@@ -13,6 +13,10 @@ pub struct Block {
 impl Block {
     /// A block of sides `lx`, `ly`, `lz` (m); each must be finite and > 0, and so must
     /// the volume `Lx Ly Lz` (the Green function divides by it).
+    ///
+    /// # Errors
+    /// [`Error::InvalidLength`] for a side that is not finite and `> 0`;
+    /// [`Error::InvalidParameter`] when the volume overflows or underflows.
     pub fn new(lx: f64, ly: f64, lz: f64) -> Result<Self> {
         let block = Self {
             lx: check_length("Lx", lx)?,
@@ -119,6 +123,11 @@ const MAX_AXIS_CELLS: f64 = 9_007_199_254_740_992.0;
 impl Grid {
     /// `nx x ny` cells on the bottom face of `block`; both counts must be >= 1, the cell
     /// area `ΔA` must not underflow to zero, and `Nx Ny` f64 values must fit in memory.
+    ///
+    /// # Errors
+    /// [`Error::EmptyGrid`] for a zero count; [`Error::GridTooLarge`] when `Nx Ny`
+    /// overflows the address space; [`Error::InvalidLength`] when `Δx` or `Δy` rounds to
+    /// zero; [`Error::InvalidParameter`] when `ΔA` underflows.
     pub fn new(block: Block, nx: usize, ny: usize) -> Result<Self> {
         if nx == 0 {
             return Err(Error::EmptyGrid { axis: "x" });
@@ -126,13 +135,8 @@ impl Grid {
         if ny == 0 {
             return Err(Error::EmptyGrid { axis: "y" });
         }
-        if nx.checked_mul(ny).is_none_or(|n| n > MAX_CELLS) {
-            return Err(Error::InvalidParameter {
-                name: "Nx Ny",
-                value: nx as f64 * ny as f64,
-                reason: "more cells than a vector of one f64 per cell can hold",
-            });
-        }
+        // More cells than a vector of one f64 per cell can hold.
+        crate::green::check_cells(nx, ny, MAX_CELLS)?;
         let grid = Self { block, nx, ny };
         // lx / nx rounds to zero when nx is huge against a tiny block.
         check_length("dx", grid.dx())?;
@@ -150,6 +154,11 @@ impl Grid {
 
     /// Cells of size `dx x dy` (m), which must divide `Lx` and `Ly` into whole numbers
     /// (to 1e-9 relative) of at most `2^53` cells each, then as [`Grid::new`].
+    ///
+    /// # Errors
+    /// [`Error::InvalidLength`] for a size that is not finite and `> 0`;
+    /// [`Error::InvalidParameter`] when `L / cell` exceeds `2^53`;
+    /// [`Error::GridDoesNotDivide`]; those of [`Grid::new`].
     pub fn from_cell_size(block: Block, dx: f64, dy: f64) -> Result<Self> {
         let count = |axis, length: f64, cell: f64| -> Result<usize> {
             check_length(if axis == "x" { "dx" } else { "dy" }, cell)?;

@@ -39,6 +39,9 @@ impl Default for Material {
 
 impl Material {
     /// A validated material: `E` (Pa) finite and > 0, `ν` in `(-1, 0.5]`, `μ` finite and `≥ 0`.
+    ///
+    /// # Errors
+    /// As [`Material::validate`].
     pub fn new(young_modulus: f64, poisson_ratio: f64, friction_coefficient: f64) -> Result<Self> {
         let m = Self {
             young_modulus,
@@ -50,6 +53,9 @@ impl Material {
     }
 
     /// Checks the fields (they are public, so a struct literal may hold anything).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the first field out of range.
     pub fn validate(&self) -> Result<()> {
         if !(self.young_modulus.is_finite() && self.young_modulus > 0.0) {
             return Err(Error::InvalidParameter {
@@ -126,6 +132,9 @@ impl Default for SpringLaw {
 
 impl SpringLaw {
     /// A validated law: both constants finite and > 0; the paper's area law.
+    ///
+    /// # Errors
+    /// As [`SpringLaw::validate`].
     pub fn new(c_x: f64, c_z: f64) -> Result<Self> {
         let law = Self {
             c_x,
@@ -144,6 +153,9 @@ impl SpringLaw {
     }
 
     /// Checks the fields.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a constant that is not finite and `> 0`.
     pub fn validate(&self) -> Result<()> {
         for (name, value) in [("c_x", self.c_x), ("c_z", self.c_z)] {
             if !(value.is_finite() && value > 0.0) {
@@ -201,6 +213,10 @@ impl Heights {
     /// The stream is fixed: `Xoshiro256PlusPlus::seed_from_u64(seed)` feeding
     /// `rand_distr::Normal`, one height per cell in cell order. The same seed gives the
     /// same heights on every platform (a value-stability test pins them).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a mean or standard deviation that is not finite (or
+    /// negative), or a mean below `-3` standard deviations.
     pub fn truncated_gaussian(grid: &Grid, dist: HeightDistribution, seed: u64) -> Result<Self> {
         let HeightDistribution { mean, std_dev } = dist;
         if !mean.is_finite() {
@@ -251,6 +267,10 @@ impl Heights {
 
     /// User-supplied heights (a measured topography), in cell order `i = iy * Nx + ix`:
     /// one finite value `> 0` (m) per cell.
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] for a count other than the grid's; [`Error::NonFinite`];
+    /// [`Error::NonPositiveHeight`].
     pub fn from_values(grid: &Grid, values: Vec<f64>) -> Result<Self> {
         check_slice("heights", &values, grid.len())?;
         if let Some((index, &value)) = values.iter().enumerate().find(|(_, h)| **h <= 0.0) {
@@ -355,6 +375,10 @@ pub struct Interface {
 impl Interface {
     /// An interface on `grid` with every site attached (the solvers then detach what
     /// must be). `heights` must have one value per cell.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for an invalid law; [`Error::LengthMismatch`] when the
+    /// heights are not one per cell.
     pub fn new(grid: Grid, heights: Heights, law: SpringLaw) -> Result<Self> {
         law.validate()?;
         if heights.len() != grid.len() {
@@ -407,6 +431,9 @@ impl Interface {
     }
 
     /// Breaks site `index` (Coulomb slip): it carries no force from now on.
+    ///
+    /// # Errors
+    /// [`Error::SiteOutOfRange`] for an index beyond the grid.
     pub fn break_site(&mut self, index: usize) -> Result<()> {
         let n = self.states.len();
         let state = self
@@ -431,7 +458,7 @@ impl Interface {
     ///
     /// # Errors
     /// [`Error::LengthMismatch`] when `states` does not hold one state per site;
-    /// [`Error::InvalidParameter`] when a broken site would be revived (only
+    /// [`Error::BrokenSite`] when a broken site would be revived (only
     /// [`Interface::heal`] does that).
     pub fn set_states(&mut self, states: &[SiteState]) -> Result<()> {
         if states.len() != self.states.len() {
@@ -444,11 +471,7 @@ impl Interface {
         if let Some(i) = (0..states.len())
             .find(|&i| self.states[i] == SiteState::Broken && states[i] != SiteState::Broken)
         {
-            return Err(Error::InvalidParameter {
-                name: "states (a broken site)",
-                value: i as f64,
-                reason: "a broken site stays broken until the interface is healed",
-            });
+            return Err(Error::BrokenSite { index: i });
         }
         self.states.copy_from_slice(states);
         Ok(())
@@ -523,6 +546,9 @@ impl Interface {
     /// `k_x = c_x exp(-u_z / u0)` on attached sites, 0 on detached and broken ones (as in
     /// the paper). An overflow (a huge penetration of a tiny asperity) is reported as
     /// [`Error::NonFinite`].
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`]; [`Error::NonFinite`] for a NaN input or an overflow.
     pub fn tangential_stiffness(&self, u_z: &[f64]) -> Result<Vec<f64>> {
         check_slice("u_z", u_z, self.grid.len())?;
         u_z.iter()
@@ -554,6 +580,10 @@ impl Interface {
     /// block penetrates below the substrate mean plane (`u_z < 0`); [`AreaLaw::Capped`]
     /// caps it at `ΔA`. Under the paper's law an overflow of the exponential is
     /// reported as [`Error::NonFinite`] (the capped law gives `ΔA`).
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`]; [`Error::NonFinite`] for a NaN input or (paper's law) an
+    /// overflow.
     pub fn real_contact_area(&self, u_z: &[f64]) -> Result<Vec<f64>> {
         check_slice("u_z", u_z, self.grid.len())?;
         let cell = self.grid.cell_area();

@@ -35,6 +35,7 @@
 //! # Ok::<(), precursors::Error>(())
 //! ```
 #![deny(missing_docs)]
+#![warn(clippy::missing_errors_doc)]
 #![forbid(unsafe_code)]
 
 pub mod calibration;
@@ -63,6 +64,7 @@ pub use nalgebra;
 pub struct ReadmeDoctests;
 pub use driver::{Checkpoint, Driver, Event, Load, Site, SolveStats};
 pub use geometry::{Block, Grid, Point};
+pub use green::GridCost;
 pub use interface::{
     AreaLaw, HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw,
 };

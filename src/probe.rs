@@ -305,6 +305,11 @@ pub struct StressProbe {
 impl StressProbe {
     /// Plans the probes of `spec` on `plan`'s grid; `lateral` is the trailing-face load
     /// (if the scene has one), whose stress term is tabulated now.
+    ///
+    /// # Errors
+    /// [`Error::OutsideBlock`] for a plane or point outside the block;
+    /// [`Error::InvalidTolerance`]; [`Error::NotConverged`] when a transfer's or a point's
+    /// series does not reach the tolerance.
     pub fn new(plan: &InfluencePlan, spec: &ProbeSpec, lateral: Option<&RodLoad>) -> Result<Self> {
         let grid = *plan.grid();
         let block = *grid.block();
@@ -355,6 +360,11 @@ impl StressProbe {
 
     /// The stresses of a state. A lateral force needs a probe planned with a lateral
     /// load ([`Error::InvalidParameter`] otherwise).
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] / [`Error::NonFinite`] for bad tractions;
+    /// [`Error::InvalidParameter`] for a negative or NaN friction coefficient, or a lateral
+    /// force on a probe planned without a lateral load.
     pub fn evaluate(&self, input: &ProbeInput<'_>) -> Result<Stresses> {
         let n = self.grid.len();
         check_slice("shear_traction", input.shear_traction, n)?;

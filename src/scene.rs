@@ -119,13 +119,15 @@ impl HeightSource {
     /// `i = iy·Nx + ix`; blank lines and lines starting with `#` are skipped. Each value
     /// must be finite and `> 0`; the count is checked against the grid at
     /// [`SceneBuilder::build`].
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be read (with its path); [`Error::HeightsFile`]
+    /// for a line that is not a finite height `> 0`, or no height at all.
     pub fn from_file(path: impl AsRef<std::path::Path>) -> Result<HeightSource> {
         let path = path.as_ref();
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-            path: name.clone(),
-            reason: e.to_string(),
-        })?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| Error::io("reading heights file", path, e))?;
         let mut values = Vec::new();
         for (number, line) in text.lines().enumerate() {
             let line = line.trim();
@@ -206,6 +208,7 @@ pub struct SceneBuilder {
     solver: SolverOptions,
     plan_tolerance: f64,
     probes: ProbeSpec,
+    max_cells: usize,
 }
 
 impl Default for SceneBuilder {
@@ -221,6 +224,7 @@ impl Default for SceneBuilder {
             solver: SolverOptions::default(),
             plan_tolerance: 1e-6,
             probes: ProbeSpec::default(),
+            max_cells: crate::green::DEFAULT_MAX_CELLS,
         }
     }
 }
@@ -297,10 +301,20 @@ impl SceneBuilder {
         self
     }
 
+    /// The most cells [`SceneBuilder::build`] accepts (default
+    /// [`DEFAULT_MAX_CELLS`](crate::green::DEFAULT_MAX_CELLS) = `1e6`; scene-file key
+    /// `max_cells`): a larger grid is refused with [`Error::GridTooLarge`] and its
+    /// estimated memory and time ([`crate::GridCost`]) before anything is allocated.
+    /// Raise it for a grid whose cost you accept; it does not change results.
+    pub fn max_cells(mut self, max_cells: usize) -> Self {
+        self.max_cells = max_cells;
+        self
+    }
+
     /// The first option (by its scene-file key path, e.g. `block.lx`, `normal_load`,
     /// `drive.lateral.height`) in which `other` describes another run, `None` for the
     /// same run: every option equal but those of [`SceneBuilder::identity`] (the solver's
-    /// parallelism and the probes), which do not change the events (checkpoints resume
+    /// parallelism, the cell limit and the probes), which do not change the events (checkpoints resume
     /// across them).
     pub(crate) fn run_difference(&self, other: &SceneBuilder) -> Option<String> {
         let (mine, theirs) = (self.run_keys(), other.run_keys());
@@ -322,7 +336,7 @@ impl SceneBuilder {
 
     /// Every option that identifies the run as `(key path, value)`, with the scene
     /// format's key names (`docs/scene-format.md`) and values written exactly (`{:?}`
-    /// of an `f64` round-trips); the solver's parallelism and the probes are left out.
+    /// of an `f64` round-trips); the solver's parallelism, the cell limit and the probes are left out.
     /// Checkpoints store a digest of it.
     pub(crate) fn run_keys(&self) -> Vec<(String, String)> {
         fn put(keys: &mut Vec<(String, String)>, key: &str, value: String) {
@@ -423,11 +437,12 @@ impl SceneBuilder {
 
     /// The scene's identity: this builder without the options that do not change the
     /// events, the solver's parallelism (results are bit for bit the same for every
-    /// choice) and the probes (observers, which a driver may add at any time).
+    /// choice), the cell limit and the probes (observers, which a driver may add at any time).
     pub(crate) fn identity(&self) -> SceneBuilder {
         let mut identity = self.clone();
         identity.solver.parallelism = SolverOptions::default().parallelism;
         identity.probes = ProbeSpec::default();
+        identity.max_cells = crate::green::DEFAULT_MAX_CELLS;
         identity
     }
 
@@ -483,8 +498,10 @@ impl SceneBuilder {
             Cells::Size(dx, dy) => Grid::from_cell_size(block, dx, dy)?,
             Cells::Count(nx, ny) => Grid::new(block, nx, ny)?,
         };
+        crate::green::check_cells(grid.nx(), grid.ny(), self.max_cells)?;
         self.material.validate()?;
         self.law.validate()?;
+        self.solver.validate()?;
         if !(self.normal_load.is_finite() && self.normal_load > 0.0) {
             return Err(Error::InvalidParameter {
                 name: "normal_load",
@@ -522,7 +539,7 @@ impl SceneBuilder {
                 Some(lateral)
             }
         };
-        let plan = planner.plan(grid, self.plan_tolerance)?;
+        let plan = planner.plan_with_max_cells(grid, self.plan_tolerance, self.max_cells)?;
         // Displacement per newton of the lateral load, cell-averaged (m/N): only built
         // when a lateral load exists.
         let rod = match lateral {

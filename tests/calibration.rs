@@ -83,6 +83,17 @@ fn bad_calibration_input_is_refused() {
         fit_tangential_stiffness(&base(), &[], (1e11, 1e13), &options),
         Err(Error::EmptyInput { .. })
     ));
+    // A scan of fewer than three points is refused (it was silently raised to three).
+    let mut few = options.clone();
+    few.scan_points = 2;
+    assert!(matches!(
+        fit_tangential_stiffness(&base(), &[(1.0, 1e-3)], (1e11, 1e13), &few),
+        Err(Error::InvalidCount {
+            name: "scan_points",
+            value: 2,
+            ..
+        })
+    ));
     // The misfit of no target point is refused, not NaN (0/0).
     assert!(matches!(
         precursor_misfit(&base(), &[], &options),

@@ -78,7 +78,7 @@ fn tolerances_must_be_positive() {
     let opts = SeriesOptions::with_tolerance(1e-6).max_terms(0);
     assert!(matches!(
         gf.value_with(r, s, &opts),
-        Err(Error::InvalidParameter { .. })
+        Err(Error::InvalidCount { .. })
     ));
 }
 
@@ -149,9 +149,9 @@ fn zero_solver_threads_are_refused() {
         .build()
         .and_then(|scene| scene.driver());
     match built {
-        Err(Error::InvalidParameter { name, value, .. }) => {
+        Err(Error::InvalidCount { name, value, .. }) => {
             assert_eq!(name, "threads");
-            assert_eq!(value, 0.0);
+            assert_eq!(value, 0);
         }
         other => panic!("threads = 0: {other:?}"),
     }
@@ -209,7 +209,7 @@ fn absurdly_fine_cells_get_a_typed_error_not_a_panic() {
     for (nx, ny) in [(usize::MAX, 2), (2, usize::MAX), (1 << 32, 1 << 32)] {
         let e = Grid::new(b, nx, ny).unwrap_err();
         assert!(
-            matches!(e, Error::InvalidParameter { name: "Nx Ny", .. }),
+            matches!(e, Error::GridTooLarge { cells, .. } if cells == nx as u128 * ny as u128),
             "{e}"
         );
     }
@@ -283,4 +283,181 @@ fn result_alias_takes_another_error_type() {
     }
     assert!(parse("x").is_err() && parse("7") == Ok(7));
     assert_eq!(build().unwrap().len(), 100);
+}
+
+/// A grid above the cell limit is refused at once, before anything is allocated, with
+/// the count, the limit and the estimated cost; the limit can be raised.
+#[test]
+fn grids_above_the_cell_limit_are_refused_quickly() {
+    use precursors::green::DEFAULT_MAX_CELLS;
+    let clock = std::time::Instant::now();
+    let huge = precursors::Scene::builder()
+        .block(10.0, 10.0, 0.075)
+        .cells(10_000, 10_000)
+        .build()
+        .unwrap_err();
+    assert!(clock.elapsed().as_secs_f64() < 1.0, "{:?}", clock.elapsed());
+    match &huge {
+        Error::GridTooLarge {
+            nx: 10_000,
+            ny: 10_000,
+            cells: 100_000_000,
+            limit,
+            memory_bytes,
+            plan_seconds,
+            solve_seconds,
+        } => {
+            assert_eq!(*limit, DEFAULT_MAX_CELLS);
+            // 240 B and 26 µs per cell (docs/performance.md).
+            assert!((*memory_bytes - 2.4e10).abs() < 1e8, "{memory_bytes}");
+            assert!((*plan_seconds - 2600.0).abs() < 1.0, "{plan_seconds}");
+            assert!(*solve_seconds > 3600.0, "{solve_seconds}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let text = huge.to_string();
+    for part in [
+        "10000 x 10000 = 100000000 cells",
+        "1000000 cells",
+        "24.000 GB",
+        "max_cells",
+    ] {
+        assert!(text.contains(part), "{part:?} not in {text}");
+    }
+    // The same guard on the plan builder; the documented large run (1000 x 100) passes
+    // the default limit, and a limit below a grid refuses it.
+    let block = Block::new(1.0, 0.1, 0.075).unwrap();
+    let big = Grid::new(block, 1000, 100).unwrap();
+    let e = InfluencePlan::builder(big)
+        .max_cells(99_999)
+        .build()
+        .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            Error::GridTooLarge {
+                cells: 100_000,
+                limit: 99_999,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let small = precursors::Scene::builder()
+        .max_cells(979)
+        .build()
+        .unwrap_err();
+    assert!(
+        matches!(small, Error::GridTooLarge { cells: 980, .. }),
+        "{small}"
+    );
+    let scene = precursors::Scene::builder().max_cells(980).build().unwrap();
+    assert_eq!(scene.grid().len(), 980);
+    // The limit is part of neither the physics nor the run: a raised one plans alike.
+    let raised = precursors::Scene::builder()
+        .max_cells(usize::MAX)
+        .build()
+        .unwrap();
+    assert_eq!(raised.interface().heights(), scene.interface().heights());
+}
+
+/// The dense backend runs on one thread: an explicit thread count with it is refused and
+/// says what to do; `Backend::Auto` accepts any parallelism and reports the threads used.
+#[test]
+fn threads_with_the_dense_backend() {
+    use precursors::{Backend, Parallelism, Scene, SolverOptions};
+    let options = |backend, parallelism| {
+        SolverOptions::default()
+            .backend(backend)
+            .parallelism(parallelism)
+    };
+    let e = Scene::builder()
+        .solver(options(Backend::Dense, Parallelism::Threads(4)))
+        .build()
+        .unwrap_err();
+    assert!(matches!(e, Error::DenseThreads { threads: 4 }), "{e}");
+    assert!(e.to_string().contains("Backend::Spectral"), "{e}");
+    for parallelism in [
+        Parallelism::Sequential,
+        Parallelism::Threads(1),
+        Parallelism::CurrentPool,
+    ] {
+        let scene = Scene::builder()
+            .solver(options(Backend::Dense, parallelism))
+            .build()
+            .unwrap();
+        assert_eq!(scene.driver().unwrap().threads(), 1);
+    }
+    // Auto picks dense at 980 cells: threads accepted, one used.
+    let scene = Scene::builder()
+        .solver(options(Backend::Auto, Parallelism::Threads(4)))
+        .build()
+        .unwrap();
+    let mut driver = scene.driver().unwrap();
+    assert_eq!(driver.backend(), Backend::Dense);
+    assert_eq!(driver.threads(), 1);
+    // Spectral: as many as asked, up to the parts of the grid (one part below 2048 cells).
+    let spectral = Scene::builder()
+        .block(0.128, 0.032, 0.075)
+        .solver(options(Backend::Spectral, Parallelism::Threads(2)))
+        .build()
+        .unwrap()
+        .driver()
+        .unwrap();
+    assert_eq!(spectral.threads(), 2);
+    // Setting threads later: the same rule.
+    driver.set_parallelism(Parallelism::Threads(3)).unwrap();
+    let mut dense = Scene::builder()
+        .solver(options(Backend::Dense, Parallelism::Sequential))
+        .build()
+        .unwrap()
+        .driver()
+        .unwrap();
+    assert!(matches!(
+        dense.set_parallelism(Parallelism::Threads(2)),
+        Err(Error::DenseThreads { threads: 2 })
+    ));
+}
+
+/// Asking a driver for its equilibrium before it solved one, or for stresses without
+/// probes, is a misuse with its own error, not an empty contact.
+#[test]
+fn misuse_of_the_driver_has_its_own_errors() {
+    let driver = precursors::Scene::builder()
+        .build()
+        .unwrap()
+        .driver()
+        .unwrap();
+    for e in [
+        driver.normal_traction().map(|_| ()).unwrap_err(),
+        driver.shear_traction().map(|_| ()).unwrap_err(),
+        driver.real_contact_area().map(|_| ()).unwrap_err(),
+    ] {
+        assert!(matches!(e, Error::NotSolved { .. }), "{e}");
+        assert!(e.to_string().contains("call step() first"), "{e}");
+    }
+    assert!(matches!(driver.stresses(), Err(Error::NoProbes)));
+}
+
+/// Integer parameters are reported as integers.
+#[test]
+fn counts_are_reported_as_integers() {
+    let b = Block::new(0.1, 0.01, 0.05).unwrap();
+    let gf = GreenFunction::new(b);
+    let (r, s) = (Point::new(0.05, 0.005, 0.01), Point::new(0.02, 0.001, 0.0));
+    let e = gf
+        .value_with(r, s, &SeriesOptions::with_tolerance(1e-6).max_terms(0))
+        .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            Error::InvalidCount {
+                name: "max_terms",
+                value: 0,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().starts_with("max_terms = 0 is invalid"), "{e}");
 }

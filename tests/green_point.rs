@@ -232,7 +232,7 @@ fn forced_axis_without_separation_is_a_typed_error() {
     let opts = SeriesOptions::with_tolerance(1e-8).axis(SummationAxis::Z);
     assert!(matches!(
         gf.value_with(r, s, &opts),
-        Err(Error::InvalidParameter { .. })
+        Err(Error::InvalidChoice { value: "z", .. })
     ));
 }
 

@@ -16,6 +16,7 @@ mod matrix;
 mod operator;
 mod probe;
 mod properties;
+mod robustness;
 #[cfg(feature = "serde")]
 mod scene_file;
 mod solver;

@@ -418,7 +418,9 @@ fn the_driver_reports_probes_only_when_requested() {
     assert!(plain.probes().is_empty());
     let mut d = plain.driver().unwrap();
     d.step().unwrap();
-    assert!(matches!(d.stresses(), Err(Error::InvalidParameter { .. })));
+    let e = d.stresses().unwrap_err();
+    assert!(matches!(e, Error::NoProbes), "{e}");
+    assert!(e.to_string().contains("SceneBuilder::probes"), "{e}");
 
     let scene = base
         .probes(ProbeSpec::default().plane(0.0).plane(2e-3))

@@ -137,7 +137,12 @@ fn mistakes_are_typed_errors() {
     ];
     for text in cases {
         match SceneBuilder::from_json_str(text) {
-            Err(Error::SceneFile { reason }) => assert!(reason.contains("line"), "{reason}"),
+            Err(e @ Error::SceneFile { line, .. }) => {
+                // The parser's message, with its line and column, is the source.
+                let source = std::error::Error::source(&e).expect("the parser's error");
+                assert!(line >= 1 && source.to_string().contains("line"), "{e}");
+                assert!(e.to_string().contains(&source.to_string()), "{e}");
+            }
             other => panic!("{text}: {other:?}"),
         }
     }
@@ -191,10 +196,25 @@ fn bad_heights_files_name_the_line() {
             other => panic!("{text:?}: {other:?}"),
         }
     }
-    assert!(matches!(
-        HeightSource::from_file(dir.join("missing.txt")),
-        Err(Error::Io { .. })
-    ));
+    // A missing file: the I/O error keeps its kind, the message the operation and path.
+    let missing = dir.join("missing.txt");
+    match HeightSource::from_file(&missing) {
+        Err(e @ Error::Io { .. }) => {
+            let Error::Io { source, path, .. } = &e else {
+                unreachable!()
+            };
+            assert_eq!(source.kind(), std::io::ErrorKind::NotFound);
+            assert_eq!(path, &missing);
+            let text = e.to_string();
+            assert!(
+                text.starts_with(&format!("reading heights file {}: ", missing.display())),
+                "{text}"
+            );
+            let cause = std::error::Error::source(&e).expect("the io::Error");
+            assert!(cause.downcast_ref::<std::io::Error>().is_some());
+        }
+        other => panic!("{other:?}"),
+    }
     // Too few values for the grid: refused at build with the sizes.
     let path = dir.join("short.txt");
     std::fs::write(&path, "1e-6\n2e-6\n").unwrap();
@@ -268,4 +288,77 @@ fn solver_threads_take_counts_and_names() {
             "threads = {bad}"
         );
     }
+}
+
+/// Files that cannot be read or parsed: the error names the operation and the file and
+/// chains the cause (the `std::io::Error` with its kind, the parser's error).
+#[test]
+fn file_errors_name_the_file_and_chain_the_cause() {
+    let dir = scratch("file-errors");
+    let missing = dir.join("no-such-scene.json");
+    let e = SceneBuilder::from_json_file(&missing).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "reading scene file {}: {}",
+            missing.display(),
+            std::fs::read_to_string(&missing).unwrap_err()
+        )
+    );
+    let cause = std::error::Error::source(&e).expect("the io::Error");
+    assert_eq!(
+        cause.downcast_ref::<std::io::Error>().map(|io| io.kind()),
+        Some(std::io::ErrorKind::NotFound)
+    );
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, "{\n  \"normal_load\": }\n").unwrap();
+    let e = SceneBuilder::from_json_file(&bad).unwrap_err();
+    match &e {
+        Error::SceneFile {
+            path, line, column, ..
+        } => {
+            assert_eq!(path.as_deref(), Some(bad.as_path()));
+            assert_eq!((*line, *column), (2, 18));
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(
+        e.to_string()
+            .starts_with(&format!("scene file {}: ", bad.display())),
+        "{e}"
+    );
+    assert!(std::error::Error::source(&e).is_some());
+    // Text given directly has no path.
+    let e = SceneBuilder::from_json_str("{").unwrap_err();
+    assert!(matches!(e, Error::SceneFile { path: None, .. }), "{e}");
+}
+
+/// `max_cells` and the dense backend's threads in scene files.
+#[test]
+fn the_cell_limit_and_dense_threads_in_scene_files() {
+    let b = SceneBuilder::from_json_str(r#"{"max_cells": 500}"#).unwrap();
+    assert!(matches!(
+        b.clone().build(),
+        Err(Error::GridTooLarge {
+            cells: 980,
+            limit: 500,
+            ..
+        })
+    ));
+    // Written only away from its default, and read back.
+    assert!(b.to_json().unwrap().contains("\"max_cells\": 500"));
+    assert_eq!(
+        SceneBuilder::from_json_str(&b.to_json().unwrap()).unwrap(),
+        b
+    );
+    assert!(!Scene::builder().to_json().unwrap().contains("max_cells"));
+    let dense = r#"{"solver": {"backend": "dense", "threads": 2}}"#;
+    let e = SceneBuilder::from_json_str(dense)
+        .unwrap()
+        .build()
+        .unwrap_err();
+    assert!(matches!(e, Error::DenseThreads { threads: 2 }), "{e}");
+    let auto = r#"{"solver": {"backend": "auto", "threads": 2}}"#;
+    let scene = SceneBuilder::from_json_str(auto).unwrap().build().unwrap();
+    assert_eq!(scene.driver().unwrap().threads(), 1);
 }

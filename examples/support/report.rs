@@ -13,15 +13,22 @@ use std::process::ExitCode;
 pub type Outcome = Result<(), Box<dyn Error>>;
 
 /// Prints `error: <message>` and one `caused by: <message>` per source to stderr and
-/// fails; succeeds quietly on `Ok`.
+/// fails; succeeds quietly on `Ok`. A cause whose message already ends the message before
+/// it (the crate's `Error::Io` says "reading scene file <path>: <the io::Error>") is not
+/// printed twice.
 pub fn report(outcome: Outcome) -> ExitCode {
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
+            let mut previous = e.to_string();
             let mut source = e.source();
             while let Some(cause) = source {
-                eprintln!("  caused by: {cause}");
+                let text = cause.to_string();
+                if !previous.ends_with(&text) {
+                    eprintln!("  caused by: {text}");
+                }
+                previous = text;
                 source = cause.source();
             }
             ExitCode::FAILURE

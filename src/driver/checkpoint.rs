@@ -108,6 +108,10 @@ impl Checkpoint {
     }
 
     /// The checkpoint as compact JSON (feature `serde`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidCheckpoint`] if serialisation fails (it does not for a checkpoint
+    /// taken by [`Driver::checkpoint`]).
     #[cfg(feature = "serde")]
     pub fn to_json(&self) -> Result<String> {
         serde_json::to_string(self).map_err(|e| Error::InvalidCheckpoint {
@@ -116,6 +120,9 @@ impl Checkpoint {
     }
 
     /// Reads a checkpoint written by [`Checkpoint::to_json`] (feature `serde`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidCheckpoint`] when `text` is not a checkpoint.
     #[cfg(feature = "serde")]
     pub fn from_json_str(text: &str) -> Result<Checkpoint> {
         serde_json::from_str(text).map_err(|e| Error::InvalidCheckpoint {
@@ -136,14 +143,13 @@ impl Checkpoint {
     pub fn write_to(&self, path: impl AsRef<std::path::Path>) -> Result<()> {
         use std::io::Write;
         let path = path.as_ref();
-        let io = |p: &std::path::Path, e: std::io::Error| Error::Io {
-            path: p.display().to_string(),
-            reason: e.to_string(),
-        };
+        let io = |p: &std::path::Path, e: std::io::Error| Error::io("writing checkpoint", p, e);
         let text = self.to_json()?;
-        let name = path.file_name().ok_or_else(|| Error::Io {
-            path: path.display().to_string(),
-            reason: "not a file name".into(),
+        let name = path.file_name().ok_or_else(|| {
+            io(
+                path,
+                std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file name"),
+            )
         })?;
         let dir = match path.parent() {
             Some(d) if !d.as_os_str().is_empty() => d,
@@ -185,10 +191,8 @@ impl Checkpoint {
     #[cfg(feature = "serde")]
     pub fn read_from(path: impl AsRef<std::path::Path>) -> Result<Checkpoint> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-            path: path.display().to_string(),
-            reason: e.to_string(),
-        })?;
+        let text =
+            std::fs::read_to_string(path).map_err(|e| Error::io("reading checkpoint", path, e))?;
         serde_json::from_str(&text).map_err(|e| Error::CheckpointFile {
             path: path.display().to_string(),
             reason: e.to_string(),
@@ -229,7 +233,7 @@ impl Scene {
     /// [`Error::CheckpointSceneMismatch`], naming the first differing option by its
     /// scene-file key, when the checkpoint was taken on another scene or its stored
     /// scene was edited since (the digest differs); [`Error::InvalidCheckpoint`] when it
-    /// is of another layout version or inconsistent.
+    /// is of another layout version or inconsistent; those of [`Scene::driver`].
     pub fn resume(&self, checkpoint: &Checkpoint) -> Result<Driver> {
         let bad = |reason: String| Err(Error::InvalidCheckpoint { reason });
         if checkpoint.format != FORMAT {

@@ -30,6 +30,9 @@ pub fn top_influence(block: &Block) -> f64 {
 /// Top-face load per unit force, transferred to height `z` (m):
 /// `(1/(Lx Ly)) ∫∫_top ∂G/∂z (x,ξ;y,η;z,Lz) dξ dη = z/(Lz Lx Ly)` (m⁻²), paper Eq.
 /// `derivative_G_B` divided by the face area.
+///
+/// # Errors
+/// [`Error::OutsideBlock`] for `z` outside `[0, Lz]`.
 pub fn top_stress_influence(block: &Block, z: f64) -> Result<f64> {
     let z = block.check_height(z)?;
     Ok(z / (block.lz() * block.lx() * block.ly()))
@@ -47,6 +50,10 @@ pub struct RodLoad {
 impl RodLoad {
     /// A rod at height `h` (m) with half-width `half_width = Δh` (m); the band
     /// `[h - Δh, h + Δh]` must lie inside `[0, Lz]` (to 1e-12 relative).
+    ///
+    /// # Errors
+    /// [`Error::InvalidLength`] for a half-width or height that is not finite and `> 0`;
+    /// [`Error::RodBandOutsideFace`] when the band leaves `[0, Lz]`.
     pub fn new(block: &Block, h: f64, half_width: f64) -> Result<Self> {
         check_length("rod half-width", half_width)?;
         let lz = block.lz();
@@ -107,6 +114,10 @@ impl RodLoad {
     /// `tol` (m⁻¹). Closed form (docs/model.md section 1, paper Eq. `G_x_lat` with all its
     /// constants):
     /// `(1/(Ly Lz)) [Lx(x²/2Lx² - x/Lx + 1/3) + (1/Δh) Σ_n (I_n/k_n) cosh k_n(Lx-x)/sinh k_nLx]`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidTolerance`]; [`Error::OutsideBlock`] for `x` outside `[0, Lx]`;
+    /// [`Error::NotConverged`] when the series does not reach `tol`.
     pub fn influence_at(&self, x: f64, tol: f64) -> Result<Estimate> {
         check_tolerance(tol)?;
         let lx = self.block.lx();
@@ -132,6 +143,10 @@ impl RodLoad {
 
     /// Rod load per unit force averaged over each column of cells (m⁻¹): `Nx` values,
     /// each within `tol` (m⁻¹) of the exact cell average of [`RodLoad::influence_at`].
+    ///
+    /// # Errors
+    /// [`Error::InvalidTolerance`]; [`Error::InvalidParameter`] for a grid on another
+    /// block; [`Error::NotConverged`] when a series does not reach `tol`.
     pub fn influence_cells(&self, grid: &Grid, tol: f64) -> Result<Vec<f64>> {
         check_tolerance(tol)?;
         self.check_grid(grid)?;
@@ -170,6 +185,11 @@ impl RodLoad {
     ///  = -(1/(Δh Ly Lz)) Σ_n sin(k_n z) I_n cosh k_n(Lx-x)/sinh k_nLx` (m⁻²), to absolute
     /// tolerance `tol` (m⁻²). At `x = 0` on an edge of the band the stress is
     /// logarithmically infinite and [`Error::SingularPoint`] is returned.
+    ///
+    /// # Errors
+    /// [`Error::InvalidTolerance`]; [`Error::OutsideBlock`] for `x` or `z` outside the
+    /// block; [`Error::SingularPoint`] on an edge of the band at `x = 0`;
+    /// [`Error::NotConverged`].
     pub fn stress_influence_at(&self, x: f64, z: f64, tol: f64) -> Result<Estimate> {
         check_tolerance(tol)?;
         let lx = self.block.lx();
@@ -225,6 +245,10 @@ impl RodLoad {
 
     /// Rod load per unit force transferred to height `z`, averaged over each column of
     /// cells (m⁻²): `Nx` values, each within `tol` (m⁻²) of the exact cell average.
+    ///
+    /// # Errors
+    /// [`Error::InvalidTolerance`]; [`Error::OutsideBlock`] for `z` outside `[0, Lz]`;
+    /// [`Error::InvalidParameter`] for a grid on another block; [`Error::NotConverged`].
     pub fn stress_influence_cells(&self, grid: &Grid, z: f64, tol: f64) -> Result<Vec<f64>> {
         check_tolerance(tol)?;
         self.check_grid(grid)?;

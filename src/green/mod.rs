@@ -11,6 +11,7 @@
 //!   solvers.
 //! * [`PlaneTransfer`] (`transfer.rs`): bottom tractions carried to a plane at height `z`.
 
+mod cost;
 mod dct;
 pub mod loads;
 mod plan;
@@ -20,6 +21,8 @@ mod spectrum;
 mod staged;
 mod transfer;
 
+pub(crate) use cost::{check_cells, format_bytes, format_seconds};
+pub use cost::{GridCost, DEFAULT_MAX_CELLS};
 pub use loads::RodLoad;
 pub(crate) use plan::SpectralTable;
 pub use plan::{InfluencePlan, InfluencePlanBuilder, DENSE_LIMIT};

@@ -30,6 +30,7 @@ pub const DENSE_LIMIT: usize = 20_000;
 pub struct InfluencePlanBuilder {
     grid: Grid,
     tolerance: f64,
+    max_cells: usize,
 }
 
 impl InfluencePlanBuilder {
@@ -39,10 +40,25 @@ impl InfluencePlanBuilder {
         self
     }
 
+    /// The most cells [`InfluencePlanBuilder::build`] accepts (default
+    /// [`DEFAULT_MAX_CELLS`](super::DEFAULT_MAX_CELLS) = `1e6`): a larger grid is refused
+    /// with [`Error::GridTooLarge`] and its estimated cost ([`GridCost`](super::GridCost))
+    /// before anything is allocated. Raise it for a grid whose cost you accept.
+    pub fn max_cells(mut self, max_cells: usize) -> Self {
+        self.max_cells = max_cells;
+        self
+    }
+
     /// Computes the eigenvalues and plans the DCTs.
+    ///
+    /// # Errors
+    /// [`Error::GridTooLarge`] above [`InfluencePlanBuilder::max_cells`] cells;
+    /// [`Error::InvalidTolerance`] for a tolerance that is not finite and `> 0`;
+    /// [`Error::NotConverged`] when an eigenvalue's alias sum does not reach it.
     pub fn build(self) -> Result<InfluencePlan> {
-        let tol = check_tolerance(self.tolerance)?;
         let grid = self.grid;
+        super::check_cells(grid.nx(), grid.ny(), self.max_cells)?;
+        let tol = check_tolerance(self.tolerance)?;
         let (nx, ny) = (grid.nx(), grid.ny());
         let mut lambda = vec![0.0; grid.len()];
         let mut max_rel_error: f64 = 0.0;
@@ -136,6 +152,7 @@ impl InfluencePlan {
         InfluencePlanBuilder {
             grid,
             tolerance: 1e-6,
+            max_cells: super::DEFAULT_MAX_CELLS,
         }
     }
 
@@ -195,6 +212,10 @@ impl InfluencePlan {
     }
 
     /// `out = Ĝ v` (m⁻¹ times the units of `v`), matrix-free in `O(N log N)`.
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] when `v` or `out` does not hold one value per cell;
+    /// [`Error::NonFinite`] for a NaN or infinite input.
     pub fn apply(&self, v: &[f64], out: &mut [f64]) -> Result<()> {
         let n = self.inner.grid.len();
         check_slice("v", v, n)?;
@@ -252,6 +273,9 @@ impl InfluencePlan {
     /// The dense matrix `Ĝ` (m⁻¹), row-major `N x N`, assembled from the eigenvalue table
     /// by explicit cosine sums (independent of the DCT path). Refused above
     /// [`DENSE_LIMIT`] cells.
+    ///
+    /// # Errors
+    /// [`Error::TooLargeForDense`] above [`DENSE_LIMIT`] cells.
     pub fn dense(&self) -> Result<Vec<f64>> {
         let n = self.inner.grid.len();
         if n > DENSE_LIMIT {
@@ -298,6 +322,10 @@ impl InfluencePlan {
 
     /// The transfer of bottom tractions to the plane at height `z` (m), with the alias
     /// sums converged to absolute tolerance `tol` (the factors are at most 1).
+    ///
+    /// # Errors
+    /// [`Error::InvalidTolerance`],
+    /// [`Error::OutsideBlock`] for `z` outside `[0, Lz]`, [`Error::NotConverged`].
     pub fn plane_transfer(&self, z: f64, tol: f64) -> Result<PlaneTransfer> {
         PlaneTransfer::new(self, z, tol)
     }

@@ -34,10 +34,28 @@ impl Planner {
     /// The plan of `grid` with relative tolerance `tolerance` ([`InfluencePlan::builder`]),
     /// planned on the first request and shared afterwards.
     ///
+    /// Grids above [`DEFAULT_MAX_CELLS`](super::DEFAULT_MAX_CELLS) cells are refused;
+    /// [`Planner::plan_with_max_cells`] raises the limit.
+    ///
     /// # Errors
-    /// Those of [`crate::green::InfluencePlanBuilder::build`] (invalid tolerance, an alias
-    /// sum that does not converge).
+    /// Those of [`crate::green::InfluencePlanBuilder::build`]: [`crate::Error::GridTooLarge`],
+    /// [`crate::Error::InvalidTolerance`], [`crate::Error::NotConverged`].
     pub fn plan(&self, grid: Grid, tolerance: f64) -> Result<InfluencePlan> {
+        self.plan_with_max_cells(grid, tolerance, super::DEFAULT_MAX_CELLS)
+    }
+
+    /// [`Planner::plan`] with a limit of `max_cells` cells instead of the default
+    /// ([`crate::green::InfluencePlanBuilder::max_cells`]); a cached plan is returned
+    /// whatever the limit.
+    ///
+    /// # Errors
+    /// As [`Planner::plan`].
+    pub fn plan_with_max_cells(
+        &self,
+        grid: Grid,
+        tolerance: f64,
+        max_cells: usize,
+    ) -> Result<InfluencePlan> {
         let same =
             |p: &InfluencePlan| *p.grid() == grid && p.tolerance().to_bits() == tolerance.to_bits();
         if let Some(plan) = self.lock().iter().find(|p| same(p)) {
@@ -45,7 +63,10 @@ impl Planner {
         }
         // Planned outside the lock (other geometries stay available meanwhile); a plan
         // of the same geometry planned meanwhile by another thread wins.
-        let plan = InfluencePlan::builder(grid).tolerance(tolerance).build()?;
+        let plan = InfluencePlan::builder(grid)
+            .tolerance(tolerance)
+            .max_cells(max_cells)
+            .build()?;
         let mut plans = self.lock();
         if let Some(existing) = plans.iter().find(|p| same(p)) {
             return Ok(existing.clone());

@@ -94,9 +94,9 @@ impl SeriesOptions {
     fn check(&self) -> Result<()> {
         check_tolerance(self.tolerance)?;
         if self.max_terms == 0 {
-            return Err(Error::InvalidParameter {
+            return Err(Error::InvalidCount {
                 name: "max_terms",
-                value: 0.0,
+                value: 0,
                 reason: "a series needs at least one term",
             });
         }
@@ -148,11 +148,20 @@ impl GreenFunction {
     }
 
     /// `G(r, r')` (m⁻¹) by the rapid representation, to absolute tolerance `tol` (m⁻¹).
+    ///
+    /// # Errors
+    /// As [`GreenFunction::value_with`].
     pub fn value(&self, target: Point, source: Point, tol: f64) -> Result<Estimate> {
         self.value_with(target, source, &SeriesOptions::with_tolerance(tol))
     }
 
     /// `G(r, r')` (m⁻¹) by the rapid representation with explicit options.
+    ///
+    /// # Errors
+    /// [`Error::InvalidTolerance`]; [`Error::InvalidCount`] for a term budget of zero;
+    /// [`Error::OutsideBlock`] for a point outside the block; [`Error::SingularPoint`] when
+    /// target and source coincide; [`Error::InvalidChoice`] for a forced axis along which
+    /// they do not differ; [`Error::NotConverged`] past the term budget.
     pub fn value_with(
         &self,
         target: Point,
@@ -163,11 +172,17 @@ impl GreenFunction {
     }
 
     /// `∂G/∂z (r, r')` (m⁻²), derivative in the target's height, to absolute tolerance `tol`.
+    ///
+    /// # Errors
+    /// As [`GreenFunction::value_with`].
     pub fn dz(&self, target: Point, source: Point, tol: f64) -> Result<Estimate> {
         self.dz_with(target, source, &SeriesOptions::with_tolerance(tol))
     }
 
     /// `∂G/∂z (r, r')` (m⁻²) with explicit options.
+    ///
+    /// # Errors
+    /// As [`GreenFunction::value_with`].
     pub fn dz_with(&self, target: Point, source: Point, opts: &SeriesOptions) -> Result<Estimate> {
         self.rapid(target, source, opts, true)
     }
@@ -210,9 +225,9 @@ impl GreenFunction {
                     z: a[2],
                 });
             }
-            return Err(Error::InvalidParameter {
-                name: "axis",
-                value: axis as f64,
+            return Err(Error::InvalidChoice {
+                name: "summation axis",
+                value: ["x", "y", "z"][axis],
                 reason: "the target has the source's coordinate along the summed axis, \
                          where that representation does not converge; use SummationAxis::Auto",
             });
@@ -227,6 +242,9 @@ impl GreenFunction {
     /// difference is the error estimate. It converges algebraically, and only where the
     /// target differs from the source in every coordinate; expect
     /// [`Error::NotConverged`] for tight tolerances.
+    ///
+    /// # Errors
+    /// As [`GreenFunction::value_with`]; [`Error::NotConverged`] is common here.
     pub fn raw_series(
         &self,
         target: Point,

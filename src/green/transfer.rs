@@ -135,6 +135,10 @@ impl PlaneTransfer {
     /// Cell-averaged stress on the plane (Pa) due to the bottom tractions `traction` (Pa):
     /// `σ(z) = -T(z) φ`, so that `σ_xz` follows from `φ_x` and `σ_zz` from `φ_z`; at
     /// `z = 0` it is `-φ`. External load terms are not included (see [`crate::green::loads`]).
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] when `traction` or `out` does not hold one value per cell;
+    /// [`Error::NonFinite`] for a NaN or infinite traction.
     pub fn stress(&self, traction: &[f64], out: &mut [f64]) -> Result<()> {
         let n = self.grid.len();
         check_slice("traction", traction, n)?;

@@ -27,6 +27,14 @@ struct SceneFile {
     solver: SolverSpec,
     plan_tolerance: f64,
     probes: ProbesSpec,
+    /// Written only when it is not the default, so files of scenes within the default
+    /// limit stay as they were.
+    #[serde(skip_serializing_if = "is_default_max_cells")]
+    max_cells: usize,
+}
+
+fn is_default_max_cells(max_cells: &usize) -> bool {
+    *max_cells == crate::green::DEFAULT_MAX_CELLS
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -279,6 +287,7 @@ impl From<&SceneBuilder> for SceneFile {
                 points: b.probes.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
                 tolerance: b.probes.tolerance,
             },
+            max_cells: b.max_cells,
         }
     }
 }
@@ -355,13 +364,18 @@ impl SceneFile {
                     .collect();
                 probes
             },
+            max_cells: self.max_cells,
         })
     }
 }
 
-fn json_error(e: serde_json::Error) -> Error {
+/// A JSON error of the scene file at `path` (`None`: text given directly).
+fn json_error(path: Option<&Path>, e: serde_json::Error) -> Error {
     Error::SceneFile {
-        reason: e.to_string(),
+        path: path.map(Path::to_path_buf),
+        line: e.line(),
+        column: e.column(),
+        source: Box::new(e),
     }
 }
 
@@ -369,30 +383,38 @@ impl SceneBuilder {
     /// Reads a scene from JSON text (`docs/scene-format.md`; feature `serde`). A heights
     /// file named in it is read relative to the current directory. Nothing is validated
     /// beyond the format until [`SceneBuilder::build`].
+    ///
+    /// # Errors
+    /// [`Error::SceneFile`] for invalid JSON or a key outside the format; those of
+    /// [`HeightSource::from_file`] for a heights file.
     pub fn from_json_str(text: &str) -> Result<SceneBuilder> {
-        let file: SceneFile = serde_json::from_str(text).map_err(json_error)?;
+        let file: SceneFile = serde_json::from_str(text).map_err(|e| json_error(None, e))?;
         file.into_builder(Path::new("."))
     }
 
     /// Reads a scene file (`docs/scene-format.md`; feature `serde`). A heights file named
     /// in it is read relative to the scene file's directory.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be read; [`Error::SceneFile`] (with the path,
+    /// line and column) for invalid JSON or a key outside the format; those of
+    /// [`HeightSource::from_file`] for a heights file.
     pub fn from_json_file(path: impl AsRef<Path>) -> Result<SceneBuilder> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-            path: path.display().to_string(),
-            reason: e.to_string(),
-        })?;
-        let file: SceneFile = serde_json::from_str(&text).map_err(|e| Error::SceneFile {
-            reason: format!("{}: {e}", path.display()),
-        })?;
+        let text =
+            std::fs::read_to_string(path).map_err(|e| Error::io("reading scene file", path, e))?;
+        let file: SceneFile = serde_json::from_str(&text).map_err(|e| json_error(Some(path), e))?;
         file.into_builder(path.parent().unwrap_or(Path::new(".")))
     }
 
     /// The scene as JSON (`docs/scene-format.md`; feature `serde`), every key written.
     /// Heights read from a file are written as values. Reading it back gives an equal
     /// builder: floats round-trip exactly.
+    ///
+    /// # Errors
+    /// [`Error::SceneFile`] if serialisation fails (it does not for a builder's values).
     pub fn to_json(&self) -> Result<String> {
-        serde_json::to_string_pretty(&SceneFile::from(self)).map_err(json_error)
+        serde_json::to_string_pretty(&SceneFile::from(self)).map_err(|e| json_error(None, e))
     }
 }
 

@@ -214,7 +214,8 @@ impl FactorCache {
             self.order.clear();
             return Err(Error::Factorization {
                 n,
-                reason: format!("{e:?}"),
+                reason: format!("faer reported {e}"),
+                source: Some(Box::new(e)),
             });
         }
         if let Some(a) = bad_pivot {
@@ -225,6 +226,7 @@ impl FactorCache {
                 reason: format!(
                     "pivot {a} is {pivot:e}: the matrix is not numerically positive definite"
                 ),
+                source: None,
             });
         }
         Ok(())

@@ -43,7 +43,7 @@ pub use options::{
 };
 pub use parallel::Parallelism;
 
-use crate::error::{check_tolerance, Error, Result};
+use crate::error::{Error, Result};
 use crate::geometry::Grid;
 use crate::green::{InfluencePlan, Partition};
 use crate::interface::{Interface, Material};
@@ -98,13 +98,14 @@ impl EquilibriumSolverBuilder {
     /// Validates and prepares the backend (assembles `C` for the dense one).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for an invalid material, tolerance or thread count;
-    /// [`Error::TooLargeForDense`] for the dense backend on a grid above
-    /// [`crate::green::DENSE_LIMIT`] cells.
+    /// [`Error::InvalidParameter`] for an invalid material; [`Error::InvalidTolerance`]
+    /// for an invalid tolerance; [`Error::InvalidCount`] for `Parallelism::Threads(0)`;
+    /// [`Error::DenseThreads`] for an explicit [`Backend::Dense`] with
+    /// `Parallelism::Threads(n > 1)`; [`Error::TooLargeForDense`] for the dense backend
+    /// on a grid above [`crate::green::DENSE_LIMIT`] cells.
     pub fn build(self) -> Result<EquilibriumSolver> {
         self.material.validate()?;
-        check_tolerance(self.options.tolerance)?;
-        self.options.parallelism.validate()?;
+        self.options.validate()?;
         let grid = *self.plan.grid();
         let n = grid.len();
         let backend = match self.options.backend {
@@ -225,11 +226,23 @@ impl EquilibriumSolver {
     /// Uses `parallelism` from the next solve on (the results do not change).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for `Parallelism::Threads(0)`.
+    /// [`Error::InvalidCount`] for `Parallelism::Threads(0)`; [`Error::DenseThreads`] for
+    /// `Parallelism::Threads(n > 1)` when the options ask for [`Backend::Dense`].
     pub fn set_parallelism(&mut self, parallelism: Parallelism) -> Result<()> {
-        parallelism.validate()?;
+        options::check_threads(self.options.backend, parallelism)?;
         self.options.parallelism = parallelism;
         Ok(())
+    }
+
+    /// The threads a solve actually uses: 1 on the dense backend (one part, whatever
+    /// the parallelism; [`SolverOptions::parallelism`]), at most the grid's parts on the
+    /// spectral one (up to 16; grids below 2048 cells are one part).
+    pub fn threads(&self) -> usize {
+        let parts = match &self.core {
+            Core::Dense(_) => 1,
+            Core::Spectral(s) => s.parts(),
+        };
+        self.options.parallelism.threads().min(parts).max(1)
     }
 
     /// Forgets factors and warm starts (the next solve starts cold).

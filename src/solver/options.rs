@@ -2,6 +2,7 @@
 //! report of a solve.
 
 use super::parallel::Parallelism;
+use crate::error::{check_tolerance, Error, Result};
 use crate::interface::SiteState;
 
 /// Largest grid the [`Backend::Auto`] choice solves densely.
@@ -38,10 +39,14 @@ pub struct SolverOptions {
     /// The threads a solve may use (default [`Parallelism::Sequential`]). The spectral
     /// backend shares each solve's work over the parts of the grid (fixed by the grid);
     /// the results are the same bit for bit for every choice (tested), only the wall time
-    /// changes (docs/performance.md). The dense backend (grids up to
-    /// [`AUTO_DENSE_LIMIT`] cells under [`Backend::Auto`]) is one part: it runs on the
-    /// calling thread whatever the choice. To run several scenes at once (seeds), give
-    /// each [`Parallelism::Sequential`] and one scene per core.
+    /// changes (docs/performance.md). The dense backend is one part: it runs on the
+    /// calling thread. So an explicit [`Backend::Dense`] with
+    /// [`Parallelism::Threads`]`(n > 1)` is refused ([`Error::DenseThreads`]: use the
+    /// spectral backend for threads), while [`Backend::Auto`], which picks the dense
+    /// backend up to [`AUTO_DENSE_LIMIT`] cells, accepts any parallelism and runs such
+    /// small grids on the calling thread ([`crate::EquilibriumSolver::threads`] and
+    /// [`crate::Driver::threads`] tell the threads actually used). To run several scenes
+    /// at once (seeds), give each [`Parallelism::Sequential`] and one scene per core.
     pub parallelism: Parallelism,
 }
 
@@ -77,6 +82,25 @@ impl SolverOptions {
     pub fn parallelism(mut self, parallelism: Parallelism) -> Self {
         self.parallelism = parallelism;
         self
+    }
+
+    /// Checks the options: the tolerance, the thread count and the thread count with an
+    /// explicit dense backend.
+    pub(crate) fn validate(&self) -> Result<()> {
+        check_tolerance(self.tolerance)?;
+        check_threads(self.backend, self.parallelism)
+    }
+}
+
+/// Refuses a thread count the backend cannot honour: `Threads(0)`, and an explicit
+/// [`Backend::Dense`] with `Threads(n > 1)`.
+pub(crate) fn check_threads(backend: Backend, parallelism: Parallelism) -> Result<()> {
+    parallelism.validate()?;
+    match (backend, parallelism) {
+        (Backend::Dense, Parallelism::Threads(threads)) if threads > 1 => {
+            Err(Error::DenseThreads { threads })
+        }
+        _ => Ok(()),
     }
 }
 

@@ -63,9 +63,9 @@ impl Parallelism {
     /// Checks the thread count.
     pub(crate) fn validate(&self) -> Result<()> {
         match self {
-            Self::Threads(0) => Err(Error::InvalidParameter {
+            Self::Threads(0) => Err(Error::InvalidCount {
                 name: "threads",
-                value: 0.0,
+                value: 0,
                 reason: "a solve needs at least one thread (Parallelism::Threads(n >= 1))",
             }),
             _ => Ok(()),
@@ -337,7 +337,7 @@ fn shared_pool(size: usize) -> Result<Arc<rayon::ThreadPool>> {
         .build()
         .map_err(|e| Error::ThreadPool {
             threads: size + 1,
-            reason: e.to_string(),
+            source: Box::new(e),
         })?;
     let pool = Arc::new(pool);
     pools.push((size, pool.clone()));

@@ -151,6 +151,11 @@ impl SpectralCore {
     }
 
     /// The `d̄` of the spectral preconditioner's table, if one was built (checkpoints).
+    /// The parts of the grid a solve runs over.
+    pub(crate) fn parts(&self) -> usize {
+        self.staging.partition().parts()
+    }
+
     pub(crate) fn preconditioner_mean(&self) -> Option<f64> {
         self.inverse.as_ref().map(|(_, d, _)| *d)
     }
