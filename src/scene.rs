@@ -222,7 +222,7 @@ impl Default for SceneBuilder {
             normal_load: 3.5e3,
             drive: Drive::default(),
             solver: SolverOptions::default(),
-            plan_tolerance: 1e-6,
+            plan_tolerance: 1e-8,
             probes: ProbeSpec::default(),
             max_cells: crate::green::DEFAULT_MAX_CELLS,
         }
@@ -447,7 +447,7 @@ impl SceneBuilder {
     }
 
     /// Relative accuracy of the influence operator's eigenvalues (dimensionless, default
-    /// `1e-6`, as [`InfluencePlan::builder`]; see `docs/accuracy.md`). The lateral load
+    /// `1e-8`, as [`InfluencePlan::builder`]; see `docs/accuracy.md`). The lateral load
     /// table is always summed to `1e-12` relative (closed forms, cheap).
     pub fn plan_tolerance(mut self, tolerance: f64) -> Self {
         self.plan_tolerance = tolerance;

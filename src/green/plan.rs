@@ -34,7 +34,7 @@ pub struct InfluencePlanBuilder {
 }
 
 impl InfluencePlanBuilder {
-    /// Relative tolerance on every eigenvalue's alias sum (default `1e-6`).
+    /// Relative tolerance on every eigenvalue's alias sum (default `1e-8`).
     pub fn tolerance(mut self, tolerance: f64) -> Self {
         self.tolerance = tolerance;
         self
@@ -151,7 +151,7 @@ impl InfluencePlan {
     pub fn builder(grid: Grid) -> InfluencePlanBuilder {
         InfluencePlanBuilder {
             grid,
-            tolerance: 1e-6,
+            tolerance: 1e-8,
             max_cells: super::DEFAULT_MAX_CELLS,
         }
     }
