@@ -1,5 +1,5 @@
 //! The tables of a run, as written by the `precursors` program (`run`, `resume`, `sweep`)
-//! and by [`crate::sweep::Sweep::run_one`]: CSV files that survive a crash.
+//! and by `Sweep::run_one` (module `sweep`, feature `serde`): CSV files that survive a crash.
 //!
 //! * `events.csv`, one row per event ([`EVENTS_HEADER`]): `index,kind,ix,iy,force_N,
 //!   drive_displacement_m,energy_J,ruptures,area_exceeds_nominal` (empty cells where a

@@ -235,7 +235,9 @@ fn set_path(scene: &mut Value, key: &str, value: &Value) -> Result<()> {
                 ),
             ));
         }
-        let next = object.get_mut(*segment).ok_or_else(|| key_error(key, "missing"))?;
+        let next = object
+            .get_mut(*segment)
+            .ok_or_else(|| key_error(key, "missing"))?;
         if depth + 1 == segments.len() {
             *next = value.clone();
             return Ok(());
@@ -289,7 +291,9 @@ impl Sweep {
             });
         }
         let random = matches!(
-            builder_from_value(spec.base.clone()).map_err(base_error)?.current_heights(),
+            builder_from_value(spec.base.clone())
+                .map_err(base_error)?
+                .current_heights(),
             HeightSource::Random { .. }
         );
         if spec.realizations > 1 && !random {
@@ -321,10 +325,16 @@ impl Sweep {
                 let mut scene = spec.base.clone();
                 set_path(&mut scene, key, value)?;
                 let builder = builder_from_value(scene).map_err(|reason| {
-                    key_error(key, format!("value {value} (#{i}) is not valid here: {reason}"))
+                    key_error(
+                        key,
+                        format!("value {value} (#{i}) is not valid here: {reason}"),
+                    )
                 })?;
                 builder.checked().map_err(|e| {
-                    key_error(key, format!("value {value} (#{i}) gives an invalid scene: {e}"))
+                    key_error(
+                        key,
+                        format!("value {value} (#{i}) gives an invalid scene: {e}"),
+                    )
                 })?;
             }
         }
@@ -365,7 +375,10 @@ impl Sweep {
                     set_path(&mut scene_value, "heights.seed", &Value::from(seed))?;
                 }
                 let builder = builder_from_value(scene_value).map_err(|reason| {
-                    key_error(&keys(), format!("the point {} is not valid: {reason}", describe()))
+                    key_error(
+                        &keys(),
+                        format!("the point {} is not valid: {reason}", describe()),
+                    )
                 })?;
                 if realization == 0 {
                     builder.checked().map_err(|e| {
@@ -387,11 +400,7 @@ impl Sweep {
                 });
             }
         }
-        Ok(Sweep {
-            spec,
-            points,
-            runs,
-        })
+        Ok(Sweep { spec, points, runs })
     }
 
     /// The sweep as JSON, its base scene with every key (heights files as values): the

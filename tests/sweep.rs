@@ -44,30 +44,54 @@ fn key_of(e: Error) -> String {
 fn format_errors_name_the_key() {
     let err = |axes: &str| Sweep::from_json_str(&sweep_text(axes, 1)).unwrap_err();
     // Not a scene key, at the top and inside an object.
-    assert_eq!(key_of(err(r#"{ "key": "normal_lod", "values": [1.0] }"#)), "normal_lod");
+    assert_eq!(
+        key_of(err(r#"{ "key": "normal_lod", "values": [1.0] }"#)),
+        "normal_lod"
+    );
     let e = err(r#"{ "key": "block.lxx", "values": [0.02] }"#);
     assert!(e.to_string().contains("`block` has no `lxx`"), "{e}");
     assert_eq!(key_of(e), "block.lxx");
     // Below a number.
-    assert_eq!(key_of(err(r#"{ "key": "normal_load.x", "values": [1.0] }"#)), "normal_load.x");
+    assert_eq!(
+        key_of(err(r#"{ "key": "normal_load.x", "values": [1.0] }"#)),
+        "normal_load.x"
+    );
     // A value of the wrong type, and values the scene refuses.
     let e = err(r#"{ "key": "normal_load", "values": [300.0, "heavy"] }"#);
     assert!(e.to_string().contains("\"heavy\""), "{e}");
     assert_eq!(key_of(e), "normal_load");
-    assert_eq!(key_of(err(r#"{ "key": "block.lx", "values": [-0.03] }"#)), "block.lx");
-    assert_eq!(key_of(err(r#"{ "key": "normal_load", "values": [0.0] }"#)), "normal_load");
-    assert_eq!(key_of(err(r#"{ "key": "drive.height", "values": [0.5] }"#)), "drive.height");
+    assert_eq!(
+        key_of(err(r#"{ "key": "block.lx", "values": [-0.03] }"#)),
+        "block.lx"
+    );
+    assert_eq!(
+        key_of(err(r#"{ "key": "normal_load", "values": [0.0] }"#)),
+        "normal_load"
+    );
+    assert_eq!(
+        key_of(err(r#"{ "key": "drive.height", "values": [0.5] }"#)),
+        "drive.height"
+    );
     // A cell size that does not divide the block.
-    assert_eq!(key_of(err(r#"{ "key": "cells.dx", "values": [0.0007] }"#)), "cells.dx");
+    assert_eq!(
+        key_of(err(r#"{ "key": "cells.dx", "values": [0.0007] }"#)),
+        "cells.dx"
+    );
     // No values, twice the same key, the seed (derived by the sweep).
-    assert_eq!(key_of(err(r#"{ "key": "normal_load", "values": [] }"#)), "normal_load");
+    assert_eq!(
+        key_of(err(r#"{ "key": "normal_load", "values": [] }"#)),
+        "normal_load"
+    );
     assert_eq!(
         key_of(err(
             r#"{ "key": "normal_load", "values": [1.0] }, { "key": "normal_load", "values": [2.0] }"#
         )),
         "normal_load"
     );
-    assert_eq!(key_of(err(r#"{ "key": "heights.seed", "values": [1, 2] }"#)), "heights.seed");
+    assert_eq!(
+        key_of(err(r#"{ "key": "heights.seed", "values": [1, 2] }"#)),
+        "heights.seed"
+    );
     // A combination of valid values that is not valid: named by the axes' keys.
     let e = err(r#"{ "key": "block.lz", "values": [0.02, 0.005] },
                    { "key": "drive.height", "values": [0.004, 0.008] }"#);
@@ -82,7 +106,16 @@ fn format_errors_name_the_key() {
         assert!(matches!(e, Error::SweepFile { .. }), "{text}: {e:?}");
     }
     let e = Sweep::from_json_str(&sweep_text("", 0)).unwrap_err();
-    assert!(matches!(e, Error::InvalidCount { name: "realizations", .. }), "{e:?}");
+    assert!(
+        matches!(
+            e,
+            Error::InvalidCount {
+                name: "realizations",
+                ..
+            }
+        ),
+        "{e:?}"
+    );
     let sweep = Sweep::from_json_str(&small()).unwrap();
     assert!(matches!(sweep.shard(2, 2), Err(Error::InvalidCount { .. })));
     assert!(matches!(sweep.shard(0, 0), Err(Error::InvalidCount { .. })));
@@ -113,6 +146,20 @@ fn seeds_are_derived_stably_from_the_base_seed_and_the_coordinates() {
     seeds.sort_unstable();
     seeds.dedup();
     assert_eq!(seeds.len(), 8);
+}
+
+#[test]
+fn the_documented_sweep_is_valid() {
+    let doc = include_str!("../docs/sweep-format.md");
+    let block = doc
+        .split("```json\n")
+        .nth(1)
+        .and_then(|rest| rest.split("```").next())
+        .unwrap();
+    let sweep = Sweep::from_json_str(block).unwrap();
+    assert_eq!((sweep.points(), sweep.realizations()), (6, 10));
+    assert_eq!(sweep.keys(), ["normal_load", "drive.height"]);
+    assert_eq!(sweep.runs().len(), 60);
 }
 
 /// Every file of the runs and the merge in `dir`, but the timings (`meta.json`).
@@ -160,7 +207,10 @@ fn complete_runs_are_skipped_and_a_cut_one_is_redone() {
     assert_eq!((second.runs, second.completed, second.skipped), (8, 1, 7));
     let mut reports = reports.into_inner().unwrap();
     reports.sort_unstable();
-    assert!(reports.iter().all(|&(i, skipped)| skipped == (i != 5)), "{reports:?}");
+    assert!(
+        reports.iter().all(|&(i, skipped)| skipped == (i != 5)),
+        "{reports:?}"
+    );
     assert!(!cut.join("stray").exists() && cut.join(DONE_FILE).is_file());
     assert!(complete.join("stray").exists());
     merge(&dir).unwrap();
@@ -171,7 +221,9 @@ fn complete_runs_are_skipped_and_a_cut_one_is_redone() {
         1,
     ))
     .unwrap();
-    let e = other.execute(&dir, &SweepOptions::new(), |_| {}).unwrap_err();
+    let e = other
+        .execute(&dir, &SweepOptions::new(), |_| {})
+        .unwrap_err();
     assert!(matches!(e, Error::SweepDirectory { .. }), "{e:?}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -182,8 +234,12 @@ fn tables_do_not_depend_on_jobs_or_shards() {
     let one = scratch("jobs1");
     let two = scratch("jobs2");
     let sharded = scratch("shards");
-    sweep.execute(&one, &SweepOptions::new().jobs(1), |_| {}).unwrap();
-    sweep.execute(&two, &SweepOptions::new().jobs(2), |_| {}).unwrap();
+    sweep
+        .execute(&one, &SweepOptions::new().jobs(1), |_| {})
+        .unwrap();
+    sweep
+        .execute(&two, &SweepOptions::new().jobs(2), |_| {})
+        .unwrap();
     let a = sweep
         .execute(&sharded, &SweepOptions::new().shard(0, 2).jobs(2), |_| {})
         .unwrap();
@@ -195,7 +251,10 @@ fn tables_do_not_depend_on_jobs_or_shards() {
     assert_eq!((a.runs, b.runs, a.completed + b.completed), (4, 4, 8));
     for dir in [&one, &two, &sharded] {
         let summary = merge(dir).unwrap();
-        assert_eq!((summary.points, summary.runs_merged, summary.runs_missing), (4, 8, 0));
+        assert_eq!(
+            (summary.points, summary.runs_merged, summary.runs_missing),
+            (4, 8, 0)
+        );
     }
     let reference = tables(&one);
     // 8 runs x 2 tables + 4 merged files.
@@ -291,7 +350,12 @@ mod cli {
         let (one, two, shards) = (dir.join("one"), dir.join("two"), dir.join("shards"));
         for (out, jobs) in [(&one, "1"), (&two, "2")] {
             let o = precursors(&["sweep", path(&file), "--out", path(out), "--jobs", jobs]);
-            assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+            assert_eq!(
+                o.status.code(),
+                Some(0),
+                "{}",
+                String::from_utf8_lossy(&o.stderr)
+            );
         }
         // Shards from SLURM's variables (an array 1-2: the minimum is subtracted).
         for id in ["1", "2"] {
@@ -302,14 +366,24 @@ mod cli {
                 .env("SLURM_ARRAY_TASK_MIN", "1")
                 .output()
                 .unwrap();
-            assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+            assert_eq!(
+                o.status.code(),
+                Some(0),
+                "{}",
+                String::from_utf8_lossy(&o.stderr)
+            );
             let text = String::from_utf8_lossy(&o.stderr).to_string();
             let k = id.parse::<usize>().unwrap() - 1;
             assert!(text.contains(&format!("shard {k}/2: 4 runs")), "{text}");
         }
         for out in [&one, &two, &shards] {
             let o = precursors(&["merge", path(out)]);
-            assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+            assert_eq!(
+                o.status.code(),
+                Some(0),
+                "{}",
+                String::from_utf8_lossy(&o.stderr)
+            );
         }
         let reference = tables(&one);
         assert_eq!(reference.len(), 20);
@@ -325,8 +399,11 @@ mod cli {
     fn errors_name_the_key_and_have_their_exit_codes() {
         let dir = scratch("cli-errors");
         let file = dir.join("bad.json");
-        std::fs::write(&file, sweep_text(r#"{ "key": "block.lxx", "values": [0.02] }"#, 1))
-            .unwrap();
+        std::fs::write(
+            &file,
+            sweep_text(r#"{ "key": "block.lxx", "values": [0.02] }"#, 1),
+        )
+        .unwrap();
         let o = precursors(&["sweep", path(&file), "--out", path(&dir.join("o"))]);
         assert_eq!(o.status.code(), Some(3));
         let text = String::from_utf8_lossy(&o.stderr);
@@ -343,7 +420,10 @@ mod cli {
         let o = precursors(&["info", path(&scene)]);
         assert_eq!(o.status.code(), Some(0));
         let text = String::from_utf8_lossy(&o.stdout);
-        assert!(text.contains("30 x 5 = 150") && text.contains("dense (auto)"), "{text}");
+        assert!(
+            text.contains("30 x 5 = 150") && text.contains("dense (auto)"),
+            "{text}"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -100,8 +100,14 @@ fn parse_shard(text: &str) -> Result<(usize, usize), String> {
     let (k, n) = text
         .split_once('/')
         .ok_or_else(|| format!("{text:?} is not K/N (e.g. 0/4)"))?;
-    let k: usize = k.trim().parse().map_err(|e| format!("K in {text:?}: {e}"))?;
-    let n: usize = n.trim().parse().map_err(|e| format!("N in {text:?}: {e}"))?;
+    let k: usize = k
+        .trim()
+        .parse()
+        .map_err(|e| format!("K in {text:?}: {e}"))?;
+    let n: usize = n
+        .trim()
+        .parse()
+        .map_err(|e| format!("N in {text:?}: {e}"))?;
     if n == 0 || k >= n {
         return Err(format!("{text:?}: need 0 <= K < N"));
     }
@@ -172,7 +178,13 @@ fn main() -> ExitCode {
             out,
             checkpoint,
             every,
-        } => run(Start::Scene(&scene), &out, checkpoint.as_deref(), every, progress),
+        } => run(
+            Start::Scene(&scene),
+            &out,
+            checkpoint.as_deref(),
+            every,
+            progress,
+        ),
         Command::Resume {
             checkpoint,
             out,
@@ -378,9 +390,15 @@ fn info(path: &Path) -> Result<(), Failure> {
         grid.dx(),
         grid.dy()
     );
-    println!("backend    {resolved}, solver threads {}", file["solver"]["threads"]);
+    println!(
+        "backend    {resolved}, solver threads {}",
+        file["solver"]["threads"]
+    );
     println!("memory     ~{} (estimate)", bytes(cost.memory_bytes));
-    println!("plan       ~{} (estimate, one thread)", seconds(cost.plan_seconds));
+    println!(
+        "plan       ~{} (estimate, one thread)",
+        seconds(cost.plan_seconds)
+    );
     println!(
         "equilibrium ~{} per cold normal + tangential solve (estimate, one thread)",
         seconds(cost.solve_seconds)
@@ -444,8 +462,10 @@ fn run_sweep(
     let options = SweepOptions::new().jobs(jobs).shard(shard.0, shard.1);
     let summary = sweep.execute(out, &options, |report| {
         let d = done.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1;
-        let r = ran.fetch_add(usize::from(!report.skipped), std::sync::atomic::Ordering::SeqCst)
-            + usize::from(!report.skipped);
+        let r = ran.fetch_add(
+            usize::from(!report.skipped),
+            std::sync::atomic::Ordering::SeqCst,
+        ) + usize::from(!report.skipped);
         if let Ok(mut bar) = bar.lock() {
             bar.show(d == share, |elapsed| {
                 let rate = r as f64 / elapsed.max(1e-9);

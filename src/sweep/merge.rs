@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 /// The loads `F/(μF_N)` at which [`merge`] reports ℓ/Lx and `A_R/A_R(0)`:
 /// 0.05, 0.10, ..., 0.95.
 pub const LOAD_GRID: [f64; 19] = [
-    0.05, 0.10, 0.15, 0.20, 0.25, 0.30, 0.35, 0.40, 0.45, 0.50, 0.55, 0.60, 0.65, 0.70, 0.75,
-    0.80, 0.85, 0.90, 0.95,
+    0.05, 0.10, 0.15, 0.20, 0.25, 0.30, 0.35, 0.40, 0.45, 0.50, 0.55, 0.60, 0.65, 0.70, 0.75, 0.80,
+    0.85, 0.90, 0.95,
 ];
 
 /// What [`merge`] wrote.
@@ -33,9 +33,9 @@ pub struct MergeSummary {
 /// 3e-3); `NaN` for `df = 0`.
 pub fn t_quantile_975(df: usize) -> f64 {
     const TABLE: [f64; 30] = [
-        12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179,
-        2.160, 2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064,
-        2.060, 2.056, 2.052, 2.048, 2.045, 2.042,
+        12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
+        2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
+        2.052, 2.048, 2.045, 2.042,
     ];
     match df {
         0 => f64::NAN,
@@ -123,7 +123,10 @@ fn read_run(dir: &Path, run: &SweepRun) -> Result<RunData> {
     let curve_path = dir.join("curve.csv");
     let text = read(&curve_path)?;
     let mut curve = Vec::new();
-    for (i, row) in columns(&curve_path, &text, CURVE_HEADER)?.iter().enumerate() {
+    for (i, row) in columns(&curve_path, &text, CURVE_HEADER)?
+        .iter()
+        .enumerate()
+    {
         // event,force_N,force_over_mu_FN,drive,area,ell,ell_over_Lx,...
         if row.len() < 7 {
             return Err(Error::CorruptTable {
@@ -139,14 +142,13 @@ fn read_run(dir: &Path, run: &SweepRun) -> Result<RunData> {
     }
     let events_path = dir.join("events.csv");
     let text = read(&events_path)?;
-    let mu_fn = run
-        .scene
-        .current_material()
-        .friction_coefficient
-        * run.scene.current_normal_load();
+    let mu_fn = run.scene.current_material().friction_coefficient * run.scene.current_normal_load();
     let mut avalanches = Vec::new();
     let mut slip = None;
-    for (i, row) in columns(&events_path, &text, EVENTS_HEADER)?.iter().enumerate() {
+    for (i, row) in columns(&events_path, &text, EVENTS_HEADER)?
+        .iter()
+        .enumerate()
+    {
         match (row.get(1).copied(), row.get(4), row.get(7)) {
             (Some("stable"), _, Some(r)) => avalanches.push(parse(&events_path, i, r)? as usize),
             (Some("global_slip"), Some(f), _) => slip = Some(parse(&events_path, i, f)? / mu_fn),
@@ -265,8 +267,17 @@ pub fn merge(dir: &Path) -> Result<MergeSummary> {
             );
         }
         let s: Vec<f64> = data.iter().filter_map(|d| d.slip).collect();
-        let last: Vec<f64> = data.iter().filter_map(|d| d.curve.last().map(|c| c.0)).collect();
-        let _ = writeln!(slips, "{point},{values}{},{},{}", s.len(), stats(&s), stats(&last));
+        let last: Vec<f64> = data
+            .iter()
+            .filter_map(|d| d.curve.last().map(|c| c.0))
+            .collect();
+        let _ = writeln!(
+            slips,
+            "{point},{values}{},{},{}",
+            s.len(),
+            stats(&s),
+            stats(&last)
+        );
         let sizes: Vec<usize> = data
             .iter()
             .flat_map(|d| d.avalanches.iter().copied())
