@@ -391,6 +391,48 @@ pub enum Error {
         /// What the parser reported.
         reason: String,
     },
+    /// A run's CSV table (`events.csv`, `curve.csv`) cannot be continued: a damaged row
+    /// before the last one, another header, or an index that is not a whole number
+    /// ([`crate::output::rows_to_keep`]).
+    #[error("table{}: {reason}", path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default())]
+    CorruptTable {
+        /// The file (`None` for text given directly).
+        path: Option<PathBuf>,
+        /// What is wrong, with the line number.
+        reason: String,
+    },
+    /// A sweep file is not valid JSON or does not follow `docs/sweep-format.md` outside
+    /// its axes (an axis's key or values: [`Error::SweepKey`]).
+    #[error("sweep file{}: {source}", path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default())]
+    SweepFile {
+        /// The file (`None` for JSON text given directly).
+        path: Option<PathBuf>,
+        /// Line of the error (1-based; 0 when the parser gave none).
+        line: usize,
+        /// Column of the error (1-based; 0 when the parser gave none).
+        column: usize,
+        /// What the parser reported.
+        #[source]
+        source: Cause,
+    },
+    /// An axis of a sweep names a key that is not a scene key, or one of its values does
+    /// not give a valid scene (the value's type, or the scene's own check of it).
+    #[error("sweep axis `{key}`: {reason}")]
+    SweepKey {
+        /// The axis's key, a dotted scene-file path (`block.lx`, `drive.height`, ...).
+        key: String,
+        /// What is wrong, with the value when one is at fault.
+        reason: String,
+    },
+    /// A sweep's output directory cannot be used: it holds another sweep, or (for a
+    /// merge) no sweep or a run's files that do not belong to it.
+    #[error("sweep directory {}: {reason}", path.display())]
+    SweepDirectory {
+        /// The directory or the file at fault.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
 }
 
 impl Error {

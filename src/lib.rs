@@ -46,9 +46,12 @@ pub mod green;
 pub mod interface;
 #[cfg(feature = "nalgebra")]
 mod matrix;
+pub mod output;
 pub mod probe;
 pub mod scene;
 pub mod solver;
+#[cfg(feature = "serde")]
+pub mod sweep;
 
 pub use error::{Error, Result};
 /// The `nalgebra` this crate converts to and from (feature `nalgebra`): heights from an

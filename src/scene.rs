@@ -29,7 +29,7 @@ use crate::probe::{ProbeSpec, StressProbe};
 use crate::solver::SolverOptions;
 
 #[cfg(feature = "serde")]
-mod file;
+pub(crate) mod file;
 
 /// Relative tolerance of the lateral load table.
 const LATERAL_TOLERANCE: f64 = 1e-12;
@@ -471,27 +471,31 @@ impl SceneBuilder {
         self.law
     }
 
+    /// The material set so far (see [`SceneBuilder::current_springs`]).
+    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
+    pub(crate) fn current_material(&self) -> Material {
+        self.material
+    }
+
+    /// The normal load set so far (N; see [`SceneBuilder::current_springs`]).
+    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
+    pub(crate) fn current_normal_load(&self) -> f64 {
+        self.normal_load
+    }
+
     /// The heights source set so far (see [`SceneBuilder::current_springs`]).
     pub(crate) fn current_heights(&self) -> &HeightSource {
         &self.heights
     }
 
-    /// Validates everything and plans the operator (`O(N)` eigenvalues).
+    /// The block and grid of the scene, validated (and the cell limit checked) without
+    /// building anything else: e.g. to print a scene's size and [`crate::GridCost`]
+    /// before running it.
     ///
     /// # Errors
-    /// The first invalid option, as a typed [`Error`] naming it.
-    pub fn build(self) -> Result<Scene> {
-        self.build_with(&Planner::new())
-    }
-
-    /// [`SceneBuilder::build`] with the operator from `planner`: scenes of one geometry
-    /// (block, cells, plan tolerance) share one plan, planned once, e.g. realizations of
-    /// the heights or sweeps over loads and drives.
-    ///
-    /// # Errors
-    /// As [`SceneBuilder::build`].
-    pub fn build_with(self, planner: &Planner) -> Result<Scene> {
-        let builder = self.clone();
+    /// The first invalid length or cell size or count; [`Error::GridTooLarge`] above
+    /// [`SceneBuilder::max_cells`].
+    pub fn grid(&self) -> Result<Grid> {
         let (lx, ly, lz) = self.lengths;
         let block = Block::new(lx, ly, lz)?;
         let grid = match self.cells {
@@ -499,6 +503,14 @@ impl SceneBuilder {
             Cells::Count(nx, ny) => Grid::new(block, nx, ny)?,
         };
         crate::green::check_cells(grid.nx(), grid.ny(), self.max_cells)?;
+        Ok(grid)
+    }
+
+    /// Everything [`SceneBuilder::build`] checks before planning the operator (`O(N)`:
+    /// the heights are drawn), with the block, grid, heights and lateral load.
+    pub(crate) fn checked(&self) -> Result<(Block, Grid, Heights, Option<Lateral>)> {
+        let grid = self.grid()?;
+        let block = *grid.block();
         self.material.validate()?;
         self.law.validate()?;
         self.solver.validate()?;
@@ -539,6 +551,30 @@ impl SceneBuilder {
                 Some(lateral)
             }
         };
+        if let Some(Lateral::Rod { height, half_width }) = lateral {
+            RodLoad::new(&block, height, half_width)?;
+        }
+        Ok((block, grid, heights, lateral))
+    }
+
+    /// Validates everything and plans the operator (`O(N)` eigenvalues).
+    ///
+    /// # Errors
+    /// The first invalid option, as a typed [`Error`] naming it.
+    pub fn build(self) -> Result<Scene> {
+        self.build_with(&Planner::new())
+    }
+
+    /// [`SceneBuilder::build`] with the operator from `planner`: scenes of one geometry
+    /// (block, cells, plan tolerance) share one plan, planned once, e.g. realizations of
+    /// the heights or sweeps over loads and drives.
+    ///
+    /// # Errors
+    /// As [`SceneBuilder::build`].
+    pub fn build_with(self, planner: &Planner) -> Result<Scene> {
+        let builder = self.clone();
+        let (lx, ly, lz) = self.lengths;
+        let (block, grid, heights, lateral) = self.checked()?;
         let plan = planner.plan_with_max_cells(grid, self.plan_tolerance, self.max_cells)?;
         // Displacement per newton of the lateral load, cell-averaged (m/N): only built
         // when a lateral load exists.

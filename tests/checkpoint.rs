@@ -430,9 +430,9 @@ mod json {
     }
 }
 
-/// The tables of `examples/run_scene.rs` on resume (`examples/support/table.rs`).
+/// The tables of a run on resume (`precursors::output`, used by `precursors run`/`resume`).
 mod tables {
-    use crate::table::{open, rows_to_keep};
+    use precursors::output::{open_table as open, rows_to_keep};
     use std::io::Write;
 
     const HEADER: &str = "index,kind,force_N";

@@ -21,6 +21,5 @@ mod robustness;
 mod scene_file;
 mod solver;
 mod stability;
-/// The crash-safe CSV tables of `examples/run_scene.rs`.
-#[path = "../examples/support/table.rs"]
-mod table;
+#[cfg(feature = "serde")]
+mod sweep;

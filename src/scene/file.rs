@@ -379,6 +379,24 @@ fn json_error(path: Option<&Path>, e: serde_json::Error) -> Error {
     }
 }
 
+/// A scene-file JSON object read and written back with every key (the form a sweep's
+/// axes edit by dotted path); heights files are read relative to `base` and written as
+/// values.
+pub(crate) fn normalized_value(
+    value: serde_json::Value,
+    base: &Path,
+) -> Result<serde_json::Value, String> {
+    let file: SceneFile = serde_json::from_value(value).map_err(|e| e.to_string())?;
+    let builder = file.into_builder(base).map_err(|e| e.to_string())?;
+    serde_json::to_value(SceneFile::from(&builder)).map_err(|e| e.to_string())
+}
+
+/// The builder of a scene-file JSON object (heights given as values: no file is read).
+pub(crate) fn builder_from_value(value: serde_json::Value) -> Result<SceneBuilder, String> {
+    let file: SceneFile = serde_json::from_value(value).map_err(|e| e.to_string())?;
+    file.into_builder(Path::new(".")).map_err(|e| e.to_string())
+}
+
 impl SceneBuilder {
     /// Reads a scene from JSON text (`docs/scene-format.md`; feature `serde`). A heights
     /// file named in it is read relative to the current directory. Nothing is validated

@@ -1,0 +1,516 @@
+//! The `precursors` program (feature `cli`; docs/cli.md): runs a scene file, resumes a
+//! checkpoint, estimates a scene's cost, runs and merges sweeps.
+//!
+//! ```sh
+//! cargo install --path . --features cli
+//! precursors run examples/scenes/calibration.json --out out
+//! precursors --help
+//! ```
+
+use clap::{Parser, Subcommand};
+use precursors::output::{counts, RunTables};
+use precursors::sweep::{Sweep, SweepOptions};
+use precursors::{Checkpoint, Driver, Error, Event, GridCost, SceneBuilder};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+const EXIT_CODES: &str = "\
+Exit codes:
+  0  success
+  1  the computation failed (a solver did not converge, the contact emptied, ...)
+  2  bad command line (unknown option, missing argument, bad --shard)
+  3  invalid input: a scene, sweep or checkpoint file that is not valid JSON, names an
+     unknown key, holds an invalid value, or does not fit; a damaged table
+  4  a file or directory could not be read or written
+  5  merge: some runs of the sweep are not complete (the tables of the others written)";
+
+/// Quasi-static friction precursors: runs scene files and sweeps (docs/cli.md).
+#[derive(Debug, Parser)]
+#[command(name = "precursors", version, after_help = EXIT_CODES)]
+struct Cli {
+    /// No progress line on stderr (it is also off when stderr is not a terminal).
+    #[arg(short, long, global = true)]
+    quiet: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Runs a scene file (docs/scene-format.md) to global slip; writes DIR/events.csv and
+    /// DIR/curve.csv.
+    Run {
+        /// The scene file.
+        scene: PathBuf,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// Writes a checkpoint to FILE every N stable states.
+        #[arg(long, value_name = "FILE")]
+        checkpoint: Option<PathBuf>,
+        /// Stable states between checkpoints.
+        #[arg(long, value_name = "N", default_value_t = 100,
+              value_parser = clap::value_parser!(u64).range(1..))]
+        every: u64,
+    },
+    /// Continues a run from a checkpoint; the tables in DIR are cut back to it and end as
+    /// those of an uninterrupted run.
+    Resume {
+        /// The checkpoint file (written by `run --checkpoint`).
+        checkpoint: PathBuf,
+        /// Output directory of the run.
+        #[arg(long)]
+        out: PathBuf,
+        /// Stable states between checkpoints (written over CHECKPOINT).
+        #[arg(long, value_name = "N", default_value_t = 100,
+              value_parser = clap::value_parser!(u64).range(1..))]
+        every: u64,
+    },
+    /// Prints a scene's cells, backend and estimated memory and time.
+    Info {
+        /// The scene file.
+        scene: PathBuf,
+    },
+    /// Runs a sweep file (docs/sweep-format.md): one directory per run under DIR;
+    /// complete runs are skipped, cut ones redone.
+    Sweep {
+        /// The sweep file.
+        sweep: PathBuf,
+        /// Output directory (created if missing; shards share it).
+        #[arg(long)]
+        out: PathBuf,
+        /// Runs at the same time [default: the number of cores].
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+        jobs: Option<u64>,
+        /// Runs share K of N (runs whose index is K modulo N) [default: from
+        /// SLURM_ARRAY_TASK_ID - SLURM_ARRAY_TASK_MIN and SLURM_ARRAY_TASK_COUNT, else 0/1].
+        #[arg(long, value_name = "K/N", value_parser = parse_shard)]
+        shard: Option<(usize, usize)>,
+    },
+    /// Merges a sweep's runs into DIR/curves.csv, slip.csv, avalanches.csv and runs.csv.
+    Merge {
+        /// The sweep's output directory.
+        dir: PathBuf,
+    },
+}
+
+fn parse_shard(text: &str) -> Result<(usize, usize), String> {
+    let (k, n) = text
+        .split_once('/')
+        .ok_or_else(|| format!("{text:?} is not K/N (e.g. 0/4)"))?;
+    let k: usize = k
+        .trim()
+        .parse()
+        .map_err(|e| format!("K in {text:?}: {e}"))?;
+    let n: usize = n
+        .trim()
+        .parse()
+        .map_err(|e| format!("N in {text:?}: {e}"))?;
+    if n == 0 || k >= n {
+        return Err(format!("{text:?}: need 0 <= K < N"));
+    }
+    Ok((k, n))
+}
+
+/// The shard from SLURM's job-array variables, if set.
+fn slurm_shard() -> Result<Option<(usize, usize)>, String> {
+    let var = |name: &str| std::env::var(name).ok().filter(|v| !v.trim().is_empty());
+    let (Some(id), Some(count)) = (var("SLURM_ARRAY_TASK_ID"), var("SLURM_ARRAY_TASK_COUNT"))
+    else {
+        return Ok(None);
+    };
+    let number = |name: &str, v: &str| {
+        v.trim()
+            .parse::<usize>()
+            .map_err(|e| format!("{name}={v:?}: {e}"))
+    };
+    let id = number("SLURM_ARRAY_TASK_ID", &id)?;
+    let count = number("SLURM_ARRAY_TASK_COUNT", &count)?;
+    let min = match var("SLURM_ARRAY_TASK_MIN") {
+        Some(m) => number("SLURM_ARRAY_TASK_MIN", &m)?,
+        None => 0,
+    };
+    let k = id
+        .checked_sub(min)
+        .ok_or_else(|| format!("SLURM_ARRAY_TASK_ID={id} is below SLURM_ARRAY_TASK_MIN={min}"))?;
+    parse_shard(&format!("{k}/{count}")).map(Some)
+}
+
+/// A failure and its exit code.
+struct Failure {
+    error: Box<dyn std::error::Error>,
+    code: u8,
+}
+
+impl From<Error> for Failure {
+    fn from(e: Error) -> Self {
+        let code = match &e {
+            Error::Io { .. } => 4,
+            Error::SolverNotConverged { .. }
+            | Error::Factorization { .. }
+            | Error::EmptyContact { .. }
+            | Error::ThreadPool { .. }
+            | Error::NotSolved { .. } => 1,
+            _ => 3,
+        };
+        Failure {
+            error: Box::new(e),
+            code,
+        }
+    }
+}
+
+fn usage(message: String) -> Failure {
+    Failure {
+        error: message.into(),
+        code: 2,
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let progress = !cli.quiet && std::io::stderr().is_terminal();
+    let outcome = match cli.command {
+        Command::Run {
+            scene,
+            out,
+            checkpoint,
+            every,
+        } => run(
+            Start::Scene(&scene),
+            &out,
+            checkpoint.as_deref(),
+            every,
+            progress,
+        ),
+        Command::Resume {
+            checkpoint,
+            out,
+            every,
+        } => run(
+            Start::Checkpoint(&checkpoint),
+            &out,
+            Some(&checkpoint),
+            every,
+            progress,
+        ),
+        Command::Info { scene } => info(&scene),
+        Command::Sweep {
+            sweep,
+            out,
+            jobs,
+            shard,
+        } => run_sweep(&sweep, &out, jobs, shard, progress),
+        Command::Merge { dir } => merge(&dir),
+    };
+    match outcome {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(failure) => {
+            report(&*failure.error);
+            ExitCode::from(failure.code)
+        }
+    }
+}
+
+/// Prints `error: <message>` and one `caused by: <message>` per source; a cause whose
+/// message already ends the message before it is not printed twice.
+fn report(e: &dyn std::error::Error) {
+    eprintln!("error: {e}");
+    let mut previous = e.to_string();
+    let mut source = e.source();
+    while let Some(cause) = source {
+        let text = cause.to_string();
+        if !previous.ends_with(&text) {
+            eprintln!("  caused by: {text}");
+        }
+        previous = text;
+        source = cause.source();
+    }
+}
+
+/// A one-line progress display on stderr, redrawn at most four times a second.
+struct Progress {
+    enabled: bool,
+    started: Instant,
+    last: Option<Instant>,
+}
+
+impl Progress {
+    fn new(enabled: bool) -> Self {
+        Self {
+            enabled,
+            started: Instant::now(),
+            last: None,
+        }
+    }
+
+    /// Redraws with `line(elapsed seconds)` if due (or `force`).
+    fn show(&mut self, force: bool, line: impl FnOnce(f64) -> String) {
+        if !self.enabled {
+            return;
+        }
+        let due = self
+            .last
+            .is_none_or(|t| t.elapsed() >= Duration::from_millis(250));
+        if due || force {
+            self.last = Some(Instant::now());
+            eprint!("\r{}\x1b[K", line(self.started.elapsed().as_secs_f64()));
+        }
+    }
+
+    fn finish(&self) {
+        if self.enabled && self.last.is_some() {
+            eprintln!();
+        }
+    }
+}
+
+fn eta(seconds: f64) -> String {
+    if !seconds.is_finite() {
+        return "?".into();
+    }
+    let s = seconds.round() as u64;
+    if s >= 3600 {
+        format!("{}h{:02}m", s / 3600, (s % 3600) / 60)
+    } else {
+        format!("{}m{:02}s", s / 60, s % 60)
+    }
+}
+
+enum Start<'a> {
+    Scene(&'a Path),
+    Checkpoint(&'a Path),
+}
+
+fn writable_dir(dir: &Path) -> Result<(), Failure> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io("creating the output directory", dir, e))?;
+    Ok(())
+}
+
+fn run(
+    start: Start<'_>,
+    out: &Path,
+    checkpoint: Option<&Path>,
+    every: u64,
+    progress: bool,
+) -> Result<(), Failure> {
+    writable_dir(out)?;
+    let (scene, mut driver, mut tables) = match start {
+        Start::Scene(path) => {
+            let scene = SceneBuilder::from_json_file(path)?.build()?;
+            let driver = scene.driver()?;
+            let tables = RunTables::open(out, None)?;
+            (scene, driver, tables)
+        }
+        Start::Checkpoint(path) => {
+            let checkpoint = Checkpoint::read_from(path)?;
+            let scene = checkpoint.scene().clone().build()?;
+            let driver = scene.resume(&checkpoint)?;
+            // Keep the rows up to the checkpoint (a crashed run may have written more).
+            let k = checkpoint.event_count();
+            let tables = RunTables::open(out, Some(k))?;
+            eprintln!("resumed at event {k} from {}", path.display());
+            (scene, driver, tables)
+        }
+    };
+    let grid = *scene.grid();
+    eprintln!(
+        "{} x {} cells ({:?} backend), F_N = {} N",
+        grid.nx(),
+        grid.ny(),
+        driver.backend(),
+        scene.normal_load()
+    );
+    let mu_fn = driver.friction_coefficient() * driver.normal_load();
+    let first_event = driver.event_count();
+    let mut bar = Progress::new(progress);
+    let line = |driver: &Driver, elapsed: f64| {
+        let (broken, _) = counts(driver.site_states());
+        let x = driver.force() / mu_fn;
+        let done = (driver.event_count() - first_event) as f64;
+        format!(
+            "{:>9} events  {:>8.0} events/s  {broken:>7}/{} broken  F/(μF_N) = {x:.4}  \
+             {elapsed:.0} s, ETA ~{} (from the load)",
+            driver.event_count(),
+            done / elapsed.max(1e-9),
+            driver.site_states().len(),
+            eta(elapsed * (1.0 - x) / x.max(1e-9)),
+        )
+    };
+    while let Some(event) = driver.step()? {
+        tables.record(&driver, &event)?;
+        if let (Event::Stable { .. }, Some(path)) = (&event, checkpoint) {
+            if (tables.stable_states() as u64).is_multiple_of(every) {
+                tables.flush()?;
+                driver.checkpoint().write_to(path)?;
+            }
+        }
+        bar.show(false, |elapsed| line(&driver, elapsed));
+    }
+    tables.flush()?;
+    bar.show(true, |elapsed| line(&driver, elapsed));
+    bar.finish();
+    let (events_path, curve_path) = tables.paths();
+    eprintln!(
+        "global slip after {} events at F/(μF_N) = {:.6}; wrote {} and {}",
+        driver.event_count(),
+        driver.force() / mu_fn,
+        events_path.display(),
+        curve_path.display()
+    );
+    Ok(())
+}
+
+fn info(path: &Path) -> Result<(), Failure> {
+    let builder = SceneBuilder::from_json_file(path)?;
+    let file: serde_json::Value = serde_json::from_str(&builder.to_json()?).unwrap_or_default();
+    let grid = builder.grid()?;
+    let n = grid.len();
+    let cost = GridCost::of(grid.nx(), grid.ny());
+    let backend = file["solver"]["backend"].as_str().unwrap_or("auto");
+    let resolved = match backend {
+        "auto" if n <= precursors::solver::AUTO_DENSE_LIMIT => "dense (auto)",
+        "auto" => "spectral (auto)",
+        other => other,
+    };
+    let block = grid.block();
+    println!("scene      {}", path.display());
+    println!(
+        "block      {} x {} x {} m",
+        block.lx(),
+        block.ly(),
+        block.lz()
+    );
+    println!(
+        "cells      {} x {} = {n} (cell {} x {} m)",
+        grid.nx(),
+        grid.ny(),
+        grid.dx(),
+        grid.dy()
+    );
+    println!(
+        "backend    {resolved}, solver threads {}",
+        file["solver"]["threads"]
+    );
+    println!("memory     ~{} (estimate)", bytes(cost.memory_bytes));
+    println!(
+        "plan       ~{} (estimate, one thread)",
+        seconds(cost.plan_seconds)
+    );
+    println!(
+        "equilibrium ~{} per cold normal + tangential solve (estimate, one thread)",
+        seconds(cost.solve_seconds)
+    );
+    // Fitted to two documented runs to global slip on one thread (release build): the
+    // calibration scene, 980 cells, 0.84 s; N = 1e4, about 70 s (docs/performance.md).
+    let run = 0.84 * (n as f64 / 980.0).powf(1.9);
+    println!(
+        "run        ~{} to global slip (rough: 0.84 s·(N/980)^1.9, fitted to the calibration \
+         scene and N = 1e4; the events depend on the scene)",
+        seconds(run)
+    );
+    Ok(())
+}
+
+fn bytes(b: f64) -> String {
+    match b {
+        b if b >= 1e9 => format!("{:.3} GB", b / 1e9),
+        b if b >= 1e6 => format!("{:.3} MB", b / 1e6),
+        b if b >= 1e3 => format!("{:.3} kB", b / 1e3),
+        b => format!("{b:.0} B"),
+    }
+}
+
+fn seconds(s: f64) -> String {
+    match s {
+        s if s >= 3600.0 => format!("{:.2} h", s / 3600.0),
+        s if s >= 60.0 => format!("{:.2} min", s / 60.0),
+        s => format!("{s:.3} s"),
+    }
+}
+
+fn run_sweep(
+    path: &Path,
+    out: &Path,
+    jobs: Option<u64>,
+    shard: Option<(usize, usize)>,
+    progress: bool,
+) -> Result<(), Failure> {
+    let shard = match shard {
+        Some(s) => s,
+        None => slurm_shard().map_err(usage)?.unwrap_or((0, 1)),
+    };
+    let jobs = match jobs {
+        Some(j) => usize::try_from(j).unwrap_or(usize::MAX),
+        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+    };
+    let sweep = Sweep::from_json_file(path)?;
+    let share = sweep.shard(shard.0, shard.1)?.len();
+    eprintln!(
+        "{} points x {} realizations = {} runs; shard {}/{}: {share} runs on {jobs} jobs",
+        sweep.points(),
+        sweep.realizations(),
+        sweep.runs().len(),
+        shard.0,
+        shard.1
+    );
+    let bar = std::sync::Mutex::new(Progress::new(progress));
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let ran = std::sync::atomic::AtomicUsize::new(0);
+    let options = SweepOptions::new().jobs(jobs).shard(shard.0, shard.1);
+    let summary = sweep.execute(out, &options, |report| {
+        let d = done.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1;
+        let r = ran.fetch_add(
+            usize::from(!report.skipped),
+            std::sync::atomic::Ordering::SeqCst,
+        ) + usize::from(!report.skipped);
+        if let Ok(mut bar) = bar.lock() {
+            bar.show(d == share, |elapsed| {
+                let rate = r as f64 / elapsed.max(1e-9);
+                format!(
+                    "{d}/{share} runs ({} skipped)  {:.2} runs/min  {elapsed:.0} s, ETA {}",
+                    d - r,
+                    60.0 * rate,
+                    eta((share - d) as f64 / rate)
+                )
+            });
+        }
+    })?;
+    if let Ok(bar) = bar.lock() {
+        bar.finish();
+    }
+    eprintln!(
+        "{} runs done, {} skipped (complete already), in {:.1} s; results in {}",
+        summary.completed,
+        summary.skipped,
+        summary.seconds,
+        out.display()
+    );
+    Ok(())
+}
+
+fn merge(dir: &Path) -> Result<(), Failure> {
+    let summary = precursors::sweep::merge(dir)?;
+    for file in &summary.files {
+        eprintln!("wrote {}", file.display());
+    }
+    eprintln!(
+        "{} points, {} runs merged, {} missing",
+        summary.points, summary.runs_merged, summary.runs_missing
+    );
+    if summary.runs_missing > 0 {
+        return Err(Failure {
+            error: format!(
+                "{} runs of the sweep in {} are not complete: run the sweep (or its \
+                 missing shards) again, then merge",
+                summary.runs_missing,
+                dir.display()
+            )
+            .into(),
+            code: 5,
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,635 @@
+//! Sweeps: a base scene, axes over scene keys and realizations, run in parallel, sharded
+//! across machines, merged into ensemble statistics (feature `serde`; the file format:
+//! `docs/sweep-format.md`; the program: `precursors sweep`, `precursors merge`).
+//!
+//! ```
+//! use precursors::sweep::{Sweep, SweepOptions};
+//!
+//! let sweep = Sweep::from_json_str(r#"{
+//!     "base": { "block": { "lx": 0.02, "ly": 0.004, "lz": 0.02 },
+//!               "cells": { "kind": "size", "dx": 0.001, "dy": 0.001 },
+//!               "normal_load": 300.0 },
+//!     "axes": [ { "key": "normal_load", "values": [300.0, 400.0] } ],
+//!     "realizations": 2,
+//!     "seed": 7
+//! }"#)?;
+//! assert_eq!(sweep.runs().len(), 4);                 // 2 points x 2 realizations
+//! assert_eq!(sweep.shard(1, 2)?.len(), 2);           // runs 1 and 3
+//! # let out = std::env::temp_dir().join(format!("precursors-doc-sweep-{}", std::process::id()));
+//! let summary = sweep.execute(&out, &SweepOptions::new().jobs(2), |_| {})?;
+//! assert_eq!(summary.completed, 4);
+//! let merged = precursors::sweep::merge(&out)?;
+//! assert_eq!(merged.runs_missing, 0);
+//! # std::fs::remove_dir_all(&out).ok();
+//! # Ok::<(), precursors::Error>(())
+//! ```
+
+mod merge;
+
+pub use merge::{merge, t_quantile_975, MergeSummary, LOAD_GRID};
+
+use crate::error::{Error, Result};
+use crate::output::RunTables;
+use crate::scene::file::{builder_from_value, normalized_value};
+use crate::scene::{HeightSource, SceneBuilder};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// The name of a sweep's own copy of its file in the output directory.
+pub const SWEEP_FILE: &str = "sweep.json";
+/// The completion marker of a run, written last (atomically) into its directory.
+pub const DONE_FILE: &str = "done";
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SweepSpec {
+    #[serde(default = "empty_object")]
+    base: Value,
+    #[serde(default)]
+    axes: Vec<AxisSpec>,
+    #[serde(default = "one")]
+    realizations: usize,
+    #[serde(default)]
+    seed: u64,
+}
+
+fn empty_object() -> Value {
+    Value::Object(serde_json::Map::new())
+}
+
+fn one() -> usize {
+    1
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AxisSpec {
+    key: String,
+    values: Vec<Value>,
+}
+
+/// One run of a sweep: a parameter point, a realization, its seed and its scene.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct SweepRun {
+    /// Position in the sweep's run order (points in axis order, the last axis fastest;
+    /// realizations innermost): `point · realizations + realization`.
+    pub index: usize,
+    /// The parameter point (row-major over the axes).
+    pub point: usize,
+    /// The index of the value on each axis.
+    pub coordinates: Vec<usize>,
+    /// The realization (`0 .. realizations`).
+    pub realization: usize,
+    /// The heights' seed ([`derive_seed`]).
+    pub seed: u64,
+    /// Each axis's key and value, the value as JSON text (`"0.02"`, `"{\"kind\":\"side\"}"`).
+    pub values: Vec<(String, String)>,
+    /// The run's scene.
+    pub scene: SceneBuilder,
+    /// The run's directory under the sweep's output directory: `p{point:04}-r{realization:04}`.
+    pub dir_name: String,
+}
+
+/// A sweep, validated: every run's scene passed the checks [`SceneBuilder::build`] makes
+/// before planning.
+#[derive(Debug, Clone)]
+pub struct Sweep {
+    spec: SweepSpec,
+    points: usize,
+    runs: Vec<SweepRun>,
+}
+
+/// How [`Sweep::execute`] runs its share.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct SweepOptions {
+    /// Runs at the same time (each on its scene's solver threads, one by default).
+    pub jobs: usize,
+    /// This share `k` of `n` ([`Sweep::shard`]); `(0, 1)`: the whole sweep.
+    pub shard: (usize, usize),
+}
+
+impl Default for SweepOptions {
+    fn default() -> Self {
+        Self {
+            jobs: 1,
+            shard: (0, 1),
+        }
+    }
+}
+
+impl SweepOptions {
+    /// One job, the whole sweep.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Runs at the same time (0 counts as 1).
+    pub fn jobs(mut self, jobs: usize) -> Self {
+        self.jobs = jobs.max(1);
+        self
+    }
+
+    /// Share `k` of `n`.
+    pub fn shard(mut self, k: usize, n: usize) -> Self {
+        self.shard = (k, n);
+        self
+    }
+}
+
+/// What one run did ([`Sweep::run_one`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct RunReport {
+    /// [`SweepRun::index`].
+    pub index: usize,
+    /// It was complete already (its marker found) and was not run again.
+    pub skipped: bool,
+    /// Events of the run (0 when skipped).
+    pub events: usize,
+    /// Wall time of the run (s; 0 when skipped).
+    pub seconds: f64,
+}
+
+/// What [`Sweep::execute`] did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct SweepSummary {
+    /// Runs in this share.
+    pub runs: usize,
+    /// Runs of the share run now.
+    pub completed: usize,
+    /// Runs of the share found complete and skipped.
+    pub skipped: usize,
+    /// Wall time (s).
+    pub seconds: f64,
+}
+
+/// The seed of a run, from the sweep's `seed` and the run's coordinates: with
+/// SplitMix64's finaliser `mix`, `s = seed`, then `s = mix(s ^ mix(c))` for each axis
+/// coordinate `c` (the value's index on the axis) in axis order and then for the
+/// realization. Stable across versions (a test pins its values): a sweep re-run later,
+/// or extended by realizations, draws the same heights for the same runs.
+pub fn derive_seed(seed: u64, coordinates: &[usize], realization: usize) -> u64 {
+    let mut s = seed;
+    for &c in coordinates.iter().chain(std::iter::once(&realization)) {
+        s = splitmix64(s ^ splitmix64(c as u64));
+    }
+    s
+}
+
+fn splitmix64(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+fn sweep_json_error(path: Option<&Path>, e: serde_json::Error) -> Error {
+    Error::SweepFile {
+        path: path.map(Path::to_path_buf),
+        line: e.line(),
+        column: e.column(),
+        source: Box::new(e),
+    }
+}
+
+fn key_error(key: &str, reason: impl Into<String>) -> Error {
+    Error::SweepKey {
+        key: key.to_string(),
+        reason: reason.into(),
+    }
+}
+
+/// Sets `key` (dotted path) in `scene` to `value`: every segment must exist.
+fn set_path(scene: &mut Value, key: &str, value: &Value) -> Result<()> {
+    let mut node = scene;
+    let segments: Vec<&str> = key.split('.').collect();
+    for (depth, segment) in segments.iter().enumerate() {
+        let here = segments[..depth].join(".");
+        let object = node.as_object_mut().ok_or_else(|| {
+            key_error(
+                key,
+                format!("`{here}` is not an object of the scene: it has no key `{segment}`"),
+            )
+        })?;
+        if !object.contains_key(*segment) {
+            let mut known: Vec<&String> = object.keys().collect();
+            known.sort();
+            let known: Vec<&str> = known.iter().map(|k| k.as_str()).collect();
+            let place = if here.is_empty() {
+                "the scene".to_string()
+            } else {
+                format!("`{here}`")
+            };
+            return Err(key_error(
+                key,
+                format!(
+                    "not a scene key: {place} has no `{segment}` (it has: {})",
+                    known.join(", ")
+                ),
+            ));
+        }
+        let next = object
+            .get_mut(*segment)
+            .ok_or_else(|| key_error(key, "missing"))?;
+        if depth + 1 == segments.len() {
+            *next = value.clone();
+            return Ok(());
+        }
+        node = next;
+    }
+    Err(key_error(key, "an empty key"))
+}
+
+impl Sweep {
+    /// Reads a sweep from JSON text (`docs/sweep-format.md`). A heights file of the base
+    /// scene is read relative to the current directory.
+    ///
+    /// # Errors
+    /// [`Error::SweepFile`] for invalid JSON or a key outside the format, or a base scene
+    /// that is not a scene file; [`Error::SweepKey`] (naming the key) for an axis whose key
+    /// is not a scene key or whose value gives no valid scene; [`Error::InvalidCount`] for
+    /// zero realizations, or several with heights that are not random.
+    pub fn from_json_str(text: &str) -> Result<Sweep> {
+        let spec: SweepSpec = serde_json::from_str(text).map_err(|e| sweep_json_error(None, e))?;
+        Self::from_spec(spec, None, Path::new("."))
+    }
+
+    /// Reads a sweep file (`docs/sweep-format.md`). A heights file of the base scene is
+    /// read relative to the sweep file's directory.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be read; the others as [`Sweep::from_json_str`].
+    pub fn from_json_file(path: impl AsRef<Path>) -> Result<Sweep> {
+        let path = path.as_ref();
+        let text =
+            std::fs::read_to_string(path).map_err(|e| Error::io("reading sweep file", path, e))?;
+        let spec: SweepSpec =
+            serde_json::from_str(&text).map_err(|e| sweep_json_error(Some(path), e))?;
+        Self::from_spec(spec, Some(path), path.parent().unwrap_or(Path::new(".")))
+    }
+
+    fn from_spec(mut spec: SweepSpec, path: Option<&Path>, base_dir: &Path) -> Result<Sweep> {
+        let base_error = |reason: String| Error::SweepFile {
+            path: path.map(Path::to_path_buf),
+            line: 0,
+            column: 0,
+            source: format!("base scene: {reason}").into(),
+        };
+        spec.base = normalized_value(spec.base.clone(), base_dir).map_err(base_error)?;
+        if spec.realizations == 0 {
+            return Err(Error::InvalidCount {
+                name: "realizations",
+                value: 0,
+                reason: "a sweep needs at least one realization per point",
+            });
+        }
+        let random = matches!(
+            builder_from_value(spec.base.clone())
+                .map_err(base_error)?
+                .current_heights(),
+            HeightSource::Random { .. }
+        );
+        if spec.realizations > 1 && !random {
+            return Err(Error::InvalidCount {
+                name: "realizations",
+                value: spec.realizations as u64,
+                reason: "realizations differ by the seed of random heights, but the base \
+                         scene's heights are values (give one realization)",
+            });
+        }
+        // Each axis on its own: the key exists, each value gives a valid scene.
+        for (a, axis) in spec.axes.iter().enumerate() {
+            let key = axis.key.as_str();
+            if spec.axes[..a].iter().any(|b| b.key == key) {
+                return Err(key_error(key, "the key has two axes"));
+            }
+            if key == "heights" || key.starts_with("heights.seed") {
+                return Err(key_error(
+                    key,
+                    "the sweep derives the heights' seeds from `seed` and the run's \
+                     coordinates (give `realizations`); sweep `heights.mean` or \
+                     `heights.std_dev` instead",
+                ));
+            }
+            if axis.values.is_empty() {
+                return Err(key_error(key, "the axis has no values"));
+            }
+            for (i, value) in axis.values.iter().enumerate() {
+                let mut scene = spec.base.clone();
+                set_path(&mut scene, key, value)?;
+                let builder = builder_from_value(scene).map_err(|reason| {
+                    key_error(
+                        key,
+                        format!("value {value} (#{i}) is not valid here: {reason}"),
+                    )
+                })?;
+                builder.checked().map_err(|e| {
+                    key_error(
+                        key,
+                        format!("value {value} (#{i}) gives an invalid scene: {e}"),
+                    )
+                })?;
+            }
+        }
+        let shape: Vec<usize> = spec.axes.iter().map(|a| a.values.len()).collect();
+        let points = shape.iter().product::<usize>();
+        let mut runs = Vec::with_capacity(points * spec.realizations);
+        for point in 0..points {
+            let mut coordinates = vec![0; shape.len()];
+            let mut rest = point;
+            for (a, n) in shape.iter().enumerate().rev() {
+                coordinates[a] = rest % n;
+                rest /= n;
+            }
+            let mut scene = spec.base.clone();
+            let mut values = Vec::with_capacity(shape.len());
+            for (axis, &c) in spec.axes.iter().zip(&coordinates) {
+                set_path(&mut scene, &axis.key, &axis.values[c])?;
+                values.push((axis.key.clone(), axis.values[c].to_string()));
+            }
+            let describe = || {
+                values
+                    .iter()
+                    .map(|(k, v)| format!("{k} = {v}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            let keys = || {
+                spec.axes
+                    .iter()
+                    .map(|a| a.key.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            for realization in 0..spec.realizations {
+                let seed = derive_seed(spec.seed, &coordinates, realization);
+                let mut scene_value = scene.clone();
+                if random {
+                    set_path(&mut scene_value, "heights.seed", &Value::from(seed))?;
+                }
+                let builder = builder_from_value(scene_value).map_err(|reason| {
+                    key_error(
+                        &keys(),
+                        format!("the point {} is not valid: {reason}", describe()),
+                    )
+                })?;
+                if realization == 0 {
+                    builder.checked().map_err(|e| {
+                        key_error(
+                            &keys(),
+                            format!("the point {} gives an invalid scene: {e}", describe()),
+                        )
+                    })?;
+                }
+                runs.push(SweepRun {
+                    index: runs.len(),
+                    point,
+                    coordinates: coordinates.clone(),
+                    realization,
+                    seed,
+                    values: values.clone(),
+                    scene: builder,
+                    dir_name: format!("p{point:04}-r{realization:04}"),
+                });
+            }
+        }
+        Ok(Sweep { spec, points, runs })
+    }
+
+    /// The sweep as JSON, its base scene with every key (heights files as values): the
+    /// copy [`Sweep::execute`] keeps in the output directory ([`SWEEP_FILE`]).
+    ///
+    /// # Errors
+    /// [`Error::SweepFile`] if serialisation fails (it does not for a read sweep).
+    pub fn to_json(&self) -> Result<String> {
+        serde_json::to_string_pretty(&self.spec).map_err(|e| sweep_json_error(None, e))
+    }
+
+    /// Every run, in run order.
+    pub fn runs(&self) -> &[SweepRun] {
+        &self.runs
+    }
+
+    /// Number of parameter points (the product of the axes' lengths; 1 without axes).
+    pub fn points(&self) -> usize {
+        self.points
+    }
+
+    /// Realizations per point.
+    pub fn realizations(&self) -> usize {
+        self.spec.realizations
+    }
+
+    /// The axes' keys, in order.
+    pub fn keys(&self) -> Vec<&str> {
+        self.spec.axes.iter().map(|a| a.key.as_str()).collect()
+    }
+
+    /// Share `k` of `n` (`0 <= k < n`): the runs whose index is `k` modulo `n`. The shares
+    /// of `0..n` are disjoint and cover the sweep.
+    ///
+    /// # Errors
+    /// [`Error::InvalidCount`] for `n = 0` or `k >= n`.
+    pub fn shard(&self, k: usize, n: usize) -> Result<Vec<&SweepRun>> {
+        if n == 0 {
+            return Err(Error::InvalidCount {
+                name: "shard count",
+                value: 0,
+                reason: "a sweep is shared among at least one shard",
+            });
+        }
+        if k >= n {
+            return Err(Error::InvalidCount {
+                name: "shard index",
+                value: k as u64,
+                reason: "the shard index must be below the shard count (shards 0 .. n-1)",
+            });
+        }
+        Ok(self.runs.iter().filter(|r| r.index % n == k).collect())
+    }
+
+    /// Runs `run` into `out/run.dir_name` (unless it is complete: its [`DONE_FILE`]
+    /// exists): the directory is emptied, then `events.csv` and `curve.csv` are written
+    /// ([`crate::output`]), then `meta.json` (the scene, the crate version, the run's
+    /// coordinates and seed, its counts and timings), then the marker, atomically. A run
+    /// cut before its marker is redone from the start.
+    ///
+    /// # Errors
+    /// [`Error::Io`] for a file or directory that cannot be written; the scene's and the
+    /// driver's errors.
+    pub fn run_one(&self, run: &SweepRun, out: &Path) -> Result<RunReport> {
+        let dir = out.join(&run.dir_name);
+        if dir.join(DONE_FILE).is_file() {
+            return Ok(RunReport {
+                index: run.index,
+                skipped: true,
+                events: 0,
+                seconds: 0.0,
+            });
+        }
+        if dir.exists() {
+            std::fs::remove_dir_all(&dir)
+                .map_err(|e| Error::io("removing the cut run directory", &dir, e))?;
+        }
+        std::fs::create_dir_all(&dir)
+            .map_err(|e| Error::io("creating the run directory", &dir, e))?;
+        let started = Instant::now();
+        let scene = run.scene.clone().build()?;
+        let built = started.elapsed().as_secs_f64();
+        let mut driver = scene.driver()?;
+        let mut tables = RunTables::open(&dir, None)?;
+        let mut slip = None;
+        let mut ruptures = 0usize;
+        while let Some(event) = driver.step()? {
+            tables.record(&driver, &event)?;
+            match event {
+                crate::Event::GlobalSlip { load } => slip = Some(load.force),
+                crate::Event::Rupture { .. } => ruptures += 1,
+                _ => {}
+            }
+        }
+        tables.flush()?;
+        let seconds = started.elapsed().as_secs_f64();
+        let mu_fn = driver.friction_coefficient() * driver.normal_load();
+        let meta = serde_json::json!({
+            "crate_version": env!("CARGO_PKG_VERSION"),
+            "run": run.index,
+            "point": run.point,
+            "coordinates": run.coordinates,
+            "realization": run.realization,
+            "seed": run.seed,
+            "values": run.values.iter().map(|(k, v)| {
+                (k.clone(), serde_json::from_str::<Value>(v).unwrap_or(Value::Null))
+            }).collect::<serde_json::Map<String, Value>>(),
+            "events": driver.event_count(),
+            "stable_states": tables.stable_states(),
+            "ruptures": ruptures,
+            "mu_FN_N": mu_fn,
+            "slip_force_N": slip,
+            "slip_over_mu_FN": slip.map(|f| f / mu_fn),
+            "backend": format!("{:?}", driver.backend()),
+            "seconds": { "build": built, "total": seconds },
+            "scene": &run.scene,
+        });
+        let text = serde_json::to_string_pretty(&meta).map_err(|e| Error::SweepFile {
+            path: None,
+            line: 0,
+            column: 0,
+            source: Box::new(e),
+        })?;
+        write_atomically(&dir.join("meta.json"), text.as_bytes())?;
+        write_atomically(&dir.join(DONE_FILE), b"complete\n")?;
+        Ok(RunReport {
+            index: run.index,
+            skipped: false,
+            events: driver.event_count(),
+            seconds,
+        })
+    }
+
+    /// Runs share `options.shard` of the sweep into `out` on `options.jobs` threads,
+    /// skipping complete runs ([`Sweep::run_one`]); `progress` is called after each run
+    /// (from the thread that ran it). `out` keeps a copy of the sweep ([`SWEEP_FILE`]); a
+    /// directory holding another sweep is refused. The tables do not depend on the jobs
+    /// or the shards.
+    ///
+    /// On a failed run no new run starts; the runs under way finish and the first error
+    /// (in run order) is returned.
+    ///
+    /// # Errors
+    /// [`Error::SweepDirectory`] for a directory of another sweep; [`Error::InvalidCount`]
+    /// for a bad shard; [`Error::Io`]; the first run's error.
+    pub fn execute(
+        &self,
+        out: &Path,
+        options: &SweepOptions,
+        progress: impl Fn(&RunReport) + Sync,
+    ) -> Result<SweepSummary> {
+        let started = Instant::now();
+        let (k, n) = options.shard;
+        let share = self.shard(k, n)?;
+        self.prepare(out)?;
+        let next = AtomicUsize::new(0);
+        let failed = AtomicBool::new(false);
+        let reports: Mutex<Vec<RunReport>> = Mutex::new(Vec::new());
+        let errors: Mutex<Vec<(usize, Error)>> = Mutex::new(Vec::new());
+        let jobs = options.jobs.clamp(1, share.len().max(1));
+        std::thread::scope(|scope| {
+            for _ in 0..jobs {
+                scope.spawn(|| loop {
+                    if failed.load(Ordering::SeqCst) {
+                        break;
+                    }
+                    let i = next.fetch_add(1, Ordering::SeqCst);
+                    let Some(run) = share.get(i) else { break };
+                    match self.run_one(run, out) {
+                        Ok(report) => {
+                            progress(&report);
+                            if let Ok(mut r) = reports.lock() {
+                                r.push(report);
+                            }
+                        }
+                        Err(e) => {
+                            failed.store(true, Ordering::SeqCst);
+                            if let Ok(mut errs) = errors.lock() {
+                                errs.push((run.index, e));
+                            }
+                        }
+                    }
+                });
+            }
+        });
+        let mut errors = errors.into_inner().unwrap_or_else(|p| p.into_inner());
+        errors.sort_by_key(|(i, _)| *i);
+        if let Some((_, e)) = errors.into_iter().next() {
+            return Err(e);
+        }
+        let reports = reports.into_inner().unwrap_or_else(|p| p.into_inner());
+        let skipped = reports.iter().filter(|r| r.skipped).count();
+        Ok(SweepSummary {
+            runs: share.len(),
+            completed: reports.len() - skipped,
+            skipped,
+            seconds: started.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Creates `out` and writes (or checks) its copy of the sweep.
+    fn prepare(&self, out: &Path) -> Result<()> {
+        std::fs::create_dir_all(out)
+            .map_err(|e| Error::io("creating the sweep directory", out, e))?;
+        let path = out.join(SWEEP_FILE);
+        let text = self.to_json()?;
+        match std::fs::read_to_string(&path) {
+            Ok(old) if old == text => Ok(()),
+            Ok(_) => Err(Error::SweepDirectory {
+                path,
+                reason: "the directory holds another sweep (its sweep.json differs): \
+                         choose another output directory"
+                    .into(),
+            }),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                write_atomically(&path, text.as_bytes())
+            }
+            Err(e) => Err(Error::io("reading", &path, e)),
+        }
+    }
+}
+
+/// Writes `bytes` to a temporary file beside `path` and renames it over `path`.
+fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp: PathBuf = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
+    std::fs::write(&tmp, bytes).map_err(|e| Error::io("writing", &tmp, e))?;
+    std::fs::rename(&tmp, path).map_err(|e| Error::io("renaming into place", path, e))
+}

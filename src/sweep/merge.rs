@@ -1,0 +1,318 @@
+//! Ensemble statistics of a sweep's runs (`precursors merge DIR`; docs/sweep-format.md).
+
+use super::{Sweep, SweepRun, DONE_FILE, SWEEP_FILE};
+use crate::error::{Error, Result};
+use crate::output::{CURVE_HEADER, EVENTS_HEADER};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The loads `F/(μF_N)` at which [`merge`] reports ℓ/Lx and `A_R/A_R(0)`:
+/// 0.05, 0.10, ..., 0.95.
+pub const LOAD_GRID: [f64; 19] = [
+    0.05, 0.10, 0.15, 0.20, 0.25, 0.30, 0.35, 0.40, 0.45, 0.50, 0.55, 0.60, 0.65, 0.70, 0.75, 0.80,
+    0.85, 0.90, 0.95,
+];
+
+/// What [`merge`] wrote.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct MergeSummary {
+    /// Parameter points.
+    pub points: usize,
+    /// Complete runs merged.
+    pub runs_merged: usize,
+    /// Runs without their completion marker (not run yet, or cut): left out.
+    pub runs_missing: usize,
+    /// The files written: `curves.csv`, `slip.csv`, `avalanches.csv`, `runs.csv`.
+    pub files: Vec<PathBuf>,
+}
+
+/// The 97.5 % quantile of Student's t distribution with `df` degrees of freedom (the
+/// half-width of a two-sided 95 % band is `t · s/√n`, `df = n - 1`): tabulated for
+/// `df <= 30`, above by the Cornish-Fisher expansion `z + (z³ + z)/(4 df)` (error below
+/// 3e-3); `NaN` for `df = 0`.
+pub fn t_quantile_975(df: usize) -> f64 {
+    const TABLE: [f64; 30] = [
+        12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
+        2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
+        2.052, 2.048, 2.045, 2.042,
+    ];
+    match df {
+        0 => f64::NAN,
+        1..=30 => TABLE[df - 1],
+        _ => {
+            let z = 1.959_963_984_540_054;
+            z + (z * z * z + z) / (4.0 * df as f64)
+        }
+    }
+}
+
+/// Mean and 95 % t-band `(mean, lo, hi)` of `x`; the band is `NaN` below two values.
+fn band(x: &[f64]) -> (f64, f64, f64) {
+    let n = x.len();
+    if n == 0 {
+        return (f64::NAN, f64::NAN, f64::NAN);
+    }
+    let mean = x.iter().sum::<f64>() / n as f64;
+    if n < 2 {
+        return (mean, f64::NAN, f64::NAN);
+    }
+    let var = x.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1) as f64;
+    let half = t_quantile_975(n - 1) * (var / n as f64).sqrt();
+    (mean, mean - half, mean + half)
+}
+
+/// `mean,lo,hi,min,max` of `x` as CSV cells.
+fn stats(x: &[f64]) -> String {
+    let (m, lo, hi) = band(x);
+    let min = x.iter().copied().fold(f64::INFINITY, f64::min);
+    let max = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    [m, lo, hi, min, max].map(num).join(",")
+}
+
+fn num(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:.12e}")
+    } else {
+        String::new()
+    }
+}
+
+/// A CSV cell: quoted when it holds a comma or a quote.
+fn cell(text: &str) -> String {
+    if text.contains([',', '"', '\n']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
+}
+
+/// One complete run's data.
+struct RunData {
+    /// `(F/(μF_N), ℓ/Lx, A_R)` per stable state.
+    curve: Vec<(f64, f64, f64)>,
+    /// Ruptures of each stable state.
+    avalanches: Vec<usize>,
+    /// `F/(μF_N)` of global slip.
+    slip: Option<f64>,
+}
+
+fn columns<'a>(path: &Path, text: &'a str, header: &str) -> Result<Vec<Vec<&'a str>>> {
+    let mut lines = text.lines();
+    if lines.next() != Some(header) {
+        return Err(Error::CorruptTable {
+            path: Some(path.to_path_buf()),
+            reason: format!("line 1 is not the header {header:?}"),
+        });
+    }
+    Ok(lines.map(|l| l.split(',').collect()).collect())
+}
+
+fn parse(path: &Path, line: usize, text: &str) -> Result<f64> {
+    text.parse().map_err(|e| Error::CorruptTable {
+        path: Some(path.to_path_buf()),
+        reason: format!("line {}: {text:?} is not a number ({e})", line + 2),
+    })
+}
+
+fn read(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).map_err(|e| Error::io("reading", path, e))
+}
+
+fn read_run(dir: &Path, run: &SweepRun) -> Result<RunData> {
+    let curve_path = dir.join("curve.csv");
+    let text = read(&curve_path)?;
+    let mut curve = Vec::new();
+    for (i, row) in columns(&curve_path, &text, CURVE_HEADER)?
+        .iter()
+        .enumerate()
+    {
+        // event,force_N,force_over_mu_FN,drive,area,ell,ell_over_Lx,...
+        if row.len() < 7 {
+            return Err(Error::CorruptTable {
+                path: Some(curve_path.clone()),
+                reason: format!("line {} has {} fields", i + 2, row.len()),
+            });
+        }
+        curve.push((
+            parse(&curve_path, i, row[2])?,
+            parse(&curve_path, i, row[6])?,
+            parse(&curve_path, i, row[4])?,
+        ));
+    }
+    let events_path = dir.join("events.csv");
+    let text = read(&events_path)?;
+    let mu_fn = run.scene.current_material().friction_coefficient * run.scene.current_normal_load();
+    let mut avalanches = Vec::new();
+    let mut slip = None;
+    for (i, row) in columns(&events_path, &text, EVENTS_HEADER)?
+        .iter()
+        .enumerate()
+    {
+        match (row.get(1).copied(), row.get(4), row.get(7)) {
+            (Some("stable"), _, Some(r)) => avalanches.push(parse(&events_path, i, r)? as usize),
+            (Some("global_slip"), Some(f), _) => slip = Some(parse(&events_path, i, f)? / mu_fn),
+            _ => {}
+        }
+    }
+    Ok(RunData {
+        curve,
+        avalanches,
+        slip,
+    })
+}
+
+/// Merges the runs of the sweep in `dir` (written by [`Sweep::execute`], all shards into
+/// one directory) into four CSV files in `dir`, one block of rows per parameter point
+/// (the axes' values as columns, named by their keys):
+///
+/// * `curves.csv`: on [`LOAD_GRID`], the mean and 95 % band of ℓ/Lx and of `A_R/A_R(0)`
+///   over the realizations, each taking the value of its last stable state at or below
+///   the load (a realization with none yet is left out; `runs` counts those in). `A_R(0)`
+///   is the real contact area of the run's first stable state (zero shear). The band is
+///   Student's t: `mean ± t(0.975, n-1)·s/√n` ([`t_quantile_975`]), empty below two runs;
+/// * `slip.csv`: the global-slip load `F/(μF_N)` and the load of the last stable state
+///   before it: mean, band, min, max of each;
+/// * `avalanches.csv`: the distribution of the ruptures per stable state (avalanche
+///   size ≥ 1; stable states reached without a rupture are not counted), pooled over the
+///   realizations: size, count, fraction;
+/// * `runs.csv`: one row per run: its point, realization, seed, stable states and slip
+///   load (empty for a run not complete).
+///
+/// Runs without their completion marker are left out and counted.
+///
+/// # Errors
+/// [`Error::SweepDirectory`] when `dir` holds no `sweep.json`; its errors as a sweep file;
+/// [`Error::Io`], [`Error::CorruptTable`] for a run's tables.
+pub fn merge(dir: &Path) -> Result<MergeSummary> {
+    let sweep_path = dir.join(SWEEP_FILE);
+    if !sweep_path.is_file() {
+        return Err(Error::SweepDirectory {
+            path: dir.to_path_buf(),
+            reason: format!("no {SWEEP_FILE}: not the output directory of a sweep"),
+        });
+    }
+    let sweep = Sweep::from_json_file(&sweep_path)?;
+    let keys: Vec<String> = sweep.keys().iter().map(|k| cell(k)).collect();
+    let key_header = keys.iter().map(|k| format!("{k},")).collect::<String>();
+    let mut curves = format!(
+        "point,{key_header}force_over_mu_FN,runs,precursor_over_Lx_mean,precursor_over_Lx_lo,\
+         precursor_over_Lx_hi,area_ratio_mean,area_ratio_lo,area_ratio_hi\n"
+    );
+    let mut slips = format!(
+        "point,{key_header}runs,slip_over_mu_FN_mean,slip_over_mu_FN_lo,slip_over_mu_FN_hi,\
+         slip_over_mu_FN_min,slip_over_mu_FN_max,last_stable_over_mu_FN_mean,\
+         last_stable_over_mu_FN_lo,last_stable_over_mu_FN_hi,last_stable_over_mu_FN_min,\
+         last_stable_over_mu_FN_max\n"
+    );
+    let mut avalanches = format!("point,{key_header}ruptures,count,fraction\n");
+    let mut runs_csv =
+        format!("run,point,realization,seed,{key_header}stable_states,slip_over_mu_FN\n");
+    let (mut merged, mut missing) = (0, 0);
+    for point in 0..sweep.points() {
+        let runs: Vec<&SweepRun> = sweep.runs().iter().filter(|r| r.point == point).collect();
+        let Some(first) = runs.first() else { continue };
+        let values: String = first
+            .values
+            .iter()
+            .map(|(_, v)| format!("{},", cell(v)))
+            .collect();
+        let mut data = Vec::new();
+        for run in &runs {
+            let run_dir = dir.join(&run.dir_name);
+            if !run_dir.join(DONE_FILE).is_file() {
+                missing += 1;
+                let _ = writeln!(
+                    runs_csv,
+                    "{},{point},{},{},{values},,",
+                    run.index, run.realization, run.seed
+                );
+                continue;
+            }
+            let d = read_run(&run_dir, run)?;
+            let _ = writeln!(
+                runs_csv,
+                "{},{point},{},{},{values}{},{}",
+                run.index,
+                run.realization,
+                run.seed,
+                d.curve.len(),
+                d.slip.map(num).unwrap_or_default()
+            );
+            data.push(d);
+            merged += 1;
+        }
+        for &f in &LOAD_GRID {
+            let mut ell = Vec::new();
+            let mut area = Vec::new();
+            for d in &data {
+                let a0 = d.curve.first().map_or(f64::NAN, |c| c.2);
+                if let Some(c) = d.curve.iter().rev().find(|c| c.0 <= f + 1e-12) {
+                    ell.push(c.1);
+                    area.push(c.2 / a0);
+                }
+            }
+            let (em, el, eh) = band(&ell);
+            let (am, al, ah) = band(&area);
+            let _ = writeln!(
+                curves,
+                "{point},{values}{f:.2},{},{},{},{},{},{},{}",
+                ell.len(),
+                num(em),
+                num(el),
+                num(eh),
+                num(am),
+                num(al),
+                num(ah)
+            );
+        }
+        let s: Vec<f64> = data.iter().filter_map(|d| d.slip).collect();
+        let last: Vec<f64> = data
+            .iter()
+            .filter_map(|d| d.curve.last().map(|c| c.0))
+            .collect();
+        let _ = writeln!(
+            slips,
+            "{point},{values}{},{},{}",
+            s.len(),
+            stats(&s),
+            stats(&last)
+        );
+        let sizes: Vec<usize> = data
+            .iter()
+            .flat_map(|d| d.avalanches.iter().copied())
+            .filter(|&s| s >= 1)
+            .collect();
+        let largest = sizes.iter().copied().max().unwrap_or(0);
+        let mut counts = vec![0usize; largest + 1];
+        for &s in &sizes {
+            counts[s] += 1;
+        }
+        for (size, &count) in counts.iter().enumerate().skip(1) {
+            if count > 0 {
+                let _ = writeln!(
+                    avalanches,
+                    "{point},{values}{size},{count},{}",
+                    num(count as f64 / sizes.len() as f64)
+                );
+            }
+        }
+    }
+    let mut files = Vec::new();
+    for (name, text) in [
+        ("curves.csv", curves),
+        ("slip.csv", slips),
+        ("avalanches.csv", avalanches),
+        ("runs.csv", runs_csv),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, text).map_err(|e| Error::io("writing", &path, e))?;
+        files.push(path);
+    }
+    Ok(MergeSummary {
+        points: sweep.points(),
+        runs_merged: merged,
+        runs_missing: missing,
+        files,
+    })
+}

@@ -1,0 +1,429 @@
+//! Sweeps (feature `serde`, docs/sweep-format.md): format errors name the key, derived
+//! seeds are stable, complete runs are skipped and cut ones redone, and the tables do not
+//! depend on the jobs or the shards. The program's side (feature `cli`) is at the end.
+
+use precursors::sweep::{derive_seed, merge, t_quantile_975, Sweep, SweepOptions, DONE_FILE};
+use precursors::Error;
+use std::path::{Path, PathBuf};
+
+/// A fresh, empty directory under the system's temporary one.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("precursors-{}-sweep-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A tiny base scene: 30 x 5 = 150 cells (a run to global slip: about 10 ms).
+const BASE: &str = r#"{ "block": { "lx": 0.03, "ly": 0.005, "lz": 0.02 },
+    "cells": { "kind": "size", "dx": 0.001, "dy": 0.001 },
+    "normal_load": 500.0,
+    "drive": { "kind": "rod", "height": 0.004, "half_width": 0.001 } }"#;
+
+fn sweep_text(axes: &str, realizations: usize) -> String {
+    format!(r#"{{ "base": {BASE}, "axes": [{axes}], "realizations": {realizations}, "seed": 11 }}"#)
+}
+
+/// Two loads, two rod heights, two realizations: 8 runs.
+fn small() -> String {
+    sweep_text(
+        r#"{ "key": "normal_load", "values": [400.0, 600.0] },
+           { "key": "drive.height", "values": [0.004, 0.008] }"#,
+        2,
+    )
+}
+
+fn key_of(e: Error) -> String {
+    match e {
+        Error::SweepKey { key, .. } => key,
+        other => panic!("expected Error::SweepKey, got {other:?}"),
+    }
+}
+
+#[test]
+fn format_errors_name_the_key() {
+    let err = |axes: &str| Sweep::from_json_str(&sweep_text(axes, 1)).unwrap_err();
+    // Not a scene key, at the top and inside an object.
+    assert_eq!(
+        key_of(err(r#"{ "key": "normal_lod", "values": [1.0] }"#)),
+        "normal_lod"
+    );
+    let e = err(r#"{ "key": "block.lxx", "values": [0.02] }"#);
+    assert!(e.to_string().contains("`block` has no `lxx`"), "{e}");
+    assert_eq!(key_of(e), "block.lxx");
+    // Below a number.
+    assert_eq!(
+        key_of(err(r#"{ "key": "normal_load.x", "values": [1.0] }"#)),
+        "normal_load.x"
+    );
+    // A value of the wrong type, and values the scene refuses.
+    let e = err(r#"{ "key": "normal_load", "values": [300.0, "heavy"] }"#);
+    assert!(e.to_string().contains("\"heavy\""), "{e}");
+    assert_eq!(key_of(e), "normal_load");
+    assert_eq!(
+        key_of(err(r#"{ "key": "block.lx", "values": [-0.03] }"#)),
+        "block.lx"
+    );
+    assert_eq!(
+        key_of(err(r#"{ "key": "normal_load", "values": [0.0] }"#)),
+        "normal_load"
+    );
+    assert_eq!(
+        key_of(err(r#"{ "key": "drive.height", "values": [0.5] }"#)),
+        "drive.height"
+    );
+    // A cell size that does not divide the block.
+    assert_eq!(
+        key_of(err(r#"{ "key": "cells.dx", "values": [0.0007] }"#)),
+        "cells.dx"
+    );
+    // No values, twice the same key, the seed (derived by the sweep).
+    assert_eq!(
+        key_of(err(r#"{ "key": "normal_load", "values": [] }"#)),
+        "normal_load"
+    );
+    assert_eq!(
+        key_of(err(
+            r#"{ "key": "normal_load", "values": [1.0] }, { "key": "normal_load", "values": [2.0] }"#
+        )),
+        "normal_load"
+    );
+    assert_eq!(
+        key_of(err(r#"{ "key": "heights.seed", "values": [1, 2] }"#)),
+        "heights.seed"
+    );
+    // A combination of valid values that is not valid: named by the axes' keys.
+    let e = err(r#"{ "key": "block.lz", "values": [0.02, 0.005] },
+                   { "key": "drive.height", "values": [0.004, 0.008] }"#);
+    assert_eq!(key_of(e), "block.lz, drive.height");
+    // Outside the axes: the file itself, and the counts.
+    for text in [
+        r#"{ "base": {}, "axis": [] }"#.to_string(),
+        r#"{ "base": { "normal_lod": 3.0 } }"#.to_string(),
+        "{ not json".to_string(),
+    ] {
+        let e = Sweep::from_json_str(&text).unwrap_err();
+        assert!(matches!(e, Error::SweepFile { .. }), "{text}: {e:?}");
+    }
+    let e = Sweep::from_json_str(&sweep_text("", 0)).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            Error::InvalidCount {
+                name: "realizations",
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    let sweep = Sweep::from_json_str(&small()).unwrap();
+    assert!(matches!(sweep.shard(2, 2), Err(Error::InvalidCount { .. })));
+    assert!(matches!(sweep.shard(0, 0), Err(Error::InvalidCount { .. })));
+}
+
+#[test]
+fn seeds_are_derived_stably_from_the_base_seed_and_the_coordinates() {
+    // Pinned values: changing the derivation changes every sweep's heights.
+    assert_eq!(derive_seed(11, &[0], 0), 8404586307421351767);
+    assert_eq!(derive_seed(11, &[0], 1), 6972708929841935523);
+    assert_eq!(derive_seed(11, &[1], 0), 17092487410889562692);
+    assert_eq!(derive_seed(0, &[], 0), 12035550249420947055);
+    assert_eq!(derive_seed(1, &[2, 3], 4), 10281589820224458653);
+    let sweep = Sweep::from_json_str(&small()).unwrap();
+    assert_eq!(sweep.runs().len(), 8);
+    let mut seeds = Vec::new();
+    for run in sweep.runs() {
+        assert_eq!(run.index, run.point * 2 + run.realization);
+        assert_eq!(run.seed, derive_seed(11, &run.coordinates, run.realization));
+        // The scene draws its heights from it.
+        let json = run.scene.to_json().unwrap();
+        assert!(json.contains(&format!("\"seed\": {}", run.seed)), "{json}");
+        seeds.push(run.seed);
+    }
+    // The last axis is the fastest; every run has its own seed.
+    assert_eq!(sweep.runs()[2].coordinates, vec![0, 1]);
+    assert_eq!(sweep.runs()[4].coordinates, vec![1, 0]);
+    seeds.sort_unstable();
+    seeds.dedup();
+    assert_eq!(seeds.len(), 8);
+}
+
+#[test]
+fn the_documented_sweep_is_valid() {
+    let doc = include_str!("../docs/sweep-format.md");
+    let block = doc
+        .split("```json\n")
+        .nth(1)
+        .and_then(|rest| rest.split("```").next())
+        .unwrap();
+    let sweep = Sweep::from_json_str(block).unwrap();
+    assert_eq!((sweep.points(), sweep.realizations()), (6, 10));
+    assert_eq!(sweep.keys(), ["normal_load", "drive.height"]);
+    assert_eq!(sweep.runs().len(), 60);
+}
+
+/// Every file of the runs and the merge in `dir`, but the timings (`meta.json`).
+fn tables(dir: &Path) -> Vec<(String, String)> {
+    let mut files = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "csv") {
+                let name = path.strip_prefix(dir).unwrap().display().to_string();
+                files.push((name, std::fs::read_to_string(&path).unwrap()));
+            }
+        }
+    }
+    files.sort();
+    files
+}
+
+#[test]
+fn complete_runs_are_skipped_and_a_cut_one_is_redone() {
+    let sweep = Sweep::from_json_str(&small()).unwrap();
+    let dir = scratch("restart");
+    let first = sweep.execute(&dir, &SweepOptions::new(), |_| {}).unwrap();
+    assert_eq!((first.runs, first.completed, first.skipped), (8, 8, 0));
+    merge(&dir).unwrap();
+    let before = tables(&dir);
+    // A run killed before its marker: the marker missing, a table cut, a stray file.
+    let cut = dir.join(&sweep.runs()[5].dir_name);
+    std::fs::remove_file(cut.join(DONE_FILE)).unwrap();
+    let curve = std::fs::read_to_string(cut.join("curve.csv")).unwrap();
+    std::fs::write(cut.join("curve.csv"), &curve[..curve.len() / 2]).unwrap();
+    std::fs::write(cut.join("stray"), "x").unwrap();
+    // A complete run is not touched: a file put there survives.
+    let complete = dir.join(&sweep.runs()[2].dir_name);
+    std::fs::write(complete.join("stray"), "x").unwrap();
+    let reports = std::sync::Mutex::new(Vec::new());
+    let second = sweep
+        .execute(&dir, &SweepOptions::new().jobs(2), |r| {
+            reports.lock().unwrap().push((r.index, r.skipped))
+        })
+        .unwrap();
+    assert_eq!((second.runs, second.completed, second.skipped), (8, 1, 7));
+    let mut reports = reports.into_inner().unwrap();
+    reports.sort_unstable();
+    assert!(
+        reports.iter().all(|&(i, skipped)| skipped == (i != 5)),
+        "{reports:?}"
+    );
+    assert!(!cut.join("stray").exists() && cut.join(DONE_FILE).is_file());
+    assert!(complete.join("stray").exists());
+    merge(&dir).unwrap();
+    assert_eq!(tables(&dir), before);
+    // The directory holds this sweep: another one is refused there.
+    let other = Sweep::from_json_str(&sweep_text(
+        r#"{ "key": "normal_load", "values": [450.0] }"#,
+        1,
+    ))
+    .unwrap();
+    let e = other
+        .execute(&dir, &SweepOptions::new(), |_| {})
+        .unwrap_err();
+    assert!(matches!(e, Error::SweepDirectory { .. }), "{e:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn tables_do_not_depend_on_jobs_or_shards() {
+    let sweep = Sweep::from_json_str(&small()).unwrap();
+    let one = scratch("jobs1");
+    let two = scratch("jobs2");
+    let sharded = scratch("shards");
+    sweep
+        .execute(&one, &SweepOptions::new().jobs(1), |_| {})
+        .unwrap();
+    sweep
+        .execute(&two, &SweepOptions::new().jobs(2), |_| {})
+        .unwrap();
+    let a = sweep
+        .execute(&sharded, &SweepOptions::new().shard(0, 2).jobs(2), |_| {})
+        .unwrap();
+    // Half the sweep: the merge counts the other half missing.
+    assert_eq!(merge(&sharded).unwrap().runs_missing, 4);
+    let b = sweep
+        .execute(&sharded, &SweepOptions::new().shard(1, 2), |_| {})
+        .unwrap();
+    assert_eq!((a.runs, b.runs, a.completed + b.completed), (4, 4, 8));
+    for dir in [&one, &two, &sharded] {
+        let summary = merge(dir).unwrap();
+        assert_eq!(
+            (summary.points, summary.runs_merged, summary.runs_missing),
+            (4, 8, 0)
+        );
+    }
+    let reference = tables(&one);
+    // 8 runs x 2 tables + 4 merged files.
+    assert_eq!(reference.len(), 20);
+    assert_eq!(tables(&two), reference);
+    assert_eq!(tables(&sharded), reference);
+    // The merge has the axes as columns and every grid load per point.
+    let curves = &reference.iter().find(|(n, _)| n == "curves.csv").unwrap().1;
+    assert!(curves.starts_with("point,normal_load,drive.height,force_over_mu_FN,runs,"));
+    assert_eq!(curves.lines().count(), 1 + 4 * 19);
+    for dir in [one, two, sharded] {
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+}
+
+#[test]
+fn merged_bands_are_student_t() {
+    assert_eq!(t_quantile_975(1), 12.706);
+    assert_eq!(t_quantile_975(9), 2.262);
+    assert_eq!(t_quantile_975(30), 2.042);
+    assert!((t_quantile_975(60) - 2.000).abs() < 3e-3);
+    assert!((t_quantile_975(1_000_000) - 1.95996).abs() < 1e-4);
+    assert!(t_quantile_975(0).is_nan());
+    // One point, three realizations: the band is mean ± t(2)·s/√3 of the runs' values.
+    let sweep = Sweep::from_json_str(&sweep_text("", 3)).unwrap();
+    let dir = scratch("bands");
+    sweep.execute(&dir, &SweepOptions::new(), |_| {}).unwrap();
+    merge(&dir).unwrap();
+    let slips: Vec<f64> = sweep
+        .runs()
+        .iter()
+        .map(|run| {
+            let curve = std::fs::read_to_string(dir.join(&run.dir_name).join("curve.csv")).unwrap();
+            let last = curve.lines().last().unwrap();
+            last.split(',').nth(2).unwrap().parse().unwrap()
+        })
+        .collect();
+    let mean = slips.iter().sum::<f64>() / 3.0;
+    let s = (slips.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / 2.0).sqrt();
+    let row: Vec<f64> = std::fs::read_to_string(dir.join("slip.csv"))
+        .unwrap()
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .skip(7)
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let half = 4.303 * s / 3f64.sqrt();
+    assert!(half > 0.0);
+    for (got, want) in row.iter().zip([mean, mean - half, mean + half]) {
+        assert!((got - want).abs() < 1e-11, "{row:?} vs {mean} ± {half}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The program (`src/bin/precursors.rs`).
+#[cfg(feature = "cli")]
+mod cli {
+    use super::*;
+    use std::process::Command;
+
+    fn precursors(args: &[&str]) -> std::process::Output {
+        Command::new(env!("CARGO_BIN_EXE_precursors"))
+            .args(args)
+            .env_remove("SLURM_ARRAY_TASK_ID")
+            .env_remove("SLURM_ARRAY_TASK_COUNT")
+            .output()
+            .unwrap()
+    }
+
+    fn path(p: &Path) -> &str {
+        p.to_str().unwrap()
+    }
+
+    #[test]
+    fn help_exits_0_and_lists_the_exit_codes() {
+        let out = precursors(&["--help"]);
+        assert_eq!(out.status.code(), Some(0));
+        let text = String::from_utf8(out.stdout).unwrap();
+        for word in ["run", "resume", "info", "sweep", "merge", "Exit codes"] {
+            assert!(text.contains(word), "{text}");
+        }
+        assert_eq!(precursors(&["sweep", "--help"]).status.code(), Some(0));
+        assert_eq!(precursors(&["frobnicate"]).status.code(), Some(2));
+    }
+
+    #[test]
+    fn jobs_shards_and_slurm_give_the_same_tables() {
+        let dir = scratch("cli");
+        let file = dir.join("sweep.json");
+        std::fs::write(&file, small()).unwrap();
+        let (one, two, shards) = (dir.join("one"), dir.join("two"), dir.join("shards"));
+        for (out, jobs) in [(&one, "1"), (&two, "2")] {
+            let o = precursors(&["sweep", path(&file), "--out", path(out), "--jobs", jobs]);
+            assert_eq!(
+                o.status.code(),
+                Some(0),
+                "{}",
+                String::from_utf8_lossy(&o.stderr)
+            );
+        }
+        // Shards from SLURM's variables (an array 1-2: the minimum is subtracted).
+        for id in ["1", "2"] {
+            let o = Command::new(env!("CARGO_BIN_EXE_precursors"))
+                .args(["sweep", path(&file), "--out", path(&shards), "--jobs", "1"])
+                .env("SLURM_ARRAY_TASK_ID", id)
+                .env("SLURM_ARRAY_TASK_COUNT", "2")
+                .env("SLURM_ARRAY_TASK_MIN", "1")
+                .output()
+                .unwrap();
+            assert_eq!(
+                o.status.code(),
+                Some(0),
+                "{}",
+                String::from_utf8_lossy(&o.stderr)
+            );
+            let text = String::from_utf8_lossy(&o.stderr).to_string();
+            let k = id.parse::<usize>().unwrap() - 1;
+            assert!(text.contains(&format!("shard {k}/2: 4 runs")), "{text}");
+        }
+        for out in [&one, &two, &shards] {
+            let o = precursors(&["merge", path(out)]);
+            assert_eq!(
+                o.status.code(),
+                Some(0),
+                "{}",
+                String::from_utf8_lossy(&o.stderr)
+            );
+        }
+        let reference = tables(&one);
+        assert_eq!(reference.len(), 20);
+        assert_eq!(tables(&two), reference);
+        assert_eq!(tables(&shards), reference);
+        // A missing run: merge writes the rest and exits 5.
+        std::fs::remove_file(shards.join("p0000-r0001").join(DONE_FILE)).unwrap();
+        assert_eq!(precursors(&["merge", path(&shards)]).status.code(), Some(5));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn errors_name_the_key_and_have_their_exit_codes() {
+        let dir = scratch("cli-errors");
+        let file = dir.join("bad.json");
+        std::fs::write(
+            &file,
+            sweep_text(r#"{ "key": "block.lxx", "values": [0.02] }"#, 1),
+        )
+        .unwrap();
+        let o = precursors(&["sweep", path(&file), "--out", path(&dir.join("o"))]);
+        assert_eq!(o.status.code(), Some(3));
+        let text = String::from_utf8_lossy(&o.stderr);
+        assert!(text.starts_with("error: sweep axis `block.lxx`"), "{text}");
+        let missing = dir.join("missing.json");
+        let o = precursors(&["run", path(&missing), "--out", path(&dir.join("o"))]);
+        assert_eq!(o.status.code(), Some(4));
+        assert!(String::from_utf8_lossy(&o.stderr).contains("missing.json"));
+        let o = precursors(&["sweep", path(&file), "--out", "o", "--shard", "2/2"]);
+        assert_eq!(o.status.code(), Some(2));
+        // info: cells and estimates of a scene.
+        let scene = dir.join("scene.json");
+        std::fs::write(&scene, BASE).unwrap();
+        let o = precursors(&["info", path(&scene)]);
+        assert_eq!(o.status.code(), Some(0));
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            text.contains("30 x 5 = 150") && text.contains("dense (auto)"),
+            "{text}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
