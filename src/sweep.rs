@@ -102,6 +102,8 @@ pub struct Sweep {
     spec: SweepSpec,
     points: usize,
     runs: Vec<SweepRun>,
+    /// One plan per geometry for all the runs (the jobs share it; a plan is read-only).
+    planner: crate::green::Planner,
 }
 
 /// How [`Sweep::execute`] runs its share.
@@ -400,7 +402,12 @@ impl Sweep {
                 });
             }
         }
-        Ok(Sweep { spec, points, runs })
+        Ok(Sweep {
+            spec,
+            points,
+            runs,
+            planner: crate::green::Planner::new(),
+        })
     }
 
     /// The sweep as JSON, its base scene with every key (heights files as values): the
@@ -481,7 +488,7 @@ impl Sweep {
         std::fs::create_dir_all(&dir)
             .map_err(|e| Error::io("creating the run directory", &dir, e))?;
         let started = Instant::now();
-        let scene = run.scene.clone().build()?;
+        let scene = run.scene.clone().build_with(&self.planner)?;
         let built = started.elapsed().as_secs_f64();
         let mut driver = scene.driver()?;
         let mut tables = RunTables::open(&dir, None)?;
