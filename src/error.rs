@@ -493,3 +493,27 @@ pub(crate) fn check_slice(name: &'static str, values: &[f64], expected: usize) -
     }
     Ok(())
 }
+
+/// The messages of `error` and of its causes ([`std::error::Error::source`]), outermost
+/// first, leaving out a cause whose message already ends the one before it (this crate's
+/// [`Error::Io`] says "reading scene file `<path>`: `<the io::Error>`"): what a program prints
+/// as `error: ...` and `caused by: ...` lines.
+///
+/// ```
+/// use precursors::error::messages;
+/// let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
+/// let e = precursors::Error::io("reading scene file", "/x/y.json", io);
+/// assert_eq!(messages(&e), vec!["reading scene file /x/y.json: no such file".to_string()]);
+/// ```
+pub fn messages(error: &(dyn std::error::Error + 'static)) -> Vec<String> {
+    let mut out = vec![error.to_string()];
+    let mut source = error.source();
+    while let Some(cause) = source {
+        let text = cause.to_string();
+        if !out.last().is_some_and(|previous| previous.ends_with(&text)) {
+            out.push(text);
+        }
+        source = cause.source();
+    }
+    out
+}

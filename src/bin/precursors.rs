@@ -216,17 +216,13 @@ fn main() -> ExitCode {
 
 /// Prints `error: <message>` and one `caused by: <message>` per source; a cause whose
 /// message already ends the message before it is not printed twice.
-fn report(e: &dyn std::error::Error) {
-    eprintln!("error: {e}");
-    let mut previous = e.to_string();
-    let mut source = e.source();
-    while let Some(cause) = source {
-        let text = cause.to_string();
-        if !previous.ends_with(&text) {
+fn report(e: &(dyn std::error::Error + 'static)) {
+    for (k, text) in precursors::error::messages(e).iter().enumerate() {
+        if k == 0 {
+            eprintln!("error: {text}");
+        } else {
             eprintln!("  caused by: {text}");
         }
-        previous = text;
-        source = cause.source();
     }
 }
 
