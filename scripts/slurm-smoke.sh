@@ -15,6 +15,8 @@ REPO=$(cd "$(dirname "$0")/.." && pwd)
 W=${SMOKE_DIR:-/tmp/precursors-slurm-smoke}
 NODE=$(hostname -s)
 CPUS=$(nproc)
+# 90 % of the memory (MB): a node configured with more than it has is drained.
+MEMORY=$(awk '/^MemTotal/ { print int($2 / 1024 * 0.9) }' /proc/meminfo)
 # Ports of our own, so that a SLURM the machine may run is not disturbed.
 CTLD_PORT=16817
 SLURMD_PORT=16818
@@ -97,7 +99,7 @@ done
 munge --socket="$W/run/munge.socket" -n | unmunge --socket="$W/run/munge.socket" |
     grep -E '^STATUS' || fail "munge does not answer (log: $W/log/munged.log)"
 
-say "slurm.conf: one node ($NODE, $CPUS CPUs) on localhost"
+say "slurm.conf: one node ($NODE, $CPUS CPUs, $MEMORY MB) on localhost"
 export SLURM_CONF=$W/etc/slurm.conf
 cat >"$SLURM_CONF" <<EOF
 ClusterName=smoke
@@ -125,7 +127,7 @@ SelectTypeParameters=CR_CPU
 SchedulerType=sched/backfill
 MpiDefault=none
 ReturnToService=2
-NodeName=$NODE NodeAddr=127.0.0.1 CPUs=$CPUS State=UNKNOWN
+NodeName=$NODE NodeAddr=127.0.0.1 CPUs=$CPUS RealMemory=$MEMORY State=UNKNOWN
 PartitionName=debug Nodes=ALL Default=YES MaxTime=INFINITE State=UP
 EOF
 grep -v '^#' "$SLURM_CONF" | sed 's/^/  /'
@@ -169,32 +171,22 @@ echo "task \$SLURM_ARRAY_TASK_ID on \$(hostname -s): SLURM_ARRAY_TASK_COUNT=\${S
 exec "$P" sweep "$W/study.json" --out "\$1" --jobs "\${SLURM_CPUS_PER_TASK:-1}" \${SHARD:+--shard "\$SHARD"}
 EOF
 
-# Submits an array of $1 tasks writing into $2 (sbatch's options: the rest), waits for
-# every task, checks in the job completion record that each ended COMPLETED with exit code
-# 0, and prints the tasks' logs. With MERGE=1, also submits `precursors merge` at once as a
-# job that waits for the array (--dependency=afterok): it must find every run complete.
-run_array() {
-    local tasks=$1 out=$2 job t0 records
-    shift 2
-    job=$(sbatch --parsable "$@" "$W/job.sh" "$out")
-    job=${job%%;*}
-    JOB=$job
-    echo "sbatch $* job.sh $out: job $job"
-    local jobs=$job merge_job=
-    if [ "${MERGE:-0}" = 1 ]; then
-        merge_job=$(sbatch --parsable --dependency=afterok:"$job" --job-name=precursors-merge \
-            --output="$W/logs/merge-%j.out" --wrap "$P merge $out")
-        echo "sbatch --dependency=afterok:$job --wrap \"precursors merge $out\": job $merge_job"
-        jobs=$job,$merge_job
-    fi
-    squeue -r -j "$jobs" -o '%.10i %.9T %.6M %R' || true
-    t0=$SECONDS
-    while [ -n "$(squeue -h -j "$jobs" 2>/dev/null)" ]; do
-        [ $((SECONDS - t0)) -lt "$WAIT_SECONDS" ] || fail "job $job still running after ${WAIT_SECONDS}s"
+# Waits until squeue shows none of the jobs $1 (comma-separated).
+wait_jobs() {
+    local t0=$SECONDS
+    while [ -n "$(squeue -h -j "$1" 2>/dev/null)" ]; do
+        [ $((SECONDS - t0)) -lt "$WAIT_SECONDS" ] || fail "jobs $1 still running after ${WAIT_SECONDS}s"
         sleep 1
     done
     echo "all tasks ended after $((SECONDS - t0)) s"
-    # The completion record (one line per task), given a few seconds to be written.
+}
+
+# Checks in the job completion record that the $2 tasks of array job $1 ended COMPLETED
+# with exit code 0, and prints the record and the tasks' logs ($3: their file names, with
+# the task id as '*').
+check_tasks() {
+    local job=$1 tasks=$2 logs=$3 records f
+    # One line per task, given a few seconds to be written.
     for _ in $(seq 10); do
         records=$(awk -v job="$job" '$0 ~ (" ArrayJobId=" job " ") {
             for (i = 1; i <= NF; i++) { split($i, kv, "="); f[kv[1]] = $i }
@@ -205,17 +197,43 @@ run_array() {
     done
     echo "$records"
     [ "$(grep -c 'JobState=COMPLETED ExitCode=0:0' <<<"$records")" = "$tasks" ] ||
-        fail "not every task of job $job completed with exit code 0 (logs: $W/logs)"
-    for f in "$W"/logs/precursors-smoke-"$job"_*.out; do
+        fail "not every task of job $job completed with exit code 0 (logs: $logs)"
+    for f in $logs; do
         echo "--- $(basename "$f")"
         cat "$f"
     done
-    if [ -n "$merge_job" ]; then
-        echo "--- merge-$merge_job.out"
-        cat "$W/logs/merge-$merge_job.out"
-        grep -q "^JobId=$merge_job .*JobState=COMPLETED .*ExitCode=0:0" "$W/log/jobcomp.txt" ||
-            fail "the merge job $merge_job did not complete with exit code 0"
+}
+
+# Checks that the (non-array) job $1 ended COMPLETED with exit code 0 and prints its log $2.
+check_job() {
+    echo "--- $(basename "$2")"
+    cat "$2"
+    grep -q "^JobId=$1 .*JobState=COMPLETED .*ExitCode=0:0" "$W/log/jobcomp.txt" ||
+        fail "job $1 did not complete with exit code 0"
+}
+
+# Submits job.sh as an array of $1 tasks writing into $2 (sbatch's options: the rest),
+# waits for it and checks its tasks. With MERGE=1, also submits `precursors merge` at once
+# as a job that waits for the array (--dependency=afterok): it must find every run
+# complete.
+run_array() {
+    local tasks=$1 out=$2 job jobs merge_job=
+    shift 2
+    job=$(sbatch --parsable "$@" "$W/job.sh" "$out")
+    job=${job%%;*}
+    JOB=$job
+    jobs=$job
+    echo "sbatch $* job.sh $out: job $job"
+    if [ "${MERGE:-0}" = 1 ]; then
+        merge_job=$(sbatch --parsable --dependency=afterok:"$job" --job-name=precursors-merge \
+            --output="$W/logs/merge-%j.out" --wrap "$P merge $out")
+        echo "sbatch --dependency=afterok:$job --wrap \"precursors merge $out\": job $merge_job"
+        jobs=$job,$merge_job
     fi
+    squeue -r -j "$jobs" -o '%.10i %.9T %.6M %R' || true
+    wait_jobs "$jobs"
+    check_tasks "$job" "$tasks" "$W/logs/precursors-smoke-${job}_*.out"
+    [ -z "$merge_job" ] || check_job "$merge_job" "$W/logs/merge-$merge_job.out"
 }
 
 # Compares two sweep directories: every file byte for byte, except meta.json, compared
@@ -278,5 +296,24 @@ run_array 1 "$W/slurm" --array=2 --export=ALL,SHARD=2/4
 [ "$(runs_done)" = 1 ] || fail "the restarted task ran $(runs_done) runs, not the 1 cut"
 "$P" merge "$W/slurm"
 compare "$W/local" "$W/slurm"
+
+say "the batch script of docs/cluster.md, as written there but for --array=0-3 and --cpus-per-task=1"
+mkdir -p "$W/doc/logs"
+cp "$W/study.json" "$W/doc/study.json"
+awk '/^## The batch script/ { f = 1 } f && /^```bash/ { b = 1; next } b && /^```/ { exit } b' \
+    "$REPO/docs/cluster.md" >"$W/doc/sweep.sbatch"
+[ -s "$W/doc/sweep.sbatch" ] || fail "no batch script found in docs/cluster.md"
+(
+    cd "$W/doc"
+    job=$(PRECURSORS=$P sbatch --parsable --array=0-3 --cpus-per-task=1 sweep.sbatch)
+    merge_job=$(sbatch --parsable --dependency=afterok:"$job" --output=logs/merge-%j.out \
+        --wrap "$P merge study")
+    echo "cd $W/doc; sbatch --array=0-3 --cpus-per-task=1 sweep.sbatch: job $job;" \
+        "sbatch --dependency=afterok:$job --wrap \"precursors merge study\": job $merge_job"
+    wait_jobs "$job,$merge_job"
+    check_tasks "$job" 4 "$W/doc/logs/precursors-sweep-${job}_*.out"
+    check_job "$merge_job" "$W/doc/logs/merge-$merge_job.out"
+)
+compare "$W/local" "$W/doc/study"
 
 say "PASS: the SLURM arrays' tables equal the local sweep's"
