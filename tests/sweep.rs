@@ -379,19 +379,19 @@ mod cli {
         // `sbatch --array=1-2` (the minimum is subtracted) and `--array=10-16:2` (ids 10, 12,
         // 14, 16: divided by the step), and as older SLURM releases set them (no COUNT: N
         // from MIN and MAX). Seen on a real SLURM: docs/cluster.md, scripts/slurm-smoke.sh.
-        let layouts: [(&str, &[&str], &str, &str, &str, Option<&str>); 3] = [
-            ("shards", &["1", "2"], "1", "2", "1", Some("2")),
+        // (directory, task ids, then MIN, MAX, STEP and COUNT as each task sees them)
+        type Layout<'a> = (&'a str, &'a [&'a str], [&'a str; 3], Option<&'a str>);
+        let layouts: [Layout; 3] = [
+            ("shards", &["1", "2"], ["1", "2", "1"], Some("2")),
             (
                 "step",
                 &["10", "12", "14", "16"],
-                "10",
-                "16",
-                "2",
+                ["10", "16", "2"],
                 Some("4"),
             ),
-            ("nocount", &["3", "4"], "3", "4", "1", None),
+            ("nocount", &["3", "4"], ["3", "4", "1"], None),
         ];
-        for (name, ids, min, max, step, count) in layouts {
+        for (name, ids, [min, max, step], count) in layouts {
             let out = dir.join(name);
             let n = ids.len();
             for (k, id) in ids.iter().enumerate() {
