@@ -317,13 +317,31 @@ mod cli {
     use super::*;
     use std::process::Command;
 
-    fn precursors(args: &[&str]) -> std::process::Output {
-        Command::new(env!("CARGO_BIN_EXE_precursors"))
+    /// SLURM's job-array variables (all unset for the program but those given).
+    const SLURM_VARS: [&str; 5] = [
+        "SLURM_ARRAY_TASK_ID",
+        "SLURM_ARRAY_TASK_COUNT",
+        "SLURM_ARRAY_TASK_MIN",
+        "SLURM_ARRAY_TASK_MAX",
+        "SLURM_ARRAY_TASK_STEP",
+    ];
+
+    /// The program with `vars` as its only SLURM array variables (the tests may run inside
+    /// an array task).
+    fn precursors_in(vars: &[(&str, &str)], args: &[&str]) -> std::process::Output {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_precursors"));
+        for name in SLURM_VARS {
+            command.env_remove(name);
+        }
+        command
             .args(args)
-            .env_remove("SLURM_ARRAY_TASK_ID")
-            .env_remove("SLURM_ARRAY_TASK_COUNT")
+            .envs(vars.iter().copied())
             .output()
             .unwrap()
+    }
+
+    fn precursors(args: &[&str]) -> std::process::Output {
+        precursors_in(&[], args)
     }
 
     fn path(p: &Path) -> &str {
@@ -357,26 +375,48 @@ mod cli {
                 String::from_utf8_lossy(&o.stderr)
             );
         }
-        // Shards from SLURM's variables (an array 1-2: the minimum is subtracted).
-        for id in ["1", "2"] {
-            let o = Command::new(env!("CARGO_BIN_EXE_precursors"))
-                .args(["sweep", path(&file), "--out", path(&shards), "--jobs", "1"])
-                .env("SLURM_ARRAY_TASK_ID", id)
-                .env("SLURM_ARRAY_TASK_COUNT", "2")
-                .env("SLURM_ARRAY_TASK_MIN", "1")
-                .output()
-                .unwrap();
-            assert_eq!(
-                o.status.code(),
-                Some(0),
-                "{}",
-                String::from_utf8_lossy(&o.stderr)
-            );
-            let text = String::from_utf8_lossy(&o.stderr).to_string();
-            let k = id.parse::<usize>().unwrap() - 1;
-            assert!(text.contains(&format!("shard {k}/2: 4 runs")), "{text}");
+        // Shards from SLURM's variables, as SLURM 22.05 sets them in the tasks of
+        // `sbatch --array=1-2` (the minimum is subtracted) and `--array=10-16:2` (ids 10, 12,
+        // 14, 16: divided by the step), and as older SLURM releases set them (no COUNT: N
+        // from MIN and MAX). Seen on a real SLURM: docs/cluster.md, scripts/slurm-smoke.sh.
+        // (directory, task ids, then MIN, MAX, STEP and COUNT as each task sees them)
+        type Layout<'a> = (&'a str, &'a [&'a str], [&'a str; 3], Option<&'a str>);
+        let layouts: [Layout; 3] = [
+            ("shards", &["1", "2"], ["1", "2", "1"], Some("2")),
+            (
+                "step",
+                &["10", "12", "14", "16"],
+                ["10", "16", "2"],
+                Some("4"),
+            ),
+            ("nocount", &["3", "4"], ["3", "4", "1"], None),
+        ];
+        for (name, ids, [min, max, step], count) in layouts {
+            let out = dir.join(name);
+            let n = ids.len();
+            for (k, id) in ids.iter().enumerate() {
+                let mut vars = vec![
+                    ("SLURM_ARRAY_TASK_ID", *id),
+                    ("SLURM_ARRAY_TASK_MIN", min),
+                    ("SLURM_ARRAY_TASK_MAX", max),
+                    ("SLURM_ARRAY_TASK_STEP", step),
+                ];
+                vars.extend(count.map(|c| ("SLURM_ARRAY_TASK_COUNT", c)));
+                let o = precursors_in(
+                    &vars,
+                    &["sweep", path(&file), "--out", path(&out), "--jobs", "1"],
+                );
+                let text = String::from_utf8_lossy(&o.stderr).to_string();
+                assert_eq!(o.status.code(), Some(0), "{name} {id}: {text}");
+                let share = 8 / n;
+                assert!(
+                    text.contains(&format!("shard {k}/{n}: {share} runs")),
+                    "{name} {id}: {text}"
+                );
+            }
         }
-        for out in [&one, &two, &shards] {
+        let (step, nocount) = (dir.join("step"), dir.join("nocount"));
+        for out in [&one, &two, &shards, &step, &nocount] {
             let o = precursors(&["merge", path(out)]);
             assert_eq!(
                 o.status.code(),
@@ -389,6 +429,8 @@ mod cli {
         assert_eq!(reference.len(), 20);
         assert_eq!(tables(&two), reference);
         assert_eq!(tables(&shards), reference);
+        assert_eq!(tables(&step), reference);
+        assert_eq!(tables(&nocount), reference);
         // A missing run: merge writes the rest and exits 5.
         std::fs::remove_file(shards.join("p0000-r0001").join(DONE_FILE)).unwrap();
         assert_eq!(precursors(&["merge", path(&shards)]).status.code(), Some(5));
@@ -424,6 +466,71 @@ mod cli {
             text.contains("30 x 5 = 150") && text.contains("dense (auto)"),
             "{text}"
         );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn slurm_variables_that_give_no_shard_are_refused() {
+        let dir = scratch("cli-slurm");
+        let file = dir.join("sweep.json");
+        std::fs::write(&file, small()).unwrap();
+        let out = dir.join("o");
+        // (variables, words of the message); exit code 2 and nothing written for each.
+        let cases: [(&[(&str, &str)], &str); 4] = [
+            // `sbatch --array=1,3,8` on SLURM 22.05, task 8: ids not evenly spaced.
+            (
+                &[
+                    ("SLURM_ARRAY_TASK_ID", "8"),
+                    ("SLURM_ARRAY_TASK_COUNT", "3"),
+                    ("SLURM_ARRAY_TASK_MIN", "1"),
+                    ("SLURM_ARRAY_TASK_MAX", "8"),
+                    ("SLURM_ARRAY_TASK_STEP", "1"),
+                ],
+                "not evenly spaced",
+            ),
+            // An id alone: every task would run the whole sweep.
+            (
+                &[("SLURM_ARRAY_TASK_ID", "3")],
+                "neither SLURM_ARRAY_TASK_COUNT nor SLURM_ARRAY_TASK_MAX",
+            ),
+            // An id off the step.
+            (
+                &[
+                    ("SLURM_ARRAY_TASK_ID", "13"),
+                    ("SLURM_ARRAY_TASK_COUNT", "4"),
+                    ("SLURM_ARRAY_TASK_MIN", "10"),
+                    ("SLURM_ARRAY_TASK_MAX", "16"),
+                    ("SLURM_ARRAY_TASK_STEP", "2"),
+                ],
+                "plus a multiple of SLURM_ARRAY_TASK_STEP=2",
+            ),
+            // An id past the count (MIN missing: taken as 0).
+            (
+                &[
+                    ("SLURM_ARRAY_TASK_ID", "4"),
+                    ("SLURM_ARRAY_TASK_COUNT", "4"),
+                ],
+                "need 0 <= K < N",
+            ),
+        ];
+        for (vars, words) in cases {
+            let o = precursors_in(vars, &["sweep", path(&file), "--out", path(&out)]);
+            let text = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(2), "{vars:?}: {text}");
+            assert!(
+                text.starts_with("error: ") && text.contains(words),
+                "{vars:?}: {text}"
+            );
+            assert!(!out.exists(), "{vars:?}: wrote {}", out.display());
+        }
+        // An explicit --shard overrides the variables.
+        let o = precursors_in(
+            cases[0].0,
+            &["sweep", path(&file), "--out", path(&out), "--shard", "1/4"],
+        );
+        let text = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(0), "{text}");
+        assert!(text.contains("shard 1/4: 2 runs"), "{text}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -20,7 +20,7 @@ const EXIT_CODES: &str = "\
 Exit codes:
   0  success
   1  the computation failed (a solver did not converge, the contact emptied, ...)
-  2  bad command line (unknown option, missing argument, bad --shard)
+  2  bad command line (unknown option, missing argument, bad --shard or SLURM variables)
   3  invalid input: a scene, sweep or checkpoint file that is not valid JSON, names an
      unknown key, holds an invalid value, or does not fit; a damaged table
   4  a file or directory could not be read or written
@@ -84,8 +84,9 @@ enum Command {
         /// Runs at the same time [default: the number of cores].
         #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
         jobs: Option<u64>,
-        /// Runs share K of N (runs whose index is K modulo N) [default: from
-        /// SLURM_ARRAY_TASK_ID - SLURM_ARRAY_TASK_MIN and SLURM_ARRAY_TASK_COUNT, else 0/1].
+        /// Runs share K of N (runs whose index is K modulo N) [default: in a SLURM array
+        /// task, K = (SLURM_ARRAY_TASK_ID - _MIN) / _STEP of N = SLURM_ARRAY_TASK_COUNT
+        /// (docs/cluster.md); else 0/1].
         #[arg(long, value_name = "K/N", value_parser = parse_shard)]
         shard: Option<(usize, usize)>,
     },
@@ -114,28 +115,73 @@ fn parse_shard(text: &str) -> Result<(usize, usize), String> {
     Ok((k, n))
 }
 
-/// The shard from SLURM's job-array variables, if set.
-fn slurm_shard() -> Result<Option<(usize, usize)>, String> {
-    let var = |name: &str| std::env::var(name).ok().filter(|v| !v.trim().is_empty());
-    let (Some(id), Some(count)) = (var("SLURM_ARRAY_TASK_ID"), var("SLURM_ARRAY_TASK_COUNT"))
-    else {
+/// The shard from SLURM's job-array variables (`SLURM_ARRAY_TASK_*`), if this is an array
+/// task. Task ids need not start at 0 nor be contiguous: `--array=10-16:2` gives ids 10,
+/// 12, 14, 16 with MIN 10 and STEP 2, so shard K = (ID - MIN) / STEP of COUNT. Older SLURM
+/// releases set no COUNT, only MIN and MAX: N is then (MAX - MIN) / STEP + 1. A list such as
+/// `--array=1,3,8` (COUNT 3, MIN 1, MAX 8, STEP 1 on SLURM 22.05) has no such rank and is
+/// refused, as is an ID without COUNT or MAX: each task would run the whole sweep.
+fn slurm_shard(var: impl Fn(&str) -> Option<String>) -> Result<Option<(usize, usize)>, String> {
+    let var = |name: &str| var(name).filter(|v| !v.trim().is_empty());
+    let number = |name: &str| -> Result<Option<usize>, String> {
+        var(name)
+            .map(|v| {
+                v.trim()
+                    .parse::<usize>()
+                    .map_err(|e| format!("{name}={v:?}: {e}"))
+            })
+            .transpose()
+    };
+    let Some(id) = number("SLURM_ARRAY_TASK_ID")? else {
         return Ok(None);
     };
-    let number = |name: &str, v: &str| {
-        v.trim()
-            .parse::<usize>()
-            .map_err(|e| format!("{name}={v:?}: {e}"))
+    let count = number("SLURM_ARRAY_TASK_COUNT")?;
+    let min = number("SLURM_ARRAY_TASK_MIN")?.unwrap_or(0);
+    let max = number("SLURM_ARRAY_TASK_MAX")?;
+    let step = number("SLURM_ARRAY_TASK_STEP")?.unwrap_or(1);
+    let give = "give the shard with --shard K/N";
+    if step == 0 {
+        return Err(format!("SLURM_ARRAY_TASK_STEP=0: {give}"));
+    }
+    // The number of ids MIN, MIN + STEP, ..., MAX.
+    let span = match max {
+        Some(max) if max >= min && (max - min) % step == 0 => Some((max - min) / step + 1),
+        Some(max) => {
+            return Err(format!(
+                "SLURM_ARRAY_TASK_MAX={max} is not SLURM_ARRAY_TASK_MIN={min} plus a multiple \
+                 of SLURM_ARRAY_TASK_STEP={step}: {give}"
+            ))
+        }
+        None => None,
     };
-    let id = number("SLURM_ARRAY_TASK_ID", &id)?;
-    let count = number("SLURM_ARRAY_TASK_COUNT", &count)?;
-    let min = match var("SLURM_ARRAY_TASK_MIN") {
-        Some(m) => number("SLURM_ARRAY_TASK_MIN", &m)?,
-        None => 0,
+    let n = match (count, span) {
+        (Some(count), Some(span)) if count != span => {
+            let max = max.unwrap_or_default();
+            return Err(format!(
+                "the array's task ids are not evenly spaced: SLURM_ARRAY_TASK_COUNT={count}, but \
+                 MIN={min} to MAX={max} by STEP={step} are {span} ids (an --array list?): {give}"
+            ));
+        }
+        (Some(n), _) | (None, Some(n)) => n,
+        (None, None) => {
+            return Err(format!(
+                "SLURM_ARRAY_TASK_ID={id} is set but neither SLURM_ARRAY_TASK_COUNT nor \
+                 SLURM_ARRAY_TASK_MAX: {give}"
+            ))
+        }
     };
-    let k = id
+    let offset = id
         .checked_sub(min)
-        .ok_or_else(|| format!("SLURM_ARRAY_TASK_ID={id} is below SLURM_ARRAY_TASK_MIN={min}"))?;
-    parse_shard(&format!("{k}/{count}")).map(Some)
+        .filter(|o| o % step == 0)
+        .ok_or_else(|| {
+            format!(
+                "SLURM_ARRAY_TASK_ID={id} is not SLURM_ARRAY_TASK_MIN={min} plus a multiple of \
+                 SLURM_ARRAY_TASK_STEP={step}: {give}"
+            )
+        })?;
+    parse_shard(&format!("{}/{n}", offset / step))
+        .map(Some)
+        .map_err(|e| format!("the shard from SLURM's variables, {e}: {give}"))
 }
 
 /// A failure and its exit code.
@@ -436,7 +482,9 @@ fn run_sweep(
 ) -> Result<(), Failure> {
     let shard = match shard {
         Some(s) => s,
-        None => slurm_shard().map_err(usage)?.unwrap_or((0, 1)),
+        None => slurm_shard(|name| std::env::var(name).ok())
+            .map_err(usage)?
+            .unwrap_or((0, 1)),
     };
     let jobs = match jobs {
         Some(j) => usize::try_from(j).unwrap_or(usize::MAX),
