@@ -28,13 +28,14 @@ mod merge;
 
 pub use merge::{merge, t_quantile_975, MergeSummary, LOAD_GRID};
 
+use crate::driver::write_atomically;
 use crate::error::{Error, Result};
 use crate::output::RunTables;
 use crate::scene::file::{builder_from_value, normalized_value};
 use crate::scene::{HeightSource, SceneBuilder};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
@@ -531,8 +532,8 @@ impl Sweep {
             column: 0,
             source: Box::new(e),
         })?;
-        write_atomically(&dir.join("meta.json"), text.as_bytes())?;
-        write_atomically(&dir.join(DONE_FILE), b"complete\n")?;
+        write_atomically(&dir.join("meta.json"), text.as_bytes(), "writing")?;
+        write_atomically(&dir.join(DONE_FILE), b"complete\n", "writing")?;
         Ok(RunReport {
             index: run.index,
             skipped: false,
@@ -623,20 +624,9 @@ impl Sweep {
                     .into(),
             }),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                write_atomically(&path, text.as_bytes())
+                write_atomically(&path, text.as_bytes(), "writing")
             }
             Err(e) => Err(Error::io("reading", &path, e)),
         }
     }
-}
-
-/// Writes `bytes` to a temporary file beside `path` and renames it over `path`.
-fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp: PathBuf = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-    std::fs::write(&tmp, bytes).map_err(|e| Error::io("writing", &tmp, e))?;
-    std::fs::rename(&tmp, path).map_err(|e| Error::io("renaming into place", path, e))
 }

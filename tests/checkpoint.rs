@@ -361,6 +361,30 @@ mod json {
                 c.to_json().unwrap()
             );
         }
+        // Concurrent writers of one file (the tasks of a job array sharing a directory):
+        // every write succeeds and the file is always one whole checkpoint.
+        let texts = [
+            std::fs::read_to_string(&path).unwrap(),
+            scene.driver().unwrap().checkpoint().to_json().unwrap(),
+        ];
+        let shared = dir.join("shared.json");
+        std::thread::scope(|s| {
+            for w in 0..4 {
+                let (shared, texts, scene) = (&shared, &texts, &scene);
+                s.spawn(move || {
+                    let c = [
+                        Checkpoint::from_json_str(&texts[0]).unwrap(),
+                        scene.driver().unwrap().checkpoint(),
+                    ];
+                    for k in 0..25 {
+                        c[(w + k) % 2].write_to(shared).unwrap();
+                        let now = std::fs::read_to_string(shared).unwrap();
+                        assert!(texts.contains(&now), "a torn checkpoint file");
+                    }
+                });
+            }
+        });
+        std::fs::remove_file(&shared).unwrap();
         let names: Vec<_> = std::fs::read_dir(&dir)
             .unwrap()
             .map(|e| e.unwrap().file_name())

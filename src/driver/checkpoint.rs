@@ -141,45 +141,11 @@ impl Checkpoint {
     /// checkpoint cannot be written as JSON.
     #[cfg(feature = "serde")]
     pub fn write_to(&self, path: impl AsRef<std::path::Path>) -> Result<()> {
-        use std::io::Write;
-        let path = path.as_ref();
-        let io = |p: &std::path::Path, e: std::io::Error| Error::io("writing checkpoint", p, e);
-        let text = self.to_json()?;
-        let name = path.file_name().ok_or_else(|| {
-            io(
-                path,
-                std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file name"),
-            )
-        })?;
-        let dir = match path.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d,
-            _ => std::path::Path::new("."),
-        };
-        let mut tmp_name = std::ffi::OsString::from(".");
-        tmp_name.push(name);
-        // Unique per process and call: concurrent writers never share a temporary file.
-        static CALLS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-        let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        tmp_name.push(format!(".tmp{}-{call}", std::process::id()));
-        let tmp = dir.join(tmp_name);
-        let written = (|| {
-            let mut file = std::fs::File::create(&tmp)?;
-            file.write_all(text.as_bytes())?;
-            file.sync_all()
-        })();
-        if let Err(e) = written {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(io(&tmp, e));
-        }
-        if let Err(e) = std::fs::rename(&tmp, path) {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(io(path, e));
-        }
-        #[cfg(unix)]
-        std::fs::File::open(dir)
-            .and_then(|d| d.sync_all())
-            .map_err(|e| io(dir, e))?;
-        Ok(())
+        write_atomically(
+            path.as_ref(),
+            self.to_json()?.as_bytes(),
+            "writing checkpoint",
+        )
     }
 
     /// Reads a checkpoint file written by [`Checkpoint::write_to`] (or holding
@@ -325,4 +291,69 @@ impl Scene {
         driver.refresh_shear();
         Ok(driver)
     }
+}
+
+/// Writes `bytes` to `path` atomically: to a new temporary file in the same directory,
+/// synced to disk, then renamed over `path` (and the directory synced on Unix). A crash
+/// leaves the old file or the new one, never half of one. The temporary file is created
+/// exclusively (`create_new`), with another name on a clash, so writers in other
+/// processes or on other hosts sharing the directory (a SLURM array on a network file
+/// system) never write into the same temporary file.
+///
+/// # Errors
+/// [`Error::Io`] with `operation` and the path of the file that could not be written,
+/// synced or renamed (the temporary file is removed).
+#[cfg(feature = "serde")]
+pub(crate) fn write_atomically(
+    path: &std::path::Path,
+    bytes: &[u8],
+    operation: &'static str,
+) -> Result<()> {
+    use std::io::Write;
+    use std::sync::atomic::{AtomicU64, Ordering};
+    let io = |p: &std::path::Path, e: std::io::Error| Error::io(operation, p, e);
+    let name = path.file_name().ok_or_else(|| {
+        io(
+            path,
+            std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file name"),
+        )
+    })?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => std::path::Path::new("."),
+    };
+    static CALLS: AtomicU64 = AtomicU64::new(0);
+    let (tmp, mut file) = loop {
+        let call = CALLS.fetch_add(1, Ordering::Relaxed);
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.subsec_nanos());
+        let mut tmp_name = std::ffi::OsString::from(".");
+        tmp_name.push(name);
+        tmp_name.push(format!(".tmp{}-{call}-{nanos}", std::process::id()));
+        let tmp = dir.join(tmp_name);
+        match std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&tmp)
+        {
+            Ok(file) => break (tmp, file),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(io(&tmp, e)),
+        }
+    };
+    if let Err(e) = file.write_all(bytes).and_then(|()| file.sync_all()) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(io(&tmp, e));
+    }
+    drop(file);
+    if let Err(e) = std::fs::rename(&tmp, path) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(io(path, e));
+    }
+    #[cfg(unix)]
+    std::fs::File::open(dir)
+        .and_then(|d| d.sync_all())
+        .map_err(|e| io(dir, e))?;
+    Ok(())
 }
