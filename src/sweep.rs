@@ -321,8 +321,9 @@ impl Sweep {
     /// scene is read relative to the current directory.
     ///
     /// # Errors
-    /// [`Error::SweepFile`] for invalid JSON or a key outside the format, or a base scene
-    /// that is not a scene file; [`Error::SweepKey`] (naming the key) for an axis whose key
+    /// [`Error::SweepFile`] for invalid JSON or a key outside the format, an axis without
+    /// exactly one of `key` and `keys`, or a base scene that is not a scene file;
+    /// [`Error::SweepKey`] (naming the key, or a linked axis's keys) for an axis whose key
     /// is not a scene key or whose value gives no valid scene; [`Error::InvalidCount`] for
     /// zero realizations, or several with heights that are not random.
     pub fn from_json_str(text: &str) -> Result<Sweep> {
@@ -345,12 +346,13 @@ impl Sweep {
     }
 
     fn from_spec(mut spec: SweepSpec, path: Option<&Path>, base_dir: &Path) -> Result<Sweep> {
-        let base_error = |reason: String| Error::SweepFile {
+        let file_error = |reason: String| Error::SweepFile {
             path: path.map(Path::to_path_buf),
             line: 0,
             column: 0,
-            source: format!("base scene: {reason}").into(),
+            source: reason.into(),
         };
+        let base_error = |reason: String| file_error(format!("base scene: {reason}"));
         spec.base = normalized_value(spec.base.clone(), base_dir).map_err(base_error)?;
         if spec.realizations == 0 {
             return Err(Error::InvalidCount {
@@ -373,19 +375,14 @@ impl Sweep {
                          scene's heights are values (give one realization)",
             });
         }
-        let axes = read_axes(&spec, |reason| Error::SweepFile {
-            path: path.map(Path::to_path_buf),
-            line: 0,
-            column: 0,
-            source: reason.into(),
-        })?;
+        let axes = read_axes(&spec, &file_error)?;
         // Each axis on its own: the keys exist, each step gives a valid scene.
         for (a, axis) in axes.iter().enumerate() {
             let name = axis.name();
             for (k, key) in axis.keys.iter().enumerate() {
                 let earlier = axes[..a].iter().flat_map(|b| &b.keys);
                 if earlier.chain(&axis.keys[..k]).any(|b| b == key) {
-                    return Err(key_error(key, "the key has two axes"));
+                    return Err(key_error(key, "the key is on two axes, or twice on one"));
                 }
                 if key == "heights" || key.starts_with("heights.seed") {
                     return Err(key_error(
