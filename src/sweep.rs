@@ -375,7 +375,7 @@ impl Sweep {
                          scene's heights are values (give one realization)",
             });
         }
-        let axes = read_axes(&spec, &file_error)?;
+        let axes = read_axes(&spec, file_error)?;
         // Each axis on its own: the keys exist, each step gives a valid scene.
         for (a, axis) in axes.iter().enumerate() {
             let name = axis.name();
@@ -441,12 +441,7 @@ impl Sweep {
                     .collect::<Vec<_>>()
                     .join(", ")
             };
-            let keys = || {
-                axes.iter()
-                    .map(Axis::name)
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            };
+            let keys = || axes.iter().map(Axis::name).collect::<Vec<_>>().join(", ");
             for realization in 0..spec.realizations {
                 let seed = derive_seed(spec.seed, &coordinates, realization);
                 let mut scene_value = scene.clone();

@@ -56,7 +56,11 @@ fn readme_table() -> BTreeMap<String, (usize, usize, usize)> {
     for line in lines.skip(1).take_while(|l| l.starts_with('|')) {
         let row = cells(line);
         // `[`fig5a.json`](fig5a.json)` or `fig5a.json`: the name between the first backticks.
-        let name = row[file].split('`').nth(1).unwrap_or(&row[file]).to_string();
+        let name = row[file]
+            .split('`')
+            .nth(1)
+            .unwrap_or(&row[file])
+            .to_string();
         let number = |c: usize| -> usize {
             row[c]
                 .parse()
@@ -78,12 +82,18 @@ fn every_sweep_file_expands_to_its_documented_runs() {
         .collect();
     files.sort();
     let documented: Vec<String> = table.keys().cloned().collect();
-    assert_eq!(files, documented, "files in examples/sweeps vs the README's table");
+    assert_eq!(
+        files, documented,
+        "files in examples/sweeps vs the README's table"
+    );
     let expected: BTreeMap<String, (usize, usize, usize)> = STUDIES
         .iter()
         .map(|&(f, p, r)| (f.to_string(), (p, r, p * r)))
         .collect();
-    assert_eq!(table, expected, "the README's counts drifted from the figures'");
+    assert_eq!(
+        table, expected,
+        "the README's counts drifted from the figures'"
+    );
     for (name, &(points, realizations, runs)) in &table {
         let sweep = Sweep::from_json_file(Path::new(DIR).join(name))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -232,9 +242,6 @@ fn every_point_is_its_captions_scene_on_1_mm_cells() {
         assert_eq!(varied.len(), points, "{name}");
         assert_eq!(sweep.runs().len(), points * realizations, "{name}");
         // The varied parameter grows along the axis: one curve per value.
-        assert!(
-            varied.windows(2).all(|w| w[0] < w[1]),
-            "{name}: {varied:?}"
-        );
+        assert!(varied.windows(2).all(|w| w[0] < w[1]), "{name}: {varied:?}");
     }
 }

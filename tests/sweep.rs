@@ -140,7 +140,10 @@ fn linked_axes_move_their_keys_together() {
         ]
     );
     let json = run.scene.to_json().unwrap();
-    assert!(json.contains("\"lz\": 0.03") && json.contains("\"height\": 0.012"), "{json}");
+    assert!(
+        json.contains("\"lz\": 0.03") && json.contains("\"height\": 0.012"),
+        "{json}"
+    );
     // With a plain axis after it: the linked axis is the slower one.
     let both = format!(r#"{linked}, {{ "key": "normal_load", "values": [400.0, 600.0] }}"#);
     let sweep = Sweep::from_json_str(&sweep_text(&both, 1)).unwrap();
@@ -216,7 +219,11 @@ fn a_linked_sweep_merges_with_a_column_per_key() {
         curves.starts_with("point,block.lz,drive.height,force_over_mu_FN,"),
         "{curves}"
     );
-    assert!(curves.lines().nth(20).unwrap().starts_with("1,0.03,0.012,0.05,"));
+    assert!(curves
+        .lines()
+        .nth(20)
+        .unwrap()
+        .starts_with("1,0.03,0.012,0.05,"));
     let meta = std::fs::read_to_string(dir.join("p0001-r0000").join("meta.json")).unwrap();
     assert!(meta.contains("\"drive.height\": 0.012"), "{meta}");
     std::fs::remove_dir_all(&dir).unwrap();
