@@ -66,11 +66,76 @@ fn one() -> usize {
     1
 }
 
+/// An axis as written: one `key` and its values, or linked `keys` (several scene keys that
+/// change together) and one array of values per step. `None` fields are not written, so
+/// the copy of a sweep with plain axes ([`SWEEP_FILE`]) is as before linked axes existed.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct AxisSpec {
-    key: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    key: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    keys: Option<Vec<String>>,
     values: Vec<Value>,
+}
+
+/// An axis read: its keys (one for a plain axis) and, per step, one value per key.
+#[derive(Debug, Clone, PartialEq)]
+struct Axis {
+    keys: Vec<String>,
+    steps: Vec<Vec<Value>>,
+}
+
+impl Axis {
+    /// The keys joined, as errors name an axis.
+    fn name(&self) -> String {
+        self.keys.join(", ")
+    }
+}
+
+/// The axes of `spec` in one shape: a linked axis's values must be arrays of one value
+/// per key.
+fn read_axes(spec: &SweepSpec, file_error: impl Fn(String) -> Error) -> Result<Vec<Axis>> {
+    let mut axes = Vec::with_capacity(spec.axes.len());
+    for (a, axis) in spec.axes.iter().enumerate() {
+        let read = match (&axis.key, &axis.keys) {
+            (Some(key), None) => Axis {
+                keys: vec![key.clone()],
+                steps: axis.values.iter().map(|v| vec![v.clone()]).collect(),
+            },
+            (None, Some(keys)) if !keys.is_empty() => {
+                let name = keys.join(", ");
+                let mut steps = Vec::with_capacity(axis.values.len());
+                for (i, value) in axis.values.iter().enumerate() {
+                    match value.as_array() {
+                        Some(tuple) if tuple.len() == keys.len() => steps.push(tuple.clone()),
+                        _ => {
+                            return Err(key_error(
+                                &name,
+                                format!(
+                                    "value {value} (#{i}) is not an array of {} values, one \
+                                     per key",
+                                    keys.len()
+                                ),
+                            ))
+                        }
+                    }
+                }
+                Axis {
+                    keys: keys.clone(),
+                    steps,
+                }
+            }
+            (None, Some(_)) => return Err(file_error(format!("axis #{a}: `keys` is empty"))),
+            _ => {
+                return Err(file_error(format!(
+                    "axis #{a}: give either `key` (one scene key) or `keys` (linked keys)"
+                )))
+            }
+        };
+        axes.push(read);
+    }
+    Ok(axes)
 }
 
 /// One run of a sweep: a parameter point, a realization, its seed and its scene.
@@ -88,7 +153,8 @@ pub struct SweepRun {
     pub realization: usize,
     /// The heights' seed ([`derive_seed`]).
     pub seed: u64,
-    /// Each axis's key and value, the value as JSON text (`"0.02"`, `"{\"kind\":\"side\"}"`).
+    /// Each key and its value, the value as JSON text (`"0.02"`, `"{\"kind\":\"side\"}"`),
+    /// in the order of [`Sweep::keys`] (a linked axis gives one pair per key).
     pub values: Vec<(String, String)>,
     /// The run's scene.
     pub scene: SceneBuilder,
@@ -101,6 +167,7 @@ pub struct SweepRun {
 #[derive(Debug, Clone)]
 pub struct Sweep {
     spec: SweepSpec,
+    axes: Vec<Axis>,
     points: usize,
     runs: Vec<SweepRun>,
     /// One plan per geometry for all the runs (the jobs share it; a plan is read-only).
@@ -255,8 +322,9 @@ impl Sweep {
     /// scene is read relative to the current directory.
     ///
     /// # Errors
-    /// [`Error::SweepFile`] for invalid JSON or a key outside the format, or a base scene
-    /// that is not a scene file; [`Error::SweepKey`] (naming the key) for an axis whose key
+    /// [`Error::SweepFile`] for invalid JSON or a key outside the format, an axis without
+    /// exactly one of `key` and `keys`, or a base scene that is not a scene file;
+    /// [`Error::SweepKey`] (naming the key, or a linked axis's keys) for an axis whose key
     /// is not a scene key or whose value gives no valid scene; [`Error::InvalidCount`] for
     /// zero realizations, or several with heights that are not random.
     pub fn from_json_str(text: &str) -> Result<Sweep> {
@@ -279,12 +347,13 @@ impl Sweep {
     }
 
     fn from_spec(mut spec: SweepSpec, path: Option<&Path>, base_dir: &Path) -> Result<Sweep> {
-        let base_error = |reason: String| Error::SweepFile {
+        let file_error = |reason: String| Error::SweepFile {
             path: path.map(Path::to_path_buf),
             line: 0,
             column: 0,
-            source: format!("base scene: {reason}").into(),
+            source: reason.into(),
         };
+        let base_error = |reason: String| file_error(format!("base scene: {reason}"));
         spec.base = normalized_value(spec.base.clone(), base_dir).map_err(base_error)?;
         if spec.realizations == 0 {
             return Err(Error::InvalidCount {
@@ -307,41 +376,48 @@ impl Sweep {
                          scene's heights are values (give one realization)",
             });
         }
-        // Each axis on its own: the key exists, each value gives a valid scene.
-        for (a, axis) in spec.axes.iter().enumerate() {
-            let key = axis.key.as_str();
-            if spec.axes[..a].iter().any(|b| b.key == key) {
-                return Err(key_error(key, "the key has two axes"));
+        let axes = read_axes(&spec, file_error)?;
+        // Each axis on its own: the keys exist, each step gives a valid scene.
+        for (a, axis) in axes.iter().enumerate() {
+            let name = axis.name();
+            for (k, key) in axis.keys.iter().enumerate() {
+                let earlier = axes[..a].iter().flat_map(|b| &b.keys);
+                if earlier.chain(&axis.keys[..k]).any(|b| b == key) {
+                    return Err(key_error(key, "the key is on two axes, or twice on one"));
+                }
+                if key == "heights" || key.starts_with("heights.seed") {
+                    return Err(key_error(
+                        key,
+                        "the sweep derives the heights' seeds from `seed` and the run's \
+                         coordinates (give `realizations`); sweep `heights.mean` or \
+                         `heights.std_dev` instead",
+                    ));
+                }
             }
-            if key == "heights" || key.starts_with("heights.seed") {
-                return Err(key_error(
-                    key,
-                    "the sweep derives the heights' seeds from `seed` and the run's \
-                     coordinates (give `realizations`); sweep `heights.mean` or \
-                     `heights.std_dev` instead",
-                ));
+            if axis.steps.is_empty() {
+                return Err(key_error(&name, "the axis has no values"));
             }
-            if axis.values.is_empty() {
-                return Err(key_error(key, "the axis has no values"));
-            }
-            for (i, value) in axis.values.iter().enumerate() {
+            for (i, step) in axis.steps.iter().enumerate() {
                 let mut scene = spec.base.clone();
-                set_path(&mut scene, key, value)?;
+                for (key, value) in axis.keys.iter().zip(step) {
+                    set_path(&mut scene, key, value)?;
+                }
+                let value = describe_step(step);
                 let builder = builder_from_value(scene).map_err(|reason| {
                     key_error(
-                        key,
+                        &name,
                         format!("value {value} (#{i}) is not valid here: {reason}"),
                     )
                 })?;
                 builder.checked().map_err(|e| {
                     key_error(
-                        key,
+                        &name,
                         format!("value {value} (#{i}) gives an invalid scene: {e}"),
                     )
                 })?;
             }
         }
-        let shape: Vec<usize> = spec.axes.iter().map(|a| a.values.len()).collect();
+        let shape: Vec<usize> = axes.iter().map(|a| a.steps.len()).collect();
         let points = shape.iter().product::<usize>();
         let mut runs = Vec::with_capacity(points * spec.realizations);
         for point in 0..points {
@@ -353,9 +429,11 @@ impl Sweep {
             }
             let mut scene = spec.base.clone();
             let mut values = Vec::with_capacity(shape.len());
-            for (axis, &c) in spec.axes.iter().zip(&coordinates) {
-                set_path(&mut scene, &axis.key, &axis.values[c])?;
-                values.push((axis.key.clone(), axis.values[c].to_string()));
+            for (axis, &c) in axes.iter().zip(&coordinates) {
+                for (key, value) in axis.keys.iter().zip(&axis.steps[c]) {
+                    set_path(&mut scene, key, value)?;
+                    values.push((key.clone(), value.to_string()));
+                }
             }
             let describe = || {
                 values
@@ -364,13 +442,7 @@ impl Sweep {
                     .collect::<Vec<_>>()
                     .join(", ")
             };
-            let keys = || {
-                spec.axes
-                    .iter()
-                    .map(|a| a.key.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            };
+            let keys = || axes.iter().map(Axis::name).collect::<Vec<_>>().join(", ");
             for realization in 0..spec.realizations {
                 let seed = derive_seed(spec.seed, &coordinates, realization);
                 let mut scene_value = scene.clone();
@@ -405,6 +477,7 @@ impl Sweep {
         }
         Ok(Sweep {
             spec,
+            axes,
             points,
             runs,
             planner: crate::green::Planner::new(),
@@ -435,9 +508,13 @@ impl Sweep {
         self.spec.realizations
     }
 
-    /// The axes' keys, in order.
+    /// The axes' keys, in order (a linked axis's keys in their order): the value columns
+    /// of [`SweepRun::values`] and of the merged tables.
     pub fn keys(&self) -> Vec<&str> {
-        self.spec.axes.iter().map(|a| a.key.as_str()).collect()
+        self.axes
+            .iter()
+            .flat_map(|a| a.keys.iter().map(String::as_str))
+            .collect()
     }
 
     /// Share `k` of `n` (`0 <= k < n`): the runs whose index is `k` modulo `n`. The shares
@@ -628,5 +705,13 @@ impl Sweep {
             }
             Err(e) => Err(Error::io("reading", &path, e)),
         }
+    }
+}
+
+/// A step of an axis as errors show it: the value of a plain axis, the array of a linked one.
+fn describe_step(step: &[Value]) -> String {
+    match step {
+        [one] => one.to_string(),
+        many => Value::Array(many.to_vec()).to_string(),
     }
 }

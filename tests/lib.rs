@@ -14,6 +14,8 @@ mod loads;
 #[cfg(feature = "nalgebra")]
 mod matrix;
 mod operator;
+#[cfg(feature = "serde")]
+mod paper_sweeps;
 mod probe;
 mod properties;
 mod robustness;

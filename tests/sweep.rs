@@ -122,6 +122,114 @@ fn format_errors_name_the_key() {
 }
 
 #[test]
+fn linked_axes_move_their_keys_together() {
+    // Two keys on one axis: 2 points (not 2 x 2), one coordinate, one value per key.
+    let linked = r#"{ "keys": ["block.lz", "drive.height"],
+                      "values": [[0.02, 0.004], [0.03, 0.012]] }"#;
+    let sweep = Sweep::from_json_str(&sweep_text(linked, 2)).unwrap();
+    assert_eq!((sweep.points(), sweep.runs().len()), (2, 4));
+    assert_eq!(sweep.keys(), ["block.lz", "drive.height"]);
+    let run = &sweep.runs()[2];
+    assert_eq!((run.point, run.coordinates.clone()), (1, vec![1]));
+    assert_eq!(run.seed, derive_seed(11, &[1], 0));
+    assert_eq!(
+        run.values,
+        [
+            ("block.lz".to_string(), "0.03".to_string()),
+            ("drive.height".to_string(), "0.012".to_string())
+        ]
+    );
+    let json = run.scene.to_json().unwrap();
+    assert!(
+        json.contains("\"lz\": 0.03") && json.contains("\"height\": 0.012"),
+        "{json}"
+    );
+    // With a plain axis after it: the linked axis is the slower one.
+    let both = format!(r#"{linked}, {{ "key": "normal_load", "values": [400.0, 600.0] }}"#);
+    let sweep = Sweep::from_json_str(&sweep_text(&both, 1)).unwrap();
+    assert_eq!(sweep.points(), 4);
+    assert_eq!(sweep.keys(), ["block.lz", "drive.height", "normal_load"]);
+    assert_eq!(sweep.runs()[1].coordinates, vec![0, 1]);
+    // A plain sweep's copy does not mention `keys` (directories of older sweeps still
+    // match it).
+    assert!(!Sweep::from_json_str(&small())
+        .unwrap()
+        .to_json()
+        .unwrap()
+        .contains("keys"));
+
+    let err = |axes: &str| Sweep::from_json_str(&sweep_text(axes, 1)).unwrap_err();
+    // A step that is not one value per key; a step the scene refuses (the rod above a
+    // 20 mm block): named by the axis's keys.
+    for bad in [
+        r#"{ "keys": ["block.lz", "drive.height"], "values": [[0.02, 0.004], [0.03]] }"#,
+        r#"{ "keys": ["block.lz", "drive.height"], "values": [0.02] }"#,
+        r#"{ "keys": ["block.lz", "drive.height"], "values": [[0.02, 0.03]] }"#,
+    ] {
+        let e = err(bad);
+        assert!(e.to_string().contains("(#"), "{e}");
+        assert_eq!(key_of(e), "block.lz, drive.height", "{bad}");
+    }
+    // A key twice, within the axis or across axes; the derived seed.
+    assert_eq!(
+        key_of(err(
+            r#"{ "keys": ["normal_load", "normal_load"], "values": [[1.0, 2.0]] }"#
+        )),
+        "normal_load"
+    );
+    assert_eq!(
+        key_of(err(&format!(
+            r#"{linked}, {{ "key": "drive.height", "values": [0.004] }}"#
+        ))),
+        "drive.height"
+    );
+    assert_eq!(
+        key_of(err(
+            r#"{ "keys": ["normal_load", "heights.seed"], "values": [[1.0, 2]] }"#
+        )),
+        "heights.seed"
+    );
+    // Neither or both of `key` and `keys`, or no keys: the file's shape.
+    for bad in [
+        r#"{ "values": [1.0] }"#,
+        r#"{ "key": "normal_load", "keys": ["normal_load"], "values": [[1.0]] }"#,
+        r#"{ "keys": [], "values": [] }"#,
+    ] {
+        let e = err(bad);
+        assert!(
+            matches!(e, Error::SweepFile { .. }) && e.to_string().contains("axis #0"),
+            "{bad}: {e:?}"
+        );
+    }
+}
+
+#[test]
+fn a_linked_sweep_merges_with_a_column_per_key() {
+    let sweep = Sweep::from_json_str(&sweep_text(
+        r#"{ "keys": ["block.lz", "drive.height"], "values": [[0.02, 0.004], [0.03, 0.012]] }"#,
+        1,
+    ))
+    .unwrap();
+    let dir = scratch("linked");
+    sweep.execute(&dir, &SweepOptions::new(), |_| {}).unwrap();
+    let summary = merge(&dir).unwrap();
+    assert_eq!((summary.points, summary.runs_merged), (2, 2));
+    let curves = std::fs::read_to_string(dir.join("curves.csv")).unwrap();
+    assert!(
+        curves.starts_with("point,block.lz,drive.height,force_over_mu_FN,"),
+        "{curves}"
+    );
+    assert!(curves
+        .lines()
+        .nth(20)
+        .unwrap()
+        .starts_with("1,0.03,0.012,0.05,"));
+    let meta = std::fs::read_to_string(dir.join("p0001-r0000").join("meta.json")).unwrap();
+    assert!(meta.contains("\"drive.height\": 0.012"), "{meta}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn seeds_are_derived_stably_from_the_base_seed_and_the_coordinates() {
     // Pinned values: changing the derivation changes every sweep's heights.
     assert_eq!(derive_seed(11, &[0], 0), 8404586307421351767);
@@ -160,6 +268,15 @@ fn the_documented_sweep_is_valid() {
     assert_eq!((sweep.points(), sweep.realizations()), (6, 10));
     assert_eq!(sweep.keys(), ["normal_load", "drive.height"]);
     assert_eq!(sweep.runs().len(), 60);
+    // The linked axis's example.
+    let block = doc
+        .split("```json\n")
+        .nth(2)
+        .and_then(|rest| rest.split("```").next())
+        .unwrap();
+    let sweep = Sweep::from_json_str(block).unwrap();
+    assert_eq!((sweep.points(), sweep.runs().len()), (4, 40));
+    assert_eq!(sweep.keys(), ["block.lz", "drive.height"]);
 }
 
 /// Every file of the runs and the merge in `dir`, but the timings (`meta.json`).
