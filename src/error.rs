@@ -424,6 +424,15 @@ pub enum Error {
         /// What is wrong, with the value when one is at fault.
         reason: String,
     },
+    /// A figure cannot be drawn or written (feature `plot`): an unknown file extension, an
+    /// invalid axis range, a drawing backend that fails.
+    #[error("figure{}: {reason}", path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default())]
+    Figure {
+        /// The figure's file, when known.
+        path: Option<PathBuf>,
+        /// What is wrong.
+        reason: String,
+    },
     /// A sweep's output directory cannot be used: it holds another sweep, or (for a
     /// merge) no sweep or a run's files that do not belong to it.
     #[error("sweep directory {}: {reason}", path.display())]

@@ -19,7 +19,8 @@
 //! slip).
 //!
 //! Features: `serde` (JSON scene files and checkpoints), `nalgebra` (heights from and
-//! fields to `nalgebra` matrices and vectors, row `iy` and column `ix`).
+//! fields to `nalgebra` matrices and vectors, row `iy` and column `ix`), `plot` (figures
+//! as PNG or SVG: [`plot`](crate#features)), `cli` (the program `precursors`).
 //!
 //! ```
 //! use precursors::{Block, Grid, green::InfluencePlan};
@@ -47,6 +48,8 @@ pub mod interface;
 #[cfg(feature = "nalgebra")]
 mod matrix;
 pub mod output;
+#[cfg(feature = "plot")]
+pub mod plot;
 pub mod probe;
 pub mod scene;
 pub mod solver;

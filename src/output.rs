@@ -6,7 +6,16 @@
 //!   column does not apply);
 //! * `curve.csv`, one row per stable state ([`CURVE_HEADER`]): `event,force_N,
 //!   force_over_mu_FN,drive_displacement_m,real_contact_area_m2,precursor_length_m,
-//!   precursor_over_Lx,broken,attached,area_exceeds_nominal`.
+//!   precursor_over_Lx,broken,attached,area_exceeds_nominal`;
+//! * `contact_map.csv` ([`contact_map_header`]): the map over x and F of the paper's
+//!   Fig. 2b inset, one row per load level `F/(μF_N)` = 0, 0.005, 0.01, ...
+//!   ([`CONTACT_MAP_STEP`]) from the first stable state up to global slip: the real
+//!   contact area of each column `ix` (m², summed over y) in the stable state in effect
+//!   at that load (the last one reached at or below it), and that state's event index:
+//!   `event,force_over_mu_FN,area_m2_ix0,...`. At most about 200 rows whatever the
+//!   number of stable states. Levels are passed in order: where the load drops (a
+//!   driving spring's slip), a level's row is the state in effect when the load first
+//!   passed it.
 //!
 //! `area_exceeds_nominal` is 1 when the total real contact area of the state after the
 //! event exceeds the nominal area `Lx·Ly` (the paper's unbounded area law), 0 otherwise.
@@ -30,6 +39,18 @@ pub const EVENTS_HEADER: &str =
 pub const CURVE_HEADER: &str = "event,force_N,force_over_mu_FN,drive_displacement_m,\
                                 real_contact_area_m2,precursor_length_m,precursor_over_Lx,\
                                 broken,attached,area_exceeds_nominal";
+
+/// The spacing in `F/(μF_N)` of the rows of `contact_map.csv`.
+pub const CONTACT_MAP_STEP: f64 = 0.005;
+
+/// The header of `contact_map.csv` for a grid of `nx` columns.
+pub fn contact_map_header(nx: usize) -> String {
+    let mut header = String::from("event,force_over_mu_FN");
+    for ix in 0..nx {
+        header.push_str(&format!(",area_m2_ix{ix}"));
+    }
+    header
+}
 
 /// The text a resumed table starts from: `header`, then the rows of `old` whose first
 /// column (an event index) is at most `keep`. A last row cut by a crash (no trailing
@@ -111,39 +132,98 @@ pub fn open_table(path: &Path, header: &str, keep: Option<usize>) -> Result<BufW
     Ok(BufWriter::new(file))
 }
 
-/// The two tables of a run in a directory: `events.csv` and `curve.csv`.
+/// The three tables of a run in a directory: `events.csv`, `curve.csv` and
+/// `contact_map.csv`.
 #[derive(Debug)]
 pub struct RunTables {
     events: BufWriter<File>,
     curve: BufWriter<File>,
+    map: BufWriter<File>,
     events_path: PathBuf,
     curve_path: PathBuf,
+    map_path: PathBuf,
     stable_states: usize,
+    /// The next level of `contact_map.csv`, in steps of [`CONTACT_MAP_STEP`].
+    next_level: u64,
+    /// The stable state in effect: the rows of the levels below the next state's load.
+    in_effect: Option<MapState>,
+}
+
+/// A stable state as `contact_map.csv` needs it.
+#[derive(Debug)]
+struct MapState {
+    event: usize,
+    columns: Vec<f64>,
 }
 
 impl RunTables {
-    /// New tables in `dir` (which must exist), header only; `keep = Some(k)` continues
-    /// existing ones after a checkpoint at event `k` instead ([`open_table`]).
+    /// New tables in `dir` (which must exist), header only, for `driver`'s run.
     ///
     /// # Errors
     /// As [`open_table`].
-    pub fn open(dir: &Path, keep: Option<usize>) -> Result<Self> {
+    pub fn create(dir: &Path, driver: &Driver) -> Result<Self> {
+        Self::open(dir, driver, None)
+    }
+
+    /// The tables in `dir` continued after `driver` was resumed from a checkpoint: rows
+    /// after the checkpoint's event are dropped ([`open_table`]), missing tables start
+    /// empty.
+    ///
+    /// # Errors
+    /// As [`open_table`].
+    pub fn resume(dir: &Path, driver: &Driver) -> Result<Self> {
+        Self::open(dir, driver, Some(driver.event_count()))
+    }
+
+    fn open(dir: &Path, driver: &Driver, keep: Option<usize>) -> Result<Self> {
         let events_path = dir.join("events.csv");
         let curve_path = dir.join("curve.csv");
+        let map_path = dir.join("contact_map.csv");
         let events = open_table(&events_path, EVENTS_HEADER, keep)?;
         let curve = open_table(&curve_path, CURVE_HEADER, keep)?;
+        let map = open_table(&map_path, &contact_map_header(driver.grid().nx()), keep)?;
+        // The level after the last row kept (the table was just written back); the
+        // state in effect is the driver's: a resumed run is at a stable state.
+        let text =
+            fs::read_to_string(&map_path).map_err(|e| Error::io("reading table", &map_path, e))?;
+        let x = driver.force() / (driver.friction_coefficient() * driver.normal_load());
+        let (next_level, in_effect) = match (keep, text.lines().nth(1).and(text.lines().last())) {
+            (None, _) => (0, None),
+            (Some(_), None) => (first_level_at_or_above(x), None),
+            (Some(_), Some(row)) => {
+                let level = row.split(',').nth(1).and_then(|f| f.parse::<f64>().ok());
+                let Some(level) = level.filter(|l| l.is_finite() && *l >= 0.0) else {
+                    return Err(Error::CorruptTable {
+                        path: Some(map_path),
+                        reason: "the last row's force_over_mu_FN is not a load level".into(),
+                    });
+                };
+                (first_level_at_or_above(level) + 1, None)
+            }
+        };
+        let in_effect = match keep {
+            Some(k) if k > 0 => Some(MapState {
+                event: k,
+                columns: driver.column_contact_area()?,
+            }),
+            _ => in_effect,
+        };
         Ok(Self {
             events,
             curve,
+            map,
             events_path,
             curve_path,
+            map_path,
             stable_states: 0,
+            next_level,
+            in_effect,
         })
     }
 
-    /// The paths of `events.csv` and `curve.csv`.
-    pub fn paths(&self) -> (&Path, &Path) {
-        (&self.events_path, &self.curve_path)
+    /// The paths of `events.csv`, `curve.csv` and `contact_map.csv`.
+    pub fn paths(&self) -> [&Path; 3] {
+        [&self.events_path, &self.curve_path, &self.map_path]
     }
 
     /// Stable states recorded by this writer (not counting rows kept on resume).
@@ -152,7 +232,8 @@ impl RunTables {
     }
 
     /// Writes the row(s) of `event`, just returned by `driver.step()`: one row of
-    /// `events.csv`, and one of `curve.csv` for a stable state.
+    /// `events.csv`, and one of `curve.csv` for a stable state (and one of
+    /// `contact_map.csv` when it reaches the map's next level).
     ///
     /// # Errors
     /// [`Error::Io`] when a row cannot be written; the driver's errors for the fields of
@@ -179,22 +260,67 @@ impl RunTables {
                 u8::from(exceeds),
             )
             .map_err(|e| Error::io("writing table", &self.curve_path, e))?;
+            let x = load.force / mu_fn;
+            self.map_rows_below(x)?;
+            self.in_effect = Some(MapState {
+                event: index,
+                columns: driver.column_contact_area()?,
+            });
+        }
+        if let Event::GlobalSlip { load } = *event {
+            let mu_fn = driver.friction_coefficient() * driver.normal_load();
+            self.map_rows_below(load.force / mu_fn)?;
         }
         Ok(())
     }
 
-    /// Flushes both tables to their files (before a checkpoint is written, and at the end).
+    /// The rows of `contact_map.csv` for the levels below the load `x = F/(μF_N)` of a new
+    /// state: the state in effect until now held there. Before the first stable state
+    /// there is none: the map starts at the first level at or above its load.
+    fn map_rows_below(&mut self, x: f64) -> Result<()> {
+        let Some(state) = &self.in_effect else {
+            self.next_level = first_level_at_or_above(x);
+            return Ok(());
+        };
+        while level(self.next_level) < x {
+            let mut row = format!("{},{:.3}", state.event, level(self.next_level));
+            for a in &state.columns {
+                row.push_str(&format!(",{a:.12e}"));
+            }
+            writeln!(self.map, "{row}")
+                .map_err(|e| Error::io("writing table", &self.map_path, e))?;
+            self.next_level += 1;
+        }
+        Ok(())
+    }
+
+    /// Flushes the tables to their files (before a checkpoint is written, and at the end).
     ///
     /// # Errors
     /// [`Error::Io`] when a file cannot be written.
     pub fn flush(&mut self) -> Result<()> {
-        self.events
-            .flush()
-            .map_err(|e| Error::io("writing table", &self.events_path, e))?;
-        self.curve
-            .flush()
-            .map_err(|e| Error::io("writing table", &self.curve_path, e))
+        for (table, path) in [
+            (&mut self.events, &self.events_path),
+            (&mut self.curve, &self.curve_path),
+            (&mut self.map, &self.map_path),
+        ] {
+            table
+                .flush()
+                .map_err(|e| Error::io("writing table", path, e))?;
+        }
+        Ok(())
     }
+}
+
+/// Map level `k`: `F/(μF_N) = k·`[`CONTACT_MAP_STEP`].
+fn level(k: u64) -> f64 {
+    k as f64 * CONTACT_MAP_STEP
+}
+
+/// The first map level at or above the load `x = F/(μF_N)` (0 for `x <= 0`). Rounded to
+/// 1e-9 of a step first, so that a load on a level up to rounding counts as on it.
+fn first_level_at_or_above(x: f64) -> u64 {
+    ((x / CONTACT_MAP_STEP * 1e9).round() / 1e9).max(0.0).ceil() as u64
 }
 
 /// Broken and attached sites of `states`.

@@ -26,6 +26,8 @@
 
 mod merge;
 
+#[cfg(feature = "plot")]
+pub(crate) use merge::ensemble_curves;
 pub use merge::{merge, t_quantile_975, MergeSummary, LOAD_GRID};
 
 use crate::driver::write_atomically;
@@ -569,7 +571,7 @@ impl Sweep {
         let scene = run.scene.clone().build_with(&self.planner)?;
         let built = started.elapsed().as_secs_f64();
         let mut driver = scene.driver()?;
-        let mut tables = RunTables::open(&dir, None)?;
+        let mut tables = RunTables::create(&dir, &driver)?;
         let mut slip = None;
         let mut ruptures = 0usize;
         while let Some(event) = driver.step()? {

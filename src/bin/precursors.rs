@@ -1,5 +1,5 @@
 //! The `precursors` program (feature `cli`; docs/cli.md): runs a scene file, resumes a
-//! checkpoint, estimates a scene's cost, runs and merges sweeps.
+//! checkpoint, estimates a scene's cost, runs and merges sweeps, draws figures.
 //!
 //! ```sh
 //! cargo install --path . --features cli
@@ -24,7 +24,8 @@ Exit codes:
   3  invalid input: a scene, sweep or checkpoint file that is not valid JSON, names an
      unknown key, holds an invalid value, or does not fit; a damaged table
   4  a file or directory could not be read or written
-  5  merge: some runs of the sweep are not complete (the tables of the others written)";
+  5  merge, plot: some runs of the sweep are not complete (the tables and figures of the
+     others written)";
 
 /// Quasi-static friction precursors: runs scene files and sweeps (docs/cli.md).
 #[derive(Debug, Parser)]
@@ -95,6 +96,22 @@ enum Command {
         /// The sweep's output directory.
         dir: PathBuf,
     },
+    /// Draws the figures of a run (precursor_length, contact_area, contact_map) or of a
+    /// sweep (merged first; ensemble curves with 95 % bands) into DIR.
+    Plot {
+        /// A run's or a sweep's output directory.
+        dir: PathBuf,
+        /// File format(s).
+        #[arg(long, value_enum, default_value_t = FormatArg::Png)]
+        format: FormatArg,
+    },
+}
+
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum FormatArg {
+    Png,
+    Svg,
+    Both,
 }
 
 fn parse_shard(text: &str) -> Result<(usize, usize), String> {
@@ -250,6 +267,7 @@ fn main() -> ExitCode {
             shard,
         } => run_sweep(&sweep, &out, jobs, shard, progress),
         Command::Merge { dir } => merge(&dir),
+        Command::Plot { dir, format } => plot(&dir, format),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
@@ -343,7 +361,7 @@ fn run(
         Start::Scene(path) => {
             let scene = SceneBuilder::from_json_file(path)?.build()?;
             let driver = scene.driver()?;
-            let tables = RunTables::open(out, None)?;
+            let tables = RunTables::create(out, &driver)?;
             (scene, driver, tables)
         }
         Start::Checkpoint(path) => {
@@ -352,7 +370,7 @@ fn run(
             let driver = scene.resume(&checkpoint)?;
             // Keep the rows up to the checkpoint (a crashed run may have written more).
             let k = checkpoint.event_count();
-            let tables = RunTables::open(out, Some(k))?;
+            let tables = RunTables::resume(out, &driver)?;
             eprintln!("resumed at event {k} from {}", path.display());
             (scene, driver, tables)
         }
@@ -394,13 +412,14 @@ fn run(
     tables.flush()?;
     bar.show(true, |elapsed| line(&driver, elapsed));
     bar.finish();
-    let (events_path, curve_path) = tables.paths();
+    let [events_path, curve_path, map_path] = tables.paths();
     eprintln!(
-        "global slip after {} events at F/(μF_N) = {:.6}; wrote {} and {}",
+        "global slip after {} events at F/(μF_N) = {:.6}; wrote {}, {} and {}",
         driver.event_count(),
         driver.force() / mu_fn,
         events_path.display(),
-        curve_path.display()
+        curve_path.display(),
+        map_path.display()
     );
     Ok(())
 }
@@ -535,6 +554,45 @@ fn run_sweep(
     Ok(())
 }
 
+fn plot(dir: &Path, format: FormatArg) -> Result<(), Failure> {
+    use precursors::plot::figures::{draw, Format};
+    let formats: &[Format] = match format {
+        FormatArg::Png => &[Format::Png],
+        FormatArg::Svg => &[Format::Svg],
+        FormatArg::Both => &[Format::Png, Format::Svg],
+    };
+    let drawn = draw(dir, formats)?;
+    if let Some(summary) = &drawn.merge {
+        for file in &summary.files {
+            eprintln!("wrote {}", file.display());
+        }
+    }
+    for file in &drawn.files {
+        eprintln!("wrote {}", file.display());
+    }
+    for note in &drawn.notes {
+        eprintln!("note: {note}");
+    }
+    match &drawn.merge {
+        Some(summary) if summary.runs_missing > 0 => Err(incomplete(summary, dir)),
+        _ => Ok(()),
+    }
+}
+
+/// The failure of a merge or plot of a sweep with runs not complete.
+fn incomplete(summary: &precursors::sweep::MergeSummary, dir: &Path) -> Failure {
+    Failure {
+        error: format!(
+            "{} runs of the sweep in {} are not complete: run the sweep (or its missing \
+             shards) again, then merge",
+            summary.runs_missing,
+            dir.display()
+        )
+        .into(),
+        code: 5,
+    }
+}
+
 fn merge(dir: &Path) -> Result<(), Failure> {
     let summary = precursors::sweep::merge(dir)?;
     for file in &summary.files {
@@ -545,16 +603,7 @@ fn merge(dir: &Path) -> Result<(), Failure> {
         summary.points, summary.runs_merged, summary.runs_missing
     );
     if summary.runs_missing > 0 {
-        return Err(Failure {
-            error: format!(
-                "{} runs of the sweep in {} are not complete: run the sweep (or its \
-                 missing shards) again, then merge",
-                summary.runs_missing,
-                dir.display()
-            )
-            .into(),
-            code: 5,
-        });
+        return Err(incomplete(&summary, dir));
     }
     Ok(())
 }

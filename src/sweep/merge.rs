@@ -162,6 +162,70 @@ fn read_run(dir: &Path, run: &SweepRun) -> Result<RunData> {
     })
 }
 
+/// The mean and 95 % band `(mean, lo, hi)` of ℓ/Lx and of `A_R/A_R(0)` over the runs of
+/// `data` at the load `f = F/(μF_N)`, each run at its last stable state at or below `f`
+/// (a run with none yet is left out), and the number of runs counted.
+fn bands_at(data: &[RunData], f: f64) -> (usize, (f64, f64, f64), (f64, f64, f64)) {
+    let mut ell = Vec::new();
+    let mut area = Vec::new();
+    for d in data {
+        let a0 = d.curve.first().map_or(f64::NAN, |c| c.2);
+        if let Some(c) = d.curve.iter().rev().find(|c| c.0 <= f + 1e-12) {
+            ell.push(c.1);
+            area.push(c.2 / a0);
+        }
+    }
+    (ell.len(), band(&ell), band(&area))
+}
+
+/// The ensemble curves of one parameter point (what `plot::figures` draws).
+#[cfg(feature = "plot")]
+pub(crate) struct EnsembleCurves {
+    /// Each key and its value (JSON text).
+    pub values: Vec<(String, String)>,
+    /// Complete runs.
+    pub runs: usize,
+    /// `(F/(μF_N), mean, lo, hi)` of ℓ/Lx on the load grid.
+    pub precursor: Vec<(f64, f64, f64, f64)>,
+    /// The same for `A_R/A_R(0)`.
+    pub area: Vec<(f64, f64, f64, f64)>,
+}
+
+/// The ensemble curves of each parameter point of the sweep in `dir` on `grid` (loads
+/// `F/(μF_N)`), as [`merge`] computes them, from the complete runs.
+///
+/// # Errors
+/// As [`merge`].
+#[cfg(feature = "plot")]
+pub(crate) fn ensemble_curves(dir: &Path, grid: &[f64]) -> Result<Vec<EnsembleCurves>> {
+    let sweep = Sweep::from_json_file(&dir.join(SWEEP_FILE))?;
+    let mut out = Vec::new();
+    for point in 0..sweep.points() {
+        let runs: Vec<&SweepRun> = sweep.runs().iter().filter(|r| r.point == point).collect();
+        let Some(first) = runs.first() else { continue };
+        let mut data = Vec::new();
+        for run in &runs {
+            let run_dir = dir.join(&run.dir_name);
+            if run_dir.join(DONE_FILE).is_file() {
+                data.push(read_run(&run_dir, run)?);
+            }
+        }
+        let (mut precursor, mut area) = (Vec::new(), Vec::new());
+        for &f in grid {
+            let (_, e, a) = bands_at(&data, f);
+            precursor.push((f, e.0, e.1, e.2));
+            area.push((f, a.0, a.1, a.2));
+        }
+        out.push(EnsembleCurves {
+            values: first.values.clone(),
+            runs: data.len(),
+            precursor,
+            area,
+        });
+    }
+    Ok(out)
+}
+
 /// Merges the runs of the sweep in `dir` (written by [`Sweep::execute`], all shards into
 /// one directory) into four CSV files in `dir`, one block of rows per parameter point
 /// (the axes' values as columns, named by their keys):
@@ -243,21 +307,10 @@ pub fn merge(dir: &Path) -> Result<MergeSummary> {
             merged += 1;
         }
         for &f in &LOAD_GRID {
-            let mut ell = Vec::new();
-            let mut area = Vec::new();
-            for d in &data {
-                let a0 = d.curve.first().map_or(f64::NAN, |c| c.2);
-                if let Some(c) = d.curve.iter().rev().find(|c| c.0 <= f + 1e-12) {
-                    ell.push(c.1);
-                    area.push(c.2 / a0);
-                }
-            }
-            let (em, el, eh) = band(&ell);
-            let (am, al, ah) = band(&area);
+            let (runs, (em, el, eh), (am, al, ah)) = bands_at(&data, f);
             let _ = writeln!(
                 curves,
-                "{point},{values}{f:.2},{},{},{},{},{},{},{}",
-                ell.len(),
+                "{point},{values}{f:.2},{runs},{},{},{},{},{},{}",
                 num(em),
                 num(el),
                 num(eh),

@@ -1,0 +1,790 @@
+//! Figures (feature `plot`): line charts with legends and confidence bands, and maps with
+//! a colour bar, written as PNG or SVG (chosen by the file's extension), with axes, tick
+//! values and labels in an embedded font (DejaVu Sans, cut to the characters labels use:
+//! Latin, Greek, super- and subscripts, `ℓ`, `−`, `≈`, `≤`; `assets/fonts`), so that no
+//! system font is needed.
+//!
+//! [`Chart`] and [`Map`] are the building blocks; [`figures`] draws the standard figures
+//! of a run or of a sweep directory (`precursors plot DIR`).
+//!
+//! Non-finite values are not drawn: a line is cut at a point with a `NaN` or infinite
+//! coordinate (a band where its bounds are not finite), and a map cell holding one is
+//! drawn grey; automatic axis ranges cover the finite values only.
+//!
+//! ```no_run
+//! use precursors::plot::{Chart, Corner};
+//! let curve: Vec<(f64, f64)> = (0..=100).map(|k| (k as f64 / 100.0, (k as f64 / 100.0).powi(8))).collect();
+//! Chart::new("Precursor length", "F/(μF_N)", "ℓ/Lx")
+//!     .x_range(0.0, 1.0)
+//!     .y_range(0.0, 1.0)
+//!     .steps("seed 1", &curve)
+//!     .legend(Corner::UpperLeft)
+//!     .save("precursors.png")?;
+//! # Ok::<(), precursors::Error>(())
+//! ```
+
+pub mod figures;
+
+use crate::error::{Error, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
+use std::sync::OnceLock;
+
+/// DejaVu Sans cut to the characters the labels use (scripts/subset-font.sh; licence in
+/// assets/fonts/LICENSE-DejaVu.txt).
+const FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans-subset.ttf");
+const FAMILY: &str = "sans-serif";
+
+/// Registers the embedded font once per process: plotters' text goes through it.
+fn register_font() -> Result<()> {
+    static REGISTERED: OnceLock<bool> = OnceLock::new();
+    let ok = *REGISTERED
+        .get_or_init(|| plotters::style::register_font(FAMILY, FontStyle::Normal, FONT).is_ok());
+    if ok {
+        Ok(())
+    } else {
+        Err(Error::Figure {
+            path: None,
+            reason: "the embedded font could not be read".into(),
+        })
+    }
+}
+
+/// A figure ready to draw on any plotters backend.
+trait Draw {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+    ) -> std::result::Result<(), String>;
+}
+
+/// The corner of the plotting area that holds a chart's legend.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum Corner {
+    /// Upper left (the default).
+    #[default]
+    UpperLeft,
+    /// Upper right.
+    UpperRight,
+    /// Lower left.
+    LowerLeft,
+    /// Lower right.
+    LowerRight,
+}
+
+/// How a chart colours its series.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum Colours {
+    /// Ten distinct colours in turn (the default).
+    #[default]
+    Distinct,
+    /// From blue (first series) through grey to red (last): an ordered family of curves,
+    /// e.g. the same profile at increasing loads.
+    Ordered,
+}
+
+/// The colour scale of a [`Map`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Palette {
+    /// Blue (low) through white to red (high): signed quantities, centred on zero by the
+    /// range given.
+    Diverging,
+    /// White (low) through blue to dark (high): quantities from zero up.
+    Sequential,
+}
+
+impl Palette {
+    /// The colour of `t ∈ [0, 1]` (clamped: values outside the map's range take the end
+    /// colours, as the colour bar shows).
+    fn colour(self, t: f64) -> RGBColor {
+        let t = t.clamp(0.0, 1.0);
+        let mix = |a: [f64; 3], b: [f64; 3], s: f64| {
+            RGBColor(
+                (a[0] + (b[0] - a[0]) * s).round() as u8,
+                (a[1] + (b[1] - a[1]) * s).round() as u8,
+                (a[2] + (b[2] - a[2]) * s).round() as u8,
+            )
+        };
+        match self {
+            Palette::Diverging => {
+                let (blue, white, red) = (
+                    [33.0, 102.0, 172.0],
+                    [247.0, 247.0, 247.0],
+                    [178.0, 24.0, 43.0],
+                );
+                if t < 0.5 {
+                    mix(blue, white, 2.0 * t)
+                } else {
+                    mix(white, red, 2.0 * t - 1.0)
+                }
+            }
+            Palette::Sequential => {
+                let (white, blue, dark) = (
+                    [255.0, 255.0, 217.0],
+                    [65.0, 182.0, 196.0],
+                    [8.0, 29.0, 88.0],
+                );
+                if t < 0.5 {
+                    mix(white, blue, 2.0 * t)
+                } else {
+                    mix(blue, dark, 2.0 * t - 1.0)
+                }
+            }
+        }
+    }
+}
+
+/// Ten distinct line colours (Tableau 10).
+const DISTINCT: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Kind {
+    Line,
+    Steps,
+    Markers,
+}
+
+#[derive(Debug, Clone)]
+struct Series {
+    label: String,
+    kind: Kind,
+    points: Vec<(f64, f64)>,
+    /// `(x, lower, upper)`: a shaded band under the line.
+    band: Vec<(f64, f64, f64)>,
+}
+
+/// A line chart: lines, staircases, markers and shaded bands over linear axes, with a
+/// title, axis labels (give the units in them, e.g. `"x (mm)"`), tick values and a legend
+/// of the labelled series.
+#[derive(Debug, Clone)]
+pub struct Chart {
+    title: String,
+    x_label: String,
+    y_label: String,
+    x_range: Option<(f64, f64)>,
+    y_range: Option<(f64, f64)>,
+    size: (u32, u32),
+    legend: Corner,
+    colours: Colours,
+    series: Vec<Series>,
+}
+
+impl Chart {
+    /// An empty chart: 800 x 560 pixels, ranges fitted to the data, legend upper left.
+    pub fn new(title: &str, x_label: &str, y_label: &str) -> Self {
+        Self {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            x_range: None,
+            y_range: None,
+            size: (800, 560),
+            legend: Corner::UpperLeft,
+            colours: Colours::Distinct,
+            series: Vec::new(),
+        }
+    }
+
+    /// The x axis spans `[low, high]` (in the data's units) instead of the data's extent.
+    pub fn x_range(mut self, low: f64, high: f64) -> Self {
+        self.x_range = Some((low, high));
+        self
+    }
+
+    /// The y axis spans `[low, high]` instead of the data's extent.
+    pub fn y_range(mut self, low: f64, high: f64) -> Self {
+        self.y_range = Some((low, high));
+        self
+    }
+
+    /// The picture's size in pixels (PNG) or user units (SVG).
+    pub fn size(mut self, width: u32, height: u32) -> Self {
+        self.size = (width, height);
+        self
+    }
+
+    /// Where the legend goes.
+    pub fn legend(mut self, corner: Corner) -> Self {
+        self.legend = corner;
+        self
+    }
+
+    /// How the series are coloured.
+    pub fn colours(mut self, colours: Colours) -> Self {
+        self.colours = colours;
+        self
+    }
+
+    fn push(mut self, label: &str, kind: Kind, points: Vec<(f64, f64)>) -> Self {
+        self.series.push(Series {
+            label: label.into(),
+            kind,
+            points,
+            band: Vec::new(),
+        });
+        self
+    }
+
+    /// A polyline through `points`; `label` goes into the legend (none if empty).
+    pub fn line(self, label: &str, points: &[(f64, f64)]) -> Self {
+        self.push(label, Kind::Line, points.to_vec())
+    }
+
+    /// A staircase: each value holds until the next point's x, where it jumps (a quantity
+    /// known at discrete states, like ℓ at the stable states of a run).
+    pub fn steps(self, label: &str, points: &[(f64, f64)]) -> Self {
+        self.push(label, Kind::Steps, points.to_vec())
+    }
+
+    /// Markers at `points`, no line.
+    pub fn markers(self, label: &str, points: &[(f64, f64)]) -> Self {
+        self.push(label, Kind::Markers, points.to_vec())
+    }
+
+    /// A mean curve with its band: `(x, mean, lower, upper)`; the band is shaded in the
+    /// line's colour.
+    pub fn band(self, label: &str, rows: &[(f64, f64, f64, f64)]) -> Self {
+        let mut chart = self.push(label, Kind::Line, rows.iter().map(|r| (r.0, r.1)).collect());
+        if let Some(s) = chart.series.last_mut() {
+            s.band = rows.iter().map(|r| (r.0, r.2, r.3)).collect();
+        }
+        chart
+    }
+
+    fn colour(&self, k: usize) -> RGBColor {
+        match self.colours {
+            Colours::Distinct => DISTINCT[k % DISTINCT.len()],
+            Colours::Ordered => {
+                let n = self.series.len().max(2) - 1;
+                Palette::Diverging.colour(k as f64 / n as f64)
+            }
+        }
+    }
+
+    /// Writes the chart to `path`: PNG for `.png`, SVG for `.svg`.
+    ///
+    /// # Errors
+    /// [`Error::Figure`] for another extension, an axis range that is not finite and
+    /// increasing, or a drawing backend that fails (the file cannot be written, ...).
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
+        let path = path.as_ref();
+        let xs = self
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter().map(|p| p.0));
+        let x = axis_range(path, "x", self.x_range, xs)?;
+        let ys = self.series.iter().flat_map(|s| {
+            s.points
+                .iter()
+                .map(|p| p.1)
+                .chain(s.band.iter().flat_map(|b| [b.1, b.2]))
+        });
+        let y = axis_range(path, "y", self.y_range, ys)?;
+        render(path, self.size, &ChartDrawing { chart: self, x, y })
+    }
+}
+
+/// A chart with its axis ranges settled.
+struct ChartDrawing<'a> {
+    chart: &'a Chart,
+    x: (f64, f64),
+    y: (f64, f64),
+}
+
+impl Draw for ChartDrawing<'_> {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+    ) -> std::result::Result<(), String> {
+        let (me, x, y) = (self.chart, self.x, self.y);
+        let font = |size: f64| (FAMILY, size).into_font();
+        let mut chart = ChartBuilder::on(root)
+            .caption(&me.title, font(22.0))
+            .margin(16)
+            .x_label_area_size(52)
+            .y_label_area_size(72)
+            .build_cartesian_2d(x.0..x.1, y.0..y.1)
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc(me.x_label.as_str())
+            .y_desc(me.y_label.as_str())
+            .axis_desc_style(font(18.0))
+            .label_style(font(15.0))
+            .x_labels(8)
+            .y_labels(8)
+            .x_label_formatter(&|v| tick(*v, x))
+            .y_label_formatter(&|v| tick(*v, y))
+            .light_line_style(RGBColor(235, 235, 235))
+            .bold_line_style(RGBColor(215, 215, 215))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        let mut labelled = false;
+        for (k, s) in me.series.iter().enumerate() {
+            let colour = me.colour(k);
+            for run in finite_runs(&s.band, |b| [b.0, b.1, b.2]) {
+                let mut outline: Vec<(f64, f64)> = run.iter().map(|b| (b.0, b.2)).collect();
+                outline.extend(run.iter().rev().map(|b| (b.0, b.1)));
+                chart
+                    .draw_series(std::iter::once(Polygon::new(
+                        outline,
+                        colour.mix(0.22).filled(),
+                    )))
+                    .map_err(|e| e.to_string())?;
+            }
+            let style = colour.stroke_width(2);
+            let legend = |annotation: &mut plotters::chart::SeriesAnno<'_, DB>| {
+                annotation.label(s.label.as_str()).legend(move |(px, py)| {
+                    PathElement::new(vec![(px, py), (px + 22, py)], colour.stroke_width(3))
+                });
+            };
+            if s.kind == Kind::Markers {
+                let points = s
+                    .points
+                    .iter()
+                    .filter(|p| p.0.is_finite() && p.1.is_finite());
+                let annotation = chart
+                    .draw_series(points.map(|p| Circle::new(*p, 3, colour.filled())))
+                    .map_err(|e| e.to_string())?;
+                if !s.label.is_empty() {
+                    legend(annotation);
+                    labelled = true;
+                }
+                continue;
+            }
+            for (r, run) in finite_runs(&s.points, |p| [p.0, p.1])
+                .into_iter()
+                .enumerate()
+            {
+                let line = if s.kind == Kind::Steps {
+                    staircase(run)
+                } else {
+                    run.to_vec()
+                };
+                let annotation = chart
+                    .draw_series(LineSeries::new(line, style))
+                    .map_err(|e| e.to_string())?;
+                if r == 0 && !s.label.is_empty() {
+                    legend(annotation);
+                    labelled = true;
+                }
+            }
+        }
+        if labelled {
+            chart
+                .configure_series_labels()
+                .position(match me.legend {
+                    Corner::UpperLeft => SeriesLabelPosition::UpperLeft,
+                    Corner::UpperRight => SeriesLabelPosition::UpperRight,
+                    Corner::LowerLeft => SeriesLabelPosition::LowerLeft,
+                    Corner::LowerRight => SeriesLabelPosition::LowerRight,
+                })
+                .label_font(font(15.0))
+                .background_style(WHITE.mix(0.85))
+                .border_style(RGBColor(160, 160, 160))
+                .draw()
+                .map_err(|e| e.to_string())?;
+        }
+        Ok(())
+    }
+}
+
+/// A map of values on a regular grid of cells over `[x0, x1] x [y0, y1]`, with a colour
+/// bar labelled with the quantity and its unit.
+#[derive(Debug, Clone)]
+pub struct Map {
+    title: String,
+    x_label: String,
+    y_label: String,
+    colour_label: String,
+    columns: usize,
+    rows: usize,
+    values: Vec<f64>,
+    x_range: (f64, f64),
+    y_range: (f64, f64),
+    colour_range: Option<(f64, f64)>,
+    palette: Palette,
+    size: (u32, u32),
+}
+
+impl Map {
+    /// A map of `values`, `columns x rows` cells in row-major order, row 0 at the bottom
+    /// (`values[r·columns + c]`), over the unit square until [`Map::x_range`] and
+    /// [`Map::y_range`] say otherwise; sequential palette over the values' range.
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] when `values` does not hold `columns·rows` numbers;
+    /// [`Error::InvalidCount`] for zero columns or rows.
+    pub fn new(columns: usize, rows: usize, values: Vec<f64>) -> Result<Self> {
+        for (name, n) in [("map columns", columns), ("map rows", rows)] {
+            if n == 0 {
+                return Err(Error::InvalidCount {
+                    name,
+                    value: 0,
+                    reason: "a map needs at least one cell along each axis",
+                });
+            }
+        }
+        let expected = columns.checked_mul(rows).unwrap_or(usize::MAX);
+        if values.len() != expected {
+            return Err(Error::LengthMismatch {
+                name: "map values",
+                expected,
+                found: values.len(),
+            });
+        }
+        Ok(Self {
+            title: String::new(),
+            x_label: String::new(),
+            y_label: String::new(),
+            colour_label: String::new(),
+            columns,
+            rows,
+            values,
+            x_range: (0.0, 1.0),
+            y_range: (0.0, 1.0),
+            colour_range: None,
+            palette: Palette::Sequential,
+            size: (900, 560),
+        })
+    }
+
+    /// The title and the labels of the axes and of the colour bar (with units).
+    pub fn labels(mut self, title: &str, x: &str, y: &str, colour: &str) -> Self {
+        self.title = title.into();
+        self.x_label = x.into();
+        self.y_label = y.into();
+        self.colour_label = colour.into();
+        self
+    }
+
+    /// The cells span `[low, high]` along x (the left edge of column 0 to the right edge
+    /// of the last).
+    pub fn x_range(mut self, low: f64, high: f64) -> Self {
+        self.x_range = (low, high);
+        self
+    }
+
+    /// The cells span `[low, high]` along y (the bottom edge of row 0 to the top edge of
+    /// the last).
+    pub fn y_range(mut self, low: f64, high: f64) -> Self {
+        self.y_range = (low, high);
+        self
+    }
+
+    /// The palette, and the values at its two ends (`None`: the finite values' range).
+    pub fn colour_scale(mut self, palette: Palette, range: Option<(f64, f64)>) -> Self {
+        self.palette = palette;
+        self.colour_range = range;
+        self
+    }
+
+    /// The picture's size in pixels (PNG) or user units (SVG).
+    pub fn size(mut self, width: u32, height: u32) -> Self {
+        self.size = (width, height);
+        self
+    }
+
+    /// Writes the map to `path`: PNG for `.png`, SVG for `.svg`.
+    ///
+    /// # Errors
+    /// [`Error::Figure`] for another extension, a range that is not finite and
+    /// increasing, or a drawing backend that fails.
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
+        let path = path.as_ref();
+        let x = axis_range(path, "x", Some(self.x_range), std::iter::empty())?;
+        let y = axis_range(path, "y", Some(self.y_range), std::iter::empty())?;
+        let c = axis_range(
+            path,
+            "colour",
+            self.colour_range,
+            self.values.iter().copied(),
+        )?;
+        render(path, self.size, &MapDrawing { map: self, x, y, c })
+    }
+}
+
+/// A map with its ranges settled.
+struct MapDrawing<'a> {
+    map: &'a Map,
+    x: (f64, f64),
+    y: (f64, f64),
+    c: (f64, f64),
+}
+
+impl Draw for MapDrawing<'_> {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+    ) -> std::result::Result<(), String> {
+        let (me, x, y, c) = (self.map, self.x, self.y, self.c);
+        let font = |size: f64| (FAMILY, size).into_font();
+        let (width, _) = root.dim_in_pixel();
+        let bar_width = 130.min(width / 3);
+        let (main, bar) = root.split_horizontally(width - bar_width);
+        let mut chart = ChartBuilder::on(&main)
+            .caption(&me.title, font(22.0))
+            .margin(16)
+            .x_label_area_size(52)
+            .y_label_area_size(72)
+            .build_cartesian_2d(x.0..x.1, y.0..y.1)
+            .map_err(|e| e.to_string())?;
+        let (dx, dy) = (
+            (x.1 - x.0) / me.columns as f64,
+            (y.1 - y.0) / me.rows as f64,
+        );
+        let grey = RGBColor(200, 200, 200);
+        chart
+            .draw_series((0..me.rows).flat_map(|r| {
+                (0..me.columns).map(move |col| {
+                    let v = me.values[r * me.columns + col];
+                    let fill = if v.is_finite() {
+                        me.palette.colour((v - c.0) / (c.1 - c.0))
+                    } else {
+                        grey
+                    };
+                    let (x0, y0) = (x.0 + col as f64 * dx, y.0 + r as f64 * dy);
+                    Rectangle::new([(x0, y0), (x0 + dx, y0 + dy)], fill.filled())
+                })
+            }))
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc(me.x_label.as_str())
+            .y_desc(me.y_label.as_str())
+            .axis_desc_style(font(18.0))
+            .label_style(font(15.0))
+            .x_labels(8)
+            .y_labels(8)
+            .x_label_formatter(&|v| tick(*v, x))
+            .y_label_formatter(&|v| tick(*v, y))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        // The colour bar: a one-column chart of the colour scale, its values on the right.
+        let mut scale = ChartBuilder::on(&bar)
+            .margin_top(16 + 30)
+            .margin_bottom(16 + 52)
+            .margin_left(8)
+            .margin_right(8)
+            .right_y_label_area_size(80)
+            .build_cartesian_2d(0.0..1.0, c.0..c.1)
+            .map_err(|e| e.to_string())?;
+        let steps = 200;
+        scale
+            .draw_series((0..steps).map(|k| {
+                let (a, b) = (k as f64 / steps as f64, (k + 1) as f64 / steps as f64);
+                let (v0, v1) = (c.0 + a * (c.1 - c.0), c.0 + b * (c.1 - c.0));
+                let fill = me.palette.colour((a + b) / 2.0);
+                Rectangle::new([(0.0, v0), (1.0, v1)], fill.filled())
+            }))
+            .map_err(|e| e.to_string())?;
+        scale
+            .configure_mesh()
+            .disable_mesh()
+            .disable_x_axis()
+            .y_desc(me.colour_label.as_str())
+            .axis_desc_style(font(16.0))
+            .label_style(font(14.0))
+            .y_labels(8)
+            .y_label_formatter(&|v| tick(*v, c))
+            .draw()
+            .map_err(|e| e.to_string())?;
+        Ok(())
+    }
+}
+
+/// Draws through the backend that `path`'s extension names and writes the file.
+fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
+    register_font()?;
+    let fail = |reason: String| Error::Figure {
+        path: Some(path.to_path_buf()),
+        reason,
+    };
+    if size.0 < 200 || size.1 < 150 {
+        return Err(fail(format!(
+            "{} x {} is too small for a figure with axes and labels: at least 200 x 150",
+            size.0, size.1
+        )));
+    }
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match extension.as_deref() {
+        Some("png") => {
+            let root = BitMapBackend::new(path, size).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
+            figure.draw(&root).map_err(fail)?;
+            root.present().map_err(|e| fail(e.to_string()))
+        }
+        Some("svg") => {
+            let root = SVGBackend::new(path, size).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
+            figure.draw(&root).map_err(fail)?;
+            root.present().map_err(|e| fail(e.to_string()))
+        }
+        _ => Err(fail(
+            "the file name must end in .png or .svg (the format is chosen by it)".into(),
+        )),
+    }
+}
+
+/// The range of an axis: the one given (checked), or the finite values' extent with 4 %
+/// room on each side (`[0, 1]` without finite values, `v ± 1` or `v ± 5 %` for a single
+/// value `v`).
+fn axis_range(
+    path: &Path,
+    axis: &str,
+    given: Option<(f64, f64)>,
+    values: impl Iterator<Item = f64>,
+) -> Result<(f64, f64)> {
+    if let Some((low, high)) = given {
+        if low.is_finite() && high.is_finite() && low < high {
+            return Ok((low, high));
+        }
+        return Err(Error::Figure {
+            path: Some(path.to_path_buf()),
+            reason: format!(
+                "the {axis} range [{low}, {high}] is invalid: both ends must be finite and \
+                 the first below the second"
+            ),
+        });
+    }
+    let (low, high) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    Ok(if low > high {
+        (0.0, 1.0)
+    } else if low == high {
+        let pad = if low == 0.0 { 1.0 } else { 0.05 * low.abs() };
+        (low - pad, high + pad)
+    } else {
+        let pad = 0.04 * (high - low);
+        (low - pad, high + pad)
+    })
+}
+
+/// A tick value printed with as many decimals as the axis span needs; `−` as the minus.
+fn tick(v: f64, range: (f64, f64)) -> String {
+    let span = (range.1 - range.0).abs();
+    let scale = range.0.abs().max(range.1.abs());
+    let text = if !(1e-3..1e5).contains(&scale) && scale > 0.0 {
+        let digits = ((scale / span).log10().ceil().max(1.0) as usize).min(6);
+        if v == 0.0 {
+            "0".to_string()
+        } else {
+            format!("{v:.digits$e}")
+        }
+    } else {
+        let digits = (1.0 - (span / 8.0).log10().floor()).clamp(0.0, 8.0) as usize;
+        let digits = digits.saturating_sub(1);
+        format!("{v:.digits$}")
+    };
+    // "-0.0" for a tick at rounding distance below zero.
+    let text = if text
+        .trim_start_matches('-')
+        .chars()
+        .all(|c| "0.".contains(c))
+    {
+        text.trim_start_matches('-').to_string()
+    } else {
+        text
+    };
+    text.replace('-', "−")
+}
+
+/// The maximal runs of consecutive items whose coordinates are all finite.
+fn finite_runs<T: Copy, const K: usize>(items: &[T], coords: impl Fn(&T) -> [f64; K]) -> Vec<&[T]> {
+    items
+        .split(|t| coords(t).iter().any(|v| !v.is_finite()))
+        .filter(|run| !run.is_empty())
+        .collect()
+}
+
+/// The staircase through `points`: each value holds until the next x.
+fn staircase(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut out = Vec::with_capacity(2 * points.len());
+    for (k, p) in points.iter().enumerate() {
+        if k > 0 {
+            out.push((p.0, points[k - 1].1));
+        }
+        out.push(*p);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ticks_have_the_decimals_the_span_needs() {
+        assert_eq!(tick(0.5, (0.0, 1.0)), "0.5");
+        assert_eq!(tick(0.25, (0.0, 1.0)), "0.2"); // eight ticks over 1: one decimal
+        assert_eq!(tick(-2.0, (-5.0, 5.0)), "−2.0");
+        assert_eq!(tick(120.0, (0.0, 140.0)), "120");
+        assert_eq!(tick(2.5e-6, (0.0, 5e-6)), "2.5e−6");
+        assert_eq!(tick(5e5, (-1e6, 1e6)), "5.0e5");
+        assert_eq!(tick(0.0, (-1e6, 1e6)), "0");
+        assert_eq!(tick(-1e-17, (-1.0, 1.0)), "0.0");
+    }
+
+    #[test]
+    fn staircase_holds_each_value_until_the_next_x() {
+        let s = staircase(&[(0.0, 1.0), (1.0, 2.0), (3.0, 0.5)]);
+        assert_eq!(
+            s,
+            vec![(0.0, 1.0), (1.0, 1.0), (1.0, 2.0), (3.0, 2.0), (3.0, 0.5)]
+        );
+    }
+
+    #[test]
+    fn lines_are_cut_at_non_finite_points() {
+        let p = [
+            (0.0, 1.0),
+            (1.0, f64::NAN),
+            (2.0, 2.0),
+            (3.0, 3.0),
+            (f64::INFINITY, 0.0),
+        ];
+        let runs = finite_runs(&p, |q| [q.0, q.1]);
+        assert_eq!(runs.len(), 2);
+        assert_eq!(runs[0], &p[0..1]);
+        assert_eq!(runs[1], &p[2..4]);
+    }
+
+    #[test]
+    fn automatic_ranges_cover_the_finite_values() {
+        let p = Path::new("f.png");
+        let r = axis_range(p, "x", None, [1.0, f64::NAN, 3.0].into_iter()).unwrap();
+        assert!((r.0 - 0.92).abs() < 1e-12 && (r.1 - 3.08).abs() < 1e-12);
+        assert_eq!(
+            axis_range(p, "x", None, std::iter::empty()).unwrap(),
+            (0.0, 1.0)
+        );
+        assert_eq!(
+            axis_range(p, "x", None, [0.0].into_iter()).unwrap(),
+            (-1.0, 1.0)
+        );
+        assert!(axis_range(p, "x", Some((1.0, 1.0)), std::iter::empty()).is_err());
+        assert!(axis_range(p, "x", Some((0.0, f64::NAN)), std::iter::empty()).is_err());
+    }
+}
