@@ -16,6 +16,8 @@ mod matrix;
 mod operator;
 #[cfg(feature = "serde")]
 mod paper_sweeps;
+#[cfg(feature = "plot")]
+mod plot;
 mod probe;
 mod properties;
 mod robustness;

@@ -587,6 +587,56 @@ mod cli {
     }
 
     #[test]
+    fn plot_draws_a_sweep_merged_first_and_a_run() {
+        let dir = scratch("cli-plot");
+        let file = dir.join("study.json");
+        std::fs::write(&file, small()).unwrap();
+        let out = dir.join("o");
+        let o = precursors(&["sweep", path(&file), "--out", path(&out), "-q"]);
+        assert_eq!(o.status.code(), Some(0));
+        // No merge first: plot merges.
+        let o = precursors(&["plot", path(&out), "--format", "both"]);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        for name in [
+            "curves.csv",
+            "precursor_length.png",
+            "precursor_length.svg",
+            "contact_area.png",
+        ] {
+            assert!(out.join(name).is_file(), "{name}");
+        }
+        // One curve per point, named by the axes' values and its runs.
+        let svg = std::fs::read_to_string(out.join("precursor_length.svg")).unwrap();
+        for label in [
+            "normal_load = 400.0, drive.height = 0.004 (2 runs)",
+            "normal_load = 600.0, drive.height = 0.008 (2 runs)",
+        ] {
+            assert!(svg.contains(label), "{label}");
+        }
+        // A run of the sweep is a run directory: its three figures.
+        let run = out.join("p0000-r0000");
+        let o = precursors(&["plot", path(&run)]);
+        assert_eq!(o.status.code(), Some(0));
+        assert!(run.join("contact_map.png").is_file());
+        // A run not complete: figures of the others, exit code 5.
+        std::fs::remove_file(out.join("p0001-r0001").join(DONE_FILE)).unwrap();
+        let o = precursors(&["plot", path(&out), "--format", "svg"]);
+        assert_eq!(o.status.code(), Some(5));
+        let svg = std::fs::read_to_string(out.join("precursor_length.svg")).unwrap();
+        assert!(svg.contains("drive.height = 0.008 (1 runs)"));
+        // Neither a run nor a sweep: invalid input.
+        let o = precursors(&["plot", path(&dir)]);
+        assert_eq!(o.status.code(), Some(3));
+        assert!(String::from_utf8_lossy(&o.stderr).contains("neither a sweep directory"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
     fn slurm_variables_that_give_no_shard_are_refused() {
         let dir = scratch("cli-slurm");
         let file = dir.join("sweep.json");

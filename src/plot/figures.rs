@@ -265,6 +265,17 @@ fn draw_sweep(dir: &Path, formats: &[Format]) -> Result<Drawn> {
         }
         format!("{text} ({runs} runs)")
     };
+    // As for a run: near slip the unbounded area law can reach many times A_R(0).
+    let area_top = points
+        .iter()
+        .flat_map(|p| p.area.iter().flat_map(|r| [r.1, r.3]))
+        .filter(|a| a.is_finite())
+        .fold(1.0, f64::max);
+    let area_note = if area_top > 2.0 {
+        format!(" (up to {area_top:.2e}: above 2 off the chart)")
+    } else {
+        String::new()
+    };
     let mut drawn = Drawn {
         files: Vec::new(),
         merge: None,
@@ -286,11 +297,12 @@ fn draw_sweep(dir: &Path, formats: &[Format]) -> Result<Drawn> {
         chart.save(&path)?;
         drawn.files.push(path);
         let mut chart = Chart::new(
-            &format!("Real contact area, {title}: mean and 95 % band"),
+            &format!("Real contact area, {title}: mean and 95 % band{area_note}"),
             "F/(μF_N)",
             "A_R/A_R(0)",
         )
         .x_range(0.0, 1.0)
+        .y_range(0.0, (1.04 * area_top).min(2.0))
         .legend(Corner::LowerLeft);
         for p in &points {
             chart = chart.band(&label(&p.values, p.runs), &p.area);

@@ -1,0 +1,329 @@
+//! Figures (feature `plot`) and the contact-map table they draw from.
+//!
+//! The map table is checked against its definition recomputed from the driver's states
+//! (the column areas of every stable state, the last state at or below each load level);
+//! resumed tables against the uninterrupted run's; figures by decoding the PNG (the
+//! series' colours are drawn, the text of the embedded font is drawn where the title
+//! goes) and by reading the SVG's text.
+
+use precursors::output::{RunTables, CONTACT_MAP_STEP};
+use precursors::plot::figures::{draw, Format};
+use precursors::plot::{Chart, Corner, Map, Palette};
+use precursors::{Drive, Error, Event, Lateral, Scene};
+use std::path::{Path, PathBuf};
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("precursors-{}-plot-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A 40 x 5-cell rod-driven scene: about 200 events to global slip.
+fn scene() -> Scene {
+    Scene::builder()
+        .block(0.04, 0.005, 0.02)
+        .cell_size(1e-3, 1e-3)
+        .normal_load(700.0)
+        .drive(Drive::Force(precursors::ForceLoad::Lateral(Lateral::Rod {
+            height: 4e-3,
+            half_width: 1e-3,
+        })))
+        .seed(3)
+        .build()
+        .unwrap()
+}
+
+/// Decoded RGB pixels, width and height.
+fn decode(path: &Path) -> (Vec<u8>, u32, u32) {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgb);
+    buf.truncate(info.buffer_size());
+    (buf, info.width, info.height)
+}
+
+#[test]
+fn the_contact_map_is_the_state_in_effect_at_each_load_level() {
+    let scene = scene();
+    let dir = scratch("map");
+    let mut driver = scene.driver().unwrap();
+    let mut tables = RunTables::create(&dir, &driver).unwrap();
+    let mu_fn = driver.friction_coefficient() * driver.normal_load();
+    // (event, F/(μF_N), column areas) of every stable state; the slip load.
+    let mut states = Vec::new();
+    let mut slip = f64::NAN;
+    while let Some(event) = driver.step().unwrap() {
+        tables.record(&driver, &event).unwrap();
+        match event {
+            Event::Stable { load, .. } => states.push((
+                driver.event_count(),
+                load.force / mu_fn,
+                driver.column_contact_area().unwrap(),
+            )),
+            Event::GlobalSlip { load } => slip = load.force / mu_fn,
+            _ => {}
+        }
+    }
+    tables.flush().unwrap();
+    assert!(slip > 0.9 && states.len() > 10, "{slip} {}", states.len());
+    // The reference: level k·step from the first state's up to the slip load (levels
+    // below the load, rounding aside), each with the last stable state at or below it.
+    let text = std::fs::read_to_string(dir.join("contact_map.csv")).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    assert_eq!(header.split(',').count(), 2 + 40);
+    assert!(header.starts_with("event,force_over_mu_FN,area_m2_ix0,area_m2_ix1,"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|c| c.parse().unwrap()).collect())
+        .collect();
+    let mut expected = Vec::new();
+    for k in 0u32.. {
+        let level = f64::from(k) * CONTACT_MAP_STEP;
+        if level >= slip {
+            break;
+        }
+        if let Some(state) = states.iter().rev().find(|s| s.1 <= level + 1e-12) {
+            expected.push((level, state));
+        }
+    }
+    assert_eq!(rows.len(), expected.len());
+    for (row, (level, (event, _, columns))) in rows.iter().zip(&expected) {
+        assert_eq!(row[0], *event as f64, "level {level}");
+        assert!((row[1] - level).abs() < 1e-12);
+        for (a, b) in row[2..].iter().zip(columns) {
+            assert!(
+                (a - b).abs() <= 1e-12 * b.abs(),
+                "level {level}: {a} vs {b}"
+            );
+        }
+    }
+    // The first state is the zero-shear one: its columns are the initial ones.
+    assert_eq!(rows[0][1], 0.0);
+    for (a, b) in rows[0][2..]
+        .iter()
+        .zip(driver.initial_column_contact_area())
+    {
+        assert!((a - b).abs() <= 1e-12 * b.abs());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn resumed_tables_end_as_the_uninterrupted_ones() {
+    let scene = scene();
+    let whole = scratch("whole");
+    let mut driver = scene.driver().unwrap();
+    let mut tables = RunTables::create(&whole, &driver).unwrap();
+    let mut checkpoint = None;
+    let mut stable = 0;
+    while let Some(event) = driver.step().unwrap() {
+        tables.record(&driver, &event).unwrap();
+        if matches!(event, Event::Stable { .. }) {
+            stable += 1;
+            if stable == 20 {
+                tables.flush().unwrap();
+                checkpoint = Some(driver.checkpoint());
+            }
+        }
+    }
+    tables.flush().unwrap();
+    drop(tables);
+    // The same run, killed some events after the checkpoint (its tables hold rows past
+    // it, the last one cut), then resumed.
+    let cut = scratch("cut");
+    let checkpoint = checkpoint.unwrap();
+    let mut driver = scene.driver().unwrap();
+    let mut tables = RunTables::create(&cut, &driver).unwrap();
+    for _ in 0..checkpoint.event_count() + 40 {
+        let event = driver.step().unwrap().unwrap();
+        tables.record(&driver, &event).unwrap();
+    }
+    tables.flush().unwrap();
+    drop(tables);
+    let map = cut.join("contact_map.csv");
+    let text = std::fs::read_to_string(&map).unwrap();
+    std::fs::write(&map, &text[..text.len() - 7]).unwrap();
+    let mut driver = scene.resume(&checkpoint).unwrap();
+    let mut tables = RunTables::resume(&cut, &driver).unwrap();
+    while let Some(event) = driver.step().unwrap() {
+        tables.record(&driver, &event).unwrap();
+    }
+    tables.flush().unwrap();
+    for name in ["events.csv", "curve.csv", "contact_map.csv"] {
+        let a = std::fs::read_to_string(whole.join(name)).unwrap();
+        let b = std::fs::read_to_string(cut.join(name)).unwrap();
+        assert!(a == b, "{name} differs after resume");
+    }
+    std::fs::remove_dir_all(&whole).unwrap();
+    std::fs::remove_dir_all(&cut).unwrap();
+}
+
+#[test]
+fn a_chart_draws_its_series_and_its_text() {
+    let dir = scratch("chart");
+    let line: Vec<(f64, f64)> = (0..=20)
+        .map(|k| (k as f64 / 20.0, (k as f64 / 20.0).powi(2)))
+        .collect();
+    let band: Vec<(f64, f64, f64, f64)> = line
+        .iter()
+        .map(|&(x, y)| (x, 0.5 * y, 0.4 * y, 0.6 * y))
+        .collect();
+    let titled = dir.join("titled.png");
+    Chart::new("A title", "F/(μF_N)", "ℓ/Lx")
+        .x_range(0.0, 1.0)
+        .y_range(0.0, 1.0)
+        .line("first", &line)
+        .band("second", &band)
+        .legend(Corner::UpperLeft)
+        .save(&titled)
+        .unwrap();
+    let (pixels, w, h) = decode(&titled);
+    assert_eq!((w, h), (800, 560));
+    let count = |rgb: [u8; 3]| pixels.chunks_exact(3).filter(|p| *p == rgb).count();
+    // Tableau blue and red: the first and the second series (lines 2 px wide).
+    assert!(count([31, 119, 180]) > 500, "{}", count([31, 119, 180]));
+    assert!(count([214, 39, 40]) > 300, "{}", count([214, 39, 40]));
+    // The title is drawn in the top band of the picture; without a title that band is
+    // white: the embedded font draws text on a machine without fonts.
+    let dark_on_top = |pixels: &[u8]| {
+        pixels[..(w * 30 * 3) as usize]
+            .chunks_exact(3)
+            .filter(|p| p.iter().all(|c| *c < 100))
+            .count()
+    };
+    assert!(dark_on_top(&pixels) > 50, "{}", dark_on_top(&pixels));
+    let untitled = dir.join("untitled.png");
+    Chart::new("", "F/(μF_N)", "ℓ/Lx")
+        .x_range(0.0, 1.0)
+        .y_range(0.0, 1.0)
+        .line("first", &line)
+        .save(&untitled)
+        .unwrap();
+    assert_eq!(dark_on_top(&decode(&untitled).0), 0);
+    // SVG: the labels as text.
+    let svg = dir.join("chart.svg");
+    Chart::new("A title", "F/(μF_N)", "ℓ/Lx")
+        .line("first", &line)
+        .band("second", &band)
+        .save(&svg)
+        .unwrap();
+    let text = std::fs::read_to_string(&svg).unwrap();
+    let texts: Vec<&str> = text
+        .split("<text")
+        .skip(1)
+        .filter_map(|t| Some(t.split_once('>')?.1.split_once("</text>")?.0.trim()))
+        .collect();
+    for label in ["A title", "F/(μF_N)", "ℓ/Lx", "first", "second", "0.4"] {
+        assert!(
+            texts.contains(&label),
+            "{label} not in the SVG's text: {texts:?}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_map_draws_its_cells_through_the_palette_and_grey_for_nan() {
+    let dir = scratch("map-figure");
+    // Two cells: the low end and the high end of a diverging scale, and a NaN.
+    let path = dir.join("map.png");
+    Map::new(3, 1, vec![-1.0, 1.0, f64::NAN])
+        .unwrap()
+        .labels("t", "x (mm)", "y (mm)", "σ (MPa)")
+        .colour_scale(Palette::Diverging, Some((-1.0, 1.0)))
+        .save(&path)
+        .unwrap();
+    let (pixels, ..) = decode(&path);
+    let count = |rgb: [u8; 3]| pixels.chunks_exact(3).filter(|p| *p == rgb).count();
+    // Each cell covers about a third of the 900 x 560 plot area's ~640 x 440 pixels.
+    for rgb in [[33, 102, 172], [178, 24, 43], [200, 200, 200]] {
+        assert!(count(rgb) > 50_000, "{rgb:?}: {}", count(rgb));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_figures_are_refused_with_typed_errors() {
+    let dir = scratch("bad");
+    let e = Chart::new("t", "x", "y")
+        .save(dir.join("chart.jpg"))
+        .unwrap_err();
+    assert!(matches!(e, Error::Figure { .. }), "{e:?}");
+    assert!(e.to_string().contains(".png or .svg"), "{e}");
+    let e = Chart::new("t", "x", "y")
+        .x_range(1.0, 0.0)
+        .save(dir.join("chart.png"))
+        .unwrap_err();
+    assert!(e.to_string().contains("x range [1, 0] is invalid"), "{e}");
+    let e = Chart::new("t", "x", "y")
+        .size(10, 10)
+        .save(dir.join("chart.png"))
+        .unwrap_err();
+    assert!(e.to_string().contains("too small"), "{e}");
+    assert!(matches!(
+        Map::new(3, 2, vec![0.0; 5]),
+        Err(Error::LengthMismatch {
+            expected: 6,
+            found: 5,
+            ..
+        })
+    ));
+    assert!(matches!(
+        Map::new(0, 2, vec![]),
+        Err(Error::InvalidCount { .. })
+    ));
+    // A directory that is neither a run's nor a sweep's.
+    let e = draw(&dir, &[Format::Png]).unwrap_err();
+    assert!(e.to_string().contains("neither a sweep directory"), "{e}");
+    // A file that cannot be created (its directory is missing).
+    let e = Chart::new("t", "x", "y")
+        .save(dir.join("missing").join("chart.png"))
+        .unwrap_err();
+    assert!(matches!(e, Error::Figure { .. }), "{e:?}");
+    // Non-finite data is not drawn and does not fail.
+    Chart::new("t", "x", "y")
+        .line("nan", &[(0.0, f64::NAN), (1.0, 1.0), (f64::INFINITY, 2.0)])
+        .save(dir.join("nan.png"))
+        .unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_run_directory_gets_its_three_figures() {
+    let scene = scene();
+    let dir = scratch("run");
+    let mut driver = scene.driver().unwrap();
+    let mut tables = RunTables::create(&dir, &driver).unwrap();
+    while let Some(event) = driver.step().unwrap() {
+        tables.record(&driver, &event).unwrap();
+    }
+    tables.flush().unwrap();
+    let drawn = draw(&dir, &[Format::Png, Format::Svg]).unwrap();
+    let mut names: Vec<String> = drawn
+        .files
+        .iter()
+        .map(|f| f.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "contact_area.png",
+            "contact_area.svg",
+            "contact_map.png",
+            "contact_map.svg",
+            "precursor_length.png",
+            "precursor_length.svg"
+        ]
+    );
+    assert!(drawn.notes.is_empty() && drawn.merge.is_none());
+    // Without the map table: two figures and a note saying why.
+    std::fs::remove_file(dir.join("contact_map.csv")).unwrap();
+    let drawn = draw(&dir, &[Format::Png]).unwrap();
+    assert_eq!(drawn.files.len(), 2);
+    assert!(drawn.notes[0].contains("contact_map.csv is missing"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
