@@ -19,8 +19,9 @@
 //! slip).
 //!
 //! Features: `serde` (JSON scene files and checkpoints), `nalgebra` (heights from and
-//! fields to `nalgebra` matrices and vectors, row `iy` and column `ix`), `plot` (figures
-//! as PNG or SVG: [`plot`](crate#features)), `cli` (the program `precursors`).
+//! fields to `nalgebra` matrices and vectors, row `iy` and column `ix`), `plot` (module
+//! `plot`: figures with axes, units, legends and colour bars as PNG or SVG), `cli` (the
+//! program `precursors`, docs/cli.md).
 //!
 //! ```
 //! use precursors::{Block, Grid, green::InfluencePlan};

@@ -440,7 +440,7 @@ impl Map {
                 });
             }
         }
-        let expected = columns.checked_mul(rows).unwrap_or(usize::MAX);
+        let expected = columns.saturating_mul(rows);
         if values.len() != expected {
             return Err(Error::LengthMismatch {
                 name: "map values",

@@ -198,7 +198,7 @@ pub(crate) struct EnsembleCurves {
 /// As [`merge`].
 #[cfg(feature = "plot")]
 pub(crate) fn ensemble_curves(dir: &Path, grid: &[f64]) -> Result<Vec<EnsembleCurves>> {
-    let sweep = Sweep::from_json_file(&dir.join(SWEEP_FILE))?;
+    let sweep = Sweep::from_json_file(dir.join(SWEEP_FILE))?;
     let mut out = Vec::new();
     for point in 0..sweep.points() {
         let runs: Vec<&SweepRun> = sweep.runs().iter().filter(|r| r.point == point).collect();
