@@ -102,13 +102,6 @@ impl Palette {
     /// colours, as the colour bar shows).
     fn colour(self, t: f64) -> RGBColor {
         let t = t.clamp(0.0, 1.0);
-        let mix = |a: [f64; 3], b: [f64; 3], s: f64| {
-            RGBColor(
-                (a[0] + (b[0] - a[0]) * s).round() as u8,
-                (a[1] + (b[1] - a[1]) * s).round() as u8,
-                (a[2] + (b[2] - a[2]) * s).round() as u8,
-            )
-        };
         match self {
             Palette::Diverging => {
                 let (blue, white, red) = (
@@ -136,6 +129,15 @@ impl Palette {
             }
         }
     }
+}
+
+/// The colour a fraction `s ∈ [0, 1]` of the way from `a` to `b`.
+fn mix(a: [f64; 3], b: [f64; 3], s: f64) -> RGBColor {
+    RGBColor(
+        (a[0] + (b[0] - a[0]) * s).round() as u8,
+        (a[1] + (b[1] - a[1]) * s).round() as u8,
+        (a[2] + (b[2] - a[2]) * s).round() as u8,
+    )
 }
 
 /// Ten distinct line colours (Tableau 10).
@@ -270,8 +272,16 @@ impl Chart {
         match self.colours {
             Colours::Distinct => DISTINCT[k % DISTINCT.len()],
             Colours::Ordered => {
+                // Blue, grey, red: every step visible on white (the diverging palette's
+                // middle is white).
                 let n = self.series.len().max(2) - 1;
-                Palette::Diverging.colour(k as f64 / n as f64)
+                let t = k as f64 / n as f64;
+                let (blue, grey, red) = ([33.0, 102.0, 172.0], [110.0; 3], [178.0, 24.0, 43.0]);
+                if t < 0.5 {
+                    mix(blue, grey, 2.0 * t)
+                } else {
+                    mix(grey, red, 2.0 * t - 1.0)
+                }
             }
         }
     }
@@ -745,6 +755,19 @@ mod tests {
         assert_eq!(tick(5e5, (-1e6, 1e6)), "5.0e5");
         assert_eq!(tick(0.0, (-1e6, 1e6)), "0");
         assert_eq!(tick(-1e-17, (-1.0, 1.0)), "0.0");
+    }
+
+    #[test]
+    fn ordered_colours_run_blue_grey_red_and_stay_visible() {
+        let chart = Chart::new("", "", "")
+            .colours(Colours::Ordered)
+            .line("a", &[])
+            .line("b", &[])
+            .line("c", &[]);
+        assert_eq!(chart.colour(0), RGBColor(33, 102, 172));
+        assert_eq!(chart.colour(1), RGBColor(110, 110, 110));
+        assert_eq!(chart.colour(2), RGBColor(178, 24, 43));
+        assert_eq!(Palette::Diverging.colour(0.5), RGBColor(247, 247, 247));
     }
 
     #[test]
