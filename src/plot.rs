@@ -749,7 +749,7 @@ mod tests {
     fn ticks_have_the_decimals_the_span_needs() {
         assert_eq!(tick(0.5, (0.0, 1.0)), "0.5");
         assert_eq!(tick(0.25, (0.0, 1.0)), "0.2"); // eight ticks over 1: one decimal
-        assert_eq!(tick(-2.0, (-5.0, 5.0)), "−2.0");
+        assert_eq!(tick(-2.0, (-5.0, 5.0)), "−2"); // ticks every 2: no decimals
         assert_eq!(tick(120.0, (0.0, 140.0)), "120");
         assert_eq!(tick(2.5e-6, (0.0, 5e-6)), "2.5e−6");
         assert_eq!(tick(5e5, (-1e6, 1e6)), "5.0e5");
