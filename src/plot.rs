@@ -103,36 +103,33 @@ impl Palette {
     fn colour(self, t: f64) -> RGBColor {
         let t = t.clamp(0.0, 1.0);
         match self {
-            Palette::Diverging => {
-                let (blue, white, red) = (
+            Palette::Diverging => gradient(
+                [
                     [33.0, 102.0, 172.0],
                     [247.0, 247.0, 247.0],
                     [178.0, 24.0, 43.0],
-                );
-                if t < 0.5 {
-                    mix(blue, white, 2.0 * t)
-                } else {
-                    mix(white, red, 2.0 * t - 1.0)
-                }
-            }
-            Palette::Sequential => {
-                let (white, blue, dark) = (
+                ],
+                t,
+            ),
+            Palette::Sequential => gradient(
+                [
                     [255.0, 255.0, 217.0],
                     [65.0, 182.0, 196.0],
                     [8.0, 29.0, 88.0],
-                );
-                if t < 0.5 {
-                    mix(white, blue, 2.0 * t)
-                } else {
-                    mix(blue, dark, 2.0 * t - 1.0)
-                }
-            }
+                ],
+                t,
+            ),
         }
     }
 }
 
-/// The colour a fraction `s ∈ [0, 1]` of the way from `a` to `b`.
-fn mix(a: [f64; 3], b: [f64; 3], s: f64) -> RGBColor {
+/// The colour at `t ∈ [0, 1]` of the gradient through three stops (the middle at 0.5).
+fn gradient(stops: [[f64; 3]; 3], t: f64) -> RGBColor {
+    let (a, b, s) = if t < 0.5 {
+        (stops[0], stops[1], 2.0 * t)
+    } else {
+        (stops[1], stops[2], 2.0 * t - 1.0)
+    };
     RGBColor(
         (a[0] + (b[0] - a[0]) * s).round() as u8,
         (a[1] + (b[1] - a[1]) * s).round() as u8,
@@ -276,12 +273,7 @@ impl Chart {
                 // middle is white).
                 let n = self.series.len().max(2) - 1;
                 let t = k as f64 / n as f64;
-                let (blue, grey, red) = ([33.0, 102.0, 172.0], [110.0; 3], [178.0, 24.0, 43.0]);
-                if t < 0.5 {
-                    mix(blue, grey, 2.0 * t)
-                } else {
-                    mix(grey, red, 2.0 * t - 1.0)
-                }
+                gradient([[33.0, 102.0, 172.0], [110.0; 3], [178.0, 24.0, 43.0]], t)
             }
         }
     }
