@@ -629,22 +629,21 @@ fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     match extension.as_deref() {
-        Some("png") => {
-            let root = BitMapBackend::new(path, size).into_drawing_area();
-            root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
-            figure.draw(&root).map_err(fail)?;
-            root.present().map_err(|e| fail(e.to_string()))
-        }
-        Some("svg") => {
-            let root = SVGBackend::new(path, size).into_drawing_area();
-            root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
-            figure.draw(&root).map_err(fail)?;
-            root.present().map_err(|e| fail(e.to_string()))
-        }
-        _ => Err(fail(
-            "the file name must end in .png or .svg (the format is chosen by it)".into(),
-        )),
+        Some("png") => paint(BitMapBackend::new(path, size).into_drawing_area(), figure),
+        Some("svg") => paint(SVGBackend::new(path, size).into_drawing_area(), figure),
+        _ => Err("the file name must end in .png or .svg (the format is chosen by it)".into()),
     }
+    .map_err(fail)
+}
+
+/// Draws `figure` on a white `root` and writes the file.
+fn paint<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    figure: &impl Draw,
+) -> std::result::Result<(), String> {
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    figure.draw(&root)?;
+    root.present().map_err(|e| e.to_string())
 }
 
 /// The range of an axis: the one given (checked), or the finite values' extent with 4 %
