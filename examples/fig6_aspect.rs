@@ -16,7 +16,9 @@
 //! The claim: (a) and (b) collapse (the interface shear depends on R = Lx/(Ly Lz)),
 //! (c) does not and the precursors fade as Ly, Lz grow, (d) precursors are suppressed for
 //! large n.
-//! Writes `fig6{a,b,c,d}.csv` and `.png` (see `figures::precursor_panel`).
+//! Writes `fig6{a,b,c,d}.csv` and `.png`: ℓ/Lx against F/(μF_N), one curve per size (or
+//! per n in 6d) with legend entries such as `Lx = 43 mm, Ly = 7 mm` and `n = 0.5` (see
+//! `figures::precursor_panel`).
 //! Run: `cargo run --release --example fig6_aspect [output directory] [realizations]`.
 
 #[path = "support/report.rs"]
@@ -25,6 +27,7 @@ mod report;
 #[path = "support/figures.rs"]
 mod figures;
 
+use figures::Curve;
 use precursors::{Drive, ForceLoad, Lateral, Scene, SceneBuilder};
 use std::process::ExitCode;
 
@@ -47,30 +50,62 @@ fn run() -> report::Outcome {
     let figures::Args { dir, seeds } = figures::args(Some(1))?;
     let a: Vec<_> = [(43.0, 7.0), (61.0, 10.0), (92.0, 15.0), (122.0, 20.0)]
         .iter()
-        .map(|&(lx, ly)| (format!("Lx{lx}Ly{ly}"), side(mm(lx), mm(ly), mm(10.0), 4e3)))
+        .map(|&(lx, ly)| {
+            Curve::new(
+                format!("Lx{lx}Ly{ly}"),
+                format!("Lx = {lx} mm, Ly = {ly} mm"),
+                side(mm(lx), mm(ly), mm(10.0), 4e3),
+            )
+        })
         .collect();
-    figures::precursor_panel(&dir, "fig6a", &a, &seeds)?;
+    figures::precursor_panel(
+        &dir,
+        "fig6a",
+        "Fig. 6a: side load, Lx/Ly ≈ 6.1, Lz = 10 mm, F_N = 4 kN",
+        &a,
+        &seeds,
+    )?;
     let b: Vec<_> = [(40.0, 20.0), (80.0, 40.0), (140.0, 70.0), (200.0, 100.0)]
         .iter()
-        .map(|&(lx, lz)| (format!("Lx{lx}Lz{lz}"), side(mm(lx), mm(7.0), mm(lz), 4e3)))
+        .map(|&(lx, lz)| {
+            Curve::new(
+                format!("Lx{lx}Lz{lz}"),
+                format!("Lx = {lx} mm, Lz = {lz} mm"),
+                side(mm(lx), mm(7.0), mm(lz), 4e3),
+            )
+        })
         .collect();
-    figures::precursor_panel(&dir, "fig6b", &b, &seeds)?;
+    figures::precursor_panel(
+        &dir,
+        "fig6b",
+        "Fig. 6b: side load, Lx/Lz = 2, Ly = 7 mm, F_N = 4 kN",
+        &b,
+        &seeds,
+    )?;
     let c: Vec<_> = [7.0, 14.0, 29.0, 50.0]
         .iter()
         .map(|&ly| {
             let lz = ly / 0.36;
-            (
+            Curve::new(
                 format!("Ly{ly}Lz{lz:.1}"),
+                format!("Ly = {ly} mm, Lz = {lz:.1} mm"),
                 side(mm(40.0), mm(ly), mm(lz), 4e3),
             )
         })
         .collect();
-    figures::precursor_panel(&dir, "fig6c", &c, &seeds)?;
+    figures::precursor_panel(
+        &dir,
+        "fig6c",
+        "Fig. 6c: side load, Ly/Lz ≈ 0.36, Lx = 40 mm, F_N = 4 kN",
+        &c,
+        &seeds,
+    )?;
     let d: Vec<_> = [0.0, 0.5, 1.0, 2.0, 5.0]
         .iter()
         .map(|&n| {
-            (
+            Curve::new(
                 format!("n{n}"),
+                format!("n = {n}"),
                 Scene::builder()
                     .block(mm(201.0), mm(7.0), mm(132.0))
                     .cells(201, 7)
@@ -85,7 +120,13 @@ fn run() -> report::Outcome {
             )
         })
         .collect();
-    figures::precursor_panel(&dir, "fig6d", &d, &seeds)?;
+    figures::precursor_panel(
+        &dir,
+        "fig6d",
+        "Fig. 6d: rod (h = 6 mm) + top, F_top = n·F_lat, 201 x 7 x 132 mm, F_N = 2.7 kN",
+        &d,
+        &seeds,
+    )?;
     println!("wrote {dir}/fig6{{a,b,c,d}}.csv and .png");
     Ok(())
 }

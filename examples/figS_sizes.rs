@@ -12,7 +12,9 @@
 //!
 //! The paper's claim: the curves depend on each size (no collapse in S4-S9), and
 //! precursors fade as a size grows (a larger force is needed for a given ℓ/Lx).
-//! Writes `figS4.csv` ... `figS9.csv` and `.png` (see `figures::precursor_panel`).
+//! Writes `figS4.csv` ... `figS9.csv` and `.png`: ℓ/Lx against F/(μF_N), one curve per
+//! size with legend entries such as `Ly = 4 mm` or `h = 6 mm, Lz = 13 mm` (see
+//! `figures::precursor_panel`).
 //! Run: `cargo run --release --example figS_sizes [output directory] [realizations]`.
 
 #[path = "support/report.rs"]
@@ -21,6 +23,7 @@ mod report;
 #[path = "support/figures.rs"]
 mod figures;
 
+use figures::Curve;
 use precursors::{Drive, Lateral, Scene, SceneBuilder};
 use std::process::ExitCode;
 
@@ -43,55 +46,95 @@ fn main() -> ExitCode {
 
 fn run() -> report::Outcome {
     let figures::Args { dir, seeds } = figures::args(Some(1))?;
-    let panels: Vec<(&str, Vec<(String, SceneBuilder)>)> = vec![
+    let panels: Vec<(&str, &str, Vec<Curve>)> = vec![
         (
             "figS4",
+            "Fig. S4: Lx = 41 mm, Lz = 132 mm, rod h = 6 mm, F_N = 4 kN",
             [4.0, 7.0, 14.0, 28.0]
                 .iter()
-                .map(|&ly| (format!("Ly{ly}"), rod(41.0, ly, 132.0, 6.0)))
+                .map(|&ly| {
+                    Curve::new(
+                        format!("Ly{ly}"),
+                        format!("Ly = {ly} mm"),
+                        rod(41.0, ly, 132.0, 6.0),
+                    )
+                })
                 .collect(),
         ),
         (
             "figS5",
+            "Fig. S5: Lx = 141 mm, Ly = 7 mm, rod h = 6 mm, F_N = 4 kN",
             [20.0, 40.0, 75.0, 132.0]
                 .iter()
-                .map(|&lz| (format!("Lz{lz}"), rod(141.0, 7.0, lz, 6.0)))
+                .map(|&lz| {
+                    Curve::new(
+                        format!("Lz{lz}"),
+                        format!("Lz = {lz} mm"),
+                        rod(141.0, 7.0, lz, 6.0),
+                    )
+                })
                 .collect(),
         ),
         (
             "figS6",
+            "Fig. S6: Lx/Ly ≈ 6, Lz = 100 mm, rod h = 6 mm, F_N = 4 kN",
             [(42.0, 7.0), (84.0, 14.0), (126.0, 21.0)]
                 .iter()
-                .map(|&(lx, ly)| (format!("Lx{lx}Ly{ly}"), rod(lx, ly, 100.0, 6.0)))
+                .map(|&(lx, ly)| {
+                    Curve::new(
+                        format!("Lx{lx}Ly{ly}"),
+                        format!("Lx = {lx} mm, Ly = {ly} mm"),
+                        rod(lx, ly, 100.0, 6.0),
+                    )
+                })
                 .collect(),
         ),
         (
             "figS7",
+            "Fig. S7: Lx/Lz ≈ 4, Ly = 7 mm, rod h = 6 mm, F_N = 4 kN",
             [(80.0, 20.0), (160.0, 40.0), (240.0, 60.0)]
                 .iter()
-                .map(|&(lx, lz)| (format!("Lx{lx}Lz{lz}"), rod(lx, 7.0, lz, 6.0)))
+                .map(|&(lx, lz)| {
+                    Curve::new(
+                        format!("Lx{lx}Lz{lz}"),
+                        format!("Lx = {lx} mm, Lz = {lz} mm"),
+                        rod(lx, 7.0, lz, 6.0),
+                    )
+                })
                 .collect(),
         ),
         (
             "figS8",
+            "Fig. S8: Ly/Lz ≈ 0.36, Lx = 141 mm, rod h = 6 mm, F_N = 4 kN",
             [7.0, 14.0, 28.0]
                 .iter()
                 .map(|&ly| {
                     let lz = ly / 0.36;
-                    (format!("Ly{ly}Lz{lz:.1}"), rod(141.0, ly, lz, 6.0))
+                    Curve::new(
+                        format!("Ly{ly}Lz{lz:.1}"),
+                        format!("Ly = {ly} mm, Lz = {lz:.1} mm"),
+                        rod(141.0, ly, lz, 6.0),
+                    )
                 })
                 .collect(),
         ),
         (
             "figS9",
+            "Fig. S9: h/Lz ≈ 0.46, Lx = 141 mm, Ly = 7 mm, F_N = 4 kN",
             [(6.0, 13.0), (12.0, 26.0), (24.0, 52.0), (35.0, 76.0)]
                 .iter()
-                .map(|&(h, lz)| (format!("h{h}Lz{lz}"), rod(141.0, 7.0, lz, h)))
+                .map(|&(h, lz)| {
+                    Curve::new(
+                        format!("h{h}Lz{lz}"),
+                        format!("h = {h} mm, Lz = {lz} mm"),
+                        rod(141.0, 7.0, lz, h),
+                    )
+                })
                 .collect(),
         ),
     ];
-    for (name, curves) in &panels {
-        figures::precursor_panel(&dir, name, curves, &seeds)?;
+    for (name, title, curves) in &panels {
+        figures::precursor_panel(&dir, name, title, curves, &seeds)?;
     }
     println!("wrote {dir}/figS4.csv ... figS9.csv and the PNGs");
     Ok(())

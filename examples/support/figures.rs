@@ -3,9 +3,7 @@
 #![allow(dead_code)] // each example uses its own part
 
 use precursors::calibration::{length_at, precursor_curve};
-#[path = "plot.rs"]
-pub mod plot;
-
+use precursors::plot::{Chart, Corner};
 use precursors::{Drive, ForceLoad, Lateral, Result, Scene, SceneBuilder};
 
 /// The block of Figs. 7, 8 and S10: 200 x 7 x 100 mm, F_N = 6.25 kN, rod (h = 6 mm,
@@ -104,19 +102,46 @@ pub fn mean_precursor_curve(
     Ok(mean)
 }
 
+/// One curve of a precursor panel.
+pub struct Curve {
+    /// The CSV column's suffix (`ell_over_Lx_<column>`), e.g. `Lx100mm`.
+    pub column: String,
+    /// The legend entry, with units, e.g. `Lx = 100 mm`.
+    pub legend: String,
+    /// The scene (without seed: the realizations set it).
+    pub builder: SceneBuilder,
+}
+
+impl Curve {
+    pub fn new(
+        column: impl Into<String>,
+        legend: impl Into<String>,
+        builder: SceneBuilder,
+    ) -> Self {
+        Self {
+            column: column.into(),
+            legend: legend.into(),
+            builder,
+        }
+    }
+}
+
 /// Realization-averaged precursor curves `ℓ/Lx` of several scenes on one grid of
-/// `F/(μF_N)`: writes `<name>.csv` (one column per curve) and `<name>.png` (one colour per
-/// curve, in column order) and prints where each curve reaches ℓ/Lx = 0.1 and 0.5.
+/// `F/(μF_N)` (step 0.005): writes `<name>.csv` (one column per curve) and `<name>.png`
+/// (titled `<title>, mean of <k> realizations`; ℓ/Lx against F/(μF_N), both from 0 to 1;
+/// one colour per curve, in column order, with its legend entry in the upper left) and
+/// prints where each curve reaches ℓ/Lx = 0.1 and 0.5.
 pub fn precursor_panel(
     dir: &str,
     name: &str,
-    curves: &[(String, SceneBuilder)],
+    title: &str,
+    curves: &[Curve],
     seeds: &[u64],
 ) -> std::result::Result<(), Box<dyn std::error::Error>> {
     let grid = unit_grid(0.005);
     let mut columns = Vec::new();
-    for (label, builder) in curves {
-        let mean = mean_precursor_curve(builder, seeds, &grid)?;
+    for curve in curves {
+        let mean = mean_precursor_curve(&curve.builder, seeds, &grid)?;
         let reach = |level: f64| {
             grid.iter()
                 .zip(&mean)
@@ -124,14 +149,15 @@ pub fn precursor_panel(
                 .map_or(f64::NAN, |(f, _)| *f)
         };
         println!(
-            "{name} {label:>10}: ℓ/Lx reaches 0.1 at F/(μF_N) = {:.3}, 0.5 at {:.3}",
+            "{name} {:<30} ℓ/Lx reaches 0.1 at F/(μF_N) = {:.3}, 0.5 at {:.3}",
+            format!("{}:", curve.legend),
             reach(0.1),
             reach(0.5)
         );
         columns.push(mean);
     }
     let header = std::iter::once("force_over_mu_FN".to_string())
-        .chain(curves.iter().map(|(l, _)| format!("ell_over_Lx_{l}")))
+        .chain(curves.iter().map(|c| format!("ell_over_Lx_{}", c.column)))
         .collect::<Vec<_>>()
         .join(",");
     let rows: Vec<String> = grid
@@ -145,13 +171,30 @@ pub fn precursor_panel(
         })
         .collect();
     write_csv(&format!("{dir}/{name}.csv"), &header, &rows)?;
-    let mut canvas = plot::Plot::new(640, 480, (0.0, 1.0), (0.0, 1.0));
-    for (k, c) in columns.iter().enumerate() {
+    let mut chart = Chart::new(
+        &format!("{title}, {}", realizations(seeds.len())),
+        "F/(μF_N)",
+        "ℓ/Lx",
+    )
+    .x_range(0.0, 1.0)
+    .y_range(0.0, 1.0)
+    .legend(Corner::UpperLeft)
+    .size(900, 600);
+    for (curve, c) in curves.iter().zip(&columns) {
         let points: Vec<(f64, f64)> = grid.iter().copied().zip(c.iter().copied()).collect();
-        canvas.line(&points, plot::COLOURS[k % plot::COLOURS.len()]);
+        chart = chart.line(&curve.legend, &points);
     }
-    canvas.save(&format!("{dir}/{name}.png"))?;
+    chart.save(format!("{dir}/{name}.png"))?;
     Ok(())
+}
+
+/// "mean of k realizations" ("1 realization" for one).
+pub fn realizations(k: usize) -> String {
+    if k == 1 {
+        "1 realization".into()
+    } else {
+        format!("mean of {k} realizations")
+    }
 }
 
 /// `0, step, 2 step, ..., 1`.
