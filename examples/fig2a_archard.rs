@@ -5,7 +5,8 @@
 //! with `F_N` (`A_R = α F_N`); the least-squares slope and intercept are printed.
 //!
 //! Writes `fig2a.csv` (normal_load_N, area_percent_mean, area_percent_sd, alpha_m2_per_N)
-//! and `fig2a.png` (A_R/A0 in % against F_N from 0 to 4 kN).
+//! and `fig2a.png`: A_R/A0 (%) against F_N (N) from 0 to 4.2 kN, the realizations' mean
+//! at each load (markers) and the least-squares line.
 //! Run: `cargo run --release --example fig2a_archard [output directory] [realizations]`.
 
 #[path = "support/report.rs"]
@@ -14,7 +15,7 @@ mod report;
 #[path = "support/figures.rs"]
 mod figures;
 
-use figures::plot;
+use precursors::plot::{Chart, Corner};
 use precursors::Scene;
 use std::process::ExitCode;
 
@@ -70,14 +71,29 @@ fn run() -> report::Outcome {
         "normal_load_N,area_percent_mean,area_percent_sd,alpha_m2_per_N",
         &rows,
     )?;
-    let top = points.iter().fold(0.0f64, |m, p| m.max(p.1)) * 1.2;
-    let mut canvas = plot::Plot::new(640, 480, (0.0, 4000.0), (0.0, top));
-    canvas.line(&points, plot::COLOURS[0]);
-    canvas.line(
-        &[(0.0, intercept), (4000.0, intercept + slope * 4000.0)],
-        plot::COLOURS[6],
-    );
-    canvas.save(&format!("{dir}/fig2a.png"))?;
+    let top = points.iter().fold(0.0f64, |m, p| m.max(p.1)) * 1.15;
+    Chart::new(
+        &format!(
+            "Fig. 2a: real contact area at zero shear, 30 x 6 x 150 mm, {}",
+            figures::realizations(seeds.len())
+        ),
+        "F_N (N)",
+        "A_R/A0 (%)",
+    )
+    .x_range(0.0, 4200.0)
+    .y_range(0.0, top)
+    .markers("mean of the realizations", &points)
+    .line(
+        &format!(
+            "least squares: {:.4} %/kN · F_N {} {:.3} %",
+            slope * 1e3,
+            if intercept < 0.0 { "−" } else { "+" },
+            intercept.abs()
+        ),
+        &[(0.0, intercept), (4200.0, intercept + slope * 4200.0)],
+    )
+    .legend(Corner::UpperLeft)
+    .save(format!("{dir}/fig2a.png"))?;
     println!("wrote {dir}/fig2a.csv and {dir}/fig2a.png");
     Ok(())
 }

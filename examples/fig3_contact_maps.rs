@@ -3,10 +3,12 @@
 //! for a rod (h = 6 mm, Δh = 2 mm), a uniform side load and a uniform top load.
 //!
 //! Writes `fig3_<drive>.csv` (one row per stable state and column: force_over_mu_FN, x_m,
-//! area_ratio) and `fig3_<drive>.png`: x along the block (trailing edge left), F/(μF_N)
-//! from 0 (bottom) to 1 (top); blue where the area fell (the precursor), red where it
-//! grew, white unchanged (colour ∝ log10 of the ratio, saturating at a factor 10). Prints
-//! the precursor length ℓ/Lx at a few loads.
+//! area_ratio) and `fig3_<drive>.png`: a map over x (mm) along the block (trailing edge
+//! left) and F/(μF_N) from 0 (bottom) to 1 (top), each load showing the last stable state
+//! at or below it; the colour bar gives log₁₀(A_R(x)/A_R(x, 0)): blue where the area fell
+//! (the precursor; a column that lost all contact is at the blue end), red where it
+//! grew, white unchanged, saturating at a factor 10. Prints the precursor length ℓ/Lx at
+//! a few loads.
 //! Run: `cargo run --release --example fig3_contact_maps [output directory]`.
 
 #[path = "support/report.rs"]
@@ -15,7 +17,7 @@ mod report;
 #[path = "support/figures.rs"]
 mod figures;
 
-use figures::plot;
+use precursors::plot::{Map, Palette};
 use precursors::{Drive, Event, ForceLoad, Lateral, Scene};
 use std::ops::ControlFlow;
 use std::process::ExitCode;
@@ -29,15 +31,20 @@ fn run() -> report::Outcome {
     let drives = [
         (
             "rod",
+            "rod at h = 6 mm",
             Drive::Force(ForceLoad::Lateral(Lateral::Rod {
                 height: 6e-3,
                 half_width: 2e-3,
             })),
         ),
-        ("side", Drive::Force(ForceLoad::Lateral(Lateral::Side))),
-        ("top", Drive::Force(ForceLoad::Top)),
+        (
+            "side",
+            "uniform side load",
+            Drive::Force(ForceLoad::Lateral(Lateral::Side)),
+        ),
+        ("top", "uniform top load", Drive::Force(ForceLoad::Top)),
     ];
-    for (name, drive) in drives {
+    for (name, what, drive) in drives {
         let scene = Scene::builder()
             .block(0.200, 0.007, 0.075)
             .normal_load(2.7e3)
@@ -83,13 +90,26 @@ fn run() -> report::Outcome {
             let f = (r as f64 + 0.5) / load_rows as f64;
             if let Some((_, ratio, _)) = states.iter().take_while(|s| s.0 <= f).last() {
                 for (ix, v) in ratio.iter().enumerate() {
-                    map[r * nx + ix] = v.log10();
+                    // A column without contact (log10(0) = -inf) is at the blue end.
+                    map[r * nx + ix] = v.log10().clamp(-1.0, 1.0);
                 }
             }
         }
-        let mut canvas = plot::Plot::new(800, 480, (0.0, 1.0), (0.0, 1.0));
-        canvas.heatmap(&map, nx, load_rows, plot::diverging);
-        canvas.save(&format!("{dir}/fig3_{name}.png"))?;
+        let lx_mm = scene.grid().block().lx() * 1e3;
+        Map::new(nx, load_rows, map)?
+            .labels(
+                &format!(
+                    "Fig. 3: real contact area, {what}, 200 x 7 x 75 mm, F_N = 2.7 kN, seed 1"
+                ),
+                "x (mm)",
+                "F/(μF_N)",
+                "log₁₀(A_R(x)/A_R(x, 0))",
+            )
+            .x_range(0.0, lx_mm)
+            .y_range(0.0, 1.0)
+            .colour_scale(Palette::Diverging, Some((-1.0, 1.0)))
+            .size(1000, 600)
+            .save(format!("{dir}/fig3_{name}.png"))?;
         let ell = |target: f64| {
             states
                 .iter()

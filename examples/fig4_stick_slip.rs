@@ -5,7 +5,8 @@
 //! interface sticks and drops at each slip.
 //!
 //! Writes `fig4.csv` (one row per load step and per rupture: event, drive_displacement_m,
-//! spring_force_N, force_over_mu_FN) and `fig4.png` (spring force / μF_N against U_S).
+//! spring_force_N, force_over_mu_FN) and `fig4.png`: the spring force F_S/(μF_N)
+//! against the drive displacement U_S (μm), one point per load step and per rupture.
 //! Prints the number of drops and the largest one.
 //! Run: `cargo run --release --example fig4_stick_slip [output directory]`.
 
@@ -15,7 +16,7 @@ mod report;
 #[path = "support/figures.rs"]
 mod figures;
 
-use figures::plot;
+use precursors::plot::{Chart, Corner};
 use precursors::{Drive, Event, Lateral, Scene};
 use std::ops::ControlFlow;
 use std::process::ExitCode;
@@ -66,9 +67,19 @@ fn run() -> report::Outcome {
         .collect();
     let largest = drops.iter().fold(0.0f64, |m, d| m.max(*d));
     let u_max = points.iter().fold(0.0f64, |m, p| m.max(p.0));
-    let mut canvas = plot::Plot::new(800, 480, (0.0, u_max * 1.05), (0.0, 1.1));
-    canvas.line(&points, plot::COLOURS[0]);
-    canvas.save(&format!("{dir}/fig4.png"))?;
+    let microns: Vec<(f64, f64)> = points.iter().map(|(u, f)| (u * 1e6, *f)).collect();
+    Chart::new(
+        "Fig. 4: stick-slip, 140 x 7 x 75 mm, F_N = 3.5 kN, spring K_S = 4 MN/m on a rod \
+         (h = 6 mm), seed 1",
+        "U_S (μm)",
+        "F_S/(μF_N)",
+    )
+    .x_range(0.0, u_max * 1e6 * 1.05)
+    .y_range(0.0, 1.1)
+    .line("spring force K_S (U_S − <u_x>)", &microns)
+    .legend(Corner::LowerRight)
+    .size(1000, 600)
+    .save(format!("{dir}/fig4.png"))?;
     println!(
         "{} force drops (stick-slip), largest {:.4} μF_N; global slip at U_S = {:.4e} m",
         drops.len(),

@@ -10,8 +10,9 @@
 //! over height realizations (seeds 1-10; the second argument changes the count).
 //!
 //! Writes `fig7.csv` (x_m, abs_tau_zP_Pa, abs_sigma_zP_Pa, coulomb_zP_Pa (|τ| - μ|σ| of
-//! the y-averages), coulomb_interface_Pa (y-average of τ_C at z = 0)) and `fig7.png`
-//! (|τ| blue, |σ| red, τ_C(z_P) green, τ_C(0) purple, in MPa, against x/Lx).
+//! the y-averages), coulomb_interface_Pa (y-average of τ_C at z = 0)) and `fig7.png`:
+//! |τ(x, z_P)|, |σ(x, z_P)|, τ_C(x, z_P) and τ_C(x, 0) in MPa against x (mm), with a
+//! legend naming each.
 //! Run: `cargo run --release --example fig7_stresses [output directory] [realizations]`.
 
 #[path = "support/report.rs"]
@@ -20,7 +21,7 @@ mod report;
 #[path = "support/figures.rs"]
 mod figures;
 
-use figures::plot;
+use precursors::plot::{Chart, Corner};
 use precursors::probe::{ProbeSpec, Profile};
 use precursors::Event;
 use std::process::ExitCode;
@@ -93,21 +94,38 @@ fn run() -> report::Outcome {
         "x_m,abs_tau_zP_Pa,abs_sigma_zP_Pa,coulomb_zP_Pa,coulomb_interface_Pa",
         &rows,
     )?;
+    let mean_load = loads.iter().sum::<f64>() / n;
+    // Profiles in MPa against x in mm (1 mm cells).
     let mpa = |c: &Vec<f64>| -> Vec<(f64, f64)> {
         c.iter()
             .enumerate()
-            .map(|(i, v)| ((i as f64 + 0.5) / nx as f64, v / 1e6))
+            .map(|(i, v)| (i as f64 + 0.5, v / 1e6))
             .collect()
     };
-    let top = sums[1].iter().fold(0.0f64, |m, v| m.max(*v)) / 1e6 * 1.1;
-    let low = sums[3].iter().fold(0.0f64, |m, v| m.min(*v)) / 1e6 * 1.1;
-    let mut canvas = plot::Plot::new(800, 480, (0.0, 1.0), (low, top));
-    canvas.line(&[(0.0, 0.0), (1.0, 0.0)], plot::COLOURS[6]);
-    for (k, colour) in [0, 1, 2, 4].into_iter().enumerate() {
-        canvas.line(&mpa(&sums[k]), plot::COLOURS[colour]);
-    }
-    canvas.save(&format!("{dir}/fig7.png"))?;
-    let mean_load = loads.iter().sum::<f64>() / n;
+    let lx_mm = nx as f64;
+    // Room above the curves for the legend.
+    let (low, high) = sums
+        .iter()
+        .flatten()
+        .fold((0.0f64, 0.0f64), |(a, b), v| (a.min(*v), b.max(*v)));
+    let (low, high) = (low / 1e6, high / 1e6);
+    Chart::new(
+        &format!(
+            "Fig. 7: stresses before the first precursor, F/(μF_N) = {mean_load:.3}, {}",
+            figures::realizations(seeds.len())
+        ),
+        "x (mm)",
+        "stress (MPa)",
+    )
+    .x_range(0.0, lx_mm)
+    .y_range(low - 0.05 * (high - low), high + 0.35 * (high - low))
+    .line("|τ_xz| at z_P = 2 mm", &mpa(&sums[0]))
+    .line("|σ_zz| at z_P = 2 mm", &mpa(&sums[1]))
+    .line("τ_C = |τ| − μ|σ| at z_P = 2 mm", &mpa(&sums[2]))
+    .line("τ_C at the interface, z = 0", &mpa(&sums[3]))
+    .legend(Corner::UpperRight)
+    .size(1000, 600)
+    .save(format!("{dir}/fig7.png"))?;
     let positive = sums[2].iter().filter(|v| **v > 0.0).count();
     let interface_max = sums[3].iter().fold(f64::MIN, |m, v| m.max(*v));
     println!(

@@ -5,8 +5,10 @@
 //! reached at F/(μF_N) = 0.6, 0.8 and 0.95. Planes every 1 mm from z = 0.5 mm to 99.5 mm.
 //!
 //! Writes `fig8.csv` (stage, force_over_mu_FN, precursor_m, x_m, z_m, coulomb_Pa) and
-//! `fig8_<stage>.png`: x right, z up (the interface at the bottom); red where τ_C > 0,
-//! blue where τ_C < 0 (scaled by 1 MPa, saturating).
+//! `fig8_<stage>.png` (stage `before`, `0.6`, `0.8`, `0.95`): a map of τ_C (MPa) over x
+//! (mm, right) and z (mm, up; the interface at the bottom), titled with the stage's load
+//! and precursor length; red where τ_C > 0, blue where τ_C < 0, the colour bar from −2 to
+//! 2 MPa (saturating).
 //! Run: `cargo run --release --example fig8_coulomb_map [output directory]`.
 
 #[path = "support/report.rs"]
@@ -15,7 +17,7 @@ mod report;
 #[path = "support/figures.rs"]
 mod figures;
 
-use figures::plot;
+use precursors::plot::{Map, Palette};
 use precursors::probe::ProbeSpec;
 use precursors::Event;
 use std::process::ExitCode;
@@ -37,6 +39,7 @@ fn run() -> report::Outcome {
     let mu = scene.material().friction_coefficient;
     let mu_fn = mu * scene.normal_load();
     let nx = scene.grid().nx();
+    let lx_mm = scene.grid().block().lx() * 1e3;
     // τ_C(x, z) of the y-averages, rows = planes.
     let map = |d: &precursors::Driver| -> precursors::Result<Vec<f64>> {
         let s = d.stresses()?;
@@ -81,9 +84,24 @@ fn run() -> report::Outcome {
                 ));
             }
         }
-        let mut canvas = plot::Plot::new(800, 480, (0.0, 0.2), (0.0, 0.1));
-        canvas.heatmap(values, nx, heights.len(), |v| plot::diverging(v / 1e6));
-        canvas.save(&format!("{dir}/fig8_{name}.png"))?;
+        let stage = if name == "before" {
+            format!("before the first precursor, F/(μF_N) = {f:.3}")
+        } else {
+            format!("at F/(μF_N) = {f:.3} (first state ≥ {name})")
+        };
+        let mpa: Vec<f64> = values.iter().map(|v| v / 1e6).collect();
+        Map::new(nx, heights.len(), mpa)?
+            .labels(
+                &format!("Fig. 8: τ_C {stage}, ℓ = {:.0} mm, seed 1", ell * 1e3),
+                "x (mm)",
+                "z (mm)",
+                "τ_C = |τ| − μ|σ| (MPa)",
+            )
+            .x_range(0.0, lx_mm)
+            .y_range(0.0, heights.len() as f64) // planes 1 mm apart
+            .colour_scale(Palette::Diverging, Some((-2.0, 2.0)))
+            .size(1000, 600)
+            .save(format!("{dir}/fig8_{name}.png"))?;
         let positive = values.iter().filter(|v| **v > 0.0).count();
         println!(
             "stage {name:>6}: F/(μF_N) = {f:.3}, ℓ = {:.0} mm, τ_C > 0 on {:.1} % of the x-z plane",

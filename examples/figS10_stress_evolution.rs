@@ -5,8 +5,9 @@
 //! stable state reached at each load).
 //!
 //! Writes `figS10.csv` (force_over_mu_FN, x_m, abs_sigma_Pa, abs_tau_Pa) and
-//! `figS10_sigma.png`, `figS10_tau.png` (x/Lx right, stress up in MPa, one colour per
-//! load, blue to red as the load grows).
+//! `figS10_sigma.png`, `figS10_tau.png`: |σ_zz(x, z_P)| and |τ_xz(x, z_P)| (MPa) against
+//! x (mm), one colour per load, blue through grey to red as the load grows, with legend
+//! entries `F/(μF_N) = 0.0`, ..., `0.9`.
 //! Run: `cargo run --release --example figS10_stress_evolution [output directory] [realizations]`.
 
 #[path = "support/report.rs"]
@@ -15,7 +16,7 @@ mod report;
 #[path = "support/figures.rs"]
 mod figures;
 
-use figures::plot;
+use precursors::plot::{Chart, Colours, Corner};
 use precursors::probe::ProbeSpec;
 use precursors::Event;
 use std::process::ExitCode;
@@ -72,20 +73,35 @@ fn run() -> report::Outcome {
         "force_over_mu_FN,x_m,abs_sigma_Pa,abs_tau_Pa",
         &rows,
     )?;
-    for (name, data) in [("sigma", &sigma), ("tau", &tau)] {
-        let top = data.iter().flatten().fold(0.0f64, |m, v| m.max(*v)) / 1e6 * 1.1;
-        let mut canvas = plot::Plot::new(800, 480, (0.0, 1.0), (0.0, top));
+    let figures = [
+        ("sigma", "normal stress", "|σ_zz(x, z_P)| (MPa)", &sigma),
+        ("tau", "shear stress", "|τ_xz(x, z_P)| (MPa)", &tau),
+    ];
+    for (name, what, y_label, data) in figures {
+        let top = data.iter().flatten().fold(0.0f64, |m, v| m.max(*v)) / 1e6;
+        let mut chart = Chart::new(
+            &format!(
+                "Fig. S10: {what} at z_P = 2 mm as the load grows, {}",
+                figures::realizations(seeds.len())
+            ),
+            "x (mm)",
+            y_label,
+        )
+        .x_range(0.0, nx as f64)
+        .y_range(0.0, top * 1.1)
+        .legend(Corner::UpperRight)
+        .colours(Colours::Ordered)
+        .size(1000, 600);
         for (k, profile) in data.iter().enumerate() {
-            let t = k as f64 / (levels.len() - 1) as f64;
-            let colour = plot::diverging(2.0 * t - 1.0);
+            // Cells of 1 mm.
             let points: Vec<(f64, f64)> = profile
                 .iter()
                 .enumerate()
-                .map(|(ix, v)| ((ix as f64 + 0.5) / nx as f64, v / 1e6))
+                .map(|(ix, v)| (ix as f64 + 0.5, v / 1e6))
                 .collect();
-            canvas.line(&points, colour);
+            chart = chart.line(&format!("F/(μF_N) = {:.1}", levels[k]), &points);
         }
-        canvas.save(&format!("{dir}/figS10_{name}.png"))?;
+        chart.save(format!("{dir}/figS10_{name}.png"))?;
     }
     let edge = |d: &Vec<Vec<f64>>, k: usize| d[k][0] / 1e6;
     println!(

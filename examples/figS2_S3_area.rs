@@ -7,10 +7,12 @@
 //!   (Lz = 75 mm), uniform side shear and rod (h = 6 mm, Δh = 2 mm), averaged over 10
 //!   realizations. A_R depends on F_N only, not on A0; every run slides at F = μF_N.
 //!
-//! Writes `figS2.csv` (force_over_mu_FN, area_ratio) + `figS2.png`, and `figS3.csv`
-//! (force_over_mu_FN, then A_R in mm² per sample and drive) + `figS3.png` (side: solid
-//! colours, rod: the next colours). Prints, per sample, A_R(0), the spread of A_R(0)
-//! across samples relative to its mean, and the slip load.
+//! Writes `figS2.csv` (force_over_mu_FN, area_ratio) + `figS2.png` (A_R/A_R(0) against
+//! F/(μF_N) as a staircase over the stable states, shown up to A_R/A_R(0) = 2), and
+//! `figS3.csv` (force_over_mu_FN, then A_R in mm² per sample and drive) + `figS3.png`
+//! (A_R (mm²) against F/(μF_N) up to twice the largest A_R(0), one curve per drive and
+//! sample, legend entries such as `side, 50 x 7 mm`). Prints, per sample, A_R(0), the spread of A_R(0) across samples
+//! relative to its mean, and the slip load.
 //! Run: `cargo run --release --example figS2_S3_area [output directory] [realizations]`.
 
 #[path = "support/report.rs"]
@@ -19,7 +21,7 @@ mod report;
 #[path = "support/figures.rs"]
 mod figures;
 
-use figures::plot;
+use precursors::plot::{Chart, Corner};
 use precursors::{Drive, Event, ForceLoad, Lateral, Scene, SceneBuilder};
 use std::process::ExitCode;
 
@@ -81,9 +83,21 @@ fn run() -> report::Outcome {
     const CAP: f64 = 2.0;
     let shown: Vec<(f64, f64)> = points.iter().copied().take_while(|p| p.1 <= CAP).collect();
     let low = points.iter().fold(1.0f64, |m, p| m.min(p.1)) * 0.98;
-    let mut canvas = plot::Plot::new(640, 480, (0.0, 1.0), (low, CAP));
-    canvas.line(&shown, plot::COLOURS[0]);
-    canvas.save(&format!("{dir}/figS2.png"))?;
+    let above = points.len() - shown.len();
+    let label = match above {
+        0 => "A_R/A_R(0) at the stable states".to_string(),
+        k => format!("A_R/A_R(0) at the stable states ({k} later above {CAP}, not shown)"),
+    };
+    Chart::new(
+        "Fig. S2: real contact area, top shear, 100 x 7 x 75 mm, F_N = 4 kN, seed 1",
+        "F/(μF_N)",
+        "A_R/A_R(0)",
+    )
+    .x_range(0.0, 1.0)
+    .y_range(low, CAP)
+    .steps(&label, &shown)
+    .legend(Corner::UpperLeft)
+    .save(format!("{dir}/figS2.png"))?;
     for target in [0.5, 0.75, 0.9, 0.95] {
         let r = points
             .iter()
@@ -119,6 +133,7 @@ fn run() -> report::Outcome {
     ];
     let mut columns = Vec::new();
     let mut header = vec!["force_over_mu_FN".to_string()];
+    let mut legends = Vec::new();
     let mut initial = Vec::new();
     for (drive_name, drive) in drives {
         for &(lx, ly) in &samples {
@@ -145,6 +160,11 @@ fn run() -> report::Outcome {
                 mean[0]
             );
             initial.push(mean[0]);
+            legends.push(format!(
+                "{drive_name}, {:.0} x {:.0} mm",
+                lx * 1e3,
+                ly * 1e3
+            ));
             header.push(format!(
                 "area_mm2_{drive_name}_{:.0}x{:.0}",
                 lx * 1e3,
@@ -170,22 +190,32 @@ fn run() -> report::Outcome {
         })
         .collect();
     figures::write_csv(&format!("{dir}/figS3.csv"), &header.join(","), &rows)?;
-    let top = columns
-        .iter()
-        .flatten()
-        .fold(0.0f64, |m, v| if v.is_finite() { m.max(*v) } else { m })
-        * 1.1;
-    let mut canvas = plot::Plot::new(640, 480, (0.0, 1.0), (0.0, top));
-    for (k, c) in columns.iter().enumerate() {
+    // As in S2, the unbounded area law explodes just before slip: the picture shows A_R up
+    // to twice the largest A_R(0), each curve until it leaves that range (the CSV has
+    // every value).
+    let top = CAP * initial.iter().fold(0.0f64, |m, a| m.max(*a));
+    let mut chart = Chart::new(
+        &format!(
+            "Fig. S3: real contact area up to 2 A_R(0), Lz = 75 mm, F_N = 4 kN, {}",
+            figures::realizations(seeds.len())
+        ),
+        "F/(μF_N)",
+        "A_R (mm²)",
+    )
+    .x_range(0.0, 1.0)
+    .y_range(0.0, top)
+    .legend(Corner::UpperLeft)
+    .size(900, 600);
+    for (c, legend) in columns.iter().zip(&legends) {
         let points: Vec<(f64, f64)> = grid
             .iter()
             .copied()
             .zip(c.iter().copied())
-            .filter(|p| p.1.is_finite())
+            .take_while(|p| p.1.is_finite() && p.1 <= top)
             .collect();
-        canvas.line(&points, plot::COLOURS[k % plot::COLOURS.len()]);
+        chart = chart.line(legend, &points);
     }
-    canvas.save(&format!("{dir}/figS3.png"))?;
+    chart.save(format!("{dir}/figS3.png"))?;
     println!("wrote {dir}/figS2.csv, {dir}/figS3.csv and the PNGs");
     Ok(())
 }

@@ -5,17 +5,16 @@
 //! Writes `quickstart.csv` (one row per stable state: F/(μF_N), ℓ/Lx, the total real
 //! contact area, the ruptures of the avalanche that ended there, and 1 where that area
 //! exceeds the nominal area Lx·Ly: the paper's area law has no cap, see
-//! `precursors::AreaLaw`) and `quickstart.png`
-//! (ℓ/Lx against F/(μF_N), both axes from 0 to 1 with ticks every 0.1).
+//! `precursors::AreaLaw`) and `quickstart.png`: the precursor length ℓ/Lx against the
+//! load F/(μF_N) at the stable states, as a staircase (both axes from 0 to 1; title with
+//! the scene and the seed), drawn by `precursors::plot`.
 //!
 //! Run: `cargo run --release --example quickstart [seed] [output directory]`.
 
 #[path = "support/report.rs"]
 mod report;
 
-#[path = "support/plot.rs"]
-mod plot;
-
+use precursors::plot::{Chart, Corner};
 use precursors::{Event, Scene};
 use report::AtPath;
 use std::io::Write;
@@ -84,17 +83,20 @@ fn run() -> report::Outcome {
     write().at("write", &csv)?;
 
     // The envelope as the paper draws it: ℓ at each stable state, as a staircase.
-    let mut points = Vec::new();
-    let mut last = 0.0;
-    for (f, l, ..) in &rows {
-        points.push((*f, last));
-        points.push((*f, *l));
-        last = *l;
-    }
-    let mut canvas = plot::Plot::new(640, 480, (0.0, 1.0), (0.0, 1.0));
-    canvas.line(&points, [20, 60, 200]);
+    let points: Vec<(f64, f64)> = rows.iter().map(|(f, l, ..)| (*f, *l)).collect();
     let png = format!("{dir}/quickstart.png");
-    canvas.save(&png)?;
+    Chart::new(
+        &format!(
+            "Precursor length, calibration scene (140 x 7 x 75 mm, F_N = 3.5 kN), seed {seed}"
+        ),
+        "F/(μF_N)",
+        "ℓ/Lx",
+    )
+    .x_range(0.0, 1.0)
+    .y_range(0.0, 1.0)
+    .steps("ℓ/Lx at the stable states (rod, h = 6 mm)", &points)
+    .legend(Corner::UpperLeft)
+    .save(&png)?;
 
     let ruptures: usize = rows.iter().map(|r| r.3).sum();
     println!(
