@@ -1,7 +1,7 @@
 //! Paper Fig. 4: stick-slip under displacement control. The calibration block (140 x 7 x
 //! 75 mm, 1 mm cells, F_N = 3.5 kN, seed 1) is driven through a spring of stiffness
 //! K_S = 4e6 N/m acting on the trailing edge as the paper's rod (h = 6 mm, Δh = 2 mm):
-//! the drive displacement U_S grows, the spring force K_S (U_S - <u_x>) rises while the
+//! the drive displacement U_S grows, the spring force K_S (U_S - ⟨u_x⟩) rises while the
 //! interface sticks and drops at each slip.
 //!
 //! Writes `fig4.csv` (one row per load step and per rupture: event, drive_displacement_m,
@@ -76,7 +76,7 @@ fn run() -> report::Outcome {
     )
     .x_range(0.0, u_max * 1e6 * 1.05)
     .y_range(0.0, 1.1)
-    .line("spring force K_S (U_S − <u_x>)", &microns)
+    .line("spring force K_S (U_S − ⟨u_x⟩)", &microns)
     .legend(Corner::LowerRight)
     .size(1000, 600)
     .save(format!("{dir}/fig4.png"))?;

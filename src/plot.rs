@@ -1,7 +1,7 @@
 //! Figures (feature `plot`): line charts with legends and confidence bands, and maps with
 //! a colour bar, written as PNG or SVG (chosen by the file's extension), with axes, tick
 //! values and labels in an embedded font (DejaVu Sans, cut to the characters labels use:
-//! Latin, Greek, super- and subscripts, `ℓ`, `−`, `≈`, `≤`; `assets/fonts`), so that no
+//! Latin, Greek, super- and subscripts, `ℓ`, `−`, `≈`, `≤`, `∑`, `⟨ ⟩`; `assets/fonts`), so that no
 //! system font is needed.
 //!
 //! [`Chart`] and [`Map`] are the building blocks; [`figures`] draws the standard figures
@@ -350,12 +350,18 @@ impl Draw for ChartDrawing<'_> {
                     .map_err(|e| e.to_string())?;
             }
             let style = colour.stroke_width(2);
+            let markers = s.kind == Kind::Markers;
             let legend = |annotation: &mut plotters::chart::SeriesAnno<'_, DB>| {
-                annotation.label(s.label.as_str()).legend(move |(px, py)| {
-                    PathElement::new(vec![(px, py), (px + 22, py)], colour.stroke_width(3))
-                });
+                let entry = annotation.label(s.label.as_str());
+                if markers {
+                    entry.legend(move |(px, py)| Circle::new((px + 11, py), 4, colour.filled()));
+                } else {
+                    entry.legend(move |(px, py)| {
+                        PathElement::new(vec![(px, py), (px + 22, py)], colour.stroke_width(3))
+                    });
+                }
             };
-            if s.kind == Kind::Markers {
+            if markers {
                 let points = s
                     .points
                     .iter()
