@@ -253,7 +253,7 @@ for m in metas:
 print(f"meta.json: {len(metas)} files identical but for `seconds`")
 EOF
     n=$(cd "$a" && find . -type f ! -name meta.json | wc -l)
-    echo "IDENTICAL: $a and $b ($n files byte for byte: merged tables, each run's events.csv, curve.csv, done; sweep.json)"
+    echo "IDENTICAL: $a and $b ($n files byte for byte: merged tables, each run's events.csv, curve.csv, contact_map.csv, done; sweep.json)"
 }
 
 say "local: the same sweep, unsharded, --jobs $CPUS"
