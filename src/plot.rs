@@ -26,6 +26,7 @@
 pub mod figures;
 
 use crate::error::{Error, Result};
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -315,27 +316,8 @@ impl Draw for ChartDrawing<'_> {
     ) -> std::result::Result<(), String> {
         let (me, x, y) = (self.chart, self.x, self.y);
         let font = |size: f64| (FAMILY, size).into_font();
-        let mut chart = ChartBuilder::on(root)
-            .caption(&me.title, font(22.0))
-            .margin(16)
-            .x_label_area_size(52)
-            .y_label_area_size(72)
-            .build_cartesian_2d(x.0..x.1, y.0..y.1)
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc(me.x_label.as_str())
-            .y_desc(me.y_label.as_str())
-            .axis_desc_style(font(18.0))
-            .label_style(font(15.0))
-            .x_labels(8)
-            .y_labels(8)
-            .x_label_formatter(&|v| tick(*v, x))
-            .y_label_formatter(&|v| tick(*v, y))
-            .light_line_style(RGBColor(235, 235, 235))
-            .bold_line_style(RGBColor(215, 215, 215))
-            .draw()
-            .map_err(|e| e.to_string())?;
+        let mut chart = axes(root, &me.title, x, y)?;
+        draw_axes(&mut chart, (&me.x_label, x), (&me.y_label, y), true)?;
         let mut labelled = false;
         for (k, s) in me.series.iter().enumerate() {
             let colour = me.colour(k);
@@ -545,13 +527,7 @@ impl Draw for MapDrawing<'_> {
         let (width, _) = root.dim_in_pixel();
         let bar_width = 130.min(width / 3);
         let (main, bar) = root.split_horizontally(width - bar_width);
-        let mut chart = ChartBuilder::on(&main)
-            .caption(&me.title, font(22.0))
-            .margin(16)
-            .x_label_area_size(52)
-            .y_label_area_size(72)
-            .build_cartesian_2d(x.0..x.1, y.0..y.1)
-            .map_err(|e| e.to_string())?;
+        let mut chart = axes(&main, &me.title, x, y)?;
         let (dx, dy) = (
             (x.1 - x.0) / me.columns as f64,
             (y.1 - y.0) / me.rows as f64,
@@ -571,19 +547,7 @@ impl Draw for MapDrawing<'_> {
                 })
             }))
             .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc(me.x_label.as_str())
-            .y_desc(me.y_label.as_str())
-            .axis_desc_style(font(18.0))
-            .label_style(font(15.0))
-            .x_labels(8)
-            .y_labels(8)
-            .x_label_formatter(&|v| tick(*v, x))
-            .y_label_formatter(&|v| tick(*v, y))
-            .draw()
-            .map_err(|e| e.to_string())?;
+        draw_axes(&mut chart, (&me.x_label, x), (&me.y_label, y), false)?;
         // The colour bar: a one-column chart of the colour scale, its values on the right.
         let mut scale = ChartBuilder::on(&bar)
             .margin_top(16 + 30)
@@ -615,6 +579,52 @@ impl Draw for MapDrawing<'_> {
             .map_err(|e| e.to_string())?;
         Ok(())
     }
+}
+
+/// A titled plotting area with room for tick values and axis labels.
+fn axes<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    title: &str,
+    x: (f64, f64),
+    y: (f64, f64),
+) -> std::result::Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String>
+{
+    ChartBuilder::on(area)
+        .caption(title, (FAMILY, 22.0).into_font())
+        .margin(16)
+        .x_label_area_size(52)
+        .y_label_area_size(72)
+        .build_cartesian_2d(x.0..x.1, y.0..y.1)
+        .map_err(|e| e.to_string())
+}
+
+/// The axes' tick values and labels, with a light grid when `grid` (charts; not on maps).
+fn draw_axes<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    (x_label, x): (&str, (f64, f64)),
+    (y_label, y): (&str, (f64, f64)),
+    grid: bool,
+) -> std::result::Result<(), String> {
+    let font = |size: f64| (FAMILY, size).into_font();
+    let x_ticks = |v: &f64| tick(*v, x);
+    let y_ticks = |v: &f64| tick(*v, y);
+    let mut mesh = chart.configure_mesh();
+    if grid {
+        mesh.light_line_style(RGBColor(235, 235, 235))
+            .bold_line_style(RGBColor(215, 215, 215));
+    } else {
+        mesh.disable_mesh();
+    }
+    mesh.x_desc(x_label)
+        .y_desc(y_label)
+        .axis_desc_style(font(18.0))
+        .label_style(font(15.0))
+        .x_labels(8)
+        .y_labels(8)
+        .x_label_formatter(&x_ticks)
+        .y_label_formatter(&y_ticks)
+        .draw()
+        .map_err(|e| e.to_string())
 }
 
 /// Draws through the backend that `path`'s extension names and writes the file.
