@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates assets/fonts/DejaVuSans-subset.ttf, the font the figures embed (feature
 # `plot`): DejaVu Sans cut to the characters figure labels use, so that the crate carries
-# ~60 kB instead of 760 kB and a fresh machine needs no system font.
+# ~51 kB instead of 760 kB and a fresh machine needs no system font.
 # Needs Debian's fonts-dejavu-core and fonttools (`pip install fonttools`); not run by CI.
 set -euo pipefail
 cd "$(dirname "$0")/.."
