@@ -21,7 +21,7 @@ mod report;
 #[path = "support/figures.rs"]
 mod figures;
 
-use precursors::plot::{Chart, Corner};
+use precursors::plot::{Chart, Corner, Style};
 use precursors::probe::{ProbeSpec, Profile};
 use precursors::Event;
 use std::process::ExitCode;
@@ -123,6 +123,9 @@ fn run() -> report::Outcome {
     .line("|σ_zz| at z_P = 2 mm", &mpa(&sums[1]))
     .line("τ_C = |τ| − μ|σ| at z_P = 2 mm", &mpa(&sums[2]))
     .line("τ_C at the interface, z = 0", &mpa(&sums[3]))
+    // Zero, where τ_C changes sign: the Coulomb stress ahead of the front.
+    .line("", &[(0.0, 0.0), (lx_mm, 0.0)])
+    .style(Style::new().colour(140, 140, 140).dashed())
     .legend(Corner::UpperRight)
     .size(1000, 600)
     .save(format!("{dir}/fig7.png"))?;

@@ -28,6 +28,7 @@ pub mod figures;
 use crate::error::{Error, Result};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use std::path::Path;
 use std::sync::OnceLock;
@@ -87,6 +88,38 @@ pub enum Colours {
     Ordered,
 }
 
+/// How one series of a [`Chart`] is drawn ([`Chart::style`]): by default in the chart's
+/// colouring ([`Colours`]), solid. A reference curve, say a zero line or a published
+/// value, is typically grey and dashed:
+/// `Style::new().colour(120, 120, 120).dashed()`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub struct Style {
+    colour: Option<RGBColor>,
+    dashed: bool,
+}
+
+impl Style {
+    /// The default: the chart's colouring, a solid line.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// A fixed colour (red, green, blue from 0 to 255). Series with a fixed colour are
+    /// left out of the chart's colouring: the others keep their colours in turn (or
+    /// their places on the [`Colours::Ordered`] gradient).
+    pub fn colour(mut self, red: u8, green: u8, blue: u8) -> Self {
+        self.colour = Some(RGBColor(red, green, blue));
+        self
+    }
+
+    /// A dashed line (lines, staircases and bands' mean curves; refused on markers).
+    pub fn dashed(mut self) -> Self {
+        self.dashed = true;
+        self
+    }
+}
+
 /// The colour scale of a [`Map`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
@@ -138,6 +171,10 @@ fn gradient(stops: [[f64; 3]; 3], t: f64) -> RGBColor {
     )
 }
 
+/// Dash and gap lengths (pixels) of a dashed line.
+const DASH: u32 = 9;
+const GAP: u32 = 6;
+
 /// Ten distinct line colours (Tableau 10).
 const DISTINCT: [RGBColor; 10] = [
     RGBColor(31, 119, 180),
@@ -166,6 +203,7 @@ struct Series {
     points: Vec<(f64, f64)>,
     /// `(x, lower, upper)`: a shaded band under the line.
     band: Vec<(f64, f64, f64)>,
+    style: Style,
 }
 
 /// A line chart: lines, staircases, markers and shaded bands over linear axes, with a
@@ -182,6 +220,8 @@ pub struct Chart {
     legend: Corner,
     colours: Colours,
     series: Vec<Series>,
+    /// [`Chart::style`] was called with no series to apply to (refused by `save`).
+    orphan_style: bool,
 }
 
 impl Chart {
@@ -197,6 +237,7 @@ impl Chart {
             legend: Corner::UpperLeft,
             colours: Colours::Distinct,
             series: Vec::new(),
+            orphan_style: false,
         }
     }
 
@@ -236,7 +277,19 @@ impl Chart {
             kind,
             points,
             band: Vec::new(),
+            style: Style::default(),
         });
+        self
+    }
+
+    /// Draws the series added last with `style` (a fixed colour, a dashed line):
+    /// `chart.line("paper", &points).style(Style::new().dashed())`. Called before any
+    /// series, [`Chart::save`] refuses the chart.
+    pub fn style(mut self, style: Style) -> Self {
+        match self.series.last_mut() {
+            Some(series) => series.style = style,
+            None => self.orphan_style = true,
+        }
         self
     }
 
@@ -266,13 +319,19 @@ impl Chart {
         chart
     }
 
-    fn colour(&self, k: usize) -> RGBColor {
+    /// The colour of series `index`: its own, or its turn among the series without one.
+    fn colour(&self, index: usize) -> RGBColor {
+        if let Some(colour) = self.series[index].style.colour {
+            return colour;
+        }
+        let auto = |s: &&Series| s.style.colour.is_none();
+        let k = self.series[..index].iter().filter(auto).count();
         match self.colours {
             Colours::Distinct => DISTINCT[k % DISTINCT.len()],
             Colours::Ordered => {
                 // Blue, grey, red: every step visible on white (the diverging palette's
                 // middle is white).
-                let n = self.series.len().max(2) - 1;
+                let n = self.series.iter().filter(auto).count().max(2) - 1;
                 let t = k as f64 / n as f64;
                 gradient([[33.0, 102.0, 172.0], [110.0; 3], [178.0, 24.0, 43.0]], t)
             }
@@ -283,9 +342,29 @@ impl Chart {
     ///
     /// # Errors
     /// [`Error::Figure`] for another extension, an axis range that is not finite and
-    /// increasing, or a drawing backend that fails (the file cannot be written, ...).
+    /// increasing, a [`Style`] given before any series or a dashed style on markers, or a
+    /// drawing backend that fails (the file cannot be written, ...).
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = path.as_ref();
+        let refuse = |reason: String| Error::Figure {
+            path: Some(path.to_path_buf()),
+            reason,
+        };
+        if self.orphan_style {
+            return Err(refuse(
+                "Chart::style was called before any series: it styles the series added last".into(),
+            ));
+        }
+        if let Some(s) = self
+            .series
+            .iter()
+            .find(|s| s.kind == Kind::Markers && s.style.dashed)
+        {
+            return Err(refuse(format!(
+                "the markers '{}' have a dashed style: dashes apply to lines only",
+                s.label
+            )));
+        }
         let xs = self
             .series
             .iter()
@@ -333,10 +412,20 @@ impl Draw for ChartDrawing<'_> {
             }
             let style = colour.stroke_width(2);
             let markers = s.kind == Kind::Markers;
+            let dashed = s.style.dashed;
             let legend = |annotation: &mut plotters::chart::SeriesAnno<'_, DB>| {
                 let entry = annotation.label(s.label.as_str());
                 if markers {
                     entry.legend(move |(px, py)| Circle::new((px + 11, py), 4, colour.filled()));
+                } else if dashed {
+                    entry.legend(move |(px, py)| {
+                        DashedPathElement::new(
+                            vec![(px, py), (px + 22, py)],
+                            DASH,
+                            GAP,
+                            colour.stroke_width(3),
+                        )
+                    });
                 } else {
                     entry.legend(move |(px, py)| {
                         PathElement::new(vec![(px, py), (px + 22, py)], colour.stroke_width(3))
@@ -366,9 +455,12 @@ impl Draw for ChartDrawing<'_> {
                 } else {
                     run.to_vec()
                 };
-                let annotation = chart
-                    .draw_series(LineSeries::new(line, style))
-                    .map_err(|e| e.to_string())?;
+                let annotation = if dashed {
+                    chart.draw_series(DashedLineSeries::new(line, DASH, GAP, style))
+                } else {
+                    chart.draw_series(LineSeries::new(line, style))
+                }
+                .map_err(|e| e.to_string())?;
                 if r == 0 && !s.label.is_empty() {
                     legend(annotation);
                     labelled = true;

@@ -8,7 +8,7 @@
 
 use precursors::output::{RunTables, CONTACT_MAP_STEP};
 use precursors::plot::figures::{draw, Format};
-use precursors::plot::{Chart, Corner, Map, Palette};
+use precursors::plot::{Chart, Corner, Map, Palette, Style};
 use precursors::{Drive, Error, Event, Lateral, Scene};
 use std::path::{Path, PathBuf};
 
@@ -222,6 +222,67 @@ fn a_chart_draws_its_series_and_its_text() {
             "{label} not in the SVG's text: {texts:?}"
         );
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A fixed colour replaces the chart's colouring for its series only, and a dashed line
+/// leaves gaps: counted on a horizontal line's pixel row.
+#[test]
+fn a_styled_series_has_its_colour_and_its_dashes() {
+    let dir = scratch("styles");
+    let flat = |y: f64| vec![(0.0, y), (1.0, y)];
+    let path = dir.join("styles.png");
+    Chart::new("", "x", "y")
+        .x_range(0.0, 1.0)
+        .y_range(0.0, 1.0)
+        .line("reference", &flat(0.25))
+        .style(Style::new().colour(120, 120, 120).dashed())
+        .line("solid", &flat(0.75))
+        .save(&path)
+        .unwrap();
+    let (pixels, w, h) = decode(&path);
+    let at = |x: u32, y: u32| {
+        let i = 3 * (y * w + x) as usize;
+        [pixels[i], pixels[i + 1], pixels[i + 2]]
+    };
+    // The row (and the one below: 2 px lines) holding most pixels of a colour, and how
+    // many of that row's pixels have it.
+    let best_row = |rgb: [u8; 3]| {
+        (0..h - 1)
+            .map(|y| {
+                (0..w)
+                    .filter(|&x| at(x, y) == rgb || at(x, y + 1) == rgb)
+                    .count()
+            })
+            .max()
+            .unwrap()
+    };
+    let grey = best_row([120, 120, 120]);
+    // The second series, the first without a fixed colour, takes the first colour of
+    // the chart's turn (Tableau blue), not the second (red).
+    let blue = best_row([31, 119, 180]);
+    assert_eq!(best_row([214, 39, 40]), 0);
+    // The plotting area is about 700 px wide: the solid line covers it, the dashed line
+    // (9 px dashes, 6 px gaps) about 60 % of it, plus the legend's samples.
+    assert!(blue > 600, "solid line: {blue} px");
+    assert!(grey > 300 && grey < 500, "dashed line: {grey} px");
+    // Styles that cannot apply are refused.
+    let e = Chart::new("t", "x", "y")
+        .style(Style::new().dashed())
+        .line("a", &flat(0.5))
+        .save(dir.join("orphan.png"))
+        .unwrap_err();
+    assert!(matches!(e, Error::Figure { .. }), "{e:?}");
+    assert!(e.to_string().contains("before any series"), "{e}");
+    let e = Chart::new("t", "x", "y")
+        .markers("m", &flat(0.5))
+        .style(Style::new().dashed())
+        .save(dir.join("markers.png"))
+        .unwrap_err();
+    assert!(
+        e.to_string().contains("markers 'm' have a dashed style"),
+        "{e}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
