@@ -52,22 +52,24 @@ fn run() -> report::Outcome {
             (e.value - reference).abs()
         );
     }
-    let grid = Grid::new(block, 140, 7)?;
-    let tight = InfluencePlan::builder(grid).tolerance(1e-10).build()?;
-    println!("\noperator_build_140x7 (reference: tolerance 1e-10)");
-    println!("| tolerance (relative) | max estimate | max achieved relative error |");
-    for tol in [1e-3, 1e-6, 1e-9] {
-        let plan = InfluencePlan::builder(grid).tolerance(tol).build()?;
-        let mut worst: f64 = 0.0;
-        for m in 0..grid.ny() {
-            for p in 0..grid.nx() {
-                let (a, b) = (plan.lambda(p, m).unwrap(), tight.lambda(p, m).unwrap());
-                worst = worst.max((a - b).abs() / b);
-            }
-        }
+    // The operator's eigenvalues cost the same at every tolerance (docs/accuracy.md); their
+    // achieved accuracy is checked against the alias sums summed term by term in
+    // tests/operator.rs.
+    println!("\noperator_build (default tolerance)");
+    println!("| grid | max error estimate (relative) | build time |");
+    println!("|---|---|---|");
+    for (lx, ly, nx, ny) in [
+        (0.14, 0.007, 140, 7),
+        (0.2, 0.05, 200, 50),
+        (1.0, 0.1, 1000, 100),
+    ] {
+        let grid = Grid::new(Block::new(lx, ly, block.lz())?, nx, ny)?;
+        let started = std::time::Instant::now();
+        let plan = InfluencePlan::builder(grid).build()?;
         println!(
-            "| {tol:e} | {:.1e} | {worst:.1e} |",
-            plan.max_relative_error()
+            "| {nx} x {ny} | {:.1e} | {:.1} ms |",
+            plan.max_relative_error(),
+            started.elapsed().as_secs_f64() * 1e3
         );
     }
     Ok(())

@@ -7,9 +7,9 @@ use std::sync::{Arc, Mutex};
 
 /// Plans influence operators once per grid and tolerance and hands out shared clones.
 ///
-/// Planning a grid costs `O(N)` alias sums (78 ms for the paper's 140 x 7 calibration
-/// grid, seconds at `N = 1e5`); every scene, solver and probe of one geometry can share
-/// one plan. A `Planner` is cheap to clone (clones share the cache) and may be used from
+/// Planning a grid costs `O(N)` work (its eigenvalues and DCT plans: milliseconds for the
+/// paper's 140 x 7 calibration grid, a fraction of a second at `N = 1e5`,
+/// docs/accuracy.md); every scene, solver and probe of one geometry can share one plan. A `Planner` is cheap to clone (clones share the cache) and may be used from
 /// several threads. Plans stay cached while the planner lives.
 ///
 /// ```
