@@ -61,8 +61,8 @@ fn depth_images(s: f64, lz: f64) -> f64 {
     }
 }
 
-/// Gauss–Legendre panels of the integral over `s` (half-width of a cell, in cells) and the
-/// two orders whose difference is the error estimate.
+/// Panels of the integral over `s` (m, the width of the Gaussians) and the two
+/// Gauss–Legendre orders whose difference is the error estimate.
 const FINE_PANELS: usize = 9;
 const HIGH_ORDER: usize = 20;
 const LOW_ORDER: usize = 17;
@@ -164,8 +164,8 @@ impl AxisMode {
         for &s in nodes {
             let sigma = 2.0 * s / cell;
             let x0 = w0 * (-(k0 * s).powi(2)).exp();
-            // Σ_{q≠0}: directly where the Gaussians are narrow (|θ + qπ| ≥ π/2, so
-            // |q| ≤ 4 reaches e^{-(σ·3.5π)²} < 1e-50 for σ ≥ 1); for σ < 1 from
+            // Σ_{q≠0}: directly where the Gaussians are narrow (σ ≥ 1: the first alias
+            // left out, |q| = 5, has |θ + qπ| ≥ 4.5π, e^{-(4.5π)²} < 1e-80); for σ < 1 from
             // X = sin²θ Σ_q e^{-σ²u_q²}/u_q² = 1 - sin²θ ∫_0^{σ²} Θ(t) dt (Σ_q 1/u_q² =
             // 1/sin²θ), with Poisson's dual Θ(t) = (1 + 2Σ_n e^{-n²/t} cos 2nθ)/√(πt),
             // integrated in closed form (n ≤ 8: e^{-81/σ²} < 1e-35).
