@@ -1,4 +1,4 @@
-//! What a grid costs: the time to build its scene (the plan's `O(N)` alias sums and the
+//! What a grid costs: the time to build its scene (the plan's `O(N)` eigenvalues and the
 //! rod load table), the time of its first equilibrium (cold normal and tangential
 //! solves) and the process's peak memory, for `Nx x Ny` cells of 1 mm, `Lz = 75 mm`,
 //! 3.5 MPa normal pressure, rod drive, seed 1, one thread. The numbers behind

@@ -6,9 +6,9 @@ use crate::solver::AUTO_DENSE_LIMIT;
 
 /// Default limit on the cells of a plan or scene ([`InfluencePlanBuilder::max_cells`],
 /// [`crate::SceneBuilder::max_cells`]): `1e6`, ten times the largest run documented
-/// (`N = 1e5`, 1000 x 100). At the limit a scene needs about 240 MB, 80 s to plan and
+/// (`N = 1e5`, 1000 x 100). At the limit a scene needs about 240 MB, 1.5 s to plan and
 /// 28 s per cold equilibrium ([`GridCost`]); 10000 x 10000 cells would need about 24 GB,
-/// 2.2 h to plan and hours per equilibrium.
+/// minutes to plan and hours per equilibrium.
 ///
 /// [`InfluencePlanBuilder::max_cells`]: super::InfluencePlanBuilder::max_cells
 pub const DEFAULT_MAX_CELLS: usize = 1_000_000;
@@ -19,7 +19,7 @@ const BYTES_PER_CELL: f64 = 240.0;
 /// Bytes per entry of the dense backend's `N x N` matrices (the operator and its factor).
 const DENSE_BYTES_PER_ENTRY: f64 = 16.0;
 /// Planning time per cell (s, one thread, release build), measured.
-const PLAN_SECONDS_PER_CELL: f64 = 80e-6;
+const PLAN_SECONDS_PER_CELL: f64 = 1.5e-6;
 /// One cold equilibrium (normal and tangential) takes `SOLVE_SECONDS · N^SOLVE_EXPONENT`
 /// (s, one thread, release build), fitted to N = 1e4, 1e5 and 4e5.
 const SOLVE_SECONDS: f64 = 1.1e-7;
@@ -36,7 +36,7 @@ const SOLVE_EXPONENT: f64 = 1.4;
 /// ```
 /// use precursors::GridCost;
 /// let cost = GridCost::of(10_000, 10_000);
-/// assert!(cost.memory_bytes > 1e10 && cost.plan_seconds > 1000.0);
+/// assert!(cost.memory_bytes > 1e10 && cost.solve_seconds > 3600.0);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
@@ -46,7 +46,7 @@ pub struct GridCost {
     /// Peak memory of a scene and its driver (bytes): 240 B per cell, plus the two
     /// `N x N` matrices of the dense backend when [`crate::Backend::Auto`] picks it.
     pub memory_bytes: f64,
-    /// Time to plan the operator at the default plan tolerance `1e-8` (s): 80 µs per cell.
+    /// Time to plan the operator (s): 1.5 µs per cell.
     pub plan_seconds: f64,
     /// Time of one cold normal and tangential equilibrium (s): `1.1e-7 · N^1.4`.
     pub solve_seconds: f64,
@@ -145,7 +145,7 @@ mod tests {
         ));
         let text = e.to_string();
         assert!(
-            text.contains("24.000 GB") && text.contains("2.222 h"),
+            text.contains("24.000 GB") && text.contains("2.500 min"),
             "{text}"
         );
         // Nx·Ny overflowing usize is still reported exactly.
