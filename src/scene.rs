@@ -447,8 +447,9 @@ impl SceneBuilder {
     }
 
     /// The largest relative error accepted on the influence operator's eigenvalues
-    /// (dimensionless, default `1e-8`, as [`crate::green::InfluencePlanBuilder::tolerance`]): they are
-    /// computed to about 1e-13 whatever it is (`docs/accuracy.md`). The lateral load
+    /// (dimensionless, default `1e-8`, as
+    /// [`crate::green::InfluencePlanBuilder::tolerance`]): they are computed to about
+    /// 1e-13 whatever it is (`docs/accuracy.md`). The lateral load
     /// table is always summed to `1e-12` relative (closed forms, cheap).
     pub fn plan_tolerance(mut self, tolerance: f64) -> Self {
         self.plan_tolerance = tolerance;

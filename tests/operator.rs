@@ -292,6 +292,7 @@ fn eigenvalues_match_the_alias_sum_and_their_estimates_are_small() {
         .build()
         .unwrap_err();
     assert!(matches!(e, precursors::Error::NotConverged { .. }), "{e:?}");
+    assert!(e.to_string().contains("about 1e-13 at best"), "{e}");
 }
 
 #[test]

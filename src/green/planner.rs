@@ -9,8 +9,9 @@ use std::sync::{Arc, Mutex};
 ///
 /// Planning a grid costs `O(N)` work (its eigenvalues and DCT plans: milliseconds for the
 /// paper's 140 x 7 calibration grid, a fraction of a second at `N = 1e5`,
-/// docs/accuracy.md); every scene, solver and probe of one geometry can share one plan. A `Planner` is cheap to clone (clones share the cache) and may be used from
-/// several threads. Plans stay cached while the planner lives.
+/// docs/accuracy.md); every scene, solver and probe of one geometry can share one plan.
+/// A `Planner` is cheap to clone (clones share the cache) and may be used from several
+/// threads. Plans stay cached while the planner lives.
 ///
 /// ```
 /// use precursors::{green::Planner, Scene};

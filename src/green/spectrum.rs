@@ -213,8 +213,9 @@ impl AxisMode {
 /// `e^{-π² s²/Δ²}` and is integrated by composite Gauss–Legendre. The 1-D sums are
 /// tabulated per mode and shared by every eigenvalue: `O(N)` work. Error estimate: the
 /// difference of two quadrature orders plus rounding; the values agree with alias boxes
-/// of half-width 4096 to about 1e-13 (docs/accuracy.md).
-pub(super) fn eigenvalues(grid: &Grid) -> (Vec<f64>, Vec<f64>) {
+/// of half-width 4096 to about 1e-13 (docs/accuracy.md). Also returns the number of
+/// quadrature nodes per eigenvalue.
+pub(super) fn eigenvalues(grid: &Grid) -> (Vec<f64>, Vec<f64>, usize) {
     let b = grid.block();
     let lz = b.lz();
     let (dx, dy) = (grid.dx(), grid.dy());
@@ -257,5 +258,5 @@ pub(super) fn eigenvalues(grid: &Grid) -> (Vec<f64>, Vec<f64>) {
             errors.push(scale * error);
         }
     }
-    (lambda, errors)
+    (lambda, errors, nodes.len())
 }
