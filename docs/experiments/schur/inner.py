@@ -6,12 +6,11 @@ Usage: python3 inner.py NX NY SCALE   (SCALE = cell area / (E/(1+nu)), printed b
 Needs numpy and scipy (pip install numpy scipy).
 """
 import numpy as np, sys
+from common import load
 nx, ny, scale = int(sys.argv[1]), int(sys.argv[2]), float(sys.argv[3])
 n = nx*ny
-G = np.fromfile('/tmp/proto/g.bin').reshape(n, n)
-d = np.fromfile('/tmp/proto/d.bin'); att = np.fromfile('/tmp/proto/att.bin') > 0.5
+C, d, att = load(nx, ny, scale)
 S = np.where(att)[0]; H = np.where(~att)[0]
-C = scale*G; del G
 dbar = d[S].mean()
 W = np.linalg.inv(C + dbar*np.eye(n)); del C
 Whh = W[np.ix_(H,H)]

@@ -6,12 +6,11 @@ Usage: python3 outer.py NX NY SCALE   (SCALE = cell area / (E/(1+nu)), printed b
 Needs numpy and scipy (pip install numpy scipy).
 """
 import numpy as np, sys
+from common import load, fsai
 nx, ny, scale = int(sys.argv[1]), int(sys.argv[2]), float(sys.argv[3])
 n = nx*ny
-G = np.fromfile('/tmp/proto/g.bin').reshape(n, n)
-d = np.fromfile('/tmp/proto/d.bin'); att = np.fromfile('/tmp/proto/att.bin') > 0.5
+C, d, att = load(nx, ny, scale)
 S = np.where(att)[0]; H = np.where(~att)[0]
-C = scale*G
 A = C[np.ix_(S,S)] + np.diag(d[S])
 dbar = d[S].mean()
 W = np.linalg.inv(C + dbar*np.eye(n))
@@ -35,16 +34,8 @@ def jacobi_sweeps(k):
     return solve
 res = {}
 res['jacobi'] = pcg(A, b, lambda r: jac*r)
-# FSAI as in src/solver/fsai.rs (radius 1): row i of G on the attached sites j <= i within
-# one cell, A[P,P] g = e_i, scaled by 1/sqrt(g_i); M^-1 = G^T G.
-ixs, iys = S % nx, S // nx
-Gf = np.zeros((len(S), len(S)))
-pos = {s: k for k, s in enumerate(S)}
-for k, i in enumerate(S):
-    P = [pos[j] for j in S[max(0, k - 2*nx - 2):k+1] if j <= i and abs(j % nx - i % nx) <= 1 and abs(j // nx - i // nx) <= 1]
-    e = np.zeros(len(P)); e[P.index(k)] = 1.0
-    g = np.linalg.solve(A[np.ix_(P, P)], e)
-    Gf[k, P] = g / np.sqrt(g[P.index(k)])
+# FSAI as in src/solver/fsai.rs (common.fsai).
+Gf = fsai(S, A, nx)
 res['FSAI radius 1 (as the crate)'] = pcg(A, b, lambda r: Gf.T @ (Gf @ r))
 res['restricted spectral W_SS'] = pcg(A, b, lambda r: Wss@r)
 res['schur exact W_HH^-1'] = pcg(A, b, lambda r: schur_exact@r)
