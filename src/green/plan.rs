@@ -17,7 +17,6 @@
 
 use super::dct::{cosine_table, Dct2d};
 use super::spectrum::eigenvalues;
-use super::transfer::PlaneTransfer;
 use crate::error::{check_slice, check_tolerance, Error, Result};
 use crate::geometry::Grid;
 use std::sync::Arc;
@@ -327,15 +326,5 @@ impl InfluencePlan {
             }
         }
         Ok(g)
-    }
-
-    /// The transfer of bottom tractions to the plane at height `z` (m), with the alias
-    /// sums converged to absolute tolerance `tol` (the factors are at most 1).
-    ///
-    /// # Errors
-    /// [`Error::InvalidTolerance`],
-    /// [`Error::OutsideBlock`] for `z` outside `[0, Lz]`, [`Error::NotConverged`].
-    pub fn plane_transfer(&self, z: f64, tol: f64) -> Result<PlaneTransfer> {
-        PlaneTransfer::new(self, z, tol)
     }
 }

@@ -40,8 +40,21 @@ fn transfer(kappa: f64, z: f64, lz: f64) -> f64 {
     ((-kappa * z).exp() - (-kappa * (2.0 * lz - z)).exp()) / (-(-2.0 * kappa * lz).exp_m1())
 }
 
+// Defined here, not in plan.rs: the plan knows nothing of the transfers built on it.
+impl InfluencePlan {
+    /// The transfer of bottom tractions to the plane at height `z` (m), with the alias
+    /// sums converged to absolute tolerance `tol` (the factors are at most 1).
+    ///
+    /// # Errors
+    /// [`Error::InvalidTolerance`],
+    /// [`Error::OutsideBlock`] for `z` outside `[0, Lz]`, [`Error::NotConverged`].
+    pub fn plane_transfer(&self, z: f64, tol: f64) -> Result<PlaneTransfer> {
+        PlaneTransfer::new(self, z, tol)
+    }
+}
+
 impl PlaneTransfer {
-    pub(super) fn new(plan: &InfluencePlan, z: f64, tol: f64) -> Result<Self> {
+    fn new(plan: &InfluencePlan, z: f64, tol: f64) -> Result<Self> {
         let grid = *plan.grid();
         let lz = grid.block().lz();
         let z = grid.block().check_height(z)?;

@@ -15,7 +15,7 @@
 //! The solution, hence the final attached set, is unique whatever order sites flip in.
 
 use super::options::{NormalEquilibrium, SolveReport};
-use super::spectral::SetProblem;
+use super::set::SetProblem;
 use super::{EquilibriumSolver, SolveKind};
 use crate::error::{Error, Result};
 use crate::interface::{Interface, SiteState};

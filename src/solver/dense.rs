@@ -9,8 +9,9 @@
 //! from the last response (the spectral backend's path) costs less than keeping a second
 //! factor up to date (docs/performance.md, "The cost of one event").
 
-use super::spectral::{Effort, SetProblem, SetSolve, SpectralCore};
-use super::system::Preconditioner;
+use super::set::{Effort, SetProblem, SetSolve};
+use super::spectral::SpectralCore;
+use super::system::{ExactInverse, Preconditioner};
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt;
@@ -368,7 +369,7 @@ impl DenseCore {
             work: Mutex::new(Mat::zeros(perm.len(), 1)),
             perm,
         };
-        let solved = spectral.solve_with(problem, Preconditioner::Factor(factor), f, effort)?;
+        let solved = spectral.solve_with(problem, Preconditioner::Factor(&factor), f, effort)?;
         // How many iterations the factor needed (a stale factor is replaced).
         cache.last_iterations = solved.outcome.iterations;
         Ok(solved)
@@ -376,15 +377,15 @@ impl DenseCore {
 }
 
 /// `z = (L D Lᵀ)⁻¹ r` with the cached factor, in the factor's site order.
-pub(crate) struct FactorSolve<'a> {
+struct FactorSolve<'a> {
     cache: &'a FactorCache,
     /// Positions in the set of the factor's sites.
     perm: Vec<usize>,
     work: Mutex<Mat<f64>>,
 }
 
-impl FactorSolve<'_> {
-    pub(crate) fn solve(&self, r: &[f64], z: &mut [f64]) {
+impl ExactInverse for FactorSolve<'_> {
+    fn solve(&self, r: &[f64], z: &mut [f64]) {
         let mut work = self.work.lock().unwrap_or_else(|e| e.into_inner());
         for (a, &p) in self.perm.iter().enumerate() {
             work[(a, 0)] = r[p];

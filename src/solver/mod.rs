@@ -34,6 +34,7 @@ mod fsai;
 mod options;
 mod parallel;
 mod pcg;
+mod set;
 mod spectral;
 mod system;
 mod tangential;
@@ -48,7 +49,8 @@ use crate::geometry::Grid;
 use crate::green::{InfluencePlan, Partition};
 use crate::interface::{Interface, Material};
 use dense::{DenseCore, FactorState};
-use spectral::{Effort, Precond, SetProblem, SetSolve, SpectralCore};
+use set::{Effort, SetProblem, SetSolve};
+use spectral::{Precond, SpectralCore};
 use system::Compliance;
 
 /// Backward error of the linear solves while a cold attached set is explored.

@@ -3,8 +3,8 @@
 //! no `N x N` matrix is ever formed. The dense backend uses the same product.
 
 use super::fsai::{Entries, Fsai};
-use super::parallel::Parallelism;
-use super::pcg::{projected_pcg, PcgOutcome, PcgSettings, PcgVectors};
+use super::pcg::{projected_pcg, PcgVectors};
+use super::set::{Effort, SetProblem, SetSolve};
 use super::system::{Compliance, FsaiBuffers, Preconditioner, StagedSystem};
 use crate::error::Result;
 use crate::green::{InfluencePlan, Partition, SpectralTable, Staging};
@@ -36,42 +36,6 @@ pub(crate) enum Precond {
     Spectral,
     /// The factorised sparse approximate inverse ([`Fsai`], cached between solves).
     Fsai,
-}
-
-/// One equality-constrained solve on a set: the tractions, how it went, and `C_s f` on
-/// every cell (from the solve's last product).
-pub(crate) struct SetSolve {
-    pub f: Vec<f64>,
-    pub outcome: PcgOutcome,
-    pub grid_product: Vec<f64>,
-}
-
-/// A set problem: `(C_SS + diag(d)) f + U 1 = b`, `Σ f = total` on the sites `set`.
-#[derive(Clone, Copy)]
-pub(crate) struct SetProblem<'a> {
-    pub set: &'a [usize],
-    pub d: &'a [f64],
-    pub b: &'a [f64],
-    pub total: f64,
-}
-
-/// How to solve: tolerance, iterations, threads.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Effort {
-    pub tolerance: f64,
-    pub max_iterations: usize,
-    pub parallelism: Parallelism,
-}
-
-impl Effort {
-    fn settings(&self, total: f64) -> PcgSettings {
-        PcgSettings {
-            total,
-            tolerance: self.tolerance,
-            max_iterations: self.max_iterations,
-            parallelism: self.parallelism,
-        }
-    }
 }
 
 /// Buffers and preconditioners of the spectral product, kept between solves.

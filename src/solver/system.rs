@@ -2,7 +2,6 @@
 //! `C_s = scale (Ĝ - shift 11ᵀ)` applied through the plan's staged product (part by
 //! part, [`crate::green::Staging`]) and one of the preconditioners.
 
-use super::dense::FactorSolve;
 use super::fsai::Fsai;
 use super::pcg::{sum, SetSystem};
 use crate::green::{Partition, SpectralTable, Staging};
@@ -25,7 +24,14 @@ pub(crate) enum Preconditioner<'a> {
         table: &'a SpectralTable,
     },
     /// The dense backend's LDLᵀ factor (a system of one part).
-    Factor(FactorSolve<'a>),
+    Factor(&'a (dyn ExactInverse + Sync)),
+}
+
+/// `z = A_SS⁻¹ r` by a factor of the set's matrix (the dense backend's): a preconditioner
+/// defined here and implemented by the backend, so the system does not depend on it.
+pub(crate) trait ExactInverse {
+    /// `z = A⁻¹ r` on the whole set.
+    fn solve(&self, r: &[f64], z: &mut [f64]);
 }
 
 /// `A = C_SS + diag(d)` on `set` (ascending sites), part by part.

@@ -2,7 +2,7 @@
 //! set (linear in the load).
 
 use super::options::{SolveReport, TangentialResponse};
-use super::spectral::SetProblem;
+use super::set::SetProblem;
 use super::{EquilibriumSolver, SolveKind};
 use crate::error::{check_slice, Error, Result};
 use crate::interface::{Interface, SiteState};
