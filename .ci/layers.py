@@ -1,0 +1,140 @@
+#!/usr/bin/env python3
+"""Fails when a module of the crate imports from a layer above its own, or when the files
+of one module import each other in a circle (docs/architecture.md, "Layers").
+
+The layer table below is the one truth of the crate's layering: a module may use only
+modules of a strictly lower layer. Imports are read as text (`crate::name` anywhere in a
+file's code, comments stripped; `super::sibling::` inside a module's own files), which is how the crate spells every one of them.
+"""
+import os
+import re
+import sys
+
+# Bottom to top. A module may import only from rows above its own.
+LAYERS = [
+    ["error"],
+    ["geometry"],
+    ["green"],
+    ["interface"],
+    ["solver"],
+    ["probe"],
+    ["scene"],
+    ["driver"],
+    ["calibration", "output", "matrix"],
+    ["sweep"],
+    ["plot"],
+]
+RANK = {name: rank for rank, row in enumerate(LAYERS) for name in row}
+
+
+def code(path):
+    """The file's text without comments, string and char literals (one pass, so a `//`
+    inside a string or a quote inside a comment cannot confuse it)."""
+    text = open(path, encoding="utf-8").read()
+    out, i, n = [], 0, len(text)
+    while i < n:
+        c = text[i]
+        if text.startswith("//", i):
+            i = text.find("\n", i)
+            i = n if i < 0 else i
+        elif text.startswith("/*", i):
+            j = text.find("*/", i + 2)
+            i = n if j < 0 else j + 2
+        elif c == "r" and re.match(r'r#*"', text[i:]) and not (i and (text[i - 1].isalnum() or text[i - 1] == "_")):
+            hashes = re.match(r'r(#*)"', text[i:]).group(1)
+            j = text.find('"' + hashes, i + len(hashes) + 2)
+            i = n if j < 0 else j + 1 + len(hashes)
+            out.append('""')
+        elif c == '"':
+            j = i + 1
+            while j < n and text[j] != '"':
+                j += 2 if text[j] == "\\" else 1
+            i = j + 1
+            out.append('""')
+        elif c == "'" and re.match(r"'(\\.|[^\\'])'", text[i:i + 4]):
+            i += len(re.match(r"'(\\.|[^\\'])'", text[i:i + 4]).group(0))
+        else:
+            out.append(c)
+            i += 1
+    return "".join(out)
+
+
+def module_of(rel):
+    first = rel.split(os.sep)[0]
+    return first[:-3] if first.endswith(".rs") else first
+
+
+def files():
+    for root, _, names in os.walk("src"):
+        for name in sorted(names):
+            if name.endswith(".rs"):
+                path = os.path.join(root, name)
+                rel = os.path.relpath(path, "src")
+                if rel in ("lib.rs",) or rel.startswith("bin" + os.sep):
+                    continue  # the root re-exports; the program sits above everything
+                yield path, rel
+
+
+def main():
+    os.chdir(os.path.join(os.path.dirname(__file__), ".."))
+    problems = []
+    # 1. Module layers.
+    for path, rel in files():
+        mod = module_of(rel)
+        if mod not in RANK:
+            problems.append(f"{path}: module `{mod}` is not in the layer table of .ci/layers.py")
+            continue
+        for used in sorted(set(re.findall(r"\bcrate::([a-z_]+)", code(path)))):
+            if used == mod or used not in RANK:
+                continue
+            if RANK[used] >= RANK[mod]:
+                problems.append(
+                    f"{path}: `{mod}` (layer {RANK[mod]}) imports `crate::{used}` "
+                    f"(layer {RANK[used]}): only lower layers may be imported"
+                )
+    # 2. No circle among the sibling files of one module (`super::x::`). A parent file
+    #    (`mod.rs`, `scene.rs`) and its children may use each other: the parent holds the
+    #    type, the children its methods.
+    graph = {}
+    for path, rel in files():
+        parts = rel[:-3].split(os.sep)
+        if len(parts) == 1:
+            continue
+        node = rel[:-3]
+        parent = os.sep.join(parts[:-1])
+        siblings = {
+            f[:-3]
+            for f in os.listdir(os.path.join("src", parent))
+            if f.endswith(".rs") and f != "mod.rs"
+        }
+        text = code(path)
+        targets = set()
+        for name in re.findall(r"\bsuper::([a-z_]+)::", text):
+            if name in siblings:
+                targets.add(os.path.join(parent, name))
+        graph.setdefault(node, set()).update(t for t in targets if t != node)
+    state = {}
+
+    def visit(node, stack):
+        state[node] = 1
+        stack.append(node)
+        for nxt in sorted(graph.get(node, ())):
+            if state.get(nxt) == 1:
+                cycle = stack[stack.index(nxt):] + [nxt]
+                problems.append("circle among files: " + " -> ".join(cycle))
+            elif nxt not in state:
+                visit(nxt, stack)
+        stack.pop()
+        state[node] = 2
+
+    for node in sorted(graph):
+        if node not in state:
+            visit(node, [])
+    if problems:
+        print("\n".join(problems))
+        sys.exit(1)
+    print(f"layers: {len(RANK)} modules in {len(LAYERS)} layers, no upward import, no circle")
+
+
+if __name__ == "__main__":
+    main()
