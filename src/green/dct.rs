@@ -6,7 +6,6 @@
 use rustdct::num_complex::Complex;
 use rustdct::rustfft::{Fft, FftPlanner};
 use rustdct::{DctPlanner, TransformType2And3};
-use std::cell::RefCell;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -102,15 +101,6 @@ pub(crate) struct Dct2d {
     columns_matmul: Option<ColumnMatrices>,
 }
 
-/// Complex buffers of [`PairDct`]: the lines' data and the FFT's scratch.
-type PairBuffers = (Vec<Complex<f64>>, Vec<Complex<f64>>);
-
-thread_local! {
-    /// Complex scratch of [`PairDct`] (one per thread: the plan is shared between clones).
-    static PAIR_SCRATCH: RefCell<PairBuffers> =
-        const { RefCell::new((Vec::new(), Vec::new())) };
-}
-
 /// Unnormalised DCT-II / DCT-III of even length `n` on two real lines at once, through
 /// one complex FFT of length `n` (Makhoul's reordering; line `a` in the real part, line
 /// `b` in the imaginary part). Why: rustdct runs a full complex FFT per real line, so
@@ -139,10 +129,38 @@ impl PairDct {
         }
     }
 
-    fn scratch_len(&self) -> usize {
+    fn fft_scratch_len(&self) -> usize {
         self.forward
             .get_inplace_scratch_len()
             .max(self.inverse.get_inplace_scratch_len())
+    }
+
+    /// Scratch (f64 values) of [`PairDct::dct2`] and [`PairDct::dct3`] on `lines` lines of
+    /// stride `step`: the lines' complex data, the FFT's complex scratch, and copies of a
+    /// strided pair.
+    fn scratch_len(&self, lines: usize, step: usize) -> usize {
+        let copies = if step == 1 { 0 } else { 2 * self.n };
+        lines * self.n + 2 * self.fft_scratch_len() + copies
+    }
+
+    /// `scratch` cut into the lines' complex data, the FFT's complex scratch and the copies
+    /// (the complex parts viewed in place: no allocation per transform).
+    fn split<'a>(
+        &self,
+        scratch: &'a mut [f64],
+        lines: usize,
+    ) -> (
+        &'a mut [Complex<f64>],
+        &'a mut [Complex<f64>],
+        &'a mut [f64],
+    ) {
+        let (z, rest) = scratch.split_at_mut(lines * self.n);
+        let (fft, copies) = rest.split_at_mut(2 * self.fft_scratch_len());
+        (
+            bytemuck::cast_slice_mut(z),
+            bytemuck::cast_slice_mut(fft),
+            copies,
+        )
     }
 
     /// Runs `body` on line pair `c` (lines `2c` and `2c+1`, element `j` of line `l` at
@@ -154,7 +172,7 @@ impl PairDct {
         line: usize,
         step: usize,
         c: usize,
-        copies: &mut Vec<f64>,
+        copies: &mut [f64],
         body: impl FnOnce(&mut [f64], &mut [f64]),
     ) {
         let n = self.n;
@@ -163,8 +181,7 @@ impl PairDct {
             body(&mut a[..n], &mut b[..n]);
             return;
         }
-        copies.resize(2 * n, 0.0);
-        let (a, b) = copies.split_at_mut(n);
+        let (a, b) = copies[..2 * n].split_at_mut(n);
         let (sa, sb) = (2 * c * line, (2 * c + 1) * line);
         for j in 0..n {
             a[j] = data[sa + j * step];
@@ -177,23 +194,15 @@ impl PairDct {
         }
     }
 
-    /// DCT-II of every line (`lines` even) in place.
-    fn dct2(
-        &self,
-        data: &mut [f64],
-        lines: usize,
-        line: usize,
-        step: usize,
-        z: &mut Vec<Complex<f64>>,
-        scratch: &mut Vec<Complex<f64>>,
-    ) {
+    /// DCT-II of every line (`lines` even) in place; `scratch` holds at least
+    /// [`PairDct::scratch_len`] values.
+    fn dct2(&self, data: &mut [f64], lines: usize, line: usize, step: usize, scratch: &mut [f64]) {
         let n = self.n;
-        z.resize(lines / 2 * n, Complex::new(0.0, 0.0));
-        scratch.resize(self.scratch_len(), Complex::new(0.0, 0.0));
-        let mut copies = Vec::new();
+        // Every value of `z` is written before it is read.
+        let (z, scratch, copies) = self.split(scratch, lines);
         for (c, zc) in z.chunks_exact_mut(n).enumerate() {
             // Makhoul's order: z[j] = (a[2j], b[2j]), z[n-1-j] = (a[2j+1], b[2j+1]).
-            self.with_lines(data, line, step, c, &mut copies, |a, b| {
+            self.with_lines(data, line, step, c, copies, |a, b| {
                 let (lo, hi) = zc.split_at_mut(n / 2);
                 let pairs = a.chunks_exact(2).zip(b.chunks_exact(2));
                 for ((zl, zh), (pa, pb)) in lo.iter_mut().zip(hi.iter_mut().rev()).zip(pairs) {
@@ -207,7 +216,7 @@ impl PairDct {
             // Z(k) = V_a(k) + i V_b(k) with V_a, V_b Hermitian: with Z(k) = X + iY and
             // Z(n-k) = P + iQ, V_a(k) = (X+P + i(Y-Q))/2 and V_b(k) = (Y+Q - i(X-P))/2;
             // the DCT-II is Re(exp(-iπk/(2n)) V(k)). At k = 0: V_a = X, V_b = Y.
-            self.with_lines(data, line, step, c, &mut copies, |a, b| {
+            self.with_lines(data, line, step, c, copies, |a, b| {
                 a[0] = zc[0].re;
                 b[0] = zc[0].im;
                 let twiddles = self.half_cos[1..].iter().zip(&self.half_sin[1..]);
@@ -221,25 +230,16 @@ impl PairDct {
         }
     }
 
-    /// DCT-III of every line (`lines` even) in place.
-    fn dct3(
-        &self,
-        data: &mut [f64],
-        lines: usize,
-        line: usize,
-        step: usize,
-        z: &mut Vec<Complex<f64>>,
-        scratch: &mut Vec<Complex<f64>>,
-    ) {
+    /// DCT-III of every line (`lines` even) in place; `scratch` as for [`PairDct::dct2`].
+    fn dct3(&self, data: &mut [f64], lines: usize, line: usize, step: usize, scratch: &mut [f64]) {
         let n = self.n;
-        z.resize(lines / 2 * n, Complex::new(0.0, 0.0));
-        scratch.resize(self.scratch_len(), Complex::new(0.0, 0.0));
-        let mut copies = Vec::new();
+        // Every value of `z` is written before it is read.
+        let (z, scratch, copies) = self.split(scratch, lines);
         for (c, zc) in z.chunks_exact_mut(n).enumerate() {
             // W(k) = (X(k) - i X(n-k)) exp(iπk/(2n)) / 2 per line (X(n) = 0); the inverse
             // FFT of W_a + i W_b is v_a + i v_b (both real). In real parts, with A = X_a(k),
             // Ā = X_a(n-k) and B, B̄ alike: Re = c(A + B̄) + s(Ā - B), Im = s(A + B̄) + c(B - Ā).
-            self.with_lines(data, line, step, c, &mut copies, |a, b| {
+            self.with_lines(data, line, step, c, copies, |a, b| {
                 zc[0] = Complex::new(self.half_cos[0] * a[0], self.half_cos[0] * b[0]);
                 let twiddles = self.half_cos[1..].iter().zip(&self.half_sin[1..]);
                 let ahead = a[1..].iter().zip(&b[1..]);
@@ -256,7 +256,7 @@ impl PairDct {
         }
         self.inverse.process_with_scratch(z, scratch);
         for (c, zc) in z.chunks_exact(n).enumerate() {
-            self.with_lines(data, line, step, c, &mut copies, |a, b| {
+            self.with_lines(data, line, step, c, copies, |a, b| {
                 let (lo, hi) = zc.split_at(n / 2);
                 let pairs = a.chunks_exact_mut(2).zip(b.chunks_exact_mut(2));
                 for ((zl, zh), (pa, pb)) in lo.iter().zip(hi.iter().rev()).zip(pairs) {
@@ -311,11 +311,46 @@ impl Dct2d {
         }
     }
 
+    /// Scratch (f64 values) of [`Dct2d::filter`] on the whole grid.
+    pub(crate) fn filter_scratch_len(&self) -> usize {
+        self.rows_scratch_len(self.ny)
+            .max(self.columns_scratch_len(self.nx))
+    }
+
+    /// Scratch (f64 values) of [`Dct2d::rows`] on `lines` rows.
+    pub(crate) fn rows_scratch_len(&self, lines: usize) -> usize {
+        let paired = match &self.pairs {
+            Some((px, _)) if lines >= 2 => px.scratch_len(lines & !1, 1),
+            _ => 0,
+        };
+        let single = match &self.pairs {
+            Some(_) if lines.is_multiple_of(2) => 0,
+            _ => self.scratch_len,
+        };
+        paired.max(single)
+    }
+
+    /// Scratch (f64 values) of [`Dct2d::columns`] on a block `width` columns wide.
+    pub(crate) fn columns_scratch_len(&self, width: usize) -> usize {
+        let n = self.ny * width;
+        if self.ny == 1 {
+            0
+        } else if self.columns_matmul.is_some() || self.direct.is_some() {
+            n
+        } else {
+            match &self.pairs {
+                Some((_, py)) if width.is_multiple_of(2) => py.scratch_len(width, width),
+                _ => self.scratch_len + self.ny,
+            }
+        }
+    }
+
     /// In place: forward (unnormalised DCT-II) on both axes, multiply by `diag`, then
-    /// unnormalised DCT-III on both axes. `work` is scratch (resized as needed), so that
-    /// iterative solvers do not allocate per product.
-    pub(crate) fn filter(&self, buf: &mut [f64], diag: &[f64], stride: usize, work: &mut Vec<f64>) {
-        self.rows(buf, true, work);
+    /// unnormalised DCT-III on both axes. `scratch` holds at least
+    /// [`Dct2d::filter_scratch_len`] values (iterative solvers keep theirs: no allocation
+    /// per product).
+    pub(crate) fn filter(&self, buf: &mut [f64], diag: &[f64], stride: usize, scratch: &mut [f64]) {
+        self.rows(buf, true, scratch);
         self.columns(
             buf,
             self.nx,
@@ -323,9 +358,9 @@ impl Dct2d {
                 values: diag,
                 stride,
             },
-            work,
+            scratch,
         );
-        self.rows(buf, false, work);
+        self.rows(buf, false, scratch);
     }
 
     /// Whether [`Dct2d::rows`] and [`Dct2d::columns`] pair their lines (the paired FFT
@@ -337,7 +372,8 @@ impl Dct2d {
     /// Unnormalised DCT-II (`forward`) or DCT-III of every row of `rows`, a whole number
     /// of rows of the grid, in place (on the paired path, an odd last row runs alone:
     /// rounding then depends on where a block of rows starts, fixed by the caller).
-    pub(crate) fn rows(&self, rows: &mut [f64], forward: bool, work: &mut Vec<f64>) {
+    /// `scratch` holds at least [`Dct2d::rows_scratch_len`] values.
+    pub(crate) fn rows(&self, rows: &mut [f64], forward: bool, scratch: &mut [f64]) {
         let nx = self.nx;
         let lines = rows.len() / nx;
         if lines == 0 {
@@ -349,23 +385,18 @@ impl Dct2d {
             let paired = lines & !1;
             let (head, tail) = single.split_at_mut(paired * nx);
             if paired > 0 {
-                PAIR_SCRATCH.with_borrow_mut(|(z, scratch)| {
-                    if forward {
-                        px.dct2(head, paired, nx, 1, z, scratch);
-                    } else {
-                        px.dct3(head, paired, nx, 1, z, scratch);
-                    }
-                });
+                if forward {
+                    px.dct2(head, paired, nx, 1, scratch);
+                } else {
+                    px.dct3(head, paired, nx, 1, scratch);
+                }
             }
             single = tail;
         }
         if single.is_empty() {
             return;
         }
-        if work.len() < self.scratch_len {
-            work.resize(self.scratch_len, 0.0);
-        }
-        let scratch = &mut work[..self.scratch_len];
+        let scratch = &mut scratch[..self.scratch_len];
         for row in single.chunks_exact_mut(nx) {
             if forward {
                 self.x.process_dct2_with_scratch(row, scratch);
@@ -376,13 +407,14 @@ impl Dct2d {
     }
 
     /// `block ← DCT-III_y (diag ⊙ DCT-II_y block)` on a row-major `Ny x width` block of
-    /// columns (`diag` the same block of the table), in place.
+    /// columns (`diag` the same block of the table), in place; `scratch` holds at least
+    /// [`Dct2d::columns_scratch_len`] values.
     pub(crate) fn columns(
         &self,
         block: &mut [f64],
         width: usize,
         diag: Diag<'_>,
-        work: &mut Vec<f64>,
+        scratch: &mut [f64],
     ) {
         let ny = self.ny;
         let n = ny * width;
@@ -392,17 +424,11 @@ impl Dct2d {
             return;
         }
         if let Some(columns) = &self.columns_matmul {
-            if work.len() < n {
-                work.resize(n, 0.0);
-            }
-            columns.filter(block, width, diag, work);
+            columns.filter(block, width, diag, scratch);
             return;
         }
         if let Some(table) = &self.direct {
-            if work.len() < n {
-                work.resize(n, 0.0);
-            }
-            let tmp = &mut work[..n];
+            let tmp = &mut scratch[..n];
             for forward in [true, false] {
                 // DCT-II: out_m = Σ_j cos(π m (2j+1)/2Ny) in_j; DCT-III: out_j = in_0/2 +
                 // Σ_{m>0} cos(π m (2j+1)/2Ny) in_m (rustdct's unnormalised conventions).
@@ -432,19 +458,13 @@ impl Dct2d {
         }
         if let Some((_, py)) = &self.pairs {
             if width.is_multiple_of(2) {
-                PAIR_SCRATCH.with_borrow_mut(|(z, scratch)| {
-                    py.dct2(block, width, 1, width, z, scratch);
-                    diag.scale(block, width);
-                    py.dct3(block, width, 1, width, z, scratch);
-                });
+                py.dct2(block, width, 1, width, scratch);
+                diag.scale(block, width);
+                py.dct3(block, width, 1, width, scratch);
                 return;
             }
         }
-        let need = self.scratch_len + ny;
-        if work.len() < need {
-            work.resize(need, 0.0);
-        }
-        let (scratch, column) = work[..need].split_at_mut(self.scratch_len);
+        let (scratch, column) = scratch[..self.scratch_len + ny].split_at_mut(self.scratch_len);
         for forward in [true, false] {
             for ix in 0..width {
                 for (iy, c) in column.iter_mut().enumerate() {
@@ -495,9 +515,18 @@ mod pair_tests {
             let v: Vec<f64> = (0..n).map(|i| ((i * 7919) % 101) as f64 - 50.0).collect();
             let diag: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 31) % 17) as f64).collect();
             let (mut a, mut b) = (v.clone(), v);
-            let mut work = Vec::new();
-            paired.filter(&mut a, &diag, nx, &mut work);
-            plain.filter(&mut b, &diag, nx, &mut work);
+            paired.filter(
+                &mut a,
+                &diag,
+                nx,
+                &mut vec![0.0; paired.filter_scratch_len()],
+            );
+            plain.filter(
+                &mut b,
+                &diag,
+                nx,
+                &mut vec![0.0; plain.filter_scratch_len()],
+            );
             let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             for (x, y) in a.iter().zip(&b) {
                 assert!((x - y).abs() <= 1e-14 * scale, "{nx}x{ny}: {x} vs {y}");
@@ -517,9 +546,8 @@ mod pair_tests {
                 let v: Vec<f64> = (0..n).map(|i| ((i * 7919) % 101) as f64 - 50.0).collect();
                 let diag: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 31) % 17) as f64).collect();
                 let (mut a, mut b) = (v.clone(), v);
-                let mut work = Vec::new();
-                fast.filter(&mut a, &diag, nx, &mut work);
-                fft.filter(&mut b, &diag, nx, &mut work);
+                fast.filter(&mut a, &diag, nx, &mut vec![0.0; fast.filter_scratch_len()]);
+                fft.filter(&mut b, &diag, nx, &mut vec![0.0; fft.filter_scratch_len()]);
                 let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
                 let worst = a
                     .iter()

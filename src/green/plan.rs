@@ -219,7 +219,9 @@ impl InfluencePlan {
         self.lambda(p, m).map(|l| l / (ax * ay))
     }
 
-    /// `out = Ĝ v` (m⁻¹ times the units of `v`), matrix-free in `O(N log N)`.
+    /// `out = Ĝ v` (m⁻¹ times the units of `v`), matrix-free in `O(N log N)`. Allocates
+    /// its scratch on every call: repeated products go through
+    /// [`InfluencePlan::apply_with_scratch`].
     ///
     /// # Errors
     /// [`Error::LengthMismatch`] when `v` or `out` does not hold one value per cell;
@@ -235,25 +237,60 @@ impl InfluencePlan {
             });
         }
         out.copy_from_slice(v);
-        self.apply_in_place(out, &mut Vec::new());
+        self.apply_with_scratch(out, &mut vec![0.0; self.scratch_len()])
+    }
+
+    /// The scratch [`InfluencePlan::apply_with_scratch`] needs: this many `f64` values
+    /// (about `N` plus the 1-D transforms' own; fixed per plan).
+    pub fn scratch_len(&self) -> usize {
+        self.inner.dct.filter_scratch_len()
+    }
+
+    /// `buffer ← Ĝ buffer` in place (m⁻¹ times the units of `buffer`), with caller-owned
+    /// scratch of at least [`InfluencePlan::scratch_len`] values whose contents are
+    /// overwritten: no allocation, so a loop of products allocates once (the convention of
+    /// rustdct's `process_dct2_with_scratch`).
+    ///
+    /// ```
+    /// use precursors::{Block, Grid, green::InfluencePlan};
+    /// let grid = Grid::from_cell_size(Block::new(0.14, 0.007, 0.075)?, 1e-3, 1e-3)?;
+    /// let plan = InfluencePlan::builder(grid).build()?;
+    /// let mut scratch = vec![0.0; plan.scratch_len()];
+    /// let mut u = vec![1.0; grid.len()];                     // 1 Pa everywhere
+    /// for _ in 0..3 {
+    ///     plan.apply_with_scratch(&mut u, &mut scratch)?;    // Ĝ³ φ, no allocation
+    /// }
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] when `buffer` does not hold one value per cell or
+    /// `scratch` is shorter than [`InfluencePlan::scratch_len`]; [`Error::NonFinite`] for a
+    /// NaN or infinite input.
+    pub fn apply_with_scratch(&self, buffer: &mut [f64], scratch: &mut [f64]) -> Result<()> {
+        check_slice("buffer", buffer, self.inner.grid.len())?;
+        let need = self.scratch_len();
+        if scratch.len() < need {
+            return Err(Error::LengthMismatch {
+                name: "scratch",
+                expected: need,
+                found: scratch.len(),
+            });
+        }
+        self.filter_in_place(&self.inner.table, buffer, scratch);
         Ok(())
     }
 
-    /// `buf ← Ĝ buf` in place (`work`: scratch).
-    pub(crate) fn apply_in_place(&self, buf: &mut [f64], work: &mut Vec<f64>) {
-        self.filter_in_place(&self.inner.table, buf, work);
-    }
-
     /// `buf ← T buf` in place for an operator `T` with `Ĝ`'s eigenvectors, given by its
-    /// table (`work`: scratch).
+    /// table (`scratch`: at least [`InfluencePlan::scratch_len`] values).
     pub(crate) fn filter_in_place(
         &self,
         table: &SpectralTable,
         buf: &mut [f64],
-        work: &mut Vec<f64>,
+        scratch: &mut [f64],
     ) {
         let nx = self.inner.grid.nx();
-        self.inner.dct.filter(buf, &table.0, nx, work);
+        self.inner.dct.filter(buf, &table.0, nx, scratch);
     }
 
     /// The operator's own table.

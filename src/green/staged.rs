@@ -113,7 +113,8 @@ pub(crate) struct Staging {
     rows: Vec<RwLock<Vec<f64>>>,
     /// Column block `k`, row-major (`Ny x width`).
     blocks: Vec<RwLock<Vec<f64>>>,
-    /// Scratch of the transforms, per part.
+    /// Scratch of the transforms, per part, sized once for the part's rows and its
+    /// column block.
     work: Vec<Mutex<Vec<f64>>>,
 }
 
@@ -127,7 +128,15 @@ impl Staging {
         let blocks = buffers(&|k| partition.columns(k).len() * partition.ny);
         Self {
             plan: plan.clone(),
-            work: (0..parts).map(|_| Mutex::new(Vec::new())).collect(),
+            work: (0..parts)
+                .map(|k| {
+                    let dct = plan.dct();
+                    let len = dct
+                        .rows_scratch_len(partition.cells(k).len() / partition.nx)
+                        .max(dct.columns_scratch_len(partition.columns(k).len()));
+                    Mutex::new(vec![0.0; len])
+                })
+                .collect(),
             rows,
             blocks,
             partition,
@@ -246,7 +255,8 @@ mod tests {
             let n = nx * ny;
             let x: Vec<f64> = (0..n).map(|i| ((i * 7919) % 101) as f64 - 50.0).collect();
             let mut whole = x.clone();
-            plan.apply_in_place(&mut whole, &mut Vec::new());
+            plan.apply_with_scratch(&mut whole, &mut vec![0.0; plan.scratch_len()])
+                .unwrap();
             for partition in [Partition::of(&plan), Partition::single(nx, ny)] {
                 let staging = Staging::new(&plan, partition.clone());
                 let parts = partition.parts();

@@ -163,8 +163,9 @@ impl PlaneTransfer {
             });
         }
         out.copy_from_slice(traction);
+        let mut scratch = vec![0.0; self.dct.filter_scratch_len()];
         self.dct
-            .filter(out, &self.scaled, self.grid.nx(), &mut Vec::new());
+            .filter(out, &self.scaled, self.grid.nx(), &mut scratch);
         out.iter_mut().for_each(|s| *s = -*s);
         Ok(())
     }

@@ -90,7 +90,9 @@ impl SpectralCore {
             out[i] = xi;
             sum += xi;
         }
-        self.plan.apply_in_place(out, &mut Vec::new());
+        let mut scratch = vec![0.0; self.plan.scratch_len()];
+        self.plan
+            .filter_in_place(self.plan.operator_table(), out, &mut scratch);
         let (s, c) = (self.compliance.scale, self.compliance.shift * sum);
         out.iter_mut().for_each(|o| *o = s * (*o - c));
     }
