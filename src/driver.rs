@@ -51,8 +51,7 @@ use std::ops::ControlFlow;
 const NOMINAL_AREA_SLACK: f64 = 1e-9;
 
 mod checkpoint;
-#[cfg(feature = "serde")]
-pub(crate) use checkpoint::write_atomically;
+pub(crate) use checkpoint::{scene_mismatch, sync_dir, write_atomically};
 pub use checkpoint::Checkpoint;
 
 /// A site of the interface grid.
