@@ -520,7 +520,6 @@ impl RunTables {
         let lock = DirLock::lock(dir)?;
         #[cfg(feature = "serde")]
         check_scene_record(dir, driver)?;
-        remove_stale_temporaries(dir)?;
         let k = driver.event_count();
         let (paths, partials) = table_paths(dir);
         // The tables of the run under way (or cut), else those of a finished run.
@@ -553,6 +552,8 @@ impl RunTables {
         } else {
             None
         };
+        // Checked: now the directory is written.
+        remove_stale_temporaries(dir)?;
         let mut files = Vec::with_capacity(3);
         for (path, text) in partials.iter().zip(&plan.texts) {
             write_atomically(path, text.as_bytes(), "writing table")?;
