@@ -51,8 +51,10 @@ use std::ops::ControlFlow;
 const NOMINAL_AREA_SLACK: f64 = 1e-9;
 
 mod checkpoint;
-pub(crate) use checkpoint::{scene_mismatch, sync_dir, write_atomically};
 pub use checkpoint::Checkpoint;
+#[cfg(feature = "serde")]
+pub(crate) use checkpoint::scene_mismatch;
+pub(crate) use checkpoint::{sync_dir, write_atomically};
 
 /// A site of the interface grid.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

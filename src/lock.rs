@@ -81,6 +81,7 @@ impl DirLock {
     /// # Errors
     /// [`Error::DirectoryLocked`] naming the holder when it still holds the lock after
     /// `patience`; [`Error::Io`] as [`DirLock::try_lock`].
+    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
     pub(crate) fn lock_waiting(dir: &Path, patience: Duration) -> Result<DirLock> {
         let start = Instant::now();
         loop {

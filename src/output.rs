@@ -81,7 +81,10 @@ pub fn contact_map_header(nx: usize) -> String {
 /// The complete rows of a table's text (line number, row), its header checked: a last
 /// row cut by a crash (no trailing newline, or not as many fields as the header) is left
 /// out; the same damage on an earlier row is refused.
-fn complete_rows<'a>(old: &'a str, header: &str) -> std::result::Result<Vec<(usize, &'a str)>, String> {
+fn complete_rows<'a>(
+    old: &'a str,
+    header: &str,
+) -> std::result::Result<Vec<(usize, &'a str)>, String> {
     let fields = header.split(',').count();
     let mut lines = old.split_inclusive('\n');
     let Some(first) = lines.next() else {
@@ -475,8 +478,7 @@ impl RunTables {
             writeln!(file, "{header}").map_err(|e| Error::io("writing table", path, e))?;
             files.push(file);
         }
-        let [events, curve, map]: [BufWriter<File>; 3] =
-            files.try_into().expect("three tables");
+        let [events, curve, map]: [BufWriter<File>; 3] = files.try_into().expect("three tables");
         Ok(Self {
             events,
             curve,
@@ -513,8 +515,7 @@ impl RunTables {
         if !dir.is_dir() {
             return Err(Error::RunDirectory {
                 path: dir.to_path_buf(),
-                reason: "no such directory: resume continues the run whose tables are there"
-                    .into(),
+                reason: "no such directory: resume continues the run whose tables are there".into(),
             });
         }
         let lock = DirLock::lock(dir)?;
@@ -563,8 +564,7 @@ impl RunTables {
                 .map_err(|e| Error::io("opening table", path, e))?;
             files.push(BufWriter::new(file));
         }
-        let [events, curve, map]: [BufWriter<File>; 3] =
-            files.try_into().expect("three tables");
+        let [events, curve, map]: [BufWriter<File>; 3] = files.try_into().expect("three tables");
         Ok(Self {
             events,
             curve,
@@ -748,11 +748,10 @@ fn check_scene_record(dir: &Path, driver: &Driver) -> Result<()> {
         }
         Err(e) => return Err(Error::io("reading the scene record", &path, e)),
     };
-    let recorded =
-        crate::SceneBuilder::from_json_str(&text).map_err(|e| Error::RunDirectory {
-            path: path.clone(),
-            reason: format!("not a scene file ({e})"),
-        })?;
+    let recorded = crate::SceneBuilder::from_json_str(&text).map_err(|e| Error::RunDirectory {
+        path: path.clone(),
+        reason: format!("not a scene file ({e})"),
+    })?;
     match crate::driver::scene_mismatch(
         &driver.scene().to_builder(),
         "the checkpoint's scene",

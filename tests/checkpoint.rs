@@ -487,7 +487,10 @@ pub(crate) mod json {
         // Edits and damage: the event count, a site's state, a key this build does not
         // know (at the top, inside), a flipped byte, a missing or altered digest.
         let states = text.find("\"states\":[").unwrap();
-        let attached = states + text[states..].find("\"Attached\"").expect("an attached site");
+        let attached = states
+            + text[states..]
+                .find("\"Attached\"")
+                .expect("an attached site");
         let flip = text.len() / 2;
         let flipped = {
             let mut bytes = text.clone().into_bytes();

@@ -326,7 +326,10 @@ mod cli {
         let mut child = spawn(&["run", path(&big), "--out", path(&out)]);
         let lock = out.join(".precursors.lock");
         let start = Instant::now();
-        while std::fs::read_to_string(&lock).unwrap_or_default().is_empty() {
+        while std::fs::read_to_string(&lock)
+            .unwrap_or_default()
+            .is_empty()
+        {
             assert!(start.elapsed() < Duration::from_secs(60), "no lock taken");
             std::thread::sleep(Duration::from_millis(5));
         }
