@@ -51,9 +51,9 @@ use std::ops::ControlFlow;
 const NOMINAL_AREA_SLACK: f64 = 1e-9;
 
 mod checkpoint;
-pub use checkpoint::Checkpoint;
 #[cfg(feature = "serde")]
 pub(crate) use checkpoint::scene_mismatch;
+pub use checkpoint::Checkpoint;
 pub(crate) use checkpoint::{sync_dir, write_atomically};
 
 /// A site of the interface grid.
