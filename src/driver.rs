@@ -52,8 +52,9 @@ const NOMINAL_AREA_SLACK: f64 = 1e-9;
 
 mod checkpoint;
 #[cfg(feature = "serde")]
-pub(crate) use checkpoint::write_atomically;
+pub(crate) use checkpoint::scene_mismatch;
 pub use checkpoint::Checkpoint;
+pub(crate) use checkpoint::{sync_dir, write_atomically};
 
 /// A site of the interface grid.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -391,9 +391,11 @@ pub enum Error {
         /// What the parser reported.
         reason: String,
     },
-    /// A run's CSV table (`events.csv`, `curve.csv`) cannot be continued: a damaged row
-    /// before the last one, another header, or an index that is not a whole number
-    /// ([`crate::output::rows_to_keep`]).
+    /// A run's CSV table (`events.csv`, `curve.csv`, `contact_map.csv`) cannot be
+    /// continued: a damaged row before the last one, another header, an index that is not
+    /// a whole number ([`crate::output::rows_to_keep`]), or rows that do not reach the
+    /// checkpoint's event or do not agree with the other tables
+    /// ([`crate::output::RunTables::resume`]).
     #[error("table{}: {reason}", path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default())]
     CorruptTable {
         /// The file (`None` for text given directly).
@@ -438,6 +440,30 @@ pub enum Error {
     #[error("sweep directory {}: {reason}", path.display())]
     SweepDirectory {
         /// The directory or the file at fault.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// Another process holds the directory's lock: it is writing a run there (`run`,
+    /// `resume`, a sweep's run) or checking a sweep's `sweep.json`. The lock is the
+    /// operating system's and ends with that process, also when it is killed.
+    #[error(
+        "{} is in use by another process ({holder}): wait until it ends or choose another \
+         directory (the lock ends with that process, also if it is killed)",
+        path.display()
+    )]
+    DirectoryLocked {
+        /// The directory.
+        path: PathBuf,
+        /// Who holds the lock, as it wrote it: pid, host, start time (UTC), command.
+        holder: String,
+    },
+    /// A run directory cannot be continued or finished: it has no record of its scene
+    /// (`scene.json`), or a checkpoint taken inside an avalanche, or the run did not reach
+    /// global slip.
+    #[error("run directory {}: {reason}", path.display())]
+    RunDirectory {
+        /// The directory, or its file at fault.
         path: PathBuf,
         /// What is wrong.
         reason: String,

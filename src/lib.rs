@@ -46,6 +46,7 @@ pub mod error;
 pub mod geometry;
 pub mod green;
 pub mod interface;
+mod lock;
 #[cfg(feature = "nalgebra")]
 mod matrix;
 pub mod output;

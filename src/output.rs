@@ -22,12 +22,28 @@
 //! Numbers are written with 13 significant digits (`{:.12e}`), so the tables of two runs
 //! compare equal exactly when their results do.
 //!
-//! On resume from a checkpoint a table keeps its complete rows up to the checkpoint's event
-//! and drops the rest, including a last row cut by the crash ([`rows_to_keep`]).
+//! **Complete or marked partial.** While a run is under way its tables are written as
+//! `events.csv.partial`, `curve.csv.partial` and `contact_map.csv.partial`
+//! ([`PARTIAL_SUFFIX`]); [`RunTables::finish`], once the run reached global slip, syncs
+//! them to disk and renames them to their names. A crash, a kill or a full disk leaves
+//! `.partial` files (or the tables of a complete run), never a table under its name that
+//! is not complete. The directory is locked while the tables are written (an advisory lock
+//! of the operating system, on the file `.precursors.lock`, that ends with the process): a
+//! second writer is refused ([`Error::DirectoryLocked`], naming the holder). With the
+//! `serde` feature the run's scene is recorded in the directory ([`SCENE_RECORD`]).
+//!
+//! **Resume.** [`RunTables::resume`] continues the tables of a run from a checkpoint taken
+//! at a stable state: it checks, before it writes anything, that the directory's recorded
+//! scene is the checkpoint's, that the three tables have their headers and whole rows
+//! (a last row cut by a crash is dropped: [`rows_to_keep`]), that `events.csv` numbers its
+//! rows 1, 2, 3, ... up to at least the checkpoint's event, and that `curve.csv` and
+//! `contact_map.csv` hold the stable states and load levels reached by then; then it
+//! rewrites the `.partial` tables with the rows up to the checkpoint's event.
 
-use crate::driver::{Driver, Event};
+use crate::driver::{sync_dir, write_atomically, Driver, Event};
 use crate::error::{Error, Result};
 use crate::interface::SiteState;
+use crate::lock::DirLock;
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -43,6 +59,16 @@ pub const CURVE_HEADER: &str = "event,force_N,force_over_mu_FN,drive_displacemen
 /// The spacing in `F/(μF_N)` of the rows of `contact_map.csv`.
 pub const CONTACT_MAP_STEP: f64 = 0.005;
 
+/// The names of a run's tables, in the order of [`RunTables::paths`].
+pub const TABLE_NAMES: [&str; 3] = ["events.csv", "curve.csv", "contact_map.csv"];
+
+/// Appended to a table's name while its run is under way (`events.csv.partial`).
+pub const PARTIAL_SUFFIX: &str = ".partial";
+
+/// The record of a run's scene in its directory (feature `serde`: the scene file of
+/// [`crate::SceneBuilder::to_json`]), written when the run starts, checked on resume.
+pub const SCENE_RECORD: &str = "scene.json";
+
 /// The header of `contact_map.csv` for a grid of `nx` columns.
 pub fn contact_map_header(nx: usize) -> String {
     let mut header = String::from("event,force_over_mu_FN");
@@ -50,6 +76,52 @@ pub fn contact_map_header(nx: usize) -> String {
         header.push_str(&format!(",area_m2_ix{ix}"));
     }
     header
+}
+
+/// The complete rows of a table's text (line number, row), its header checked: a last
+/// row cut by a crash (no trailing newline, or not as many fields as the header) is left
+/// out; the same damage on an earlier row is refused.
+fn complete_rows<'a>(
+    old: &'a str,
+    header: &str,
+) -> std::result::Result<Vec<(usize, &'a str)>, String> {
+    let fields = header.split(',').count();
+    let mut lines = old.split_inclusive('\n');
+    let Some(first) = lines.next() else {
+        return Ok(Vec::new());
+    };
+    if first.trim_end_matches(['\n', '\r']) != header {
+        return Err(format!(
+            "line 1 is not the header {header:?}: the table was written by another program"
+        ));
+    }
+    let lines: Vec<&str> = lines.collect();
+    let count = lines.len();
+    let mut rows = Vec::with_capacity(count);
+    for (k, line) in lines.into_iter().enumerate() {
+        let row = line.trim_end_matches(['\n', '\r']);
+        if !line.ends_with('\n') || row.split(',').count() != fields {
+            if k + 1 == count {
+                break; // cut by a crash
+            }
+            return Err(format!(
+                "line {} has {} fields, the header {fields}",
+                k + 2,
+                row.split(',').count()
+            ));
+        }
+        rows.push((k + 2, row));
+    }
+    Ok(rows)
+}
+
+/// The event index in the first column of a row.
+fn index_of(line: usize, row: &str) -> std::result::Result<usize, String> {
+    row.split(',')
+        .next()
+        .unwrap_or("")
+        .parse()
+        .map_err(|e| format!("line {line}: the event index is not a whole number ({e})"))
 }
 
 /// The text a resumed table starts from: `header`, then the rows of `old` whose first
@@ -62,40 +134,9 @@ pub fn contact_map_header(nx: usize) -> String {
 /// this run.
 pub fn rows_to_keep(old: &str, header: &str, keep: usize) -> Result<String> {
     let corrupt = |reason: String| Error::CorruptTable { path: None, reason };
-    let fields = header.split(',').count();
     let mut text = format!("{header}\n");
-    let mut lines: Vec<&str> = old.split_inclusive('\n').collect();
-    if lines.is_empty() {
-        return Ok(text);
-    }
-    let first = lines.remove(0);
-    if first.trim_end_matches(['\n', '\r']) != header {
-        return Err(corrupt(format!(
-            "line 1 is not the header {header:?}: the table was written by another program"
-        )));
-    }
-    let count = lines.len();
-    for (k, line) in lines.into_iter().enumerate() {
-        let last = k + 1 == count;
-        let complete = line.ends_with('\n');
-        let row = line.trim_end_matches(['\n', '\r']);
-        if !complete || row.split(',').count() != fields {
-            if last {
-                break; // cut by a crash
-            }
-            return Err(corrupt(format!(
-                "line {} has {} fields, the header {fields}",
-                k + 2,
-                row.split(',').count()
-            )));
-        }
-        let index: usize = row.split(',').next().unwrap_or("").parse().map_err(|e| {
-            corrupt(format!(
-                "line {}: the event index is not a whole number ({e})",
-                k + 2
-            ))
-        })?;
-        if index <= keep {
+    for (line, row) in complete_rows(old, header).map_err(corrupt)? {
+        if index_of(line, row).map_err(corrupt)? <= keep {
             text.push_str(row);
             text.push('\n');
         }
@@ -103,50 +144,279 @@ pub fn rows_to_keep(old: &str, header: &str, keep: usize) -> Result<String> {
     Ok(text)
 }
 
-/// A table ready for appending rows: new (the header only) with `keep = None`, or the
-/// existing `path` cut back by [`rows_to_keep`] (a missing file starts empty).
-///
-/// # Errors
-/// [`Error::Io`] when the file cannot be read or written; [`Error::CorruptTable`] (with
-/// the path) as [`rows_to_keep`].
-pub fn open_table(path: &Path, header: &str, keep: Option<usize>) -> Result<BufWriter<File>> {
-    let text = match keep {
-        None => format!("{header}\n"),
-        Some(k) => match fs::read_to_string(path) {
-            Ok(old) => rows_to_keep(&old, header, k).map_err(|e| match e {
-                Error::CorruptTable { reason, .. } => Error::CorruptTable {
-                    path: Some(path.to_path_buf()),
-                    reason,
-                },
-                other => other,
-            })?,
-            Err(e) if e.kind() == io::ErrorKind::NotFound => format!("{header}\n"),
-            Err(e) => return Err(Error::io("reading table", path, e)),
-        },
+/// What a resumed run starts from: the three tables' texts up to the checkpoint's event,
+/// the next level of the map, and whether a stable state is in effect.
+#[derive(Debug)]
+struct Continuation {
+    texts: [String; 3],
+    next_level: u64,
+    in_effect: bool,
+}
+
+/// Checks the three tables (`old[t]`: the text of table `t` in [`TABLE_NAMES`] order,
+/// `None` when missing; `paths` for the messages) against each other and against the
+/// checkpoint's event `k`, and cuts them back to it. Nothing is written.
+fn continuation(
+    old: [Option<&str>; 3],
+    paths: &[PathBuf; 3],
+    k: usize,
+    nx: usize,
+) -> Result<Continuation> {
+    let corrupt = |t: usize, reason: String| Error::CorruptTable {
+        path: Some(paths[t].clone()),
+        reason,
     };
-    fs::write(path, text).map_err(|e| Error::io("writing table", path, e))?;
-    let file = OpenOptions::new()
-        .append(true)
-        .open(path)
-        .map_err(|e| Error::io("opening table", path, e))?;
-    Ok(BufWriter::new(file))
+    let map_header = contact_map_header(nx);
+    let headers = [EVENTS_HEADER, CURVE_HEADER, map_header.as_str()];
+    // Every table's header and rows first, so a damaged third table refuses the resume
+    // before anything is cut.
+    let mut rows: [Vec<(usize, &str)>; 3] = Default::default();
+    for t in 0..3 {
+        rows[t] = complete_rows(old[t].unwrap_or(""), headers[t]).map_err(|r| corrupt(t, r))?;
+    }
+    let [events, curve, map] = rows;
+
+    // events.csv: rows 1, 2, 3, ... (one run's), up to at least k.
+    let mut last = 0;
+    let mut stable = Vec::new();
+    let mut kind_at_k = "";
+    for &(line, row) in &events {
+        let index = index_of(line, row).map_err(|r| corrupt(0, r))?;
+        if index != last + 1 {
+            return Err(corrupt(
+                0,
+                format!(
+                    "line {line}: event {index} follows event {last}: the rows are not those \
+                     of one run (numbered 1, 2, 3, ...)"
+                ),
+            ));
+        }
+        last = index;
+        let kind = row.split(',').nth(1).unwrap_or("");
+        if index <= k && kind == "stable" {
+            stable.push(index);
+        }
+        if index == k {
+            kind_at_k = kind;
+        }
+    }
+    if last < k {
+        let what = if old[0].is_none() {
+            "the table is missing".to_string()
+        } else {
+            format!("the table ends at event {last}")
+        };
+        return Err(corrupt(
+            0,
+            format!(
+                "{what}, the checkpoint is at event {k}: events {} to {k} are missing",
+                last + 1
+            ),
+        ));
+    }
+    if k > 0 && kind_at_k != "stable" {
+        return Err(Error::InvalidCheckpoint {
+            reason: format!(
+                "it was taken after event {k}, a {kind_at_k} inside an avalanche: tables are \
+                 continued from a checkpoint at a stable state (as `precursors run \
+                 --checkpoint` takes them)"
+            ),
+        });
+    }
+
+    // curve.csv: one row per stable state of events.csv up to k, in order.
+    let mut loads = Vec::with_capacity(stable.len());
+    let mut previous = 0;
+    for &(line, row) in &curve {
+        let event = index_of(line, row).map_err(|r| corrupt(1, r))?;
+        if event <= previous {
+            return Err(corrupt(
+                1,
+                format!("line {line}: event {event} follows event {previous}"),
+            ));
+        }
+        previous = event;
+        if event > k {
+            break;
+        }
+        match stable.get(loads.len()) {
+            Some(&s) if s == event => {}
+            Some(&s) => {
+                return Err(corrupt(
+                    1,
+                    format!(
+                        "line {line} holds the state of event {event}, but the stable state \
+                         of events.csv there is event {s}"
+                    ),
+                ))
+            }
+            None => {
+                return Err(corrupt(
+                    1,
+                    format!("line {line}: event {event} is not a stable state of events.csv"),
+                ))
+            }
+        }
+        let x = row.split(',').nth(2).and_then(|f| f.parse::<f64>().ok());
+        let Some(x) = x.filter(|x| x.is_finite()) else {
+            return Err(corrupt(
+                1,
+                format!("line {line}: force_over_mu_FN is not a finite number"),
+            ));
+        };
+        loads.push(x);
+    }
+    if loads.len() < stable.len() {
+        return Err(corrupt(
+            1,
+            format!(
+                "it holds {} stable states up to the checkpoint's event {k}, events.csv {}: \
+                 the rows from event {} on are missing",
+                loads.len(),
+                stable.len(),
+                stable[loads.len()]
+            ),
+        ));
+    }
+
+    // contact_map.csv: consecutive levels from the first state's load, each row a stable
+    // state, reaching the levels below the highest load of the states up to k.
+    let mut kept_levels: Vec<u64> = Vec::new();
+    let mut previous: Option<(u64, usize)> = None;
+    for &(line, row) in &map {
+        let event = index_of(line, row).map_err(|r| corrupt(2, r))?;
+        let level = row.split(',').nth(1).and_then(|f| f.parse::<f64>().ok());
+        let step = level.map(|l| (l / CONTACT_MAP_STEP).round());
+        let level = match (level, step) {
+            (Some(l), Some(s))
+                if l.is_finite() && s >= 0.0 && (s * CONTACT_MAP_STEP - l).abs() < 1e-9 =>
+            {
+                s as u64
+            }
+            _ => {
+                return Err(corrupt(
+                    2,
+                    format!(
+                        "line {line}: force_over_mu_FN is not a load level (a multiple of \
+                         {CONTACT_MAP_STEP})"
+                    ),
+                ))
+            }
+        };
+        if let Some((l, e)) = previous {
+            if level != l + 1 || event < e {
+                return Err(corrupt(
+                    2,
+                    format!(
+                        "line {line}: level {} of event {event} follows level {} of event \
+                         {e}: the rows are not those of one run",
+                        level_text(level),
+                        level_text(l)
+                    ),
+                ));
+            }
+        }
+        previous = Some((level, event));
+        if event > k {
+            break;
+        }
+        if stable.binary_search(&event).is_err() {
+            return Err(corrupt(
+                2,
+                format!("line {line}: event {event} is not a stable state of events.csv"),
+            ));
+        }
+        kept_levels.push(level);
+    }
+    let first = loads.first().map_or(0, |&x| first_level_at_or_above(x));
+    if let Some(&l) = kept_levels.first() {
+        if l != first {
+            return Err(corrupt(
+                2,
+                format!(
+                    "the first row is level {}, the first stable state's load gives level {}",
+                    level_text(l),
+                    level_text(first)
+                ),
+            ));
+        }
+    }
+    // Levels below the load of each state after the first were written when it was
+    // reached (up to a load within 1e-9 of a step of a level).
+    let needed = loads
+        .iter()
+        .enumerate()
+        .skip(1)
+        .map(|(i, &x)| (first_level_at_or_above(x), i))
+        .filter(|&(above, _)| above > first)
+        .max_by_key(|&(above, _)| above);
+    if let Some((above, i)) = needed {
+        let reached = kept_levels.last().map(|&l| l + 1).unwrap_or(first);
+        if reached < above {
+            return Err(corrupt(
+                2,
+                format!(
+                    "it reaches level {} only, but the stable state of event {} reached \
+                     F/(μF_N) = {}: the rows of the levels up to {} are missing",
+                    if kept_levels.is_empty() {
+                        "none".to_string()
+                    } else {
+                        level_text(reached - 1)
+                    },
+                    stable[i],
+                    loads[i],
+                    level_text(above - 1)
+                ),
+            ));
+        }
+    }
+    let next_level = kept_levels.last().map_or(first, |&l| l + 1);
+
+    let text = |header: &str, rows: &[(usize, &str)], count: usize| {
+        let mut text = format!("{header}\n");
+        for (_, row) in &rows[..count] {
+            text.push_str(row);
+            text.push('\n');
+        }
+        text
+    };
+    Ok(Continuation {
+        texts: [
+            text(EVENTS_HEADER, &events, k),
+            text(CURVE_HEADER, &curve, loads.len()),
+            text(&map_header, &map, kept_levels.len()),
+        ],
+        next_level,
+        in_effect: k > 0,
+    })
+}
+
+/// A map level as the table writes it.
+fn level_text(k: u64) -> String {
+    format!("{:.3}", level(k))
 }
 
 /// The three tables of a run in a directory: `events.csv`, `curve.csv` and
-/// `contact_map.csv`.
+/// `contact_map.csv`, written as `NAME.partial` until [`RunTables::finish`].
 #[derive(Debug)]
 pub struct RunTables {
     events: BufWriter<File>,
     curve: BufWriter<File>,
     map: BufWriter<File>,
-    events_path: PathBuf,
-    curve_path: PathBuf,
-    map_path: PathBuf,
+    dir: PathBuf,
+    /// The tables' names (after [`RunTables::finish`]).
+    paths: [PathBuf; 3],
+    /// The files written until then.
+    partials: [PathBuf; 3],
     stable_states: usize,
     /// The next level of `contact_map.csv`, in steps of [`CONTACT_MAP_STEP`].
     next_level: u64,
     /// The stable state in effect: the rows of the levels below the next state's load.
     in_effect: Option<MapState>,
+    /// Global slip was recorded.
+    slipped: bool,
+    /// The directory's lock, `None` when the caller holds it (a sweep's run).
+    _lock: Option<DirLock>,
 }
 
 /// A stable state as `contact_map.csv` needs it.
@@ -156,74 +426,164 @@ struct MapState {
     columns: Vec<f64>,
 }
 
+/// `dir/NAME` and `dir/NAME.partial` of each table.
+fn table_paths(dir: &Path) -> ([PathBuf; 3], [PathBuf; 3]) {
+    (
+        TABLE_NAMES.map(|n| dir.join(n)),
+        TABLE_NAMES.map(|n| dir.join(format!("{n}{PARTIAL_SUFFIX}"))),
+    )
+}
+
 impl RunTables {
-    /// New tables in `dir` (which must exist), header only, for `driver`'s run.
+    /// New tables in `dir` (which must exist), header only, for `driver`'s run: the
+    /// directory is locked, the tables of an earlier run there removed, the scene
+    /// recorded ([`SCENE_RECORD`], feature `serde`).
     ///
     /// # Errors
-    /// As [`open_table`].
+    /// [`Error::DirectoryLocked`] when another process writes the directory;
+    /// [`Error::Io`] when a file cannot be written or removed.
     pub fn create(dir: &Path, driver: &Driver) -> Result<Self> {
-        Self::open(dir, driver, None)
+        let lock = DirLock::lock(dir)?;
+        Self::start(dir, driver, Some(lock))
     }
 
-    /// The tables in `dir` continued after `driver` was resumed from a checkpoint: rows
-    /// after the checkpoint's event are dropped ([`open_table`]), missing tables start
-    /// empty.
-    ///
-    /// # Errors
-    /// As [`open_table`].
-    pub fn resume(dir: &Path, driver: &Driver) -> Result<Self> {
-        Self::open(dir, driver, Some(driver.event_count()))
-    }
-
-    fn open(dir: &Path, driver: &Driver, keep: Option<usize>) -> Result<Self> {
-        let events_path = dir.join("events.csv");
-        let curve_path = dir.join("curve.csv");
-        let map_path = dir.join("contact_map.csv");
-        let events = open_table(&events_path, EVENTS_HEADER, keep)?;
-        let curve = open_table(&curve_path, CURVE_HEADER, keep)?;
-        let map = open_table(&map_path, &contact_map_header(driver.grid().nx()), keep)?;
-        // The level after the last row kept (the table was just written back); the
-        // state in effect is the driver's: a resumed run is at a stable state.
-        let text =
-            fs::read_to_string(&map_path).map_err(|e| Error::io("reading table", &map_path, e))?;
-        let x = driver.force() / (driver.friction_coefficient() * driver.normal_load());
-        let (next_level, in_effect) = match (keep, text.lines().nth(1).and(text.lines().last())) {
-            (None, _) => (0, None),
-            (Some(_), None) => (first_level_at_or_above(x), None),
-            (Some(_), Some(row)) => {
-                let level = row.split(',').nth(1).and_then(|f| f.parse::<f64>().ok());
-                let Some(level) = level.filter(|l| l.is_finite() && *l >= 0.0) else {
-                    return Err(Error::CorruptTable {
-                        path: Some(map_path),
-                        reason: "the last row's force_over_mu_FN is not a load level".into(),
-                    });
-                };
-                (first_level_at_or_above(level) + 1, None)
+    /// [`RunTables::create`] in a directory whose lock the caller holds (`lock: None`)
+    /// or passes on.
+    pub(crate) fn start(dir: &Path, driver: &Driver, lock: Option<DirLock>) -> Result<Self> {
+        let (paths, partials) = table_paths(dir);
+        remove_stale_temporaries(dir)?;
+        for path in &paths {
+            match fs::remove_file(path) {
+                Err(e) if e.kind() != io::ErrorKind::NotFound => {
+                    return Err(Error::io("removing the earlier run's table", path, e))
+                }
+                _ => {}
             }
-        };
-        let in_effect = match keep {
-            Some(k) if k > 0 => Some(MapState {
-                event: k,
-                columns: driver.column_contact_area()?,
-            }),
-            _ => in_effect,
-        };
+        }
+        #[cfg(feature = "serde")]
+        write_atomically(
+            &dir.join(SCENE_RECORD),
+            driver.scene().to_builder().to_json()?.as_bytes(),
+            "recording the scene",
+        )?;
+        let headers = [
+            EVENTS_HEADER.to_string(),
+            CURVE_HEADER.to_string(),
+            contact_map_header(driver.grid().nx()),
+        ];
+        let mut files = Vec::with_capacity(3);
+        for (path, header) in partials.iter().zip(&headers) {
+            let file = File::create(path).map_err(|e| Error::io("creating table", path, e))?;
+            let mut file = BufWriter::new(file);
+            writeln!(file, "{header}").map_err(|e| Error::io("writing table", path, e))?;
+            files.push(file);
+        }
+        let [events, curve, map]: [BufWriter<File>; 3] = files.try_into().expect("three tables");
         Ok(Self {
             events,
             curve,
             map,
-            events_path,
-            curve_path,
-            map_path,
+            dir: dir.to_path_buf(),
+            paths,
+            partials,
             stable_states: 0,
-            next_level,
-            in_effect,
+            next_level: 0,
+            in_effect: None,
+            slipped: false,
+            _lock: lock,
         })
     }
 
-    /// The paths of `events.csv`, `curve.csv` and `contact_map.csv`.
+    /// The tables in `dir` continued after `driver` was resumed ([`crate::Scene::resume`])
+    /// from a checkpoint taken at a stable state. The directory is locked; then, before
+    /// anything is written, its recorded scene ([`SCENE_RECORD`], feature `serde`) must be
+    /// the driver's, and the tables (each `NAME.partial` if present, else `NAME`) must
+    /// hold whole rows under their headers, `events.csv` the events 1, 2, ... up to the
+    /// checkpoint's (a last row cut by a crash is dropped), `curve.csv` and
+    /// `contact_map.csv` the stable states and load levels reached by then. The `.partial`
+    /// tables are then rewritten (atomically) with the rows up to the checkpoint's event;
+    /// complete tables of a finished run stay until [`RunTables::finish`] replaces them.
+    ///
+    /// # Errors
+    /// [`Error::RunDirectory`] for a missing directory or (feature `serde`) one without
+    /// its scene record; [`Error::CheckpointSceneMismatch`], naming the first differing
+    /// key, when the recorded scene is another; [`Error::CorruptTable`], naming the file
+    /// and line, for a table that is damaged, too short or inconsistent with the others;
+    /// [`Error::InvalidCheckpoint`] for a checkpoint inside an avalanche;
+    /// [`Error::DirectoryLocked`]; [`Error::Io`].
+    pub fn resume(dir: &Path, driver: &Driver) -> Result<Self> {
+        if !dir.is_dir() {
+            return Err(Error::RunDirectory {
+                path: dir.to_path_buf(),
+                reason: "no such directory: resume continues the run whose tables are there".into(),
+            });
+        }
+        let lock = DirLock::lock(dir)?;
+        #[cfg(feature = "serde")]
+        check_scene_record(dir, driver)?;
+        let k = driver.event_count();
+        let (paths, partials) = table_paths(dir);
+        // The tables of the run under way (or cut), else those of a finished run.
+        let mut old: [Option<String>; 3] = Default::default();
+        let mut read = partials.clone();
+        for t in 0..3 {
+            for path in [&partials[t], &paths[t]] {
+                match fs::read_to_string(path) {
+                    Ok(text) => {
+                        old[t] = Some(text);
+                        read[t] = path.clone();
+                        break;
+                    }
+                    Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+                    Err(e) => return Err(Error::io("reading table", path, e)),
+                }
+            }
+        }
+        let plan = continuation(
+            [old[0].as_deref(), old[1].as_deref(), old[2].as_deref()],
+            &read,
+            k,
+            driver.grid().nx(),
+        )?;
+        let in_effect = if plan.in_effect {
+            Some(MapState {
+                event: k,
+                columns: driver.column_contact_area()?,
+            })
+        } else {
+            None
+        };
+        // Checked: now the directory is written.
+        remove_stale_temporaries(dir)?;
+        let mut files = Vec::with_capacity(3);
+        for (path, text) in partials.iter().zip(&plan.texts) {
+            write_atomically(path, text.as_bytes(), "writing table")?;
+            let file = OpenOptions::new()
+                .append(true)
+                .open(path)
+                .map_err(|e| Error::io("opening table", path, e))?;
+            files.push(BufWriter::new(file));
+        }
+        let [events, curve, map]: [BufWriter<File>; 3] = files.try_into().expect("three tables");
+        Ok(Self {
+            events,
+            curve,
+            map,
+            dir: dir.to_path_buf(),
+            paths,
+            partials,
+            stable_states: 0,
+            next_level: plan.next_level,
+            in_effect,
+            slipped: false,
+            _lock: Some(lock),
+        })
+    }
+
+    /// The paths of `events.csv`, `curve.csv` and `contact_map.csv` (their names once
+    /// [`RunTables::finish`]ed; until then they are written with [`PARTIAL_SUFFIX`]).
     pub fn paths(&self) -> [&Path; 3] {
-        [&self.events_path, &self.curve_path, &self.map_path]
+        [&self.paths[0], &self.paths[1], &self.paths[2]]
     }
 
     /// Stable states recorded by this writer (not counting rows kept on resume).
@@ -242,7 +602,7 @@ impl RunTables {
         let index = driver.event_count();
         let exceeds = driver.area_exceeds_nominal()?;
         write_event(&mut self.events, index, event, exceeds)
-            .map_err(|e| Error::io("writing table", &self.events_path, e))?;
+            .map_err(|e| Error::io("writing table", &self.partials[0], e))?;
         if let Event::Stable { load, .. } = *event {
             self.stable_states += 1;
             let mu_fn = driver.friction_coefficient() * driver.normal_load();
@@ -259,7 +619,7 @@ impl RunTables {
                 ell / driver.grid().block().lx(),
                 u8::from(exceeds),
             )
-            .map_err(|e| Error::io("writing table", &self.curve_path, e))?;
+            .map_err(|e| Error::io("writing table", &self.partials[1], e))?;
             let x = load.force / mu_fn;
             self.map_rows_below(x)?;
             self.in_effect = Some(MapState {
@@ -270,6 +630,7 @@ impl RunTables {
         if let Event::GlobalSlip { load } = *event {
             let mu_fn = driver.friction_coefficient() * driver.normal_load();
             self.map_rows_below(load.force / mu_fn)?;
+            self.slipped = true;
         }
         Ok(())
     }
@@ -288,27 +649,117 @@ impl RunTables {
                 row.push_str(&format!(",{a:.12e}"));
             }
             writeln!(self.map, "{row}")
-                .map_err(|e| Error::io("writing table", &self.map_path, e))?;
+                .map_err(|e| Error::io("writing table", &self.partials[2], e))?;
             self.next_level += 1;
         }
         Ok(())
     }
 
-    /// Flushes the tables to their files (before a checkpoint is written, and at the end).
+    /// Writes the rows so far to disk (flushed and synced): call it before a checkpoint is
+    /// written, so that the tables reach the checkpoint's event whatever happens next.
     ///
     /// # Errors
-    /// [`Error::Io`] when a file cannot be written.
+    /// [`Error::Io`] when a file cannot be written or synced.
     pub fn flush(&mut self) -> Result<()> {
         for (table, path) in [
-            (&mut self.events, &self.events_path),
-            (&mut self.curve, &self.curve_path),
-            (&mut self.map, &self.map_path),
+            (&mut self.events, &self.partials[0]),
+            (&mut self.curve, &self.partials[1]),
+            (&mut self.map, &self.partials[2]),
         ] {
             table
                 .flush()
+                .and_then(|()| table.get_ref().sync_data())
                 .map_err(|e| Error::io("writing table", path, e))?;
         }
         Ok(())
+    }
+
+    /// Ends a run that reached global slip: the tables are flushed, synced and renamed
+    /// from `NAME.partial` to `NAME` (replacing those of an earlier run), and the
+    /// directory's lock (if this writer took it) is released. Returns the tables' paths.
+    ///
+    /// # Errors
+    /// [`Error::RunDirectory`] when global slip was not recorded (the tables stay
+    /// `.partial`); [`Error::Io`] when a table cannot be written, synced or renamed.
+    pub fn finish(mut self) -> Result<[PathBuf; 3]> {
+        if !self.slipped {
+            return Err(Error::RunDirectory {
+                path: self.dir.clone(),
+                reason: format!(
+                    "the run has not reached global slip: its tables stay \
+                     NAME{PARTIAL_SUFFIX}"
+                ),
+            });
+        }
+        self.flush()?;
+        // events.csv last: a crash between the renames leaves it .partial, so a resume
+        // or a rerun still sees the run as not finished.
+        for t in [2, 1, 0] {
+            fs::rename(&self.partials[t], &self.paths[t])
+                .map_err(|e| Error::io("renaming table", &self.paths[t], e))?;
+        }
+        sync_dir(&self.dir).map_err(|e| Error::io("syncing directory", &self.dir, e))?;
+        Ok(self.paths.clone())
+    }
+}
+
+/// Removes the temporary files of the tables and the scene record that a writer killed
+/// while writing one left in `dir` (`write_atomically` names them `.NAME.tmp...`); only
+/// the lock holder writes them.
+fn remove_stale_temporaries(dir: &Path) -> Result<()> {
+    let prefixes: Vec<String> = TABLE_NAMES
+        .iter()
+        .map(|n| format!(".{n}{PARTIAL_SUFFIX}.tmp"))
+        .chain([format!(".{SCENE_RECORD}.tmp")])
+        .collect();
+    let entries = fs::read_dir(dir).map_err(|e| Error::io("reading directory", dir, e))?;
+    for entry in entries {
+        let entry = entry.map_err(|e| Error::io("reading directory", dir, e))?;
+        let name = entry.file_name();
+        let name = name.to_string_lossy();
+        if prefixes.iter().any(|p| name.starts_with(p.as_str())) {
+            match fs::remove_file(entry.path()) {
+                Err(e) if e.kind() != io::ErrorKind::NotFound => {
+                    return Err(Error::io("removing a temporary file", entry.path(), e))
+                }
+                _ => {}
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a directory whose recorded scene is not `driver`'s, or that records none.
+#[cfg(feature = "serde")]
+fn check_scene_record(dir: &Path, driver: &Driver) -> Result<()> {
+    let path = dir.join(SCENE_RECORD);
+    let text = match fs::read_to_string(&path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            return Err(Error::RunDirectory {
+                path: dir.to_path_buf(),
+                reason: format!(
+                    "it holds no {SCENE_RECORD}, the record of the scene its tables belong to \
+                     (written when a run starts), so the checkpoint cannot be checked against \
+                     them: run the scene again into this directory, or resume into a copy of \
+                     the directory of the checkpoint's run"
+                ),
+            })
+        }
+        Err(e) => return Err(Error::io("reading the scene record", &path, e)),
+    };
+    let recorded = crate::SceneBuilder::from_json_str(&text).map_err(|e| Error::RunDirectory {
+        path: path.clone(),
+        reason: format!("not a scene file ({e})"),
+    })?;
+    match crate::driver::scene_mismatch(
+        &driver.scene().to_builder(),
+        "the checkpoint's scene",
+        &recorded,
+        &format!("the scene recorded in {}", path.display()),
+    ) {
+        Some(e) => Err(e),
+        None => Ok(()),
     }
 }
 

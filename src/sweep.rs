@@ -32,6 +32,7 @@ pub use merge::{merge, t_quantile_975, MergeSummary, LOAD_GRID};
 
 use crate::driver::write_atomically;
 use crate::error::{Error, Result};
+use crate::lock::{Attempt, DirLock, LOCK_FILE};
 use crate::output::RunTables;
 use crate::scene::file::{builder_from_value, normalized_value};
 use crate::scene::{HeightSource, SceneBuilder};
@@ -222,7 +223,10 @@ pub struct RunReport {
     pub index: usize,
     /// It was complete already (its marker found) and was not run again.
     pub skipped: bool,
-    /// Events of the run (0 when skipped).
+    /// Another process holds its directory (it is running it): left to that process,
+    /// neither run nor marked complete here.
+    pub held_elsewhere: bool,
+    /// Events of the run (0 when skipped or held elsewhere).
     pub events: usize,
     /// Wall time of the run (s; 0 when skipped).
     pub seconds: f64,
@@ -238,6 +242,9 @@ pub struct SweepSummary {
     pub completed: usize,
     /// Runs of the share found complete and skipped.
     pub skipped: usize,
+    /// Runs of the share that another process was running (their directories locked):
+    /// left to it, not complete as far as this call knows.
+    pub held_elsewhere: usize,
     /// Wall time (s).
     pub seconds: f64,
 }
@@ -542,36 +549,46 @@ impl Sweep {
         Ok(self.runs.iter().filter(|r| r.index % n == k).collect())
     }
 
-    /// Runs `run` into `out/run.dir_name` (unless it is complete: its [`DONE_FILE`]
-    /// exists): the directory is emptied, then `events.csv` and `curve.csv` are written
-    /// ([`crate::output`]), then `meta.json` (the scene, the crate version, the run's
-    /// coordinates and seed, its counts and timings), then the marker, atomically. A run
-    /// cut before its marker is redone from the start.
+    /// Runs `run` into `out/run.dir_name` unless it is complete (its [`DONE_FILE`]
+    /// exists) or another process holds the directory's lock (it is running it). The
+    /// directory is locked (an advisory lock of the operating system, which ends with the
+    /// process) and emptied, then `events.csv`, `curve.csv` and `contact_map.csv` are
+    /// written ([`crate::output`]: as `NAME.partial` until global slip), then `meta.json`
+    /// (the scene, the crate version, the run's coordinates and seed, its counts and
+    /// timings), then the marker, both atomically. A run cut before its marker is redone
+    /// from the start.
     ///
     /// # Errors
     /// [`Error::Io`] for a file or directory that cannot be written; the scene's and the
     /// driver's errors.
     pub fn run_one(&self, run: &SweepRun, out: &Path) -> Result<RunReport> {
         let dir = out.join(&run.dir_name);
+        let report = |skipped, held_elsewhere| RunReport {
+            index: run.index,
+            skipped,
+            held_elsewhere,
+            events: 0,
+            seconds: 0.0,
+        };
         if dir.join(DONE_FILE).is_file() {
-            return Ok(RunReport {
-                index: run.index,
-                skipped: true,
-                events: 0,
-                seconds: 0.0,
-            });
-        }
-        if dir.exists() {
-            std::fs::remove_dir_all(&dir)
-                .map_err(|e| Error::io("removing the cut run directory", &dir, e))?;
+            return Ok(report(true, false));
         }
         std::fs::create_dir_all(&dir)
             .map_err(|e| Error::io("creating the run directory", &dir, e))?;
+        let _lock = match DirLock::try_lock(&dir)? {
+            Attempt::Locked(lock) => lock,
+            Attempt::Held(_) => return Ok(report(false, true)),
+        };
+        // Complete by a process that held the lock since the first look.
+        if dir.join(DONE_FILE).is_file() {
+            return Ok(report(true, false));
+        }
+        empty_but_lock(&dir)?;
         let started = Instant::now();
         let scene = run.scene.clone().build_with(&self.planner)?;
         let built = started.elapsed().as_secs_f64();
         let mut driver = scene.driver()?;
-        let mut tables = RunTables::create(&dir, &driver)?;
+        let mut tables = RunTables::start(&dir, &driver, None)?;
         let mut slip = None;
         let mut ruptures = 0usize;
         while let Some(event) = driver.step()? {
@@ -582,7 +599,8 @@ impl Sweep {
                 _ => {}
             }
         }
-        tables.flush()?;
+        let stable_states = tables.stable_states();
+        tables.finish()?;
         let seconds = started.elapsed().as_secs_f64();
         let mu_fn = driver.friction_coefficient() * driver.normal_load();
         let meta = serde_json::json!({
@@ -596,7 +614,7 @@ impl Sweep {
                 (k.clone(), serde_json::from_str::<Value>(v).unwrap_or(Value::Null))
             }).collect::<serde_json::Map<String, Value>>(),
             "events": driver.event_count(),
-            "stable_states": tables.stable_states(),
+            "stable_states": stable_states,
             "ruptures": ruptures,
             "mu_FN_N": mu_fn,
             "slip_force_N": slip,
@@ -616,16 +634,19 @@ impl Sweep {
         Ok(RunReport {
             index: run.index,
             skipped: false,
+            held_elsewhere: false,
             events: driver.event_count(),
             seconds,
         })
     }
 
     /// Runs share `options.shard` of the sweep into `out` on `options.jobs` threads,
-    /// skipping complete runs ([`Sweep::run_one`]); `progress` is called after each run
-    /// (from the thread that ran it). `out` keeps a copy of the sweep ([`SWEEP_FILE`]); a
-    /// directory holding another sweep is refused. The tables do not depend on the jobs
-    /// or the shards.
+    /// skipping complete runs and leaving runs that another process is running to it
+    /// ([`Sweep::run_one`]), so two processes on one directory share its runs; `progress`
+    /// is called after each run (from the thread that ran it). `out` keeps a copy of the
+    /// sweep ([`SWEEP_FILE`], checked or written under the directory's lock); a directory
+    /// holding another sweep is refused. The tables do not depend on the jobs, the shards
+    /// or the processes.
     ///
     /// On a failed run no new run starts; the runs under way finish and the first error
     /// (in run order) is returned.
@@ -680,18 +701,24 @@ impl Sweep {
         }
         let reports = reports.into_inner().unwrap_or_else(|p| p.into_inner());
         let skipped = reports.iter().filter(|r| r.skipped).count();
+        let held_elsewhere = reports.iter().filter(|r| r.held_elsewhere).count();
         Ok(SweepSummary {
             runs: share.len(),
-            completed: reports.len() - skipped,
+            completed: reports.len() - skipped - held_elsewhere,
             skipped,
+            held_elsewhere,
             seconds: started.elapsed().as_secs_f64(),
         })
     }
 
-    /// Creates `out` and writes (or checks) its copy of the sweep.
+    /// Creates `out` and writes (or checks) its copy of the sweep, under the directory's
+    /// lock: of two processes starting on a new directory, the second sees the first's
+    /// copy.
     fn prepare(&self, out: &Path) -> Result<()> {
         std::fs::create_dir_all(out)
             .map_err(|e| Error::io("creating the sweep directory", out, e))?;
+        // Held for a file's read or write; longer only by a process misusing the directory.
+        let _lock = DirLock::lock_waiting(out, std::time::Duration::from_secs(30))?;
         let path = out.join(SWEEP_FILE);
         let text = self.to_json()?;
         match std::fs::read_to_string(&path) {
@@ -708,6 +735,25 @@ impl Sweep {
             Err(e) => Err(Error::io("reading", &path, e)),
         }
     }
+}
+
+/// Removes everything in `dir` but its lock file (whose lock this process holds).
+fn empty_but_lock(dir: &Path) -> Result<()> {
+    let entries =
+        std::fs::read_dir(dir).map_err(|e| Error::io("emptying the cut run directory", dir, e))?;
+    for entry in entries {
+        let entry = entry.map_err(|e| Error::io("emptying the cut run directory", dir, e))?;
+        if entry.file_name() == LOCK_FILE {
+            continue;
+        }
+        let path = entry.path();
+        let removed = match entry.file_type() {
+            Ok(t) if t.is_dir() => std::fs::remove_dir_all(&path),
+            _ => std::fs::remove_file(&path),
+        };
+        removed.map_err(|e| Error::io("removing from the cut run directory", &path, e))?;
+    }
+    Ok(())
 }
 
 /// A step of an axis as errors show it: the value of a plain axis, the array of a linked one.

@@ -252,8 +252,32 @@ fn a_checkpoint_is_refused_on_another_scene() {
 }
 
 #[cfg(feature = "serde")]
-mod json {
+pub(crate) mod json {
     use super::*;
+
+    /// FNV-1a, 64 bits (offset basis 0xcbf29ce484222325, prime 0x100000001b3: the
+    /// published constants), written here from its definition.
+    fn fnv1a_64(bytes: &[u8]) -> u64 {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for &b in bytes {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        h
+    }
+
+    /// `text` (a checkpoint's JSON, possibly edited) with its digest recomputed, as a
+    /// deliberate editor would: the digest covers the text before `,"digest":"..."`,
+    /// closed with `}`.
+    pub(crate) fn resigned(text: &str) -> String {
+        let at = text.rfind(",\"digest\":\"").expect("a digest");
+        let body = format!("{}}}", &text[..at]);
+        format!(
+            "{},\"digest\":\"{:016x}\"}}",
+            &text[..at],
+            fnv1a_64(body.as_bytes())
+        )
+    }
 
     fn round_trip(c: Checkpoint) -> Checkpoint {
         let text = c.to_json().unwrap();
@@ -311,8 +335,18 @@ mod json {
             // The first occurrence is in the scene (the solver reports repeat F_N).
             let digest = text.find("\"scene_digest\"").unwrap();
             assert!(text.find(from).unwrap() < digest, "{from}");
-            let edited = Checkpoint::from_json_str(&text.replacen(from, to, 1)).unwrap();
-            // Resumed on its own (edited) scene, or on the original one: refused.
+            let edited = text.replacen(from, to, 1);
+            // Refused when read: the content's digest differs, and the scene's names the key.
+            match Checkpoint::from_json_str(&edited) {
+                Err(Error::CheckpointSceneMismatch { key: k, reason }) => {
+                    assert_eq!(k, key, "{reason}");
+                    assert!(reason.contains("edited"), "{reason}");
+                }
+                other => panic!("{key}: not refused when read: {other:?}"),
+            }
+            // With the content's digest recomputed, the scene's digest still refuses it:
+            // resumed on its own (edited) scene, or on the original one.
+            let edited = Checkpoint::from_json_str(&resigned(&edited)).unwrap();
             let own = edited.scene().clone().build().unwrap();
             for target in [&own, &scene] {
                 match target.resume(&edited) {
@@ -431,21 +465,90 @@ mod json {
             driver.step().unwrap();
         }
         let text = driver.checkpoint().to_json().unwrap();
-        assert!(matches!(
-            Checkpoint::from_json_str(&text[..text.len() / 2]),
-            Err(Error::InvalidCheckpoint { .. })
-        ));
-        let newer = text.replacen("\"format\":2", "\"format\":3", 1);
-        assert_ne!(newer, text);
-        let c = Checkpoint::from_json_str(&newer).unwrap();
-        assert!(matches!(
-            scene.resume(&c),
-            Err(Error::InvalidCheckpoint { .. })
-        ));
-        // A warm start of the wrong length.
+        // The test's digest is the program's.
+        assert_eq!(resigned(&text), text);
+        let refused = |text: &str| match Checkpoint::from_json_str(text) {
+            Err(Error::InvalidCheckpoint { reason }) => reason,
+            other => panic!("not refused: {other:?}"),
+        };
+        let reason = refused(&text[..text.len() / 2]);
+        assert!(reason.contains("EOF"), "{reason}");
+        // Another layout version, newer or older (older ones carry no digest): refused,
+        // saying which.
+        for (version, words) in [(4, "layout version 4"), (2, "layout version 2")] {
+            let other = text.replacen("\"format\":3", &format!("\"format\":{version}"), 1);
+            assert_ne!(other, text);
+            let reason = refused(&other);
+            assert!(
+                reason.contains(words) && reason.contains("reads version 3"),
+                "{reason}"
+            );
+        }
+        // Edits and damage: the event count, a site's state, a key this build does not
+        // know (at the top, inside), a flipped byte, a missing or altered digest.
+        let states = text.find("\"states\":[").unwrap();
+        let attached = states
+            + text[states..]
+                .find("\"Attached\"")
+                .expect("an attached site");
+        let flip = text.len() / 2;
+        let flipped = {
+            let mut bytes = text.clone().into_bytes();
+            bytes[flip] ^= 0x01;
+            String::from_utf8(bytes).unwrap()
+        };
+        let digest_at = text.rfind("\"digest\"").unwrap();
+        for (name, edited, words) in [
+            (
+                "events",
+                text.replacen("\"events\":5,", "\"events\":6,", 1),
+                "does not match its digest",
+            ),
+            (
+                "state",
+                format!(
+                    "{}\"Broken\"{}",
+                    &text[..attached],
+                    &text[attached + "\"Attached\"".len()..]
+                ),
+                "does not match its digest",
+            ),
+            (
+                "unknown key",
+                text.replacen("{\"format\"", "{\"note\":1,\"format\"", 1),
+                "unknown field `note`",
+            ),
+            (
+                "unknown key inside",
+                {
+                    // In the solver's state (the last `solver`; the first is the scene's).
+                    let at = text.rfind("\"solver\":{").unwrap() + "\"solver\":{".len();
+                    format!("{}\"note\":1,{}", &text[..at], &text[at..])
+                },
+                "does not match its digest",
+            ),
+            ("flipped byte", flipped, ""),
+            (
+                "no digest",
+                format!("{}}}", &text[..digest_at - 1]),
+                "does not end with its digest",
+            ),
+            (
+                "altered digest",
+                text.replacen("\"digest\":\"", "\"digest\":\"0", 1),
+                "does not end with its digest",
+            ),
+        ] {
+            assert_ne!(edited, text, "{name}");
+            let reason = refused(&edited);
+            assert!(reason.contains(words), "{name}: {reason}");
+        }
+        // Unedited, it is read back equal.
+        assert!(Checkpoint::from_json_str(&text).unwrap() == driver.checkpoint());
+        // A warm start of the wrong length, the digest recomputed: refused on resume.
         let key = "\"warm_normal\":[";
         let at = text.find(key).unwrap() + key.len();
-        let short = format!("{}0.0,{}", &text[..at], &text[at..]);
+        let short = resigned(&format!("{}0.0,{}", &text[..at], &text[at..]));
         let c = Checkpoint::from_json_str(&short).unwrap();
         assert!(matches!(
             scene.resume(&c),
@@ -456,8 +559,7 @@ mod json {
 
 /// The tables of a run on resume (`precursors::output`, used by `precursors run`/`resume`).
 mod tables {
-    use precursors::output::{open_table as open, rows_to_keep};
-    use std::io::Write;
+    use precursors::output::rows_to_keep;
 
     const HEADER: &str = "index,kind,force_N";
 
@@ -497,39 +599,5 @@ mod tables {
         .is_err());
         // An empty file starts with the header.
         assert_eq!(rows_to_keep("", HEADER, 3).unwrap(), "index,kind,force_N\n");
-    }
-
-    #[test]
-    fn a_resumed_table_continues_where_the_checkpoint_was() {
-        let dir = std::env::temp_dir().join(format!("precursors-{}-tables", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("events.csv");
-        // A run that crashed while writing row 4, after a checkpoint at event 2.
-        std::fs::write(
-            &path,
-            "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n3,rupture,1.5\n4,st",
-        )
-        .unwrap();
-        let mut table = open(&path, HEADER, Some(2)).unwrap();
-        writeln!(table, "3,rupture,1.5").unwrap();
-        drop(table);
-        assert_eq!(
-            std::fs::read_to_string(&path).unwrap(),
-            "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n3,rupture,1.5\n"
-        );
-        // Resumed into an empty directory: the header only; a new run: the header only.
-        std::fs::remove_file(&path).unwrap();
-        drop(open(&path, HEADER, Some(2)).unwrap());
-        assert_eq!(
-            std::fs::read_to_string(&path).unwrap(),
-            "index,kind,force_N\n"
-        );
-        std::fs::write(&path, "junk").unwrap();
-        drop(open(&path, HEADER, None).unwrap());
-        assert_eq!(
-            std::fs::read_to_string(&path).unwrap(),
-            "index,kind,force_N\n"
-        );
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -22,6 +22,8 @@ mod probe;
 mod properties;
 mod robustness;
 #[cfg(feature = "serde")]
+mod runs;
+#[cfg(feature = "serde")]
 mod scene_file;
 mod solver;
 mod stability;

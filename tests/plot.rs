@@ -67,7 +67,7 @@ fn the_contact_map_is_the_state_in_effect_at_each_load_level() {
             _ => {}
         }
     }
-    tables.flush().unwrap();
+    tables.finish().unwrap();
     assert!(slip > 0.9 && states.len() > 10, "{slip} {}", states.len());
     // The reference: level k·step from the first state's up to the slip load (levels
     // below the load, rounding aside), each with the last stable state at or below it.
@@ -129,8 +129,7 @@ fn resumed_tables_end_as_the_uninterrupted_ones() {
             }
         }
     }
-    tables.flush().unwrap();
-    drop(tables);
+    tables.finish().unwrap();
     // The same run, killed some events after the checkpoint (its tables hold rows past
     // it, the last one cut), then resumed.
     let cut = scratch("cut");
@@ -143,7 +142,7 @@ fn resumed_tables_end_as_the_uninterrupted_ones() {
     }
     tables.flush().unwrap();
     drop(tables);
-    let map = cut.join("contact_map.csv");
+    let map = cut.join("contact_map.csv.partial");
     let text = std::fs::read_to_string(&map).unwrap();
     std::fs::write(&map, &text[..text.len() - 7]).unwrap();
     let mut driver = scene.resume(&checkpoint).unwrap();
@@ -151,7 +150,7 @@ fn resumed_tables_end_as_the_uninterrupted_ones() {
     while let Some(event) = driver.step().unwrap() {
         tables.record(&driver, &event).unwrap();
     }
-    tables.flush().unwrap();
+    tables.finish().unwrap();
     for name in ["events.csv", "curve.csv", "contact_map.csv"] {
         let a = std::fs::read_to_string(whole.join(name)).unwrap();
         let b = std::fs::read_to_string(cut.join(name)).unwrap();
@@ -361,7 +360,7 @@ fn a_run_directory_gets_its_three_figures() {
     while let Some(event) = driver.step().unwrap() {
         tables.record(&driver, &event).unwrap();
     }
-    tables.flush().unwrap();
+    tables.finish().unwrap();
     let drawn = draw(&dir, &[Format::Png, Format::Svg]).unwrap();
     let mut names: Vec<String> = drawn
         .files

@@ -356,9 +356,9 @@ fn run(
     every: u64,
     progress: bool,
 ) -> Result<(), Failure> {
-    writable_dir(out)?;
     let (scene, mut driver, mut tables) = match start {
         Start::Scene(path) => {
+            writable_dir(out)?;
             let scene = SceneBuilder::from_json_file(path)?.build()?;
             let driver = scene.driver()?;
             let tables = RunTables::create(out, &driver)?;
@@ -368,7 +368,8 @@ fn run(
             let checkpoint = Checkpoint::read_from(path)?;
             let scene = checkpoint.scene().clone().build()?;
             let driver = scene.resume(&checkpoint)?;
-            // Keep the rows up to the checkpoint (a crashed run may have written more).
+            // Keep the rows up to the checkpoint (a crashed run may have written more),
+            // once the directory's scene and tables are checked against it.
             let k = checkpoint.event_count();
             let tables = RunTables::resume(out, &driver)?;
             eprintln!("resumed at event {k} from {}", path.display());
@@ -409,10 +410,9 @@ fn run(
         }
         bar.show(false, |elapsed| line(&driver, elapsed));
     }
-    tables.flush()?;
+    let [events_path, curve_path, map_path] = tables.finish()?;
     bar.show(true, |elapsed| line(&driver, elapsed));
     bar.finish();
-    let [events_path, curve_path, map_path] = tables.paths();
     eprintln!(
         "global slip after {} events at F/(μF_N) = {:.6}; wrote {}, {} and {}",
         driver.event_count(),
@@ -525,10 +525,8 @@ fn run_sweep(
     let options = SweepOptions::new().jobs(jobs).shard(shard.0, shard.1);
     let summary = sweep.execute(out, &options, |report| {
         let d = done.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1;
-        let r = ran.fetch_add(
-            usize::from(!report.skipped),
-            std::sync::atomic::Ordering::SeqCst,
-        ) + usize::from(!report.skipped);
+        let here = usize::from(!report.skipped && !report.held_elsewhere);
+        let r = ran.fetch_add(here, std::sync::atomic::Ordering::SeqCst) + here;
         if let Ok(mut bar) = bar.lock() {
             bar.show(d == share, |elapsed| {
                 let rate = r as f64 / elapsed.max(1e-9);
@@ -544,8 +542,12 @@ fn run_sweep(
     if let Ok(bar) = bar.lock() {
         bar.finish();
     }
+    let held = match summary.held_elsewhere {
+        0 => String::new(),
+        h => format!(", {h} left to another process running them (merge once it ends)"),
+    };
     eprintln!(
-        "{} runs done, {} skipped (complete already), in {:.1} s; results in {}",
+        "{} runs done, {} skipped (complete already){held}, in {:.1} s; results in {}",
         summary.completed,
         summary.skipped,
         summary.seconds,

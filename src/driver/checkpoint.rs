@@ -16,8 +16,13 @@ use crate::solver::{NormalEquilibrium, SolverState, TangentialResponse};
 use crate::Event;
 
 /// Version of the checkpoint layout; a checkpoint of another version is refused.
-/// Version 2: the scene digest; the dense backend's one factor.
-const FORMAT: u32 = 2;
+/// Version 2: the scene digest; the dense backend's one factor. Version 3: the JSON form
+/// ends with a digest of its whole content; unknown keys are refused.
+const FORMAT: u32 = 3;
+
+/// The last key of a checkpoint's JSON form: its digest ([`Checkpoint::to_json`]).
+#[cfg(feature = "serde")]
+const DIGEST_KEY: &str = ",\"digest\":\"";
 
 /// FNV-1a (64 bits) of a text: a digest that is the same on every platform and build.
 fn fnv1a(text: &str) -> u64 {
@@ -43,6 +48,25 @@ fn first_difference(a: &[(String, u64)], b: &[(String, u64)]) -> Option<String> 
         .map(|(key, _)| key.clone())
 }
 
+/// [`Error::CheckpointSceneMismatch`] naming the first option in which `b` describes
+/// another run than `a` (`a_is`, `b_is`: what each scene is, for the message), if any.
+pub(crate) fn scene_mismatch(
+    a: &SceneBuilder,
+    a_is: &str,
+    b: &SceneBuilder,
+    b_is: &str,
+) -> Option<Error> {
+    let key = a.run_difference(b)?;
+    Some(Error::CheckpointSceneMismatch {
+        reason: format!(
+            "{a_is} has {}, {b_is} has {}",
+            value_of(a, &key),
+            value_of(b, &key)
+        ),
+        key,
+    })
+}
+
 /// The value of `key` in `scene`, shortened for a message.
 fn value_of(scene: &SceneBuilder, key: &str) -> String {
     match scene.run_keys().into_iter().find(|(k, _)| k == key) {
@@ -63,7 +87,10 @@ fn value_of(scene: &SceneBuilder, key: &str) -> String {
 /// A checkpoint holds its scene and a digest of it (a hash of every option by its
 /// scene-file key): [`Scene::resume`] refuses, naming the first differing key, a scene
 /// that differs from the checkpoint's and a checkpoint whose stored scene was edited
-/// after it was taken ([`Error::CheckpointSceneMismatch`]).
+/// after it was taken ([`Error::CheckpointSceneMismatch`]). Its JSON form also ends with
+/// a digest of its whole content (FNV-1a, 64 bits: it detects edits and damage, it is no
+/// signature), checked when it is read: an edited count, site state or number, or a
+/// damaged file, is refused with the reason.
 ///
 /// ```
 /// use precursors::{Event, Scene};
@@ -80,6 +107,7 @@ fn value_of(scene: &SceneBuilder, key: &str) -> String {
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Checkpoint {
     format: u32,
     scene: SceneBuilder,
@@ -107,26 +135,37 @@ impl Checkpoint {
         self.events
     }
 
-    /// The checkpoint as compact JSON (feature `serde`).
+    /// The checkpoint as compact JSON (feature `serde`), ending with the key `digest`:
+    /// the FNV-1a (64 bits, 16 hexadecimal digits) of the text before it closed with `}`,
+    /// that is of the checkpoint's compact JSON without its digest.
     ///
     /// # Errors
     /// [`Error::InvalidCheckpoint`] if serialisation fails (it does not for a checkpoint
     /// taken by [`Driver::checkpoint`]).
     #[cfg(feature = "serde")]
     pub fn to_json(&self) -> Result<String> {
-        serde_json::to_string(self).map_err(|e| Error::InvalidCheckpoint {
+        let body = serde_json::to_string(self).map_err(|e| Error::InvalidCheckpoint {
             reason: format!("cannot be written as JSON: {e}"),
-        })
+        })?;
+        let open = body.strip_suffix('}').unwrap_or(&body);
+        Ok(format!("{open}{DIGEST_KEY}{:016x}\"}}", fnv1a(&body)))
     }
 
-    /// Reads a checkpoint written by [`Checkpoint::to_json`] (feature `serde`).
+    /// Reads a checkpoint written by [`Checkpoint::to_json`] (feature `serde`) and checks
+    /// its digest.
     ///
     /// # Errors
-    /// [`Error::InvalidCheckpoint`] when `text` is not a checkpoint.
+    /// [`Error::InvalidCheckpoint`] when `text` is not a checkpoint (not JSON, cut short,
+    /// an unknown key), is of another layout version, or does not match its digest (it
+    /// was edited or damaged); [`Error::CheckpointSceneMismatch`], naming the key, when
+    /// the edit is in its scene.
     #[cfg(feature = "serde")]
     pub fn from_json_str(text: &str) -> Result<Checkpoint> {
-        serde_json::from_str(text).map_err(|e| Error::InvalidCheckpoint {
-            reason: format!("not a checkpoint: {e}"),
+        verified(text).map_err(|refusal| match refusal {
+            Refusal::Scene(e) => e,
+            Refusal::Reason(reason) => Error::InvalidCheckpoint {
+                reason: format!("not a valid checkpoint: {reason}"),
+            },
         })
     }
 
@@ -153,17 +192,82 @@ impl Checkpoint {
     ///
     /// # Errors
     /// [`Error::Io`] when the file cannot be read; [`Error::CheckpointFile`], with the
-    /// path, when it holds no checkpoint (not JSON, cut short, another layout).
+    /// path, when it holds no valid checkpoint (not JSON, cut short, an unknown key,
+    /// another layout version, a content that does not match its digest);
+    /// [`Error::CheckpointSceneMismatch`] as [`Checkpoint::from_json_str`].
     #[cfg(feature = "serde")]
     pub fn read_from(path: impl AsRef<std::path::Path>) -> Result<Checkpoint> {
         let path = path.as_ref();
         let text =
             std::fs::read_to_string(path).map_err(|e| Error::io("reading checkpoint", path, e))?;
-        serde_json::from_str(&text).map_err(|e| Error::CheckpointFile {
-            path: path.display().to_string(),
-            reason: e.to_string(),
+        verified(&text).map_err(|refusal| match refusal {
+            Refusal::Scene(e) => e,
+            Refusal::Reason(reason) => Error::CheckpointFile {
+                path: path.display().to_string(),
+                reason,
+            },
         })
     }
+}
+
+/// Why a checkpoint's text was refused.
+#[cfg(feature = "serde")]
+enum Refusal {
+    /// Its scene was edited: the error names the key.
+    Scene(Error),
+    /// Anything else.
+    Reason(String),
+}
+
+/// The checkpoint of `text` once its version, keys and digest are checked.
+#[cfg(feature = "serde")]
+fn verified(text: &str) -> std::result::Result<Checkpoint, Refusal> {
+    /// The version alone, read before the layout it decides.
+    #[derive(serde::Deserialize)]
+    struct Version {
+        format: Option<u32>,
+    }
+    let reason = |r: String| Refusal::Reason(r);
+    let text = text.trim_end();
+    let version: Version = serde_json::from_str(text).map_err(|e| reason(e.to_string()))?;
+    match version.format {
+        None => return Err(reason("it has no `format` key".into())),
+        Some(v) if v != FORMAT => {
+            return Err(reason(format!(
+                "layout version {v}, this build reads version {FORMAT} (version 3 added a \
+                 digest of the whole content): resume it with the precursors version that \
+                 wrote it, or start the run again"
+            )))
+        }
+        Some(_) => {}
+    }
+    let no_digest = || reason("it does not end with its digest (the key `digest`)".into());
+    let at = text.rfind(DIGEST_KEY).ok_or_else(no_digest)?;
+    let hex = text[at + DIGEST_KEY.len()..]
+        .strip_suffix("\"}")
+        .filter(|h| h.len() == 16)
+        .ok_or_else(no_digest)?;
+    let stored = u64::from_str_radix(hex, 16).map_err(|_| no_digest())?;
+    let body = format!("{}}}", &text[..at]);
+    let checkpoint: Checkpoint = serde_json::from_str(&body).map_err(|e| reason(e.to_string()))?;
+    if fnv1a(&body) != stored {
+        if let Some(key) = first_difference(&checkpoint.scene_digest, &digest(&checkpoint.scene)) {
+            return Err(Refusal::Scene(Error::CheckpointSceneMismatch {
+                reason: format!(
+                    "the scene stored in the checkpoint was edited after the checkpoint was \
+                     taken (its digest differs; it now holds {})",
+                    value_of(&checkpoint.scene, &key)
+                ),
+                key,
+            }));
+        }
+        return Err(reason(
+            "its content does not match its digest: it was edited or damaged after it was \
+             written"
+                .into(),
+        ));
+    }
+    Ok(checkpoint)
 }
 
 impl Driver {
@@ -219,15 +323,13 @@ impl Scene {
             });
         }
         let mine = self.to_builder();
-        if let Some(key) = checkpoint.scene.run_difference(&mine) {
-            return Err(Error::CheckpointSceneMismatch {
-                reason: format!(
-                    "the checkpoint's scene has {}, the scene resumed on has {}",
-                    value_of(&checkpoint.scene, &key),
-                    value_of(&mine, &key)
-                ),
-                key,
-            });
+        if let Some(e) = scene_mismatch(
+            &checkpoint.scene,
+            "the checkpoint's scene",
+            &mine,
+            "the scene resumed on",
+        ) {
+            return Err(e);
         }
         let mut driver = self.driver()?;
         let n = self.grid().len();
@@ -303,7 +405,6 @@ impl Scene {
 /// # Errors
 /// [`Error::Io`] with `operation` and the path of the file that could not be written,
 /// synced or renamed (the temporary file is removed).
-#[cfg(feature = "serde")]
 pub(crate) fn write_atomically(
     path: &std::path::Path,
     bytes: &[u8],
@@ -351,9 +452,15 @@ pub(crate) fn write_atomically(
         let _ = std::fs::remove_file(&tmp);
         return Err(io(path, e));
     }
+    sync_dir(dir).map_err(|e| io(dir, e))
+}
+
+/// Syncs a directory's entries (a rename into it) to disk; a no-op where directories
+/// cannot be opened (Windows).
+pub(crate) fn sync_dir(dir: &std::path::Path) -> std::io::Result<()> {
     #[cfg(unix)]
-    std::fs::File::open(dir)
-        .and_then(|d| d.sync_all())
-        .map_err(|e| io(dir, e))?;
+    std::fs::File::open(dir)?.sync_all()?;
+    #[cfg(not(unix))]
+    let _ = dir;
     Ok(())
 }

@@ -1,0 +1,226 @@
+//! Advisory locks on directories: a run directory while a process writes it
+//! ([`crate::output::RunTables`], a sweep's run), a sweep directory while its `sweep.json`
+//! is checked or written.
+//!
+//! The lock is the operating system's (`File::try_lock`: `flock` on Unix, `LockFileEx` on
+//! Windows) on the file [`LOCK_FILE`] in the directory, so it dies with its process, also
+//! when the process is killed: a lock is never stale. The holder writes who it is into the
+//! file (pid, host, start time, command) for the message of a refused process, and empties
+//! it when it lets go. The file itself stays: removing it would let a process that opened
+//! it just before lock a file no longer in the directory while a third one locks a new
+//! file of the same name.
+
+use crate::error::{Error, Result};
+use std::fs::{File, OpenOptions, TryLockError};
+use std::io::{Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+/// The lock file of a run or sweep directory.
+pub(crate) const LOCK_FILE: &str = ".precursors.lock";
+
+/// An exclusive lock on a directory, released (and its file emptied) on drop.
+#[derive(Debug)]
+pub(crate) struct DirLock {
+    file: File,
+}
+
+/// What [`DirLock::try_lock`] found.
+#[derive(Debug)]
+pub(crate) enum Attempt {
+    /// This process holds the lock now.
+    Locked(DirLock),
+    /// Another process (or another open of the file in this one) holds it: who, as it
+    /// wrote it.
+    Held(String),
+}
+
+impl DirLock {
+    /// Takes the lock of `dir` (which must exist) if no one holds it; never waits.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the lock file cannot be opened, locked or written.
+    pub(crate) fn try_lock(dir: &Path) -> Result<Attempt> {
+        let path = dir.join(LOCK_FILE);
+        // Not truncated on open: the holder's name is in it.
+        let mut file = OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&path)
+            .map_err(|e| Error::io("opening the lock file", &path, e))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(TryLockError::WouldBlock) => return Ok(Attempt::Held(holder(&path))),
+            Err(TryLockError::Error(e)) => return Err(Error::io("locking", &path, e)),
+        }
+        let me = identity();
+        file.set_len(0)
+            .and_then(|()| file.seek(SeekFrom::Start(0)))
+            .and_then(|_| file.write_all(me.as_bytes()))
+            .map_err(|e| Error::io("writing the lock file", &path, e))?;
+        Ok(Attempt::Locked(DirLock { file }))
+    }
+
+    /// Takes the lock of `dir`, refusing at once when another process holds it.
+    ///
+    /// # Errors
+    /// [`Error::DirectoryLocked`] naming the holder; [`Error::Io`] as
+    /// [`DirLock::try_lock`].
+    pub(crate) fn lock(dir: &Path) -> Result<DirLock> {
+        match Self::try_lock(dir)? {
+            Attempt::Locked(lock) => Ok(lock),
+            Attempt::Held(holder) => Err(locked(dir, holder)),
+        }
+    }
+
+    /// Takes the lock of `dir`, waiting up to `patience` for a holder that keeps it
+    /// briefly (a sweep's `sweep.json` check).
+    ///
+    /// # Errors
+    /// [`Error::DirectoryLocked`] naming the holder when it still holds the lock after
+    /// `patience`; [`Error::Io`] as [`DirLock::try_lock`].
+    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
+    pub(crate) fn lock_waiting(dir: &Path, patience: Duration) -> Result<DirLock> {
+        let start = Instant::now();
+        loop {
+            match Self::try_lock(dir)? {
+                Attempt::Locked(lock) => return Ok(lock),
+                Attempt::Held(holder) if start.elapsed() >= patience => {
+                    return Err(locked(dir, holder))
+                }
+                Attempt::Held(_) => std::thread::sleep(Duration::from_millis(10)),
+            }
+        }
+    }
+}
+
+impl Drop for DirLock {
+    fn drop(&mut self) {
+        // Emptied first, so a finished directory holds an empty lock file whoever wrote
+        // it; closing the file would release the lock anyway.
+        let _ = self.file.set_len(0);
+        let _ = self.file.unlock();
+    }
+}
+
+fn locked(dir: &Path, holder: String) -> Error {
+    Error::DirectoryLocked {
+        path: PathBuf::from(dir),
+        holder,
+    }
+}
+
+/// The holder as it described itself in the lock file.
+fn holder(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    let text = text.trim();
+    if text.is_empty() {
+        // It locked the file and has not written its name yet (microseconds).
+        return "a process that has not written its name yet".into();
+    }
+    shorten(text, 400)
+}
+
+/// Who this process is: `pid P on host H, since T: COMMAND`.
+fn identity() -> String {
+    let host = std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .map(|h| h.trim().to_string())
+        .filter(|h| !h.is_empty());
+    let command: Vec<String> = std::env::args_os()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect();
+    format!(
+        "pid {}{}, since {}: {}",
+        std::process::id(),
+        host.map(|h| format!(" on host {h}")).unwrap_or_default(),
+        started(),
+        shorten(&command.join(" "), 300)
+    )
+}
+
+/// The process's start as UTC `YYYY-MM-DDTHH:MM:SSZ` (the time of the first call:
+/// close enough, the lock is taken early).
+fn started() -> String {
+    static START: std::sync::OnceLock<SystemTime> = std::sync::OnceLock::new();
+    let since = START
+        .get_or_init(SystemTime::now)
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    utc(since)
+}
+
+/// Seconds since 1970-01-01T00:00:00Z as UTC `YYYY-MM-DDTHH:MM:SSZ`.
+fn utc(since: u64) -> String {
+    let (days, secs) = ((since / 86_400) as i64, since % 86_400);
+    // Days to a civil date (H. Hinnant's algorithm, proleptic Gregorian calendar).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        secs / 3600,
+        (secs % 3600) / 60,
+        secs % 60
+    )
+}
+
+/// `text` cut to `max` characters (with `...`).
+fn shorten(text: &str, max: usize) -> String {
+    if text.chars().count() <= max {
+        text.to_string()
+    } else {
+        format!("{}...", text.chars().take(max - 3).collect::<String>())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_held_lock_is_refused_naming_its_holder_and_released_on_drop() {
+        let dir = std::env::temp_dir().join(format!("precursors-lock-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let first = DirLock::lock(&dir).unwrap();
+        // Another open of the file, even in this process, is another holder.
+        match DirLock::lock(&dir) {
+            Err(Error::DirectoryLocked { holder, .. }) => {
+                assert!(
+                    holder.starts_with(&format!("pid {}", std::process::id())),
+                    "{holder}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+        let e = DirLock::lock_waiting(&dir, Duration::from_millis(30)).unwrap_err();
+        assert!(matches!(e, Error::DirectoryLocked { .. }), "{e:?}");
+        drop(first);
+        assert_eq!(std::fs::read(dir.join(LOCK_FILE)).unwrap(), b"");
+        drop(DirLock::lock(&dir).unwrap());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn times_are_utc_dates() {
+        // References: Python's datetime.fromtimestamp(s, timezone.utc).
+        for (s, t) in [
+            (0, "1970-01-01T00:00:00Z"),
+            (951_825_600, "2000-02-29T12:00:00Z"),
+            (1_709_251_199, "2024-02-29T23:59:59Z"),
+            (4_102_444_800, "2100-01-01T00:00:00Z"),
+        ] {
+            assert_eq!(utc(s), t);
+        }
+        assert_eq!(started().len(), 20);
+    }
+}
