@@ -13,7 +13,7 @@ import sys
 # Bottom to top. A module may import only from rows above its own.
 LAYERS = [
     ["error"],
-    ["geometry"],
+    ["geometry", "lock"],
     ["green"],
     ["interface"],
     ["solver"],
