@@ -212,10 +212,13 @@ pub enum Error {
     },
     /// An explicit thread count above one with the dense backend, which runs on one
     /// thread (its factor solve needs the whole attached set).
+    // Spelled as the scene file spells them (`solver.backend`, `solver.threads`): most
+    // users meet this message from a scene file.
     #[error(
-        "Backend::Dense runs on one thread, but Parallelism::Threads({threads}) was asked for: \
-         use Backend::Spectral (or Backend::Auto above {auto_limit} cells) to solve on several \
-         threads, or Parallelism::Sequential with the dense backend",
+        "backend \"dense\" runs on one thread, but threads {threads} was asked for: use \
+         backend \"spectral\" (or \"auto\" above {auto_limit} cells) to solve on several \
+         threads, or threads 1 with backend \"dense\" (scene file: solver.backend, \
+         solver.threads)",
         auto_limit = crate::solver::AUTO_DENSE_LIMIT
     )]
     DenseThreads {
@@ -223,7 +226,7 @@ pub enum Error {
         threads: usize,
     },
     /// The operating system refused the solver's threads.
-    #[error("could not start a pool of {threads} solver threads: {source}")]
+    #[error("could not start a pool of {threads} solver threads: {}", Bounded(&source.to_string()))]
     ThreadPool {
         /// Threads requested ([`crate::SolverOptions::parallelism`]).
         threads: usize,
@@ -301,14 +304,18 @@ pub enum Error {
         tolerance: f64,
     },
     /// A factorisation met a non-positive pivot (the system lost definiteness to rounding).
-    #[error("LDLT factorisation of the {n} x {n} attached-set matrix failed: {reason}")]
+    #[error(
+        "LDLT factorisation of the {n} x {n} attached-set matrix failed: {}",
+        Bounded(reason)
+    )]
     Factorization {
         /// Size of the matrix.
         n: usize,
-        /// What went wrong (the pivot and its value, or faer's error).
+        /// What went wrong, in words (the pivot and its value).
         reason: String,
-        /// faer's error, when faer reported one (a pivot found non-positive afterwards
-        /// has none).
+        /// Another library's error behind it, when it has a message a user can read
+        /// (`None` for faer's pivot errors: their text is a Rust debug dump, and `reason`
+        /// says the same in words).
         #[source]
         source: Option<Cause>,
     },
@@ -325,7 +332,7 @@ pub enum Error {
         source: std::io::Error,
     },
     /// A heights file has a line that is not a finite, positive height in metres.
-    #[error("{path}, line {line}: {reason}")]
+    #[error("{path}, line {line}: {}", Bounded(reason))]
     HeightsFile {
         /// The file.
         path: String,
@@ -335,7 +342,11 @@ pub enum Error {
         reason: String,
     },
     /// A scene file is not valid JSON or does not follow `docs/scene-format.md`.
-    #[error("scene file{}: {source}", path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default())]
+    #[error(
+        "scene file{}: {}",
+        path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default(),
+        Bounded(&source.to_string())
+    )]
     SceneFile {
         /// The file (`None` for JSON text given directly).
         path: Option<PathBuf>,
@@ -348,7 +359,7 @@ pub enum Error {
         source: Cause,
     },
     /// A checkpoint does not fit the scene it is resumed on, or is inconsistent.
-    #[error("checkpoint refused: {reason}")]
+    #[error("checkpoint refused: {}", Bounded(reason))]
     InvalidCheckpoint {
         /// Why.
         reason: String,
@@ -374,7 +385,10 @@ pub enum Error {
     /// A checkpoint belongs to another scene: the scene it is resumed on differs from the
     /// checkpoint's, or the scene stored in the checkpoint was edited after it was taken
     /// (its digest no longer matches).
-    #[error("checkpoint refused: the scenes differ at `{key}`: {reason}")]
+    #[error(
+        "checkpoint refused: the scenes differ at `{key}`: {}",
+        Bounded(reason)
+    )]
     CheckpointSceneMismatch {
         /// The first differing option, by its scene-file key path (`block.lx`,
         /// `normal_load`, `drive.lateral.height`, ...).
@@ -384,7 +398,7 @@ pub enum Error {
     },
     /// A checkpoint file holds no valid checkpoint (a read or write failure of the file
     /// itself is [`Error::Io`]).
-    #[error("{path}: not a checkpoint: {reason}")]
+    #[error("{path}: not a checkpoint: {}", Bounded(reason))]
     CheckpointFile {
         /// The file.
         path: String,
@@ -396,7 +410,11 @@ pub enum Error {
     /// a whole number ([`crate::output::rows_to_keep`]), or rows that do not reach the
     /// checkpoint's event or do not agree with the other tables
     /// ([`crate::output::RunTables::resume`]).
-    #[error("table{}: {reason}", path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default())]
+    #[error(
+        "table{}: {}",
+        path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default(),
+        Bounded(reason)
+    )]
     CorruptTable {
         /// The file (`None` for text given directly).
         path: Option<PathBuf>,
@@ -405,7 +423,11 @@ pub enum Error {
     },
     /// A sweep file is not valid JSON or does not follow `docs/sweep-format.md` outside
     /// its axes (an axis's key or values: [`Error::SweepKey`]).
-    #[error("sweep file{}: {source}", path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default())]
+    #[error(
+        "sweep file{}: {}",
+        path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default(),
+        Bounded(&source.to_string())
+    )]
     SweepFile {
         /// The file (`None` for JSON text given directly).
         path: Option<PathBuf>,
@@ -419,16 +441,21 @@ pub enum Error {
     },
     /// An axis of a sweep names a key that is not a scene key, or one of its values does
     /// not give a valid scene (the value's type, or the scene's own check of it).
-    #[error("sweep axis `{key}`: {reason}")]
+    #[error("sweep axis `{}`: {}", Bounded(key), Bounded(reason))]
     SweepKey {
         /// The axis's key, a dotted scene-file path (`block.lx`, `drive.height`, ...).
         key: String,
         /// What is wrong, with the value when one is at fault.
         reason: String,
     },
-    /// A figure cannot be drawn or written (feature `plot`): an unknown file extension, an
-    /// invalid axis range, a drawing backend that fails.
-    #[error("figure{}: {reason}", path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default())]
+    /// A figure cannot be drawn (feature `plot`): an unknown file extension, an invalid
+    /// axis range or size, a drawing backend that fails. A figure that cannot be written
+    /// to its file is [`Error::Io`].
+    #[error(
+        "figure{}: {}",
+        path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default(),
+        Bounded(reason)
+    )]
     Figure {
         /// The figure's file, when known.
         path: Option<PathBuf>,
@@ -437,7 +464,7 @@ pub enum Error {
     },
     /// A sweep's output directory cannot be used: it holds another sweep, or (for a
     /// merge) no sweep or a run's files that do not belong to it.
-    #[error("sweep directory {}: {reason}", path.display())]
+    #[error("sweep directory {}: {}", path.display(), Bounded(reason))]
     SweepDirectory {
         /// The directory or the file at fault.
         path: PathBuf,
@@ -461,12 +488,30 @@ pub enum Error {
     /// A run directory cannot be continued or finished: it has no record of its scene
     /// (`scene.json`), or a checkpoint taken inside an avalanche, or the run did not reach
     /// global slip.
-    #[error("run directory {}: {reason}", path.display())]
+    #[error("run directory {}: {}", path.display(), Bounded(reason))]
     RunDirectory {
         /// The directory, or its file at fault.
         path: PathBuf,
         /// What is wrong.
         reason: String,
+    },
+    /// A table that `merge` or `plot` reads holds, where a number belongs, a value that is
+    /// not a finite number (`NaN`, `inf`, an empty cell): a damaged or edited table, which
+    /// would turn every statistic and figure made from it into NaN.
+    #[error(
+        "table {}, line {line}, column {column}: {} is not a finite number",
+        path.display(),
+        Bounded(&format!("{value:?}"))
+    )]
+    NonFiniteCell {
+        /// The file.
+        path: PathBuf,
+        /// Line number (1-based; the header is line 1).
+        line: usize,
+        /// The column's name in the header.
+        column: String,
+        /// The cell's text.
+        value: String,
     },
 }
 
@@ -541,14 +586,174 @@ pub(crate) fn check_slice(name: &'static str, values: &[f64], expected: usize) -
 /// assert_eq!(messages(&e), vec!["reading scene file /x/y.json: no such file".to_string()]);
 /// ```
 pub fn messages(error: &(dyn std::error::Error + 'static)) -> Vec<String> {
-    let mut out = vec![error.to_string()];
+    let mut out = vec![bounded(&error.to_string()).into_owned()];
     let mut source = error.source();
     while let Some(cause) = source {
-        let text = cause.to_string();
+        let text = bounded(&cause.to_string()).into_owned();
         if !out.last().is_some_and(|previous| previous.ends_with(&text)) {
             out.push(text);
         }
         source = cause.source();
     }
     out
+}
+
+/// A quoted value longer than this (in characters) is cut in a message.
+const LONGEST_VALUE: usize = 120;
+/// A cut value keeps its first this many characters (then `... (N bytes)`): a cut value
+/// is no longer than [`LONGEST_VALUE`], so cutting twice changes nothing.
+const KEPT: usize = 80;
+/// Text between quoted values longer than this is cut too: the messages' own prose is
+/// shorter, so only a value that holds quote characters itself reaches it.
+const LONGEST_PROSE: usize = 1000;
+/// Whatever its pieces, a message longer than this (in bytes) is cut as a whole.
+const LONGEST_MESSAGE: usize = 4096;
+
+/// `text` (a message, or a value to echo in one) with every value quoted in it (between
+/// backticks, or between double quotes with backslash escapes, as the JSON parser and
+/// `{:?}` quote) longer than [`LONGEST_VALUE`] characters cut to its first [`KEPT`] and its
+/// length: `"aaaa... (104857600 bytes)"`. A scene file can hold a 100 MB string, and the
+/// parser echoes an unknown variant or field whole. Every message of [`enum@Error`] that
+/// carries text from a file goes through it, and so does [`messages`].
+pub(crate) fn bounded(text: &str) -> std::borrow::Cow<'_, str> {
+    fn push_cut(out: &mut String, piece: &str, longest: usize) {
+        match piece.char_indices().nth(longest) {
+            None => out.push_str(piece),
+            Some(_) => {
+                let end = piece
+                    .char_indices()
+                    .nth(KEPT)
+                    .map_or(piece.len(), |(i, _)| i);
+                out.push_str(&piece[..end]);
+                out.push_str(&format!("... ({} bytes)", piece.len()));
+            }
+        }
+    }
+    /// The byte index of the quote closing the one at `open` (or `text.len()`).
+    fn closing(text: &str, open: usize) -> usize {
+        let bytes = text.as_bytes();
+        let quote = bytes[open];
+        let mut i = open + 1;
+        while i < bytes.len() && bytes[i] != quote {
+            // A backslash escapes the next character in double quotes (`{:?}`, JSON).
+            i += if quote == b'"' && bytes[i] == b'\\' {
+                2
+            } else {
+                1
+            };
+        }
+        i.min(bytes.len())
+    }
+    if text.len() <= KEPT {
+        return text.into();
+    }
+    let mut out = String::new();
+    let mut prose = 0;
+    let mut i = 0;
+    let bytes = text.as_bytes();
+    while i < bytes.len() {
+        if bytes[i] == b'`' || bytes[i] == b'"' {
+            push_cut(&mut out, &text[prose..i], LONGEST_PROSE);
+            let end = closing(text, i);
+            out.push(char::from(bytes[i]));
+            push_cut(&mut out, &text[i + 1..end], LONGEST_VALUE);
+            if end < bytes.len() {
+                out.push(char::from(bytes[end]));
+            }
+            i = end + 1;
+            prose = i.min(bytes.len());
+        } else {
+            i += 1;
+        }
+    }
+    push_cut(&mut out, &text[prose..], LONGEST_PROSE);
+    if out.len() > LONGEST_MESSAGE {
+        let whole = out;
+        out = String::new();
+        push_cut(&mut out, &whole, KEPT);
+    }
+    if out == text {
+        text.into()
+    } else {
+        out.into()
+    }
+}
+
+/// Displays [`bounded`] text: `format!("{}", Bounded(reason))`.
+pub(crate) struct Bounded<'a>(pub(crate) &'a str);
+
+impl std::fmt::Display for Bounded<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&bounded(self.0))
+    }
+}
+
+/// The number in the cell `text` of column `column` (named as in the header), line `line`
+/// (1-based) of the table `path`: a finite `f64`. What `merge` and `plot` read from a
+/// run's tables, so that a damaged or edited cell is refused with its place, not carried
+/// into every statistic and figure as NaN.
+///
+/// # Errors
+/// [`Error::NonFiniteCell`] for `NaN`, an infinity or an empty cell;
+/// [`Error::CorruptTable`] for text that is not a number.
+#[cfg(feature = "serde")]
+pub(crate) fn table_number(
+    path: &std::path::Path,
+    line: usize,
+    column: &str,
+    text: &str,
+) -> Result<f64> {
+    let value: Result<f64> = text.parse().map_err(|e| Error::CorruptTable {
+        path: Some(path.to_path_buf()),
+        reason: format!("line {line}, column {column}: {text:?} is not a number ({e})"),
+    });
+    match value {
+        Ok(v) if v.is_finite() => Ok(v),
+        Err(_) if !text.is_empty() => value,
+        _ => Err(Error::NonFiniteCell {
+            path: path.to_path_buf(),
+            line,
+            column: column.to_string(),
+            value: text.to_string(),
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::bounded;
+
+    #[test]
+    fn long_quoted_values_are_cut_once_and_prose_is_kept() {
+        let long = "y".repeat(1000);
+        let cut = format!("{}... (1000 bytes)", "y".repeat(80));
+        let text = format!("unknown field `{long}`, expected one of `lx`, `ly` at line 1");
+        let once = bounded(&text).into_owned();
+        assert_eq!(
+            once,
+            format!("unknown field `{cut}`, expected one of `lx`, `ly` at line 1")
+        );
+        assert_eq!(bounded(&once), once);
+        // `{:?}` quoting: an escaped quote does not end the value.
+        let text = format!(
+            "invalid type: string {:?}, expected f64",
+            format!("a\"{long}")
+        );
+        let once = bounded(&text).into_owned();
+        assert!(once.ends_with("(1003 bytes)\", expected f64"), "{once}");
+        // Short messages, quotes and all, are left alone.
+        let short = "cell \"1e400\" of `curve.csv` is not finite";
+        assert_eq!(bounded(short), short);
+    }
+
+    #[test]
+    fn a_value_full_of_quotes_is_bounded_as_a_whole() {
+        let text = format!(
+            "unknown variant `{}`, expected `auto`",
+            "`a".repeat(100_000)
+        );
+        let once = bounded(&text);
+        assert!(once.len() < 200, "{} bytes", once.len());
+        assert!(once.ends_with(" bytes)"), "{once}");
+    }
 }

@@ -342,8 +342,10 @@ impl Chart {
     ///
     /// # Errors
     /// [`Error::Figure`] for another extension, an axis range that is not finite and
-    /// increasing, a [`Style`] given before any series or a dashed style on markers, or a
-    /// drawing backend that fails (the file cannot be written, ...).
+    /// increasing, a size outside 200 x 150 to 16384 x 16384, a [`Style`] given before any
+    /// series or a dashed style on markers, or a drawing backend that fails;
+    /// [`Error::Io`] when the file cannot be written (it is written atomically: no half
+    /// file is left under its name).
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = path.as_ref();
         let refuse = |reason: String| Error::Figure {
@@ -586,7 +588,9 @@ impl Map {
     ///
     /// # Errors
     /// [`Error::Figure`] for another extension, a range that is not finite and
-    /// increasing, or a drawing backend that fails.
+    /// increasing, a size outside 200 x 150 to 16384 x 16384, or a drawing backend that
+    /// fails; [`Error::Io`] when the file cannot be written (atomically, as
+    /// [`Chart::save`]).
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = path.as_ref();
         let x = axis_range(path, "x", Some(self.x_range), std::iter::empty())?;
@@ -719,7 +723,12 @@ fn draw_axes<DB: DrawingBackend>(
         .map_err(|e| e.to_string())
 }
 
-/// Draws through the backend that `path`'s extension names and writes the file.
+/// The largest picture side (pixels): a PNG is drawn in memory first, 3 bytes a pixel.
+const LARGEST_SIDE: u32 = 16384;
+
+/// Draws in memory through the backend that `path`'s extension names, then writes the
+/// file atomically (temporary file and rename, as checkpoints): a full disk or a kill
+/// never leaves a half or empty figure under its name.
 fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
     register_font()?;
     let fail = |reason: String| Error::Figure {
@@ -732,19 +741,65 @@ fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
             size.0, size.1
         )));
     }
+    if size.0 > LARGEST_SIDE || size.1 > LARGEST_SIDE {
+        return Err(fail(format!(
+            "{} x {} is too large for a figure: at most {LARGEST_SIDE} x {LARGEST_SIDE}",
+            size.0, size.1
+        )));
+    }
     let extension = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    match extension.as_deref() {
-        Some("png") => paint(BitMapBackend::new(path, size).into_drawing_area(), figure),
-        Some("svg") => paint(SVGBackend::new(path, size).into_drawing_area(), figure),
-        _ => Err("the file name must end in .png or .svg (the format is chosen by it)".into()),
-    }
-    .map_err(fail)
+    let bytes = match extension.as_deref() {
+        Some("png") => {
+            let mut pixels = vec![0u8; 3 * size.0 as usize * size.1 as usize];
+            paint(
+                BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area(),
+                figure,
+            )
+            .map_err(fail)?;
+            encode_png(&pixels, size).map_err(|e| fail(format!("encoding the PNG: {e}")))?
+        }
+        Some("svg") => {
+            let mut text = String::new();
+            paint(
+                SVGBackend::with_string(&mut text, size).into_drawing_area(),
+                figure,
+            )
+            .map_err(fail)?;
+            text.into_bytes()
+        }
+        _ => {
+            return Err(fail(
+                "the file name must end in .png or .svg (the format is chosen by it)".into(),
+            ))
+        }
+    };
+    crate::driver::write_atomically(path, &bytes, "writing figure")
 }
 
-/// Draws `figure` on a white `root` and writes the file.
+/// 8-bit RGB `pixels` (rows from the top) as a PNG file's bytes.
+fn encode_png(
+    pixels: &[u8],
+    (width, height): (u32, u32),
+) -> std::result::Result<Vec<u8>, png::EncodingError> {
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    // As image's PNG encoder (which plotters used): a filter chosen per row, a quarter
+    // of the size of one fixed filter for these flat-coloured pictures.
+    encoder.set_compression(png::Compression::Default);
+    encoder.set_filter(png::FilterType::Sub);
+    encoder.set_adaptive_filter(png::AdaptiveFilterType::Adaptive);
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(pixels)?;
+    writer.finish()?;
+    Ok(bytes)
+}
+
+/// Draws `figure` on a white `root` and finishes it (`present`).
 fn paint<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     figure: &impl Draw,

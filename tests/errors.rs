@@ -376,7 +376,7 @@ fn threads_with_the_dense_backend() {
         .build()
         .unwrap_err();
     assert!(matches!(e, Error::DenseThreads { threads: 4 }), "{e}");
-    assert!(e.to_string().contains("Backend::Spectral"), "{e}");
+    assert!(e.to_string().contains(r#"backend "spectral""#), "{e}");
     for parallelism in [
         Parallelism::Sequential,
         Parallelism::Threads(1),

@@ -13,6 +13,8 @@ mod laws;
 mod loads;
 #[cfg(feature = "nalgebra")]
 mod matrix;
+#[cfg(feature = "cli")]
+mod messages;
 mod operator;
 #[cfg(feature = "serde")]
 mod paper_sweeps;

@@ -323,6 +323,12 @@ fn bad_figures_are_refused_with_typed_errors() {
         .save(dir.join("chart.png"))
         .unwrap_err();
     assert!(e.to_string().contains("too small"), "{e}");
+    // Drawn in memory first (3 bytes a pixel): a size that would need gigabytes is refused.
+    let e = Chart::new("t", "x", "y")
+        .size(100_000, 100_000)
+        .save(dir.join("chart.png"))
+        .unwrap_err();
+    assert!(e.to_string().contains("too large"), "{e}");
     assert!(matches!(
         Map::new(3, 2, vec![0.0; 5]),
         Err(Error::LengthMismatch {
@@ -338,11 +344,13 @@ fn bad_figures_are_refused_with_typed_errors() {
     // A directory that is neither a run's nor a sweep's.
     let e = draw(&dir, &[Format::Png]).unwrap_err();
     assert!(e.to_string().contains("neither a sweep directory"), "{e}");
-    // A file that cannot be created (its directory is missing).
+    // A file that cannot be created (its directory is missing): an I/O failure, which
+    // names the file.
     let e = Chart::new("t", "x", "y")
         .save(dir.join("missing").join("chart.png"))
         .unwrap_err();
-    assert!(matches!(e, Error::Figure { .. }), "{e:?}");
+    assert!(matches!(e, Error::Io { .. }), "{e:?}");
+    assert!(e.to_string().contains("chart.png"), "{e}");
     // Non-finite data is not drawn and does not fail.
     Chart::new("t", "x", "y")
         .line("nan", &[(0.0, f64::NAN), (1.0, 1.0), (f64::INFINITY, 2.0)])

@@ -16,14 +16,28 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
+/// Writes a line to stderr. An error (stderr a closed pipe, `precursors run ... 2>&1 |
+/// head -1`, or a full disk) is ignored, where `eprintln!` would panic: a message or a
+/// progress line must never end a run that is writing its tables.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 const EXIT_CODES: &str = "\
 Exit codes:
-  0  success
-  1  the computation failed (a solver did not converge, the contact emptied, ...)
-  2  bad command line (unknown option, missing argument, bad --shard or SLURM variables)
-  3  invalid input: a scene, sweep or checkpoint file that is not valid JSON, names an
-     unknown key, holds an invalid value, or does not fit; a damaged table
-  4  a file or directory could not be read or written
+  0  success: every table and figure written is complete
+  1  run, resume, sweep: the computation failed (a solver did not converge, the contact
+     emptied, ...)
+  2  bad command line (unknown option, missing argument, --every without --checkpoint,
+     bad --shard or SLURM variables)
+  3  invalid input: a scene, sweep or checkpoint file that is not UTF-8 text or not valid
+     JSON, names an unknown key, holds an invalid value, or does not fit; a damaged table
+     or one with NaN, inf or an empty cell where a number belongs
+  4  a file or directory could not be read or written (none is left half written), or
+     another process is writing the directory (run, resume: the holder is named)
   5  merge, plot: some runs of the sweep are not complete (the tables and figures of the
      others written)";
 
@@ -51,8 +65,8 @@ enum Command {
         /// Writes a checkpoint to FILE every N stable states.
         #[arg(long, value_name = "FILE")]
         checkpoint: Option<PathBuf>,
-        /// Stable states between checkpoints.
-        #[arg(long, value_name = "N", default_value_t = 100,
+        /// Stable states between checkpoints (needs --checkpoint).
+        #[arg(long, value_name = "N", default_value_t = 100, requires = "checkpoint",
               value_parser = clap::value_parser!(u64).range(1..))]
         every: u64,
     },
@@ -210,7 +224,11 @@ struct Failure {
 impl From<Error> for Failure {
     fn from(e: Error) -> Self {
         let code = match &e {
-            Error::Io { .. } => 4,
+            // Bytes that are not UTF-8 text (a binary given as a scene file) are bad input,
+            // not a failure to read.
+            Error::Io { source, .. } if source.kind() == std::io::ErrorKind::InvalidData => 3,
+            // Another process writes the directory: it cannot be written now.
+            Error::Io { .. } | Error::DirectoryLocked { .. } => 4,
             Error::SolverNotConverged { .. }
             | Error::Factorization { .. }
             | Error::EmptyContact { .. }
@@ -283,9 +301,9 @@ fn main() -> ExitCode {
 fn report(e: &(dyn std::error::Error + 'static)) {
     for (k, text) in precursors::error::messages(e).iter().enumerate() {
         if k == 0 {
-            eprintln!("error: {text}");
+            say!("error: {text}");
         } else {
-            eprintln!("  caused by: {text}");
+            say!("  caused by: {text}");
         }
     }
 }
@@ -316,13 +334,15 @@ impl Progress {
             .is_none_or(|t| t.elapsed() >= Duration::from_millis(250));
         if due || force {
             self.last = Some(Instant::now());
-            eprint!("\r{}\x1b[K", line(self.started.elapsed().as_secs_f64()));
+            use std::io::Write as _;
+            let line = line(self.started.elapsed().as_secs_f64());
+            let _ = write!(std::io::stderr(), "\r{line}\x1b[K");
         }
     }
 
     fn finish(&self) {
         if self.enabled && self.last.is_some() {
-            eprintln!();
+            say!();
         }
     }
 }
@@ -372,13 +392,13 @@ fn run(
             // once the directory's scene and tables are checked against it.
             let k = checkpoint.event_count();
             let tables = RunTables::resume(out, &driver)?;
-            eprintln!("resumed at event {k} from {}", path.display());
+            say!("resumed at event {k} from {}", path.display());
             (scene, driver, tables)
         }
     };
     let grid = *scene.grid();
-    eprintln!(
-        "{} x {} cells ({:?} backend), F_N = {} N",
+    say!(
+        "{} x {} cells ({} backend), F_N = {} N",
         grid.nx(),
         grid.ny(),
         driver.backend(),
@@ -413,7 +433,7 @@ fn run(
     let [events_path, curve_path, map_path] = tables.finish()?;
     bar.show(true, |elapsed| line(&driver, elapsed));
     bar.finish();
-    eprintln!(
+    say!(
         "global slip after {} events at F/(μF_N) = {:.6}; wrote {}, {} and {}",
         driver.event_count(),
         driver.force() / mu_fn,
@@ -424,11 +444,20 @@ fn run(
     Ok(())
 }
 
+/// The largest grid (cells) for which `info` builds the whole scene to check it as `run`
+/// does: planning is about 1.5 µs a cell (docs/performance.md), so 0.15 s here.
+const INFO_BUILDS_BELOW: usize = 100_000;
+
 fn info(path: &Path) -> Result<(), Failure> {
     let builder = SceneBuilder::from_json_file(path)?;
     let file: serde_json::Value = serde_json::from_str(&builder.to_json()?).unwrap_or_default();
     let grid = builder.grid()?;
     let n = grid.len();
+    // What `run` refuses, `info` refuses: the whole scene is built (everything checked,
+    // the operator planned) when that is quick; above, the grid's checks only.
+    if n < INFO_BUILDS_BELOW {
+        builder.build()?;
+    }
     let cost = GridCost::of(grid.nx(), grid.ny());
     let backend = file["solver"]["backend"].as_str().unwrap_or("auto");
     let resolved = match backend {
@@ -437,42 +466,59 @@ fn info(path: &Path) -> Result<(), Failure> {
         other => other,
     };
     let block = grid.block();
-    println!("scene      {}", path.display());
-    println!(
-        "block      {} x {} x {} m",
-        block.lx(),
-        block.ly(),
-        block.lz()
-    );
-    println!(
-        "cells      {} x {} = {n} (cell {} x {} m)",
-        grid.nx(),
-        grid.ny(),
-        grid.dx(),
-        grid.dy()
-    );
-    println!(
-        "backend    {resolved}, solver threads {}",
-        file["solver"]["threads"]
-    );
-    println!("memory     ~{} (estimate)", bytes(cost.memory_bytes));
-    println!(
-        "plan       ~{} (estimate, one thread)",
-        seconds(cost.plan_seconds)
-    );
-    println!(
-        "equilibrium ~{} per cold normal + tangential solve (estimate, one thread)",
-        seconds(cost.solve_seconds)
-    );
     // Fitted to two documented runs to global slip on one thread (release build): the
     // calibration scene, 980 cells, 0.84 s; N = 1e4, about 70 s (docs/performance.md).
     let run = 0.84 * (n as f64 / 980.0).powf(1.9);
-    println!(
-        "run        ~{} to global slip (rough: 0.84 s·(N/980)^1.9, fitted to the calibration \
-         scene and N = 1e4; the events depend on the scene)",
-        seconds(run)
+    let text = format!(
+        "scene      {}\n\
+         block      {} x {} x {} m\n\
+         cells      {} x {} = {n} (cell {} x {} m)\n\
+         backend    {resolved}, solver threads {}\n\
+         memory     ~{} (estimate)\n\
+         plan       ~{} (estimate, one thread)\n\
+         equilibrium ~{} per cold normal + tangential solve (estimate, one thread)\n\
+         run        ~{} to global slip (rough: 0.84 s·(N/980)^1.9, fitted to the calibration \
+         scene and N = 1e4; the events depend on the scene)\n",
+        path.display(),
+        metres(block.lx()),
+        metres(block.ly()),
+        metres(block.lz()),
+        grid.nx(),
+        grid.ny(),
+        metres(grid.dx()),
+        metres(grid.dy()),
+        file["solver"]["threads"],
+        bytes(cost.memory_bytes),
+        seconds(cost.plan_seconds),
+        seconds(cost.solve_seconds),
+        seconds(run),
     );
-    Ok(())
+    print_out(&text)
+}
+
+/// Writes `text` to stdout. A reader that went away (`precursors info x | head -1`) has
+/// all it wanted: the program ends quietly with code 0; any other failure is code 4.
+fn print_out(text: &str) -> Result<(), Failure> {
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Failure {
+            error: format!("writing to standard output: {e}").into(),
+            code: 4,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// A length with six significant digits, as a person writes it: `0.0007`, not the
+/// `0.0007000000000000001` that `0.007 / 10` is in binary; `1e-9`, not 0.000000001.
+fn metres(m: f64) -> String {
+    let rounded: f64 = format!("{m:.5e}").parse().unwrap_or(m);
+    if rounded == 0.0 || (1e-4..1e6).contains(&rounded.abs()) {
+        format!("{rounded}")
+    } else {
+        format!("{rounded:e}")
+    }
 }
 
 fn bytes(b: f64) -> String {
@@ -511,7 +557,7 @@ fn run_sweep(
     };
     let sweep = Sweep::from_json_file(path)?;
     let share = sweep.shard(shard.0, shard.1)?.len();
-    eprintln!(
+    say!(
         "{} points x {} realizations = {} runs; shard {}/{}: {share} runs on {jobs} jobs",
         sweep.points(),
         sweep.realizations(),
@@ -546,7 +592,7 @@ fn run_sweep(
         0 => String::new(),
         h => format!(", {h} left to another process running them (merge once it ends)"),
     };
-    eprintln!(
+    say!(
         "{} runs done, {} skipped (complete already){held}, in {:.1} s; results in {}",
         summary.completed,
         summary.skipped,
@@ -566,14 +612,14 @@ fn plot(dir: &Path, format: FormatArg) -> Result<(), Failure> {
     let drawn = draw(dir, formats)?;
     if let Some(summary) = &drawn.merge {
         for file in &summary.files {
-            eprintln!("wrote {}", file.display());
+            say!("wrote {}", file.display());
         }
     }
     for file in &drawn.files {
-        eprintln!("wrote {}", file.display());
+        say!("wrote {}", file.display());
     }
     for note in &drawn.notes {
-        eprintln!("note: {note}");
+        say!("note: {note}");
     }
     match &drawn.merge {
         Some(summary) if summary.runs_missing > 0 => Err(incomplete(summary, dir)),
@@ -598,11 +644,13 @@ fn incomplete(summary: &precursors::sweep::MergeSummary, dir: &Path) -> Failure 
 fn merge(dir: &Path) -> Result<(), Failure> {
     let summary = precursors::sweep::merge(dir)?;
     for file in &summary.files {
-        eprintln!("wrote {}", file.display());
+        say!("wrote {}", file.display());
     }
-    eprintln!(
+    say!(
         "{} points, {} runs merged, {} missing",
-        summary.points, summary.runs_merged, summary.runs_missing
+        summary.points,
+        summary.runs_merged,
+        summary.runs_missing
     );
     if summary.runs_missing > 0 {
         return Err(incomplete(&summary, dir));

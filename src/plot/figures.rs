@@ -9,7 +9,7 @@
 //! mean over its realizations and the 95 % band, on a load grid of step 0.005.
 
 use super::{Chart, Corner, Map, Palette};
-use crate::error::{Error, Result};
+use crate::error::{table_number, Error, Result};
 use crate::output::{CONTACT_MAP_STEP, CURVE_HEADER};
 use crate::sweep::{merge, MergeSummary, SWEEP_FILE};
 use std::path::{Path, PathBuf};
@@ -49,9 +49,12 @@ pub struct Drawn {
 /// `sweep.json`) or a run's (`dir` holds `curve.csv`).
 ///
 /// # Errors
-/// [`Error::Figure`] when `dir` is neither, or a figure cannot be written;
-/// [`Error::Io`], [`Error::CorruptTable`] for tables that cannot be read; a sweep's
-/// errors as [`crate::sweep::merge`].
+/// [`Error::Figure`] when `dir` is neither, or a figure cannot be drawn; [`Error::Io`]
+/// for a table that cannot be read or a figure that cannot be written (each figure is
+/// written atomically: none is left half written); [`Error::CorruptTable`] for a damaged
+/// table, [`Error::NonFiniteCell`] for a `NaN`, an infinity or an empty cell where a
+/// number belongs (with the file, line and column); a sweep's errors as
+/// [`crate::sweep::merge`].
 pub fn draw(dir: &Path, formats: &[Format]) -> Result<Drawn> {
     if dir.join(SWEEP_FILE).is_file() {
         draw_sweep(dir, formats)
@@ -86,8 +89,10 @@ fn corrupt(path: &Path, reason: String) -> Error {
     }
 }
 
-/// The rows of a CSV table with the given header, as numbers (an empty cell is `NaN`).
-fn numbers(path: &Path, header: &str) -> Result<Vec<Vec<f64>>> {
+/// The columns `wanted` (named as in `header`) of the rows of a CSV table with that
+/// header, as finite numbers: a `NaN`, an infinity or an empty cell in them is refused
+/// with its line ([`crate::error::table_number`]), not drawn as a gap.
+fn numbers(path: &Path, header: &str, wanted: &[&str]) -> Result<Vec<Vec<f64>>> {
     let text = read(path)?;
     let mut lines = text.lines();
     if lines.next() != Some(header) {
@@ -96,31 +101,33 @@ fn numbers(path: &Path, header: &str) -> Result<Vec<Vec<f64>>> {
             format!("line 1 is not the header {header:?}"),
         ));
     }
-    let fields = header.split(',').count();
+    let names: Vec<&str> = header.split(',').collect();
+    let columns = wanted
+        .iter()
+        .map(|w| {
+            names
+                .iter()
+                .position(|n| n == w)
+                .ok_or_else(|| corrupt(path, format!("the header has no column {w}")))
+        })
+        .collect::<Result<Vec<usize>>>()?;
     let mut rows = Vec::new();
     for (i, line) in lines.enumerate() {
         let cells: Vec<&str> = line.split(',').collect();
-        if cells.len() != fields {
+        if cells.len() != names.len() {
             return Err(corrupt(
                 path,
                 format!(
-                    "line {} has {} fields, the header {fields}",
+                    "line {} has {} fields, the header {}",
                     i + 2,
-                    cells.len()
+                    cells.len(),
+                    names.len()
                 ),
             ));
         }
-        let row = cells
+        let row = columns
             .iter()
-            .map(|c| {
-                if c.is_empty() {
-                    Ok(f64::NAN)
-                } else {
-                    c.parse::<f64>().map_err(|e| {
-                        corrupt(path, format!("line {}: {c:?} is not a number ({e})", i + 2))
-                    })
-                }
-            })
+            .map(|&k| table_number(path, i + 2, names[k], cells[k]))
             .collect::<Result<Vec<f64>>>()?;
         rows.push(row);
     }
@@ -131,23 +138,19 @@ fn numbers(path: &Path, header: &str) -> Result<Vec<Vec<f64>>> {
 fn draw_run(dir: &Path, formats: &[Format]) -> Result<Drawn> {
     let title = name(dir);
     let curve_path = dir.join("curve.csv");
-    let rows = numbers(&curve_path, CURVE_HEADER)?;
-    let column = |name: &str| {
-        let k = CURVE_HEADER.split(',').position(|h| h == name).unwrap_or(0);
-        rows.iter().map(move |r| r[k])
-    };
-    let force: Vec<f64> = column("force_over_mu_FN").collect();
-    let ell: Vec<(f64, f64)> = force
-        .iter()
-        .copied()
-        .zip(column("precursor_over_Lx"))
-        .collect();
-    let a0 = column("real_contact_area_m2").next().unwrap_or(f64::NAN);
-    let area: Vec<(f64, f64)> = force
-        .iter()
-        .copied()
-        .zip(column("real_contact_area_m2").map(|a| a / a0))
-        .collect();
+    let rows = numbers(
+        &curve_path,
+        CURVE_HEADER,
+        &[
+            "force_over_mu_FN",
+            "precursor_over_Lx",
+            "real_contact_area_m2",
+        ],
+    )?;
+    let force: Vec<f64> = rows.iter().map(|r| r[0]).collect();
+    let ell: Vec<(f64, f64)> = rows.iter().map(|r| (r[0], r[1])).collect();
+    let a0 = rows.first().map_or(f64::NAN, |r| r[2]);
+    let area: Vec<(f64, f64)> = rows.iter().map(|r| (r[0], r[2] / a0)).collect();
     // Near slip the paper's unbounded area law can reach many times A_R(0) (flagged in
     // area_exceeds_nominal): the chart shows up to 2 and its legend says how many
     // states lie above.
@@ -203,8 +206,9 @@ fn draw_run(dir: &Path, formats: &[Format]) -> Result<Drawn> {
     }
     let text = read(&map_path)?;
     let header = text.lines().next().unwrap_or("");
-    let map = numbers(&map_path, header)?;
-    let nx = header.split(',').count().saturating_sub(2);
+    let columns: Vec<&str> = header.split(',').collect();
+    let map = numbers(&map_path, header, &columns)?;
+    let nx = columns.len().saturating_sub(2);
     let Some(first) = map.first() else {
         drawn.notes.push(format!(
             "no contact map: {} has no rows",

@@ -213,11 +213,7 @@ impl FactorCache {
         let bad_pivot = (0..n).find(|&a| !(self.ld[(a, a)] > 0.0 && self.ld[(a, a)].is_finite()));
         if let Err(e) = result {
             self.order.clear();
-            return Err(Error::Factorization {
-                n,
-                reason: format!("faer reported {e}"),
-                source: Some(Box::new(e)),
-            });
+            return Err(factorization_failed(n, e));
         }
         if let Some(a) = bad_pivot {
             let pivot = self.ld[(a, a)];
@@ -402,5 +398,39 @@ impl ExactInverse for FactorSolve<'_> {
         for (a, &p) in self.perm.iter().enumerate() {
             z[p] = work[(a, 0)];
         }
+    }
+}
+
+/// faer's failure of the LDLᵀ factorisation of the `n x n` matrix, said in words (faer's
+/// own text is a Rust debug dump, `ZeroPivot { index: 0 }`).
+fn factorization_failed(n: usize, e: ldlt::factor::LdltError) -> Error {
+    let ldlt::factor::LdltError::ZeroPivot { index } = e;
+    Error::Factorization {
+        n,
+        reason: format!(
+            "pivot {index} is zero: the matrix is singular to working precision (look for \
+             extreme values among the scene's lengths and spring constants)"
+        ),
+        source: None,
+    }
+}
+
+#[cfg(test)]
+mod message_tests {
+    use super::*;
+
+    /// faer's error text is its Debug dump (`ZeroPivot { index: 0 }`): the message says
+    /// it in words, once (no `caused by:` line repeating faer's text).
+    #[test]
+    fn a_zero_pivot_is_said_in_words() {
+        let e = factorization_failed(98, ldlt::factor::LdltError::ZeroPivot { index: 0 });
+        let lines = crate::error::messages(&e);
+        assert_eq!(lines.len(), 1, "{lines:?}");
+        let text = &lines[0];
+        assert!(
+            text.contains("98 x 98") && text.contains("pivot 0 is zero"),
+            "{text}"
+        );
+        assert!(!text.contains("ZeroPivot") && !text.contains('{'), "{text}");
     }
 }

@@ -277,7 +277,7 @@ impl EquilibriumSolver {
         let bad = |reason: String| Err(Error::InvalidCheckpoint { reason });
         if state.backend != self.backend {
             return bad(format!(
-                "the checkpoint's solver ran the {:?} backend, this scene's runs {:?}",
+                "the checkpoint's solver ran backend \"{}\", this scene's runs backend \"{}\"",
                 state.backend, self.backend
             ));
         }

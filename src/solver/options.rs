@@ -23,6 +23,17 @@ pub enum Backend {
     Spectral,
 }
 
+/// The backend as a scene file spells it (`solver.backend`): `auto`, `dense`, `spectral`.
+impl std::fmt::Display for Backend {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Backend::Auto => "auto",
+            Backend::Dense => "dense",
+            Backend::Spectral => "spectral",
+        })
+    }
+}
+
 /// Options of the equilibrium solvers.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]

@@ -1,7 +1,8 @@
 //! Ensemble statistics of a sweep's runs (`precursors merge DIR`; docs/sweep-format.md).
 
 use super::{Sweep, SweepRun, DONE_FILE, SWEEP_FILE};
-use crate::error::{Error, Result};
+use crate::driver::write_atomically;
+use crate::error::{table_number, Error, Result};
 use crate::output::{CURVE_HEADER, EVENTS_HEADER};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -108,50 +109,73 @@ fn columns<'a>(path: &Path, text: &'a str, header: &str) -> Result<Vec<Vec<&'a s
     Ok(lines.map(|l| l.split(',').collect()).collect())
 }
 
-fn parse(path: &Path, line: usize, text: &str) -> Result<f64> {
-    text.parse().map_err(|e| Error::CorruptTable {
-        path: Some(path.to_path_buf()),
-        reason: format!("line {}: {text:?} is not a number ({e})", line + 2),
-    })
-}
-
 fn read(path: &Path) -> Result<String> {
     std::fs::read_to_string(path).map_err(|e| Error::io("reading", path, e))
+}
+
+/// The index of the column `name` in `header`.
+fn column(header: &str, name: &str) -> usize {
+    header.split(',').position(|h| h == name).unwrap_or(0)
 }
 
 fn read_run(dir: &Path, run: &SweepRun) -> Result<RunData> {
     let curve_path = dir.join("curve.csv");
     let text = read(&curve_path)?;
     let mut curve = Vec::new();
+    let wanted = [
+        "force_over_mu_FN",
+        "precursor_over_Lx",
+        "real_contact_area_m2",
+    ]
+    .map(|name| (name, column(CURVE_HEADER, name)));
+    let fields = CURVE_HEADER.split(',').count();
     for (i, row) in columns(&curve_path, &text, CURVE_HEADER)?
         .iter()
         .enumerate()
     {
-        // event,force_N,force_over_mu_FN,drive,area,ell,ell_over_Lx,...
-        if row.len() < 7 {
+        if row.len() != fields {
             return Err(Error::CorruptTable {
                 path: Some(curve_path.clone()),
-                reason: format!("line {} has {} fields", i + 2, row.len()),
+                reason: format!(
+                    "line {} has {} fields, the header {fields}",
+                    i + 2,
+                    row.len()
+                ),
             });
         }
-        curve.push((
-            parse(&curve_path, i, row[2])?,
-            parse(&curve_path, i, row[6])?,
-            parse(&curve_path, i, row[4])?,
-        ));
+        let [f, ell, area] = wanted.map(|(name, k)| table_number(&curve_path, i + 2, name, row[k]));
+        curve.push((f?, ell?, area?));
     }
     let events_path = dir.join("events.csv");
     let text = read(&events_path)?;
     let mu_fn = run.scene.current_material().friction_coefficient * run.scene.current_normal_load();
     let mut avalanches = Vec::new();
     let mut slip = None;
+    let (kind, force, ruptures) = (
+        column(EVENTS_HEADER, "kind"),
+        column(EVENTS_HEADER, "force_N"),
+        column(EVENTS_HEADER, "ruptures"),
+    );
     for (i, row) in columns(&events_path, &text, EVENTS_HEADER)?
         .iter()
         .enumerate()
     {
-        match (row.get(1).copied(), row.get(4), row.get(7)) {
-            (Some("stable"), _, Some(r)) => avalanches.push(parse(&events_path, i, r)? as usize),
-            (Some("global_slip"), Some(f), _) => slip = Some(parse(&events_path, i, f)? / mu_fn),
+        let at = |k: usize| row.get(k).copied().unwrap_or("");
+        match at(kind) {
+            "stable" => {
+                let r = at(ruptures);
+                let count = r.parse::<usize>().map_err(|e| Error::CorruptTable {
+                    path: Some(events_path.clone()),
+                    reason: format!(
+                        "line {}, column ruptures: {r:?} is not a count ({e})",
+                        i + 2
+                    ),
+                })?;
+                avalanches.push(count);
+            }
+            "global_slip" => {
+                slip = Some(table_number(&events_path, i + 2, "force_N", at(force))? / mu_fn);
+            }
             _ => {}
         }
     }
@@ -245,9 +269,14 @@ pub(crate) fn ensemble_curves(dir: &Path, grid: &[f64]) -> Result<Vec<EnsembleCu
 ///
 /// Runs without their completion marker are left out and counted.
 ///
+/// Each file is written atomically (a temporary file renamed over it): a full disk or a
+/// kill leaves the previous file or the new one.
+///
 /// # Errors
 /// [`Error::SweepDirectory`] when `dir` holds no `sweep.json`; its errors as a sweep file;
-/// [`Error::Io`], [`Error::CorruptTable`] for a run's tables.
+/// [`Error::Io`] for a file that cannot be read or written; [`Error::CorruptTable`] for a
+/// run's damaged table, [`Error::NonFiniteCell`] for a `NaN`, an infinity or an empty
+/// cell where a number belongs in one (with the file, line and column).
 pub fn merge(dir: &Path) -> Result<MergeSummary> {
     let sweep_path = dir.join(SWEEP_FILE);
     if !sweep_path.is_file() {
@@ -336,19 +365,18 @@ pub fn merge(dir: &Path) -> Result<MergeSummary> {
             .flat_map(|d| d.avalanches.iter().copied())
             .filter(|&s| s >= 1)
             .collect();
-        let largest = sizes.iter().copied().max().unwrap_or(0);
-        let mut counts = vec![0usize; largest + 1];
+        // A map, not a vector indexed by size: an edited table's size of 1e18 must not
+        // allocate 8e18 bytes.
+        let mut counts = std::collections::BTreeMap::<usize, usize>::new();
         for &s in &sizes {
-            counts[s] += 1;
+            *counts.entry(s).or_default() += 1;
         }
-        for (size, &count) in counts.iter().enumerate().skip(1) {
-            if count > 0 {
-                let _ = writeln!(
-                    avalanches,
-                    "{point},{values}{size},{count},{}",
-                    num(count as f64 / sizes.len() as f64)
-                );
-            }
+        for (size, count) in counts {
+            let _ = writeln!(
+                avalanches,
+                "{point},{values}{size},{count},{}",
+                num(count as f64 / sizes.len() as f64)
+            );
         }
     }
     let mut files = Vec::new();
@@ -358,8 +386,10 @@ pub fn merge(dir: &Path) -> Result<MergeSummary> {
         ("avalanches.csv", avalanches),
         ("runs.csv", runs_csv),
     ] {
+        // Atomically: a full disk or a kill leaves the old table or the new one, never an
+        // empty or half one that looks complete.
         let path = dir.join(name);
-        std::fs::write(&path, text).map_err(|e| Error::io("writing", &path, e))?;
+        write_atomically(&path, text.as_bytes(), "writing")?;
         files.push(path);
     }
     Ok(MergeSummary {

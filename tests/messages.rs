@@ -1,0 +1,598 @@
+//! The program's messages and exit codes (docs/cli.md): a closed stdout or stderr never
+//! panics; messages are Display text in the scene file's spelling, with long values cut;
+//! each class of failure has its exit code; `merge` and `plot` refuse non-finite cells and
+//! write their files atomically; `info` refuses what `run` refuses.
+//!
+//! Full and read-only disks are real ones where the machine allows it: a small tmpfs
+//! mounted over a directory in a private mount namespace (`unshare -rm`), filled up or
+//! remounted read-only. Elsewhere (or with `PRECURSORS_TEST_NO_TMPFS` set) a directory
+//! with permissions 0o555 stands for the read-only disk (when they stop this user's
+//! writes), else a directory in the way of the file to write.
+
+use precursors::SceneBuilder;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+fn scratch(name: &str) -> PathBuf {
+    let dir =
+        std::env::temp_dir().join(format!("precursors-{}-messages-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A tiny scene: 30 x 5 = 150 cells (a run to global slip: about 10 ms).
+const BASE: &str = r#"{ "block": { "lx": 0.03, "ly": 0.005, "lz": 0.02 },
+    "cells": { "kind": "size", "dx": 0.001, "dy": 0.001 },
+    "normal_load": 500.0,
+    "drive": { "kind": "rod", "height": 0.004, "half_width": 0.001 } }"#;
+
+/// A sweep of the tiny scene: one point, two realizations.
+fn sweep_text() -> String {
+    format!(r#"{{ "base": {BASE}, "axes": [], "realizations": 2, "seed": 5 }}"#)
+}
+
+fn program() -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_precursors"));
+    // The tests may run inside a SLURM array task.
+    for name in ["ID", "COUNT", "MIN", "MAX", "STEP"] {
+        command.env_remove(format!("SLURM_ARRAY_TASK_{name}"));
+    }
+    command
+}
+
+fn precursors(args: &[&str]) -> Output {
+    program().args(args).output().unwrap()
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Traces of Rust's `{:?}` or Rust names in a message a user reads.
+fn debug_traces(text: &str) -> Vec<&'static str> {
+    [
+        "::",
+        "Some(",
+        "Os {",
+        "kind:",
+        "ZeroPivot",
+        "IoError",
+        "ImageError",
+        "{ index",
+    ]
+    .into_iter()
+    .filter(|t| text.contains(t))
+    .collect()
+}
+
+/// The write end of a pipe whose read end is closed: every write fails (broken pipe).
+fn closed_pipe() -> Stdio {
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    writer.into()
+}
+
+/// The program's exit code with its stderr a closed pipe (stdout discarded): its messages
+/// cannot be written, and it must neither panic (code 101) nor change its code.
+fn code_with_closed_stderr(args: &[&str]) -> Option<i32> {
+    program()
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(closed_pipe())
+        .status()
+        .unwrap()
+        .code()
+}
+
+#[test]
+fn a_closed_stderr_or_stdout_ends_nothing_early() {
+    let dir = scratch("pipes");
+    let scene = dir.join("scene.json");
+    std::fs::write(&scene, BASE).unwrap();
+    let out = dir.join("run");
+    let code = code_with_closed_stderr(&["run", path(&scene), "--out", path(&out)]);
+    assert_eq!(code, Some(0));
+    // The run went to global slip: its tables end with it.
+    let events = std::fs::read_to_string(out.join("events.csv")).unwrap();
+    assert!(events.lines().last().unwrap().contains("global_slip"));
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, BASE.replace("normal_load", "normal_lode")).unwrap();
+    assert_eq!(code_with_closed_stderr(&["info", path(&bad)]), Some(3));
+    let sweep = dir.join("sweep.json");
+    std::fs::write(&sweep, sweep_text()).unwrap();
+    let sweep_dir = dir.join("sweep");
+    let args = [
+        "sweep",
+        path(&sweep),
+        "--out",
+        path(&sweep_dir),
+        "--jobs",
+        "1",
+    ];
+    assert_eq!(code_with_closed_stderr(&args), Some(0));
+    assert_eq!(
+        code_with_closed_stderr(&["merge", path(&sweep_dir)]),
+        Some(0)
+    );
+    assert_eq!(code_with_closed_stderr(&["plot", path(&out)]), Some(0));
+    assert!(out.join("contact_map.png").is_file());
+    // `info` with its stdout closed (`precursors info x | head -0`): quiet, code 0.
+    let o = program()
+        .args(["info", path(&scene)])
+        .stdout(closed_pipe())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(stderr(&o), "");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn messages_are_display_text_in_the_scene_files_spelling() {
+    let dir = scratch("spelling");
+    let scene = dir.join("dense.json");
+    std::fs::write(
+        &scene,
+        BASE.replace(
+            r#""normal_load""#,
+            r#""solver": { "backend": "dense", "threads": 2 }, "normal_load""#,
+        ),
+    )
+    .unwrap();
+    let o = precursors(&["run", path(&scene), "--out", path(&dir.join("o"))]);
+    assert_eq!(o.status.code(), Some(3));
+    let text = stderr(&o);
+    assert!(
+        text.contains(r#"backend "dense""#) && text.contains("threads 2"),
+        "{text}"
+    );
+    assert_eq!(debug_traces(&text), Vec::<&str>::new(), "{text}");
+    // A block 1e308 m wide: whatever refuses it, it says so in words.
+    let scene = dir.join("wide.json");
+    std::fs::write(
+        &scene,
+        r#"{ "block": { "lx": 0.14, "ly": 1e308, "lz": 0.075 },
+             "cells": { "kind": "count", "nx": 14, "ny": 7 }, "normal_load": 3500.0,
+             "drive": { "kind": "rod", "height": 0.006, "half_width": 0.002 } }"#,
+    )
+    .unwrap();
+    let o = precursors(&["run", path(&scene), "--out", path(&dir.join("o")), "-q"]);
+    let text = stderr(&o);
+    assert_ne!(o.status.code(), Some(0), "{text}");
+    assert!(text.contains("error: "), "{text}");
+    assert_eq!(debug_traces(&text), Vec::<&str>::new(), "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The start of a long message.
+fn head(text: &str) -> String {
+    text.chars().take(300).collect()
+}
+
+/// 1 MiB of one letter.
+const LONG: usize = 1 << 20;
+
+#[test]
+fn a_long_value_is_cut_in_the_message() {
+    let long = "x".repeat(LONG);
+    let scenes = [
+        // An unknown variant, an unknown key, a string for a number: the parser echoes them.
+        BASE.replace(
+            r#""normal_load""#,
+            &format!(r#""solver": {{ "backend": "{long}" }}, "normal_load""#),
+        ),
+        BASE.replace(
+            r#""normal_load""#,
+            &format!(r#""{long}": 1, "normal_load""#),
+        ),
+        BASE.replace("500.0", &format!(r#""{long}""#)),
+    ];
+    let dir = scratch("long");
+    let cut = format!("... ({LONG} bytes)");
+    for text in &scenes {
+        // The library's Display ...
+        let e = SceneBuilder::from_json_str(text).unwrap_err().to_string();
+        assert!(
+            e.len() < 1000 && e.contains(&cut),
+            "{} bytes: {}",
+            e.len(),
+            head(&e)
+        );
+        // ... and the program's message, every line of it.
+        let file = dir.join("scene.json");
+        std::fs::write(&file, text).unwrap();
+        let o = precursors(&["info", path(&file)]);
+        assert_eq!(o.status.code(), Some(3));
+        let e = stderr(&o);
+        assert!(
+            e.len() < 1000 && e.contains(&cut),
+            "{} bytes: {}",
+            e.len(),
+            head(&e)
+        );
+    }
+    // A sweep axis's key, and a table cell that merge reads.
+    let sweep = dir.join("sweep.json");
+    std::fs::write(
+        &sweep,
+        format!(r#"{{ "base": {BASE}, "axes": [{{ "key": "{long}", "values": [1] }}] }}"#),
+    )
+    .unwrap();
+    let o = precursors(&["sweep", path(&sweep), "--out", path(&dir.join("s"))]);
+    assert_eq!(o.status.code(), Some(3));
+    let e = stderr(&o);
+    assert!(
+        e.len() < 1000 && e.contains(&cut),
+        "{} bytes: {}",
+        e.len(),
+        head(&e)
+    );
+    let sweep_dir = dir.join("t");
+    std::fs::write(&sweep, sweep_text()).unwrap();
+    let o = precursors(&["sweep", path(&sweep), "--out", path(&sweep_dir), "-q"]);
+    assert_eq!(o.status.code(), Some(0));
+    let curve = run_dir(&sweep_dir, 0).join("curve.csv");
+    edit_cell(&curve, 2, "precursor_over_Lx", &long);
+    let o = precursors(&["merge", path(&sweep_dir)]);
+    assert_eq!(o.status.code(), Some(3));
+    let e = stderr(&o);
+    assert!(
+        e.len() < 1000 && e.contains(&cut),
+        "{} bytes: {}",
+        e.len(),
+        head(&e)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The directory of realization `r` of the one point of the sweep in `dir`
+/// (docs/sweep-format.md).
+fn run_dir(dir: &Path, r: usize) -> PathBuf {
+    let run = dir.join(format!("p0000-r{r:04}"));
+    assert!(run.is_dir(), "{}", run.display());
+    run
+}
+
+/// Writes `value` into column `column` of line `line` (1-based; the header is line 1) of
+/// the CSV table `file`.
+fn edit_cell(file: &Path, line: usize, column: &str, value: &str) {
+    let text = std::fs::read_to_string(file).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let k = lines[0].split(',').position(|h| h == column).unwrap();
+    let mut cells: Vec<String> = lines[line - 1].split(',').map(String::from).collect();
+    cells[k] = value.to_string();
+    lines[line - 1] = cells.join(",");
+    std::fs::write(file, lines.join("\n") + "\n").unwrap();
+}
+
+#[test]
+fn merge_and_plot_refuse_non_finite_cells_with_their_place() {
+    let dir = scratch("nan");
+    let sweep = dir.join("sweep.json");
+    std::fs::write(&sweep, sweep_text()).unwrap();
+    let out = dir.join("s");
+    let o = precursors(&["sweep", path(&sweep), "--out", path(&out), "-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let run = run_dir(&out, 1);
+    let curve = run.join("curve.csv");
+    let events = run.join("events.csv");
+    let clean_curve = std::fs::read_to_string(&curve).unwrap();
+    let clean_events = std::fs::read_to_string(&events).unwrap();
+    let slip_line = clean_events.lines().count();
+    // (table, line, column, value)
+    let cases = [
+        (&curve, 3, "force_over_mu_FN", "NaN"),
+        (&curve, 2, "real_contact_area_m2", "inf"),
+        (&curve, 4, "precursor_over_Lx", "-infinity"),
+        (&events, slip_line, "force_N", "NaN"),
+    ];
+    for (file, line, column, value) in cases {
+        edit_cell(file, line, column, value);
+        let place = format!("{}, line {line}, column {column}", file.display());
+        let o = precursors(&["merge", path(&out)]);
+        assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+        assert!(stderr(&o).contains(&place), "{place}: {}", stderr(&o));
+        // plot reads the same tables: of the sweep (merged first) and, for curve.csv, of
+        // the run.
+        let o = precursors(&["plot", path(&out)]);
+        assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+        assert!(stderr(&o).contains(&place), "{place}: {}", stderr(&o));
+        if file == &curve {
+            let o = precursors(&["plot", path(&run)]);
+            assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+            assert!(stderr(&o).contains(&place), "{place}: {}", stderr(&o));
+        }
+        std::fs::write(&curve, &clean_curve).unwrap();
+        std::fs::write(&events, &clean_events).unwrap();
+    }
+    // A non-finite value in a contact map cell.
+    let map = run.join("contact_map.csv");
+    edit_cell(&map, 3, "area_m2_ix7", "nan");
+    let o = precursors(&["plot", path(&run)]);
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("line 3, column area_m2_ix7"),
+        "{}",
+        stderr(&o)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A disk that refuses writes.
+#[derive(Clone, Copy, PartialEq, Debug)]
+enum Disk {
+    /// No space left (ENOSPC).
+    Full,
+    /// Mounted read-only (EROFS).
+    ReadOnly,
+}
+
+/// Runs the program with `args`, where `{dir}` stands for a directory holding a copy of
+/// `content`, on a small tmpfs that is `disk`, mounted in a private mount namespace:
+/// the output and the directory's files afterwards (name and size). `None` when the
+/// machine does not allow it (no `unshare`, no user namespaces, no tmpfs).
+fn on_small_disk(
+    content: &Path,
+    disk: Disk,
+    args: &[&str],
+    scratch: &Path,
+) -> Option<(Output, Vec<(String, u64)>)> {
+    if std::env::var_os("PRECURSORS_TEST_NO_TMPFS").is_some() {
+        return None;
+    }
+    let mount = scratch.join("mnt");
+    std::fs::create_dir_all(&mount).unwrap();
+    let probe = Command::new("unshare")
+        .args(["-rm", "sh", "-c", "mount -t tmpfs -o size=1m none \"$0\""])
+        .arg(&mount)
+        .output()
+        .ok()?;
+    if !probe.status.success() {
+        return None;
+    }
+    let listing = scratch.join("listing");
+    let spoil = match disk {
+        Disk::Full => "head -c 64m /dev/zero > \"$M/.fill\" 2>/dev/null || true",
+        Disk::ReadOnly => "mount -o remount,ro \"$M\"",
+    };
+    let script = format!(
+        "set -e; mount -t tmpfs -o size=16m none \"$M\"; cp -a \"$C\"/. \"$M\"/; {spoil}; \
+         set +e; \"$@\"; code=$?; find \"$M\" -mindepth 1 -type f ! -name .fill \
+         -printf '%P %s\\n' > \"$L\"; exit $code"
+    );
+    let args: Vec<String> = args
+        .iter()
+        .map(|a| a.replace("{dir}", path(&mount)))
+        .collect();
+    let output = Command::new("unshare")
+        .args([
+            "-rm",
+            "sh",
+            "-c",
+            &script,
+            "sh",
+            env!("CARGO_BIN_EXE_precursors"),
+        ])
+        .args(&args)
+        .env("M", &mount)
+        .env("C", content)
+        .env("L", &listing)
+        .output()
+        .unwrap();
+    let files = std::fs::read_to_string(&listing)
+        .unwrap_or_else(|_| panic!("no listing: {}", stderr(&output)))
+        .lines()
+        .map(|l| {
+            let (name, size) = l.rsplit_once(' ').unwrap();
+            (name.to_string(), size.parse().unwrap())
+        })
+        .collect();
+    Some((output, files))
+}
+
+fn files(dir: &Path) -> Vec<(String, u64)> {
+    let mut out: Vec<(String, u64)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap())
+        .filter(|e| e.metadata().unwrap().is_file())
+        .map(|e| {
+            let size = e.metadata().unwrap().len();
+            (e.file_name().to_string_lossy().into_owned(), size)
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+/// Whether permissions 0o555 stop this user writing into a directory (not for root).
+fn permissions_stop_writes(scratch: &Path) -> bool {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = scratch.join("probe-555");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o555)).unwrap();
+    let stopped = std::fs::write(dir.join("x"), "x").is_err();
+    std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o755)).unwrap();
+    stopped
+}
+
+#[test]
+fn plot_on_a_read_only_disk_is_an_io_failure_and_leaves_no_file() {
+    let dir = scratch("readonly");
+    let scene = dir.join("scene.json");
+    std::fs::write(&scene, BASE).unwrap();
+    let run = dir.join("run");
+    let o = precursors(&["run", path(&scene), "--out", path(&run), "-q"]);
+    assert_eq!(o.status.code(), Some(0));
+    let before = files(&run);
+    let (o, after) = match on_small_disk(&run, Disk::ReadOnly, &["plot", "{dir}"], &dir) {
+        Some(result) => result,
+        None if permissions_stop_writes(&dir) => {
+            use std::os::unix::fs::PermissionsExt;
+            let mode = |m| std::fs::Permissions::from_mode(m);
+            std::fs::set_permissions(&run, mode(0o555)).unwrap();
+            let o = precursors(&["plot", path(&run)]);
+            std::fs::set_permissions(&run, mode(0o755)).unwrap();
+            (o, files(&run))
+        }
+        None => {
+            // Root without a tmpfs: a directory in the way of the first figure.
+            std::fs::create_dir(run.join("precursor_length.png")).unwrap();
+            let o = precursors(&["plot", path(&run)]);
+            std::fs::remove_dir(run.join("precursor_length.png")).unwrap();
+            (o, files(&run))
+        }
+    };
+    let text = stderr(&o);
+    assert_eq!(o.status.code(), Some(4), "{text}");
+    assert!(
+        text.starts_with("error: writing figure") && text.contains("precursor_length.png"),
+        "{text}"
+    );
+    assert_eq!(debug_traces(&text), Vec::<&str>::new(), "{text}");
+    let mut after = after;
+    after.sort();
+    assert_eq!(after, before, "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn merge_on_a_full_disk_keeps_the_previous_tables_whole() {
+    let dir = scratch("full");
+    let sweep = dir.join("sweep.json");
+    std::fs::write(&sweep, sweep_text()).unwrap();
+    let out = dir.join("s");
+    let o = precursors(&["sweep", path(&sweep), "--out", path(&out), "-q"]);
+    assert_eq!(o.status.code(), Some(0));
+    let o = precursors(&["merge", path(&out)]);
+    assert_eq!(o.status.code(), Some(0));
+    let tables = ["curves.csv", "slip.csv", "avalanches.csv", "runs.csv"];
+    let sizes: Vec<(String, u64)> = files(&out)
+        .into_iter()
+        .filter(|(name, _)| tables.contains(&name.as_str()))
+        .collect();
+    assert_eq!(sizes.len(), 4);
+    // One table older (it must stay whole), the others not written yet (they must not
+    // appear empty). Rewriting a file in place on a full tmpfs can reuse the pages its
+    // truncation frees: only new files show the full disk to the old in-place writes.
+    std::fs::write(out.join("curves.csv"), "old\n").unwrap();
+    for name in &tables[1..] {
+        std::fs::remove_file(out.join(name)).unwrap();
+    }
+    let (o, after) = match on_small_disk(&out, Disk::Full, &["merge", "{dir}"], &dir) {
+        Some(result) => result,
+        None => {
+            // No tmpfs here: a directory in the way of the second table (a failure to
+            // write it, not a full disk).
+            std::fs::create_dir(out.join("slip.csv")).unwrap();
+            let o = precursors(&["merge", path(&out)]);
+            (o, files(&out))
+        }
+    };
+    let text = stderr(&o);
+    assert_eq!(o.status.code(), Some(4), "{text}");
+    assert_eq!(debug_traces(&text), Vec::<&str>::new(), "{text}");
+    // Each table is the old one or a complete new one: never empty, never half, and no
+    // temporary file is left.
+    assert!(after.iter().any(|(n, _)| n == "curves.csv"), "{after:?}");
+    for (name, size) in &after {
+        assert!(!name.starts_with('.'), "{name} left: {after:?}");
+        let merged = sizes.iter().find(|(n, _)| n == name);
+        if name == "curves.csv" {
+            let merged = merged.unwrap().1;
+            assert!(*size == 4 || *size == merged, "{after:?} vs {sizes:?}");
+        } else if let Some(old) = merged {
+            assert_eq!(*size, old.1, "{after:?} vs {sizes:?}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn info_refuses_what_run_refuses_and_writes_lengths_plainly() {
+    let dir = scratch("info");
+    let refused = [
+        // The solver's options, the load, the rod's place: checked when the scene is built.
+        BASE.replace(
+            r#""normal_load""#,
+            r#""solver": { "backend": "dense", "threads": 2 }, "normal_load""#,
+        ),
+        BASE.replace("500.0", "-1.0"),
+        BASE.replace(r#""height": 0.004"#, r#""height": 0.0195"#),
+    ];
+    for (k, text) in refused.iter().enumerate() {
+        let scene = dir.join(format!("refused{k}.json"));
+        std::fs::write(&scene, text).unwrap();
+        let run = precursors(&["run", path(&scene), "--out", path(&dir.join("o")), "-q"]);
+        let info = precursors(&["info", path(&scene)]);
+        assert_eq!(run.status.code(), Some(3), "{}", stderr(&run));
+        assert_eq!(info.status.code(), Some(3), "{}", stderr(&info));
+        assert_eq!(stderr(&info), stderr(&run));
+    }
+    // 140 mm in 200 cells: 0.7 mm each, which 0.14 / 200 rounds to 0.0007000000000000001.
+    let scene = dir.join("cells.json");
+    std::fs::write(
+        &scene,
+        BASE.replace(
+            r#""kind": "size", "dx": 0.001, "dy": 0.001"#,
+            r#""kind": "count", "nx": 200, "ny": 10"#,
+        )
+        .replace(r#""lx": 0.03, "ly": 0.005"#, r#""lx": 0.14, "ly": 0.007"#),
+    )
+    .unwrap();
+    let o = precursors(&["info", path(&scene)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let text = String::from_utf8(o.stdout).unwrap();
+    assert!(
+        text.contains("block      0.14 x 0.007 x 0.02 m")
+            && text.contains("cells      200 x 10 = 2000 (cell 0.0007 x 0.0007 m)"),
+        "{text}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn every_without_checkpoint_is_a_command_line_error() {
+    let dir = scratch("every");
+    let scene = dir.join("scene.json");
+    std::fs::write(&scene, BASE).unwrap();
+    let out = dir.join("o");
+    let o = precursors(&["run", path(&scene), "--out", path(&out), "--every", "5"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--checkpoint"), "{}", stderr(&o));
+    assert!(!out.exists());
+    let checkpoint = dir.join("c.json");
+    let args = ["run", path(&scene), "--out", path(&out), "-q"];
+    let o = precursors(
+        &[
+            &args[..],
+            &["--checkpoint", path(&checkpoint), "--every", "5"],
+        ]
+        .concat(),
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(checkpoint.is_file());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_scene_file_that_is_not_text_is_invalid_input() {
+    let dir = scratch("binary");
+    let scene = dir.join("scene.json");
+    std::fs::write(&scene, b"\xff\xfe{ \"block\": 1 }").unwrap();
+    for command in ["info", "run"] {
+        let mut args = vec![command, path(&scene)];
+        let out = dir.join("o");
+        if command == "run" {
+            args.extend(["--out", path(&out)]);
+        }
+        let o = precursors(&args);
+        assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+        assert!(stderr(&o).contains("scene.json"), "{}", stderr(&o));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
