@@ -344,6 +344,12 @@ fn bad_figures_are_refused_with_typed_errors() {
     // A directory that is neither a run's nor a sweep's.
     let e = draw(&dir, &[Format::Png]).unwrap_err();
     assert!(e.to_string().contains("neither a sweep directory"), "{e}");
+    // A run cut before global slip (its tables still `.partial`): said so.
+    let cut = dir.join("cut");
+    std::fs::create_dir_all(&cut).unwrap();
+    std::fs::write(cut.join("curve.csv.partial"), "event\n").unwrap();
+    let e = draw(&cut, &[Format::Png]).unwrap_err();
+    assert!(e.to_string().contains("has not reached global slip"), "{e}");
     // A file that cannot be created (its directory is missing): an I/O failure, which
     // names the file.
     let e = Chart::new("t", "x", "y")

@@ -440,12 +440,12 @@ pub(crate) fn write_atomically(
         {
             Ok(file) => break (tmp, file),
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(io(&tmp, e)),
+            Err(e) => return Err(io(path, e)),
         }
     };
     if let Err(e) = file.write_all(bytes).and_then(|()| file.sync_all()) {
         let _ = std::fs::remove_file(&tmp);
-        return Err(io(&tmp, e));
+        return Err(io(path, e));
     }
     drop(file);
     if let Err(e) = std::fs::rename(&tmp, path) {

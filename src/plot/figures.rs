@@ -60,6 +60,19 @@ pub fn draw(dir: &Path, formats: &[Format]) -> Result<Drawn> {
         draw_sweep(dir, formats)
     } else if dir.join("curve.csv").is_file() {
         draw_run(dir, formats)
+    } else if dir
+        .join(format!("curve.csv{}", crate::output::PARTIAL_SUFFIX))
+        .is_file()
+    {
+        Err(Error::Figure {
+            path: Some(dir.to_path_buf()),
+            reason: format!(
+                "a run that has not reached global slip: it is under way, or was cut (its \
+                 tables are still named curve.csv{}); resume it from its checkpoint or run \
+                 it again, then plot",
+                crate::output::PARTIAL_SUFFIX
+            ),
+        })
     } else {
         Err(Error::Figure {
             path: Some(dir.to_path_buf()),
