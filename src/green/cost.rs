@@ -88,6 +88,42 @@ pub(crate) fn check_cells(nx: usize, ny: usize, limit: usize) -> Result<()> {
     Ok(())
 }
 
+/// The memory the machine can give a new allocation without swapping (bytes):
+/// `MemAvailable` of `/proc/meminfo` on Linux, `None` elsewhere or when it cannot be read
+/// (then no check is made).
+pub(crate) fn available_memory() -> Option<f64> {
+    if !cfg!(target_os = "linux") {
+        return None;
+    }
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let mut fields = line.split_whitespace().skip(1);
+    let value: f64 = fields.next()?.parse().ok()?;
+    match fields.next() {
+        Some("kB") => Some(value * 1024.0),
+        _ => None,
+    }
+}
+
+/// Refuses `bytes` of `what` above the memory available ([`available_memory`]) with
+/// [`Error::OutOfMemory`], before anything is allocated: an allocation that fails aborts
+/// the process, it cannot be reported.
+pub(crate) fn check_memory(
+    what: impl FnOnce() -> String,
+    bytes: f64,
+    hint: &'static str,
+) -> Result<()> {
+    match available_memory() {
+        Some(available) if !(bytes <= available) => Err(Error::OutOfMemory {
+            what: what(),
+            needed_bytes: bytes,
+            available_bytes: available,
+            hint,
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// `bytes` in kB, MB, GB or TB (decimal), three significant digits.
 pub(crate) fn format_bytes(bytes: f64) -> String {
     const UNITS: [(f64, &str); 4] = [(1e12, "TB"), (1e9, "GB"), (1e6, "MB"), (1e3, "kB")];
