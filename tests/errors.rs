@@ -514,12 +514,14 @@ mod ranges {
     }
 
     /// `(key, scene with the value, [accepted values], [refused values])`.
-    fn cases() -> Vec<(
+    type Case = (
         &'static str,
         Box<dyn Fn(f64) -> SceneBuilder>,
         Vec<f64>,
         Vec<f64>,
-    )> {
+    );
+
+    fn cases() -> Vec<Case> {
         let k = block_stiffness();
         vec![
             (

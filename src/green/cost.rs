@@ -114,7 +114,7 @@ pub(crate) fn check_memory(
     hint: &'static str,
 ) -> Result<()> {
     match available_memory() {
-        Some(available) if !(bytes <= available) => Err(Error::OutOfMemory {
+        Some(available) if bytes.is_nan() || bytes > available => Err(Error::OutOfMemory {
             what: what(),
             needed_bytes: bytes,
             available_bytes: available,

@@ -299,7 +299,7 @@ pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
     // The last site attached carries the whole normal load: its tangential stiffness and
     // area grow like e^{F_N/(ΔA c_z)}.
     let exponent = builder.normal_load / (grid.cell_area() * builder.law.c_z);
-    if !(exponent <= MAX_EXPONENT) {
+    if exponent.is_nan() || exponent > MAX_EXPONENT {
         return Err(out_of_range(
             "normal_load",
             builder.normal_load,
@@ -331,7 +331,7 @@ fn resolution(builder: &SceneBuilder) -> Result<()> {
     let r = builder.normal_load / (lx * ly) * lx.max(ly).max(lz)
         / (builder.material.modulus() * mean_height);
     let tolerance = builder.solver.tolerance;
-    if !(tolerance * r <= MAX_GAP_ERROR) {
+    if (tolerance * r).is_nan() || tolerance * r > MAX_GAP_ERROR {
         let most = MAX_GAP_ERROR / r;
         if most >= SOLVER_TOLERANCE.0 {
             return Err(out_of_range(
