@@ -58,7 +58,7 @@ impl GridCost {
         let cells = nx as u128 * ny as u128;
         let n = cells as f64;
         let dense = if cells <= AUTO_DENSE_LIMIT as u128 {
-            DENSE_BYTES_PER_ENTRY * n * n
+            dense_bytes(n)
         } else {
             0.0
         };
@@ -69,6 +69,11 @@ impl GridCost {
             solve_seconds: SOLVE_SECONDS * n.powf(SOLVE_EXPONENT),
         }
     }
+}
+
+/// Bytes of the dense backend's two `N x N` matrices for `cells` cells.
+pub(crate) fn dense_bytes(cells: f64) -> f64 {
+    DENSE_BYTES_PER_ENTRY * cells * cells
 }
 
 /// Refuses `nx x ny` cells above `limit` with [`Error::GridTooLarge`].
