@@ -513,6 +513,68 @@ pub enum Error {
         /// The cell's text.
         value: String,
     },
+    /// A scene value that is finite and of the right sign but outside the range the
+    /// computation can honour (`docs/scene-format.md`, "Valid ranges"): named by its
+    /// scene-file key, with the range.
+    #[error("{key} = {} is out of range: {reason}; the valid range is {range}", Num(*value))]
+    OutOfRange {
+        /// The scene-file key (`block.ly`, `solver.tolerance`, `drive.stiffness`, ...).
+        key: &'static str,
+        /// The value given (in the key's unit).
+        value: f64,
+        /// The valid range, with its unit (it may depend on other keys of the scene).
+        range: String,
+        /// Why values outside it are refused.
+        reason: &'static str,
+    },
+    /// The memory a scene or sweep would need exceeds what the machine has available
+    /// (Linux: `MemAvailable` of `/proc/meminfo`), refused before anything is allocated.
+    #[error(
+        "{what} would need about {needed} of memory, but only {available} is available: {hint}",
+        needed = crate::green::format_bytes(*needed_bytes),
+        available = crate::green::format_bytes(*available_bytes)
+    )]
+    OutOfMemory {
+        /// What would be allocated.
+        what: String,
+        /// Estimated bytes needed.
+        needed_bytes: f64,
+        /// Bytes available.
+        available_bytes: f64,
+        /// What to change.
+        hint: &'static str,
+    },
+    /// A load `F/(μF_N)` beyond the friction limit at a stable state or at global slip:
+    /// no stable state carries more than `μF_N` (every site holds `|φ_x| ≤ μ φ_z`), so
+    /// the computation went wrong; refused rather than written to a table.
+    #[error(
+        "F/(μF_N) = {} exceeds the friction limit {limit}: no stable state carries more than \
+         μF_N, so the result is wrong (a solver tolerance too loose, or a degenerate scene); \
+         nothing beyond it was written",
+        Num(*ratio)
+    )]
+    LoadBeyondFriction {
+        /// The load ratio reached (NaN or infinite when the computation overflowed).
+        ratio: f64,
+        /// The largest ratio accepted.
+        limit: f64,
+    },
+    /// A sweep with more runs than a sweep may have.
+    #[error(
+        "the sweep has {points} points x {realizations} realizations = {runs} runs, more than \
+         the limit of {limit} runs per sweep: split it into several sweeps (fewer values per \
+         axis or fewer realizations each, with other output directories)"
+    )]
+    SweepTooLarge {
+        /// Parameter points (the product of the axes' lengths, exact).
+        points: u128,
+        /// Realizations per point.
+        realizations: usize,
+        /// `points · realizations` (exact).
+        runs: u128,
+        /// The most runs per sweep.
+        limit: usize,
+    },
 }
 
 impl Error {

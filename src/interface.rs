@@ -218,6 +218,38 @@ impl Heights {
     /// [`Error::InvalidParameter`] for a mean or standard deviation that is not finite (or
     /// negative), or a mean below `-3` standard deviations.
     pub fn truncated_gaussian(grid: &Grid, dist: HeightDistribution, seed: u64) -> Result<Self> {
+        Self::check_distribution(dist)?;
+        let HeightDistribution { mean, std_dev } = dist;
+        let normal = Normal::new(mean, std_dev).map_err(|_| Error::InvalidParameter {
+            name: "std_dev",
+            value: std_dev,
+            reason: "rejected by rand_distr::Normal",
+        })?;
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let values = (0..grid.len())
+            .map(|_| loop {
+                let h = normal.sample(&mut rng);
+                if h > 0.0 {
+                    break h;
+                }
+            })
+            .collect();
+        Ok(Self { values })
+    }
+
+    /// User-supplied heights (a measured topography), in cell order `i = iy * Nx + ix`:
+    /// one finite value `> 0` (m) per cell.
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] for a count other than the grid's; [`Error::NonFinite`];
+    /// [`Error::NonPositiveHeight`].
+    pub fn from_values(grid: &Grid, values: Vec<f64>) -> Result<Self> {
+        Self::check_values(grid, &values)?;
+        Ok(Self { values })
+    }
+
+    /// The checks of [`Heights::truncated_gaussian`] without drawing.
+    pub(crate) fn check_distribution(dist: HeightDistribution) -> Result<()> {
         let HeightDistribution { mean, std_dev } = dist;
         if !mean.is_finite() {
             return Err(Error::InvalidParameter {
@@ -248,35 +280,16 @@ impl Heights {
                          almost every draw would be cut at 0",
             });
         }
-        let normal = Normal::new(mean, std_dev).map_err(|_| Error::InvalidParameter {
-            name: "std_dev",
-            value: std_dev,
-            reason: "rejected by rand_distr::Normal",
-        })?;
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let values = (0..grid.len())
-            .map(|_| loop {
-                let h = normal.sample(&mut rng);
-                if h > 0.0 {
-                    break h;
-                }
-            })
-            .collect();
-        Ok(Self { values })
+        Ok(())
     }
 
-    /// User-supplied heights (a measured topography), in cell order `i = iy * Nx + ix`:
-    /// one finite value `> 0` (m) per cell.
-    ///
-    /// # Errors
-    /// [`Error::LengthMismatch`] for a count other than the grid's; [`Error::NonFinite`];
-    /// [`Error::NonPositiveHeight`].
-    pub fn from_values(grid: &Grid, values: Vec<f64>) -> Result<Self> {
-        check_slice("heights", &values, grid.len())?;
+    /// The checks of [`Heights::from_values`] without copying.
+    pub(crate) fn check_values(grid: &Grid, values: &[f64]) -> Result<()> {
+        check_slice("heights", values, grid.len())?;
         if let Some((index, &value)) = values.iter().enumerate().find(|(_, h)| **h <= 0.0) {
             return Err(Error::NonPositiveHeight { index, value });
         }
-        Ok(Self { values })
+        Ok(())
     }
 
     /// The heights (m), in cell order.

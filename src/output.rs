@@ -621,7 +621,7 @@ impl RunTables {
             )
             .map_err(|e| Error::io("writing table", &self.partials[1], e))?;
             let x = load.force / mu_fn;
-            self.map_rows_below(x)?;
+            self.map_rows_below(x, true)?;
             self.in_effect = Some(MapState {
                 event: index,
                 columns: driver.column_contact_area()?,
@@ -629,16 +629,31 @@ impl RunTables {
         }
         if let Event::GlobalSlip { load } = *event {
             let mu_fn = driver.friction_coefficient() * driver.normal_load();
-            self.map_rows_below(load.force / mu_fn)?;
+            self.map_rows_below(load.force / mu_fn, false)?;
             self.slipped = true;
         }
         Ok(())
     }
 
     /// The rows of `contact_map.csv` for the levels below the load `x = F/(μF_N)` of a new
-    /// state: the state in effect until now held there. Before the first stable state
-    /// there is none: the map starts at the first level at or above its load.
-    fn map_rows_below(&mut self, x: f64) -> Result<()> {
+    /// state (`stable`) or of global slip: the state in effect until now held there.
+    /// Before the first stable state there is none: the map starts at the first level at
+    /// or above its load. The levels stop at the friction limit.
+    fn map_rows_below(&mut self, x: f64, stable: bool) -> Result<()> {
+        // No stable state carries more than μF_N (every site holds |φ_x| ≤ μφ_z): in the
+        // tests' scenes it stays below 0.999 (1 + 2.2e-16 at global slip), the
+        // margin covers the loosest solver tolerance (1e-6). Beyond, the driver's result
+        // is wrong; an infinite load made the loop below endless. Global slip under a
+        // driving spring may overshoot μF_N (sites re-attach in the last avalanche): its
+        // levels stop at the limit, so the map has at most 201 rows.
+        const LIMIT: f64 = 1.0 + 1e-5;
+        if !(x.is_finite() && (x <= LIMIT || !stable)) {
+            return Err(Error::LoadBeyondFriction {
+                ratio: x,
+                limit: LIMIT,
+            });
+        }
+        let x = x.min(LIMIT);
         let Some(state) = &self.in_effect else {
             self.next_level = first_level_at_or_above(x);
             return Ok(());

@@ -21,13 +21,14 @@
 //! # Ok::<(), precursors::Error>(())
 //! ```
 
-use crate::error::{Error, Result};
+use crate::error::{check_tolerance, Error, Result};
 use crate::geometry::{Block, Grid};
 use crate::green::{InfluencePlan, Planner, RodLoad};
 use crate::interface::{AreaLaw, HeightDistribution, Heights, Interface, Material, SpringLaw};
 use crate::probe::{ProbeSpec, StressProbe};
 use crate::solver::SolverOptions;
 
+mod bounds;
 #[cfg(feature = "serde")]
 pub(crate) mod file;
 
@@ -124,10 +125,54 @@ impl HeightSource {
     /// [`Error::Io`] when the file cannot be read (with its path); [`Error::HeightsFile`]
     /// for a line that is not a finite height `> 0`, or no height at all.
     pub fn from_file(path: impl AsRef<std::path::Path>) -> Result<HeightSource> {
-        let path = path.as_ref();
+        Self::read_file(path.as_ref(), None)
+    }
+
+    /// [`HeightSource::from_file`] for a grid of `cells` cells (when known): a file longer
+    /// than such a grid's heights can be (1 MiB of comments and 256 bytes a height), or
+    /// holding more heights, is refused before it is read whole; without a grid, the file
+    /// must fit in the memory available.
+    pub(crate) fn read_file(path: &std::path::Path, cells: Option<usize>) -> Result<HeightSource> {
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::io("reading heights file", path, e))?;
+        let size = std::fs::metadata(path)
+            .map_err(|e| Error::io("reading heights file", path, e))?
+            .len();
+        if let Some(cells) = cells {
+            let limit = (1u64 << 20).saturating_add((cells as u64).saturating_mul(256));
+            if size > limit {
+                return Err(Error::HeightsFile {
+                    path: name,
+                    line: 0,
+                    reason: format!(
+                        "the file has {size} bytes, more than the {limit} bytes that {cells} \
+                         heights (one per cell) and their comments may take"
+                    ),
+                });
+            }
+        }
+        // The text and the values (8 bytes each, from at least 2 bytes of text).
+        crate::green::check_memory(
+            || format!("reading heights file {name} ({size} bytes)"),
+            5.0 * size as f64,
+            "the file is too large for this machine",
+        )?;
+        let bytes = std::fs::read(path).map_err(|e| Error::io("reading heights file", path, e))?;
+        let text = match std::str::from_utf8(&bytes) {
+            Ok(text) => text,
+            Err(e) => {
+                let prefix = &bytes[..e.valid_up_to()];
+                let line = prefix.iter().filter(|b| **b == b'\n').count() + 1;
+                return Err(Error::HeightsFile {
+                    path: name,
+                    line,
+                    reason: format!(
+                        "the file is not UTF-8 text: byte {} (0x{:02x}) is not valid UTF-8",
+                        e.valid_up_to(),
+                        bytes[e.valid_up_to()]
+                    ),
+                });
+            }
+        };
         let mut values = Vec::new();
         for (number, line) in text.lines().enumerate() {
             let line = line.trim();
@@ -139,9 +184,18 @@ impl HeightSource {
                 line: number + 1,
                 reason,
             };
-            let value: f64 = line
-                .parse()
-                .map_err(|e| bad(format!("{line:?} is not a number ({e})")))?;
+            if cells.is_some_and(|cells| values.len() == cells) {
+                return Err(bad(format!(
+                    "one height more than the grid's {} cells",
+                    values.len()
+                )));
+            }
+            let value: f64 = line.parse().map_err(|e| {
+                // A line may be megabytes long: its start says enough.
+                let start: String = line.chars().take(40).collect();
+                let cut = if start.len() < line.len() { "..." } else { "" };
+                bad(format!("{start:?}{cut} is not a number ({e})"))
+            })?;
             if !(value.is_finite() && value > 0.0) {
                 return Err(bad(format!(
                     "{value} m is not a height: heights must be finite and > 0"
@@ -492,12 +546,15 @@ impl SceneBuilder {
 
     /// The block and grid of the scene, validated (and the cell limit checked) without
     /// building anything else: e.g. to print a scene's size and [`crate::GridCost`]
-    /// before running it.
+    /// before running it. [`SceneBuilder::check`] checks the rest of the scene too.
     ///
     /// # Errors
     /// The first invalid length or cell size or count; [`Error::GridTooLarge`] above
-    /// [`SceneBuilder::max_cells`].
+    /// [`SceneBuilder::max_cells`]; [`Error::OutOfRange`] (naming the scene-file key) for
+    /// a length, an aspect ratio or a cell size outside the ranges of
+    /// `docs/scene-format.md` ("Valid ranges").
     pub fn grid(&self) -> Result<Grid> {
+        bounds::geometry(self)?;
         let (lx, ly, lz) = self.lengths;
         let block = Block::new(lx, ly, lz)?;
         let grid = match self.cells {
@@ -508,14 +565,36 @@ impl SceneBuilder {
         Ok(grid)
     }
 
-    /// Everything [`SceneBuilder::build`] checks before planning the operator (`O(N)`:
-    /// the heights are drawn), with the block, grid, heights and lateral load.
-    pub(crate) fn checked(&self) -> Result<(Block, Grid, Heights, Option<Lateral>)> {
+    /// Everything [`SceneBuilder::build`] checks but the operator's plan, without the
+    /// allocations of a scene: every value's sign, finiteness and range
+    /// (`docs/scene-format.md`, "Valid ranges"), the heights (a count of values against
+    /// the grid; random heights are not drawn), the drive's band, and the memory the scene
+    /// would need against the memory available (Linux). A scene that passes is refused by
+    /// `build` only when its plan does not reach [`SceneBuilder::plan_tolerance`] (below
+    /// about `2e-13`) or the probes' sums do not converge ([`Error::NotConverged`]), or a
+    /// point probe lies on an edge of the rod's band at `x = 0`
+    /// ([`Error::SingularPoint`]). Returns the grid.
+    ///
+    /// # Errors
+    /// The first invalid value, as [`SceneBuilder::build`] reports it: the errors of
+    /// [`SceneBuilder::grid`]; [`Error::InvalidParameter`], [`Error::InvalidTolerance`],
+    /// [`Error::InvalidCount`], [`Error::LengthMismatch`], [`Error::NonFinite`],
+    /// [`Error::NonPositiveHeight`], [`Error::RodBandOutsideFace`],
+    /// [`Error::DenseThreads`] for values the model cannot take; [`Error::OutOfRange`]
+    /// (naming the scene-file key, with the valid range) for values it cannot honour;
+    /// [`Error::OutOfMemory`] when the scene would need more memory than is available.
+    pub fn check(&self) -> Result<Grid> {
         let grid = self.grid()?;
         let block = *grid.block();
+        crate::green::check_memory(
+            || format!("a scene of {} x {} cells", grid.nx(), grid.ny()),
+            bounds::memory_bytes(self, &grid),
+            "use fewer cells (or fewer probes), or a machine with more memory",
+        )?;
         self.material.validate()?;
         self.law.validate()?;
         self.solver.validate()?;
+        check_tolerance(self.plan_tolerance)?;
         if !(self.normal_load.is_finite() && self.normal_load > 0.0) {
             return Err(Error::InvalidParameter {
                 name: "normal_load",
@@ -523,40 +602,70 @@ impl SceneBuilder {
                 reason: "the normal load must be finite and > 0 N",
             });
         }
+        match &self.heights {
+            HeightSource::Random { distribution, .. } => {
+                Heights::check_distribution(*distribution)?;
+            }
+            HeightSource::Values(v) => Heights::check_values(&grid, v)?,
+        }
+        match self.drive {
+            Drive::Force(ForceLoad::Mixed { ratio, .. })
+                if !(ratio.is_finite() && ratio >= 0.0) =>
+            {
+                return Err(Error::InvalidParameter {
+                    name: "drive.ratio",
+                    value: ratio,
+                    reason: "the mixed-load ratio n = F_top/F_lat must be finite and >= 0",
+                });
+            }
+            Drive::Spring { stiffness, .. } if !(stiffness.is_finite() && stiffness > 0.0) => {
+                return Err(Error::InvalidParameter {
+                    name: "drive.stiffness",
+                    value: stiffness,
+                    reason: "the driving spring's stiffness K_S must be finite and > 0 N/m",
+                });
+            }
+            _ => {}
+        }
+        if let Some(Lateral::Rod { height, half_width }) = self.lateral() {
+            RodLoad::new(&block, height, half_width)?;
+        }
+        if !self.probes.is_empty() {
+            check_tolerance(self.probes.tolerance)?;
+            for &z in &self.probes.planes {
+                block.check_height(z)?;
+            }
+            for &p in &self.probes.points {
+                block.check_point(p, ["x", "y", "z"])?;
+            }
+        }
+        bounds::physics(self, &grid)?;
+        Ok(grid)
+    }
+
+    /// The lateral part of the drive, if any.
+    fn lateral(&self) -> Option<Lateral> {
+        match self.drive {
+            Drive::Force(ForceLoad::Top) => None,
+            Drive::Force(ForceLoad::Lateral(l))
+            | Drive::Force(ForceLoad::Mixed { lateral: l, .. })
+            | Drive::Spring { lateral: l, .. } => Some(l),
+        }
+    }
+
+    /// Everything [`SceneBuilder::build`] checks before planning the operator
+    /// ([`SceneBuilder::check`]), with the block, grid, heights (drawn: `O(N)`) and
+    /// lateral load.
+    pub(crate) fn checked(&self) -> Result<(Block, Grid, Heights, Option<Lateral>)> {
+        let grid = self.check()?;
+        let block = *grid.block();
         let heights = match &self.heights {
             HeightSource::Random { distribution, seed } => {
                 Heights::truncated_gaussian(&grid, *distribution, *seed)?
             }
             HeightSource::Values(v) => Heights::from_values(&grid, v.clone())?,
         };
-        let lateral = match self.drive {
-            Drive::Force(ForceLoad::Top) => None,
-            Drive::Force(ForceLoad::Lateral(l)) => Some(l),
-            Drive::Force(ForceLoad::Mixed { ratio, lateral }) => {
-                if !(ratio.is_finite() && ratio >= 0.0) {
-                    return Err(Error::InvalidParameter {
-                        name: "ratio (F_top / F_lat)",
-                        value: ratio,
-                        reason: "the mixed-load ratio n must be finite and >= 0",
-                    });
-                }
-                Some(lateral)
-            }
-            Drive::Spring { stiffness, lateral } => {
-                if !(stiffness.is_finite() && stiffness > 0.0) {
-                    return Err(Error::InvalidParameter {
-                        name: "stiffness (K_S)",
-                        value: stiffness,
-                        reason: "the driving spring's stiffness must be finite and > 0 N/m",
-                    });
-                }
-                Some(lateral)
-            }
-        };
-        if let Some(Lateral::Rod { height, half_width }) = lateral {
-            RodLoad::new(&block, height, half_width)?;
-        }
-        Ok((block, grid, heights, lateral))
+        Ok((block, grid, heights, self.lateral()))
     }
 
     /// Validates everything and plans the operator (`O(N)` eigenvalues).

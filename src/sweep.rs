@@ -34,7 +34,9 @@ use crate::driver::write_atomically;
 use crate::error::{Error, Result};
 use crate::lock::{Attempt, DirLock, LOCK_FILE};
 use crate::output::RunTables;
-use crate::scene::file::{builder_from_value, normalized_value};
+use crate::scene::file::{
+    builder_from_value, check_shape, normalized_value, read_json_text, scene_shape, Shape,
+};
 use crate::scene::{HeightSource, SceneBuilder};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -47,6 +49,10 @@ use std::time::Instant;
 pub const SWEEP_FILE: &str = "sweep.json";
 /// The completion marker of a run, written last (atomically) into its directory.
 pub const DONE_FILE: &str = "done";
+/// The most runs a sweep may have (points times realizations): `1e5` runs are a day of
+/// the calibration scene on 64 cores, a run directory of four files each, and a merge
+/// that reads them all; a larger study is several sweeps (each its own directory).
+pub const MAX_RUNS: usize = 100_000;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -93,6 +99,19 @@ impl Axis {
     /// The keys joined, as errors name an axis.
     fn name(&self) -> String {
         self.keys.join(", ")
+    }
+}
+
+/// The objects of a sweep file: the top level, `base` (a scene: [`scene_shape`]) and each
+/// axis (serde would take an array for each, by position).
+fn sweep_shape(path: &str) -> Shape {
+    match path {
+        "" | "base" | "axes.#" => Shape::Object,
+        "axes" => Shape::Objects,
+        _ => match path.strip_prefix("base.") {
+            Some(key) => scene_shape(key),
+            None => Shape::Any,
+        },
     }
 }
 
@@ -337,6 +356,7 @@ impl Sweep {
     /// is not a scene key or whose value gives no valid scene; [`Error::InvalidCount`] for
     /// zero realizations, or several with heights that are not random.
     pub fn from_json_str(text: &str) -> Result<Sweep> {
+        check_shape(text, &sweep_shape).map_err(|e| sweep_json_error(None, e))?;
         let spec: SweepSpec = serde_json::from_str(text).map_err(|e| sweep_json_error(None, e))?;
         Self::from_spec(spec, None, Path::new("."))
     }
@@ -348,8 +368,15 @@ impl Sweep {
     /// [`Error::Io`] when the file cannot be read; the others as [`Sweep::from_json_str`].
     pub fn from_json_file(path: impl AsRef<Path>) -> Result<Sweep> {
         let path = path.as_ref();
-        let text =
-            std::fs::read_to_string(path).map_err(|e| Error::io("reading sweep file", path, e))?;
+        let text = read_json_text(path, "reading sweep file", |line, column, reason| {
+            Error::SweepFile {
+                path: Some(path.to_path_buf()),
+                line,
+                column,
+                source: reason.into(),
+            }
+        })?;
+        check_shape(&text, &sweep_shape).map_err(|e| sweep_json_error(Some(path), e))?;
         let spec: SweepSpec =
             serde_json::from_str(&text).map_err(|e| sweep_json_error(Some(path), e))?;
         Self::from_spec(spec, Some(path), path.parent().unwrap_or(Path::new(".")))
@@ -386,6 +413,45 @@ impl Sweep {
             });
         }
         let axes = read_axes(&spec, file_error)?;
+        // The size of the sweep before any scene is checked or any run built.
+        let points = axes
+            .iter()
+            .try_fold(1u128, |p, a| p.checked_mul(a.steps.len() as u128));
+        let runs = points.and_then(|p| p.checked_mul(spec.realizations as u128));
+        match (points, runs) {
+            (Some(_), Some(runs)) if runs <= MAX_RUNS as u128 => {
+                let base = builder_from_value(spec.base.clone()).map_err(base_error)?;
+                let heights = match base.current_heights() {
+                    HeightSource::Values(v) => 8 * v.len(),
+                    HeightSource::Random { .. } => 0,
+                };
+                // Each run holds its scene, heights included, its values as text and its
+                // coordinates; twice that while it is built.
+                let text: usize = axes
+                    .iter()
+                    .map(|a| {
+                        let longest = a.steps.iter().map(|s| describe_step(s).len()).max();
+                        a.keys.iter().map(|k| k.len() + 48).sum::<usize>() + longest.unwrap_or(0)
+                    })
+                    .sum();
+                let per_run = std::mem::size_of::<SweepRun>() + heights + text + 64;
+                crate::green::check_memory(
+                    || format!("the list of the sweep's {runs} runs"),
+                    2.0 * runs as f64 * per_run as f64,
+                    "split the sweep into several sweeps, or give the heights as random",
+                )?;
+            }
+            _ => {
+                return Err(Error::SweepTooLarge {
+                    points: axes
+                        .iter()
+                        .fold(1u128, |p, a| p.saturating_mul(a.steps.len() as u128)),
+                    realizations: spec.realizations,
+                    runs: points.map_or(u128::MAX, |p| p.saturating_mul(spec.realizations as u128)),
+                    limit: MAX_RUNS,
+                })
+            }
+        }
         // Each axis on its own: the keys exist, each step gives a valid scene.
         for (a, axis) in axes.iter().enumerate() {
             let name = axis.name();
@@ -418,7 +484,7 @@ impl Sweep {
                         format!("value {value} (#{i}) is not valid here: {reason}"),
                     )
                 })?;
-                builder.checked().map_err(|e| {
+                builder.check().map_err(|e| {
                     key_error(
                         &name,
                         format!("value {value} (#{i}) gives an invalid scene: {e}"),
@@ -465,7 +531,7 @@ impl Sweep {
                     )
                 })?;
                 if realization == 0 {
-                    builder.checked().map_err(|e| {
+                    builder.check().map_err(|e| {
                         key_error(
                             &keys(),
                             format!("the point {} gives an invalid scene: {e}", describe()),

@@ -461,3 +461,307 @@ fn counts_are_reported_as_integers() {
     );
     assert!(e.to_string().starts_with("max_terms = 0 is invalid"), "{e}");
 }
+
+/// The valid ranges of `docs/scene-format.md` ("Valid ranges"), key by key: the
+/// documented bounds are not refused for the key, values just outside are refused at
+/// once by `SceneBuilder::check` and `build` with `Error::OutOfRange` naming the key, and
+/// the message gives the range. The bounds are the table's (the reference), not read
+/// from the code.
+mod ranges {
+    use precursors::probe::ProbeSpec;
+    use precursors::*;
+
+    /// A small valid scene: 20 x 4 cells of 1 mm on a 20 x 4 x 10 mm block.
+    fn base() -> SceneBuilder {
+        Scene::builder()
+            .block(0.020, 0.004, 0.010)
+            .cells(20, 4)
+            .normal_load(60.0)
+    }
+
+    fn material(e: f64, nu: f64, mu: f64) -> SceneBuilder {
+        let mut m = Material::default();
+        (m.young_modulus, m.poisson_ratio, m.friction_coefficient) = (e, nu, mu);
+        base().material(m)
+    }
+
+    fn springs(c_x: f64, c_z: f64) -> SceneBuilder {
+        let mut law = SpringLaw::default();
+        (law.c_x, law.c_z) = (c_x, c_z);
+        base().springs(law)
+    }
+
+    fn solver(f: impl FnOnce(&mut SolverOptions)) -> SceneBuilder {
+        let mut o = SolverOptions::default();
+        f(&mut o);
+        base().solver(o)
+    }
+
+    /// The block's shear stiffness `M·Ly·Lz/Lx` of [`base`] (N/m), the paper's PMMA.
+    fn block_stiffness() -> f64 {
+        3.833e9 / 1.38 * 0.004 * 0.010 / 0.020
+    }
+
+    fn spring(k: f64) -> SceneBuilder {
+        base().drive(Drive::Spring {
+            stiffness: k,
+            lateral: Lateral::Side,
+        })
+    }
+
+    fn refused(b: &SceneBuilder, key: &str) -> bool {
+        matches!(b.check(), Err(Error::OutOfRange { key: k, .. }) if k == key)
+    }
+
+    /// `(key, scene with the value, [accepted values], [refused values])`.
+    type Case = (
+        &'static str,
+        Box<dyn Fn(f64) -> SceneBuilder>,
+        Vec<f64>,
+        Vec<f64>,
+    );
+
+    fn cases() -> Vec<Case> {
+        let k = block_stiffness();
+        vec![
+            (
+                "block.lx",
+                Box::new(|v| base().block(v, v, v).cells(1, 1).normal_load(1e-9)),
+                vec![1e-9, 1e9],
+                vec![0.99e-9, 1.01e9, 1e308],
+            ),
+            (
+                "block.ly",
+                Box::new(|v| base().block(0.02, v, 0.01)),
+                vec![0.020001e-6, 0.004],
+                vec![0.0199e-6, 1e308],
+            ),
+            (
+                "block.lz",
+                Box::new(|v| base().block(0.02, 0.004, v)),
+                vec![8e-8, 3.99e3],
+                vec![4.01e3, 1e308],
+            ),
+            (
+                "cells.nx",
+                // Δx ≥ Lz/1e6 = 9.99e-7 m on a block 1 mm long.
+                Box::new(|v| base().block(1e-3, 1e-3, 0.999).cells(v as usize, 1)),
+                vec![1000.0],
+                vec![1002.0],
+            ),
+            (
+                // Δx ≥ Lz/1e6 = 1e-8 m on a block 0.1 mm long.
+                "cells.dx",
+                Box::new(|v| base().block(1e-4, 0.004, 0.01).cell_size(v, 0.004)),
+                vec![2e-8, 1e-4],
+                vec![0.5e-8],
+            ),
+            (
+                "material.young_modulus",
+                Box::new(|v| material(v, 0.38, 0.5)),
+                vec![1e-3, 1e15],
+                vec![0.99e-3, 1.01e15, 1e308],
+            ),
+            (
+                "material.poisson_ratio",
+                Box::new(|v| material(3e9, v, 0.5)),
+                vec![-0.999_999, 0.5],
+                vec![-0.999_999_5],
+            ),
+            (
+                "material.friction_coefficient",
+                Box::new(|v| material(3e9, 0.38, v)),
+                vec![1e-6, 1e3],
+                vec![0.99e-6, 1.01e3, 1e-300],
+            ),
+            (
+                "springs.c_x",
+                Box::new(|v| springs(v, 1.65e8)),
+                vec![1e-3, 1e24],
+                vec![0.99e-3, 1.01e24],
+            ),
+            (
+                "springs.c_z",
+                Box::new(|v| springs(1.65e12, v)),
+                vec![1e-3, 1e21],
+                vec![0.99e-3, 1.01e21],
+            ),
+            (
+                "normal_load",
+                // A stiff block on stiff springs: within 650 ΔA c_z, and the block's
+                // displacement within 1e10 asperity heights.
+                Box::new(|v| {
+                    let mut m = Material::default();
+                    m.young_modulus = 1e15;
+                    springs(1.65e12, 1e21).material(m).normal_load(v)
+                }),
+                vec![1e-9, 1e15],
+                vec![0.99e-9, 1.01e15],
+            ),
+            (
+                // At most 650 ΔA c_z: 650 · 1e-6 m² · 1.65e8 N/m² = 107250 N.
+                "normal_load",
+                Box::new(|v| base().normal_load(v)),
+                vec![107_000.0],
+                vec![107_500.0],
+            ),
+            (
+                "heights.mean",
+                Box::new(|v| {
+                    base().heights(HeightSource::Random {
+                        distribution: HeightDistribution::new(v, v),
+                        seed: 1,
+                    })
+                }),
+                vec![1e-15, 1e3],
+                vec![0.99e-15, 1.01e3],
+            ),
+            (
+                "heights.std_dev",
+                Box::new(|v| {
+                    base().heights(HeightSource::Random {
+                        distribution: HeightDistribution::new(1e-6, v),
+                        seed: 1,
+                    })
+                }),
+                vec![0.0, 1e-15, 1e3],
+                vec![0.99e-15, 1.01e3],
+            ),
+            (
+                "heights.values",
+                Box::new(|v| base().heights(HeightSource::Values(vec![v; 80]))),
+                vec![1e-15, 1e3],
+                vec![0.99e-15, 1.01e3, 1e300],
+            ),
+            (
+                "drive.ratio",
+                Box::new(|v| {
+                    base().drive(Drive::Force(ForceLoad::Mixed {
+                        ratio: v,
+                        lateral: Lateral::Side,
+                    }))
+                }),
+                vec![0.0, 1e12],
+                vec![1.01e12],
+            ),
+            (
+                "drive.half_width",
+                Box::new(|v| {
+                    base().drive(Drive::Force(
+                        Lateral::Rod {
+                            height: 0.005,
+                            half_width: v,
+                        }
+                        .into(),
+                    ))
+                }),
+                vec![1.01e-8, 0.005],
+                vec![0.99e-8],
+            ),
+            (
+                "drive.stiffness",
+                Box::new(spring),
+                vec![1e-12 * k * 1.000001, 4e6, 1e12 * k * 0.999999],
+                vec![1e-12 * k * 0.999, 1e12 * k * 1.001, 1e-306, 1e-300, 1e300],
+            ),
+            (
+                "solver.tolerance",
+                Box::new(|v| solver(|o| o.tolerance = v)),
+                vec![1e-15, 1e-6],
+                vec![0.99e-15, 1e-17, 1.01e-6, 1.0, 10.0, 1e308],
+            ),
+            (
+                "solver.max_active_set_iterations",
+                Box::new(|v| solver(|o| o.max_active_set_iterations = v as usize)),
+                vec![1.0, 1e6],
+                vec![0.0, 1e6 + 1.0, 1e19],
+            ),
+            (
+                "solver.max_linear_iterations",
+                Box::new(|v| solver(|o| o.max_linear_iterations = v as usize)),
+                vec![1.0, 1e7],
+                vec![0.0, 1e7 + 1.0],
+            ),
+            (
+                "plan_tolerance",
+                Box::new(|v| base().plan_tolerance(v)),
+                vec![1e-8, 1e-2],
+                vec![1.01e-2, 1.0, 1e308],
+            ),
+            (
+                "probes.tolerance",
+                Box::new(|v| base().probes(ProbeSpec::default().plane(1e-3).tolerance(v))),
+                vec![1e-15, 1e-2],
+                vec![0.99e-15, 1.01e-2, 1.0],
+            ),
+        ]
+    }
+
+    #[test]
+    fn values_outside_the_documented_ranges_are_refused_naming_the_key() {
+        for (key, scene, accepted, outside) in cases() {
+            for v in accepted {
+                let b = scene(v);
+                assert!(!refused(&b, key), "{key} = {v}: {:?}", b.check().err());
+            }
+            for v in outside {
+                let b = scene(v);
+                let e = b.check().unwrap_err();
+                assert!(refused(&b, key), "{key} = {v}: {e}");
+                let text = e.to_string();
+                assert!(
+                    text.starts_with(&format!("{key} = ")) && text.contains("valid range is ["),
+                    "{text}"
+                );
+                // `build` refuses it the same way, before planning.
+                assert_eq!(b.build().unwrap_err().to_string(), text);
+            }
+        }
+    }
+
+    /// The inputs of issue 23: `block.ly = 1e308` ran into "faer reported ZeroPivot",
+    /// `block.lx = 1e308` into "tolerance inf is invalid", a spring of `1e-306` N/m into an
+    /// endless contact map, `solver.tolerance` 1, 10 or 1e308 into wrong tables with exit
+    /// 0.
+    #[test]
+    fn the_reported_inputs_are_refused_with_their_key() {
+        for (b, key) in [
+            (base().block(0.02, 1e308, 0.01), "block.ly"),
+            (base().block(1e308, 0.004, 0.01), "block.lx"),
+            (spring(1e-306), "drive.stiffness"),
+            (solver(|o| o.tolerance = 1.0), "solver.tolerance"),
+            (solver(|o| o.tolerance = 10.0), "solver.tolerance"),
+            (solver(|o| o.tolerance = 1e308), "solver.tolerance"),
+        ] {
+            assert!(refused(&b, key), "{key}: {:?}", b.check());
+        }
+        // The paper's spring on the calibration block is in range.
+        assert!(Scene::builder()
+            .drive(Drive::Spring {
+                stiffness: 4e6,
+                lateral: Lateral::Side
+            })
+            .check()
+            .is_ok());
+    }
+
+    /// A grid whose estimated memory exceeds what the machine has is refused by `check`
+    /// before anything is allocated (it aborted on an 80 GB allocation); `info` runs the
+    /// same check. 1e5 x 1e5 cells need about 2.4 TB (240 bytes a cell).
+    #[test]
+    fn a_grid_larger_than_the_memory_is_refused_before_allocating() {
+        if !std::path::Path::new("/proc/meminfo").exists() {
+            return; // the check needs Linux's MemAvailable
+        }
+        let b = base().cells(100_000, 100_000).max_cells(usize::MAX);
+        let started = std::time::Instant::now();
+        let e = b.check().unwrap_err();
+        assert!(
+            matches!(e, Error::OutOfMemory { needed_bytes, .. } if needed_bytes > 2e12),
+            "{e}"
+        );
+        assert!(e.to_string().contains("TB of memory, but only"), "{e}");
+        assert!(started.elapsed().as_secs_f64() < 1.0);
+        assert_eq!(b.build().unwrap_err().to_string(), e.to_string());
+    }
+}

@@ -54,13 +54,91 @@ fn all_finite(v: &[f64]) -> bool {
     v.iter().all(|x| x.is_finite())
 }
 
-/// Builds `builder` and, if it builds, runs it to its first stable state: every value
-/// read is finite, or an error with a message is returned.
+/// Events a scene that builds is stepped through (tiny grids: milliseconds each).
+const STEPS: usize = 5;
+
+/// The most wall time one case may take (debug build, a machine shared by other jobs):
+/// a scene is refused or stepped in milliseconds, so this catches a hang, not a slow path.
+const CASE_SECONDS: f64 = 60.0;
+
+/// The largest `F/(μF_N)` a state may carry: the friction limit, as `RunTables` refuses
+/// beyond it (no stable state carries more than `μF_N`).
+const LOAD_LIMIT: f64 = 1.0 + 1e-5;
+
+/// The invariants of an equilibrium, whatever the scene: every field finite, the normal
+/// tractions balance `F_N` and push (the springs do not pull), the springs' law holds, the
+/// load is finite, the total real contact area is finite and (unless flagged) within the
+/// nominal face.
+fn check_state(driver: &Driver) -> Result<(), TestCaseError> {
+    let phi = driver.normal_traction().unwrap();
+    prop_assert!(all_finite(phi));
+    prop_assert!(all_finite(driver.normal_displacement().unwrap()));
+    prop_assert!(all_finite(driver.shear_traction().unwrap()));
+    prop_assert!(all_finite(&driver.real_contact_area().unwrap()));
+    prop_assert!(driver.breaking_loads().iter().all(|b| !b.is_nan()));
+    let f_n = driver.normal_load();
+    let cell = driver.grid().cell_area();
+    let sum: f64 = phi.iter().sum::<f64>() * cell;
+    prop_assert!(
+        (sum - f_n).abs() <= 1e-6 * f_n,
+        "ΔA Σ φ_z = {sum} N, F_N = {f_n} N"
+    );
+    let largest = phi.iter().fold(0.0f64, |m, v| m.max(*v));
+    let smallest = phi.iter().fold(0.0f64, |m, v| m.min(*v));
+    prop_assert!(
+        smallest >= -1e-6 * largest,
+        "a spring pulls: φ_z = {smallest} Pa (largest {largest} Pa)"
+    );
+    // The springs' law holds: an attached site sits at `u_z = u0 - φ_z u0/c_z`, a
+    // detached one above its height (to 1e-3 of the largest displacement or height: the
+    // loosest solver tolerance is 1e-6; `solver.tolerance = 1` gave errors of order 1).
+    let u = driver.normal_displacement().unwrap();
+    let h = driver.interface().heights();
+    let c_z = driver.interface().law().c_z;
+    let scale = h.iter().chain(u).fold(0.0f64, |m, v| m.max(v.abs()));
+    let worst = (0..u.len()).fold(0.0f64, |m, i| {
+        m.max(match driver.site_states()[i] {
+            SiteState::Attached => (u[i] - (h[i] - phi[i] * h[i] / c_z)).abs(),
+            SiteState::Detached => (h[i] - u[i]).max(0.0),
+            _ => 0.0,
+        })
+    });
+    prop_assert!(
+        worst <= 1e-3 * scale,
+        "the springs' law is off by {worst} m (scale {scale} m)"
+    );
+    let ratio = driver.force() / (driver.friction_coefficient() * f_n);
+    prop_assert!(ratio.is_finite() && ratio >= 0.0, "F/(μF_N) = {ratio}");
+    let area = driver.total_contact_area().unwrap();
+    prop_assert!(area.is_finite() && area >= 0.0, "A_R = {area}");
+    if !driver.area_exceeds_nominal().unwrap() {
+        prop_assert!(
+            area <= driver.nominal_area() * (1.0 + 1e-12),
+            "A_R = {area} m²"
+        );
+    }
+    Ok(())
+}
+
+/// Builds `builder` and, if it builds, steps it through its first [`STEPS`] events:
+/// every state passes [`check_state`], or an error with a message is returned, within
+/// [`CASE_SECONDS`]. [`SceneBuilder::check`] refuses exactly what `build` refuses, but a
+/// plan that misses its tolerance.
 fn build_and_step(builder: SceneBuilder) -> Result<(), TestCaseError> {
+    let started = std::time::Instant::now();
+    let checked = builder.check();
     let scene = match builder.build() {
         Ok(scene) => scene,
-        Err(e) => return check_error(&e),
+        Err(e) => {
+            match (&checked, &e) {
+                (Err(c), e) => prop_assert_eq!(c.to_string(), e.to_string()),
+                (Ok(_), Error::NotConverged { .. } | Error::SingularPoint { .. }) => {}
+                (Ok(_), e) => prop_assert!(false, "check() accepted what build refuses: {e}"),
+            }
+            return check_error(&e);
+        }
     };
+    prop_assert!(checked.is_ok(), "check() refused what build accepts");
     let grid = *scene.grid();
     prop_assert!(grid.len() <= MAX_CELLS && !grid.is_empty());
     prop_assert!(grid.dx().is_finite() && grid.dx() > 0.0);
@@ -72,19 +150,37 @@ fn build_and_step(builder: SceneBuilder) -> Result<(), TestCaseError> {
         Ok(driver) => driver,
         Err(e) => return check_error(&e),
     };
-    match driver.step() {
-        Ok(Some(_)) => {
-            prop_assert!(all_finite(driver.normal_traction().unwrap()));
-            prop_assert!(all_finite(driver.normal_displacement().unwrap()));
-            prop_assert!(all_finite(driver.shear_traction().unwrap()));
-            prop_assert!(all_finite(&driver.real_contact_area().unwrap()));
-            prop_assert!(driver.force().is_finite());
-            prop_assert!(driver.total_contact_area().unwrap().is_finite());
-            prop_assert!(driver.breaking_loads().iter().all(|b| !b.is_nan()));
+    for step in 0..STEPS {
+        match driver.step() {
+            Ok(Some(event)) => {
+                if let Event::Stable { load, .. }
+                | Event::Rupture { load, .. }
+                | Event::LoadRaised { load }
+                | Event::GlobalSlip { load } = event
+                {
+                    prop_assert!(load.force.is_finite() && load.force >= 0.0, "{event:?}");
+                    prop_assert!(load.drive_displacement.is_none_or(f64::is_finite));
+                }
+                // Within the friction limit at a stable state (in an avalanche a driving
+                // spring's force may overshoot it).
+                if let Event::Stable { load, .. } = event {
+                    let ratio = load.force / (driver.friction_coefficient() * driver.normal_load());
+                    prop_assert!(ratio <= LOAD_LIMIT, "F/(μF_N) = {ratio}");
+                }
+                check_state(&driver)?;
+            }
+            Ok(None) => {
+                prop_assert!(step > 0, "no first event");
+                break;
+            }
+            Err(e) => {
+                check_error(&e)?;
+                break;
+            }
         }
-        Ok(None) => prop_assert!(false, "no first event"),
-        Err(e) => check_error(&e)?,
     }
+    let seconds = started.elapsed().as_secs_f64();
+    prop_assert!(seconds < CASE_SECONDS, "{seconds} s");
     Ok(())
 }
 
@@ -154,6 +250,7 @@ proptest! {
         (mean, sd, seed) in (wild(1e-6), wild(1e-6), any::<u64>()),
         (load, drive_kind, a, b) in (wild(60.0), 0..5u8, wild(5e-3), wild(2e-3)),
         (plan_tol, solver_tol) in (wild(1e-6), wild(1e-13)),
+        (active_set, linear) in (count(), count()),
         (wild_group, second) in (0..16u32, 0..24u32),
     ) {
         // One or two groups of values are wild (none when the draw is past the last
@@ -186,7 +283,14 @@ proptest! {
             .normal_load(pick(9, load, 60.0))
             .drive(drive)
             .plan_tolerance(pick(10, plan_tol, 1e-6))
-            .solver(SolverOptions::default().tolerance(pick(11, solver_tol, 1e-13)))
+            .solver({
+                let mut solver = SolverOptions::default().tolerance(pick(11, solver_tol, 1e-13));
+                if wild_mask & (1 << 14) != 0 {
+                    solver.max_active_set_iterations = active_set;
+                    solver.max_linear_iterations = linear;
+                }
+                solver
+            })
             .max_cells(MAX_CELLS);
         builder = if by_size {
             builder.cell_size(pick(12, dx, 1e-3), pick(12, dy, 1e-3))
@@ -332,6 +436,116 @@ mod file {
         }
     }
 
+    /// Every number of a scene file, in turn, at each extreme a user can write (zero,
+    /// negative, the smallest and largest normal and subnormal magnitudes, 1e±306, huge
+    /// counts), on a spring-driven rod scene and a mixed-load scene: refused with a typed
+    /// error, or stepped through its first events with every state finite and within
+    /// the friction limit, each within the time bound. Not random: every key meets every
+    /// extreme (the inputs of issue 23 among them: `drive.stiffness = 1e-306`, a block side
+    /// of 1e308, `solver.tolerance` of 1, 10 and 1e308).
+    #[test]
+    fn every_key_at_every_extreme_is_refused_or_finite() {
+        use serde_json::json;
+        let extremes = [
+            json!(0.0),
+            json!(-1.0),
+            json!(1.0),
+            json!(10.0),
+            json!(5e-324),
+            json!(f64::MIN_POSITIVE),
+            json!(1e-306),
+            json!(1e-15),
+            json!(1e15),
+            json!(1e306),
+            json!(1e308),
+            json!(f64::MAX),
+            json!(-f64::MAX),
+            json!(u64::MAX),
+            json!(1u64 << 40),
+        ];
+        let mixed = {
+            let mut scene = base_scene();
+            scene["drive"] = json!({"kind": "mixed", "ratio": 0.5, "lateral": {"kind": "side"}});
+            scene
+        };
+        for base in [base_scene(), mixed] {
+            let mut paths = Vec::new();
+            leaves(&base, &mut Vec::new(), &mut paths);
+            for path in &paths {
+                if !at(&mut base.clone(), path).is_number() {
+                    continue;
+                }
+                for value in &extremes {
+                    let text = substitute(&base, path, value, 2, "");
+                    let outcome = match SceneBuilder::from_json_str(&text) {
+                        Err(e) => check_error(&e),
+                        Ok(builder) => build_and_step(builder),
+                    };
+                    if let Err(e) = outcome {
+                        panic!("{} = {value}: {e}", path.join("."));
+                    }
+                }
+            }
+        }
+    }
+
+    /// Each key at the bounds of its valid range (docs/scene-format.md, "Valid ranges"),
+    /// alone on the spring-driven rod scene: the computation honours the range (refused
+    /// for another key's range, or stepped with every state finite and the springs' law
+    /// and the friction limit holding).
+    #[test]
+    fn every_key_at_the_bounds_of_its_range_is_honoured() {
+        // The block's shear stiffness M·Ly·Lz/Lx of the base scene (N/m).
+        let block = 3.833e9 / 1.38 * 0.004 * 0.010 / 0.020;
+        let bounds: [(&str, f64, f64); 16] = [
+            ("material.young_modulus", 1e-3, 1e15),
+            ("material.poisson_ratio", -0.999_999, 0.5),
+            ("material.friction_coefficient", 1e-6, 1e3),
+            ("springs.c_x", 1e-3, 1e24),
+            ("springs.c_z", 1e-3, 1e21),
+            ("normal_load", 1e-9, 1e15),
+            ("heights.mean", 1e-15, 1e3),
+            ("heights.std_dev", 1e-15, 1e3),
+            (
+                "drive.stiffness",
+                1.000_001e-12 * block,
+                0.999_999e12 * block,
+            ),
+            ("drive.lateral.half_width", 1.01e-8, 2e-3),
+            ("solver.tolerance", 1e-15, 1e-6),
+            ("solver.max_active_set_iterations", 1.0, 1e6),
+            ("solver.max_linear_iterations", 1.0, 1e7),
+            ("plan_tolerance", 1e-8, 1e-2),
+            ("probes.tolerance", 1e-15, 1e-2),
+            ("block.lz", 0.02e-6 * 1.01, 4e3 * 0.99),
+        ];
+        for (key, low, high) in bounds {
+            let mut base = base_scene();
+            if key == "normal_load" {
+                // Within 650 ΔA c_z (the last site's exponent) and the block's displacement
+                // within 1e10 asperity heights up to 1e15 N: stiff springs and block.
+                base["springs"]["c_z"] = serde_json::json!(1e21);
+                base["material"]["young_modulus"] = serde_json::json!(1e15);
+            }
+            let path: Vec<String> = key.split('.').map(String::from).collect();
+            for v in [low, high] {
+                let value = if key.contains("iterations") {
+                    serde_json::json!(v as u64)
+                } else {
+                    serde_json::json!(v)
+                };
+                let text = substitute(&base, &path, &value, 2, "");
+                let builder = SceneBuilder::from_json_str(&text).unwrap();
+                if let Err(Error::OutOfRange { key: k, .. }) = builder.check() {
+                    assert_ne!(k, key, "{key} = {v} refused for its own key");
+                }
+                if let Err(e) = build_and_step(builder) {
+                    panic!("{key} = {v}: {e}");
+                }
+            }
+        }
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig {
             cases: 48,
@@ -361,4 +575,78 @@ mod file {
             }
         }
     }
+}
+
+/// `contact_map.csv` cannot run away whatever the driver returns: a stable state beyond
+/// the friction limit (impossible physics: `F/(μF_N) = 3e4` was seen, and `+∞` wrote rows
+/// forever; JSON holds no infinity, `f64::MAX` N stands for it) is refused with
+/// `Error::LoadBeyondFriction` and no row for it, and the levels of global slip stop at
+/// the limit. The events are read from JSON (feature `serde`), as a broken driver could
+/// return them.
+#[cfg(feature = "serde")]
+#[test]
+fn the_contact_map_refuses_loads_beyond_the_friction_limit() {
+    use precursors::output::RunTables;
+    let dir = std::env::temp_dir().join(format!("precursors-{}-map-guard", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = Scene::builder()
+        .block(0.02, 0.004, 0.01)
+        .cells(20, 4)
+        .normal_load(60.0)
+        .build()
+        .unwrap();
+    let mu_fn = 0.5 * 60.0;
+    let event = |kind: &str, ratio: f64| -> Event {
+        let force = serde_json::to_string(&(ratio * mu_fn).min(f64::MAX)).unwrap();
+        let load = format!(r#"{{"force": {force}, "drive_displacement": null}}"#);
+        let text = match kind {
+            "stable" => format!(r#"{{"Stable": {{"load": {load}, "ruptures": 0}}}}"#),
+            _ => format!(r#"{{"GlobalSlip": {{"load": {load}}}}}"#),
+        };
+        serde_json::from_str(&text).unwrap()
+    };
+    // (kind, F/(μF_N), refused): a stable state beyond the limit is refused; global slip
+    // may overshoot it under a driving spring (the last avalanche), its rows stop at it.
+    for (kind, ratio, refused) in [
+        ("stable", 1.0, false),
+        ("stable", 1.0 + 1e-6, false),
+        ("stable", 1.001, true),
+        ("stable", 3e4, true),
+        ("stable", f64::INFINITY, true),
+        ("slip", 1.0, false),
+        ("slip", 1.04, false),
+        ("slip", f64::INFINITY, false),
+    ] {
+        let mut driver = scene.driver().unwrap();
+        let mut tables = RunTables::create(&dir, &driver).unwrap();
+        let first = driver.step().unwrap().unwrap();
+        tables.record(&driver, &first).unwrap();
+        // On a thread: a loop without end must fail the test, not hang it.
+        let event = event(kind, ratio);
+        let (send, receive) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let result = tables.record(&driver, &event).map(|_| tables.flush());
+            send.send(result.map_err(|e| e.to_string())).ok();
+        });
+        let result = receive
+            .recv_timeout(std::time::Duration::from_secs(20))
+            .unwrap_or_else(|_| panic!("{kind} at F/(μF_N) = {ratio}: no answer in 20 s"));
+        let map = std::fs::read_to_string(dir.join("contact_map.csv")).unwrap();
+        if refused {
+            let e = result.unwrap_err();
+            assert!(e.contains("exceeds the friction limit"), "{e}");
+            assert!(
+                map.lines().count() <= 2,
+                "{ratio}: {} rows",
+                map.lines().count()
+            );
+        } else {
+            assert!(result.is_ok(), "{kind} at {ratio}: {result:?}");
+            // The header, then one row per level 0, 0.005, ... below the load, at most
+            // up to 1 (201 levels).
+            let levels = ((ratio / 0.005).ceil() as usize).min(201);
+            assert_eq!(map.lines().count(), 1 + levels, "{kind} at {ratio}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }

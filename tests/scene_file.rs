@@ -362,3 +362,193 @@ fn the_cell_limit_and_dense_threads_in_scene_files() {
     let scene = SceneBuilder::from_json_str(auto).unwrap().build().unwrap();
     assert_eq!(scene.driver().unwrap().threads(), 1);
 }
+
+/// Where the format has an object, an array is refused (serde would read a struct's fields
+/// by position: `"block": [lx, ly, lz]` was accepted though undocumented), in scene files
+/// and in a sweep's base scene, axes and top level, with the key path.
+#[test]
+fn arrays_are_refused_where_the_format_has_objects() {
+    for (text, place) in [
+        (r#"{"block": [0.02, 0.004, 0.01]}"#, "`block`"),
+        (r#"{"cells": ["count", 20, 4]}"#, "`cells`"),
+        (r#"{"material": [3e9, 0.3, 0.5]}"#, "`material`"),
+        (r#"{"heights": ["gaussian", 1e-6, 1e-6, 1]}"#, "`heights`"),
+        (
+            r#"{"drive": {"kind": "spring", "stiffness": 4e6, "lateral": ["side"]}}"#,
+            "`drive.lateral`",
+        ),
+        (r#"{"solver": ["dense", 1e-13, 10, 10, 1]}"#, "`solver`"),
+        (
+            r#"[{"lx": 0.02, "ly": 0.004, "lz": 0.01}]"#,
+            "the top level",
+        ),
+    ] {
+        let e = SceneBuilder::from_json_str(text).unwrap_err();
+        assert!(matches!(e, Error::SceneFile { line: 1, .. }), "{text}: {e}");
+        assert!(
+            e.to_string().contains(place) && e.to_string().contains("positional"),
+            "{e}"
+        );
+    }
+    // Arrays where the format has arrays are read.
+    let b = SceneBuilder::from_json_str(
+        r#"{"probes": {"planes": [0.001], "points": [[0.01, 0.002, 0.002]]}}"#,
+    )
+    .unwrap();
+    assert_eq!(b.build().unwrap().probes().points.len(), 1);
+    use precursors::sweep::Sweep;
+    for (text, place) in [
+        (
+            r#"{"base": {"block": [0.02, 0.004, 0.01]}}"#,
+            "`base.block`",
+        ),
+        (r#"{"axes": [["normal_load", [1.0, 2.0]]]}"#, "`axes[]`"),
+        (r#"[{}, [], 1, 0]"#, "the top level"),
+    ] {
+        let e = Sweep::from_json_str(text).unwrap_err();
+        assert!(matches!(e, Error::SweepFile { line: 1, .. }), "{text}: {e}");
+        assert!(e.to_string().contains(place), "{e}");
+    }
+    // An axis value that is an array where the scene has an object.
+    let e = Sweep::from_json_str(
+        r#"{"base": {"block": {"lx": 0.02, "ly": 0.004, "lz": 0.01}, "cells": {"kind": "count", "nx": 20, "ny": 4}},
+            "axes": [{"key": "block", "values": [[0.02, 0.004, 0.01]]}]}"#,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, Error::SweepKey { .. }) && e.to_string().contains("`block`"),
+        "{e}"
+    );
+}
+
+/// A file that is not UTF-8 text is invalid input (exit code 3 in the program), at the
+/// line and column of its first bad byte, not a failure to read it (exit code 4).
+#[test]
+fn files_that_are_not_utf8_are_invalid_input() {
+    let dir = scratch("utf8");
+    let scene = dir.join("scene.json");
+    std::fs::write(&scene, b"{\n  \"normal_load\": 6\xff0\n}\n").unwrap();
+    let e = SceneBuilder::from_json_file(&scene).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            Error::SceneFile {
+                line: 2,
+                column: 19,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("not UTF-8"), "{e}");
+    let sweep = dir.join("sweep.json");
+    std::fs::write(&sweep, b"{\"seed\": 1\xc0}").unwrap();
+    let e = precursors::sweep::Sweep::from_json_file(&sweep).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            Error::SweepFile {
+                line: 1,
+                column: 11,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let heights = dir.join("h.txt");
+    std::fs::write(&heights, b"1e-6\n2e-6\n\xfe\n").unwrap();
+    let e = HeightSource::from_file(&heights).unwrap_err();
+    assert!(matches!(e, Error::HeightsFile { line: 3, .. }), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A heights file is bounded by the grid it is for before it is read whole: longer than
+/// 1 MiB plus 256 bytes a cell (a sparse file of 4 GiB here, which took the whole file
+/// into memory and echoed it back), or with more heights than cells, it is refused at once.
+#[test]
+fn heights_files_are_bounded_by_the_grid() {
+    let dir = scratch("heights-bound");
+    let big = dir.join("big.txt");
+    let file = std::fs::File::create(&big).unwrap();
+    file.set_len(4 << 30).unwrap();
+    std::fs::write(
+        dir.join("big.json"),
+        r#"{"cells": {"kind": "count", "nx": 20, "ny": 4},
+            "block": {"lx": 0.02, "ly": 0.004, "lz": 0.01},
+            "heights": {"kind": "file", "path": "big.txt"}}"#,
+    )
+    .unwrap();
+    let started = std::time::Instant::now();
+    let e = SceneBuilder::from_json_file(dir.join("big.json")).unwrap_err();
+    assert!(started.elapsed().as_secs_f64() < 1.0);
+    assert!(
+        matches!(e, Error::HeightsFile { line: 0, .. })
+            && e.to_string().contains("4294967296 bytes"),
+        "{e}"
+    );
+    std::fs::remove_file(&big).ok();
+    let long: String = (0..81).map(|i| format!("{}e-7\n", i + 1)).collect();
+    std::fs::write(dir.join("long.txt"), long).unwrap();
+    std::fs::write(
+        dir.join("long.json"),
+        r#"{"cells": {"kind": "count", "nx": 20, "ny": 4},
+            "block": {"lx": 0.02, "ly": 0.004, "lz": 0.01},
+            "heights": {"kind": "file", "path": "long.txt"}}"#,
+    )
+    .unwrap();
+    let e = SceneBuilder::from_json_file(dir.join("long.json")).unwrap_err();
+    assert!(matches!(e, Error::HeightsFile { line: 81, .. }), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A sweep is bounded before any run is built: `realizations` of 1e9 (800 GB of runs:
+/// aborted) and 2^64-1 (a "capacity overflow" panic), and an axis of 1e6 values (accepted
+/// and started) are refused at once with the count and the limit of 1e5 runs.
+#[test]
+fn sweeps_beyond_the_run_limit_are_refused_at_once() {
+    use precursors::sweep::{Sweep, MAX_RUNS};
+    assert_eq!(MAX_RUNS, 100_000);
+    let base = r#""base": {"block": {"lx": 0.02, "ly": 0.004, "lz": 0.01},
+                          "cells": {"kind": "count", "nx": 20, "ny": 4}}"#;
+    let values: Vec<String> = (0..1_000_000)
+        .map(|i| format!("{}", 10.0 + i as f64))
+        .collect();
+    let million = format!(
+        r#"{{ {base}, "axes": [{{"key": "normal_load", "values": [{}]}}]}}"#,
+        values.join(",")
+    );
+    for (text, runs) in [
+        (
+            format!(r#"{{ {base}, "realizations": 1000000000 }}"#),
+            1_000_000_000u128,
+        ),
+        (
+            format!(r#"{{ {base}, "realizations": 18446744073709551615 }}"#),
+            u64::MAX as u128,
+        ),
+        (million, 1_000_000),
+        (
+            format!(
+                r#"{{ {base}, "realizations": 50001,
+                     "axes": [{{"key": "normal_load", "values": [10.0, 20.0]}}] }}"#
+            ),
+            100_002,
+        ),
+    ] {
+        let started = std::time::Instant::now();
+        let e = Sweep::from_json_str(&text).unwrap_err();
+        assert!(
+            matches!(e, Error::SweepTooLarge { runs: r, limit: 100_000, .. } if r == runs),
+            "{e}"
+        );
+        assert!(e.to_string().contains("split it"), "{e}");
+        assert!(started.elapsed().as_secs_f64() < 10.0);
+    }
+    // At the limit the sweep is read.
+    let sweep = Sweep::from_json_str(&format!(
+        r#"{{ {base}, "realizations": 50000,
+             "axes": [{{"key": "normal_load", "values": [10.0, 20.0]}}] }}"#
+    ))
+    .unwrap();
+    assert_eq!(sweep.runs().len(), MAX_RUNS);
+}

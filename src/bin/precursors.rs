@@ -233,7 +233,8 @@ impl From<Error> for Failure {
             | Error::Factorization { .. }
             | Error::EmptyContact { .. }
             | Error::ThreadPool { .. }
-            | Error::NotSolved { .. } => 1,
+            | Error::NotSolved { .. }
+            | Error::LoadBeyondFriction { .. } => 1,
             _ => 3,
         };
         Failure {
@@ -451,10 +452,10 @@ const INFO_BUILDS_BELOW: usize = 100_000;
 fn info(path: &Path) -> Result<(), Failure> {
     let builder = SceneBuilder::from_json_file(path)?;
     let file: serde_json::Value = serde_json::from_str(&builder.to_json()?).unwrap_or_default();
-    let grid = builder.grid()?;
+    // What `run` refuses, `info` refuses: every check of `build` but the plan (memory
+    // included); and the whole scene is built when that is quick, which also plans.
+    let grid = builder.check()?;
     let n = grid.len();
-    // What `run` refuses, `info` refuses: the whole scene is built (everything checked,
-    // the operator planned) when that is quick; above, the grid's checks only.
     if n < INFO_BUILDS_BELOW {
         builder.build()?;
     }

@@ -58,7 +58,7 @@ impl GridCost {
         let cells = nx as u128 * ny as u128;
         let n = cells as f64;
         let dense = if cells <= AUTO_DENSE_LIMIT as u128 {
-            DENSE_BYTES_PER_ENTRY * n * n
+            dense_bytes(n)
         } else {
             0.0
         };
@@ -69,6 +69,11 @@ impl GridCost {
             solve_seconds: SOLVE_SECONDS * n.powf(SOLVE_EXPONENT),
         }
     }
+}
+
+/// Bytes of the dense backend's two `N x N` matrices for `cells` cells.
+pub(crate) fn dense_bytes(cells: f64) -> f64 {
+    DENSE_BYTES_PER_ENTRY * cells * cells
 }
 
 /// Refuses `nx x ny` cells above `limit` with [`Error::GridTooLarge`].
@@ -86,6 +91,42 @@ pub(crate) fn check_cells(nx: usize, ny: usize, limit: usize) -> Result<()> {
         });
     }
     Ok(())
+}
+
+/// The memory the machine can give a new allocation without swapping (bytes):
+/// `MemAvailable` of `/proc/meminfo` on Linux, `None` elsewhere or when it cannot be read
+/// (then no check is made).
+pub(crate) fn available_memory() -> Option<f64> {
+    if !cfg!(target_os = "linux") {
+        return None;
+    }
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let mut fields = line.split_whitespace().skip(1);
+    let value: f64 = fields.next()?.parse().ok()?;
+    match fields.next() {
+        Some("kB") => Some(value * 1024.0),
+        _ => None,
+    }
+}
+
+/// Refuses `bytes` of `what` above the memory available ([`available_memory`]) with
+/// [`Error::OutOfMemory`], before anything is allocated: an allocation that fails aborts
+/// the process, it cannot be reported.
+pub(crate) fn check_memory(
+    what: impl FnOnce() -> String,
+    bytes: f64,
+    hint: &'static str,
+) -> Result<()> {
+    match available_memory() {
+        Some(available) if bytes.is_nan() || bytes > available => Err(Error::OutOfMemory {
+            what: what(),
+            needed_bytes: bytes,
+            available_bytes: available,
+            hint,
+        }),
+        _ => Ok(()),
+    }
 }
 
 /// `bytes` in kB, MB, GB or TB (decimal), three significant digits.

@@ -21,7 +21,7 @@ mod spectrum;
 mod staged;
 mod transfer;
 
-pub(crate) use cost::{check_cells, format_bytes, format_seconds};
+pub(crate) use cost::{check_cells, check_memory, dense_bytes, format_bytes, format_seconds};
 pub use cost::{GridCost, DEFAULT_MAX_CELLS};
 pub use loads::RodLoad;
 pub(crate) use plan::SpectralTable;

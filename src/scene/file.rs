@@ -314,7 +314,19 @@ impl SceneFile {
                 seed,
             },
             HeightsSpec::Values { values } => HeightSource::Values(values),
-            HeightsSpec::File { path } => HeightSource::from_file(base.join(path))?,
+            HeightsSpec::File { path } => {
+                // The file is bounded by the grid's cells before it is read (when the grid
+                // is valid; otherwise by the memory available).
+                let cells = SceneBuilder::default()
+                    .block(self.block.lx, self.block.ly, self.block.lz)
+                    .max_cells(self.max_cells);
+                let cells = match self.cells {
+                    CellsSpec::Size { dx, dy } => cells.cell_size(dx, dy),
+                    CellsSpec::Count { nx, ny } => cells.cells(nx, ny),
+                };
+                let cells = cells.grid().ok().map(|g| g.len());
+                HeightSource::read_file(&base.join(path), cells)?
+            }
         };
         let drive = match self.drive {
             DriveSpec::Top => Drive::Force(ForceLoad::Top),
@@ -369,6 +381,172 @@ impl SceneFile {
     }
 }
 
+/// What the format has at a key path: an object (serde would also take an array, its
+/// fields by position, which the format does not document: refused), an array of
+/// objects, or anything (checked by the format's types).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Shape {
+    Object,
+    Objects,
+    Any,
+}
+
+/// The shape of a scene file's key path (dotted, `""` for the top level).
+pub(crate) fn scene_shape(path: &str) -> Shape {
+    match path {
+        "" | "block" | "cells" | "material" | "springs" | "heights" | "drive" | "drive.lateral"
+        | "solver" | "probes" => Shape::Object,
+        _ => Shape::Any,
+    }
+}
+
+/// A walk of a JSON document that checks the objects of `shape` (no allocation beyond the
+/// keys: the values are skipped).
+pub(crate) struct Shaped<'a> {
+    pub(crate) path: String,
+    pub(crate) shape: &'a dyn Fn(&str) -> Shape,
+}
+
+impl<'de> serde::de::DeserializeSeed<'de> for Shaped<'_> {
+    type Value = ();
+
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> std::result::Result<(), D::Error> {
+        match (self.shape)(&self.path) {
+            Shape::Object => d.deserialize_map(self),
+            Shape::Objects => d.deserialize_seq(self),
+            Shape::Any => d.deserialize_ignored_any(serde::de::IgnoredAny).map(|_| ()),
+        }
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for Shaped<'_> {
+    type Value = ();
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        let place = if self.path.is_empty() {
+            "the top level".to_string()
+        } else {
+            format!("`{}`", self.path.replace(".#", "[]"))
+        };
+        match (self.shape)(&self.path) {
+            Shape::Objects => write!(f, "an array of objects at {place}"),
+            _ => write!(
+                f,
+                "an object {{\"key\": value, ...}} at {place} (the format has no positional \
+                 arrays)"
+            ),
+        }
+    }
+
+    fn visit_map<A: serde::de::MapAccess<'de>>(
+        self,
+        mut map: A,
+    ) -> std::result::Result<(), A::Error> {
+        while let Some(key) = map.next_key::<String>()? {
+            let path = if self.path.is_empty() {
+                key
+            } else {
+                format!("{}.{key}", self.path)
+            };
+            map.next_value_seed(Shaped {
+                path,
+                shape: self.shape,
+            })?;
+        }
+        Ok(())
+    }
+
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(
+        self,
+        mut seq: A,
+    ) -> std::result::Result<(), A::Error> {
+        if (self.shape)(&self.path) != Shape::Objects {
+            return Err(serde::de::Error::invalid_type(
+                serde::de::Unexpected::Seq,
+                &self,
+            ));
+        }
+        let path = format!("{}.#", self.path);
+        while seq
+            .next_element_seed(Shaped {
+                path: path.clone(),
+                shape: self.shape,
+            })?
+            .is_some()
+        {}
+        Ok(())
+    }
+}
+
+/// Checks the objects of `text` against `shape` (as [`Shaped`]).
+pub(crate) fn check_shape(text: &str, shape: &dyn Fn(&str) -> Shape) -> serde_json::Result<()> {
+    use serde::de::DeserializeSeed;
+    let mut d = serde_json::Deserializer::from_str(text);
+    Shaped {
+        path: String::new(),
+        shape,
+    }
+    .deserialize(&mut d)?;
+    d.end()
+}
+
+/// Checks the objects of a scene-file JSON value ([`scene_shape`]).
+fn check_value_shape(value: &serde_json::Value) -> Result<(), String> {
+    use serde::de::DeserializeSeed;
+    Shaped {
+        path: String::new(),
+        shape: &scene_shape,
+    }
+    .deserialize(value)
+    .map_err(|e| e.to_string())
+}
+
+/// The text of a JSON file (`what`: `"scene file"`, `"sweep file"`): its size checked
+/// against the memory available before it is read (parsed, it takes up to about five
+/// times its size), and its bytes checked to be UTF-8 (a byte that is not is an error of
+/// the file's content, at its line and column, not of reading it: `content_error`).
+///
+/// # Errors
+/// [`Error::Io`] when the file cannot be read; [`Error::OutOfMemory`]; `content_error`'s
+/// error for bytes that are not UTF-8.
+pub(crate) fn read_json_text(
+    path: &Path,
+    operation: &'static str,
+    content_error: impl FnOnce(usize, usize, String) -> Error,
+) -> Result<String> {
+    let size = std::fs::metadata(path)
+        .map_err(|e| Error::io(operation, path, e))?
+        .len();
+    crate::green::check_memory(
+        || format!("reading {} ({size} bytes)", path.display()),
+        5.0 * size as f64,
+        "the file is too large for this machine",
+    )?;
+    let bytes = std::fs::read(path).map_err(|e| Error::io(operation, path, e))?;
+    String::from_utf8(bytes).map_err(|e| {
+        let (line, column, reason) = not_utf8(e.as_bytes(), e.utf8_error());
+        content_error(line, column, reason)
+    })
+}
+
+/// The line and column (1-based) of the first byte that is not UTF-8, and a message.
+pub(crate) fn not_utf8(bytes: &[u8], e: std::str::Utf8Error) -> (usize, usize, String) {
+    let valid = &bytes[..e.valid_up_to()];
+    let line = valid.iter().filter(|b| **b == b'\n').count() + 1;
+    let start = valid.iter().rposition(|b| *b == b'\n').map_or(0, |i| i + 1);
+    let column = String::from_utf8_lossy(&valid[start..]).chars().count() + 1;
+    (
+        line,
+        column,
+        format!(
+            "the file is not UTF-8 text: byte {} (0x{:02x}) at line {line}, column {column} is \
+             not valid UTF-8",
+            e.valid_up_to(),
+            bytes[e.valid_up_to()]
+        ),
+    )
+}
+
 /// A JSON error of the scene file at `path` (`None`: text given directly).
 fn json_error(path: Option<&Path>, e: serde_json::Error) -> Error {
     Error::SceneFile {
@@ -386,6 +564,7 @@ pub(crate) fn normalized_value(
     value: serde_json::Value,
     base: &Path,
 ) -> Result<serde_json::Value, String> {
+    check_value_shape(&value)?;
     let file: SceneFile = serde_json::from_value(value).map_err(|e| e.to_string())?;
     let builder = file.into_builder(base).map_err(|e| e.to_string())?;
     serde_json::to_value(SceneFile::from(&builder)).map_err(|e| e.to_string())
@@ -393,6 +572,7 @@ pub(crate) fn normalized_value(
 
 /// The builder of a scene-file JSON object (heights given as values: no file is read).
 pub(crate) fn builder_from_value(value: serde_json::Value) -> Result<SceneBuilder, String> {
+    check_value_shape(&value)?;
     let file: SceneFile = serde_json::from_value(value).map_err(|e| e.to_string())?;
     file.into_builder(Path::new(".")).map_err(|e| e.to_string())
 }
@@ -406,6 +586,7 @@ impl SceneBuilder {
     /// [`Error::SceneFile`] for invalid JSON or a key outside the format; those of
     /// [`HeightSource::from_file`] for a heights file.
     pub fn from_json_str(text: &str) -> Result<SceneBuilder> {
+        check_shape(text, &scene_shape).map_err(|e| json_error(None, e))?;
         let file: SceneFile = serde_json::from_str(text).map_err(|e| json_error(None, e))?;
         file.into_builder(Path::new("."))
     }
@@ -419,8 +600,15 @@ impl SceneBuilder {
     /// [`HeightSource::from_file`] for a heights file.
     pub fn from_json_file(path: impl AsRef<Path>) -> Result<SceneBuilder> {
         let path = path.as_ref();
-        let text =
-            std::fs::read_to_string(path).map_err(|e| Error::io("reading scene file", path, e))?;
+        let text = read_json_text(path, "reading scene file", |line, column, reason| {
+            Error::SceneFile {
+                path: Some(path.to_path_buf()),
+                line,
+                column,
+                source: reason.into(),
+            }
+        })?;
+        check_shape(&text, &scene_shape).map_err(|e| json_error(Some(path), e))?;
         let file: SceneFile = serde_json::from_str(&text).map_err(|e| json_error(Some(path), e))?;
         file.into_builder(path.parent().unwrap_or(Path::new(".")))
     }
