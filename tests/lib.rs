@@ -8,6 +8,8 @@ mod common;
 mod driver;
 mod errors;
 mod green_point;
+#[cfg(feature = "cli")]
+mod hostile;
 mod interface;
 mod laws;
 mod loads;
