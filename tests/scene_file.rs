@@ -125,11 +125,14 @@ fn missing_keys_take_the_calibration_defaults() {
 #[test]
 fn mistakes_are_typed_errors() {
     let cases = [
-        r#"{"normal_lod": 10}"#,                              // misspelt key
-        r#"{"material": {"mu": 0.5}}"#,                       // unknown nested key
-        r#"{"block": {"lx": 0.1, "ly": 0.01}}"#,              // incomplete block
-        r#"{"drive": {"kind": "rod", "height": 0.006}}"#,     // incomplete drive
-        r#"{"drive": {"kind": "sled"}}"#,                     // unknown kind
+        r#"{"normal_lod": 10}"#,                          // misspelt key
+        r#"{"material": {"mu": 0.5}}"#,                   // unknown nested key
+        r#"{"block": {"lx": 0.1, "ly": 0.01}}"#,          // incomplete block
+        r#"{"drive": {"kind": "rod", "height": 0.006}}"#, // incomplete drive
+        r#"{"drive": {"kind": "sled"}}"#,                 // unknown kind
+        r#"{"drive": {"kind": "top", "half_width": 1}}"#, // a key the kind lacks
+        r#"{"drive": {"kind": "side", "stiffness": 1}}"#, // a key the kind lacks
+        r#"{"drive": {"kind": "mixed", "ratio": 1, "lateral": {"kind": "side", "height": 5}}}"#,
         r#"{"cells": {"kind": "count", "nx": -3, "ny": 2}}"#, // negative count
         r#"{"solver": {"backend": "gpu"}}"#,                  // unknown backend
         r#"{"normal_load": "3.5 kN"}"#,                       // wrong type

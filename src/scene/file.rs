@@ -99,18 +99,18 @@ enum HeightsSpec {
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 enum LateralSpec {
     Rod { height: f64, half_width: f64 },
-    Side,
+    Side {},
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 enum DriveSpec {
-    Top,
+    Top {},
     Rod {
         height: f64,
         half_width: f64,
     },
-    Side,
+    Side {},
     Mixed {
         ratio: f64,
         lateral: LateralSpec,
@@ -208,7 +208,7 @@ impl From<Lateral> for LateralSpec {
     fn from(l: Lateral) -> Self {
         match l {
             Lateral::Rod { height, half_width } => LateralSpec::Rod { height, half_width },
-            Lateral::Side => LateralSpec::Side,
+            Lateral::Side => LateralSpec::Side {},
         }
     }
 }
@@ -217,7 +217,7 @@ impl From<LateralSpec> for Lateral {
     fn from(l: LateralSpec) -> Self {
         match l {
             LateralSpec::Rod { height, half_width } => Lateral::Rod { height, half_width },
-            LateralSpec::Side => Lateral::Side,
+            LateralSpec::Side {} => Lateral::Side,
         }
     }
 }
@@ -226,11 +226,11 @@ impl From<&SceneBuilder> for SceneFile {
     fn from(b: &SceneBuilder) -> Self {
         let (lx, ly, lz) = b.lengths;
         let drive = match b.drive {
-            Drive::Force(ForceLoad::Top) => DriveSpec::Top,
+            Drive::Force(ForceLoad::Top) => DriveSpec::Top {},
             Drive::Force(ForceLoad::Lateral(Lateral::Rod { height, half_width })) => {
                 DriveSpec::Rod { height, half_width }
             }
-            Drive::Force(ForceLoad::Lateral(Lateral::Side)) => DriveSpec::Side,
+            Drive::Force(ForceLoad::Lateral(Lateral::Side)) => DriveSpec::Side {},
             Drive::Force(ForceLoad::Mixed { ratio, lateral }) => DriveSpec::Mixed {
                 ratio,
                 lateral: lateral.into(),
@@ -329,11 +329,11 @@ impl SceneFile {
             }
         };
         let drive = match self.drive {
-            DriveSpec::Top => Drive::Force(ForceLoad::Top),
+            DriveSpec::Top {} => Drive::Force(ForceLoad::Top),
             DriveSpec::Rod { height, half_width } => {
                 Drive::Force(ForceLoad::Lateral(Lateral::Rod { height, half_width }))
             }
-            DriveSpec::Side => Drive::Force(ForceLoad::Lateral(Lateral::Side)),
+            DriveSpec::Side {} => Drive::Force(ForceLoad::Lateral(Lateral::Side)),
             DriveSpec::Mixed { ratio, lateral } => Drive::Force(ForceLoad::Mixed {
                 ratio,
                 lateral: lateral.into(),
