@@ -66,7 +66,7 @@ pub const TABLE_NAMES: [&str; 3] = ["events.csv", "curve.csv", "contact_map.csv"
 pub const PARTIAL_SUFFIX: &str = ".partial";
 
 /// The record of a run's scene in its directory (feature `serde`: the scene file of
-/// [`crate::SceneBuilder::to_json`]), written when the run starts, checked on resume.
+/// `SceneBuilder::to_json`), written when the run starts, checked on resume.
 pub const SCENE_RECORD: &str = "scene.json";
 
 /// The header of `contact_map.csv` for a grid of `nx` columns.

@@ -57,6 +57,9 @@ const FILE_LIMIT_BLOCKS: u64 = 100_000;
 const MESSAGE_LIMIT: usize = 4096;
 /// Slack on `F/(μF_N) <= 1` at stable states (the linear solves' residual).
 const LOAD_SLACK: f64 = 1e-6;
+/// How far beyond `μF_N` the contact map's levels may go (docs/scene-format.md: they stop
+/// at global slip or at `μF_N`, the solver's residual allowed for).
+const MAP_LIMIT_SLACK: f64 = 1e-5;
 /// The spacing of the contact map's load levels (docs/scene-format.md).
 const MAP_STEP: f64 = 0.005;
 
@@ -308,10 +311,11 @@ struct Facts {
 /// load on one site: `ΔA/(e-1)·expm1(F_N/(ΔA c_z))`. The last stable state before global
 /// slip usually has one site left and reaches it (to 1e-13 on the dense backend for
 /// every tolerance up to 1e-3; tolerances of 1e-2 and above passed it by 19 % in the
-/// exponent, and 1 by two-fold in the area). The exponent gets 1e-6 of slack for the
-/// force balance of an iterative solve.
+/// exponent, and 1 by two-fold in the area). The exponent gets 1e-2 of slack: the areas
+/// follow the springs' compression, which a solve resolves to the relative accuracy the
+/// scene's bounds allow (docs/scene-format.md, "Valid ranges": `solver.tolerance`).
 fn area_bound(cell_area: f64, normal_load: f64, c_z: f64) -> f64 {
-    let exponent = normal_load / (cell_area * c_z) * (1.0 + 1e-6);
+    let exponent = normal_load / (cell_area * c_z) * (1.0 + 1e-2);
     cell_area / (std::f64::consts::E - 1.0) * exponent.exp_m1() * (1.0 + 1e-9)
 }
 
@@ -829,7 +833,10 @@ fn check_run_tables(dir: &Path, f: &Facts) -> Result<(), String> {
         last = Some((event, level));
     }
     let (_, top) = last.unwrap_or((0, 0.0));
-    if top > peak.max(slip) + 1e-9 || top + MAP_STEP < slip - 1e-9 {
+    // The levels stop at global slip or at μF_N, whichever comes first (docs/scene-format.md):
+    // a driving spring's last avalanche may overshoot μF_N, and no state is stable there.
+    let end = slip.min(1.0 + MAP_LIMIT_SLACK);
+    if top > peak.max(slip) + 1e-9 || top + MAP_STEP < end - 1e-9 {
         return Err(format!(
             "contact_map.csv ends at level {top}, the run at F/(μF_N) = {slip} (peak {peak})"
         ));
