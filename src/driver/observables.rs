@@ -1,0 +1,250 @@
+//! What a [`Driver`] shows of its current state: the site states and breaking loads, the
+//! tractions and displacements, the spring force, the stresses at the probes, the real
+//! contact area (per cell, per column, in total) and the precursor length.
+
+use super::Driver;
+#[cfg(doc)] // the doc links
+use super::{Checkpoint, Event};
+use crate::error::{Error, Result};
+use crate::interface::{Interface, SiteState};
+use crate::probe::{ProbeInput, ProbeSpec, StressProbe, Stresses};
+use crate::scene::Drive;
+
+/// Relative slack of [`Driver::area_exceeds_nominal`]: the rounding of a sum of cell
+/// areas, so a capped area of `ΔA` on every cell is not flagged.
+const NOMINAL_AREA_SLACK: f64 = 1e-9;
+
+impl Driver {
+    /// The spring force `K_S (U_S - ⟨u_x⟩)` (N) under displacement control, `None` under
+    /// force control.
+    pub fn spring_force(&self) -> Option<f64> {
+        matches!(self.drive, Drive::Spring { .. }).then(|| self.force())
+    }
+
+    /// The interface (site states, heights, spring law).
+    pub fn interface(&self) -> &Interface {
+        &self.interface
+    }
+
+    /// Site states, in the paper's cell order.
+    pub fn site_states(&self) -> &[SiteState] {
+        self.interface.states()
+    }
+
+    /// Normal traction `φ_z` per cell (Pa).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
+    pub fn normal_traction(&self) -> Result<&[f64]> {
+        Ok(&self.normal()?.traction)
+    }
+
+    /// Normal displacement `u_z` of the bottom face per cell (m).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
+    pub fn normal_displacement(&self) -> Result<&[f64]> {
+        Ok(&self.normal()?.displacement)
+    }
+
+    /// Shear traction `φ_x` per cell (Pa; negative where the springs resist `+x`).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
+    pub fn shear_traction(&self) -> Result<&[f64]> {
+        self.response()?;
+        Ok(&self.shear_traction)
+    }
+
+    /// Shear displacement `u_x` of the bottom face per cell (m).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
+    pub fn shear_displacement(&self) -> Result<&[f64]> {
+        self.response()?;
+        Ok(&self.shear_displacement)
+    }
+
+    /// Mean shear displacement `⟨u_x⟩` of the block (m) (plus the top load's constant
+    /// when a top shear acts).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
+    pub fn mean_shear_displacement(&self) -> Result<f64> {
+        Ok(self.force() * self.response()?.offset_per_newton)
+    }
+
+    /// Breaking load `λ_i` (N) of each site in the current state (`+∞` off contact).
+    pub fn breaking_loads(&self) -> &[f64] {
+        &self.breaking
+    }
+
+    /// Adds stress probes (planes and points), planned now on the scene's operator and
+    /// read by [`Driver::stresses`] after the scene's own ([`crate::SceneBuilder::probes`]),
+    /// in the order they were added. Probes observe: they change neither the events nor
+    /// the scene's identity, so they may be added at any time, and a
+    /// [`Checkpoint`] resumes whatever probes either driver has (a checkpoint does not
+    /// hold them: add them again to the resumed driver). An empty `spec` adds nothing.
+    ///
+    /// ```
+    /// use precursors::{ProbeSpec, Scene};
+    /// let scene = Scene::builder().block(0.020, 0.004, 0.010).normal_load(80.0).build()?;
+    /// let mut driver = scene.driver()?;
+    /// driver.step()?;
+    /// driver.add_probes(&ProbeSpec::default().plane(2e-3))?;
+    /// let plane = &driver.stresses()?.planes[0];
+    /// assert_eq!((plane.nx, plane.ny), (20, 4));
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`StressProbe::new`]: a plane or point outside the block, a bad tolerance.
+    pub fn add_probes(&mut self, spec: &ProbeSpec) -> Result<()> {
+        if spec.is_empty() {
+            return Ok(());
+        }
+        let probe = StressProbe::new(self.scene.plan(), spec, self.scene.lateral_load())?;
+        self.probes.push(probe);
+        Ok(())
+    }
+
+    /// Shear, normal and Coulomb stresses (Pa) at the probes (the scene's,
+    /// [`crate::SceneBuilder::probes`], then those of [`Driver::add_probes`], planes and
+    /// points each in request order) in the current state, with every load term. Call
+    /// it at the states you want: after the [`Event::LoadRaised`] that precedes the first
+    /// [`Event::Rupture`] for "just before the first rupture", at each [`Event::Stable`]
+    /// for the quasi-static evolution.
+    ///
+    /// # Errors
+    /// [`Error::NoProbes`] when the driver has no probes ([`crate::SceneBuilder::probes`],
+    /// [`Driver::add_probes`]); [`Error::NotSolved`] before the first equilibrium (call
+    /// [`Driver::step`] first).
+    pub fn stresses(&self) -> Result<Stresses> {
+        if self.probes.is_empty() {
+            return Err(Error::NoProbes);
+        }
+        let force = self.force();
+        let input = ProbeInput::new(self.shear_traction()?, self.normal_traction()?)
+            .loads(force * self.split.0, force * self.split.1, self.normal_load)
+            .friction_coefficient(self.friction);
+        let mut all = Stresses {
+            planes: Vec::new(),
+            points: Vec::new(),
+        };
+        for probe in &self.probes {
+            let stresses = probe.evaluate(&input)?;
+            all.planes.extend(stresses.planes);
+            all.points.extend(stresses.points);
+        }
+        Ok(all)
+    }
+
+    /// Real contact area per cell (m²).
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`]; [`Error::NonFinite`] on
+    /// overflow.
+    pub fn real_contact_area(&self) -> Result<Vec<f64>> {
+        self.interface
+            .real_contact_area(&self.normal()?.displacement)
+    }
+
+    /// Total real contact area (m²).
+    ///
+    /// # Errors
+    /// As [`Driver::real_contact_area`].
+    pub fn total_contact_area(&self) -> Result<f64> {
+        Ok(self.real_contact_area()?.iter().sum())
+    }
+
+    /// The nominal area `Lx·Ly` of the interface (m²).
+    pub fn nominal_area(&self) -> f64 {
+        let block = self.grid.block();
+        block.lx() * block.ly()
+    }
+
+    /// Whether the total real contact area of the current state exceeds the nominal
+    /// area `Lx·Ly` ([`Driver::nominal_area`]) by more than `1e-9` relative (the rounding
+    /// of the sum): a state the paper's unbounded area law ([`crate::AreaLaw::Paper`])
+    /// reaches when asperities are pressed below the substrate's mean plane, physically
+    /// meaningless as an area. An area whose exponential overflows
+    /// ([`Error::NonFinite`] from [`Driver::real_contact_area`]) exceeds it too. Never
+    /// true under [`crate::AreaLaw::Capped`].
+    ///
+    /// # Errors
+    /// As [`Driver::real_contact_area`] before the first event.
+    pub fn area_exceeds_nominal(&self) -> Result<bool> {
+        match self.total_contact_area() {
+            Ok(total) => Ok(total > self.nominal_area() * (1.0 + NOMINAL_AREA_SLACK)),
+            Err(Error::NonFinite {
+                name: "real contact area",
+                ..
+            }) => Ok(true),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// Real contact area per column `ix` (summed over `y`, m²).
+    ///
+    /// # Errors
+    /// As [`Driver::real_contact_area`].
+    pub fn column_contact_area(&self) -> Result<Vec<f64>> {
+        let area = self.real_contact_area()?;
+        let nx = self.grid.nx();
+        let mut columns = vec![0.0; nx];
+        for row in area.chunks_exact(nx) {
+            columns.iter_mut().zip(row).for_each(|(c, a)| *c += a);
+        }
+        Ok(columns)
+    }
+
+    /// Real contact area per column at zero shear (m²), the reference of the precursor.
+    pub fn initial_column_contact_area(&self) -> &[f64] {
+        &self.initial_columns
+    }
+
+    /// Precursor length `ℓ` (m): the extent, from the trailing edge `x = 0`, of the run of
+    /// columns whose real contact area is below its value at zero shear (docs/model.md
+    /// section 5; paper Fig. 2b). A multiple of `Δx`.
+    ///
+    /// # Errors
+    /// As [`Driver::real_contact_area`].
+    pub fn precursor_length(&self) -> Result<f64> {
+        let columns = self.column_contact_area()?;
+        let run = columns
+            .iter()
+            .zip(&self.initial_columns)
+            .take_while(|(now, then)| now < then)
+            .count();
+        Ok(run as f64 * self.grid.dx())
+    }
+
+    /// A noise-robust precursor length (m): the extent, from the trailing edge, of the
+    /// run of columns whose real contact area fell below `(1 - drop)` times its value at
+    /// zero shear. `drop` (dimensionless, in `[0, 1)`) is the relative fall that counts;
+    /// `drop = 0` is the paper's definition ([`Driver::precursor_length`]) exactly; a
+    /// larger `drop` never gives a longer front: a column counts only once it lost that
+    /// fraction of its area, so smaller fluctuations do not extend the front. A multiple
+    /// of `Δx`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a `drop` outside `[0, 1)` (or NaN); as
+    /// [`Driver::real_contact_area`] before the first event.
+    pub fn precursor_length_with(&self, drop: f64) -> Result<f64> {
+        if !(0.0..1.0).contains(&drop) {
+            return Err(Error::InvalidParameter {
+                name: "drop",
+                value: drop,
+                reason: "the relative drop of a column's contact area must lie in [0, 1)",
+            });
+        }
+        let keep = 1.0 - drop;
+        let columns = self.column_contact_area()?;
+        let run = columns
+            .iter()
+            .zip(&self.initial_columns)
+            .take_while(|(now, then)| **now < keep * **then)
+            .count();
+        Ok(run as f64 * self.grid.dx())
+    }
+}
