@@ -13,7 +13,8 @@ import sys
 # Bottom to top. A module may import only from rows above its own.
 LAYERS = [
     ["error"],
-    ["geometry", "lock"],
+    ["cost", "lock"],
+    ["geometry"],
     ["green"],
     ["interface"],
     ["solver"],

@@ -189,9 +189,9 @@ pub enum Error {
          need about {memory} of memory, about {plan} to plan and about {solve} per cold \
          equilibrium (estimates, docs/performance.md); raise the limit with max_cells(n) \
          (\"max_cells\" in a scene file) if that is intended",
-        memory = crate::green::format_bytes(*memory_bytes),
-        plan = crate::green::format_seconds(*plan_seconds),
-        solve = crate::green::format_seconds(*solve_seconds)
+        memory = format_bytes(*memory_bytes),
+        plan = format_seconds(*plan_seconds),
+        solve = format_seconds(*solve_seconds)
     )]
     GridTooLarge {
         /// Cells along x.
@@ -218,12 +218,14 @@ pub enum Error {
         "backend \"dense\" runs on one thread, but threads {threads} was asked for: use \
          backend \"spectral\" (or \"auto\" above {auto_limit} cells) to solve on several \
          threads, or threads 1 with backend \"dense\" (scene file: solver.backend, \
-         solver.threads)",
-        auto_limit = crate::solver::AUTO_DENSE_LIMIT
+         solver.threads)"
     )]
     DenseThreads {
         /// Threads asked for.
         threads: usize,
+        /// Cells above which `Backend::Auto` picks the spectral backend
+        /// ([`crate::solver::AUTO_DENSE_LIMIT`]).
+        auto_limit: usize,
     },
     /// The operating system refused the solver's threads.
     #[error("could not start a pool of {threads} solver threads: {}", Bounded(&source.to_string()))]
@@ -531,8 +533,8 @@ pub enum Error {
     /// (Linux: `MemAvailable` of `/proc/meminfo`), refused before anything is allocated.
     #[error(
         "{what} would need about {needed} of memory, but only {available} is available: {hint}",
-        needed = crate::green::format_bytes(*needed_bytes),
-        available = crate::green::format_bytes(*available_bytes)
+        needed = format_bytes(*needed_bytes),
+        available = format_bytes(*available_bytes)
     )]
     OutOfMemory {
         /// What would be allocated.
@@ -817,5 +819,48 @@ mod tests {
         let once = bounded(&text);
         assert!(once.len() < 200, "{} bytes", once.len());
         assert!(once.ends_with(" bytes)"), "{once}");
+    }
+}
+
+/// `bytes` in kB, MB, GB or TB (decimal), three significant digits.
+pub(crate) fn format_bytes(bytes: f64) -> String {
+    const UNITS: [(f64, &str); 4] = [(1e12, "TB"), (1e9, "GB"), (1e6, "MB"), (1e3, "kB")];
+    if bytes >= 1e15 {
+        return format!("{bytes:.3e} B");
+    }
+    for (scale, unit) in UNITS {
+        if bytes >= scale {
+            return format!("{:.3} {unit}", bytes / scale);
+        }
+    }
+    format!("{bytes:.0} B")
+}
+
+/// `seconds` in s, min, h or days, three significant digits.
+pub(crate) fn format_seconds(seconds: f64) -> String {
+    const UNITS: [(f64, &str); 3] = [(86400.0, "days"), (3600.0, "h"), (60.0, "min")];
+    if seconds >= 1e3 * 86400.0 {
+        return format!("{seconds:.3e} s");
+    }
+    for (scale, unit) in UNITS {
+        if seconds >= scale {
+            return format!("{:.3} {unit}", seconds / scale);
+        }
+    }
+    format!("{seconds:.3} s")
+}
+
+#[cfg(test)]
+mod format_tests {
+    use super::*;
+
+    #[test]
+    fn units() {
+        assert_eq!(format_bytes(2.4e10), "24.000 GB");
+        assert_eq!(format_bytes(512.0), "512 B");
+        assert_eq!(format_seconds(2600.0), "43.333 min");
+        assert_eq!(format_seconds(0.25), "0.250 s");
+        assert_eq!(format_bytes(2.4e20), "2.400e20 B");
+        assert_eq!(format_seconds(1e9), "1.000e9 s");
     }
 }

@@ -136,7 +136,7 @@ impl Grid {
             return Err(Error::EmptyGrid { axis: "y" });
         }
         // More cells than a vector of one f64 per cell can hold.
-        crate::green::check_cells(nx, ny, MAX_CELLS)?;
+        crate::cost::check_cells(nx, ny, MAX_CELLS)?;
         let grid = Self { block, nx, ny };
         // lx / nx rounds to zero when nx is huge against a tiny block.
         check_length("dx", grid.dx())?;

@@ -41,6 +41,7 @@
 #![forbid(unsafe_code)]
 
 pub mod calibration;
+mod cost;
 pub mod driver;
 pub mod error;
 pub mod geometry;

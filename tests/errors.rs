@@ -375,7 +375,7 @@ fn threads_with_the_dense_backend() {
         .solver(options(Backend::Dense, Parallelism::Threads(4)))
         .build()
         .unwrap_err();
-    assert!(matches!(e, Error::DenseThreads { threads: 4 }), "{e}");
+    assert!(matches!(e, Error::DenseThreads { threads: 4, .. }), "{e}");
     assert!(e.to_string().contains(r#"backend "spectral""#), "{e}");
     for parallelism in [
         Parallelism::Sequential,
@@ -415,7 +415,7 @@ fn threads_with_the_dense_backend() {
         .unwrap();
     assert!(matches!(
         dense.set_parallelism(Parallelism::Threads(2)),
-        Err(Error::DenseThreads { threads: 2 })
+        Err(Error::DenseThreads { threads: 2, .. })
     ));
 }
 

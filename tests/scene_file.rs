@@ -360,7 +360,7 @@ fn the_cell_limit_and_dense_threads_in_scene_files() {
         .unwrap()
         .build()
         .unwrap_err();
-    assert!(matches!(e, Error::DenseThreads { threads: 2 }), "{e}");
+    assert!(matches!(e, Error::DenseThreads { threads: 2, .. }), "{e}");
     let auto = r#"{"solver": {"backend": "auto", "threads": 2}}"#;
     let scene = SceneBuilder::from_json_str(auto).unwrap().build().unwrap();
     assert_eq!(scene.driver().unwrap().threads(), 1);

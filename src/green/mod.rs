@@ -11,7 +11,6 @@
 //!   solvers.
 //! * [`PlaneTransfer`] (`transfer.rs`): bottom tractions carried to a plane at height `z`.
 
-mod cost;
 mod dct;
 pub mod loads;
 mod plan;
@@ -21,8 +20,8 @@ mod spectrum;
 mod staged;
 mod transfer;
 
-pub(crate) use cost::{check_cells, check_memory, dense_bytes, format_bytes, format_seconds};
-pub use cost::{GridCost, DEFAULT_MAX_CELLS};
+pub(crate) use crate::cost::{check_cells, check_memory, dense_bytes};
+pub use crate::cost::{GridCost, DEFAULT_MAX_CELLS};
 pub use loads::RodLoad;
 pub(crate) use plan::SpectralTable;
 pub use plan::{InfluencePlan, InfluencePlanBuilder, DENSE_LIMIT};

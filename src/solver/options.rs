@@ -5,8 +5,7 @@ use super::parallel::Parallelism;
 use crate::error::{check_tolerance, Error, Result};
 use crate::interface::SiteState;
 
-/// Largest grid the [`Backend::Auto`] choice solves densely.
-pub const AUTO_DENSE_LIMIT: usize = 2500;
+pub use crate::cost::AUTO_DENSE_LIMIT;
 
 /// Which linear-algebra backend solves the equilibria.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -109,7 +108,10 @@ pub(crate) fn check_threads(backend: Backend, parallelism: Parallelism) -> Resul
     parallelism.validate()?;
     match (backend, parallelism) {
         (Backend::Dense, Parallelism::Threads(threads)) if threads > 1 => {
-            Err(Error::DenseThreads { threads })
+            Err(Error::DenseThreads {
+                threads,
+                auto_limit: AUTO_DENSE_LIMIT,
+            })
         }
         _ => Ok(()),
     }

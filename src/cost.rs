@@ -1,8 +1,11 @@
-//! What a grid costs, estimated before anything is allocated, and the guard that refuses
+//! What a grid costs (below the geometry and the operator: every layer above checks it), estimated before anything is allocated, and the guard that refuses
 //! grids above a limit of cells (docs/performance.md, "Grid-size guard").
 
 use crate::error::{Error, Result};
-use crate::solver::AUTO_DENSE_LIMIT;
+
+/// Largest grid the [`crate::Backend::Auto`] choice solves densely (cells). Defined here,
+/// below the solver, because the cost estimate needs it too.
+pub const AUTO_DENSE_LIMIT: usize = 2500;
 
 /// Default limit on the cells of a plan or scene ([`InfluencePlanBuilder::max_cells`],
 /// [`crate::SceneBuilder::max_cells`]): `1e6`, ten times the largest run documented
@@ -10,7 +13,7 @@ use crate::solver::AUTO_DENSE_LIMIT;
 /// 28 s per cold equilibrium ([`GridCost`]); 10000 x 10000 cells would need about 24 GB,
 /// minutes to plan and hours per equilibrium.
 ///
-/// [`InfluencePlanBuilder::max_cells`]: super::InfluencePlanBuilder::max_cells
+/// [`InfluencePlanBuilder::max_cells`]: crate::green::InfluencePlanBuilder::max_cells
 pub const DEFAULT_MAX_CELLS: usize = 1_000_000;
 
 /// Bytes per cell of a spectral scene and its driver (plan, interface, load table,
@@ -129,47 +132,9 @@ pub(crate) fn check_memory(
     }
 }
 
-/// `bytes` in kB, MB, GB or TB (decimal), three significant digits.
-pub(crate) fn format_bytes(bytes: f64) -> String {
-    const UNITS: [(f64, &str); 4] = [(1e12, "TB"), (1e9, "GB"), (1e6, "MB"), (1e3, "kB")];
-    if bytes >= 1e15 {
-        return format!("{bytes:.3e} B");
-    }
-    for (scale, unit) in UNITS {
-        if bytes >= scale {
-            return format!("{:.3} {unit}", bytes / scale);
-        }
-    }
-    format!("{bytes:.0} B")
-}
-
-/// `seconds` in s, min, h or days, three significant digits.
-pub(crate) fn format_seconds(seconds: f64) -> String {
-    const UNITS: [(f64, &str); 3] = [(86400.0, "days"), (3600.0, "h"), (60.0, "min")];
-    if seconds >= 1e3 * 86400.0 {
-        return format!("{seconds:.3e} s");
-    }
-    for (scale, unit) in UNITS {
-        if seconds >= scale {
-            return format!("{:.3} {unit}", seconds / scale);
-        }
-    }
-    format!("{seconds:.3} s")
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn units() {
-        assert_eq!(format_bytes(2.4e10), "24.000 GB");
-        assert_eq!(format_bytes(512.0), "512 B");
-        assert_eq!(format_seconds(2600.0), "43.333 min");
-        assert_eq!(format_seconds(0.25), "0.250 s");
-        assert_eq!(format_bytes(2.4e20), "2.400e20 B");
-        assert_eq!(format_seconds(1e9), "1.000e9 s");
-    }
 
     #[test]
     fn the_limit_admits_the_documented_runs_and_refuses_1e8_cells() {
