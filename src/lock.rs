@@ -114,7 +114,12 @@ fn locked(dir: &Path, holder: String) -> Error {
 
 /// The holder as it described itself in the lock file.
 fn holder(path: &Path) -> String {
-    let text = std::fs::read_to_string(path).unwrap_or_default();
+    // The first 4 kB: a holder writes one line; a file grown by something else is not read
+    // whole.
+    let mut text = String::new();
+    if let Ok(file) = File::open(path) {
+        let _ = std::io::Read::read_to_string(&mut std::io::Read::take(file, 4096), &mut text);
+    }
     let text = text.trim();
     if text.is_empty() {
         // It locked the file and has not written its name yet (microseconds).

@@ -528,6 +528,7 @@ impl RunTables {
         let mut read = partials.clone();
         for t in 0..3 {
             for path in [&partials[t], &paths[t]] {
+                crate::cost::check_file_size(path)?;
                 match fs::read_to_string(path) {
                     Ok(text) => {
                         old[t] = Some(text);
@@ -748,6 +749,7 @@ fn remove_stale_temporaries(dir: &Path) -> Result<()> {
 #[cfg(feature = "serde")]
 fn check_scene_record(dir: &Path, driver: &Driver) -> Result<()> {
     let path = dir.join(SCENE_RECORD);
+    crate::cost::check_file_size(&path)?;
     let text = match fs::read_to_string(&path) {
         Ok(text) => text,
         Err(e) if e.kind() == io::ErrorKind::NotFound => {

@@ -787,6 +787,7 @@ impl Sweep {
         let _lock = DirLock::lock_waiting(out, std::time::Duration::from_secs(30))?;
         let path = out.join(SWEEP_FILE);
         let text = self.to_json()?;
+        crate::cost::check_file_size(&path)?;
         match std::fs::read_to_string(&path) {
             Ok(old) if old == text => Ok(()),
             Ok(_) => Err(Error::SweepDirectory {

@@ -555,3 +555,42 @@ fn sweeps_beyond_the_run_limit_are_refused_at_once() {
     .unwrap();
     assert_eq!(sweep.runs().len(), MAX_RUNS);
 }
+
+/// A file too large for the machine's memory (a sparse 1 TiB file: read whole, it would
+/// abort the process) is refused before it is read, by every reader of a user's file:
+/// scene files, checkpoints, and the tables `plot` reads (Linux, where the memory
+/// available is known; elsewhere no check is made and the test only runs the readers on
+/// small files).
+#[test]
+fn files_too_large_for_memory_are_refused_before_reading() {
+    if !cfg!(target_os = "linux") {
+        return;
+    }
+    let dir = scratch("too-large");
+    let huge = |name: &str| {
+        let path = dir.join(name);
+        std::fs::File::create(&path)
+            .unwrap()
+            .set_len(1 << 40)
+            .unwrap();
+        path
+    };
+    let started = std::time::Instant::now();
+    let scene = SceneBuilder::from_json_file(huge("scene.json")).unwrap_err();
+    let checkpoint = precursors::Checkpoint::read_from(huge("checkpoint.json")).unwrap_err();
+    for e in [&scene, &checkpoint] {
+        assert!(matches!(e, Error::OutOfMemory { .. }), "{e}");
+        assert!(e.to_string().contains("1099511627776 bytes"), "{e}");
+    }
+    #[cfg(feature = "plot")]
+    {
+        let run = dir.join("run");
+        std::fs::create_dir_all(&run).unwrap();
+        std::fs::rename(huge("curve.csv"), run.join("curve.csv")).unwrap();
+        let e = precursors::plot::figures::draw(&run, &[precursors::plot::figures::Format::Png])
+            .unwrap_err();
+        assert!(matches!(e, Error::OutOfMemory { .. }), "{e}");
+    }
+    assert!(started.elapsed().as_secs_f64() < 5.0);
+    std::fs::remove_dir_all(&dir).ok();
+}

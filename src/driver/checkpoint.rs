@@ -198,6 +198,7 @@ impl Checkpoint {
     #[cfg(feature = "serde")]
     pub fn read_from(path: impl AsRef<std::path::Path>) -> Result<Checkpoint> {
         let path = path.as_ref();
+        crate::cost::check_file_size(path)?;
         let text =
             std::fs::read_to_string(path).map_err(|e| Error::io("reading checkpoint", path, e))?;
         verified(&text).map_err(|refusal| match refusal {

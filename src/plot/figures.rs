@@ -92,6 +92,7 @@ fn name(dir: &Path) -> String {
 }
 
 fn read(path: &Path) -> Result<String> {
+    crate::cost::check_file_size(path)?;
     std::fs::read_to_string(path).map_err(|e| Error::io("reading table", path, e))
 }
 

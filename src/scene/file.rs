@@ -514,14 +514,7 @@ pub(crate) fn read_json_text(
     operation: &'static str,
     content_error: impl FnOnce(usize, usize, String) -> Error,
 ) -> Result<String> {
-    let size = std::fs::metadata(path)
-        .map_err(|e| Error::io(operation, path, e))?
-        .len();
-    crate::green::check_memory(
-        || format!("reading {} ({size} bytes)", path.display()),
-        5.0 * size as f64,
-        "the file is too large for this machine",
-    )?;
+    crate::cost::check_file_size(path)?;
     let bytes = std::fs::read(path).map_err(|e| Error::io(operation, path, e))?;
     String::from_utf8(bytes).map_err(|e| {
         let (line, column, reason) = not_utf8(e.as_bytes(), e.utf8_error());

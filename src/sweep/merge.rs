@@ -110,6 +110,7 @@ fn columns<'a>(path: &Path, text: &'a str, header: &str) -> Result<Vec<Vec<&'a s
 }
 
 fn read(path: &Path) -> Result<String> {
+    crate::cost::check_file_size(path)?;
     std::fs::read_to_string(path).map_err(|e| Error::io("reading", path, e))
 }
 
