@@ -685,7 +685,7 @@ impl Sweep {
             "mu_FN_N": mu_fn,
             "slip_force_N": slip,
             "slip_over_mu_FN": slip.map(|f| f / mu_fn),
-            "backend": format!("{:?}", driver.backend()),
+            "backend": driver.backend().to_string(),
             "seconds": { "build": built, "total": seconds },
             "scene": &run.scene,
         });
