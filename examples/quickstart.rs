@@ -51,6 +51,7 @@ fn run() -> report::Outcome {
     let mut driver = scene.driver()?;
     let mut rows = Vec::new();
     let mut slip = None;
+    let mut ruptures = 0usize;
     driver.run(|event, d| {
         match event {
             Event::Stable { load, ruptures } => rows.push((
@@ -61,6 +62,8 @@ fn run() -> report::Outcome {
                 d.area_exceeds_nominal().unwrap_or(false),
             )),
             Event::GlobalSlip { load } => slip = Some(load.force / scale),
+            // Every rupture, the last avalanche's (which ends in slip) included.
+            Event::Rupture { .. } => ruptures += 1,
             _ => {}
         }
         ControlFlow::<()>::Continue(())
@@ -98,7 +101,6 @@ fn run() -> report::Outcome {
     .legend(Corner::UpperLeft)
     .save(&png)?;
 
-    let ruptures: usize = rows.iter().map(|r| r.3).sum();
     println!(
         "calibration scene, seed {seed}: {} stable states, {ruptures} ruptures, global slip at \
          F/(μF_N) = {:.12}, in {:.2} s",

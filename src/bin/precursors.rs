@@ -54,8 +54,8 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
-    /// Runs a scene file (docs/scene-format.md) to global slip; writes DIR/events.csv and
-    /// DIR/curve.csv.
+    /// Runs a scene file (docs/scene-format.md) to global slip; writes DIR/events.csv,
+    /// DIR/curve.csv and DIR/contact_map.csv (NAME.partial until global slip).
     Run {
         /// The scene file.
         scene: PathBuf,
