@@ -69,14 +69,7 @@ const CURVE_HEADER: &str = "event,force_N,force_over_mu_FN,drive_displacement_m,
                             real_contact_area_m2,precursor_length_m,precursor_over_Lx,broken,\
                             attached,area_exceeds_nominal";
 
-/// SLURM's array variables: the program must not take a shard from the test's environment.
-const SLURM_VARS: [&str; 5] = [
-    "SLURM_ARRAY_TASK_ID",
-    "SLURM_ARRAY_TASK_COUNT",
-    "SLURM_ARRAY_TASK_MIN",
-    "SLURM_ARRAY_TASK_MAX",
-    "SLURM_ARRAY_TASK_STEP",
-];
+use crate::common::program::SLURM_VARS;
 
 // ---------------------------------------------------------------------------------------
 // Running the program under bounds

@@ -33,25 +33,10 @@ fn sweep_text() -> String {
 }
 
 fn program() -> Command {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_precursors"));
-    // The tests may run inside a SLURM array task.
-    for name in ["ID", "COUNT", "MIN", "MAX", "STEP"] {
-        command.env_remove(format!("SLURM_ARRAY_TASK_{name}"));
-    }
-    command
+    crate::common::program::command(&[])
 }
 
-fn precursors(args: &[&str]) -> Output {
-    program().args(args).output().unwrap()
-}
-
-fn path(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use crate::common::program::{path, precursors, stderr};
 
 /// Traces of Rust's `{:?}` or Rust names in a message a user reads.
 fn debug_traces(text: &str) -> Vec<&'static str> {

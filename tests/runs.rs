@@ -218,27 +218,10 @@ fn of_sweeps_starting_together_on_a_new_directory_one_takes_it() {
 #[cfg(feature = "cli")]
 mod cli {
     use super::*;
-    use std::process::{Child, Command, Output, Stdio};
+    use std::process::{Child, Stdio};
     use std::time::{Duration, Instant};
 
-    fn command(args: &[&str]) -> Command {
-        let mut command = Command::new(env!("CARGO_BIN_EXE_precursors"));
-        for name in [
-            "SLURM_ARRAY_TASK_ID",
-            "SLURM_ARRAY_TASK_COUNT",
-            "SLURM_ARRAY_TASK_MIN",
-            "SLURM_ARRAY_TASK_MAX",
-            "SLURM_ARRAY_TASK_STEP",
-        ] {
-            command.env_remove(name);
-        }
-        command.args(args);
-        command
-    }
-
-    fn precursors(args: &[&str]) -> Output {
-        command(args).output().unwrap()
-    }
+    use crate::common::program::{command, path, precursors, stderr};
 
     fn spawn(args: &[&str]) -> Child {
         command(args)
@@ -246,14 +229,6 @@ mod cli {
             .stderr(Stdio::piped())
             .spawn()
             .unwrap()
-    }
-
-    fn path(p: &Path) -> &str {
-        p.to_str().unwrap()
-    }
-
-    fn stderr(o: &Output) -> String {
-        String::from_utf8_lossy(&o.stderr).into_owned()
     }
 
     /// The runs a sweep says it ran ("N runs done, ...").

@@ -432,37 +432,12 @@ fn merged_bands_are_student_t() {
 #[cfg(feature = "cli")]
 mod cli {
     use super::*;
-    use std::process::Command;
 
-    /// SLURM's job-array variables (all unset for the program but those given).
-    const SLURM_VARS: [&str; 5] = [
-        "SLURM_ARRAY_TASK_ID",
-        "SLURM_ARRAY_TASK_COUNT",
-        "SLURM_ARRAY_TASK_MIN",
-        "SLURM_ARRAY_TASK_MAX",
-        "SLURM_ARRAY_TASK_STEP",
-    ];
+    use crate::common::program::{command, path, precursors};
 
-    /// The program with `vars` as its only SLURM array variables (the tests may run inside
-    /// an array task).
+    /// The program with `vars` as its only SLURM array variables.
     fn precursors_in(vars: &[(&str, &str)], args: &[&str]) -> std::process::Output {
-        let mut command = Command::new(env!("CARGO_BIN_EXE_precursors"));
-        for name in SLURM_VARS {
-            command.env_remove(name);
-        }
-        command
-            .args(args)
-            .envs(vars.iter().copied())
-            .output()
-            .unwrap()
-    }
-
-    fn precursors(args: &[&str]) -> std::process::Output {
-        precursors_in(&[], args)
-    }
-
-    fn path(p: &Path) -> &str {
-        p.to_str().unwrap()
+        command(args).envs(vars.iter().copied()).output().unwrap()
     }
 
     #[test]

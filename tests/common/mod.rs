@@ -1,6 +1,9 @@
 //! Shared test helpers: Gauss–Legendre quadrature (the independent reference for cell
 //! averages and face integrals) and relative comparison.
 
+#[cfg(feature = "cli")]
+pub mod program;
+
 /// Gauss–Legendre nodes and weights on [-1, 1] by Newton iteration on P_n.
 pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
     let mut out = Vec::with_capacity(n);
