@@ -582,7 +582,13 @@ mod ranges {
             ),
             (
                 "springs.c_z",
-                Box::new(|v| springs(1.65e12, v)),
+                // A stiff block (E = 1e15 Pa): springs up to 1e21 N/m² are then resolved
+                // against it (the tolerance's bound `5e-2·p/R`, docs/scene-format.md).
+                Box::new(|v| {
+                    let mut m = Material::default();
+                    m.young_modulus = 1e15;
+                    springs(1.65e12, v).material(m)
+                }),
                 vec![1e-3, 1e21],
                 vec![0.99e-3, 1.01e21],
             ),
