@@ -7,8 +7,11 @@
 //! Green function, and a grid of interfacial springs on the bottom face.
 //!
 //! Units are SI throughout: lengths in m, forces in N, tractions and stresses in Pa.
-//! Sign conventions are those of `docs/model.md` section 1: both shear loads point along
-//! +x, the normal load presses the block down, bottom tractions `φ_z ≥ 0` push up.
+//! Sign conventions are those of [`docs/model.md`][model] section 1: both shear loads
+//! point along +x, the normal load presses the block down, bottom tractions `φ_z ≥ 0`
+//! push up.
+//!
+//! [model]: https://github.com/precursors-model/precursors/blob/main/docs/model.md
 //!
 //! This release provides the geometry, the [`green`] module (point evaluation of `G`
 //! and `∂G/∂z`, the analytic load terms, the Galerkin influence operator of the grid,
@@ -22,6 +25,42 @@
 //! fields to `nalgebra` matrices and vectors, row `iy` and column `ix`), `plot` (module
 //! `plot`: figures with axes, units, legends and colour bars as PNG or SVG), `cli` (the
 //! program `precursors`, docs/cli.md).
+//!
+//! A scene driven from zero shear to global slip, event by event: the real contact area,
+//! the precursor length `ℓ` and the Coulomb stress on a plane inside the block, read
+//! between events (a small block so that the example runs in a moment; the builder's
+//! defaults are the paper's calibration scene, docs/model.md):
+//!
+//! ```
+//! use precursors::{Event, ProbeSpec, Scene};
+//!
+//! let scene = Scene::builder()
+//!     .block(0.030, 0.007, 0.075)                       // Lx, Ly, Lz (m)
+//!     .cell_size(1e-3, 1e-3)                            // 30 x 7 cells (m)
+//!     .normal_load(750.0)                               // F_N (N); rod drive, PMMA
+//!     .seed(1)                                          // the heights' realization
+//!     .probes(ProbeSpec::default().plane(2e-3))         // stresses at z = 2 mm
+//!     .build()?;
+//! let mut driver = scene.driver()?;
+//! let (lx, mu_fn) = (0.030, scene.material().friction_coefficient * 750.0);
+//! while let Some(event) = driver.step()? {
+//!     match event {
+//!         Event::Stable { load, .. } => {
+//!             let area = driver.total_contact_area()?;          // A_R (m²)
+//!             let ell = driver.precursor_length()?;             // ℓ (m)
+//!             let plane = &driver.stresses()?.planes[0];        // τ, σ, τ_C (Pa)
+//!             let tau_c = plane.profile(driver.friction_coefficient()).mean_coulomb;
+//!             assert!(area > 0.0 && (0.0..=lx).contains(&ell) && tau_c.len() == 30);
+//!             assert!(load.force <= mu_fn * (1.0 + 1e-9));      // F ≤ μF_N
+//!         }
+//!         Event::GlobalSlip { load } => println!("slip at F/(μF_N) = {}", load.force / mu_fn),
+//!         _ => {}                                           // load raised, ruptures, ...
+//!     }
+//! }
+//! # Ok::<(), precursors::Error>(())
+//! ```
+//!
+//! The operator alone, planned once per geometry and applied matrix-free:
 //!
 //! ```
 //! use precursors::{Block, Grid, green::InfluencePlan};
