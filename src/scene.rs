@@ -561,7 +561,7 @@ impl SceneBuilder {
             Cells::Size(dx, dy) => Grid::from_cell_size(block, dx, dy)?,
             Cells::Count(nx, ny) => Grid::new(block, nx, ny)?,
         };
-        crate::green::check_cells(grid.nx(), grid.ny(), self.max_cells)?;
+        crate::cost::check_cells(grid.nx(), grid.ny(), self.max_cells)?;
         Ok(grid)
     }
 
