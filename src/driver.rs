@@ -584,3 +584,11 @@ impl Iterator for Driver {
 }
 
 impl std::iter::FusedIterator for Driver {}
+
+#[cfg(test)]
+impl Driver {
+    /// Whether the solver holds a preconditioner (the scene tests' "leave out" check).
+    pub(crate) fn solver_holds_preconditioners(&self) -> bool {
+        self.solver.holds_preconditioners()
+    }
+}

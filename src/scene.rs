@@ -854,3 +854,45 @@ impl Scene {
         }
     }
 }
+
+/// "Leave out what a given scene does not need" (docs/architecture.md, "What a scene leaves
+/// out"): what a built scene holds follows its drive and its probes.
+#[cfg(test)]
+mod leaves_out {
+    use super::*;
+
+    fn small() -> SceneBuilder {
+        Scene::builder().block(0.010, 0.004, 0.010).cells(10, 4)
+    }
+
+    #[test]
+    fn a_top_drive_has_no_lateral_load_and_no_probes_no_transfer() {
+        let top = small().drive(Drive::Force(ForceLoad::Top)).build().unwrap();
+        assert!(top.rod.is_none() && top.lateral_response.is_none());
+        assert!(top.probe.is_none());
+        let rod = small()
+            .probes(ProbeSpec::default().plane(2e-3))
+            .build()
+            .unwrap();
+        assert!(rod.rod.is_some() && rod.lateral_response.is_some());
+        assert!(rod.probe.is_some());
+    }
+
+    #[test]
+    fn a_driver_builds_no_preconditioner_before_a_solve_needs_it() {
+        // The spectral backend's FSAI, its local entries and the spectral inverse are
+        // built on first use only.
+        let scene = small()
+            .solver(SolverOptions::default().backend(crate::Backend::Spectral))
+            .build()
+            .unwrap();
+        let mut driver = scene.driver().unwrap();
+        assert!(!driver.solver_holds_preconditioners());
+        // The first equilibria build what the warm solves use: the check can fail.
+        while !matches!(
+            driver.step().unwrap(),
+            Some(crate::Event::Rupture { .. }) | None
+        ) {}
+        assert!(driver.solver_holds_preconditioners());
+    }
+}

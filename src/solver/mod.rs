@@ -257,6 +257,15 @@ impl EquilibriumSolver {
     }
 
     /// The state carried between solves.
+    /// Whether a preconditioner is built (they are built on first use only).
+    #[cfg(test)]
+    pub(crate) fn holds_preconditioners(&self) -> bool {
+        match &self.core {
+            Core::Spectral(core) => core.built(),
+            Core::Dense(core) => core.spectral.built(),
+        }
+    }
+
     pub(crate) fn state(&self) -> SolverState {
         let (preconditioner_mean, factor) = match &self.core {
             Core::Dense(d) => (d.spectral.preconditioner_mean(), Some(d.normal.state())),

@@ -56,6 +56,12 @@ pub(crate) struct SpectralCore {
 }
 
 impl SpectralCore {
+    /// Whether a preconditioner (FSAI, its local entries, the spectral inverse) is built.
+    #[cfg(test)]
+    pub(crate) fn built(&self) -> bool {
+        self.inverse.is_some() || self.entries.is_some() || self.fsai.is_some()
+    }
+
     /// On `partition` (the plan's own for the spectral backend, one part for the dense).
     pub(crate) fn new(plan: &InfluencePlan, compliance: Compliance, partition: Partition) -> Self {
         let (nx, ny) = (plan.grid().nx(), plan.grid().ny());
