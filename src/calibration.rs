@@ -157,12 +157,12 @@ fn normal_area_with(
 /// `c_z` (N/m²) in `bracket` such that the mean real contact area at zero shear is
 /// `target_area` (m², the paper's `α F_N`). Errors: [`Error::InvalidParameter`] when the
 /// bracket does not enclose the target (with the areas at its ends in the message's
-/// value), [`Error::NotConverged`] past `max_evaluations`.
+/// value), [`Error::FitNotConverged`] past `max_evaluations`.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for a target area that is not finite and `> 0`, a bracket
 /// that is not `0 < low < high` or does not enclose the target; [`Error::InvalidTolerance`]
-/// for invalid `options`; [`Error::NotConverged`] past `max_evaluations`; those of
+/// for invalid `options`; [`Error::FitNotConverged`] past `max_evaluations`; those of
 /// [`normal_contact_area`].
 pub fn fit_normal_stiffness(
     builder: &SceneBuilder,
@@ -235,12 +235,11 @@ pub fn fit_normal_stiffness(
             });
         }
         if evaluations >= options.max_evaluations {
-            return Err(Error::NotConverged {
-                what: "c_z fit (regula falsi in ln c_z)",
+            return Err(Error::FitNotConverged {
                 value: c.exp(),
-                error: (b - a).abs(),
+                width: (b - a).abs(),
                 tolerance: options.tolerance,
-                terms: evaluations as u64,
+                evaluations,
             });
         }
     }

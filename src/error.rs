@@ -1,5 +1,10 @@
 //! Typed errors: every reachable failure says what was wrong and why.
 
+mod bounded;
+
+#[cfg(test)]
+use bounded::bounded;
+pub(crate) use bounded::Bounded;
 use std::path::PathBuf;
 use thiserror::Error;
 
@@ -7,13 +12,19 @@ use thiserror::Error;
 /// factorisation's, the thread pool's), type-erased so that no dependency's type enters
 /// the crate's API. [`std::error::Error::source`] returns the cause itself, so
 /// `downcast_ref` reaches its concrete type.
-pub type Cause = Box<dyn std::error::Error + Send + Sync + 'static>;
+pub(crate) type Cause = Box<dyn std::error::Error + Send + Sync + 'static>;
 
 /// Convenient result alias of the crate. The error type defaults to [`enum@Error`] and can be
 /// named, so `use precursors::*` leaves `Result<T, E>` usable for other errors.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
-/// Everything that can go wrong in the crate.
+/// Everything that can go wrong in the core library: geometry, Green function, interface,
+/// solver, scene, driver, checkpoints, and a run's tables, directory and lock (module
+/// `output`). A sweep's own failures are `sweep::SweepError` (feature `serde`), a
+/// figure's `plot::PlotError` (feature `plot`); each nests this type for the
+/// failures of the runs, scenes and tables under it. A variant that only a feature's code
+/// can return exists only with that feature (`ShapeMismatch`: `nalgebra`;
+/// `NonFiniteCell`: `serde`).
 ///
 /// Every variant carries the offending values so a caller can report them or recover.
 /// Variants that wrap another error (I/O, JSON, factorisation, thread pool) return it from
@@ -102,12 +113,18 @@ pub enum Error {
         /// z (m).
         z: f64,
     },
-    /// A series could not reach the requested tolerance within its term budget.
+    /// A series of the Green function reached its term budget before its truncation
+    /// tolerance (the plan's `plan_tolerance`, a point evaluation's or a probe's tolerance):
+    /// a point value of `G` or `∂G/∂z` ([`crate::green::GreenFunction`]), a load's series
+    /// ([`crate::green::RodLoad`]), an eigenvalue of the influence operator
+    /// ([`crate::green::InfluencePlanBuilder::build`], [`crate::SceneBuilder::build`]), an
+    /// alias sum of a plane transfer or a point probe (a plane or point too close to
+    /// `z = 0`). Not a linear solve: that is [`Error::SolverNotConverged`].
     #[error(
         "{what} did not reach tolerance {tolerance:e}: best value {value:e} with error estimate \
          {error:e} after {terms} terms (raise the budget or the tolerance)"
     )]
-    NotConverged {
+    SeriesNotConverged {
         /// Which series.
         what: &'static str,
         /// Best value reached.
@@ -290,7 +307,13 @@ pub enum Error {
         /// Why the contact is empty.
         reason: &'static str,
     },
-    /// An iterative solver stopped before reaching its tolerance.
+    /// An equilibrium solve stopped before reaching the solver's tolerance
+    /// ([`crate::SolverOptions`]): the projected CG of a normal or tangential set solve past
+    /// its iteration limit, or the active set of the normal equilibrium past
+    /// `max_active_set_iterations` (residual `inf`). Returned by
+    /// [`crate::EquilibriumSolver::solve_normal`], [`crate::EquilibriumSolver::solve_tangential`],
+    /// [`crate::Driver::step`] and the calibration's area. Not a series of the Green function:
+    /// that is [`Error::SeriesNotConverged`].
     #[error(
         "{what} did not converge: relative residual {residual:e} > tolerance {tolerance:e} \
          after {iterations} iterations"
@@ -304,6 +327,24 @@ pub enum Error {
         residual: f64,
         /// Requested tolerance.
         tolerance: f64,
+    },
+    /// [`crate::calibration::fit_normal_stiffness`] spent `max_evaluations` scenes
+    /// ([`crate::calibration::FitOptions`]) before its bracket on `ln c_z` narrowed to the
+    /// fit's tolerance.
+    #[error(
+        "c_z fit (regula falsi in ln c_z) did not reach tolerance {tolerance:e}: best value \
+         {value:e} N/m² with bracket width {width:e} in ln c_z after {evaluations} evaluations \
+         (raise max_evaluations or the tolerance)"
+    )]
+    FitNotConverged {
+        /// The best `c_z` (N/m²).
+        value: f64,
+        /// The width of the bracket on `ln c_z` left (dimensionless).
+        width: f64,
+        /// The fit's tolerance on `ln c_z`.
+        tolerance: f64,
+        /// Scenes evaluated.
+        evaluations: usize,
     },
     /// A factorisation met a non-positive pivot (the system lost definiteness to rounding).
     #[error(
@@ -366,8 +407,10 @@ pub enum Error {
         /// Why.
         reason: String,
     },
-    /// A matrix has the wrong shape for the grid: a field on the grid is an `Ny x Nx`
-    /// matrix (row `iy`, column `ix`); a transposed one is refused, not read sideways.
+    #[cfg(feature = "nalgebra")]
+    /// (Feature `nalgebra`.) A matrix has the wrong shape for the grid
+    /// ([`crate::Heights::from_dmatrix`]): a field on the grid is an `Ny x Nx` matrix (row
+    /// `iy`, column `ix`); a transposed one is refused, not read sideways.
     #[error(
         "{name} is a {rows} x {columns} matrix, the grid needs {expected_rows} x \
          {expected_columns} (Ny rows by Nx columns: row iy, column ix)"
@@ -423,56 +466,6 @@ pub enum Error {
         /// What is wrong, with the line number.
         reason: String,
     },
-    /// A sweep file is not valid JSON or does not follow `docs/sweep-format.md` outside
-    /// its axes (an axis's key or values: [`Error::SweepKey`]).
-    #[error(
-        "sweep file{}: {}",
-        path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default(),
-        Bounded(&source.to_string())
-    )]
-    SweepFile {
-        /// The file (`None` for JSON text given directly).
-        path: Option<PathBuf>,
-        /// Line of the error (1-based; 0 when the parser gave none).
-        line: usize,
-        /// Column of the error (1-based; 0 when the parser gave none).
-        column: usize,
-        /// What the parser reported.
-        #[source]
-        source: Cause,
-    },
-    /// An axis of a sweep names a key that is not a scene key, or one of its values does
-    /// not give a valid scene (the value's type, or the scene's own check of it).
-    #[error("sweep axis `{}`: {}", Bounded(key), Bounded(reason))]
-    SweepKey {
-        /// The axis's key, a dotted scene-file path (`block.lx`, `drive.height`, ...).
-        key: String,
-        /// What is wrong, with the value when one is at fault.
-        reason: String,
-    },
-    /// A figure cannot be drawn (feature `plot`): an unknown file extension, an invalid
-    /// axis range or size, a drawing backend that fails. A figure that cannot be written
-    /// to its file is [`Error::Io`].
-    #[error(
-        "figure{}: {}",
-        path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default(),
-        Bounded(reason)
-    )]
-    Figure {
-        /// The figure's file, when known.
-        path: Option<PathBuf>,
-        /// What is wrong.
-        reason: String,
-    },
-    /// A sweep's output directory cannot be used: it holds another sweep, or (for a
-    /// merge) no sweep or a run's files that do not belong to it.
-    #[error("sweep directory {}: {}", path.display(), Bounded(reason))]
-    SweepDirectory {
-        /// The directory or the file at fault.
-        path: PathBuf,
-        /// What is wrong.
-        reason: String,
-    },
     /// Another process holds the directory's lock: it is writing a run there (`run`,
     /// `resume`, a sweep's run) or checking a sweep's `sweep.json`. The lock is the
     /// operating system's and ends with that process, also when it is killed.
@@ -497,8 +490,10 @@ pub enum Error {
         /// What is wrong.
         reason: String,
     },
-    /// A table that `merge` or `plot` reads holds, where a number belongs, a value that is
-    /// not a finite number (`NaN`, `inf`, an empty cell): a damaged or edited table, which
+    #[cfg(feature = "serde")]
+    /// (Feature `serde`.) A run's table that [`crate::sweep::merge`] or the figures of a
+    /// directory (feature `plot`) read holds, where a number belongs, a value that is not a
+    /// finite number (`NaN`, `inf`, an empty cell): a damaged or edited table, which
     /// would turn every statistic and figure made from it into NaN.
     #[error(
         "table {}, line {line}, column {column}: {} is not a finite number",
@@ -561,27 +556,15 @@ pub enum Error {
         /// The largest ratio accepted.
         limit: f64,
     },
-    /// A sweep with more runs than a sweep may have.
-    #[error(
-        "the sweep has {points} points x {realizations} realizations = {runs} runs, more than \
-         the limit of {limit} runs per sweep: split it into several sweeps (fewer values per \
-         axis or fewer realizations each, with other output directories)"
-    )]
-    SweepTooLarge {
-        /// Parameter points (the product of the axes' lengths, exact).
-        points: u128,
-        /// Realizations per point.
-        realizations: usize,
-        /// `points · realizations` (exact).
-        runs: u128,
-        /// The most runs per sweep.
-        limit: usize,
-    },
 }
 
 impl Error {
     /// An [`Error::Io`] for `operation` (`"reading scene file"`, ...) on `path`.
-    pub fn io(operation: &'static str, path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+    pub(crate) fn io(
+        operation: &'static str,
+        path: impl Into<PathBuf>,
+        source: std::io::Error,
+    ) -> Self {
         Error::Io {
             operation,
             path: path.into(),
@@ -636,120 +619,6 @@ pub(crate) fn check_slice(name: &'static str, values: &[f64], expected: usize) -
         return Err(Error::NonFinite { name, index, value });
     }
     Ok(())
-}
-
-/// The messages of `error` and of its causes ([`std::error::Error::source`]), outermost
-/// first, leaving out a cause whose message already ends the one before it (this crate's
-/// [`Error::Io`] says "reading scene file `<path>`: `<the io::Error>`"): what a program prints
-/// as `error: ...` and `caused by: ...` lines.
-///
-/// ```
-/// use precursors::error::messages;
-/// let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
-/// let e = precursors::Error::io("reading scene file", "/x/y.json", io);
-/// assert_eq!(messages(&e), vec!["reading scene file /x/y.json: no such file".to_string()]);
-/// ```
-pub fn messages(error: &(dyn std::error::Error + 'static)) -> Vec<String> {
-    let mut out = vec![bounded(&error.to_string()).into_owned()];
-    let mut source = error.source();
-    while let Some(cause) = source {
-        let text = bounded(&cause.to_string()).into_owned();
-        if !out.last().is_some_and(|previous| previous.ends_with(&text)) {
-            out.push(text);
-        }
-        source = cause.source();
-    }
-    out
-}
-
-/// A quoted value longer than this (in characters) is cut in a message.
-const LONGEST_VALUE: usize = 120;
-/// A cut value keeps its first this many characters (then `... (N bytes)`): a cut value
-/// is no longer than [`LONGEST_VALUE`], so cutting twice changes nothing.
-const KEPT: usize = 80;
-/// Text between quoted values longer than this is cut too: the messages' own prose is
-/// shorter, so only a value that holds quote characters itself reaches it.
-const LONGEST_PROSE: usize = 1000;
-/// Whatever its pieces, a message longer than this (in bytes) is cut as a whole.
-const LONGEST_MESSAGE: usize = 4096;
-
-/// `text` (a message, or a value to echo in one) with every value quoted in it (between
-/// backticks, or between double quotes with backslash escapes, as the JSON parser and
-/// `{:?}` quote) longer than [`LONGEST_VALUE`] characters cut to its first [`KEPT`] and its
-/// length: `"aaaa... (104857600 bytes)"`. A scene file can hold a 100 MB string, and the
-/// parser echoes an unknown variant or field whole. Every message of [`enum@Error`] that
-/// carries text from a file goes through it, and so does [`messages`].
-pub(crate) fn bounded(text: &str) -> std::borrow::Cow<'_, str> {
-    fn push_cut(out: &mut String, piece: &str, longest: usize) {
-        match piece.char_indices().nth(longest) {
-            None => out.push_str(piece),
-            Some(_) => {
-                let end = piece
-                    .char_indices()
-                    .nth(KEPT)
-                    .map_or(piece.len(), |(i, _)| i);
-                out.push_str(&piece[..end]);
-                out.push_str(&format!("... ({} bytes)", piece.len()));
-            }
-        }
-    }
-    /// The byte index of the quote closing the one at `open` (or `text.len()`).
-    fn closing(text: &str, open: usize) -> usize {
-        let bytes = text.as_bytes();
-        let quote = bytes[open];
-        let mut i = open + 1;
-        while i < bytes.len() && bytes[i] != quote {
-            // A backslash escapes the next character in double quotes (`{:?}`, JSON).
-            i += if quote == b'"' && bytes[i] == b'\\' {
-                2
-            } else {
-                1
-            };
-        }
-        i.min(bytes.len())
-    }
-    if text.len() <= KEPT {
-        return text.into();
-    }
-    let mut out = String::new();
-    let mut prose = 0;
-    let mut i = 0;
-    let bytes = text.as_bytes();
-    while i < bytes.len() {
-        if bytes[i] == b'`' || bytes[i] == b'"' {
-            push_cut(&mut out, &text[prose..i], LONGEST_PROSE);
-            let end = closing(text, i);
-            out.push(char::from(bytes[i]));
-            push_cut(&mut out, &text[i + 1..end], LONGEST_VALUE);
-            if end < bytes.len() {
-                out.push(char::from(bytes[end]));
-            }
-            i = end + 1;
-            prose = i.min(bytes.len());
-        } else {
-            i += 1;
-        }
-    }
-    push_cut(&mut out, &text[prose..], LONGEST_PROSE);
-    if out.len() > LONGEST_MESSAGE {
-        let whole = out;
-        out = String::new();
-        push_cut(&mut out, &whole, KEPT);
-    }
-    if out == text {
-        text.into()
-    } else {
-        out.into()
-    }
-}
-
-/// Displays [`bounded`] text: `format!("{}", Bounded(reason))`.
-pub(crate) struct Bounded<'a>(pub(crate) &'a str);
-
-impl std::fmt::Display for Bounded<'_> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&bounded(self.0))
-    }
 }
 
 /// The number in the cell `text` of column `column` (named as in the header), line `line`

@@ -20,18 +20,24 @@
 //!     .steps("seed 1", &curve)
 //!     .legend(Corner::UpperLeft)
 //!     .save("precursors.png")?;
-//! # Ok::<(), precursors::Error>(())
+//! # Ok::<(), precursors::plot::PlotError>(())
 //! ```
 
+mod error;
 pub mod figures;
 
-use crate::error::{Error, Result};
+pub use error::PlotError;
+
+use crate::error::Error;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use std::path::Path;
 use std::sync::OnceLock;
+
+/// The results of this module: its errors are [`PlotError`]s.
+type Result<T, E = PlotError> = std::result::Result<T, E>;
 
 /// DejaVu Sans cut to the characters the labels use (scripts/subset-font.sh; licence in
 /// assets/fonts/LICENSE-DejaVu.txt).
@@ -46,7 +52,7 @@ fn register_font() -> Result<()> {
     if ok {
         Ok(())
     } else {
-        Err(Error::Figure {
+        Err(PlotError::Figure {
             path: None,
             reason: "the embedded font could not be read".into(),
         })
@@ -341,14 +347,14 @@ impl Chart {
     /// Writes the chart to `path`: PNG for `.png`, SVG for `.svg`.
     ///
     /// # Errors
-    /// [`Error::Figure`] for another extension, an axis range that is not finite and
+    /// [`PlotError::Figure`] for another extension, an axis range that is not finite and
     /// increasing, a size outside 200 x 150 to 16384 x 16384, a [`Style`] given before any
     /// series or a dashed style on markers, or a drawing backend that fails;
-    /// [`Error::Io`] when the file cannot be written (it is written atomically: no half
+    /// [`Error::Io`] (in [`PlotError::Core`]) when the file cannot be written (it is written atomically: no half
     /// file is left under its name).
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = path.as_ref();
-        let refuse = |reason: String| Error::Figure {
+        let refuse = |reason: String| PlotError::Figure {
             path: Some(path.to_path_buf()),
             reason,
         };
@@ -512,8 +518,8 @@ impl Map {
     /// [`Map::y_range`] say otherwise; sequential palette over the values' range.
     ///
     /// # Errors
-    /// [`Error::LengthMismatch`] when `values` does not hold `columns·rows` numbers;
-    /// [`Error::InvalidCount`] for zero columns or rows.
+    /// In [`PlotError::Core`]: [`Error::LengthMismatch`] when `values` does not hold
+    /// `columns·rows` numbers, [`Error::InvalidCount`] for zero columns or rows.
     pub fn new(columns: usize, rows: usize, values: Vec<f64>) -> Result<Self> {
         for (name, n) in [("map columns", columns), ("map rows", rows)] {
             if n == 0 {
@@ -521,7 +527,8 @@ impl Map {
                     name,
                     value: 0,
                     reason: "a map needs at least one cell along each axis",
-                });
+                }
+                .into());
             }
         }
         let expected = columns.saturating_mul(rows);
@@ -530,7 +537,8 @@ impl Map {
                 name: "map values",
                 expected,
                 found: values.len(),
-            });
+            }
+            .into());
         }
         Ok(Self {
             title: String::new(),
@@ -587,9 +595,9 @@ impl Map {
     /// Writes the map to `path`: PNG for `.png`, SVG for `.svg`.
     ///
     /// # Errors
-    /// [`Error::Figure`] for another extension, a range that is not finite and
+    /// [`PlotError::Figure`] for another extension, a range that is not finite and
     /// increasing, a size outside 200 x 150 to 16384 x 16384, or a drawing backend that
-    /// fails; [`Error::Io`] when the file cannot be written (atomically, as
+    /// fails; [`Error::Io`] (in [`PlotError::Core`]) when the file cannot be written (atomically, as
     /// [`Chart::save`]).
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = path.as_ref();
@@ -731,7 +739,7 @@ const LARGEST_SIDE: u32 = 16384;
 /// never leaves a half or empty figure under its name.
 fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
     register_font()?;
-    let fail = |reason: String| Error::Figure {
+    let fail = |reason: String| PlotError::Figure {
         path: Some(path.to_path_buf()),
         reason,
     };
@@ -776,7 +784,11 @@ fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
             ))
         }
     };
-    crate::driver::write_atomically(path, &bytes, "writing figure")
+    Ok(crate::driver::write_atomically(
+        path,
+        &bytes,
+        "writing figure",
+    )?)
 }
 
 /// 8-bit RGB `pixels` (rows from the top) as a PNG file's bytes.
@@ -822,7 +834,7 @@ fn axis_range(
         if low.is_finite() && high.is_finite() && low < high {
             return Ok((low, high));
         }
-        return Err(Error::Figure {
+        return Err(PlotError::Figure {
             path: Some(path.to_path_buf()),
             reason: format!(
                 "the {axis} range [{low}, {high}] is invalid: both ends must be finite and \

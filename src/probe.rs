@@ -308,7 +308,7 @@ impl StressProbe {
     ///
     /// # Errors
     /// [`Error::OutsideBlock`] for a plane or point outside the block;
-    /// [`Error::InvalidTolerance`]; [`Error::NotConverged`] when a transfer's or a point's
+    /// [`Error::InvalidTolerance`]; [`Error::SeriesNotConverged`] when a transfer's or a point's
     /// series does not reach the tolerance.
     pub fn new(plan: &InfluencePlan, spec: &ProbeSpec, lateral: Option<&RodLoad>) -> Result<Self> {
         let grid = *plan.grid();
@@ -547,7 +547,7 @@ fn point_kernel(
                     break;
                 }
                 if shell >= MAX_SHELLS {
-                    return Err(Error::NotConverged {
+                    return Err(Error::SeriesNotConverged {
                         what: "alias sum of a point stress probe (z too close to 0?)",
                         value: sum,
                         error: shell_bound,

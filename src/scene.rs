@@ -571,7 +571,7 @@ impl SceneBuilder {
     /// the grid; random heights are not drawn), the drive's band, and the memory the scene
     /// would need against the memory available (Linux). A scene that passes is refused by
     /// `build` only when its plan does not reach [`SceneBuilder::plan_tolerance`] (below
-    /// about `2e-13`) or the probes' sums do not converge ([`Error::NotConverged`]), or a
+    /// about `2e-13`) or the probes' sums do not converge ([`Error::SeriesNotConverged`]), or a
     /// point probe lies on an edge of the rod's band at `x = 0`
     /// ([`Error::SingularPoint`]). Returns the grid.
     ///

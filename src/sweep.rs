@@ -21,17 +21,22 @@
 //! let merged = precursors::sweep::merge(&out)?;
 //! assert_eq!(merged.runs_missing, 0);
 //! # std::fs::remove_dir_all(&out).ok();
-//! # Ok::<(), precursors::Error>(())
+//! # Ok::<(), precursors::sweep::SweepError>(())
 //! ```
 
+mod error;
 mod merge;
 
+pub use error::SweepError;
 #[cfg(feature = "plot")]
 pub(crate) use merge::ensemble_curves;
 pub use merge::{merge, t_quantile_975, MergeSummary, LOAD_GRID};
 
+/// The results of this module: its errors are [`SweepError`]s.
+type Result<T, E = SweepError> = std::result::Result<T, E>;
+
 use crate::driver::write_atomically;
-use crate::error::{Error, Result};
+use crate::error::Error;
 use crate::lock::{Attempt, DirLock, LOCK_FILE};
 use crate::output::RunTables;
 use crate::scene::file::{
@@ -117,7 +122,7 @@ fn sweep_shape(path: &str) -> Shape {
 
 /// The axes of `spec` in one shape: a linked axis's values must be arrays of one value
 /// per key.
-fn read_axes(spec: &SweepSpec, file_error: impl Fn(String) -> Error) -> Result<Vec<Axis>> {
+fn read_axes(spec: &SweepSpec, file_error: impl Fn(String) -> SweepError) -> Result<Vec<Axis>> {
     let mut axes = Vec::with_capacity(spec.axes.len());
     for (a, axis) in spec.axes.iter().enumerate() {
         let read = match (&axis.key, &axis.keys) {
@@ -288,8 +293,8 @@ fn splitmix64(x: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-fn sweep_json_error(path: Option<&Path>, e: serde_json::Error) -> Error {
-    Error::SweepFile {
+fn sweep_json_error(path: Option<&Path>, e: serde_json::Error) -> SweepError {
+    SweepError::File {
         path: path.map(Path::to_path_buf),
         line: e.line(),
         column: e.column(),
@@ -297,8 +302,8 @@ fn sweep_json_error(path: Option<&Path>, e: serde_json::Error) -> Error {
     }
 }
 
-fn key_error(key: &str, reason: impl Into<String>) -> Error {
-    Error::SweepKey {
+fn key_error(key: &str, reason: impl Into<String>) -> SweepError {
+    SweepError::Axis {
         key: key.to_string(),
         reason: reason.into(),
     }
@@ -350,10 +355,11 @@ impl Sweep {
     /// scene is read relative to the current directory.
     ///
     /// # Errors
-    /// [`Error::SweepFile`] for invalid JSON or a key outside the format, an axis without
+    /// [`SweepError::File`] for invalid JSON or a key outside the format, an axis without
     /// exactly one of `key` and `keys`, or a base scene that is not a scene file;
-    /// [`Error::SweepKey`] (naming the key, or a linked axis's keys) for an axis whose key
-    /// is not a scene key or whose value gives no valid scene; [`Error::InvalidCount`] for
+    /// [`SweepError::Axis`] (naming the key, or a linked axis's keys) for an axis whose key
+    /// is not a scene key or whose value gives no valid scene; [`Error::InvalidCount`] (in
+    /// [`SweepError::Core`]) for
     /// zero realizations, or several with heights that are not random.
     pub fn from_json_str(text: &str) -> Result<Sweep> {
         check_shape(text, &sweep_shape).map_err(|e| sweep_json_error(None, e))?;
@@ -365,11 +371,11 @@ impl Sweep {
     /// read relative to the sweep file's directory.
     ///
     /// # Errors
-    /// [`Error::Io`] when the file cannot be read; the others as [`Sweep::from_json_str`].
+    /// [`Error::Io`] (in [`SweepError::Core`]) when the file cannot be read; the others as [`Sweep::from_json_str`].
     pub fn from_json_file(path: impl AsRef<Path>) -> Result<Sweep> {
         let path = path.as_ref();
         let text = read_json_text(path, "reading sweep file", |line, column, reason| {
-            Error::SweepFile {
+            SweepError::File {
                 path: Some(path.to_path_buf()),
                 line,
                 column,
@@ -383,7 +389,7 @@ impl Sweep {
     }
 
     fn from_spec(mut spec: SweepSpec, path: Option<&Path>, base_dir: &Path) -> Result<Sweep> {
-        let file_error = |reason: String| Error::SweepFile {
+        let file_error = |reason: String| SweepError::File {
             path: path.map(Path::to_path_buf),
             line: 0,
             column: 0,
@@ -396,7 +402,8 @@ impl Sweep {
                 name: "realizations",
                 value: 0,
                 reason: "a sweep needs at least one realization per point",
-            });
+            }
+            .into());
         }
         let random = matches!(
             builder_from_value(spec.base.clone())
@@ -410,7 +417,8 @@ impl Sweep {
                 value: spec.realizations as u64,
                 reason: "realizations differ by the seed of random heights, but the base \
                          scene's heights are values (give one realization)",
-            });
+            }
+            .into());
         }
         let axes = read_axes(&spec, file_error)?;
         // The size of the sweep before any scene is checked or any run built.
@@ -442,7 +450,7 @@ impl Sweep {
                 )?;
             }
             _ => {
-                return Err(Error::SweepTooLarge {
+                return Err(SweepError::TooLarge {
                     points: axes
                         .iter()
                         .fold(1u128, |p, a| p.saturating_mul(a.steps.len() as u128)),
@@ -563,7 +571,7 @@ impl Sweep {
     /// copy [`Sweep::execute`] keeps in the output directory ([`SWEEP_FILE`]).
     ///
     /// # Errors
-    /// [`Error::SweepFile`] if serialisation fails (it does not for a read sweep).
+    /// [`SweepError::File`] if serialisation fails (it does not for a read sweep).
     pub fn to_json(&self) -> Result<String> {
         serde_json::to_string_pretty(&self.spec).map_err(|e| sweep_json_error(None, e))
     }
@@ -596,21 +604,23 @@ impl Sweep {
     /// of `0..n` are disjoint and cover the sweep.
     ///
     /// # Errors
-    /// [`Error::InvalidCount`] for `n = 0` or `k >= n`.
+    /// [`Error::InvalidCount`] (in [`SweepError::Core`]) for `n = 0` or `k >= n`.
     pub fn shard(&self, k: usize, n: usize) -> Result<Vec<&SweepRun>> {
         if n == 0 {
             return Err(Error::InvalidCount {
                 name: "shard count",
                 value: 0,
                 reason: "a sweep is shared among at least one shard",
-            });
+            }
+            .into());
         }
         if k >= n {
             return Err(Error::InvalidCount {
                 name: "shard index",
                 value: k as u64,
                 reason: "the shard index must be below the shard count (shards 0 .. n-1)",
-            });
+            }
+            .into());
         }
         Ok(self.runs.iter().filter(|r| r.index % n == k).collect())
     }
@@ -625,7 +635,8 @@ impl Sweep {
     /// from the start.
     ///
     /// # Errors
-    /// [`Error::Io`] for a file or directory that cannot be written; the scene's and the
+    /// [`Error::Io`] (in [`SweepError::Core`], as every core error) for a file or directory
+    /// that cannot be written; the scene's and the
     /// driver's errors.
     pub fn run_one(&self, run: &SweepRun, out: &Path) -> Result<RunReport> {
         let dir = out.join(&run.dir_name);
@@ -689,7 +700,7 @@ impl Sweep {
             "seconds": { "build": built, "total": seconds },
             "scene": &run.scene,
         });
-        let text = serde_json::to_string_pretty(&meta).map_err(|e| Error::SweepFile {
+        let text = serde_json::to_string_pretty(&meta).map_err(|e| SweepError::File {
             path: None,
             line: 0,
             column: 0,
@@ -718,8 +729,8 @@ impl Sweep {
     /// (in run order) is returned.
     ///
     /// # Errors
-    /// [`Error::SweepDirectory`] for a directory of another sweep; [`Error::InvalidCount`]
-    /// for a bad shard; [`Error::Io`]; the first run's error.
+    /// [`SweepError::Directory`] for a directory of another sweep; [`Error::InvalidCount`]
+    /// for a bad shard, [`Error::Io`] (both in [`SweepError::Core`]); the first run's error.
     pub fn execute(
         &self,
         out: &Path,
@@ -733,7 +744,7 @@ impl Sweep {
         let next = AtomicUsize::new(0);
         let failed = AtomicBool::new(false);
         let reports: Mutex<Vec<RunReport>> = Mutex::new(Vec::new());
-        let errors: Mutex<Vec<(usize, Error)>> = Mutex::new(Vec::new());
+        let errors: Mutex<Vec<(usize, SweepError)>> = Mutex::new(Vec::new());
         let jobs = options.jobs.clamp(1, share.len().max(1));
         std::thread::scope(|scope| {
             for _ in 0..jobs {
@@ -790,16 +801,16 @@ impl Sweep {
         crate::cost::check_file_size(&path)?;
         match std::fs::read_to_string(&path) {
             Ok(old) if old == text => Ok(()),
-            Ok(_) => Err(Error::SweepDirectory {
+            Ok(_) => Err(SweepError::Directory {
                 path,
                 reason: "the directory holds another sweep (its sweep.json differs): \
                          choose another output directory"
                     .into(),
             }),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                write_atomically(&path, text.as_bytes(), "writing")
+                Ok(write_atomically(&path, text.as_bytes(), "writing")?)
             }
-            Err(e) => Err(Error::io("reading", &path, e)),
+            Err(e) => Err(Error::io("reading", &path, e).into()),
         }
     }
 }

@@ -291,7 +291,10 @@ fn eigenvalues_match_the_alias_sum_and_their_estimates_are_small() {
         .tolerance(1e-15)
         .build()
         .unwrap_err();
-    assert!(matches!(e, precursors::Error::NotConverged { .. }), "{e:?}");
+    assert!(
+        matches!(e, precursors::Error::SeriesNotConverged { .. }),
+        "{e:?}"
+    );
     assert!(e.to_string().contains("about 1e-13 at best"), "{e}");
 }
 

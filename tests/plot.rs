@@ -8,7 +8,7 @@
 
 use precursors::output::{RunTables, CONTACT_MAP_STEP};
 use precursors::plot::figures::{draw, Format};
-use precursors::plot::{Chart, Corner, Map, Palette, Style};
+use precursors::plot::{Chart, Corner, Map, Palette, PlotError, Style};
 use precursors::{Drive, Error, Event, Lateral, Scene};
 use std::path::{Path, PathBuf};
 
@@ -271,7 +271,7 @@ fn a_styled_series_has_its_colour_and_its_dashes() {
         .line("a", &flat(0.5))
         .save(dir.join("orphan.png"))
         .unwrap_err();
-    assert!(matches!(e, Error::Figure { .. }), "{e:?}");
+    assert!(matches!(e, PlotError::Figure { .. }), "{e:?}");
     assert!(e.to_string().contains("before any series"), "{e}");
     let e = Chart::new("t", "x", "y")
         .markers("m", &flat(0.5))
@@ -311,7 +311,7 @@ fn bad_figures_are_refused_with_typed_errors() {
     let e = Chart::new("t", "x", "y")
         .save(dir.join("chart.jpg"))
         .unwrap_err();
-    assert!(matches!(e, Error::Figure { .. }), "{e:?}");
+    assert!(matches!(e, PlotError::Figure { .. }), "{e:?}");
     assert!(e.to_string().contains(".png or .svg"), "{e}");
     let e = Chart::new("t", "x", "y")
         .x_range(1.0, 0.0)
@@ -331,15 +331,15 @@ fn bad_figures_are_refused_with_typed_errors() {
     assert!(e.to_string().contains("too large"), "{e}");
     assert!(matches!(
         Map::new(3, 2, vec![0.0; 5]),
-        Err(Error::LengthMismatch {
+        Err(PlotError::Core(Error::LengthMismatch {
             expected: 6,
             found: 5,
             ..
-        })
+        }))
     ));
     assert!(matches!(
         Map::new(0, 2, vec![]),
-        Err(Error::InvalidCount { .. })
+        Err(PlotError::Core(Error::InvalidCount { .. }))
     ));
     // A directory that is neither a run's nor a sweep's.
     let e = draw(&dir, &[Format::Png]).unwrap_err();
@@ -355,7 +355,7 @@ fn bad_figures_are_refused_with_typed_errors() {
     let e = Chart::new("t", "x", "y")
         .save(dir.join("missing").join("chart.png"))
         .unwrap_err();
-    assert!(matches!(e, Error::Io { .. }), "{e:?}");
+    assert!(matches!(e, PlotError::Core(Error::Io { .. })), "{e:?}");
     assert!(e.to_string().contains("chart.png"), "{e}");
     // Non-finite data is not drawn and does not fail.
     Chart::new("t", "x", "y")

@@ -132,7 +132,7 @@ fn build_and_step(builder: SceneBuilder) -> Result<(), TestCaseError> {
         Err(e) => {
             match (&checked, &e) {
                 (Err(c), e) => prop_assert_eq!(c.to_string(), e.to_string()),
-                (Ok(_), Error::NotConverged { .. } | Error::SingularPoint { .. }) => {}
+                (Ok(_), Error::SeriesNotConverged { .. } | Error::SingularPoint { .. }) => {}
                 (Ok(_), e) => prop_assert!(false, "check() accepted what build refuses: {e}"),
             }
             return check_error(&e);

@@ -7,7 +7,7 @@
 //! is always an undisturbed run or sweep of the same scene.
 
 use precursors::output::{RunTables, PARTIAL_SUFFIX, TABLE_NAMES};
-use precursors::sweep::{merge, Sweep, SweepOptions, DONE_FILE};
+use precursors::sweep::{merge, Sweep, SweepError, SweepOptions, DONE_FILE};
 use precursors::{Error, Scene};
 use std::path::{Path, PathBuf};
 
@@ -189,7 +189,7 @@ fn of_sweeps_starting_together_on_a_new_directory_one_takes_it() {
         })
         .collect();
     let barrier = std::sync::Barrier::new(sweeps.len());
-    let outcomes: Vec<Result<_, Error>> = std::thread::scope(|s| {
+    let outcomes: Vec<Result<_, SweepError>> = std::thread::scope(|s| {
         let handles: Vec<_> = sweeps
             .iter()
             .map(|sweep| {
@@ -206,7 +206,7 @@ fn of_sweeps_starting_together_on_a_new_directory_one_takes_it() {
     assert_eq!(won.len(), 1, "{outcomes:?}");
     for (k, outcome) in outcomes.iter().enumerate() {
         if let Err(e) = outcome {
-            assert!(matches!(e, Error::SweepDirectory { .. }), "{k}: {e:?}");
+            assert!(matches!(e, SweepError::Directory { .. }), "{k}: {e:?}");
         }
     }
     let copy = std::fs::read_to_string(dir.join("sweep.json")).unwrap();

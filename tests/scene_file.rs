@@ -409,7 +409,10 @@ fn arrays_are_refused_where_the_format_has_objects() {
         (r#"[{}, [], 1, 0]"#, "the top level"),
     ] {
         let e = Sweep::from_json_str(text).unwrap_err();
-        assert!(matches!(e, Error::SweepFile { line: 1, .. }), "{text}: {e}");
+        assert!(
+            matches!(e, precursors::sweep::SweepError::File { line: 1, .. }),
+            "{text}: {e}"
+        );
         assert!(e.to_string().contains(place), "{e}");
     }
     // An axis value that is an array where the scene has an object.
@@ -419,7 +422,8 @@ fn arrays_are_refused_where_the_format_has_objects() {
     )
     .unwrap_err();
     assert!(
-        matches!(e, Error::SweepKey { .. }) && e.to_string().contains("`block`"),
+        matches!(e, precursors::sweep::SweepError::Axis { .. })
+            && e.to_string().contains("`block`"),
         "{e}"
     );
 }
@@ -450,7 +454,7 @@ fn files_that_are_not_utf8_are_invalid_input() {
     assert!(
         matches!(
             e,
-            Error::SweepFile {
+            precursors::sweep::SweepError::File {
                 line: 1,
                 column: 11,
                 ..
@@ -541,7 +545,7 @@ fn sweeps_beyond_the_run_limit_are_refused_at_once() {
         let started = std::time::Instant::now();
         let e = Sweep::from_json_str(&text).unwrap_err();
         assert!(
-            matches!(e, Error::SweepTooLarge { runs: r, limit: 100_000, .. } if r == runs),
+            matches!(e, precursors::sweep::SweepError::TooLarge { runs: r, limit: 100_000, .. } if r == runs),
             "{e}"
         );
         assert!(e.to_string().contains("split it"), "{e}");
@@ -589,7 +593,13 @@ fn files_too_large_for_memory_are_refused_before_reading() {
         std::fs::rename(huge("curve.csv"), run.join("curve.csv")).unwrap();
         let e = precursors::plot::figures::draw(&run, &[precursors::plot::figures::Format::Png])
             .unwrap_err();
-        assert!(matches!(e, Error::OutOfMemory { .. }), "{e}");
+        assert!(
+            matches!(
+                e,
+                precursors::plot::PlotError::Core(Error::OutOfMemory { .. })
+            ),
+            "{e}"
+        );
     }
     assert!(started.elapsed().as_secs_f64() < 5.0);
     std::fs::remove_dir_all(&dir).ok();

@@ -2,7 +2,9 @@
 //! seeds are stable, complete runs are skipped and cut ones redone, and the tables do not
 //! depend on the jobs or the shards. The program's side (feature `cli`) is at the end.
 
-use precursors::sweep::{derive_seed, merge, t_quantile_975, Sweep, SweepOptions, DONE_FILE};
+use precursors::sweep::{
+    derive_seed, merge, t_quantile_975, Sweep, SweepError, SweepOptions, DONE_FILE,
+};
 use precursors::Error;
 use std::path::{Path, PathBuf};
 
@@ -33,10 +35,10 @@ fn small() -> String {
     )
 }
 
-fn key_of(e: Error) -> String {
+fn key_of(e: SweepError) -> String {
     match e {
-        Error::SweepKey { key, .. } => key,
-        other => panic!("expected Error::SweepKey, got {other:?}"),
+        SweepError::Axis { key, .. } => key,
+        other => panic!("expected SweepError::Axis, got {other:?}"),
     }
 }
 
@@ -103,22 +105,28 @@ fn format_errors_name_the_key() {
         "{ not json".to_string(),
     ] {
         let e = Sweep::from_json_str(&text).unwrap_err();
-        assert!(matches!(e, Error::SweepFile { .. }), "{text}: {e:?}");
+        assert!(matches!(e, SweepError::File { .. }), "{text}: {e:?}");
     }
     let e = Sweep::from_json_str(&sweep_text("", 0)).unwrap_err();
     assert!(
         matches!(
             e,
-            Error::InvalidCount {
+            SweepError::Core(Error::InvalidCount {
                 name: "realizations",
                 ..
-            }
+            })
         ),
         "{e:?}"
     );
     let sweep = Sweep::from_json_str(&small()).unwrap();
-    assert!(matches!(sweep.shard(2, 2), Err(Error::InvalidCount { .. })));
-    assert!(matches!(sweep.shard(0, 0), Err(Error::InvalidCount { .. })));
+    assert!(matches!(
+        sweep.shard(2, 2),
+        Err(SweepError::Core(Error::InvalidCount { .. }))
+    ));
+    assert!(matches!(
+        sweep.shard(0, 0),
+        Err(SweepError::Core(Error::InvalidCount { .. }))
+    ));
 }
 
 #[test]
@@ -197,7 +205,7 @@ fn linked_axes_move_their_keys_together() {
     ] {
         let e = err(bad);
         assert!(
-            matches!(e, Error::SweepFile { .. }) && e.to_string().contains("axis #0"),
+            matches!(e, SweepError::File { .. }) && e.to_string().contains("axis #0"),
             "{bad}: {e:?}"
         );
     }
@@ -341,7 +349,7 @@ fn complete_runs_are_skipped_and_a_cut_one_is_redone() {
     let e = other
         .execute(&dir, &SweepOptions::new(), |_| {})
         .unwrap_err();
-    assert!(matches!(e, Error::SweepDirectory { .. }), "{e:?}");
+    assert!(matches!(e, SweepError::Directory { .. }), "{e:?}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -20,12 +20,16 @@ pub fn report(outcome: Outcome) -> ExitCode {
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            for (k, text) in precursors::error::messages(&*e).iter().enumerate() {
-                if k == 0 {
-                    eprintln!("error: {text}");
-                } else {
+            eprintln!("error: {e}");
+            let mut previous = e.to_string();
+            let mut source = e.source();
+            while let Some(cause) = source {
+                let text = cause.to_string();
+                if !previous.ends_with(&text) {
                     eprintln!("  caused by: {text}");
                 }
+                previous = text;
+                source = cause.source();
             }
             ExitCode::FAILURE
         }

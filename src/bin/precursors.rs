@@ -9,7 +9,8 @@
 
 use clap::{Parser, Subcommand};
 use precursors::output::{counts, RunTables};
-use precursors::sweep::{Sweep, SweepOptions};
+use precursors::plot::PlotError;
+use precursors::sweep::{Sweep, SweepError, SweepOptions};
 use precursors::{Checkpoint, Driver, Error, Event, GridCost, SceneBuilder};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -215,31 +216,74 @@ fn slurm_shard(var: impl Fn(&str) -> Option<String>) -> Result<Option<(usize, us
         .map_err(|e| format!("the shard from SLURM's variables, {e}: {give}"))
 }
 
+/// The library's bounding of values echoed in messages (one source, compiled here too):
+/// a cause's message is cut as the library's own messages are.
+#[allow(dead_code)] // the program uses `bounded`, not the `Display` wrapper
+#[path = "../error/bounded.rs"]
+mod bounded;
+
 /// A failure and its exit code.
 struct Failure {
     error: Box<dyn std::error::Error>,
     code: u8,
 }
 
+/// The exit code of a core error (docs/cli.md): 1 a computation that failed, 4 a file or
+/// directory that could not be read or written (or is locked by another process), 3
+/// invalid input (bytes that are not UTF-8 text included: a binary given as a scene file
+/// is bad input, not a failure to read).
+fn core_code(e: &Error) -> u8 {
+    match e {
+        Error::Io { source, .. } if source.kind() == std::io::ErrorKind::InvalidData => 3,
+        Error::Io { .. } | Error::DirectoryLocked { .. } => 4,
+        Error::SolverNotConverged { .. }
+        | Error::Factorization { .. }
+        | Error::EmptyContact { .. }
+        | Error::ThreadPool { .. }
+        | Error::NotSolved { .. }
+        | Error::LoadBeyondFriction { .. } => 1,
+        _ => 3,
+    }
+}
+
+/// The exit code of a sweep's error: its core error's, else 3 (a sweep file, an axis, a
+/// sweep too large, a directory of another sweep: invalid input).
+fn sweep_code(e: &SweepError) -> u8 {
+    match e {
+        SweepError::Core(e) => core_code(e),
+        _ => 3,
+    }
+}
+
 impl From<Error> for Failure {
     fn from(e: Error) -> Self {
+        Failure {
+            code: core_code(&e),
+            error: Box::new(e),
+        }
+    }
+}
+
+impl From<SweepError> for Failure {
+    fn from(e: SweepError) -> Self {
+        Failure {
+            code: sweep_code(&e),
+            error: Box::new(e),
+        }
+    }
+}
+
+impl From<PlotError> for Failure {
+    fn from(e: PlotError) -> Self {
         let code = match &e {
-            // Bytes that are not UTF-8 text (a binary given as a scene file) are bad input,
-            // not a failure to read.
-            Error::Io { source, .. } if source.kind() == std::io::ErrorKind::InvalidData => 3,
-            // Another process writes the directory: it cannot be written now.
-            Error::Io { .. } | Error::DirectoryLocked { .. } => 4,
-            Error::SolverNotConverged { .. }
-            | Error::Factorization { .. }
-            | Error::EmptyContact { .. }
-            | Error::ThreadPool { .. }
-            | Error::NotSolved { .. }
-            | Error::LoadBeyondFriction { .. } => 1,
+            PlotError::Core(e) => core_code(e),
+            PlotError::Sweep(e) => sweep_code(e),
+            // A figure that cannot be drawn (a directory neither a run's nor a sweep's).
             _ => 3,
         };
         Failure {
-            error: Box::new(e),
             code,
+            error: Box::new(e),
         }
     }
 }
@@ -297,10 +341,28 @@ fn main() -> ExitCode {
     }
 }
 
+/// The messages of `error` and of its causes ([`std::error::Error::source`]), outermost
+/// first, each with its echoed values cut ([`bounded::bounded`]), leaving out a cause
+/// whose message already ends the one before it (the library's `Error::Io` says "reading
+/// scene file `<path>`: `<the io::Error>`", and a sweep's or a figure's error nesting a
+/// core error repeats its message).
+fn messages(error: &(dyn std::error::Error + 'static)) -> Vec<String> {
+    let mut out = vec![bounded::bounded(&error.to_string()).into_owned()];
+    let mut source = error.source();
+    while let Some(cause) = source {
+        let text = bounded::bounded(&cause.to_string()).into_owned();
+        if !out.last().is_some_and(|previous| previous.ends_with(&text)) {
+            out.push(text);
+        }
+        source = cause.source();
+    }
+    out
+}
+
 /// Prints `error: <message>` and one `caused by: <message>` per source; a cause whose
 /// message already ends the message before it is not printed twice.
 fn report(e: &(dyn std::error::Error + 'static)) {
-    for (k, text) in precursors::error::messages(e).iter().enumerate() {
+    for (k, text) in messages(e).iter().enumerate() {
         if k == 0 {
             say!("error: {text}");
         } else {
@@ -366,7 +428,11 @@ enum Start<'a> {
 }
 
 fn writable_dir(dir: &Path) -> Result<(), Failure> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io("creating the output directory", dir, e))?;
+    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+        operation: "creating the output directory",
+        path: dir.to_path_buf(),
+        source,
+    })?;
     Ok(())
 }
 

@@ -117,7 +117,7 @@ impl RodLoad {
     ///
     /// # Errors
     /// [`Error::InvalidTolerance`]; [`Error::OutsideBlock`] for `x` outside `[0, Lx]`;
-    /// [`Error::NotConverged`] when the series does not reach `tol`.
+    /// [`Error::SeriesNotConverged`] when the series does not reach `tol`.
     pub fn influence_at(&self, x: f64, tol: f64) -> Result<Estimate> {
         check_tolerance(tol)?;
         let lx = self.block.lx();
@@ -146,7 +146,7 @@ impl RodLoad {
     ///
     /// # Errors
     /// [`Error::InvalidTolerance`]; [`Error::InvalidParameter`] for a grid on another
-    /// block; [`Error::NotConverged`] when a series does not reach `tol`.
+    /// block; [`Error::SeriesNotConverged`] when a series does not reach `tol`.
     pub fn influence_cells(&self, grid: &Grid, tol: f64) -> Result<Vec<f64>> {
         check_tolerance(tol)?;
         self.check_grid(grid)?;
@@ -189,7 +189,7 @@ impl RodLoad {
     /// # Errors
     /// [`Error::InvalidTolerance`]; [`Error::OutsideBlock`] for `x` or `z` outside the
     /// block; [`Error::SingularPoint`] on an edge of the band at `x = 0`;
-    /// [`Error::NotConverged`].
+    /// [`Error::SeriesNotConverged`].
     pub fn stress_influence_at(&self, x: f64, z: f64, tol: f64) -> Result<Estimate> {
         check_tolerance(tol)?;
         let lx = self.block.lx();
@@ -248,7 +248,7 @@ impl RodLoad {
     ///
     /// # Errors
     /// [`Error::InvalidTolerance`]; [`Error::OutsideBlock`] for `z` outside `[0, Lz]`;
-    /// [`Error::InvalidParameter`] for a grid on another block; [`Error::NotConverged`].
+    /// [`Error::InvalidParameter`] for a grid on another block; [`Error::SeriesNotConverged`].
     pub fn stress_influence_cells(&self, grid: &Grid, z: f64, tol: f64) -> Result<Vec<f64>> {
         check_tolerance(tol)?;
         self.check_grid(grid)?;
@@ -329,7 +329,7 @@ impl RodLoad {
                 });
             }
             if n >= MAX_TERMS {
-                return Err(Error::NotConverged {
+                return Err(Error::SeriesNotConverged {
                     what: "rod load series",
                     value: sum,
                     error: tail,

@@ -36,7 +36,7 @@ pub struct InfluencePlanBuilder {
 impl InfluencePlanBuilder {
     /// The largest relative error accepted on an eigenvalue (default `1e-8`). The
     /// eigenvalues are computed to about 1e-13 whatever it is (same cost); the build
-    /// fails with [`Error::NotConverged`] when an eigenvalue's error estimate exceeds
+    /// fails with [`Error::SeriesNotConverged`] when an eigenvalue's error estimate exceeds
     /// it, which happens for tolerances below about `2e-13`.
     pub fn tolerance(mut self, tolerance: f64) -> Self {
         self.tolerance = tolerance;
@@ -57,7 +57,7 @@ impl InfluencePlanBuilder {
     /// # Errors
     /// [`Error::GridTooLarge`] above [`InfluencePlanBuilder::max_cells`] cells;
     /// [`Error::InvalidTolerance`] for a tolerance that is not finite and `> 0`;
-    /// [`Error::NotConverged`] when an eigenvalue's error estimate exceeds the tolerance.
+    /// [`Error::SeriesNotConverged`] when an eigenvalue's error estimate exceeds the tolerance.
     pub fn build(self) -> Result<InfluencePlan> {
         let grid = self.grid;
         super::check_cells(grid.nx(), grid.ny(), self.max_cells)?;
@@ -66,7 +66,7 @@ impl InfluencePlanBuilder {
         let mut max_rel_error: f64 = 0.0;
         for (&value, &error) in lambda.iter().zip(&errors) {
             if error > tol * value {
-                return Err(Error::NotConverged {
+                return Err(Error::SeriesNotConverged {
                     what: "an eigenvalue of the influence operator (computed to about 1e-13 at \
                            best, from quadrature nodes counted as terms)",
                     value,

@@ -40,7 +40,7 @@ impl Planner {
     ///
     /// # Errors
     /// Those of [`crate::green::InfluencePlanBuilder::build`]: [`crate::Error::GridTooLarge`],
-    /// [`crate::Error::InvalidTolerance`], [`crate::Error::NotConverged`].
+    /// [`crate::Error::InvalidTolerance`], [`crate::Error::SeriesNotConverged`].
     pub fn plan(&self, grid: Grid, tolerance: f64) -> Result<InfluencePlan> {
         self.plan_with_max_cells(grid, tolerance, super::DEFAULT_MAX_CELLS)
     }

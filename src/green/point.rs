@@ -56,7 +56,7 @@ pub struct SeriesOptions {
     /// Axis summed in closed form by the rapid representation. Default [`SummationAxis::Auto`].
     pub axis: SummationAxis,
     /// Largest number of terms a single evaluation may sum before it reports
-    /// [`Error::NotConverged`]. Default `5e7`.
+    /// [`Error::SeriesNotConverged`]. Default `5e7`.
     pub max_terms: u64,
 }
 
@@ -161,7 +161,7 @@ impl GreenFunction {
     /// [`Error::InvalidTolerance`]; [`Error::InvalidCount`] for a term budget of zero;
     /// [`Error::OutsideBlock`] for a point outside the block; [`Error::SingularPoint`] when
     /// target and source coincide; [`Error::InvalidChoice`] for a forced axis along which
-    /// they do not differ; [`Error::NotConverged`] past the term budget.
+    /// they do not differ; [`Error::SeriesNotConverged`] past the term budget.
     pub fn value_with(
         &self,
         target: Point,
@@ -241,10 +241,10 @@ impl GreenFunction {
     /// cut-off `K` doubled until two successive sums differ by less than `tol` (m⁻¹); that
     /// difference is the error estimate. It converges algebraically, and only where the
     /// target differs from the source in every coordinate; expect
-    /// [`Error::NotConverged`] for tight tolerances.
+    /// [`Error::SeriesNotConverged`] for tight tolerances.
     ///
     /// # Errors
-    /// As [`GreenFunction::value_with`]; [`Error::NotConverged`] is common here.
+    /// As [`GreenFunction::value_with`]; [`Error::SeriesNotConverged`] is common here.
     pub fn raw_series(
         &self,
         target: Point,
@@ -265,7 +265,7 @@ impl GreenFunction {
             let size = counts.iter().map(|&c| (c + 1) as u64).product::<u64>();
             if terms + size > opts.max_terms {
                 let value = previous.unwrap_or(0.0);
-                return Err(Error::NotConverged {
+                return Err(Error::SeriesNotConverged {
                     what: "raw triple cosine series of G",
                     value,
                     error: f64::INFINITY,
@@ -372,7 +372,7 @@ fn partial_sum(
     let est_terms =
         (l[u] * l[w] * k_cut * k_cut / (4.0 * PI) + k_cut * (l[u] + l[w]) / PI + 1.0) as u64;
     if est_terms > opts.max_terms || guard >= 400 {
-        return Err(Error::NotConverged {
+        return Err(Error::SeriesNotConverged {
             what: "rapid representation of the Green function (nothing summed)",
             value: 0.0,
             error: tail(k_cut),

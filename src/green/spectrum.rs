@@ -6,7 +6,7 @@ use crate::geometry::Grid;
 use std::f64::consts::PI;
 
 /// Largest alias box half-width `Q` before an alias sum of the plane transfer reports
-/// [`crate::Error::NotConverged`].
+/// [`crate::Error::SeriesNotConverged`].
 pub(super) const MAX_ALIAS: usize = 512;
 
 /// Cell-averaging weights and wavenumbers of the aliases of one 1-D DCT mode.

@@ -47,7 +47,7 @@ impl InfluencePlan {
     ///
     /// # Errors
     /// [`Error::InvalidTolerance`],
-    /// [`Error::OutsideBlock`] for `z` outside `[0, Lz]`, [`Error::NotConverged`].
+    /// [`Error::OutsideBlock`] for `z` outside `[0, Lz]`, [`Error::SeriesNotConverged`].
     pub fn plane_transfer(&self, z: f64, tol: f64) -> Result<PlaneTransfer> {
         PlaneTransfer::new(self, z, tol)
     }
@@ -123,7 +123,7 @@ impl PlaneTransfer {
                 return Ok(sum);
             }
             if q >= MAX_ALIAS {
-                return Err(Error::NotConverged {
+                return Err(Error::SeriesNotConverged {
                     what: "alias sum of the plane transfer (z too close to 0?)",
                     value: sum,
                     error: bound,

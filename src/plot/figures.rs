@@ -8,6 +8,7 @@
 //! then `precursor_length` and `contact_area` with one curve per parameter point, the
 //! mean over its realizations and the 95 % band, on a load grid of step 0.005.
 
+use super::PlotError;
 use super::{Chart, Corner, Map, Palette};
 use crate::error::{table_number, Error, Result};
 use crate::output::{CONTACT_MAP_STEP, CURVE_HEADER};
@@ -49,13 +50,13 @@ pub struct Drawn {
 /// `sweep.json`) or a run's (`dir` holds `curve.csv`).
 ///
 /// # Errors
-/// [`Error::Figure`] when `dir` is neither, or a figure cannot be drawn; [`Error::Io`]
-/// for a table that cannot be read or a figure that cannot be written (each figure is
-/// written atomically: none is left half written); [`Error::CorruptTable`] for a damaged
-/// table, [`Error::NonFiniteCell`] for a `NaN`, an infinity or an empty cell where a
-/// number belongs (with the file, line and column); a sweep's errors as
-/// [`crate::sweep::merge`].
-pub fn draw(dir: &Path, formats: &[Format]) -> Result<Drawn> {
+/// [`PlotError::Figure`] when `dir` is neither, or a figure cannot be drawn; in
+/// [`PlotError::Core`]: [`Error::Io`] for a table that cannot be read or a figure that
+/// cannot be written (each figure is written atomically: none is left half written),
+/// [`Error::CorruptTable`] for a damaged table, [`Error::NonFiniteCell`] for a `NaN`, an
+/// infinity or an empty cell where a number belongs (with the file, line and column); in
+/// [`PlotError::Sweep`]: a sweep's errors as [`crate::sweep::merge`].
+pub fn draw(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
     if dir.join(SWEEP_FILE).is_file() {
         draw_sweep(dir, formats)
     } else if dir.join("curve.csv").is_file() {
@@ -64,7 +65,7 @@ pub fn draw(dir: &Path, formats: &[Format]) -> Result<Drawn> {
         .join(format!("curve.csv{}", crate::output::PARTIAL_SUFFIX))
         .is_file()
     {
-        Err(Error::Figure {
+        Err(PlotError::Figure {
             path: Some(dir.to_path_buf()),
             reason: format!(
                 "a run that has not reached global slip: it is under way, or was cut (its \
@@ -74,7 +75,7 @@ pub fn draw(dir: &Path, formats: &[Format]) -> Result<Drawn> {
             ),
         })
     } else {
-        Err(Error::Figure {
+        Err(PlotError::Figure {
             path: Some(dir.to_path_buf()),
             reason: format!(
                 "neither a sweep directory ({SWEEP_FILE}) nor a run directory (curve.csv)"
@@ -149,7 +150,7 @@ fn numbers(path: &Path, header: &str, wanted: &[&str]) -> Result<Vec<Vec<f64>>> 
 }
 
 /// The figures of one run directory.
-fn draw_run(dir: &Path, formats: &[Format]) -> Result<Drawn> {
+fn draw_run(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
     let title = name(dir);
     let curve_path = dir.join("curve.csv");
     let rows = numbers(
@@ -231,7 +232,7 @@ fn draw_run(dir: &Path, formats: &[Format]) -> Result<Drawn> {
         return Ok(drawn);
     };
     if nx == 0 {
-        return Err(corrupt(&map_path, "no area columns in the header".into()));
+        return Err(corrupt(&map_path, "no area columns in the header".into()).into());
     }
     // Each column relative to the map's first row (zero shear for a run from rest).
     let reference = first[2..].to_vec();
@@ -267,7 +268,7 @@ fn draw_run(dir: &Path, formats: &[Format]) -> Result<Drawn> {
 }
 
 /// The figures of a sweep directory, after merging it.
-fn draw_sweep(dir: &Path, formats: &[Format]) -> Result<Drawn> {
+fn draw_sweep(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
     let summary = merge(dir)?;
     let grid: Vec<f64> = (0..=200).map(|k| k as f64 * 0.005).collect();
     let points = crate::sweep::ensemble_curves(dir, &grid)?;

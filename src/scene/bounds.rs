@@ -60,7 +60,7 @@ pub(crate) const ACTIVE_SET_ITERATIONS: (usize, usize) = (1, 1_000_000);
 /// Conjugate-gradient iterations per linear solve (the default is `20000`).
 pub(crate) const LINEAR_ITERATIONS: (usize, usize) = (1, 10_000_000);
 /// The plan tolerance: an upper bound on the eigenvalues' relative error; below about
-/// `2e-13` the plan refuses it when built (`Error::NotConverged`), above `1e-2` it
+/// `2e-13` the plan refuses it when built (`Error::SeriesNotConverged`), above `1e-2` it
 /// accepts nothing a user could want.
 pub(crate) const PLAN_TOLERANCE_MAX: f64 = 1e-2;
 /// The probes' tolerance, relative to the largest traction: below `1e-15` the alias sums

@@ -509,11 +509,11 @@ fn check_value_shape(value: &serde_json::Value) -> Result<(), String> {
 /// # Errors
 /// [`Error::Io`] when the file cannot be read; [`Error::OutOfMemory`]; `content_error`'s
 /// error for bytes that are not UTF-8.
-pub(crate) fn read_json_text(
+pub(crate) fn read_json_text<E: From<Error>>(
     path: &Path,
     operation: &'static str,
-    content_error: impl FnOnce(usize, usize, String) -> Error,
-) -> Result<String> {
+    content_error: impl FnOnce(usize, usize, String) -> E,
+) -> Result<String, E> {
     crate::cost::check_file_size(path)?;
     let bytes = std::fs::read(path).map_err(|e| Error::io(operation, path, e))?;
     String::from_utf8(bytes).map_err(|e| {

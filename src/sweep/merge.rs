@@ -1,6 +1,6 @@
 //! Ensemble statistics of a sweep's runs (`precursors merge DIR`; docs/sweep-format.md).
 
-use super::{Sweep, SweepRun, DONE_FILE, SWEEP_FILE};
+use super::{Sweep, SweepError, SweepRun, DONE_FILE, SWEEP_FILE};
 use crate::driver::write_atomically;
 use crate::error::{table_number, Error, Result};
 use crate::output::{CURVE_HEADER, EVENTS_HEADER};
@@ -222,7 +222,7 @@ pub(crate) struct EnsembleCurves {
 /// # Errors
 /// As [`merge`].
 #[cfg(feature = "plot")]
-pub(crate) fn ensemble_curves(dir: &Path, grid: &[f64]) -> Result<Vec<EnsembleCurves>> {
+pub(crate) fn ensemble_curves(dir: &Path, grid: &[f64]) -> Result<Vec<EnsembleCurves>, SweepError> {
     let sweep = Sweep::from_json_file(dir.join(SWEEP_FILE))?;
     let mut out = Vec::new();
     for point in 0..sweep.points() {
@@ -274,14 +274,15 @@ pub(crate) fn ensemble_curves(dir: &Path, grid: &[f64]) -> Result<Vec<EnsembleCu
 /// kill leaves the previous file or the new one.
 ///
 /// # Errors
-/// [`Error::SweepDirectory`] when `dir` holds no `sweep.json`; its errors as a sweep file;
-/// [`Error::Io`] for a file that cannot be read or written; [`Error::CorruptTable`] for a
-/// run's damaged table, [`Error::NonFiniteCell`] for a `NaN`, an infinity or an empty
-/// cell where a number belongs in one (with the file, line and column).
-pub fn merge(dir: &Path) -> Result<MergeSummary> {
+/// [`SweepError::Directory`] when `dir` holds no `sweep.json`; its errors as a sweep file
+/// ([`Sweep::from_json_file`]); in [`SweepError::Core`]: [`Error::Io`] for a file that
+/// cannot be read or written, [`Error::CorruptTable`] for a run's damaged table,
+/// [`Error::NonFiniteCell`] for a `NaN`, an infinity or an empty cell where a number
+/// belongs in one (with the file, line and column).
+pub fn merge(dir: &Path) -> Result<MergeSummary, SweepError> {
     let sweep_path = dir.join(SWEEP_FILE);
     if !sweep_path.is_file() {
-        return Err(Error::SweepDirectory {
+        return Err(SweepError::Directory {
             path: dir.to_path_buf(),
             reason: format!("no {SWEEP_FILE}: not the output directory of a sweep"),
         });

@@ -1,0 +1,57 @@
+//! [`PlotError`]: what a figure can get wrong, with the core [`enum@Error`] (files, tables) and
+//! the [`SweepError`] (the merge before a sweep's figures) nested.
+
+use crate::error::{Bounded, Error};
+use crate::sweep::SweepError;
+use std::path::PathBuf;
+use thiserror::Error;
+
+/// Everything that can go wrong drawing figures (feature `plot`): [`crate::plot::Chart`],
+/// [`crate::plot::Map`] and the figures of a directory ([`crate::plot::figures::draw`]).
+///
+/// The figure's own failures are [`PlotError::Figure`]; the rest is nested: the core
+/// [`enum@Error`] in [`PlotError::Core`] (a figure or table that cannot be written or read, a
+/// damaged table, a map of the wrong size), the merge of a sweep directory in
+/// [`PlotError::Sweep`]. `?` turns either into a `PlotError`, and
+/// [`std::error::Error::source`] returns the nested error, whose `Display` it repeats.
+///
+/// ```
+/// use precursors::plot::{Chart, PlotError};
+/// let e = Chart::new("title", "x", "y").save("figure.gif").unwrap_err();
+/// assert!(matches!(e, PlotError::Figure { .. }));
+/// ```
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum PlotError {
+    /// A failure of the core library under a figure: a figure that cannot be written or a
+    /// table that cannot be read ([`Error::Io`]), a run's damaged table
+    /// ([`Error::CorruptTable`], [`Error::NonFiniteCell`]: file, line and column), map
+    /// values that do not fit its size ([`Error::LengthMismatch`], [`Error::InvalidCount`]
+    /// from [`crate::plot::Map::new`]).
+    #[error("{0}")]
+    Core(#[from] Error),
+    /// The merge of a sweep directory that [`crate::plot::figures::draw`] does before its
+    /// figures failed ([`crate::sweep::merge`]: a damaged `sweep.json`, a run's files that
+    /// do not belong to the sweep, ...).
+    #[error("{0}")]
+    Sweep(#[from] SweepError),
+    /// A figure cannot be drawn: [`crate::plot::Chart::save`] or [`crate::plot::Map::save`]
+    /// to a file name that does not end in `.png` or `.svg`, with an axis range that is not
+    /// finite and increasing, a size outside 200 x 150 to 16384 x 16384, a style given
+    /// before any series, or a drawing backend that fails;
+    /// [`crate::plot::figures::draw`] on a directory that is neither a run's nor a
+    /// sweep's. A figure that cannot be written to its file is [`Error::Io`] (in
+    /// [`PlotError::Core`]).
+    #[error(
+        "figure{}: {}",
+        path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default(),
+        Bounded(reason)
+    )]
+    Figure {
+        /// The figure's file (or the directory of [`crate::plot::figures::draw`]), when
+        /// known.
+        path: Option<PathBuf>,
+        /// What is wrong.
+        reason: String,
+    },
+}
