@@ -36,7 +36,8 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// A length (block size, cell size, rod half-width, ...) is not finite and positive.
+    /// A length (block size, cell size, rod half-width, ...) is not finite and positive:
+    /// `Block::new`, `Grid::from_cell_size`, `RodLoad::new`, a scene's block or cells.
     #[error("{name} = {} m is invalid: it must be finite and > 0", Num(*value))]
     InvalidLength {
         /// Which length.
@@ -44,13 +45,14 @@ pub enum Error {
         /// The value given (m).
         value: f64,
     },
-    /// A cell count is zero.
+    /// A cell count is zero: `Grid::new(block, 0, ny)`, a scene's `cells`.
     #[error("the grid needs at least one cell along {axis}, got 0")]
     EmptyGrid {
         /// `"x"` or `"y"`.
         axis: &'static str,
     },
-    /// The requested cell size does not divide the face into a whole number of cells.
+    /// The requested cell size does not divide the face into a whole number of cells:
+    /// `Grid::from_cell_size`, a scene's `cells` of kind `size`.
     #[error(
         "cell size {} m does not divide L{axis} = {} m (ratio {}, not an integer)",
         Num(*cell),
@@ -67,7 +69,8 @@ pub enum Error {
         /// `length / cell`.
         ratio: f64,
     },
-    /// A coordinate lies outside the block.
+    /// A coordinate lies outside the block: a point of `GreenFunction`, a load's or a plane
+    /// transfer's height `z`, a probe's plane or point.
     #[error("{name} = {} m lies outside the block, which spans [0, {}] m", Num(*value), Num(*max))]
     OutsideBlock {
         /// Which coordinate (`"x"`, `"xi"`, `"z"`, ...).
@@ -77,7 +80,8 @@ pub enum Error {
         /// The block length along that axis (m).
         max: f64,
     },
-    /// The rod band `[h - Δh, h + Δh]` is not inside the trailing face `[0, Lz]`.
+    /// The rod band `[h - Δh, h + Δh]` is not inside the trailing face `[0, Lz]`:
+    /// `RodLoad::new`, a scene's rod drive (`SceneBuilder::build`).
     #[error(
         "rod band [h - dh, h + dh] = [{}, {}] m is not inside the trailing face [0, {}] m",
         Num(*low),
@@ -92,13 +96,16 @@ pub enum Error {
         /// Block height (m).
         lz: f64,
     },
-    /// A tolerance is not finite and positive.
+    /// A tolerance is not finite and positive: of a series or plan (`SeriesOptions`,
+    /// `InfluencePlanBuilder`, `Planner`, a probe), of the solver (`SolverOptions`), of a
+    /// fit (`FitOptions`), or a scene's `plan_tolerance` / `solver.tolerance`.
     #[error("tolerance {} is invalid: it must be finite and > 0", Num(*value))]
     InvalidTolerance {
         /// The value given.
         value: f64,
     },
-    /// The target point coincides with the source point, where the Green function is infinite.
+    /// The target point coincides with the source point, where the Green function is
+    /// infinite: `GreenFunction::value` and its kin at `target == source`.
     #[error(
         "target and source coincide at ({}, {}, {}) m: the Green function is singular there",
         Num(*x),
@@ -136,7 +143,8 @@ pub enum Error {
         /// Terms summed.
         terms: u64,
     },
-    /// A slice has the wrong length for the grid.
+    /// A slice has the wrong length for the grid: tractions, heights, states or loads given
+    /// to a plan, interface, solver or driver of another grid.
     #[error("{name} has {found} values, the grid needs {expected}")]
     LengthMismatch {
         /// Which argument.
@@ -146,7 +154,8 @@ pub enum Error {
         /// Length given.
         found: usize,
     },
-    /// A slice holds a NaN or an infinity.
+    /// A slice holds a NaN or an infinity: the same inputs as [`Error::LengthMismatch`],
+    /// or a tangential stiffness that overflows in a solve.
     #[error("{name}[{index}] = {value} is not finite")]
     NonFinite {
         /// Which argument.
@@ -156,7 +165,8 @@ pub enum Error {
         /// The offending value.
         value: f64,
     },
-    /// A dense matrix was requested for a grid too large to hold one sensibly.
+    /// A dense matrix was requested for a grid too large to hold one sensibly:
+    /// `InfluencePlan::dense`, `Backend::Dense` above its cell limit.
     #[error("dense assembly of a {n} x {n} matrix refused: the limit is n <= {limit}; use the matrix-free operator")]
     TooLargeForDense {
         /// Number of cells.
@@ -187,7 +197,8 @@ pub enum Error {
         /// Why it is refused.
         reason: &'static str,
     },
-    /// A choice among named options that does not apply here (e.g. a summation axis).
+    /// A choice among named options that does not apply here: a summation axis of
+    /// `SeriesOptions` the evaluation cannot use.
     #[error("{name} = {value} is invalid: {reason}")]
     InvalidChoice {
         /// Which parameter.
@@ -228,7 +239,9 @@ pub enum Error {
         solve_seconds: f64,
     },
     /// An explicit thread count above one with the dense backend, which runs on one
-    /// thread (its factor solve needs the whole attached set).
+    /// thread (its factor solve needs the whole attached set): `SolverOptions`, a scene's
+    /// `solver` (`SceneBuilder::build`), `Driver::set_parallelism`,
+    /// `EquilibriumSolver::set_parallelism`.
     // Spelled as the scene file spells them (`solver.backend`, `solver.threads`): most
     // users meet this message from a scene file.
     #[error(
@@ -244,7 +257,8 @@ pub enum Error {
         /// ([`crate::solver::AUTO_DENSE_LIMIT`]).
         auto_limit: usize,
     },
-    /// The operating system refused the solver's threads.
+    /// The operating system refused the solver's threads: the first solve with
+    /// `Parallelism::Threads(n)` (`Driver::step`, `EquilibriumSolver`).
     #[error("could not start a pool of {threads} solver threads: {}", Bounded(&source.to_string()))]
     ThreadPool {
         /// Threads requested ([`crate::SolverOptions::parallelism`]).
@@ -253,7 +267,8 @@ pub enum Error {
         #[source]
         source: Cause,
     },
-    /// A spring height is zero or negative.
+    /// A spring height is zero or negative: heights given as values (`Interface`,
+    /// `HeightSource::Values`, a scene's `heights`, `Heights::from_dmatrix`).
     #[error("heights[{index}] = {} m is invalid: spring heights must be > 0", Num(*value))]
     NonPositiveHeight {
         /// Cell index (paper order `iy * Nx + ix`).
@@ -261,8 +276,8 @@ pub enum Error {
         /// The value given (m).
         value: f64,
     },
-    /// A broken site was given another state: broken sites stay broken until the
-    /// interface is healed.
+    /// A broken site was given another state (`Interface::set_states`): broken sites stay
+    /// broken until the interface is healed.
     #[error(
         "site {index} is broken and cannot be set to another state (heal the interface first)"
     )]
@@ -270,18 +285,19 @@ pub enum Error {
         /// Cell index (paper order `iy * Nx + ix`).
         index: usize,
     },
-    /// A driver was asked for a field of its equilibrium before it solved one.
+    /// A driver was asked for a field of its equilibrium before it solved one
+    /// (`Driver::normal_traction`, `shear_traction`, ... before the first `step`).
     #[error("the driver has not solved {what} yet: call step() first")]
     NotSolved {
         /// Which equilibrium (`"the normal equilibrium"`, `"the tangential equilibrium"`).
         what: &'static str,
     },
-    /// Stresses were asked of a driver whose scene has no stress probes.
+    /// Stresses were asked of a driver whose scene has no stress probes (`Driver::stresses`).
     #[error(
         "no stress probes: the scene was built without them (add them with SceneBuilder::probes)"
     )]
     NoProbes,
-    /// A site index beyond the grid.
+    /// A site index beyond the grid: `Interface::break_site`.
     #[error("site {index} does not exist: the interface has {sites} sites")]
     SiteOutOfRange {
         /// The index given.
@@ -289,8 +305,8 @@ pub enum Error {
         /// Number of sites.
         sites: usize,
     },
-    /// An input that must hold at least one item holds none (e.g. the target points of a
-    /// fit).
+    /// An input that must hold at least one item holds none: the target points of
+    /// `fit_tangential_stiffness`, an interface of no sites.
     #[error("{what} is empty: {reason}")]
     EmptyInput {
         /// Which input.
@@ -298,8 +314,9 @@ pub enum Error {
         /// Why it needs at least one item.
         reason: &'static str,
     },
-    /// No site can carry the load: every site broken, or none attached. A physical state
-    /// of the interface, not a misuse (see [`Error::NotSolved`]).
+    /// No site can carry the load: every site broken, or none attached, in a solve
+    /// (`EquilibriumSolver::solve_normal`, `solve_tangential`, `Driver::step`). A physical
+    /// state of the interface, not a misuse (see [`Error::NotSolved`]).
     #[error("empty contact: {reason} ({available} sites can still carry force)")]
     EmptyContact {
         /// Sites neither broken nor excluded.
@@ -346,7 +363,8 @@ pub enum Error {
         /// Scenes evaluated.
         evaluations: usize,
     },
-    /// A factorisation met a non-positive pivot (the system lost definiteness to rounding).
+    /// A factorisation met a non-positive pivot (the system lost definiteness to rounding):
+    /// the dense backend's LDLᵀ in a solve (`Driver::step`, `EquilibriumSolver`).
     #[error(
         "LDLT factorisation of the {n} x {n} attached-set matrix failed: {}",
         Bounded(reason)
@@ -374,7 +392,8 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
-    /// A heights file has a line that is not a finite, positive height in metres.
+    /// A heights file has a line that is not a finite, positive height in metres
+    /// (`HeightSource::from_file`, a scene file's `heights.file`).
     #[error("{path}, line {line}: {}", Bounded(reason))]
     HeightsFile {
         /// The file.
@@ -384,7 +403,9 @@ pub enum Error {
         /// What is wrong with it.
         reason: String,
     },
-    /// A scene file is not valid JSON or does not follow `docs/scene-format.md`.
+    /// A scene file is not valid JSON, not UTF-8 text, or does not follow
+    /// `docs/scene-format.md` (feature `serde`: `SceneBuilder::from_json_file`,
+    /// `from_json_str`).
     #[error(
         "scene file{}: {}",
         path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default(),
@@ -401,7 +422,8 @@ pub enum Error {
         #[source]
         source: Cause,
     },
-    /// A checkpoint does not fit the scene it is resumed on, or is inconsistent.
+    /// A checkpoint does not fit the scene it is resumed on, or is inconsistent
+    /// (`Scene::resume`, `RunTables::resume`).
     #[error("checkpoint refused: {}", Bounded(reason))]
     InvalidCheckpoint {
         /// Why.
@@ -427,7 +449,8 @@ pub enum Error {
         /// Columns needed (`Nx`).
         expected_columns: usize,
     },
-    /// A checkpoint belongs to another scene: the scene it is resumed on differs from the
+    /// A checkpoint belongs to another scene (`Scene::resume`, `RunTables::resume`,
+    /// `Checkpoint::read_from`): the scene it is resumed on differs from the
     /// checkpoint's, or the scene stored in the checkpoint was edited after it was taken
     /// (its digest no longer matches).
     #[error(
@@ -441,8 +464,9 @@ pub enum Error {
         /// Which scenes differ, and the values when they are known.
         reason: String,
     },
-    /// A checkpoint file holds no valid checkpoint (a read or write failure of the file
-    /// itself is [`Error::Io`]).
+    /// A checkpoint file holds no valid checkpoint (feature `serde`: `Checkpoint::read_from`,
+    /// `Checkpoint::from_json_str`; a read or write failure of the file itself is
+    /// [`Error::Io`]).
     #[error("{path}: not a checkpoint: {}", Bounded(reason))]
     CheckpointFile {
         /// The file.
@@ -466,7 +490,8 @@ pub enum Error {
         /// What is wrong, with the line number.
         reason: String,
     },
-    /// Another process holds the directory's lock: it is writing a run there (`run`,
+    /// Another process holds the directory's lock (`RunTables::create`, `RunTables::resume`,
+    /// a sweep's `execute` waiting 30 s for `sweep.json`): it is writing a run there (`run`,
     /// `resume`, a sweep's run) or checking a sweep's `sweep.json`. The lock is the
     /// operating system's and ends with that process, also when it is killed.
     #[error(
@@ -480,7 +505,8 @@ pub enum Error {
         /// Who holds the lock, as it wrote it: pid, host, start time (UTC), command.
         holder: String,
     },
-    /// A run directory cannot be continued or finished: it has no record of its scene
+    /// A run directory cannot be continued or finished (`RunTables::resume`,
+    /// `RunTables::finish`): it has no record of its scene
     /// (`scene.json`), or a checkpoint taken inside an avalanche, or the run did not reach
     /// global slip.
     #[error("run directory {}: {}", path.display(), Bounded(reason))]
@@ -525,7 +551,9 @@ pub enum Error {
         reason: &'static str,
     },
     /// The memory a scene or sweep would need exceeds what the machine has available
-    /// (Linux: `MemAvailable` of `/proc/meminfo`), refused before anything is allocated.
+    /// (Linux: `MemAvailable` of `/proc/meminfo`), refused before anything is allocated:
+    /// `SceneBuilder::check`/`build`, a file too large to read (scene, checkpoint, sweep,
+    /// table), a sweep's list of runs.
     #[error(
         "{what} would need about {needed} of memory, but only {available} is available: {hint}",
         needed = format_bytes(*needed_bytes),
@@ -543,7 +571,8 @@ pub enum Error {
     },
     /// A load `F/(μF_N)` beyond the friction limit at a stable state or at global slip:
     /// no stable state carries more than `μF_N` (every site holds `|φ_x| ≤ μ φ_z`), so
-    /// the computation went wrong; refused rather than written to a table.
+    /// the computation went wrong; refused rather than written to a table
+    /// (`RunTables::record`).
     #[error(
         "F/(μF_N) = {} exceeds the friction limit {limit}: no stable state carries more than \
          μF_N, so the result is wrong (a solver tolerance too loose, or a degenerate scene); \

@@ -37,6 +37,32 @@ fn normal_stiffness_is_recovered_over_realizations() {
     assert!(soft > target && target > stiff);
 }
 
+/// A fit that runs out of evaluations says so in its own variant (not a series' nor a
+/// solver's): three evaluations (the bracket's ends and one step) cannot narrow the
+/// bracket `[1e6, 1e11]` to a relative `1e-12`.
+#[test]
+fn a_fit_out_of_evaluations_is_fit_not_converged() {
+    let mut options = FitOptions::default().seeds(&[3]).tolerance(1e-12);
+    options.max_evaluations = 3;
+    let target = normal_contact_area(&with_law(1.65e12, 4.2e8), &options).unwrap();
+    let e = fit_normal_stiffness(&base(), target, (1e6, 1e11), &options).unwrap_err();
+    match e {
+        Error::FitNotConverged {
+            value,
+            width,
+            tolerance,
+            evaluations,
+        } => {
+            assert_eq!(evaluations, 3);
+            assert_eq!(tolerance, 1e-12);
+            assert!((1e6..=1e11).contains(&value), "{value}");
+            // The bracket in ln c_z is narrower than at the start, wider than asked.
+            assert!(width > 1e-12 && width < (1e11f64 / 1e6).ln(), "{width}");
+        }
+        other => panic!("expected Error::FitNotConverged, got {other:?}"),
+    }
+}
+
 #[test]
 fn tangential_stiffness_is_recovered_from_a_generated_curve() {
     let options = FitOptions::default().seeds(&[1, 2]).tolerance(1e-3);

@@ -6,6 +6,8 @@ mod calibration;
 mod checkpoint;
 mod common;
 mod driver;
+#[cfg(feature = "serde")]
+mod error_types;
 mod errors;
 mod green_point;
 #[cfg(feature = "cli")]

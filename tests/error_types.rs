@@ -1,0 +1,264 @@
+//! The error types of the sweep (`SweepError`) and of the figures (`PlotError`): a real
+//! failing call returns the type's variant, `source()` reaches the nested core `Error`,
+//! and the messages are those of the single error type before the split.
+//!
+//! The expected messages were written down by running the program built from main
+//! before the split (commit 1b83f13, `precursors sweep/merge/plot` on the same inputs,
+//! its `error: ...` line): an earlier, independent computation of the same text.
+
+use precursors::sweep::{merge, Sweep, SweepError};
+use precursors::Error;
+use std::error::Error as _;
+use std::path::PathBuf;
+
+/// A fresh, empty directory under the system's temporary one.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "precursors-{}-error-types-{name}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The tiny base scene of tests/sweep.rs (30 x 5 cells).
+const BASE: &str = r#"{ "block": { "lx": 0.03, "ly": 0.005, "lz": 0.02 },
+    "cells": { "kind": "size", "dx": 0.001, "dy": 0.001 },
+    "normal_load": 500.0,
+    "drive": { "kind": "rod", "height": 0.004, "half_width": 0.001 } }"#;
+
+fn sweep_text(axes: &str, realizations: usize) -> String {
+    format!(r#"{{ "base": {BASE}, "axes": [{axes}], "realizations": {realizations}, "seed": 11 }}"#)
+}
+
+#[test]
+fn a_sweep_file_that_is_not_json_is_a_sweep_file_error() {
+    let dir = scratch("file");
+    let path = dir.join("bad.json");
+    std::fs::write(&path, "{ not json\n").unwrap();
+    let e = Sweep::from_json_file(&path).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            SweepError::File {
+                line: 1,
+                column: 3,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    // main: "error: sweep file bad.json: key must be a string at line 1 column 3".
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "sweep file {}: key must be a string at line 1 column 3",
+            path.display()
+        )
+    );
+    // Its cause is the parser's error, not a core error.
+    let cause = e.source().expect("the parser's error");
+    assert!(cause.downcast_ref::<Error>().is_none());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn an_axis_that_is_not_a_scene_key_is_an_axis_error() {
+    let e = Sweep::from_json_str(&sweep_text(
+        r#"{ "key": "normal_lod", "values": [1.0] }"#,
+        1,
+    ))
+    .unwrap_err();
+    match &e {
+        SweepError::Axis { key, .. } => assert_eq!(key, "normal_lod"),
+        other => panic!("expected SweepError::Axis, got {other:?}"),
+    }
+    // main: the same line after "error: ".
+    assert_eq!(
+        e.to_string(),
+        "sweep axis `normal_lod`: not a scene key: the scene has no `normal_lod` (it has: \
+         block, cells, drive, heights, material, normal_load, plan_tolerance, probes, solver, \
+         springs)"
+    );
+}
+
+#[test]
+fn a_sweep_of_too_many_runs_is_too_large() {
+    let e = Sweep::from_json_str(&sweep_text(
+        r#"{ "key": "normal_load", "values": [1.0,2.0,3.0,4.0,5.0,6.0,7.0,8.0,9.0,10.0] }"#,
+        20000,
+    ))
+    .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            SweepError::TooLarge {
+                points: 10,
+                realizations: 20000,
+                runs: 200_000,
+                limit: 100_000,
+            }
+        ),
+        "{e:?}"
+    );
+    assert_eq!(
+        e.to_string(),
+        "the sweep has 10 points x 20000 realizations = 200000 runs, more than the limit of \
+         100000 runs per sweep: split it into several sweeps (fewer values per axis or fewer \
+         realizations each, with other output directories)"
+    );
+}
+
+#[test]
+fn merging_a_directory_without_a_sweep_is_a_directory_error() {
+    let dir = scratch("no-sweep");
+    let e = merge(&dir).unwrap_err();
+    assert!(
+        matches!(&e, SweepError::Directory { path, .. } if *path == dir),
+        "{e:?}"
+    );
+    // main: "error: sweep directory e2: no sweep.json: not the output directory of a sweep".
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "sweep directory {}: no sweep.json: not the output directory of a sweep",
+            dir.display()
+        )
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_core_failure_under_a_sweep_is_nested_and_its_source() {
+    let e = Sweep::from_json_str(&sweep_text("", 0)).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            SweepError::Core(Error::InvalidCount {
+                name: "realizations",
+                value: 0,
+                ..
+            })
+        ),
+        "{e:?}"
+    );
+    // main: the same line after "error: ".
+    let text = "realizations = 0 is invalid: a sweep needs at least one realization per point";
+    assert_eq!(e.to_string(), text);
+    let core = e
+        .source()
+        .and_then(|s| s.downcast_ref::<Error>())
+        .expect("source() is the core error");
+    assert!(matches!(core, Error::InvalidCount { .. }), "{core:?}");
+    assert_eq!(core.to_string(), text);
+    // `?` turns a core error into a sweep error.
+    fn lift() -> Result<(), SweepError> {
+        Err(Error::EmptyGrid { axis: "x" })?
+    }
+    assert!(matches!(
+        lift(),
+        Err(SweepError::Core(Error::EmptyGrid { axis: "x" }))
+    ));
+}
+
+#[cfg(feature = "plot")]
+mod plot {
+    use super::scratch;
+    use precursors::plot::figures::{draw, Format};
+    use precursors::plot::PlotError;
+    use precursors::sweep::SweepError;
+    use precursors::Error;
+    use std::error::Error as _;
+
+    #[test]
+    fn a_directory_neither_a_run_nor_a_sweep_is_a_figure_error() {
+        let dir = scratch("plot-empty");
+        let e = draw(&dir, &[Format::Png]).unwrap_err();
+        assert!(
+            matches!(&e, PlotError::Figure { path: Some(p), .. } if *p == dir),
+            "{e:?}"
+        );
+        // main: "error: figure empty: neither a sweep directory (sweep.json) nor a run
+        // directory (curve.csv)".
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "figure {}: neither a sweep directory (sweep.json) nor a run directory \
+                 (curve.csv)",
+                dir.display()
+            )
+        );
+        assert!(e.source().is_none());
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn a_nan_in_a_run_table_is_a_nested_core_error() {
+        let dir = scratch("plot-nan");
+        let curve = dir.join("curve.csv");
+        std::fs::write(
+            &curve,
+            "event,force_N,force_over_mu_FN,drive_displacement_m,real_contact_area_m2,\
+             precursor_length_m,precursor_over_Lx,broken,attached,area_exceeds_nominal\n\
+             1,0,0,,1e-6,0,0,0,98,0\n\
+             4,2.9,NaN,,1e-6,0,0,1,97,0\n",
+        )
+        .unwrap();
+        let e = draw(&dir, &[Format::Png]).unwrap_err();
+        assert!(
+            matches!(
+                &e,
+                PlotError::Core(Error::NonFiniteCell { line: 3, column, .. })
+                    if column == "force_over_mu_FN"
+            ),
+            "{e:?}"
+        );
+        // main, on this table: "error: table handnan/curve.csv, line 3, column
+        // force_over_mu_FN: "NaN" is not a finite number".
+        let text = format!(
+            "table {}, line 3, column force_over_mu_FN: \"NaN\" is not a finite number",
+            curve.display()
+        );
+        assert_eq!(e.to_string(), text);
+        let core = e
+            .source()
+            .and_then(|s| s.downcast_ref::<Error>())
+            .expect("source() is the core error");
+        assert!(matches!(core, Error::NonFiniteCell { .. }), "{core:?}");
+        assert_eq!(core.to_string(), text);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn a_damaged_sweep_file_under_a_figure_is_a_nested_sweep_error() {
+        let dir = scratch("plot-sweep");
+        std::fs::write(dir.join("sweep.json"), "{ not json\n").unwrap();
+        let e = draw(&dir, &[Format::Png]).unwrap_err();
+        assert!(
+            matches!(&e, PlotError::Sweep(SweepError::File { line: 1, .. })),
+            "{e:?}"
+        );
+        // main: "error: sweep file badsweep/sweep.json: key must be a string at line 1
+        // column 3".
+        let text = format!(
+            "sweep file {}: key must be a string at line 1 column 3",
+            dir.join("sweep.json").display()
+        );
+        assert_eq!(e.to_string(), text);
+        let sweep = e
+            .source()
+            .and_then(|s| s.downcast_ref::<SweepError>())
+            .expect("source() is the sweep error");
+        assert_eq!(sweep.to_string(), text);
+        // A core error under the figure: `?` nests it.
+        fn lift() -> Result<(), PlotError> {
+            Err(Error::EmptyGrid { axis: "y" })?
+        }
+        assert!(matches!(
+            lift(),
+            Err(PlotError::Core(Error::EmptyGrid { axis: "y" }))
+        ));
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
