@@ -32,7 +32,11 @@ fn point_series(c: &mut Criterion) {
     let mut group = c.benchmark_group("point_raw");
     group.sample_size(10);
     for tol in [1e-1, 1e-2] {
-        let opts = SeriesOptions::with_tolerance(tol).max_terms(400_000_000);
+        let opts = SeriesOptions::default()
+            .with_tolerance(tol)
+            .unwrap()
+            .with_max_terms(400_000_000)
+            .unwrap();
         group.bench_function(format!("tol={tol:e}"), |b| {
             b.iter(|| small.raw_series(black_box(r), black_box(s), &opts).unwrap())
         });

@@ -26,12 +26,14 @@ fn solver(plan: &InfluencePlan, (backend, threads): (Backend, usize)) -> Equilib
     EquilibriumSolver::builder(plan.clone())
         .options(
             SolverOptions::default()
-                .backend(backend)
-                .parallelism(if threads > 1 {
+                .with_backend(backend)
+                .unwrap()
+                .with_parallelism(if threads > 1 {
                     Parallelism::Threads(threads)
                 } else {
                     Parallelism::Sequential
-                }),
+                })
+                .unwrap(),
         )
         .build()
         .unwrap()

@@ -72,11 +72,11 @@ fn one(base: &SceneBuilder, solver: f64, threads: Parallelism) -> Result<Run, pr
         .clone()
         .solver(
             SolverOptions::default()
-                .tolerance(solver)
-                .parallelism(threads),
+                .with_tolerance(solver)?
+                .with_parallelism(threads)?,
         )
         .build()?;
-    let mu_fn = scene.material().friction_coefficient * scene.normal_load();
+    let mu_fn = scene.material().friction_coefficient() * scene.normal_load();
     let lx = scene.grid().block().lx();
     let mut driver = scene.driver()?;
     let mut run = Run {

@@ -28,7 +28,7 @@ use std::process::ExitCode;
 /// `(F/(μF_N), A_R)` at every stable state, and the slip load F/(μF_N).
 fn area_curve(builder: &SceneBuilder) -> precursors::Result<(Vec<(f64, f64)>, f64)> {
     let scene = builder.clone().build()?;
-    let mu_fn = scene.material().friction_coefficient * scene.normal_load();
+    let mu_fn = scene.material().friction_coefficient() * scene.normal_load();
     let mut driver = scene.driver()?;
     let mut curve = Vec::new();
     let mut slip = f64::NAN;

@@ -47,7 +47,7 @@ fn run() -> report::Outcome {
     // The builder's defaults are the calibration scene; only the seed is chosen here.
     let scene = Scene::builder().seed(seed).build()?;
     let lx = scene.grid().block().lx();
-    let scale = scene.material().friction_coefficient * scene.normal_load();
+    let scale = scene.material().friction_coefficient() * scene.normal_load();
     let mut driver = scene.driver()?;
     let mut rows = Vec::new();
     let mut slip = None;

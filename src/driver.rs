@@ -221,7 +221,7 @@ impl Scene {
         Ok(Driver {
             scene: self.clone(),
             grid: *self.grid(),
-            friction: self.material().friction_coefficient,
+            friction: self.material().friction_coefficient(),
             normal_load: self.normal_load(),
             drive: self.drive(),
             unit_load: self.unit_load_displacement(),

@@ -39,10 +39,10 @@
 //!     .cell_size(1e-3, 1e-3)                            // 30 x 7 cells (m)
 //!     .normal_load(750.0)                               // F_N (N); rod drive, PMMA
 //!     .seed(1)                                          // the heights' realization
-//!     .probes(ProbeSpec::default().plane(2e-3))         // stresses at z = 2 mm
+//!     .probes(ProbeSpec::default().with_plane(2e-3))         // stresses at z = 2 mm
 //!     .build()?;
 //! let mut driver = scene.driver()?;
-//! let (lx, mu_fn) = (0.030, scene.material().friction_coefficient * 750.0);
+//! let (lx, mu_fn) = (0.030, scene.material().friction_coefficient() * 750.0);
 //! while let Some(event) = driver.step()? {
 //!     match event {
 //!         Event::Stable { load, .. } => {

@@ -318,7 +318,7 @@ impl SceneBuilder {
     /// constants set by [`SceneBuilder::springs`] stay. It changes the outputs (areas,
     /// precursor lengths), not the events.
     pub fn area_law(mut self, area_law: AreaLaw) -> Self {
-        self.law.area_law = area_law;
+        self.law = self.law.with_area_law(area_law);
         self
     }
 
@@ -431,24 +431,28 @@ impl SceneBuilder {
         put(
             k,
             "material.young_modulus",
-            format!("{:?}", m.young_modulus),
+            format!("{:?}", m.young_modulus()),
         );
         put(
             k,
             "material.poisson_ratio",
-            format!("{:?}", m.poisson_ratio),
+            format!("{:?}", m.poisson_ratio()),
         );
-        let mu = m.friction_coefficient;
+        let mu = m.friction_coefficient();
         put(k, "material.friction_coefficient", format!("{mu:?}"));
-        put(k, "springs.c_x", format!("{:?}", self.law.c_x));
-        put(k, "springs.c_z", format!("{:?}", self.law.c_z));
-        let area_law = format!("{:?}", self.law.area_law).to_lowercase();
+        put(k, "springs.c_x", format!("{:?}", self.law.c_x()));
+        put(k, "springs.c_z", format!("{:?}", self.law.c_z()));
+        let area_law = format!("{:?}", self.law.area_law()).to_lowercase();
         put(k, "springs.area_law", area_law);
         match &self.heights {
             HeightSource::Random { distribution, seed } => {
                 put(k, "heights.kind", "gaussian".into());
-                put(k, "heights.mean", format!("{:?}", distribution.mean));
-                put(k, "heights.std_dev", format!("{:?}", distribution.std_dev));
+                put(k, "heights.mean", format!("{:?}", distribution.mean()));
+                put(
+                    k,
+                    "heights.std_dev",
+                    format!("{:?}", distribution.std_dev()),
+                );
                 put(k, "heights.seed", format!("{seed}"));
             }
             HeightSource::Values(values) => {
@@ -478,12 +482,12 @@ impl SceneBuilder {
         put(
             k,
             "solver.backend",
-            format!("{:?}", o.backend).to_lowercase(),
+            format!("{:?}", o.backend()).to_lowercase(),
         );
-        put(k, "solver.tolerance", format!("{:?}", o.tolerance));
-        let n = o.max_active_set_iterations;
+        put(k, "solver.tolerance", format!("{:?}", o.tolerance()));
+        let n = o.max_active_set_iterations();
         put(k, "solver.max_active_set_iterations", format!("{n}"));
-        let n = o.max_linear_iterations;
+        let n = o.max_linear_iterations();
         put(k, "solver.max_linear_iterations", format!("{n}"));
         put(k, "plan_tolerance", format!("{:?}", self.plan_tolerance));
         std::mem::take(k)
@@ -494,7 +498,9 @@ impl SceneBuilder {
     /// choice), the cell limit and the probes (observers, which a driver may add at any time).
     pub(crate) fn identity(&self) -> SceneBuilder {
         let mut identity = self.clone();
-        identity.solver.parallelism = SolverOptions::default().parallelism;
+        identity
+            .solver
+            .set_parallelism(SolverOptions::default().parallelism());
         identity.probes = ProbeSpec::default();
         identity.max_cells = crate::green::DEFAULT_MAX_CELLS;
         identity
@@ -591,9 +597,6 @@ impl SceneBuilder {
             bounds::memory_bytes(self, &grid),
             "use fewer cells (or fewer probes), or a machine with more memory",
         )?;
-        self.material.validate()?;
-        self.law.validate()?;
-        self.solver.validate()?;
         check_tolerance(self.plan_tolerance)?;
         if !(self.normal_load.is_finite() && self.normal_load > 0.0) {
             return Err(Error::InvalidParameter {
@@ -602,11 +605,8 @@ impl SceneBuilder {
                 reason: "the normal load must be finite and > 0 N",
             });
         }
-        match &self.heights {
-            HeightSource::Random { distribution, .. } => {
-                Heights::check_distribution(*distribution)?;
-            }
-            HeightSource::Values(v) => Heights::check_values(&grid, v)?,
+        if let HeightSource::Values(v) = &self.heights {
+            Heights::check_values(&grid, v)?;
         }
         match self.drive {
             Drive::Force(ForceLoad::Mixed { ratio, .. })
@@ -631,11 +631,10 @@ impl SceneBuilder {
             RodLoad::new(&block, height, half_width)?;
         }
         if !self.probes.is_empty() {
-            check_tolerance(self.probes.tolerance)?;
-            for &z in &self.probes.planes {
+            for &z in self.probes.planes() {
                 block.check_height(z)?;
             }
-            for &p in &self.probes.points {
+            for &p in self.probes.points() {
                 block.check_point(p, ["x", "y", "z"])?;
             }
         }
@@ -871,7 +870,7 @@ mod leaves_out {
         assert!(top.rod.is_none() && top.lateral_response.is_none());
         assert!(top.probe.is_none());
         let rod = small()
-            .probes(ProbeSpec::default().plane(2e-3))
+            .probes(ProbeSpec::default().with_plane(2e-3))
             .build()
             .unwrap();
         assert!(rod.rod.is_some() && rod.lateral_response.is_some());
@@ -883,7 +882,11 @@ mod leaves_out {
         // The spectral backend's FSAI, its local entries and the spectral inverse are
         // built on first use only.
         let scene = small()
-            .solver(SolverOptions::default().backend(crate::Backend::Spectral))
+            .solver(
+                SolverOptions::default()
+                    .with_backend(crate::Backend::Spectral)
+                    .unwrap(),
+            )
             .build()
             .unwrap();
         let mut driver = scene.driver().unwrap();

@@ -38,7 +38,7 @@ fn run(scene: &Scene) -> Vec<Event> {
 /// `(F/(μF_N), ℓ)` at every stable state of a run.
 fn precursor_curve(scene: &Scene) -> Vec<(f64, f64)> {
     let mut d = scene.driver().unwrap();
-    let scale = scene.material().friction_coefficient * scene.normal_load();
+    let scale = scene.material().friction_coefficient() * scene.normal_load();
     let mut out = Vec::new();
     d.run(|e, d| {
         if let Event::Stable { load, .. } = e {
@@ -292,7 +292,7 @@ fn naive_protocol(nx: usize, ny: usize, seed: u64) -> (Vec<usize>, Vec<f64>) {
     let columns = rod.influence_cells(&grid, 1e-12 * lx / (ly * lz)).unwrap();
     let e: Vec<f64> = (0..n).map(|i| columns[i % nx] / m).collect();
     let cell = grid.cell_area();
-    let (mu, normal_load) = (material.friction_coefficient, 20.0);
+    let (mu, normal_load) = (material.friction_coefficient(), 20.0);
     let mut broken = vec![false; n];
     let mut attached = vec![true; n];
     let mut ruptures = Vec::new();
@@ -303,7 +303,7 @@ fn naive_protocol(nx: usize, ny: usize, seed: u64) -> (Vec<usize>, Vec<f64>) {
         // Normal equilibrium: primal-dual active set with exact solves.
         let (f_z, u_z) = loop {
             let set: Vec<usize> = (0..n).filter(|&i| attached[i]).collect();
-            let d: Vec<f64> = set.iter().map(|&i| u0[i] / law.c_z).collect();
+            let d: Vec<f64> = set.iter().map(|&i| u0[i] / law.c_z()).collect();
             let b: Vec<f64> = set.iter().map(|&i| u0[i]).collect();
             let (f, u) = bordered_solve(&c, n, &set, &d, &b, normal_load / cell);
             let mut full = vec![0.0; n];
@@ -332,7 +332,7 @@ fn naive_protocol(nx: usize, ny: usize, seed: u64) -> (Vec<usize>, Vec<f64>) {
         let set: Vec<usize> = (0..n).filter(|&i| attached[i]).collect();
         let d: Vec<f64> = set
             .iter()
-            .map(|&i| (u_z[i] / u0[i]).exp() / law.c_x)
+            .map(|&i| (u_z[i] / u0[i]).exp() / law.c_x())
             .collect();
         let b: Vec<f64> = set.iter().map(|&i| -e[i]).collect();
         let (g, _) = bordered_solve(&c, n, &set, &d, &b, -1.0 / cell);
@@ -423,8 +423,10 @@ fn drivers_and_solvers_can_move_between_threads() {
         .normal_load(2.1e3)
         .solver(
             SolverOptions::default()
-                .backend(Backend::Spectral)
-                .parallelism(Parallelism::Threads(2)),
+                .with_backend(Backend::Spectral)
+                .unwrap()
+                .with_parallelism(Parallelism::Threads(2))
+                .unwrap(),
         )
         .seed(2)
         .build()

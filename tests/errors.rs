@@ -75,9 +75,13 @@ fn tolerances_must_be_positive() {
         InfluencePlan::builder(grid).tolerance(0.0).build(),
         Err(Error::InvalidTolerance { .. })
     ));
-    let opts = SeriesOptions::with_tolerance(1e-6).max_terms(0);
+    let opts = SeriesOptions::default()
+        .with_tolerance(1e-6)
+        .unwrap()
+        .with_max_terms(0)
+        .unwrap();
     assert!(matches!(
-        gf.value_with(r, s, &opts),
+        gf.value_with_options(r, s, &opts),
         Err(Error::InvalidCount { .. })
     ));
 }
@@ -144,7 +148,9 @@ fn operator_inputs_are_checked() {
 fn zero_solver_threads_are_refused() {
     let built = precursors::Scene::builder()
         .solver(
-            precursors::SolverOptions::default().parallelism(precursors::Parallelism::Threads(0)),
+            precursors::SolverOptions::default()
+                .with_parallelism(precursors::Parallelism::Threads(0))
+                .unwrap(),
         )
         .build()
         .and_then(|scene| scene.driver());
@@ -161,7 +167,8 @@ fn zero_solver_threads_are_refused() {
             .block(0.010, 0.005, 0.010)
             .solver(
                 precursors::SolverOptions::default()
-                    .parallelism(precursors::Parallelism::Threads(threads)),
+                    .with_parallelism(precursors::Parallelism::Threads(threads))
+                    .unwrap(),
             )
             .build()
             .unwrap();
@@ -254,12 +261,9 @@ fn zero_friction_is_refused() {
             ),
             "μ = {mu}"
         );
-        let mut material = precursors::Material::default();
-        material.friction_coefficient = mu;
-        let built = precursors::Scene::builder().material(material).build();
         assert!(
             matches!(
-                built,
+                precursors::Material::default().with_friction_coefficient(mu),
                 Err(Error::InvalidParameter {
                     name: "friction_coefficient",
                     ..
@@ -368,8 +372,10 @@ fn threads_with_the_dense_backend() {
     use precursors::{Backend, Parallelism, Scene, SolverOptions};
     let options = |backend, parallelism| {
         SolverOptions::default()
-            .backend(backend)
-            .parallelism(parallelism)
+            .with_backend(backend)
+            .unwrap()
+            .with_parallelism(parallelism)
+            .unwrap()
     };
     let e = Scene::builder()
         .solver(options(Backend::Dense, Parallelism::Threads(4)))
@@ -446,7 +452,15 @@ fn counts_are_reported_as_integers() {
     let gf = GreenFunction::new(b);
     let (r, s) = (Point::new(0.05, 0.005, 0.01), Point::new(0.02, 0.001, 0.0));
     let e = gf
-        .value_with(r, s, &SeriesOptions::with_tolerance(1e-6).max_terms(0))
+        .value_with_options(
+            r,
+            s,
+            &SeriesOptions::default()
+                .with_tolerance(1e-6)
+                .unwrap()
+                .with_max_terms(0)
+                .unwrap(),
+        )
         .unwrap_err();
     assert!(
         matches!(
@@ -480,21 +494,18 @@ mod ranges {
     }
 
     fn material(e: f64, nu: f64, mu: f64) -> SceneBuilder {
-        let mut m = Material::default();
-        (m.young_modulus, m.poisson_ratio, m.friction_coefficient) = (e, nu, mu);
-        base().material(m)
+        base().material(Material::new(e, nu, mu).unwrap())
     }
 
     fn springs(c_x: f64, c_z: f64) -> SceneBuilder {
-        let mut law = SpringLaw::default();
-        (law.c_x, law.c_z) = (c_x, c_z);
-        base().springs(law)
+        base().springs(SpringLaw::new(c_x, c_z).unwrap())
     }
 
-    fn solver(f: impl FnOnce(&mut SolverOptions)) -> SceneBuilder {
-        let mut o = SolverOptions::default();
-        f(&mut o);
-        base().solver(o)
+    /// The scene with solver options changed by `f` (values the options themselves
+    /// refuse, e.g. 0 iterations, are refused at construction:
+    /// `solver_options_refuse_invalid_values_at_construction`).
+    fn solver(f: impl FnOnce(SolverOptions) -> Result<SolverOptions>) -> SceneBuilder {
+        base().solver(f(SolverOptions::default()).unwrap())
     }
 
     /// The block's shear stiffness `M·Ly·Lz/Lx` of [`base`] (N/m), the paper's PMMA.
@@ -585,8 +596,7 @@ mod ranges {
                 // A stiff block (E = 1e15 Pa): springs up to 1e21 N/m² are then resolved
                 // against it (the tolerance's bound `5e-2·p/R`, docs/scene-format.md).
                 Box::new(|v| {
-                    let mut m = Material::default();
-                    m.young_modulus = 1e15;
+                    let m = Material::default().with_young_modulus(1e15).unwrap();
                     springs(1.65e12, v).material(m)
                 }),
                 vec![1e-3, 1e21],
@@ -597,8 +607,7 @@ mod ranges {
                 // A stiff block on stiff springs: within 650 ΔA c_z, and the block's
                 // displacement within 1e10 asperity heights.
                 Box::new(|v| {
-                    let mut m = Material::default();
-                    m.young_modulus = 1e15;
+                    let m = Material::default().with_young_modulus(1e15).unwrap();
                     springs(1.65e12, 1e21).material(m).normal_load(v)
                 }),
                 vec![1e-9, 1e15],
@@ -615,7 +624,7 @@ mod ranges {
                 "heights.mean",
                 Box::new(|v| {
                     base().heights(HeightSource::Random {
-                        distribution: HeightDistribution::new(v, v),
+                        distribution: HeightDistribution::new(v, v).unwrap(),
                         seed: 1,
                     })
                 }),
@@ -626,7 +635,7 @@ mod ranges {
                 "heights.std_dev",
                 Box::new(|v| {
                     base().heights(HeightSource::Random {
-                        distribution: HeightDistribution::new(1e-6, v),
+                        distribution: HeightDistribution::new(1e-6, v).unwrap(),
                         seed: 1,
                     })
                 }),
@@ -672,21 +681,21 @@ mod ranges {
             ),
             (
                 "solver.tolerance",
-                Box::new(|v| solver(|o| o.tolerance = v)),
+                Box::new(|v| solver(|o| o.with_tolerance(v))),
                 vec![1e-15, 1e-6],
                 vec![0.99e-15, 1e-17, 1.01e-6, 1.0, 10.0, 1e308],
             ),
             (
                 "solver.max_active_set_iterations",
-                Box::new(|v| solver(|o| o.max_active_set_iterations = v as usize)),
+                Box::new(|v| solver(|o| o.with_max_active_set_iterations(v as usize))),
                 vec![1.0, 1e6],
-                vec![0.0, 1e6 + 1.0, 1e19],
+                vec![1e6 + 1.0, 1e19],
             ),
             (
                 "solver.max_linear_iterations",
-                Box::new(|v| solver(|o| o.max_linear_iterations = v as usize)),
+                Box::new(|v| solver(|o| o.with_max_linear_iterations(v as usize))),
                 vec![1.0, 1e7],
-                vec![0.0, 1e7 + 1.0],
+                vec![1e7 + 1.0],
             ),
             (
                 "plan_tolerance",
@@ -696,7 +705,14 @@ mod ranges {
             ),
             (
                 "probes.tolerance",
-                Box::new(|v| base().probes(ProbeSpec::default().plane(1e-3).tolerance(v))),
+                Box::new(|v| {
+                    base().probes(
+                        ProbeSpec::default()
+                            .with_plane(1e-3)
+                            .with_tolerance(v)
+                            .unwrap(),
+                    )
+                }),
                 vec![1e-15, 1e-2],
                 vec![0.99e-15, 1.01e-2, 1.0],
             ),
@@ -735,9 +751,9 @@ mod ranges {
             (base().block(0.02, 1e308, 0.01), "block.ly"),
             (base().block(1e308, 0.004, 0.01), "block.lx"),
             (spring(1e-306), "drive.stiffness"),
-            (solver(|o| o.tolerance = 1.0), "solver.tolerance"),
-            (solver(|o| o.tolerance = 10.0), "solver.tolerance"),
-            (solver(|o| o.tolerance = 1e308), "solver.tolerance"),
+            (solver(|o| o.with_tolerance(1.0)), "solver.tolerance"),
+            (solver(|o| o.with_tolerance(10.0)), "solver.tolerance"),
+            (solver(|o| o.with_tolerance(1e308)), "solver.tolerance"),
         ] {
             assert!(refused(&b, key), "{key}: {:?}", b.check());
         }

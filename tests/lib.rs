@@ -11,6 +11,7 @@ mod green_point;
 #[cfg(feature = "cli")]
 mod hostile;
 mod interface;
+mod invariants;
 mod laws;
 mod loads;
 #[cfg(feature = "nalgebra")]

@@ -114,7 +114,7 @@ fn driver_fields_and_plane_stresses_as_matrices() {
         .cells(5, 3)
         .normal_load(30.0)
         .heights(Heights::from_dmatrix(&grid, &map()).unwrap().into())
-        .probes(ProbeSpec::default().plane(0.0))
+        .probes(ProbeSpec::default().with_plane(0.0))
         .build()
         .unwrap();
     let mut driver = scene.driver().unwrap();

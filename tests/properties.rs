@@ -312,13 +312,13 @@ proptest! {
         // by construction.
         let z_min = (0.05 * grid.dx().max(grid.dy())).min(lz);
         let heights: Vec<f64> = planes.iter().map(|t| z_min + t * (lz - z_min)).collect();
-        let spec = heights.iter().fold(ProbeSpec::default(), |s, z| s.plane(*z));
+        let spec = heights.iter().fold(ProbeSpec::default(), |s, z| s.with_plane(*z));
         let probe = StressProbe::new(&plan, &spec, Some(&rod)).unwrap();
         let mut rng = seed;
         let phi_x = tractions(&grid, -(f_top + f_lat), &mut rng);
         let phi_z = tractions(&grid, f_n, &mut rng);
         let out = probe
-            .evaluate(&ProbeInput::new(&phi_x, &phi_z).loads(f_top, f_lat, f_n))
+            .evaluate(&ProbeInput::new(&phi_x, &phi_z).with_loads(f_top, f_lat, f_n).unwrap())
             .unwrap();
         let area = grid.cell_area();
         // Probe accuracy (ProbeSpec::tolerance = 1e-10): transfer factors to 1e-10 times
@@ -376,7 +376,7 @@ fn check_normal(
     tol: f64,
 ) -> std::result::Result<(), TestCaseError> {
     let u0 = iface.heights();
-    let c_z = iface.law().c_z;
+    let c_z = iface.law().c_z();
     let fmax = max_abs(traction);
     let u: Vec<f64> = matvec(&c.c, traction).iter().map(|x| x + offset).collect();
     let compliance_max = u0.iter().fold(0.0f64, |m, h| m.max(h / c_z));
@@ -446,7 +446,7 @@ fn check_tangential(
     tol: f64,
 ) -> std::result::Result<(), TestCaseError> {
     let u0 = iface.heights();
-    let c_x = iface.law().c_x;
+    let c_x = iface.law().c_x();
     let states = iface.states();
     let compliance: Vec<f64> = (0..u0.len())
         .map(|i| {
@@ -562,7 +562,7 @@ fn check_equilibria(
         let mut iface = fresh.clone();
         let mut solver = EquilibriumSolver::builder(plan.clone())
             .material(material)
-            .options(SolverOptions::default().backend(backend))
+            .options(SolverOptions::default().with_backend(backend).unwrap())
             .build()
             .unwrap();
         let mut history = Vec::new();

@@ -58,7 +58,7 @@ fn run(case: Case) {
                 .for_each(|i| iface.break_site(i).unwrap());
         }
         let mut solver = EquilibriumSolver::builder(plan.clone())
-            .options(SolverOptions::default().backend(backend))
+            .options(SolverOptions::default().with_backend(backend).unwrap())
             .build()
             .unwrap();
         let eq = solver.solve_normal(&iface, case.normal_load).unwrap();
@@ -107,11 +107,11 @@ fn run(case: Case) {
             .collect();
         let dz: Vec<f64> = set
             .iter()
-            .map(|&i| case.heights[i] / case.law.c_z)
+            .map(|&i| case.heights[i] / case.law.c_z())
             .collect();
         let dx: Vec<f64> = set
             .iter()
-            .map(|&i| (eq.displacement[i] / case.heights[i]).exp() / case.law.c_x)
+            .map(|&i| (eq.displacement[i] / case.heights[i]).exp() / case.law.c_x())
             .collect();
         println!(
             "| {} | {:?} | {} / {} | {:.1e} | {:.1e} | {:.1e} | {:.1e} | {:.1e} | {} + {} | {} |",

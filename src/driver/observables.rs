@@ -91,7 +91,7 @@ impl Driver {
     /// let scene = Scene::builder().block(0.020, 0.004, 0.010).normal_load(80.0).build()?;
     /// let mut driver = scene.driver()?;
     /// driver.step()?;
-    /// driver.add_probes(&ProbeSpec::default().plane(2e-3))?;
+    /// driver.add_probes(&ProbeSpec::default().with_plane(2e-3))?;
     /// let plane = &driver.stresses()?.planes[0];
     /// assert_eq!((plane.nx, plane.ny), (20, 4));
     /// # Ok::<(), precursors::Error>(())
@@ -125,8 +125,8 @@ impl Driver {
         }
         let force = self.force();
         let input = ProbeInput::new(self.shear_traction()?, self.normal_traction()?)
-            .loads(force * self.split.0, force * self.split.1, self.normal_load)
-            .friction_coefficient(self.friction);
+            .with_loads(force * self.split.0, force * self.split.1, self.normal_load)?
+            .with_friction_coefficient(self.friction)?;
         let mut all = Stresses {
             planes: Vec::new(),
             points: Vec::new(),

@@ -15,7 +15,7 @@ fn main() {
     let mut r = 0;
     while let Some(e) = d.step().unwrap() { if matches!(e, Event::Rupture{..}) { r += 1; if r >= k { break; } } }
     let m = d.material();
-    let scale = scene.grid().cell_area() / (m.young_modulus / (1.0 + m.poisson_ratio));
+    let scale = scene.grid().cell_area() / (m.young_modulus() / (1.0 + m.poisson_ratio()));
     let comp = d.interface().normal_compliance();
     let att: Vec<f64> = d.site_states().iter().map(|s| if *s == SiteState::Attached {1.0} else {0.0}).collect();
     let w = |name: &str, v: &[f64]| { let mut f = std::fs::File::create(format!("/tmp/proto/{name}")).unwrap(); for x in v { f.write_all(&x.to_le_bytes()).unwrap(); } };
