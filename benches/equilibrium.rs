@@ -24,7 +24,7 @@ fn setup(nx: usize, ny: usize) -> (InfluencePlan, Interface, f64) {
 
 fn solver(plan: &InfluencePlan, (backend, threads): (Backend, usize)) -> EquilibriumSolver {
     EquilibriumSolver::builder(plan.clone())
-        .options(
+        .solver_options(
             SolverOptions::default()
                 .with_backend(backend)
                 .unwrap()

@@ -70,7 +70,7 @@ fn one(base: &SceneBuilder, solver: f64, threads: Parallelism) -> Result<Run, pr
     let started = Instant::now();
     let scene = base
         .clone()
-        .solver(
+        .solver_options(
             SolverOptions::default()
                 .with_tolerance(solver)?
                 .with_parallelism(threads)?,

@@ -56,7 +56,7 @@ fn run() -> report::Outcome {
     };
     let start = Instant::now();
     let scene = Scene::builder()
-        .solver(
+        .solver_options(
             SolverOptions::default()
                 .with_tolerance(tolerance)?
                 .with_parallelism(match threads {

@@ -202,7 +202,7 @@ fn normal_area_with(
     let scenes = realizations(builder, options);
     let mut total = 0.0;
     for b in &scenes {
-        let scene = b.clone().build_with(planner)?;
+        let scene = b.clone().build_with_planner(planner)?;
         let mut driver = scene.driver()?;
         driver.step()?;
         total += driver.total_contact_area()?;
@@ -311,7 +311,7 @@ pub fn precursor_curve(builder: &SceneBuilder) -> Result<Vec<(f64, f64)>> {
 
 /// [`precursor_curve`] with the plan from `planner`.
 fn curve_with(builder: &SceneBuilder, planner: &Planner) -> Result<Vec<(f64, f64)>> {
-    let scene = builder.clone().build_with(planner)?;
+    let scene = builder.clone().build_with_planner(planner)?;
     let mut driver = scene.driver()?;
     let mut curve = Vec::new();
     while let Some(event) = driver.step()? {

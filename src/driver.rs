@@ -215,7 +215,7 @@ impl Scene {
     pub fn driver(&self) -> Result<Driver> {
         let solver = EquilibriumSolver::builder(self.plan().clone())
             .material(self.material())
-            .options(self.solver())
+            .solver_options(self.solver_options())
             .build()?;
         let n = self.grid().len();
         Ok(Driver {

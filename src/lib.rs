@@ -66,7 +66,7 @@
 //! use precursors::{Block, Grid, green::InfluencePlan};
 //! let block = Block::new(0.14, 0.007, 0.075)?;          // 140 x 7 x 75 mm
 //! let grid = Grid::from_cell_size(block, 1e-3, 1e-3)?;   // 1 mm cells: 140 x 7
-//! let plan = InfluencePlan::builder(grid).tolerance(1e-8).build()?;
+//! let plan = InfluencePlan::builder(grid).plan_tolerance(1e-8).build()?;
 //! let traction = vec![1.0; grid.len()];                  // 1 Pa everywhere
 //! let mut u = vec![0.0; grid.len()];
 //! plan.apply(&traction, &mut u)?;                        // Ĝ φ (m⁻¹ Pa)

@@ -349,8 +349,9 @@ impl SceneBuilder {
         self
     }
 
-    /// Options of the equilibrium solvers.
-    pub fn solver(mut self, options: SolverOptions) -> Self {
+    /// Options of the equilibrium solvers (scene-file object `solver`; the same method
+    /// name as [`crate::solver::EquilibriumSolverBuilder::solver_options`]).
+    pub fn solver_options(mut self, options: SolverOptions) -> Self {
         self.solver = options;
         self
     }
@@ -506,13 +507,14 @@ impl SceneBuilder {
         identity
     }
 
-    /// The largest relative error accepted on the influence operator's eigenvalues
-    /// (dimensionless, default `1e-8`, as
-    /// [`crate::green::InfluencePlanBuilder::tolerance`]): they are computed to about
+    /// The plan tolerance (scene-file key `plan_tolerance`): the largest relative error
+    /// accepted on the influence operator's eigenvalues (dimensionless, default `1e-8`, as
+    /// [`crate::green::InfluencePlanBuilder::plan_tolerance`]; not the solver's linear
+    /// tolerance, [`crate::SolverOptions::tolerance`]): they are computed to about
     /// 1e-13 whatever it is (`docs/accuracy.md`). The lateral load
     /// table is always summed to `1e-12` relative (closed forms, cheap).
-    pub fn plan_tolerance(mut self, tolerance: f64) -> Self {
-        self.plan_tolerance = tolerance;
+    pub fn plan_tolerance(mut self, plan_tolerance: f64) -> Self {
+        self.plan_tolerance = plan_tolerance;
         self
     }
 
@@ -672,7 +674,7 @@ impl SceneBuilder {
     /// # Errors
     /// The first invalid option, as a typed [`Error`] naming it.
     pub fn build(self) -> Result<Scene> {
-        self.build_with(&Planner::new())
+        self.build_with_planner(&Planner::new())
     }
 
     /// [`SceneBuilder::build`] with the operator from `planner`: scenes of one geometry
@@ -681,7 +683,7 @@ impl SceneBuilder {
     ///
     /// # Errors
     /// As [`SceneBuilder::build`].
-    pub fn build_with(self, planner: &Planner) -> Result<Scene> {
+    pub fn build_with_planner(self, planner: &Planner) -> Result<Scene> {
         let builder = self.clone();
         let (lx, ly, lz) = self.lengths;
         let (block, grid, heights, lateral) = self.checked()?;
@@ -786,8 +788,8 @@ impl Scene {
         self.drive
     }
 
-    /// The solver options ([`SceneBuilder::solver`]).
-    pub fn solver(&self) -> SolverOptions {
+    /// The solver options ([`SceneBuilder::solver_options`]).
+    pub fn solver_options(&self) -> SolverOptions {
         self.solver
     }
 
@@ -882,7 +884,7 @@ mod leaves_out {
         // The spectral backend's FSAI, its local entries and the spectral inverse are
         // built on first use only.
         let scene = small()
-            .solver(
+            .solver_options(
                 SolverOptions::default()
                     .with_backend(crate::Backend::Spectral)
                     .unwrap(),

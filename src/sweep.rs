@@ -681,7 +681,7 @@ impl Sweep {
         }
         empty_but_lock(&dir)?;
         let started = Instant::now();
-        let scene = run.scene.clone().build_with(&self.planner)?;
+        let scene = run.scene.clone().build_with_planner(&self.planner)?;
         let built = started.elapsed().as_secs_f64();
         let mut driver = scene.driver()?;
         let mut tables = RunTables::start(&dir, &driver, None)?;

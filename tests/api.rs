@@ -278,14 +278,14 @@ fn getters_are_named_as_their_setters() {
     let heights = HeightSource::Values(vec![2e-6; 24]);
     let scene = small()
         .springs(law)
-        .solver(options)
+        .solver_options(options)
         .probes(probes.clone())
         .material(material)
         .heights(heights.clone())
         .build()
         .unwrap();
     assert_eq!(scene.springs(), law);
-    assert_eq!(scene.solver(), options);
+    assert_eq!(scene.solver_options(), options);
     assert_eq!(scene.probes(), &probes);
     assert_eq!(scene.material(), material);
     assert_eq!(scene.heights(), &heights);

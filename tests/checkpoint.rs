@@ -75,7 +75,7 @@ fn resumed_runs_repeat_the_uninterrupted_one_spectral() {
     let scene = Scene::builder()
         .block(0.060, 0.010, 0.030)
         .normal_load(1.5e3)
-        .solver(
+        .solver_options(
             SolverOptions::default()
                 .with_backend(Backend::Spectral)
                 .unwrap(),
@@ -97,7 +97,7 @@ fn any_thread_count_repeats_the_sequential_run_and_resumes_it() {
         Scene::builder()
             .block(0.128, 0.064, 0.030)
             .normal_load(3.5e6 * 0.128 * 0.064)
-            .solver(
+            .solver_options(
                 SolverOptions::default()
                     .with_backend(Backend::Spectral)
                     .unwrap()
@@ -250,7 +250,7 @@ fn a_checkpoint_is_refused_on_another_scene() {
         "{message}"
     );
     // The thread count is not part of the run's identity.
-    let threads = b.solver(
+    let threads = b.solver_options(
         SolverOptions::default()
             .with_parallelism(Parallelism::Threads(2))
             .unwrap(),
@@ -304,7 +304,7 @@ pub(crate) mod json {
         let spectral = Scene::builder()
             .block(0.040, 0.010, 0.030)
             .normal_load(1.0e3)
-            .solver(
+            .solver_options(
                 SolverOptions::default()
                     .with_backend(Backend::Spectral)
                     .unwrap(),

@@ -280,7 +280,7 @@ fn naive_protocol(nx: usize, ny: usize, seed: u64) -> (Vec<usize>, Vec<f64>) {
     let material = Material::default();
     let m = material.modulus();
     let plan = green::InfluencePlan::builder(grid)
-        .tolerance(1e-9)
+        .plan_tolerance(1e-9)
         .build()
         .unwrap();
     let c = compliance_matrix(&plan, m);
@@ -421,7 +421,7 @@ fn drivers_and_solvers_can_move_between_threads() {
     let scene = Scene::builder()
         .block(0.030, 0.020, 0.030)
         .normal_load(2.1e3)
-        .solver(
+        .solver_options(
             SolverOptions::default()
                 .with_backend(Backend::Spectral)
                 .unwrap()
@@ -553,12 +553,12 @@ fn precursor_length_under_top_and_rod_loading_and_with_a_drop_threshold() {
                     .zip(&then)
                     .take_while(|(a, b)| **a < (1.0 - drop) * **b)
                     .count();
-                let ell = d.precursor_length_with(*drop).unwrap();
+                let ell = d.precursor_length_with_threshold(*drop).unwrap();
                 assert_eq!(ell, run as f64 * dx, "drop {drop}");
                 assert!(ell <= paper, "a larger drop gives a shorter front");
                 worst[k] = worst[k].max(ell / lx);
             }
-            assert_eq!(d.precursor_length_with(0.0).unwrap(), paper);
+            assert_eq!(d.precursor_length_with_threshold(0.0).unwrap(), paper);
         }
         assert!(stable > 100, "many stable states before slip");
         worst
@@ -586,14 +586,14 @@ fn precursor_drop_threshold_is_refused_outside_zero_to_one() {
     for drop in [-0.1, 1.0, 1.5, f64::NAN, f64::INFINITY] {
         assert!(
             matches!(
-                d.precursor_length_with(drop),
+                d.precursor_length_with_threshold(drop),
                 Err(Error::InvalidParameter { name: "drop", .. })
             ),
             "drop = {drop}"
         );
     }
     assert_eq!(
-        d.precursor_length_with(0.0).unwrap(),
+        d.precursor_length_with_threshold(0.0).unwrap(),
         0.0,
         "zero shear: no front"
     );

@@ -72,7 +72,7 @@ fn tolerances_must_be_positive() {
     }
     let grid = Grid::new(b, 10, 2).unwrap();
     assert!(matches!(
-        InfluencePlan::builder(grid).tolerance(0.0).build(),
+        InfluencePlan::builder(grid).plan_tolerance(0.0).build(),
         Err(Error::InvalidTolerance { .. })
     ));
     let opts = SeriesOptions::default()
@@ -140,14 +140,17 @@ fn operator_inputs_are_checked() {
         Err(Error::NonFinite { index: 3, .. })
     ));
     let big = Grid::new(b, 200, 101).unwrap();
-    let plan = InfluencePlan::builder(big).tolerance(1e-2).build().unwrap();
+    let plan = InfluencePlan::builder(big)
+        .plan_tolerance(1e-2)
+        .build()
+        .unwrap();
     assert!(matches!(plan.dense(), Err(Error::TooLargeForDense { .. })));
 }
 
 #[test]
 fn zero_solver_threads_are_refused() {
     let built = precursors::Scene::builder()
-        .solver(
+        .solver_options(
             precursors::SolverOptions::default()
                 .with_parallelism(precursors::Parallelism::Threads(0))
                 .unwrap(),
@@ -165,7 +168,7 @@ fn zero_solver_threads_are_refused() {
     for threads in [1, 3, 64] {
         let scene = precursors::Scene::builder()
             .block(0.010, 0.005, 0.010)
-            .solver(
+            .solver_options(
                 precursors::SolverOptions::default()
                     .with_parallelism(precursors::Parallelism::Threads(threads))
                     .unwrap(),
@@ -378,7 +381,7 @@ fn threads_with_the_dense_backend() {
             .unwrap()
     };
     let e = Scene::builder()
-        .solver(options(Backend::Dense, Parallelism::Threads(4)))
+        .solver_options(options(Backend::Dense, Parallelism::Threads(4)))
         .build()
         .unwrap_err();
     assert!(matches!(e, Error::DenseThreads { threads: 4, .. }), "{e}");
@@ -389,14 +392,14 @@ fn threads_with_the_dense_backend() {
         Parallelism::CurrentPool,
     ] {
         let scene = Scene::builder()
-            .solver(options(Backend::Dense, parallelism))
+            .solver_options(options(Backend::Dense, parallelism))
             .build()
             .unwrap();
         assert_eq!(scene.driver().unwrap().threads(), 1);
     }
     // Auto picks dense at 980 cells: threads accepted, one used.
     let scene = Scene::builder()
-        .solver(options(Backend::Auto, Parallelism::Threads(4)))
+        .solver_options(options(Backend::Auto, Parallelism::Threads(4)))
         .build()
         .unwrap();
     let mut driver = scene.driver().unwrap();
@@ -405,7 +408,7 @@ fn threads_with_the_dense_backend() {
     // Spectral: as many as asked, up to the parts of the grid (one part below 2048 cells).
     let spectral = Scene::builder()
         .block(0.128, 0.032, 0.075)
-        .solver(options(Backend::Spectral, Parallelism::Threads(2)))
+        .solver_options(options(Backend::Spectral, Parallelism::Threads(2)))
         .build()
         .unwrap()
         .driver()
@@ -414,7 +417,7 @@ fn threads_with_the_dense_backend() {
     // Setting threads later: the same rule.
     driver.set_parallelism(Parallelism::Threads(3)).unwrap();
     let mut dense = Scene::builder()
-        .solver(options(Backend::Dense, Parallelism::Sequential))
+        .solver_options(options(Backend::Dense, Parallelism::Sequential))
         .build()
         .unwrap()
         .driver()
@@ -505,7 +508,7 @@ mod ranges {
     /// refuse, e.g. 0 iterations, are refused at construction:
     /// `solver_options_refuse_invalid_values_at_construction`).
     fn solver(f: impl FnOnce(SolverOptions) -> Result<SolverOptions>) -> SceneBuilder {
-        base().solver(f(SolverOptions::default()).unwrap())
+        base().solver_options(f(SolverOptions::default()).unwrap())
     }
 
     /// The block's shear stiffness `M·Ly·Lz/Lx` of [`base`] (N/m), the paper's PMMA.

@@ -17,7 +17,7 @@ fn setup() -> (Grid, InfluencePlan, RodLoad) {
     let block = Block::new(0.016, 0.004, 0.008).unwrap();
     let grid = Grid::new(block, 8, 2).unwrap();
     let plan = InfluencePlan::builder(grid)
-        .tolerance(1e-11)
+        .plan_tolerance(1e-11)
         .build()
         .unwrap();
     let rod = RodLoad::new(&block, 3e-3, 1e-3).unwrap();

@@ -212,7 +212,7 @@ proptest! {
     /// `Ĝ` is the reciprocity of `G` through its cell averages).
     #[test]
     fn galerkin_operator_equals_independent_assemblies(grid in grids(12, 6), seed in any::<u64>()) {
-        let plan = InfluencePlan::builder(grid).tolerance(PLAN_TOL).build().unwrap();
+        let plan = InfluencePlan::builder(grid).plan_tolerance(PLAN_TOL).build().unwrap();
         let n = grid.len();
         let dense = plan.dense().unwrap();
         let (reference, error) = reference_operator(&grid);
@@ -546,7 +546,7 @@ fn check_equilibria(
     let heights = Heights::truncated_gaussian(&grid, HeightDistribution::default(), seed).unwrap();
     let fresh = Interface::new(grid, heights, SpringLaw::default()).unwrap();
     let plan = InfluencePlan::builder(grid)
-        .tolerance(PLAN_TOL)
+        .plan_tolerance(PLAN_TOL)
         .build()
         .unwrap();
     let c = reference_compliance(&grid, material.modulus());
@@ -562,7 +562,7 @@ fn check_equilibria(
         let mut iface = fresh.clone();
         let mut solver = EquilibriumSolver::builder(plan.clone())
             .material(material)
-            .options(SolverOptions::default().with_backend(backend).unwrap())
+            .solver_options(SolverOptions::default().with_backend(backend).unwrap())
             .build()
             .unwrap();
         let mut history = Vec::new();

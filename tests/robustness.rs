@@ -296,7 +296,7 @@ proptest! {
             .normal_load(pick(9, load, 60.0))
             .drive(drive)
             .plan_tolerance(pick(10, plan_tol, 1e-6))
-            .solver(solver)
+            .solver_options(solver)
             .max_cells(MAX_CELLS);
         builder = if by_size {
             builder.cell_size(pick(12, dx, 1e-3), pick(12, dy, 1e-3))

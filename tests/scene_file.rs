@@ -44,7 +44,7 @@ fn everything() -> SceneBuilder {
                 half_width: 1.5e-3,
             },
         })
-        .solver(solver)
+        .solver_options(solver)
         .plan_tolerance(1e-7)
         .probes(
             probe::ProbeSpec::default()
@@ -280,7 +280,11 @@ fn solver_threads_take_counts_and_names() {
         );
         let builder = SceneBuilder::from_json_str(&text).unwrap();
         let scene = builder.clone().build().unwrap();
-        assert_eq!(scene.solver().parallelism(), want, "threads = {value}");
+        assert_eq!(
+            scene.solver_options().parallelism(),
+            want,
+            "threads = {value}"
+        );
         let again = SceneBuilder::from_json_str(&builder.to_json().unwrap()).unwrap();
         assert_eq!(again, builder, "threads = {value}");
     }

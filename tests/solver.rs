@@ -9,7 +9,7 @@ use precursors::*;
 
 fn solver(plan: &green::InfluencePlan, backend: Backend) -> EquilibriumSolver {
     EquilibriumSolver::builder(plan.clone())
-        .options(SolverOptions::default().with_backend(backend).unwrap())
+        .solver_options(SolverOptions::default().with_backend(backend).unwrap())
         .build()
         .unwrap()
 }
@@ -242,7 +242,7 @@ fn solver_errors_are_typed() {
     let big = scene(150, 150, 1e-4, 0.01, 1);
     assert!(matches!(
         EquilibriumSolver::builder(big.plan)
-            .options(
+            .solver_options(
                 SolverOptions::default()
                     .with_backend(Backend::Dense)
                     .unwrap()
@@ -251,7 +251,7 @@ fn solver_errors_are_typed() {
         Err(Error::TooLargeForDense { .. })
     ));
     assert!(EquilibriumSolver::builder(s.plan.clone())
-        .options(SolverOptions::default().with_tolerance(-1.0).unwrap())
+        .solver_options(SolverOptions::default().with_tolerance(-1.0).unwrap())
         .build()
         .is_err());
 }

@@ -44,7 +44,7 @@ fn condition(c: &[f64], n: usize, set: &[usize], d: &[f64]) -> f64 {
 fn run(case: Case) {
     let n = case.grid.len();
     let plan = InfluencePlan::builder(case.grid)
-        .tolerance(1e-8)
+        .plan_tolerance(1e-8)
         .build()
         .unwrap();
     let m = Material::default();
@@ -58,7 +58,7 @@ fn run(case: Case) {
                 .for_each(|i| iface.break_site(i).unwrap());
         }
         let mut solver = EquilibriumSolver::builder(plan.clone())
-            .options(SolverOptions::default().with_backend(backend).unwrap())
+            .solver_options(SolverOptions::default().with_backend(backend).unwrap())
             .build()
             .unwrap();
         let eq = solver.solve_normal(&iface, case.normal_load).unwrap();

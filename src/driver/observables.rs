@@ -230,7 +230,7 @@ impl Driver {
     /// # Errors
     /// [`Error::InvalidParameter`] for a `drop` outside `[0, 1)` (or NaN); as
     /// [`Driver::real_contact_area`] before the first event.
-    pub fn precursor_length_with(&self, drop: f64) -> Result<f64> {
+    pub fn precursor_length_with_threshold(&self, drop: f64) -> Result<f64> {
         if !(0.0..1.0).contains(&drop) {
             return Err(Error::InvalidParameter {
                 name: "drop",

@@ -91,8 +91,9 @@ impl EquilibriumSolverBuilder {
         self
     }
 
-    /// Solver options.
-    pub fn options(mut self, options: SolverOptions) -> Self {
+    /// Solver options (the same method name as
+    /// [`crate::SceneBuilder::solver_options`]).
+    pub fn solver_options(mut self, options: SolverOptions) -> Self {
         self.options = options;
         self
     }
@@ -216,8 +217,8 @@ impl EquilibriumSolver {
         self.material
     }
 
-    /// The options.
-    pub fn options(&self) -> SolverOptions {
+    /// The solver options ([`EquilibriumSolverBuilder::solver_options`]).
+    pub fn solver_options(&self) -> SolverOptions {
         self.options
     }
 

@@ -9,7 +9,7 @@ fn main() {
     let a: Vec<String> = std::env::args().skip(1).collect();
     let (lx, ly, k): (f64, f64, usize) = (a[0].parse().unwrap(), a[1].parse().unwrap(), a[2].parse().unwrap());
     let scene = Scene::builder().block(lx, ly, 0.075).cell_size(1e-3, 1e-3).normal_load(3.5e6 * lx * ly).seed(1).build().unwrap();
-    let plan = precursors::green::InfluencePlan::builder(*scene.grid()).tolerance(1e-8).build().unwrap();
+    let plan = precursors::green::InfluencePlan::builder(*scene.grid()).plan_tolerance(1e-8).build().unwrap();
     let g = plan.dense().unwrap();
     let mut d = scene.driver().unwrap();
     let mut r = 0;
