@@ -97,7 +97,7 @@ fn one(base: &SceneBuilder, solver: f64, threads: Parallelism) -> Result<Run, pr
             Event::Attach { site } => (2, site.index),
             Event::Stable { load, .. } => {
                 if run.curve.is_empty() {
-                    run.area0 = driver.total_contact_area()?;
+                    run.area0 = driver.real_contact_area()?;
                 }
                 run.curve
                     .push((load.force / mu_fn, driver.precursor_length()? / lx));

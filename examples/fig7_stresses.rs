@@ -52,7 +52,7 @@ fn run() -> report::Outcome {
                     break;
                 }
                 let s = driver.stresses()?;
-                before = Some((load.force, s.planes[0].profile(mu), s.planes[1].profile(mu)));
+                before = Some((load.force, s.planes[0].profile(), s.planes[1].profile()));
             }
         }
         let (force, plane, interface) = before.ok_or("no stable state before the precursor")?;

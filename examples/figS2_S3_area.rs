@@ -35,7 +35,7 @@ fn area_curve(builder: &SceneBuilder) -> precursors::Result<(Vec<(f64, f64)>, f6
     while let Some(event) = driver.step()? {
         match event {
             Event::Stable { load, .. } => {
-                curve.push((load.force / mu_fn, driver.total_contact_area()?))
+                curve.push((load.force / mu_fn, driver.real_contact_area()?))
             }
             Event::GlobalSlip { load } => slip = load.force / mu_fn,
             _ => {}

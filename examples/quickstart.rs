@@ -57,7 +57,7 @@ fn run() -> report::Outcome {
             Event::Stable { load, ruptures } => rows.push((
                 load.force / scale,
                 d.precursor_length().unwrap_or(f64::NAN) / lx,
-                d.total_contact_area().unwrap_or(f64::NAN),
+                d.real_contact_area().unwrap_or(f64::NAN),
                 *ruptures,
                 d.area_exceeds_nominal().unwrap_or(false),
             )),

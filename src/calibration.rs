@@ -205,7 +205,7 @@ fn normal_area_with(
         let scene = b.clone().build_with_planner(planner)?;
         let mut driver = scene.driver()?;
         driver.step()?;
-        total += driver.total_contact_area()?;
+        total += driver.real_contact_area()?;
     }
     Ok(total / scenes.len() as f64)
 }

@@ -725,7 +725,7 @@ impl Interface {
     /// # Errors
     /// [`Error::LengthMismatch`]; [`Error::NonFinite`] for a NaN input or (paper's law) an
     /// overflow.
-    pub fn real_contact_area(&self, u_z: &[f64]) -> Result<Vec<f64>> {
+    pub fn cell_contact_area(&self, u_z: &[f64]) -> Result<Vec<f64>> {
         check_slice("u_z", u_z, self.grid.len())?;
         let cell = self.grid.cell_area();
         let cap = match self.law.area_law {

@@ -46,10 +46,10 @@
 //! while let Some(event) = driver.step()? {
 //!     match event {
 //!         Event::Stable { load, .. } => {
-//!             let area = driver.total_contact_area()?;          // A_R (m²)
+//!             let area = driver.real_contact_area()?;          // A_R (m²)
 //!             let ell = driver.precursor_length()?;             // ℓ (m)
 //!             let plane = &driver.stresses()?.planes[0];        // τ, σ, τ_C (Pa)
-//!             let tau_c = plane.profile(driver.friction_coefficient()).mean_coulomb;
+//!             let tau_c = plane.profile().mean_coulomb;
 //!             assert!(area > 0.0 && (0.0..=lx).contains(&ell) && tau_c.len() == 30);
 //!             assert!(load.force <= mu_fn * (1.0 + 1e-9));      // F ≤ μF_N
 //!         }

@@ -276,6 +276,8 @@ pub struct PlaneStress {
     pub normal: Vec<f64>,
     /// Coulomb stress `τ_C = |τ| - μ|σ|` (Pa) of the cell averages.
     pub coulomb: Vec<f64>,
+    /// The `μ` of the Coulomb stresses (the driver's, or [`ProbeInput`]'s).
+    friction_coefficient: f64,
 }
 
 /// Profiles along x, averaged over y (one value per column, Pa).
@@ -322,10 +324,18 @@ impl PlaneStress {
         })
     }
 
-    /// The y-averaged profiles along x (Pa), with the friction coefficient `μ`
-    /// (dimensionless; a driver's is [`crate::Driver::friction_coefficient`]) used for
-    /// the Coulomb stress of the averages.
-    pub fn profile(&self, friction_coefficient: f64) -> Profile {
+    /// The friction coefficient `μ` (dimensionless) of [`PlaneStress::coulomb`] and of
+    /// [`PlaneStress::profile`]: the driver's ([`crate::Driver::friction_coefficient`])
+    /// for [`crate::Driver::stresses`], [`ProbeInput::with_friction_coefficient`]'s for
+    /// [`StressProbe::evaluate`].
+    pub fn friction_coefficient(&self) -> f64 {
+        self.friction_coefficient
+    }
+
+    /// The y-averaged profiles along x (Pa), with the plane's friction coefficient `μ`
+    /// ([`PlaneStress::friction_coefficient`]) for the Coulomb stress of the averages.
+    pub fn profile(&self) -> Profile {
+        let friction_coefficient = self.friction_coefficient;
         let (nx, ny) = (self.nx, self.ny);
         let mean = |v: &[f64]| -> Vec<f64> {
             let mut out = vec![0.0; nx];
@@ -520,6 +530,7 @@ impl StressProbe {
                 shear,
                 normal,
                 coulomb,
+                friction_coefficient: mu,
             });
         }
         let dot = |k: &[f64], v: &[f64]| k.iter().zip(v).map(|(a, b)| a * b).sum::<f64>();

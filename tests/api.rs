@@ -73,7 +73,7 @@ fn probe_types_are_named_from_the_crate_root() {
     let stresses: Stresses = driver.stresses().unwrap();
     let plane: &PlaneStress = &stresses.planes[0];
     let cell: CellStress = plane.at(0, 0).unwrap();
-    let profile: Profile = plane.profile(driver.friction_coefficient());
+    let profile: Profile = plane.profile();
     let points: &[PointStress] = &stresses.points;
     let probe: StressProbe =
         StressProbe::new(scene.plan(), &ProbeSpec::default().with_plane(0.0), None).unwrap();
@@ -133,11 +133,43 @@ fn plane_cells_are_read_by_column_and_row() {
         assert_eq!(plane.at(ix, iy), None, "({ix}, {iy})");
     }
     // The profile averages the three rows of each column.
-    let profile = plane.profile(mu);
+    let profile = plane.profile();
     for ix in 0..5 {
         let mean = (-shear[ix] - shear[5 + ix] - shear[10 + ix]) / 3.0;
         assert!((profile.shear[ix] - mean).abs() <= 1e-12 * mean.abs().max(1.0));
     }
+}
+
+/// The stresses a driver returns know its `μ` (item 10 of issue 24: `profile(μ)` asked
+/// for a value the driver knows); a standalone probe takes it from its input.
+#[test]
+fn plane_stresses_carry_the_friction_coefficient() {
+    let material = Material::default().with_friction_coefficient(0.7).unwrap();
+    let scene = small()
+        .material(material)
+        .probes(ProbeSpec::default().with_plane(1e-3))
+        .build()
+        .unwrap();
+    let mut driver = scene.driver().unwrap();
+    driver.step().unwrap();
+    let stresses = driver.stresses().unwrap();
+    let plane = &stresses.planes[0];
+    assert_eq!(plane.friction_coefficient(), 0.7);
+    let profile = plane.profile();
+    for ix in 0..plane.nx {
+        let expected = profile.shear[ix].abs() - 0.7 * profile.normal[ix].abs();
+        assert_eq!(profile.coulomb_of_means[ix], expected);
+    }
+    let phi = vec![1.0; scene.grid().len()];
+    let probe =
+        StressProbe::new(scene.plan(), &ProbeSpec::default().with_plane(0.0), None).unwrap();
+    let input = ProbeInput::new(&phi, &phi)
+        .with_friction_coefficient(0.3)
+        .unwrap();
+    assert_eq!(
+        probe.evaluate(&input).unwrap().planes[0].friction_coefficient(),
+        0.3
+    );
 }
 
 #[test]

@@ -476,7 +476,7 @@ fn area_laws_and_the_flag_of_areas_above_the_nominal_area() {
     while let Some(event) = d.step().unwrap() {
         paper_events.push(event);
         let (sum, _) = area_sums(&d);
-        let total = d.total_contact_area().unwrap();
+        let total = d.real_contact_area().unwrap();
         assert!((total - sum).abs() <= 1e-12 * sum.max(nominal));
         let exceeds = d.area_exceeds_nominal().unwrap();
         if matches!(event, Event::Stable { .. }) {
@@ -501,7 +501,7 @@ fn area_laws_and_the_flag_of_areas_above_the_nominal_area() {
     while let Some(event) = d.step().unwrap() {
         events.push(event);
         let (paper, capped) = area_sums(&d);
-        let total = d.total_contact_area().unwrap();
+        let total = d.real_contact_area().unwrap();
         assert!(
             (total - capped).abs() <= 1e-12 * nominal,
             "{total} vs {capped}"

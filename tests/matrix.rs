@@ -128,7 +128,7 @@ fn driver_fields_and_plane_stresses_as_matrices() {
         .field_to_dmatrix(driver.shear_traction().unwrap())
         .unwrap();
     let area = g
-        .field_to_dmatrix(&driver.real_contact_area().unwrap())
+        .field_to_dmatrix(&driver.cell_contact_area().unwrap())
         .unwrap();
     let stresses = driver.stresses().unwrap();
     let plane = &stresses.planes[0];
@@ -138,7 +138,7 @@ fn driver_fields_and_plane_stresses_as_matrices() {
             let i = 5 * iy + ix;
             assert_eq!(normal[(iy, ix)], driver.normal_traction().unwrap()[i]);
             assert_eq!(shear[(iy, ix)], driver.shear_traction().unwrap()[i]);
-            assert_eq!(area[(iy, ix)], driver.real_contact_area().unwrap()[i]);
+            assert_eq!(area[(iy, ix)], driver.cell_contact_area().unwrap()[i]);
             assert_eq!(plane_shear[(iy, ix)], plane.at(ix, iy).unwrap().shear);
         }
     }

@@ -396,14 +396,7 @@ fn probe_errors_are_typed() {
         );
     }
     assert!(matches!(
-        StressProbe::new(
-            &plan,
-            &ProbeSpec::default()
-                .with_plane(1e-3)
-                .with_tolerance(0.0)
-                .unwrap(),
-            None
-        ),
+        ProbeSpec::default().with_plane(1e-3).with_tolerance(0.0),
         Err(Error::InvalidTolerance { .. })
     ));
     let probe = StressProbe::new(&plan, &ProbeSpec::default().with_plane(1e-3), None).unwrap();
@@ -467,6 +460,6 @@ fn the_driver_reports_probes_only_when_requested() {
     // Through z = 2 mm (below the rod band [4, 8] mm) the whole shear force passes.
     let total: f64 = s.planes[1].shear.iter().sum::<f64>() * scene.grid().cell_area();
     assert!((total - d.force()).abs() < 1e-9 * d.force());
-    let profile = s.planes[1].profile(0.5);
+    let profile = s.planes[1].profile();
     assert_eq!(profile.shear.len(), scene.grid().nx());
 }

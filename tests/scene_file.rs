@@ -360,10 +360,7 @@ fn the_cell_limit_and_dense_threads_in_scene_files() {
     );
     assert!(!Scene::builder().to_json().unwrap().contains("max_cells"));
     let dense = r#"{"solver": {"backend": "dense", "threads": 2}}"#;
-    let e = SceneBuilder::from_json_str(dense)
-        .unwrap()
-        .build()
-        .unwrap_err();
+    let e = SceneBuilder::from_json_str(dense).unwrap_err();
     assert!(matches!(e, Error::DenseThreads { threads: 2, .. }), "{e}");
     let auto = r#"{"solver": {"backend": "auto", "threads": 2}}"#;
     let scene = SceneBuilder::from_json_str(auto).unwrap().build().unwrap();

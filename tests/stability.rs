@@ -93,7 +93,7 @@ fn run(case: Case) {
         assert!((shear + 1.0).abs() <= 1e-10, "{}: shear balance", case.name);
         // exp(-(u_z-u0)/u0) overflows for compressions beyond ~700 u0 (soft springs):
         // the report is a typed error, never an infinity.
-        let area_note = match iface.real_contact_area(&eq.displacement) {
+        let area_note = match iface.cell_contact_area(&eq.displacement) {
             Ok(a) => {
                 let area: f64 = a.iter().sum();
                 assert!(area.is_finite() && area > 0.0);
@@ -225,7 +225,7 @@ fn stability_penetration_below_the_substrate() {
         eq.displacement.iter().all(|u| *u < 0.0),
         "every site below the substrate plane"
     );
-    let area = iface.real_contact_area(&eq.displacement).unwrap();
+    let area = iface.cell_contact_area(&eq.displacement).unwrap();
     assert!(
         area.iter().all(|a| *a > g.cell_area()),
         "contact area exceeds the cell"

@@ -21,7 +21,7 @@ fn main() -> Result<(), Error> {
             Event::Rupture { .. } => ruptures += 1,
             Event::Stable { .. } => {
                 stable += 1;
-                let area = driver.total_contact_area()?;
+                let area = driver.real_contact_area()?;
                 let ell = driver.precursor_length()?;
                 let planes = &driver.stresses()?.planes;
                 assert!(area > 0.0 && ell >= 0.0 && planes.len() == 1);
