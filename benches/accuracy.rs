@@ -32,7 +32,11 @@ fn point_series(c: &mut Criterion) {
     let mut group = c.benchmark_group("point_raw");
     group.sample_size(10);
     for tol in [1e-1, 1e-2] {
-        let opts = SeriesOptions::with_tolerance(tol).max_terms(400_000_000);
+        let opts = SeriesOptions::default()
+            .with_tolerance(tol)
+            .unwrap()
+            .with_max_terms(400_000_000)
+            .unwrap();
         group.bench_function(format!("tol={tol:e}"), |b| {
             b.iter(|| small.raw_series(black_box(r), black_box(s), &opts).unwrap())
         });
@@ -64,7 +68,10 @@ fn grid_operator(c: &mut Criterion) {
         b.iter(|| plan.apply(black_box(&v), &mut out).unwrap())
     });
     let big = Grid::new(Block::new(1.0, 0.1, 0.5).unwrap(), 1000, 100).unwrap();
-    let plan = InfluencePlan::builder(big).tolerance(1e-3).build().unwrap();
+    let plan = InfluencePlan::builder(big)
+        .plan_tolerance(1e-3)
+        .build()
+        .unwrap();
     let v: Vec<f64> = (0..big.len()).map(|i| (i as f64 * 0.37).sin()).collect();
     let mut out = vec![0.0; big.len()];
     c.bench_function("operator_apply_1000x100", |b| {

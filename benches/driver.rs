@@ -30,7 +30,7 @@ fn bench(c: &mut Criterion) {
     for (name, backend) in [("dense", Backend::Dense), ("spectral", Backend::Spectral)] {
         let scene = Scene::builder()
             .seed(1)
-            .solver(SolverOptions::default().backend(backend))
+            .solver_options(SolverOptions::default().with_backend(backend).unwrap())
             .build()
             .unwrap();
         group.bench_function(format!("calibration_scene_to_global_slip_{name}"), |b| {
@@ -47,11 +47,15 @@ fn bench(c: &mut Criterion) {
             .cell_size(1e-3, 1e-3)
             .seed(1)
             .normal_load(3.5e6 * 0.200 * 0.050)
-            .solver(SolverOptions::default().parallelism(if threads > 1 {
-                Parallelism::Threads(threads)
-            } else {
-                Parallelism::Sequential
-            }))
+            .solver_options(
+                SolverOptions::default()
+                    .with_parallelism(if threads > 1 {
+                        Parallelism::Threads(threads)
+                    } else {
+                        Parallelism::Sequential
+                    })
+                    .unwrap(),
+            )
             .build()
             .unwrap();
         group.bench_function(format!("n1e4_first_300_ruptures/threads{threads}"), |b| {

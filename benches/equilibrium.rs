@@ -24,14 +24,16 @@ fn setup(nx: usize, ny: usize) -> (InfluencePlan, Interface, f64) {
 
 fn solver(plan: &InfluencePlan, (backend, threads): (Backend, usize)) -> EquilibriumSolver {
     EquilibriumSolver::builder(plan.clone())
-        .options(
+        .solver_options(
             SolverOptions::default()
-                .backend(backend)
-                .parallelism(if threads > 1 {
+                .with_backend(backend)
+                .unwrap()
+                .with_parallelism(if threads > 1 {
                     Parallelism::Threads(threads)
                 } else {
                     Parallelism::Sequential
-                }),
+                })
+                .unwrap(),
         )
         .build()
         .unwrap()

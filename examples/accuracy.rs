@@ -44,7 +44,11 @@ fn run() -> report::Outcome {
         let e = small.raw_series(
             r,
             s,
-            &SeriesOptions::with_tolerance(tol).max_terms(400_000_000),
+            &SeriesOptions::default()
+                .with_tolerance(tol)
+                .unwrap()
+                .with_max_terms(400_000_000)
+                .unwrap(),
         )?;
         println!(
             "| {tol:e} | {:.1e} | {:.1e} |",

@@ -24,20 +24,21 @@ fn base(law: SpringLaw) -> SceneBuilder {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let truth = SpringLaw::default();
-    let options = FitOptions::default().seeds(&[1, 2, 3]);
+    let options = FitOptions::default().with_seeds(&[1, 2, 3]);
     let target = normal_contact_area(&base(truth), &options)?;
-    let mut start_law = truth;
-    start_law.c_z = 1e7;
+    let start_law = truth.with_c_z(1e7)?;
     let clock = Instant::now();
     let fit = fit_normal_stiffness(&base(start_law), target, (1e7, 1e10), &options)?;
     println!(
         "c_z fit: {:.6e} N/m² (truth {:.6e}), {} evaluations, {:.2} s",
         fit.value,
-        truth.c_z,
+        truth.c_z(),
         fit.evaluations,
         clock.elapsed().as_secs_f64()
     );
-    let options = FitOptions::default().seeds(&[1, 2]).tolerance(1e-3);
+    let options = FitOptions::default()
+        .with_seeds(&[1, 2])
+        .with_tolerance(1e-3)?;
     let curves = [1u64, 2]
         .iter()
         .map(|&s| precursor_curve(&base(truth).seed(s)))
@@ -55,7 +56,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "c_x fit: {:.4e} N/m³ (truth {:.4e}), misfit {:.2e} m², {} evaluations, {:.2} s",
         fit.value,
-        truth.c_x,
+        truth.c_x(),
         fit.misfit,
         fit.evaluations,
         clock.elapsed().as_secs_f64()

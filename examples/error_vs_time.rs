@@ -70,13 +70,13 @@ fn one(base: &SceneBuilder, solver: f64, threads: Parallelism) -> Result<Run, pr
     let started = Instant::now();
     let scene = base
         .clone()
-        .solver(
+        .solver_options(
             SolverOptions::default()
-                .tolerance(solver)
-                .parallelism(threads),
+                .with_tolerance(solver)?
+                .with_parallelism(threads)?,
         )
         .build()?;
-    let mu_fn = scene.material().friction_coefficient * scene.normal_load();
+    let mu_fn = scene.material().friction_coefficient() * scene.normal_load();
     let lx = scene.grid().block().lx();
     let mut driver = scene.driver()?;
     let mut run = Run {
@@ -97,7 +97,7 @@ fn one(base: &SceneBuilder, solver: f64, threads: Parallelism) -> Result<Run, pr
             Event::Attach { site } => (2, site.index),
             Event::Stable { load, .. } => {
                 if run.curve.is_empty() {
-                    run.area0 = driver.total_contact_area()?;
+                    run.area0 = driver.real_contact_area()?;
                 }
                 run.curve
                     .push((load.force / mu_fn, driver.precursor_length()? / lx));

@@ -40,7 +40,7 @@ fn run() -> report::Outcome {
                 .build()?;
             let mut driver = scene.driver()?;
             driver.step()?; // the normal equilibrium at zero shear
-            values.push(100.0 * driver.total_contact_area()? / a0);
+            values.push(100.0 * driver.real_contact_area()? / a0);
         }
         let mean = values.iter().sum::<f64>() / values.len() as f64;
         let sd = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>()

@@ -53,7 +53,7 @@ fn run() -> report::Outcome {
             .build()?;
         let nx = scene.grid().nx();
         let dx = scene.grid().dx();
-        let mu_fn = scene.material().friction_coefficient * scene.normal_load();
+        let mu_fn = scene.material().friction_coefficient() * scene.normal_load();
         let mut driver = scene.driver()?;
         let mut states: Vec<(f64, Vec<f64>, f64)> = Vec::new();
         driver.run(|event, d| {

@@ -37,7 +37,7 @@ fn run() -> report::Outcome {
         })
         .seed(1)
         .build()?;
-    let mu_fn = scene.material().friction_coefficient * scene.normal_load();
+    let mu_fn = scene.material().friction_coefficient() * scene.normal_load();
     let mut driver = scene.driver()?;
     let mut rows = Vec::new();
     let mut points = Vec::new();

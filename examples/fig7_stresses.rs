@@ -40,10 +40,10 @@ fn run() -> report::Outcome {
     let mut loads = Vec::new();
     for &seed in &seeds {
         let scene = figures::stress_block()
-            .probes(ProbeSpec::default().plane(z_p).plane(0.0))
+            .probes(ProbeSpec::default().with_plane(z_p).with_plane(0.0))
             .seed(seed)
             .build()?;
-        let mu = scene.material().friction_coefficient;
+        let mu = scene.material().friction_coefficient();
         let mut driver = scene.driver()?;
         let mut before: Option<(f64, Profile, Profile)> = None;
         while let Some(event) = driver.step()? {
@@ -52,7 +52,7 @@ fn run() -> report::Outcome {
                     break;
                 }
                 let s = driver.stresses()?;
-                before = Some((load.force, s.planes[0].profile(mu), s.planes[1].profile(mu)));
+                before = Some((load.force, s.planes[0].profile(), s.planes[1].profile()));
             }
         }
         let (force, plane, interface) = before.ok_or("no stable state before the precursor")?;

@@ -33,10 +33,10 @@ fn run() -> report::Outcome {
     let heights: Vec<f64> = (0..100).map(|k| (k as f64 + 0.5) * 1e-3).collect();
     let mut spec = ProbeSpec::default();
     for &z in &heights {
-        spec = spec.plane(z);
+        spec = spec.with_plane(z);
     }
     let scene = figures::stress_block().probes(spec).seed(1).build()?;
-    let mu = scene.material().friction_coefficient;
+    let mu = scene.material().friction_coefficient();
     let mu_fn = mu * scene.normal_load();
     let nx = scene.grid().nx();
     let lx_mm = scene.grid().block().lx() * 1e3;
@@ -45,7 +45,7 @@ fn run() -> report::Outcome {
         let s = d.stresses()?;
         Ok(s.planes
             .iter()
-            .flat_map(|p| p.profile(mu).coulomb_of_means)
+            .flat_map(|p| p.profile().coulomb_of_means)
             .collect())
     };
     let mut stages: Vec<(String, f64, f64, Vec<f64>)> = Vec::new();

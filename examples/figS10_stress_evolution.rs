@@ -33,10 +33,10 @@ fn run() -> report::Outcome {
     let mut tau = vec![vec![0.0; nx]; levels.len()];
     for &seed in &seeds {
         let scene = figures::stress_block()
-            .probes(ProbeSpec::default().plane(2e-3))
+            .probes(ProbeSpec::default().with_plane(2e-3))
             .seed(seed)
             .build()?;
-        let mu = scene.material().friction_coefficient;
+        let mu = scene.material().friction_coefficient();
         let mu_fn = mu * scene.normal_load();
         let mut driver = scene.driver()?;
         let mut next = 0;
@@ -45,7 +45,7 @@ fn run() -> report::Outcome {
                 continue;
             };
             while next < levels.len() && load.force / mu_fn >= levels[next] {
-                let p = driver.stresses()?.planes[0].profile(mu);
+                let p = driver.stresses()?.planes[0].profile();
                 for ix in 0..nx {
                     sigma[next][ix] += p.normal[ix].abs() / seeds.len() as f64;
                     tau[next][ix] += p.shear[ix].abs() / seeds.len() as f64;

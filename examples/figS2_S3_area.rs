@@ -28,14 +28,14 @@ use std::process::ExitCode;
 /// `(F/(μF_N), A_R)` at every stable state, and the slip load F/(μF_N).
 fn area_curve(builder: &SceneBuilder) -> precursors::Result<(Vec<(f64, f64)>, f64)> {
     let scene = builder.clone().build()?;
-    let mu_fn = scene.material().friction_coefficient * scene.normal_load();
+    let mu_fn = scene.material().friction_coefficient() * scene.normal_load();
     let mut driver = scene.driver()?;
     let mut curve = Vec::new();
     let mut slip = f64::NAN;
     while let Some(event) = driver.step()? {
         match event {
             Event::Stable { load, .. } => {
-                curve.push((load.force / mu_fn, driver.total_contact_area()?))
+                curve.push((load.force / mu_fn, driver.real_contact_area()?))
             }
             Event::GlobalSlip { load } => slip = load.force / mu_fn,
             _ => {}

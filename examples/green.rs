@@ -18,7 +18,7 @@ fn run() -> report::Outcome {
     let block = Block::new(0.140, 0.007, 0.075)?;
     let grid = Grid::from_cell_size(block, 1e-3, 1e-3)?;
     let t = std::time::Instant::now();
-    let plan = InfluencePlan::builder(grid).tolerance(1e-8).build()?;
+    let plan = InfluencePlan::builder(grid).plan_tolerance(1e-8).build()?;
     println!(
         "influence operator of {} x {} cells planned in {:.1} ms (max relative alias error {:.1e})",
         grid.nx(),

@@ -46,7 +46,7 @@ fn run() -> report::Outcome {
     let tolerance: f64 = parse(
         args.get(1),
         "solver tolerance",
-        SolverOptions::default().tolerance,
+        SolverOptions::default().tolerance(),
     )?;
     let threads: usize = parse(args.get(2), "thread count", 1)?;
     let (lx, ly) = match args.get(3).map(String::as_str) {
@@ -56,14 +56,14 @@ fn run() -> report::Outcome {
     };
     let start = Instant::now();
     let scene = Scene::builder()
-        .solver(
+        .solver_options(
             SolverOptions::default()
-                .tolerance(tolerance)
-                .parallelism(match threads {
+                .with_tolerance(tolerance)?
+                .with_parallelism(match threads {
                     0 => Parallelism::all_cores(),
                     1 => Parallelism::Sequential,
                     n => Parallelism::Threads(n),
-                }),
+                })?,
         )
         .block(lx, ly, 0.075)
         .cell_size(1e-3, 1e-3)
@@ -71,7 +71,7 @@ fn run() -> report::Outcome {
         .normal_load(3.5e6 * lx * ly)
         .build()?;
     let built = start.elapsed();
-    let scale = scene.material().friction_coefficient * scene.normal_load();
+    let scale = scene.material().friction_coefficient() * scene.normal_load();
     let mut driver = scene.driver()?;
     let (mut events, mut ruptures, mut stable, mut detach, mut attach) = (0, 0, 0, 0, 0);
     let mut slip = None;
@@ -117,7 +117,7 @@ fn run() -> report::Outcome {
         driver.grid().len(),
         driver.grid().nx(),
         driver.grid().ny(),
-        precursors::SolverOptions::default().backend
+        precursors::SolverOptions::default().backend()
     );
     println!(
         "wall {elapsed:.2} s (scene build {:.3} s); {events} events: {ruptures} ruptures, \

@@ -47,7 +47,7 @@ fn run() -> report::Outcome {
     // The builder's defaults are the calibration scene; only the seed is chosen here.
     let scene = Scene::builder().seed(seed).build()?;
     let lx = scene.grid().block().lx();
-    let scale = scene.material().friction_coefficient * scene.normal_load();
+    let scale = scene.material().friction_coefficient() * scene.normal_load();
     let mut driver = scene.driver()?;
     let mut rows = Vec::new();
     let mut slip = None;
@@ -57,7 +57,7 @@ fn run() -> report::Outcome {
             Event::Stable { load, ruptures } => rows.push((
                 load.force / scale,
                 d.precursor_length().unwrap_or(f64::NAN) / lx,
-                d.total_contact_area().unwrap_or(f64::NAN),
+                d.real_contact_area().unwrap_or(f64::NAN),
                 *ruptures,
                 d.area_exceeds_nominal().unwrap_or(false),
             )),

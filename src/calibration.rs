@@ -13,10 +13,9 @@
 //! use precursors::calibration::{fit_normal_stiffness, normal_contact_area, FitOptions};
 //! use precursors::{Scene, SpringLaw};
 //! let base = Scene::builder().block(0.020, 0.004, 0.010).normal_load(100.0);
-//! let options = FitOptions::default().seeds(&[1, 2]);
+//! let options = FitOptions::default().with_seeds(&[1, 2]);
 //! // A target made with c_z = 3e8 N/m² is recovered.
-//! let mut law = SpringLaw::default();
-//! law.c_z = 3e8;
+//! let law = SpringLaw::default().with_c_z(3e8)?;
 //! let target = normal_contact_area(&base.clone().springs(law), &options)?;
 //! let fit = fit_normal_stiffness(&base, target, (1e7, 1e10), &options)?;
 //! assert!((fit.value / 3e8 - 1.0).abs() < 1e-6);
@@ -24,25 +23,30 @@
 //! ```
 
 use crate::driver::Event;
-use crate::error::{Error, Result};
+use crate::error::{check_tolerance, Error, Result};
 use crate::green::Planner;
 use crate::interface::HeightDistribution;
 use crate::scene::{HeightSource, SceneBuilder};
 
 /// Options of the fits.
+///
+/// The fields are private: options are valid by construction (the defaults, then the
+/// `with_` modifiers).
+///
+/// ```
+/// use precursors::calibration::FitOptions;
+/// let options = FitOptions::default().with_seeds(&[1, 2]).with_tolerance(1e-3)?;
+/// assert_eq!((options.seeds(), options.tolerance()), (&[1, 2][..], 1e-3));
+/// assert!(FitOptions::default().with_scan_points(2).is_err());
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct FitOptions {
-    /// Seeds of the height realizations averaged over (paper Gaussian heights with the
-    /// builder's distribution); empty: the builder's own heights only (default).
-    pub seeds: Vec<u64>,
-    /// Relative accuracy of the fitted constant (dimensionless, default `1e-8`).
-    pub tolerance: f64,
-    /// Largest number of model evaluations (default `200`).
-    pub max_evaluations: usize,
-    /// Points of the logarithmic scan of [`fit_tangential_stiffness`] (default `17`, at
-    /// least 3).
-    pub scan_points: usize,
+    seeds: Vec<u64>,
+    tolerance: f64,
+    max_evaluations: usize,
+    scan_points: usize,
 }
 
 impl Default for FitOptions {
@@ -57,18 +61,79 @@ impl Default for FitOptions {
 }
 
 impl FitOptions {
-    /// With these realizations.
+    /// Seeds of the height realizations averaged over (paper Gaussian heights with the
+    /// builder's distribution); empty: the builder's own heights only (default).
+    pub fn seeds(&self) -> &[u64] {
+        &self.seeds
+    }
+
+    /// Relative accuracy of the fitted constant (dimensionless, default `1e-8`).
+    pub fn tolerance(&self) -> f64 {
+        self.tolerance
+    }
+
+    /// Largest number of model evaluations (default `200`).
+    pub fn max_evaluations(&self) -> usize {
+        self.max_evaluations
+    }
+
+    /// Points of the logarithmic scan of [`fit_tangential_stiffness`] (default `17`, at
+    /// least 3).
+    pub fn scan_points(&self) -> usize {
+        self.scan_points
+    }
+
+    /// The same options with these realizations.
     #[must_use]
-    pub fn seeds(mut self, seeds: &[u64]) -> Self {
+    pub fn with_seeds(mut self, seeds: &[u64]) -> Self {
         self.seeds = seeds.to_vec();
         self
     }
 
-    /// With this relative accuracy of the constant.
-    #[must_use]
-    pub fn tolerance(mut self, tolerance: f64) -> Self {
-        self.tolerance = tolerance;
-        self
+    /// The same options with another relative accuracy of the constant (dimensionless,
+    /// finite and `> 0`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidTolerance`] for a tolerance that is not finite and `> 0`.
+    pub fn with_tolerance(self, tolerance: f64) -> Result<Self> {
+        check_tolerance(tolerance)?;
+        Ok(Self { tolerance, ..self })
+    }
+
+    /// The same options with another evaluation budget (`≥ 1`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidCount`] for 0.
+    pub fn with_max_evaluations(self, max_evaluations: usize) -> Result<Self> {
+        if max_evaluations == 0 {
+            return Err(Error::InvalidCount {
+                name: "max_evaluations",
+                value: 0,
+                reason: "a fit needs at least one model evaluation",
+            });
+        }
+        Ok(Self {
+            max_evaluations,
+            ..self
+        })
+    }
+
+    /// The same options with another scan size (`≥ 3`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidCount`] for fewer than 3 points.
+    pub fn with_scan_points(self, scan_points: usize) -> Result<Self> {
+        if scan_points < 3 {
+            return Err(Error::InvalidCount {
+                name: "scan_points",
+                value: scan_points as u64,
+                reason: "the scan needs at least 3 points to bracket a minimum",
+            });
+        }
+        Ok(Self {
+            scan_points,
+            ..self
+        })
     }
 }
 
@@ -105,15 +170,6 @@ fn realizations(builder: &SceneBuilder, options: &FitOptions) -> Vec<SceneBuilde
         .collect()
 }
 
-fn check_options(options: &FitOptions) -> Result<()> {
-    if !(options.tolerance.is_finite() && options.tolerance > 0.0) {
-        return Err(Error::InvalidTolerance {
-            value: options.tolerance,
-        });
-    }
-    Ok(())
-}
-
 fn check_bracket(name: &'static str, bracket: (f64, f64)) -> Result<()> {
     let (lo, hi) = bracket;
     if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo) {
@@ -130,7 +186,7 @@ fn check_bracket(name: &'static str, bracket: (f64, f64)) -> Result<()> {
 /// `options`.
 ///
 /// # Errors
-/// [`Error::InvalidTolerance`] for invalid `options`; those of
+/// Those of
 /// [`SceneBuilder::build`](crate::SceneBuilder::build) and of the normal solve
 /// ([`Error::SolverNotConverged`], [`Error::EmptyContact`], ...).
 pub fn normal_contact_area(builder: &SceneBuilder, options: &FitOptions) -> Result<f64> {
@@ -146,10 +202,10 @@ fn normal_area_with(
     let scenes = realizations(builder, options);
     let mut total = 0.0;
     for b in &scenes {
-        let scene = b.clone().build_with(planner)?;
+        let scene = b.clone().build_with_planner(planner)?;
         let mut driver = scene.driver()?;
         driver.step()?;
-        total += driver.total_contact_area()?;
+        total += driver.real_contact_area()?;
     }
     Ok(total / scenes.len() as f64)
 }
@@ -161,16 +217,14 @@ fn normal_area_with(
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for a target area that is not finite and `> 0`, a bracket
-/// that is not `0 < low < high` or does not enclose the target; [`Error::InvalidTolerance`]
-/// for invalid `options`; [`Error::FitNotConverged`] past `max_evaluations`; those of
-/// [`normal_contact_area`].
+/// that is not `0 < low < high` or does not enclose the target; [`Error::FitNotConverged`]
+/// past `max_evaluations`; those of [`normal_contact_area`].
 pub fn fit_normal_stiffness(
     builder: &SceneBuilder,
     target_area: f64,
     bracket: (f64, f64),
     options: &FitOptions,
 ) -> Result<Fit> {
-    check_options(options)?;
     check_bracket("c_z bracket (N/m²)", bracket)?;
     if !(target_area.is_finite() && target_area > 0.0) {
         return Err(Error::InvalidParameter {
@@ -183,8 +237,7 @@ pub fn fit_normal_stiffness(
     let planner = Planner::new(); // every evaluation shares the geometry's plan
     let misfit = |ln_cz: f64, evaluations: &mut usize| -> Result<f64> {
         *evaluations += 1;
-        let mut law = builder.current_springs();
-        law.c_z = ln_cz.exp();
+        let law = builder.current_springs().with_c_z(ln_cz.exp())?;
         Ok(normal_area_with(&builder.clone().springs(law), options, &planner)? - target_area)
     };
     let (mut a, mut b) = (bracket.0.ln(), bracket.1.ln());
@@ -257,7 +310,7 @@ pub fn precursor_curve(builder: &SceneBuilder) -> Result<Vec<(f64, f64)>> {
 
 /// [`precursor_curve`] with the plan from `planner`.
 fn curve_with(builder: &SceneBuilder, planner: &Planner) -> Result<Vec<(f64, f64)>> {
-    let scene = builder.clone().build_with(planner)?;
+    let scene = builder.clone().build_with_planner(planner)?;
     let mut driver = scene.driver()?;
     let mut curve = Vec::new();
     while let Some(event) = driver.step()? {
@@ -340,31 +393,21 @@ fn misfit_with(
 /// constant) the one found first is kept.
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] for a bracket that is not `0 < low < high`;
-/// [`Error::InvalidTolerance`] for invalid `options`; [`Error::InvalidCount`] for fewer
-/// than three `scan_points`; those of [`precursor_misfit`].
+/// [`Error::InvalidParameter`] for a bracket that is not `0 < low < high`; those of
+/// [`precursor_misfit`].
 pub fn fit_tangential_stiffness(
     builder: &SceneBuilder,
     targets: &[(f64, f64)],
     bracket: (f64, f64),
     options: &FitOptions,
 ) -> Result<Fit> {
-    check_options(options)?;
     check_bracket("c_x bracket (N/m³)", bracket)?;
     check_targets(targets)?;
-    if options.scan_points < 3 {
-        return Err(Error::InvalidCount {
-            name: "scan_points",
-            value: options.scan_points as u64,
-            reason: "the scan needs at least 3 points to bracket a minimum",
-        });
-    }
     let mut evaluations = 0;
     let planner = Planner::new(); // every evaluation shares the geometry's plan
     let misfit = |ln_cx: f64, evaluations: &mut usize| -> Result<f64> {
         *evaluations += 1;
-        let mut law = builder.current_springs();
-        law.c_x = ln_cx.exp();
+        let law = builder.current_springs().with_c_x(ln_cx.exp())?;
         misfit_with(&builder.clone().springs(law), targets, options, &planner)
     };
     let (lo, hi) = (bracket.0.ln(), bracket.1.ln());

@@ -215,13 +215,13 @@ impl Scene {
     pub fn driver(&self) -> Result<Driver> {
         let solver = EquilibriumSolver::builder(self.plan().clone())
             .material(self.material())
-            .options(self.solver())
+            .solver_options(self.solver_options())
             .build()?;
         let n = self.grid().len();
         Ok(Driver {
             scene: self.clone(),
             grid: *self.grid(),
-            friction: self.material().friction_coefficient,
+            friction: self.material().friction_coefficient(),
             normal_load: self.normal_load(),
             drive: self.drive(),
             unit_load: self.unit_load_displacement(),

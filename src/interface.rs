@@ -16,15 +16,23 @@ use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 
 /// Bulk and friction properties of the block. Defaults: the paper's PMMA.
+///
+/// The fields are private: a `Material` is valid by construction ([`Material::new`], the
+/// `with_` modifiers).
+///
+/// ```
+/// use precursors::Material;
+/// let m = Material::default().with_friction_coefficient(0.7)?;
+/// assert_eq!((m.young_modulus(), m.friction_coefficient()), (3.833e9, 0.7));
+/// assert!(Material::default().with_poisson_ratio(0.6).is_err());
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct Material {
-    /// Young's modulus `E` (Pa). Default `3.833e9`.
-    pub young_modulus: f64,
-    /// Poisson's ratio `ν` (dimensionless, in `(-1, 0.5]`). Default `0.38`.
-    pub poisson_ratio: f64,
-    /// Static local friction coefficient `μ` (dimensionless, `> 0`). Default `0.5`.
-    pub friction_coefficient: f64,
+    young_modulus: f64,
+    poisson_ratio: f64,
+    friction_coefficient: f64,
 }
 
 impl Default for Material {
@@ -38,25 +46,22 @@ impl Default for Material {
 }
 
 impl Material {
-    /// A validated material: `E` (Pa) finite and > 0, `ν` in `(-1, 0.5]`, `μ` finite and `≥ 0`.
+    /// A validated material: Young's modulus `E` (Pa) finite and `> 0`, Poisson's ratio
+    /// `ν` in `(-1, 0.5]`, the friction coefficient `μ` (dimensionless) finite and `> 0`.
     ///
     /// # Errors
-    /// As [`Material::validate`].
+    /// [`Error::InvalidParameter`] naming the first value out of range.
     pub fn new(young_modulus: f64, poisson_ratio: f64, friction_coefficient: f64) -> Result<Self> {
         let m = Self {
             young_modulus,
             poisson_ratio,
             friction_coefficient,
         };
-        m.validate()?;
+        m.check()?;
         Ok(m)
     }
 
-    /// Checks the fields (they are public, so a struct literal may hold anything).
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] naming the first field out of range.
-    pub fn validate(&self) -> Result<()> {
+    fn check(self) -> Result<Self> {
         if !(self.young_modulus.is_finite() && self.young_modulus > 0.0) {
             return Err(Error::InvalidParameter {
                 name: "young_modulus",
@@ -79,7 +84,58 @@ impl Material {
                          site slips at zero shear and the loads F/(μF_N) are undefined)",
             });
         }
-        Ok(())
+        Ok(self)
+    }
+
+    /// Young's modulus `E` (Pa). Default `3.833e9`.
+    pub fn young_modulus(&self) -> f64 {
+        self.young_modulus
+    }
+
+    /// Poisson's ratio `ν` (dimensionless, in `(-1, 0.5]`). Default `0.38`.
+    pub fn poisson_ratio(&self) -> f64 {
+        self.poisson_ratio
+    }
+
+    /// Static local friction coefficient `μ` (dimensionless, `> 0`). Default `0.5`.
+    pub fn friction_coefficient(&self) -> f64 {
+        self.friction_coefficient
+    }
+
+    /// The same material with Young's modulus `E` (Pa).
+    ///
+    /// # Errors
+    /// As [`Material::new`].
+    pub fn with_young_modulus(self, young_modulus: f64) -> Result<Self> {
+        Self {
+            young_modulus,
+            ..self
+        }
+        .check()
+    }
+
+    /// The same material with Poisson's ratio `ν` (dimensionless).
+    ///
+    /// # Errors
+    /// As [`Material::new`].
+    pub fn with_poisson_ratio(self, poisson_ratio: f64) -> Result<Self> {
+        Self {
+            poisson_ratio,
+            ..self
+        }
+        .check()
+    }
+
+    /// The same material with the friction coefficient `μ` (dimensionless).
+    ///
+    /// # Errors
+    /// As [`Material::new`].
+    pub fn with_friction_coefficient(self, friction_coefficient: f64) -> Result<Self> {
+        Self {
+            friction_coefficient,
+            ..self
+        }
+        .check()
     }
 
     /// The scalar model's modulus `M = E / (1 + ν)` (Pa).
@@ -108,16 +164,23 @@ pub enum AreaLaw {
 
 /// The constants of the spring laws and the real-contact-area law. Defaults: the paper's
 /// calibrated PMMA values and its area law.
+///
+/// The fields are private: a `SpringLaw` is valid by construction ([`SpringLaw::new`],
+/// the `with_` modifiers).
+///
+/// ```
+/// use precursors::{AreaLaw, SpringLaw};
+/// let law = SpringLaw::default().with_c_z(3e8)?.with_area_law(AreaLaw::Capped);
+/// assert_eq!((law.c_x(), law.c_z(), law.area_law()), (1.65e12, 3e8, AreaLaw::Capped));
+/// assert!(SpringLaw::new(-1.0, 1e8).is_err());
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct SpringLaw {
-    /// `c_x` (N/m³): tangential stiffness per unit area of a site at `u_z = 0`. Default `1.65e12`.
-    pub c_x: f64,
-    /// `c_z` (N/m²): `k_z = c_z / u0`. Default `1.65e8`.
-    pub c_z: f64,
-    /// The real contact area of an attached site (m², outputs only). Default
-    /// [`AreaLaw::Paper`].
-    pub area_law: AreaLaw,
+    c_x: f64,
+    c_z: f64,
+    area_law: AreaLaw,
 }
 
 impl Default for SpringLaw {
@@ -131,32 +194,21 @@ impl Default for SpringLaw {
 }
 
 impl SpringLaw {
-    /// A validated law: both constants finite and > 0; the paper's area law.
-    ///
-    /// # Errors
-    /// As [`SpringLaw::validate`].
-    pub fn new(c_x: f64, c_z: f64) -> Result<Self> {
-        let law = Self {
-            c_x,
-            c_z,
-            area_law: AreaLaw::Paper,
-        };
-        law.validate()?;
-        Ok(law)
-    }
-
-    /// The same constants with another real-contact-area law.
-    #[must_use]
-    pub fn with_area_law(mut self, area_law: AreaLaw) -> Self {
-        self.area_law = area_law;
-        self
-    }
-
-    /// Checks the fields.
+    /// A validated law: `c_x` (N/m³) and `c_z` (N/m²) finite and `> 0`; the paper's area
+    /// law.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] for a constant that is not finite and `> 0`.
-    pub fn validate(&self) -> Result<()> {
+    pub fn new(c_x: f64, c_z: f64) -> Result<Self> {
+        Self {
+            c_x,
+            c_z,
+            area_law: AreaLaw::Paper,
+        }
+        .check()
+    }
+
+    fn check(self) -> Result<Self> {
         for (name, value) in [("c_x", self.c_x), ("c_z", self.c_z)] {
             if !(value.is_finite() && value > 0.0) {
                 return Err(Error::InvalidParameter {
@@ -166,19 +218,69 @@ impl SpringLaw {
                 });
             }
         }
-        Ok(())
+        Ok(self)
+    }
+
+    /// `c_x` (N/m³): tangential stiffness per unit area of a site at `u_z = 0`. Default
+    /// `1.65e12`.
+    pub fn c_x(&self) -> f64 {
+        self.c_x
+    }
+
+    /// `c_z` (N/m²): `k_z = c_z / u0`. Default `1.65e8`.
+    pub fn c_z(&self) -> f64 {
+        self.c_z
+    }
+
+    /// The real contact area of an attached site (m², outputs only). Default
+    /// [`AreaLaw::Paper`].
+    pub fn area_law(&self) -> AreaLaw {
+        self.area_law
+    }
+
+    /// The same law with another `c_x` (N/m³).
+    ///
+    /// # Errors
+    /// As [`SpringLaw::new`].
+    pub fn with_c_x(self, c_x: f64) -> Result<Self> {
+        Self { c_x, ..self }.check()
+    }
+
+    /// The same law with another `c_z` (N/m²).
+    ///
+    /// # Errors
+    /// As [`SpringLaw::new`].
+    pub fn with_c_z(self, c_z: f64) -> Result<Self> {
+        Self { c_z, ..self }.check()
+    }
+
+    /// The same constants with another real-contact-area law.
+    #[must_use]
+    pub fn with_area_law(self, area_law: AreaLaw) -> Self {
+        Self { area_law, ..self }
     }
 }
 
 /// The Gaussian the heights are drawn from before truncation at 0. Defaults: the paper's
 /// mean 1 µm and standard deviation 1 µm.
+///
+/// The fields are private: a distribution is valid by construction
+/// ([`HeightDistribution::new`], the `with_` modifiers): a finite mean, a finite standard
+/// deviation `≥ 0`, and `mean ≥ -3 std_dev` (and `mean > 0` when `std_dev = 0`), so that
+/// rejection sampling keeps at least 0.1 % of draws.
+///
+/// ```
+/// use precursors::HeightDistribution;
+/// let d = HeightDistribution::new(2e-6, 0.5e-6)?;
+/// assert_eq!((d.mean(), d.std_dev()), (2e-6, 0.5e-6));
+/// assert!(HeightDistribution::new(1e-6, -1e-6).is_err());
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct HeightDistribution {
-    /// Mean of the untruncated Gaussian (m). Default `1e-6`.
-    pub mean: f64,
-    /// Standard deviation of the untruncated Gaussian (m, `≥ 0`). Default `1e-6`.
-    pub std_dev: f64,
+    mean: f64,
+    std_dev: f64,
 }
 
 impl Default for HeightDistribution {
@@ -192,65 +294,42 @@ impl Default for HeightDistribution {
 
 impl HeightDistribution {
     /// A distribution with the given mean and standard deviation (m).
-    pub fn new(mean: f64, std_dev: f64) -> Self {
-        Self { mean, std_dev }
-    }
-}
-
-/// Smallest `mean / std_dev` accepted: rejection sampling then keeps at least 0.1 % of draws.
-const MIN_MEAN_OVER_SD: f64 = -3.0;
-
-/// Rest heights `u0_i > 0` (m) of the springs, one per cell in the paper's order
-/// `i = iy * Nx + ix`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Heights {
-    values: Vec<f64>,
-}
-
-impl Heights {
-    /// Heights drawn from a Gaussian truncated at 0 (draws `≤ 0` are redrawn), seeded.
-    ///
-    /// The stream is fixed: `Xoshiro256PlusPlus::seed_from_u64(seed)` feeding
-    /// `rand_distr::Normal`, one height per cell in cell order. The same seed gives the
-    /// same heights on every platform (a value-stability test pins them).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] for a mean or standard deviation that is not finite (or
     /// negative), or a mean below `-3` standard deviations.
-    pub fn truncated_gaussian(grid: &Grid, dist: HeightDistribution, seed: u64) -> Result<Self> {
-        Self::check_distribution(dist)?;
-        let HeightDistribution { mean, std_dev } = dist;
-        let normal = Normal::new(mean, std_dev).map_err(|_| Error::InvalidParameter {
-            name: "std_dev",
-            value: std_dev,
-            reason: "rejected by rand_distr::Normal",
-        })?;
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let values = (0..grid.len())
-            .map(|_| loop {
-                let h = normal.sample(&mut rng);
-                if h > 0.0 {
-                    break h;
-                }
-            })
-            .collect();
-        Ok(Self { values })
+    pub fn new(mean: f64, std_dev: f64) -> Result<Self> {
+        Self { mean, std_dev }.check()
     }
 
-    /// User-supplied heights (a measured topography), in cell order `i = iy * Nx + ix`:
-    /// one finite value `> 0` (m) per cell.
+    /// Mean of the untruncated Gaussian (m). Default `1e-6`.
+    pub fn mean(&self) -> f64 {
+        self.mean
+    }
+
+    /// Standard deviation of the untruncated Gaussian (m, `≥ 0`). Default `1e-6`.
+    pub fn std_dev(&self) -> f64 {
+        self.std_dev
+    }
+
+    /// The same distribution with another mean (m).
     ///
     /// # Errors
-    /// [`Error::LengthMismatch`] for a count other than the grid's; [`Error::NonFinite`];
-    /// [`Error::NonPositiveHeight`].
-    pub fn from_values(grid: &Grid, values: Vec<f64>) -> Result<Self> {
-        Self::check_values(grid, &values)?;
-        Ok(Self { values })
+    /// As [`HeightDistribution::new`].
+    pub fn with_mean(self, mean: f64) -> Result<Self> {
+        Self { mean, ..self }.check()
     }
 
-    /// The checks of [`Heights::truncated_gaussian`] without drawing.
-    pub(crate) fn check_distribution(dist: HeightDistribution) -> Result<()> {
-        let HeightDistribution { mean, std_dev } = dist;
+    /// The same distribution with another standard deviation (m).
+    ///
+    /// # Errors
+    /// As [`HeightDistribution::new`].
+    pub fn with_std_dev(self, std_dev: f64) -> Result<Self> {
+        Self { std_dev, ..self }.check()
+    }
+
+    fn check(self) -> Result<Self> {
+        let HeightDistribution { mean, std_dev } = self;
         if !mean.is_finite() {
             return Err(Error::InvalidParameter {
                 name: "mean",
@@ -280,7 +359,58 @@ impl Heights {
                          almost every draw would be cut at 0",
             });
         }
-        Ok(())
+        Ok(self)
+    }
+}
+
+/// Smallest `mean / std_dev` accepted: rejection sampling then keeps at least 0.1 % of draws.
+const MIN_MEAN_OVER_SD: f64 = -3.0;
+
+/// Rest heights `u0_i > 0` (m) of the springs, one per cell in the paper's order
+/// `i = iy * Nx + ix`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Heights {
+    values: Vec<f64>,
+}
+
+impl Heights {
+    /// Heights drawn from a Gaussian truncated at 0 (draws `≤ 0` are redrawn), seeded.
+    ///
+    /// The stream is fixed: `Xoshiro256PlusPlus::seed_from_u64(seed)` feeding
+    /// `rand_distr::Normal`, one height per cell in cell order. The same seed gives the
+    /// same heights on every platform (a value-stability test pins them).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] when `rand_distr` refuses the distribution (it does
+    /// not: a [`HeightDistribution`] is valid by construction).
+    pub fn truncated_gaussian(grid: &Grid, dist: HeightDistribution, seed: u64) -> Result<Self> {
+        let HeightDistribution { mean, std_dev } = dist;
+        let normal = Normal::new(mean, std_dev).map_err(|_| Error::InvalidParameter {
+            name: "std_dev",
+            value: std_dev,
+            reason: "rejected by rand_distr::Normal",
+        })?;
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let values = (0..grid.len())
+            .map(|_| loop {
+                let h = normal.sample(&mut rng);
+                if h > 0.0 {
+                    break h;
+                }
+            })
+            .collect();
+        Ok(Self { values })
+    }
+
+    /// User-supplied heights (a measured topography), in cell order `i = iy * Nx + ix`:
+    /// one finite value `> 0` (m) per cell.
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] for a count other than the grid's; [`Error::NonFinite`];
+    /// [`Error::NonPositiveHeight`].
+    pub fn from_values(grid: &Grid, values: Vec<f64>) -> Result<Self> {
+        Self::check_values(grid, &values)?;
+        Ok(Self { values })
     }
 
     /// The checks of [`Heights::from_values`] without copying.
@@ -390,10 +520,8 @@ impl Interface {
     /// must be). `heights` must have one value per cell.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for an invalid law; [`Error::LengthMismatch`] when the
-    /// heights are not one per cell.
+    /// [`Error::LengthMismatch`] when the heights are not one per cell.
     pub fn new(grid: Grid, heights: Heights, law: SpringLaw) -> Result<Self> {
-        law.validate()?;
         if heights.len() != grid.len() {
             return Err(Error::LengthMismatch {
                 name: "heights",
@@ -597,7 +725,7 @@ impl Interface {
     /// # Errors
     /// [`Error::LengthMismatch`]; [`Error::NonFinite`] for a NaN input or (paper's law) an
     /// overflow.
-    pub fn real_contact_area(&self, u_z: &[f64]) -> Result<Vec<f64>> {
+    pub fn cell_contact_area(&self, u_z: &[f64]) -> Result<Vec<f64>> {
         check_slice("u_z", u_z, self.grid.len())?;
         let cell = self.grid.cell_area();
         let cap = match self.law.area_law {

@@ -39,17 +39,17 @@
 //!     .cell_size(1e-3, 1e-3)                            // 30 x 7 cells (m)
 //!     .normal_load(750.0)                               // F_N (N); rod drive, PMMA
 //!     .seed(1)                                          // the heights' realization
-//!     .probes(ProbeSpec::default().plane(2e-3))         // stresses at z = 2 mm
+//!     .probes(ProbeSpec::default().with_plane(2e-3))         // stresses at z = 2 mm
 //!     .build()?;
 //! let mut driver = scene.driver()?;
-//! let (lx, mu_fn) = (0.030, scene.material().friction_coefficient * 750.0);
+//! let (lx, mu_fn) = (0.030, scene.material().friction_coefficient() * 750.0);
 //! while let Some(event) = driver.step()? {
 //!     match event {
 //!         Event::Stable { load, .. } => {
-//!             let area = driver.total_contact_area()?;          // A_R (m²)
+//!             let area = driver.real_contact_area()?;          // A_R (m²)
 //!             let ell = driver.precursor_length()?;             // ℓ (m)
 //!             let plane = &driver.stresses()?.planes[0];        // τ, σ, τ_C (Pa)
-//!             let tau_c = plane.profile(driver.friction_coefficient()).mean_coulomb;
+//!             let tau_c = plane.profile().mean_coulomb;
 //!             assert!(area > 0.0 && (0.0..=lx).contains(&ell) && tau_c.len() == 30);
 //!             assert!(load.force <= mu_fn * (1.0 + 1e-9));      // F ≤ μF_N
 //!         }
@@ -66,7 +66,7 @@
 //! use precursors::{Block, Grid, green::InfluencePlan};
 //! let block = Block::new(0.14, 0.007, 0.075)?;          // 140 x 7 x 75 mm
 //! let grid = Grid::from_cell_size(block, 1e-3, 1e-3)?;   // 1 mm cells: 140 x 7
-//! let plan = InfluencePlan::builder(grid).tolerance(1e-8).build()?;
+//! let plan = InfluencePlan::builder(grid).plan_tolerance(1e-8).build()?;
 //! let traction = vec![1.0; grid.len()];                  // 1 Pa everywhere
 //! let mut u = vec![0.0; grid.len()];
 //! plan.apply(&traction, &mut u)?;                        // Ĝ φ (m⁻¹ Pa)

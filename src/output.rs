@@ -615,7 +615,7 @@ impl RunTables {
                 load.force,
                 load.force / mu_fn,
                 optional(load.drive_displacement),
-                driver.total_contact_area()?,
+                driver.real_contact_area()?,
                 ell,
                 ell / driver.grid().block().lx(),
                 u8::from(exceeds),

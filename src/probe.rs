@@ -28,7 +28,7 @@
 //! let scene = Scene::builder()
 //!     .block(0.020, 0.004, 0.010)
 //!     .normal_load(80.0)
-//!     .probes(ProbeSpec::default().plane(2e-3).point(Point::new(0.005, 0.002, 2e-3)))
+//!     .probes(ProbeSpec::default().with_plane(2e-3).with_point(Point::new(0.005, 0.002, 2e-3)))
 //!     .build()?;
 //! let mut driver = scene.driver()?;
 //! driver.step()?; // the normal equilibrium at zero shear
@@ -54,20 +54,28 @@ const MAX_SHELLS: usize = 64;
 /// any time ([`crate::Driver::add_probes`]), or on a scene ([`crate::SceneBuilder::probes`])
 /// as the set every driver of the scene starts with; neither changes the scene's
 /// identity (checkpoints resume across them). Nothing is planned without them.
+///
+/// The fields are private: the tolerance is valid by construction
+/// ([`ProbeSpec::with_tolerance`]); the heights of planes and the points are checked
+/// against the block where the probes are planned (a scene's build,
+/// [`crate::Driver::add_probes`], [`StressProbe::new`]).
+///
+/// ```
+/// use precursors::{Point, ProbeSpec};
+/// let spec = ProbeSpec::default()
+///     .with_plane(2e-3)
+///     .with_point(Point::new(0.005, 0.002, 2e-3))
+///     .with_tolerance(1e-12)?;
+/// assert_eq!((spec.planes(), spec.points().len(), spec.tolerance()), (&[2e-3][..], 1, 1e-12));
+/// assert!(ProbeSpec::default().with_tolerance(0.0).is_err());
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct ProbeSpec {
-    /// Heights `z ∈ [0, Lz]` (m) of the planes.
-    pub planes: Vec<f64>,
-    /// Points inside the block (m). Each costs a kernel of `N` values, built once from
-    /// alias sums over every mode (`O(N)` times the alias shells, which grow like
-    /// `Δ/z` for points close to the interface) and one 2-D DCT: use planes for fields,
-    /// points for a few probes.
-    pub points: Vec<Point>,
-    /// Absolute accuracy of the transfer factors (dimensionless, `≤ 1`; default `1e-10`):
-    /// the stresses are accurate to this times the largest traction. The lateral load's
-    /// series is summed to this relative to the load's scale.
-    pub tolerance: f64,
+    planes: Vec<f64>,
+    points: Vec<Point>,
+    tolerance: f64,
 }
 
 impl Default for ProbeSpec {
@@ -81,25 +89,50 @@ impl Default for ProbeSpec {
 }
 
 impl ProbeSpec {
-    /// With a plane at height `z` (m).
+    /// Heights `z ∈ [0, Lz]` (m) of the planes (scene-file key `probes.planes`).
+    pub fn planes(&self) -> &[f64] {
+        &self.planes
+    }
+
+    /// Points inside the block (m; scene-file key `probes.points`). Each costs a kernel
+    /// of `N` values, built once from alias sums over every mode (`O(N)` times the alias
+    /// shells, which grow like `Δ/z` for points close to the interface) and one 2-D DCT:
+    /// use planes for fields, points for a few probes.
+    pub fn points(&self) -> &[Point] {
+        &self.points
+    }
+
+    /// Absolute accuracy of the transfer factors (dimensionless, `> 0`; default `1e-10`;
+    /// scene-file key `probes.tolerance`): the stresses are accurate to this times the
+    /// largest traction. The lateral load's series is summed to this relative to the
+    /// load's scale.
+    pub fn tolerance(&self) -> f64 {
+        self.tolerance
+    }
+
+    /// The same spec with one more plane, at height `z` (m; checked against the block
+    /// where the probes are planned).
     #[must_use]
-    pub fn plane(mut self, z: f64) -> Self {
+    pub fn with_plane(mut self, z: f64) -> Self {
         self.planes.push(z);
         self
     }
 
-    /// With a point probe (m).
+    /// The same spec with one more point probe (m; checked against the block where the
+    /// probes are planned).
     #[must_use]
-    pub fn point(mut self, point: Point) -> Self {
+    pub fn with_point(mut self, point: Point) -> Self {
         self.points.push(point);
         self
     }
 
-    /// With the given accuracy (dimensionless).
-    #[must_use]
-    pub fn tolerance(mut self, tolerance: f64) -> Self {
-        self.tolerance = tolerance;
-        self
+    /// The same spec with another accuracy (dimensionless, finite and `> 0`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidTolerance`] for a tolerance that is not finite and `> 0`.
+    pub fn with_tolerance(mut self, tolerance: f64) -> Result<Self> {
+        self.tolerance = check_tolerance(tolerance)?;
+        Ok(self)
     }
 
     /// Whether nothing is requested.
@@ -108,26 +141,34 @@ impl ProbeSpec {
     }
 }
 
-/// The loads and interface tractions a stress evaluation needs.
+/// The loads and interface tractions a stress evaluation needs
+/// ([`StressProbe::evaluate`]). The tractions' lengths are checked against the probe's
+/// grid when evaluated; the loads and the friction coefficient when set.
+///
+/// ```
+/// use precursors::ProbeInput;
+/// let (phi_x, phi_z) = (vec![0.0; 4], vec![1e5; 4]);
+/// let input = ProbeInput::new(&phi_x, &phi_z)
+///     .with_loads(0.0, 10.0, 40.0)?
+///     .with_friction_coefficient(0.7)?;
+/// assert_eq!((input.lateral_force(), input.friction_coefficient()), (10.0, 0.7));
+/// assert!(input.with_friction_coefficient(-1.0).is_err());
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy)]
 #[non_exhaustive]
 pub struct ProbeInput<'a> {
-    /// Bottom shear traction `φ_x` per cell (Pa).
-    pub shear_traction: &'a [f64],
-    /// Bottom normal traction `φ_z` per cell (Pa).
-    pub normal_traction: &'a [f64],
-    /// Top shear force `F_top` (N, along +x).
-    pub top_force: f64,
-    /// Lateral shear force `F_lat` (N, along +x) on the trailing face.
-    pub lateral_force: f64,
-    /// Normal load `F_N` (N, pressing down).
-    pub normal_load: f64,
-    /// Friction coefficient `μ` of the Coulomb stress (dimensionless).
-    pub friction_coefficient: f64,
+    shear_traction: &'a [f64],
+    normal_traction: &'a [f64],
+    top_force: f64,
+    lateral_force: f64,
+    normal_load: f64,
+    friction_coefficient: f64,
 }
 
 impl<'a> ProbeInput<'a> {
-    /// Tractions only (no external load): `F_top = F_lat = F_N = 0`, `μ = 0.5`.
+    /// Tractions only (no external load): `F_top = F_lat = F_N = 0`, `μ = 0.5`. The
+    /// shear traction `φ_x` and normal traction `φ_z` (Pa), one per cell.
     pub fn new(shear_traction: &'a [f64], normal_traction: &'a [f64]) -> Self {
         Self {
             shear_traction,
@@ -139,20 +180,80 @@ impl<'a> ProbeInput<'a> {
         }
     }
 
-    /// With the external loads (N).
-    #[must_use]
-    pub fn loads(mut self, top_force: f64, lateral_force: f64, normal_load: f64) -> Self {
-        self.top_force = top_force;
-        self.lateral_force = lateral_force;
-        self.normal_load = normal_load;
-        self
+    /// With the external loads (N, finite): the top shear force `F_top` and the lateral
+    /// shear force `F_lat` (along +x), the normal load `F_N` (pressing down).
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`] for a load that is not finite.
+    pub fn with_loads(self, top_force: f64, lateral_force: f64, normal_load: f64) -> Result<Self> {
+        for (name, value) in [
+            ("top_force", top_force),
+            ("lateral_force", lateral_force),
+            ("normal_load", normal_load),
+        ] {
+            if !value.is_finite() {
+                return Err(Error::NonFinite {
+                    name,
+                    index: 0,
+                    value,
+                });
+            }
+        }
+        Ok(Self {
+            top_force,
+            lateral_force,
+            normal_load,
+            ..self
+        })
     }
 
-    /// With the friction coefficient `μ` (dimensionless).
-    #[must_use]
-    pub fn friction_coefficient(mut self, friction_coefficient: f64) -> Self {
-        self.friction_coefficient = friction_coefficient;
-        self
+    /// With the friction coefficient `μ` of the Coulomb stress (dimensionless, finite and
+    /// `≥ 0`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a negative or non-finite coefficient.
+    pub fn with_friction_coefficient(self, friction_coefficient: f64) -> Result<Self> {
+        if !(friction_coefficient.is_finite() && friction_coefficient >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "friction_coefficient",
+                value: friction_coefficient,
+                reason: "the friction coefficient must be finite and >= 0",
+            });
+        }
+        Ok(Self {
+            friction_coefficient,
+            ..self
+        })
+    }
+
+    /// Bottom shear traction `φ_x` per cell (Pa).
+    pub fn shear_traction(&self) -> &'a [f64] {
+        self.shear_traction
+    }
+
+    /// Bottom normal traction `φ_z` per cell (Pa).
+    pub fn normal_traction(&self) -> &'a [f64] {
+        self.normal_traction
+    }
+
+    /// Top shear force `F_top` (N, along +x).
+    pub fn top_force(&self) -> f64 {
+        self.top_force
+    }
+
+    /// Lateral shear force `F_lat` (N, along +x) on the trailing face.
+    pub fn lateral_force(&self) -> f64 {
+        self.lateral_force
+    }
+
+    /// Normal load `F_N` (N, pressing down).
+    pub fn normal_load(&self) -> f64 {
+        self.normal_load
+    }
+
+    /// Friction coefficient `μ` of the Coulomb stress (dimensionless).
+    pub fn friction_coefficient(&self) -> f64 {
+        self.friction_coefficient
     }
 }
 
@@ -175,6 +276,8 @@ pub struct PlaneStress {
     pub normal: Vec<f64>,
     /// Coulomb stress `τ_C = |τ| - μ|σ|` (Pa) of the cell averages.
     pub coulomb: Vec<f64>,
+    /// The `μ` of the Coulomb stresses (the driver's, or [`ProbeInput`]'s).
+    friction_coefficient: f64,
 }
 
 /// Profiles along x, averaged over y (one value per column, Pa).
@@ -221,10 +324,18 @@ impl PlaneStress {
         })
     }
 
-    /// The y-averaged profiles along x (Pa), with the friction coefficient `μ`
-    /// (dimensionless; a driver's is [`crate::Driver::friction_coefficient`]) used for
-    /// the Coulomb stress of the averages.
-    pub fn profile(&self, friction_coefficient: f64) -> Profile {
+    /// The friction coefficient `μ` (dimensionless) of [`PlaneStress::coulomb`] and of
+    /// [`PlaneStress::profile`]: the driver's ([`crate::Driver::friction_coefficient`])
+    /// for [`crate::Driver::stresses`], [`ProbeInput::with_friction_coefficient`]'s for
+    /// [`StressProbe::evaluate`].
+    pub fn friction_coefficient(&self) -> f64 {
+        self.friction_coefficient
+    }
+
+    /// The y-averaged profiles along x (Pa), with the plane's friction coefficient `μ`
+    /// ([`PlaneStress::friction_coefficient`]) for the Coulomb stress of the averages.
+    pub fn profile(&self) -> Profile {
+        let friction_coefficient = self.friction_coefficient;
         let (nx, ny) = (self.nx, self.ny);
         let mean = |v: &[f64]| -> Vec<f64> {
             let mut out = vec![0.0; nx];
@@ -363,33 +474,13 @@ impl StressProbe {
     ///
     /// # Errors
     /// [`Error::LengthMismatch`] / [`Error::NonFinite`] for bad tractions;
-    /// [`Error::InvalidParameter`] for a negative or NaN friction coefficient, or a lateral
-    /// force on a probe planned without a lateral load.
+    /// [`Error::InvalidParameter`] for a lateral force on a probe planned without a
+    /// lateral load.
     pub fn evaluate(&self, input: &ProbeInput<'_>) -> Result<Stresses> {
         let n = self.grid.len();
         check_slice("shear_traction", input.shear_traction, n)?;
         check_slice("normal_traction", input.normal_traction, n)?;
-        for (name, value) in [
-            ("top_force", input.top_force),
-            ("lateral_force", input.lateral_force),
-            ("normal_load", input.normal_load),
-        ] {
-            if !value.is_finite() {
-                return Err(Error::NonFinite {
-                    name,
-                    index: 0,
-                    value,
-                });
-            }
-        }
-        let mu = input.friction_coefficient;
-        if !(mu.is_finite() && mu >= 0.0) {
-            return Err(Error::InvalidParameter {
-                name: "friction_coefficient",
-                value: mu,
-                reason: "the friction coefficient must be finite and >= 0",
-            });
-        }
+        let mu = input.friction_coefficient();
         let lateral_missing = input.lateral_force != 0.0
             && (self.planes.iter().any(|p| p.lateral.is_none())
                 || self.points.iter().any(|p| p.lateral.is_none()));
@@ -439,6 +530,7 @@ impl StressProbe {
                 shear,
                 normal,
                 coulomb,
+                friction_coefficient: mu,
             });
         }
         let dot = |k: &[f64], v: &[f64]| k.iter().zip(v).map(|(a, b)| a * b).sum::<f64>();

@@ -318,7 +318,7 @@ impl SceneBuilder {
     /// constants set by [`SceneBuilder::springs`] stay. It changes the outputs (areas,
     /// precursor lengths), not the events.
     pub fn area_law(mut self, area_law: AreaLaw) -> Self {
-        self.law.area_law = area_law;
+        self.law = self.law.with_area_law(area_law);
         self
     }
 
@@ -349,8 +349,9 @@ impl SceneBuilder {
         self
     }
 
-    /// Options of the equilibrium solvers.
-    pub fn solver(mut self, options: SolverOptions) -> Self {
+    /// Options of the equilibrium solvers (scene-file object `solver`; the same method
+    /// name as [`crate::solver::EquilibriumSolverBuilder::solver_options`]).
+    pub fn solver_options(mut self, options: SolverOptions) -> Self {
         self.solver = options;
         self
     }
@@ -431,24 +432,28 @@ impl SceneBuilder {
         put(
             k,
             "material.young_modulus",
-            format!("{:?}", m.young_modulus),
+            format!("{:?}", m.young_modulus()),
         );
         put(
             k,
             "material.poisson_ratio",
-            format!("{:?}", m.poisson_ratio),
+            format!("{:?}", m.poisson_ratio()),
         );
-        let mu = m.friction_coefficient;
+        let mu = m.friction_coefficient();
         put(k, "material.friction_coefficient", format!("{mu:?}"));
-        put(k, "springs.c_x", format!("{:?}", self.law.c_x));
-        put(k, "springs.c_z", format!("{:?}", self.law.c_z));
-        let area_law = format!("{:?}", self.law.area_law).to_lowercase();
+        put(k, "springs.c_x", format!("{:?}", self.law.c_x()));
+        put(k, "springs.c_z", format!("{:?}", self.law.c_z()));
+        let area_law = format!("{:?}", self.law.area_law()).to_lowercase();
         put(k, "springs.area_law", area_law);
         match &self.heights {
             HeightSource::Random { distribution, seed } => {
                 put(k, "heights.kind", "gaussian".into());
-                put(k, "heights.mean", format!("{:?}", distribution.mean));
-                put(k, "heights.std_dev", format!("{:?}", distribution.std_dev));
+                put(k, "heights.mean", format!("{:?}", distribution.mean()));
+                put(
+                    k,
+                    "heights.std_dev",
+                    format!("{:?}", distribution.std_dev()),
+                );
                 put(k, "heights.seed", format!("{seed}"));
             }
             HeightSource::Values(values) => {
@@ -478,12 +483,12 @@ impl SceneBuilder {
         put(
             k,
             "solver.backend",
-            format!("{:?}", o.backend).to_lowercase(),
+            format!("{:?}", o.backend()).to_lowercase(),
         );
-        put(k, "solver.tolerance", format!("{:?}", o.tolerance));
-        let n = o.max_active_set_iterations;
+        put(k, "solver.tolerance", format!("{:?}", o.tolerance()));
+        let n = o.max_active_set_iterations();
         put(k, "solver.max_active_set_iterations", format!("{n}"));
-        let n = o.max_linear_iterations;
+        let n = o.max_linear_iterations();
         put(k, "solver.max_linear_iterations", format!("{n}"));
         put(k, "plan_tolerance", format!("{:?}", self.plan_tolerance));
         std::mem::take(k)
@@ -494,19 +499,22 @@ impl SceneBuilder {
     /// choice), the cell limit and the probes (observers, which a driver may add at any time).
     pub(crate) fn identity(&self) -> SceneBuilder {
         let mut identity = self.clone();
-        identity.solver.parallelism = SolverOptions::default().parallelism;
+        identity
+            .solver
+            .set_parallelism(SolverOptions::default().parallelism());
         identity.probes = ProbeSpec::default();
         identity.max_cells = crate::green::DEFAULT_MAX_CELLS;
         identity
     }
 
-    /// The largest relative error accepted on the influence operator's eigenvalues
-    /// (dimensionless, default `1e-8`, as
-    /// [`crate::green::InfluencePlanBuilder::tolerance`]): they are computed to about
+    /// The plan tolerance (scene-file key `plan_tolerance`): the largest relative error
+    /// accepted on the influence operator's eigenvalues (dimensionless, default `1e-8`, as
+    /// [`crate::green::InfluencePlanBuilder::plan_tolerance`]; not the solver's linear
+    /// tolerance, [`crate::SolverOptions::tolerance`]): they are computed to about
     /// 1e-13 whatever it is (`docs/accuracy.md`). The lateral load
     /// table is always summed to `1e-12` relative (closed forms, cheap).
-    pub fn plan_tolerance(mut self, tolerance: f64) -> Self {
-        self.plan_tolerance = tolerance;
+    pub fn plan_tolerance(mut self, plan_tolerance: f64) -> Self {
+        self.plan_tolerance = plan_tolerance;
         self
     }
 
@@ -591,9 +599,6 @@ impl SceneBuilder {
             bounds::memory_bytes(self, &grid),
             "use fewer cells (or fewer probes), or a machine with more memory",
         )?;
-        self.material.validate()?;
-        self.law.validate()?;
-        self.solver.validate()?;
         check_tolerance(self.plan_tolerance)?;
         if !(self.normal_load.is_finite() && self.normal_load > 0.0) {
             return Err(Error::InvalidParameter {
@@ -602,11 +607,8 @@ impl SceneBuilder {
                 reason: "the normal load must be finite and > 0 N",
             });
         }
-        match &self.heights {
-            HeightSource::Random { distribution, .. } => {
-                Heights::check_distribution(*distribution)?;
-            }
-            HeightSource::Values(v) => Heights::check_values(&grid, v)?,
+        if let HeightSource::Values(v) = &self.heights {
+            Heights::check_values(&grid, v)?;
         }
         match self.drive {
             Drive::Force(ForceLoad::Mixed { ratio, .. })
@@ -631,11 +633,10 @@ impl SceneBuilder {
             RodLoad::new(&block, height, half_width)?;
         }
         if !self.probes.is_empty() {
-            check_tolerance(self.probes.tolerance)?;
-            for &z in &self.probes.planes {
+            for &z in self.probes.planes() {
                 block.check_height(z)?;
             }
-            for &p in &self.probes.points {
+            for &p in self.probes.points() {
                 block.check_point(p, ["x", "y", "z"])?;
             }
         }
@@ -673,7 +674,7 @@ impl SceneBuilder {
     /// # Errors
     /// The first invalid option, as a typed [`Error`] naming it.
     pub fn build(self) -> Result<Scene> {
-        self.build_with(&Planner::new())
+        self.build_with_planner(&Planner::new())
     }
 
     /// [`SceneBuilder::build`] with the operator from `planner`: scenes of one geometry
@@ -682,7 +683,7 @@ impl SceneBuilder {
     ///
     /// # Errors
     /// As [`SceneBuilder::build`].
-    pub fn build_with(self, planner: &Planner) -> Result<Scene> {
+    pub fn build_with_planner(self, planner: &Planner) -> Result<Scene> {
         let builder = self.clone();
         let (lx, ly, lz) = self.lengths;
         let (block, grid, heights, lateral) = self.checked()?;
@@ -787,8 +788,8 @@ impl Scene {
         self.drive
     }
 
-    /// The solver options ([`SceneBuilder::solver`]).
-    pub fn solver(&self) -> SolverOptions {
+    /// The solver options ([`SceneBuilder::solver_options`]).
+    pub fn solver_options(&self) -> SolverOptions {
         self.solver
     }
 
@@ -871,7 +872,7 @@ mod leaves_out {
         assert!(top.rod.is_none() && top.lateral_response.is_none());
         assert!(top.probe.is_none());
         let rod = small()
-            .probes(ProbeSpec::default().plane(2e-3))
+            .probes(ProbeSpec::default().with_plane(2e-3))
             .build()
             .unwrap();
         assert!(rod.rod.is_some() && rod.lateral_response.is_some());
@@ -883,7 +884,11 @@ mod leaves_out {
         // The spectral backend's FSAI, its local entries and the spectral inverse are
         // built on first use only.
         let scene = small()
-            .solver(SolverOptions::default().backend(crate::Backend::Spectral))
+            .solver_options(
+                SolverOptions::default()
+                    .with_backend(crate::Backend::Spectral)
+                    .unwrap(),
+            )
             .build()
             .unwrap();
         let mut driver = scene.driver().unwrap();

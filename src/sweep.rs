@@ -16,7 +16,7 @@
 //! assert_eq!(sweep.runs().len(), 4);                 // 2 points x 2 realizations
 //! assert_eq!(sweep.shard(1, 2)?.len(), 2);           // runs 1 and 3
 //! # let out = std::env::temp_dir().join(format!("precursors-doc-sweep-{}", std::process::id()));
-//! let summary = sweep.execute(&out, &SweepOptions::new().jobs(2), |_| {})?;
+//! let summary = sweep.execute(&out, &SweepOptions::new().with_jobs(2)?, |_| {})?;
 //! assert_eq!(summary.completed, 4);
 //! let merged = precursors::sweep::merge(&out)?;
 //! assert_eq!(merged.runs_missing, 0);
@@ -205,10 +205,8 @@ pub struct Sweep {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub struct SweepOptions {
-    /// Runs at the same time (each on its scene's solver threads, one by default).
-    pub jobs: usize,
-    /// This share `k` of `n` ([`Sweep::shard`]); `(0, 1)`: the whole sweep.
-    pub shard: (usize, usize),
+    jobs: usize,
+    shard: (usize, usize),
 }
 
 impl Default for SweepOptions {
@@ -226,17 +224,62 @@ impl SweepOptions {
         Self::default()
     }
 
-    /// Runs at the same time (0 counts as 1).
-    pub fn jobs(mut self, jobs: usize) -> Self {
-        self.jobs = jobs.max(1);
-        self
+    /// Runs at the same time (`≥ 1`; each on its scene's solver threads, one by default).
+    pub fn jobs(&self) -> usize {
+        self.jobs
     }
 
-    /// Share `k` of `n`.
-    pub fn shard(mut self, k: usize, n: usize) -> Self {
-        self.shard = (k, n);
-        self
+    /// This share `(k, n)`: runs `k, k + n, k + 2n, ...` ([`Sweep::shard`]); `(0, 1)`: the
+    /// whole sweep.
+    pub fn shard(&self) -> (usize, usize) {
+        self.shard
     }
+
+    /// The same options with `jobs` runs at the same time (`≥ 1`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidCount`] for 0.
+    pub fn with_jobs(self, jobs: usize) -> crate::Result<Self> {
+        if jobs == 0 {
+            return Err(Error::InvalidCount {
+                name: "jobs",
+                value: 0,
+                reason: "a sweep runs at least one job at a time",
+            });
+        }
+        Ok(Self { jobs, ..self })
+    }
+
+    /// The same options with share `k` of `n` (`n ≥ 1`, `k < n`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidCount`] for `n = 0` or `k >= n`.
+    pub fn with_shard(self, k: usize, n: usize) -> crate::Result<Self> {
+        check_shard(k, n)?;
+        Ok(Self {
+            shard: (k, n),
+            ..self
+        })
+    }
+}
+
+/// A share `k` of `n`: `n ≥ 1`, `k < n`.
+fn check_shard(k: usize, n: usize) -> crate::Result<()> {
+    if n == 0 {
+        return Err(Error::InvalidCount {
+            name: "shard count",
+            value: 0,
+            reason: "a sweep is shared among at least one shard",
+        });
+    }
+    if k >= n {
+        return Err(Error::InvalidCount {
+            name: "shard index",
+            value: k as u64,
+            reason: "the shard index must be below the shard count (shards 0 .. n-1)",
+        });
+    }
+    Ok(())
 }
 
 /// What one run did ([`Sweep::run_one`]).
@@ -606,22 +649,7 @@ impl Sweep {
     /// # Errors
     /// [`Error::InvalidCount`] (in [`SweepError::Core`]) for `n = 0` or `k >= n`.
     pub fn shard(&self, k: usize, n: usize) -> Result<Vec<&SweepRun>> {
-        if n == 0 {
-            return Err(Error::InvalidCount {
-                name: "shard count",
-                value: 0,
-                reason: "a sweep is shared among at least one shard",
-            }
-            .into());
-        }
-        if k >= n {
-            return Err(Error::InvalidCount {
-                name: "shard index",
-                value: k as u64,
-                reason: "the shard index must be below the shard count (shards 0 .. n-1)",
-            }
-            .into());
-        }
+        check_shard(k, n)?;
         Ok(self.runs.iter().filter(|r| r.index % n == k).collect())
     }
 
@@ -662,7 +690,7 @@ impl Sweep {
         }
         empty_but_lock(&dir)?;
         let started = Instant::now();
-        let scene = run.scene.clone().build_with(&self.planner)?;
+        let scene = run.scene.clone().build_with_planner(&self.planner)?;
         let built = started.elapsed().as_secs_f64();
         let mut driver = scene.driver()?;
         let mut tables = RunTables::start(&dir, &driver, None)?;

@@ -66,19 +66,21 @@ fn same_bits(a: &Stresses, b: &Stresses) -> bool {
 #[test]
 fn probe_types_are_named_from_the_crate_root() {
     // Compiles only if every type a probe user names is at the root.
-    let spec: ProbeSpec = ProbeSpec::default().plane(0.0);
+    let spec: ProbeSpec = ProbeSpec::default().with_plane(0.0);
     let scene = small().probes(spec).build().unwrap();
     let mut driver = scene.driver().unwrap();
     driver.step().unwrap();
     let stresses: Stresses = driver.stresses().unwrap();
     let plane: &PlaneStress = &stresses.planes[0];
     let cell: CellStress = plane.at(0, 0).unwrap();
-    let profile: Profile = plane.profile(driver.friction_coefficient());
+    let profile: Profile = plane.profile();
     let points: &[PointStress] = &stresses.points;
     let probe: StressProbe =
-        StressProbe::new(scene.plan(), &ProbeSpec::default().plane(0.0), None).unwrap();
+        StressProbe::new(scene.plan(), &ProbeSpec::default().with_plane(0.0), None).unwrap();
     let phi = vec![0.0; scene.grid().len()];
-    let input: ProbeInput<'_> = ProbeInput::new(&phi, &phi).friction_coefficient(0.5);
+    let input: ProbeInput<'_> = ProbeInput::new(&phi, &phi)
+        .with_friction_coefficient(0.5)
+        .unwrap();
     assert_eq!(probe.evaluate(&input).unwrap().planes[0].shear, phi);
     assert!(points.is_empty());
     assert_eq!(profile.shear.len(), 12);
@@ -104,7 +106,7 @@ fn plane_cells_are_read_by_column_and_row() {
         .block(0.005, 0.003, 0.010)
         .normal_load(30.0)
         .seed(4)
-        .probes(ProbeSpec::default().plane(0.0))
+        .probes(ProbeSpec::default().with_plane(0.0))
         .build()
         .unwrap();
     let mut driver = scene.driver().unwrap();
@@ -131,11 +133,43 @@ fn plane_cells_are_read_by_column_and_row() {
         assert_eq!(plane.at(ix, iy), None, "({ix}, {iy})");
     }
     // The profile averages the three rows of each column.
-    let profile = plane.profile(mu);
+    let profile = plane.profile();
     for ix in 0..5 {
         let mean = (-shear[ix] - shear[5 + ix] - shear[10 + ix]) / 3.0;
         assert!((profile.shear[ix] - mean).abs() <= 1e-12 * mean.abs().max(1.0));
     }
+}
+
+/// The stresses a driver returns know its `μ` (item 10 of issue 24: `profile(μ)` asked
+/// for a value the driver knows); a standalone probe takes it from its input.
+#[test]
+fn plane_stresses_carry_the_friction_coefficient() {
+    let material = Material::default().with_friction_coefficient(0.7).unwrap();
+    let scene = small()
+        .material(material)
+        .probes(ProbeSpec::default().with_plane(1e-3))
+        .build()
+        .unwrap();
+    let mut driver = scene.driver().unwrap();
+    driver.step().unwrap();
+    let stresses = driver.stresses().unwrap();
+    let plane = &stresses.planes[0];
+    assert_eq!(plane.friction_coefficient(), 0.7);
+    let profile = plane.profile();
+    for ix in 0..plane.nx {
+        let expected = profile.shear[ix].abs() - 0.7 * profile.normal[ix].abs();
+        assert_eq!(profile.coulomb_of_means[ix], expected);
+    }
+    let phi = vec![1.0; scene.grid().len()];
+    let probe =
+        StressProbe::new(scene.plan(), &ProbeSpec::default().with_plane(0.0), None).unwrap();
+    let input = ProbeInput::new(&phi, &phi)
+        .with_friction_coefficient(0.3)
+        .unwrap();
+    assert_eq!(
+        probe.evaluate(&input).unwrap().planes[0].friction_coefficient(),
+        0.3
+    );
 }
 
 #[test]
@@ -268,20 +302,22 @@ fn heights_convert_from_vectors_and_slices() {
 #[test]
 fn getters_are_named_as_their_setters() {
     let law = SpringLaw::new(1.0e12, 2.0e8).unwrap();
-    let options = SolverOptions::default().backend(Backend::Spectral);
-    let probes = ProbeSpec::default().plane(1e-3);
+    let options = SolverOptions::default()
+        .with_backend(Backend::Spectral)
+        .unwrap();
+    let probes = ProbeSpec::default().with_plane(1e-3);
     let material = Material::new(3.0e9, 0.3, 0.6).unwrap();
     let heights = HeightSource::Values(vec![2e-6; 24]);
     let scene = small()
         .springs(law)
-        .solver(options)
+        .solver_options(options)
         .probes(probes.clone())
         .material(material)
         .heights(heights.clone())
         .build()
         .unwrap();
     assert_eq!(scene.springs(), law);
-    assert_eq!(scene.solver(), options);
+    assert_eq!(scene.solver_options(), options);
     assert_eq!(scene.probes(), &probes);
     assert_eq!(scene.material(), material);
     assert_eq!(scene.heights(), &heights);
@@ -292,9 +328,9 @@ fn getters_are_named_as_their_setters() {
 fn probes_added_to_a_driver_equal_scene_probes_bit_for_bit() {
     // The rod drive: the stresses carry the lateral term too.
     let spec = ProbeSpec::default()
-        .plane(0.0)
-        .plane(2e-3)
-        .point(Point::new(0.004, 0.001, 1.5e-3));
+        .with_plane(0.0)
+        .with_plane(2e-3)
+        .with_point(Point::new(0.004, 0.001, 1.5e-3));
     let with = small().probes(spec.clone()).build().unwrap();
     let without = small().build().unwrap();
     let mut a = with.driver().unwrap();
@@ -315,14 +351,15 @@ fn probes_added_to_a_driver_equal_scene_probes_bit_for_bit() {
     }
     // More probes come after the scene's, in the order added; an empty spec adds nothing.
     a.add_probes(&ProbeSpec::default()).unwrap();
-    a.add_probes(&ProbeSpec::default().plane(5e-3)).unwrap();
+    a.add_probes(&ProbeSpec::default().with_plane(5e-3))
+        .unwrap();
     let s = a.stresses().unwrap();
     assert_eq!(
         s.planes.iter().map(|p| p.z).collect::<Vec<_>>(),
         [0.0, 2e-3, 5e-3]
     );
     // A probe outside the block is refused and adds nothing.
-    assert!(b.add_probes(&ProbeSpec::default().plane(0.5)).is_err());
+    assert!(b.add_probes(&ProbeSpec::default().with_plane(0.5)).is_err());
     assert_eq!(b.stresses().unwrap().planes.len(), 2);
 }
 
@@ -335,8 +372,8 @@ fn a_checkpoint_taken_before_adding_probes_resumes() {
     }
     let checkpoint = driver.checkpoint();
     let spec = ProbeSpec::default()
-        .plane(1e-3)
-        .point(Point::new(0.006, 0.001, 2e-3));
+        .with_plane(1e-3)
+        .with_point(Point::new(0.006, 0.001, 2e-3));
     driver.add_probes(&spec).unwrap();
     let rest: Vec<Event> = driver.by_ref().collect::<Result<_, _>>().unwrap();
     let stresses = driver.stresses().unwrap();

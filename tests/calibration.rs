@@ -16,15 +16,12 @@ fn base() -> SceneBuilder {
 }
 
 fn with_law(c_x: f64, c_z: f64) -> SceneBuilder {
-    let mut law = SpringLaw::default();
-    law.c_x = c_x;
-    law.c_z = c_z;
-    base().springs(law)
+    base().springs(SpringLaw::new(c_x, c_z).unwrap())
 }
 
 #[test]
 fn normal_stiffness_is_recovered_over_realizations() {
-    let options = FitOptions::default().seeds(&[3, 4, 5]);
+    let options = FitOptions::default().with_seeds(&[3, 4, 5]);
     let truth = 4.2e8;
     let target = normal_contact_area(&with_law(1.65e12, truth), &options).unwrap();
     let fit = fit_normal_stiffness(&base(), target, (1e6, 1e11), &options).unwrap();
@@ -42,8 +39,12 @@ fn normal_stiffness_is_recovered_over_realizations() {
 /// bracket `[1e6, 1e11]` to a relative `1e-12`.
 #[test]
 fn a_fit_out_of_evaluations_is_fit_not_converged() {
-    let mut options = FitOptions::default().seeds(&[3]).tolerance(1e-12);
-    options.max_evaluations = 3;
+    let options = FitOptions::default()
+        .with_seeds(&[3])
+        .with_tolerance(1e-12)
+        .unwrap()
+        .with_max_evaluations(3)
+        .unwrap();
     let target = normal_contact_area(&with_law(1.65e12, 4.2e8), &options).unwrap();
     let e = fit_normal_stiffness(&base(), target, (1e6, 1e11), &options).unwrap_err();
     match e {
@@ -65,7 +66,10 @@ fn a_fit_out_of_evaluations_is_fit_not_converged() {
 
 #[test]
 fn tangential_stiffness_is_recovered_from_a_generated_curve() {
-    let options = FitOptions::default().seeds(&[1, 2]).tolerance(1e-3);
+    let options = FitOptions::default()
+        .with_seeds(&[1, 2])
+        .with_tolerance(1e-3)
+        .unwrap();
     let truth = 1.65e12;
     let generating = with_law(truth, 1.65e8);
     // Target points: the generated, realization-averaged curve at a few forces.
@@ -110,10 +114,8 @@ fn bad_calibration_input_is_refused() {
         Err(Error::EmptyInput { .. })
     ));
     // A scan of fewer than three points is refused (it was silently raised to three).
-    let mut few = options.clone();
-    few.scan_points = 2;
     assert!(matches!(
-        fit_tangential_stiffness(&base(), &[(1.0, 1e-3)], (1e11, 1e13), &few),
+        options.clone().with_scan_points(2),
         Err(Error::InvalidCount {
             name: "scan_points",
             value: 2,
@@ -134,7 +136,7 @@ fn bad_calibration_input_is_refused() {
         Err(Error::NonFinite { .. })
     ));
     assert!(matches!(
-        fit_normal_stiffness(&base(), 1e-6, (1e7, 1e9), &options.clone().tolerance(0.0)),
+        options.clone().with_tolerance(0.0),
         Err(Error::InvalidTolerance { .. })
     ));
 }

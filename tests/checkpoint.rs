@@ -75,7 +75,11 @@ fn resumed_runs_repeat_the_uninterrupted_one_spectral() {
     let scene = Scene::builder()
         .block(0.060, 0.010, 0.030)
         .normal_load(1.5e3)
-        .solver(SolverOptions::default().backend(Backend::Spectral))
+        .solver_options(
+            SolverOptions::default()
+                .with_backend(Backend::Spectral)
+                .unwrap(),
+        )
         .seed(4)
         .build()
         .unwrap();
@@ -93,10 +97,12 @@ fn any_thread_count_repeats_the_sequential_run_and_resumes_it() {
         Scene::builder()
             .block(0.128, 0.064, 0.030)
             .normal_load(3.5e6 * 0.128 * 0.064)
-            .solver(
+            .solver_options(
                 SolverOptions::default()
-                    .backend(Backend::Spectral)
-                    .parallelism(parallelism),
+                    .with_backend(Backend::Spectral)
+                    .unwrap()
+                    .with_parallelism(parallelism)
+                    .unwrap(),
             )
             .seed(5)
     };
@@ -244,7 +250,11 @@ fn a_checkpoint_is_refused_on_another_scene() {
         "{message}"
     );
     // The thread count is not part of the run's identity.
-    let threads = b.solver(SolverOptions::default().parallelism(Parallelism::Threads(2)));
+    let threads = b.solver_options(
+        SolverOptions::default()
+            .with_parallelism(Parallelism::Threads(2))
+            .unwrap(),
+    );
     assert!(threads.build().unwrap().resume(&checkpoint).is_ok());
     // The checkpoint names its scene: building that resumes.
     let rebuilt = checkpoint.scene().clone().build().unwrap();
@@ -294,7 +304,11 @@ pub(crate) mod json {
         let spectral = Scene::builder()
             .block(0.040, 0.010, 0.030)
             .normal_load(1.0e3)
-            .solver(SolverOptions::default().backend(Backend::Spectral))
+            .solver_options(
+                SolverOptions::default()
+                    .with_backend(Backend::Spectral)
+                    .unwrap(),
+            )
             .seed(5)
             .build()
             .unwrap();

@@ -38,7 +38,7 @@ fn run(scene: &Scene) -> Vec<Event> {
 /// `(F/(μF_N), ℓ)` at every stable state of a run.
 fn precursor_curve(scene: &Scene) -> Vec<(f64, f64)> {
     let mut d = scene.driver().unwrap();
-    let scale = scene.material().friction_coefficient * scene.normal_load();
+    let scale = scene.material().friction_coefficient() * scene.normal_load();
     let mut out = Vec::new();
     d.run(|e, d| {
         if let Event::Stable { load, .. } = e {
@@ -280,7 +280,7 @@ fn naive_protocol(nx: usize, ny: usize, seed: u64) -> (Vec<usize>, Vec<f64>) {
     let material = Material::default();
     let m = material.modulus();
     let plan = green::InfluencePlan::builder(grid)
-        .tolerance(1e-9)
+        .plan_tolerance(1e-9)
         .build()
         .unwrap();
     let c = compliance_matrix(&plan, m);
@@ -292,7 +292,7 @@ fn naive_protocol(nx: usize, ny: usize, seed: u64) -> (Vec<usize>, Vec<f64>) {
     let columns = rod.influence_cells(&grid, 1e-12 * lx / (ly * lz)).unwrap();
     let e: Vec<f64> = (0..n).map(|i| columns[i % nx] / m).collect();
     let cell = grid.cell_area();
-    let (mu, normal_load) = (material.friction_coefficient, 20.0);
+    let (mu, normal_load) = (material.friction_coefficient(), 20.0);
     let mut broken = vec![false; n];
     let mut attached = vec![true; n];
     let mut ruptures = Vec::new();
@@ -303,7 +303,7 @@ fn naive_protocol(nx: usize, ny: usize, seed: u64) -> (Vec<usize>, Vec<f64>) {
         // Normal equilibrium: primal-dual active set with exact solves.
         let (f_z, u_z) = loop {
             let set: Vec<usize> = (0..n).filter(|&i| attached[i]).collect();
-            let d: Vec<f64> = set.iter().map(|&i| u0[i] / law.c_z).collect();
+            let d: Vec<f64> = set.iter().map(|&i| u0[i] / law.c_z()).collect();
             let b: Vec<f64> = set.iter().map(|&i| u0[i]).collect();
             let (f, u) = bordered_solve(&c, n, &set, &d, &b, normal_load / cell);
             let mut full = vec![0.0; n];
@@ -332,7 +332,7 @@ fn naive_protocol(nx: usize, ny: usize, seed: u64) -> (Vec<usize>, Vec<f64>) {
         let set: Vec<usize> = (0..n).filter(|&i| attached[i]).collect();
         let d: Vec<f64> = set
             .iter()
-            .map(|&i| (u_z[i] / u0[i]).exp() / law.c_x)
+            .map(|&i| (u_z[i] / u0[i]).exp() / law.c_x())
             .collect();
         let b: Vec<f64> = set.iter().map(|&i| -e[i]).collect();
         let (g, _) = bordered_solve(&c, n, &set, &d, &b, -1.0 / cell);
@@ -421,10 +421,12 @@ fn drivers_and_solvers_can_move_between_threads() {
     let scene = Scene::builder()
         .block(0.030, 0.020, 0.030)
         .normal_load(2.1e3)
-        .solver(
+        .solver_options(
             SolverOptions::default()
-                .backend(Backend::Spectral)
-                .parallelism(Parallelism::Threads(2)),
+                .with_backend(Backend::Spectral)
+                .unwrap()
+                .with_parallelism(Parallelism::Threads(2))
+                .unwrap(),
         )
         .seed(2)
         .build()
@@ -474,7 +476,7 @@ fn area_laws_and_the_flag_of_areas_above_the_nominal_area() {
     while let Some(event) = d.step().unwrap() {
         paper_events.push(event);
         let (sum, _) = area_sums(&d);
-        let total = d.total_contact_area().unwrap();
+        let total = d.real_contact_area().unwrap();
         assert!((total - sum).abs() <= 1e-12 * sum.max(nominal));
         let exceeds = d.area_exceeds_nominal().unwrap();
         if matches!(event, Event::Stable { .. }) {
@@ -499,7 +501,7 @@ fn area_laws_and_the_flag_of_areas_above_the_nominal_area() {
     while let Some(event) = d.step().unwrap() {
         events.push(event);
         let (paper, capped) = area_sums(&d);
-        let total = d.total_contact_area().unwrap();
+        let total = d.real_contact_area().unwrap();
         assert!(
             (total - capped).abs() <= 1e-12 * nominal,
             "{total} vs {capped}"
@@ -551,12 +553,12 @@ fn precursor_length_under_top_and_rod_loading_and_with_a_drop_threshold() {
                     .zip(&then)
                     .take_while(|(a, b)| **a < (1.0 - drop) * **b)
                     .count();
-                let ell = d.precursor_length_with(*drop).unwrap();
+                let ell = d.precursor_length_with_threshold(*drop).unwrap();
                 assert_eq!(ell, run as f64 * dx, "drop {drop}");
                 assert!(ell <= paper, "a larger drop gives a shorter front");
                 worst[k] = worst[k].max(ell / lx);
             }
-            assert_eq!(d.precursor_length_with(0.0).unwrap(), paper);
+            assert_eq!(d.precursor_length_with_threshold(0.0).unwrap(), paper);
         }
         assert!(stable > 100, "many stable states before slip");
         worst
@@ -584,14 +586,14 @@ fn precursor_drop_threshold_is_refused_outside_zero_to_one() {
     for drop in [-0.1, 1.0, 1.5, f64::NAN, f64::INFINITY] {
         assert!(
             matches!(
-                d.precursor_length_with(drop),
+                d.precursor_length_with_threshold(drop),
                 Err(Error::InvalidParameter { name: "drop", .. })
             ),
             "drop = {drop}"
         );
     }
     assert_eq!(
-        d.precursor_length_with(0.0).unwrap(),
+        d.precursor_length_with_threshold(0.0).unwrap(),
         0.0,
         "zero shear: no front"
     );

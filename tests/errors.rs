@@ -72,13 +72,16 @@ fn tolerances_must_be_positive() {
     }
     let grid = Grid::new(b, 10, 2).unwrap();
     assert!(matches!(
-        InfluencePlan::builder(grid).tolerance(0.0).build(),
+        InfluencePlan::builder(grid).plan_tolerance(0.0).build(),
         Err(Error::InvalidTolerance { .. })
     ));
-    let opts = SeriesOptions::with_tolerance(1e-6).max_terms(0);
     assert!(matches!(
-        gf.value_with(r, s, &opts),
+        SeriesOptions::default().with_max_terms(0),
         Err(Error::InvalidCount { .. })
+    ));
+    assert!(matches!(
+        gf.value(r, s, 0.0),
+        Err(Error::InvalidTolerance { .. })
     ));
 }
 
@@ -136,18 +139,18 @@ fn operator_inputs_are_checked() {
         Err(Error::NonFinite { index: 3, .. })
     ));
     let big = Grid::new(b, 200, 101).unwrap();
-    let plan = InfluencePlan::builder(big).tolerance(1e-2).build().unwrap();
+    let plan = InfluencePlan::builder(big)
+        .plan_tolerance(1e-2)
+        .build()
+        .unwrap();
     assert!(matches!(plan.dense(), Err(Error::TooLargeForDense { .. })));
 }
 
 #[test]
 fn zero_solver_threads_are_refused() {
-    let built = precursors::Scene::builder()
-        .solver(
-            precursors::SolverOptions::default().parallelism(precursors::Parallelism::Threads(0)),
-        )
-        .build()
-        .and_then(|scene| scene.driver());
+    // Refused when the options are made (there is no later point to refuse them at).
+    let built =
+        precursors::SolverOptions::default().with_parallelism(precursors::Parallelism::Threads(0));
     match built {
         Err(Error::InvalidCount { name, value, .. }) => {
             assert_eq!(name, "threads");
@@ -159,9 +162,10 @@ fn zero_solver_threads_are_refused() {
     for threads in [1, 3, 64] {
         let scene = precursors::Scene::builder()
             .block(0.010, 0.005, 0.010)
-            .solver(
+            .solver_options(
                 precursors::SolverOptions::default()
-                    .parallelism(precursors::Parallelism::Threads(threads)),
+                    .with_parallelism(precursors::Parallelism::Threads(threads))
+                    .unwrap(),
             )
             .build()
             .unwrap();
@@ -254,12 +258,9 @@ fn zero_friction_is_refused() {
             ),
             "μ = {mu}"
         );
-        let mut material = precursors::Material::default();
-        material.friction_coefficient = mu;
-        let built = precursors::Scene::builder().material(material).build();
         assert!(
             matches!(
-                built,
+                precursors::Material::default().with_friction_coefficient(mu),
                 Err(Error::InvalidParameter {
                     name: "friction_coefficient",
                     ..
@@ -368,13 +369,23 @@ fn threads_with_the_dense_backend() {
     use precursors::{Backend, Parallelism, Scene, SolverOptions};
     let options = |backend, parallelism| {
         SolverOptions::default()
-            .backend(backend)
-            .parallelism(parallelism)
+            .with_backend(backend)
+            .unwrap()
+            .with_parallelism(parallelism)
+            .unwrap()
     };
-    let e = Scene::builder()
-        .solver(options(Backend::Dense, Parallelism::Threads(4)))
-        .build()
+    // Refused when the options are made, in either order.
+    let e = SolverOptions::default()
+        .with_backend(Backend::Dense)
+        .unwrap()
+        .with_parallelism(Parallelism::Threads(4))
         .unwrap_err();
+    let other = SolverOptions::default()
+        .with_parallelism(Parallelism::Threads(4))
+        .unwrap()
+        .with_backend(Backend::Dense)
+        .unwrap_err();
+    assert_eq!(e.to_string(), other.to_string());
     assert!(matches!(e, Error::DenseThreads { threads: 4, .. }), "{e}");
     assert!(e.to_string().contains(r#"backend "spectral""#), "{e}");
     for parallelism in [
@@ -383,14 +394,14 @@ fn threads_with_the_dense_backend() {
         Parallelism::CurrentPool,
     ] {
         let scene = Scene::builder()
-            .solver(options(Backend::Dense, parallelism))
+            .solver_options(options(Backend::Dense, parallelism))
             .build()
             .unwrap();
         assert_eq!(scene.driver().unwrap().threads(), 1);
     }
     // Auto picks dense at 980 cells: threads accepted, one used.
     let scene = Scene::builder()
-        .solver(options(Backend::Auto, Parallelism::Threads(4)))
+        .solver_options(options(Backend::Auto, Parallelism::Threads(4)))
         .build()
         .unwrap();
     let mut driver = scene.driver().unwrap();
@@ -399,7 +410,7 @@ fn threads_with_the_dense_backend() {
     // Spectral: as many as asked, up to the parts of the grid (one part below 2048 cells).
     let spectral = Scene::builder()
         .block(0.128, 0.032, 0.075)
-        .solver(options(Backend::Spectral, Parallelism::Threads(2)))
+        .solver_options(options(Backend::Spectral, Parallelism::Threads(2)))
         .build()
         .unwrap()
         .driver()
@@ -408,7 +419,7 @@ fn threads_with_the_dense_backend() {
     // Setting threads later: the same rule.
     driver.set_parallelism(Parallelism::Threads(3)).unwrap();
     let mut dense = Scene::builder()
-        .solver(options(Backend::Dense, Parallelism::Sequential))
+        .solver_options(options(Backend::Dense, Parallelism::Sequential))
         .build()
         .unwrap()
         .driver()
@@ -431,7 +442,7 @@ fn misuse_of_the_driver_has_its_own_errors() {
     for e in [
         driver.normal_traction().map(|_| ()).unwrap_err(),
         driver.shear_traction().map(|_| ()).unwrap_err(),
-        driver.real_contact_area().map(|_| ()).unwrap_err(),
+        driver.cell_contact_area().map(|_| ()).unwrap_err(),
     ] {
         assert!(matches!(e, Error::NotSolved { .. }), "{e}");
         assert!(e.to_string().contains("call step() first"), "{e}");
@@ -442,12 +453,7 @@ fn misuse_of_the_driver_has_its_own_errors() {
 /// Integer parameters are reported as integers.
 #[test]
 fn counts_are_reported_as_integers() {
-    let b = Block::new(0.1, 0.01, 0.05).unwrap();
-    let gf = GreenFunction::new(b);
-    let (r, s) = (Point::new(0.05, 0.005, 0.01), Point::new(0.02, 0.001, 0.0));
-    let e = gf
-        .value_with(r, s, &SeriesOptions::with_tolerance(1e-6).max_terms(0))
-        .unwrap_err();
+    let e = SeriesOptions::default().with_max_terms(0).unwrap_err();
     assert!(
         matches!(
             e,
@@ -480,21 +486,18 @@ mod ranges {
     }
 
     fn material(e: f64, nu: f64, mu: f64) -> SceneBuilder {
-        let mut m = Material::default();
-        (m.young_modulus, m.poisson_ratio, m.friction_coefficient) = (e, nu, mu);
-        base().material(m)
+        base().material(Material::new(e, nu, mu).unwrap())
     }
 
     fn springs(c_x: f64, c_z: f64) -> SceneBuilder {
-        let mut law = SpringLaw::default();
-        (law.c_x, law.c_z) = (c_x, c_z);
-        base().springs(law)
+        base().springs(SpringLaw::new(c_x, c_z).unwrap())
     }
 
-    fn solver(f: impl FnOnce(&mut SolverOptions)) -> SceneBuilder {
-        let mut o = SolverOptions::default();
-        f(&mut o);
-        base().solver(o)
+    /// The scene with solver options changed by `f` (values the options themselves
+    /// refuse, e.g. 0 iterations, are refused at construction:
+    /// `solver_options_refuse_invalid_values_at_construction`).
+    fn solver(f: impl FnOnce(SolverOptions) -> Result<SolverOptions>) -> SceneBuilder {
+        base().solver_options(f(SolverOptions::default()).unwrap())
     }
 
     /// The block's shear stiffness `M·Ly·Lz/Lx` of [`base`] (N/m), the paper's PMMA.
@@ -585,8 +588,7 @@ mod ranges {
                 // A stiff block (E = 1e15 Pa): springs up to 1e21 N/m² are then resolved
                 // against it (the tolerance's bound `5e-2·p/R`, docs/scene-format.md).
                 Box::new(|v| {
-                    let mut m = Material::default();
-                    m.young_modulus = 1e15;
+                    let m = Material::default().with_young_modulus(1e15).unwrap();
                     springs(1.65e12, v).material(m)
                 }),
                 vec![1e-3, 1e21],
@@ -597,8 +599,7 @@ mod ranges {
                 // A stiff block on stiff springs: within 650 ΔA c_z, and the block's
                 // displacement within 1e10 asperity heights.
                 Box::new(|v| {
-                    let mut m = Material::default();
-                    m.young_modulus = 1e15;
+                    let m = Material::default().with_young_modulus(1e15).unwrap();
                     springs(1.65e12, 1e21).material(m).normal_load(v)
                 }),
                 vec![1e-9, 1e15],
@@ -615,7 +616,7 @@ mod ranges {
                 "heights.mean",
                 Box::new(|v| {
                     base().heights(HeightSource::Random {
-                        distribution: HeightDistribution::new(v, v),
+                        distribution: HeightDistribution::new(v, v).unwrap(),
                         seed: 1,
                     })
                 }),
@@ -626,7 +627,7 @@ mod ranges {
                 "heights.std_dev",
                 Box::new(|v| {
                     base().heights(HeightSource::Random {
-                        distribution: HeightDistribution::new(1e-6, v),
+                        distribution: HeightDistribution::new(1e-6, v).unwrap(),
                         seed: 1,
                     })
                 }),
@@ -672,21 +673,21 @@ mod ranges {
             ),
             (
                 "solver.tolerance",
-                Box::new(|v| solver(|o| o.tolerance = v)),
+                Box::new(|v| solver(|o| o.with_tolerance(v))),
                 vec![1e-15, 1e-6],
                 vec![0.99e-15, 1e-17, 1.01e-6, 1.0, 10.0, 1e308],
             ),
             (
                 "solver.max_active_set_iterations",
-                Box::new(|v| solver(|o| o.max_active_set_iterations = v as usize)),
+                Box::new(|v| solver(|o| o.with_max_active_set_iterations(v as usize))),
                 vec![1.0, 1e6],
-                vec![0.0, 1e6 + 1.0, 1e19],
+                vec![1e6 + 1.0, 1e19],
             ),
             (
                 "solver.max_linear_iterations",
-                Box::new(|v| solver(|o| o.max_linear_iterations = v as usize)),
+                Box::new(|v| solver(|o| o.with_max_linear_iterations(v as usize))),
                 vec![1.0, 1e7],
-                vec![0.0, 1e7 + 1.0],
+                vec![1e7 + 1.0],
             ),
             (
                 "plan_tolerance",
@@ -696,7 +697,14 @@ mod ranges {
             ),
             (
                 "probes.tolerance",
-                Box::new(|v| base().probes(ProbeSpec::default().plane(1e-3).tolerance(v))),
+                Box::new(|v| {
+                    base().probes(
+                        ProbeSpec::default()
+                            .with_plane(1e-3)
+                            .with_tolerance(v)
+                            .unwrap(),
+                    )
+                }),
                 vec![1e-15, 1e-2],
                 vec![0.99e-15, 1.01e-2, 1.0],
             ),
@@ -735,9 +743,9 @@ mod ranges {
             (base().block(0.02, 1e308, 0.01), "block.ly"),
             (base().block(1e308, 0.004, 0.01), "block.lx"),
             (spring(1e-306), "drive.stiffness"),
-            (solver(|o| o.tolerance = 1.0), "solver.tolerance"),
-            (solver(|o| o.tolerance = 10.0), "solver.tolerance"),
-            (solver(|o| o.tolerance = 1e308), "solver.tolerance"),
+            (solver(|o| o.with_tolerance(1.0)), "solver.tolerance"),
+            (solver(|o| o.with_tolerance(10.0)), "solver.tolerance"),
+            (solver(|o| o.with_tolerance(1e308)), "solver.tolerance"),
         ] {
             assert!(refused(&b, key), "{key}: {:?}", b.check());
         }

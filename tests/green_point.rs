@@ -16,9 +16,16 @@ fn paper_block() -> Block {
 }
 
 fn g(gf: &GreenFunction, r: Point, s: Point, tol: f64, axis: SummationAxis) -> f64 {
-    gf.value_with(r, s, &SeriesOptions::with_tolerance(tol).axis(axis))
-        .unwrap()
-        .value
+    gf.value_with_options(
+        r,
+        s,
+        &SeriesOptions::default()
+            .with_tolerance(tol)
+            .unwrap()
+            .with_axis(axis),
+    )
+    .unwrap()
+    .value
 }
 
 #[test]
@@ -46,7 +53,11 @@ fn rapid_representation_matches_raw_triple_series() {
             .raw_series(
                 r,
                 s,
-                &SeriesOptions::with_tolerance(1e-3).max_terms(400_000_000),
+                &SeriesOptions::default()
+                    .with_tolerance(1e-3)
+                    .unwrap()
+                    .with_max_terms(400_000_000)
+                    .unwrap(),
             )
             .unwrap();
         let rapid = gf.value(r, s, 1e-12).unwrap();
@@ -127,17 +138,17 @@ fn dz_axes_agree_including_the_papers_zeta_zero_form() {
     let gf = GreenFunction::new(paper_block());
     let r = Point::new(0.03, 0.002, 0.002);
     let s = Point::new(0.035, 0.005, 0.0);
-    let opts = SeriesOptions::with_tolerance(1e-10);
+    let opts = SeriesOptions::default().with_tolerance(1e-10).unwrap();
     let vz = gf
-        .dz_with(r, s, &opts.axis(SummationAxis::Z))
+        .dz_with_options(r, s, &opts.with_axis(SummationAxis::Z))
         .unwrap()
         .value;
     let vx = gf
-        .dz_with(r, s, &opts.axis(SummationAxis::X))
+        .dz_with_options(r, s, &opts.with_axis(SummationAxis::X))
         .unwrap()
         .value;
     let vy = gf
-        .dz_with(r, s, &opts.axis(SummationAxis::Y))
+        .dz_with_options(r, s, &opts.with_axis(SummationAxis::Y))
         .unwrap()
         .value;
     assert!(rel(vx, vz, 1.0) < 1e-9, "{vx} {vz}");
@@ -229,9 +240,12 @@ fn forced_axis_without_separation_is_a_typed_error() {
     let gf = GreenFunction::new(small_block());
     let r = Point::new(0.01, 0.01, 0.0);
     let s = Point::new(0.02, 0.012, 0.0);
-    let opts = SeriesOptions::with_tolerance(1e-8).axis(SummationAxis::Z);
+    let opts = SeriesOptions::default()
+        .with_tolerance(1e-8)
+        .unwrap()
+        .with_axis(SummationAxis::Z);
     assert!(matches!(
-        gf.value_with(r, s, &opts),
+        gf.value_with_options(r, s, &opts),
         Err(Error::InvalidChoice { value: "z", .. })
     ));
 }
@@ -400,7 +414,7 @@ proptest! {
         let raw = gf.raw_series(
             s,
             r,
-            &SeriesOptions::with_tolerance(3e-5 * g_scale).max_terms(100_000_000),
+            &SeriesOptions::default().with_tolerance(3e-5 * g_scale).unwrap().with_max_terms(100_000_000).unwrap(),
         );
         // Skip the rare pairs whose raw series needs more than 1e8 terms.
         prop_assume!(raw.is_ok());

@@ -20,7 +20,7 @@ fn real_area(lx: f64, ly: f64, lz: f64, loads: &[f64], seeds: u64) -> Vec<f64> {
             let eq = solver.solve_normal(&iface, load).unwrap();
             iface.set_states(&eq.states).unwrap();
             let area: f64 = iface
-                .real_contact_area(&eq.displacement)
+                .cell_contact_area(&eq.displacement)
                 .unwrap()
                 .iter()
                 .sum();

@@ -13,6 +13,7 @@ mod green_point;
 #[cfg(feature = "cli")]
 mod hostile;
 mod interface;
+mod invariants;
 mod laws;
 mod loads;
 #[cfg(feature = "nalgebra")]

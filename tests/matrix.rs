@@ -114,7 +114,7 @@ fn driver_fields_and_plane_stresses_as_matrices() {
         .cells(5, 3)
         .normal_load(30.0)
         .heights(Heights::from_dmatrix(&grid, &map()).unwrap().into())
-        .probes(ProbeSpec::default().plane(0.0))
+        .probes(ProbeSpec::default().with_plane(0.0))
         .build()
         .unwrap();
     let mut driver = scene.driver().unwrap();
@@ -128,7 +128,7 @@ fn driver_fields_and_plane_stresses_as_matrices() {
         .field_to_dmatrix(driver.shear_traction().unwrap())
         .unwrap();
     let area = g
-        .field_to_dmatrix(&driver.real_contact_area().unwrap())
+        .field_to_dmatrix(&driver.cell_contact_area().unwrap())
         .unwrap();
     let stresses = driver.stresses().unwrap();
     let plane = &stresses.planes[0];
@@ -138,7 +138,7 @@ fn driver_fields_and_plane_stresses_as_matrices() {
             let i = 5 * iy + ix;
             assert_eq!(normal[(iy, ix)], driver.normal_traction().unwrap()[i]);
             assert_eq!(shear[(iy, ix)], driver.shear_traction().unwrap()[i]);
-            assert_eq!(area[(iy, ix)], driver.real_contact_area().unwrap()[i]);
+            assert_eq!(area[(iy, ix)], driver.cell_contact_area().unwrap()[i]);
             assert_eq!(plane_shear[(iy, ix)], plane.at(ix, iy).unwrap().shear);
         }
     }

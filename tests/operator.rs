@@ -85,7 +85,7 @@ fn entries_equal_cell_quadrature_of_the_point_function() {
     let block = Block::new(0.016, 0.006, 0.01).unwrap();
     let grid = Grid::new(block, 16, 6).unwrap();
     let plan = InfluencePlan::builder(grid)
-        .tolerance(1e-9)
+        .plan_tolerance(1e-9)
         .build()
         .unwrap();
     let n = grid.len();
@@ -149,7 +149,7 @@ fn the_point_value_error_shrinks_like_delta_squared_over_r_squared() {
     let block = Block::new(0.14, 0.007, 0.075).unwrap();
     let grid = Grid::new(block, 140, 7).unwrap();
     let plan = InfluencePlan::builder(grid)
-        .tolerance(1e-8)
+        .plan_tolerance(1e-8)
         .build()
         .unwrap();
     let n = grid.len();
@@ -255,7 +255,7 @@ fn eigenvalues_match_the_alias_sum_and_their_estimates_are_small() {
     for (block, nx, ny) in cases {
         let grid = Grid::new(block, nx, ny).unwrap();
         let plan = InfluencePlan::builder(grid)
-            .tolerance(1e-12)
+            .plan_tolerance(1e-12)
             .build()
             .unwrap();
         assert!(plan.max_relative_error() <= 1e-12);
@@ -277,7 +277,16 @@ fn eigenvalues_match_the_alias_sum_and_their_estimates_are_small() {
         };
         for (p, m) in modes.into_iter().filter(|&(p, m)| p < nx && m < ny) {
             let reference = eigenvalue_by_alias_box(&grid, p, m, q);
-            let value = plan.lambda(p, m).unwrap();
+            // λ = eigenvalue · α_p'² α_m'² (α_0² = 1/N, α_{>0}² = 2/N): the orthonormal
+            // basis's eigenvalue in the module docs' normalisation.
+            let alpha = |k: usize, n: usize| {
+                if k == 0 {
+                    1.0 / n as f64
+                } else {
+                    2.0 / n as f64
+                }
+            };
+            let value = plan.eigenvalue(p, m).unwrap() * alpha(p, nx) * alpha(m, ny);
             assert!(
                 rel(value, reference, 1e-300) <= tol,
                 "{nx} x {ny}, Lz = {}: mode ({p},{m}): {value} vs {reference}",
@@ -288,7 +297,7 @@ fn eigenvalues_match_the_alias_sum_and_their_estimates_are_small() {
     // A tolerance the estimates cannot certify is refused, not met silently.
     let grid = Grid::new(Block::new(0.2, 0.05, 0.075).unwrap(), 200, 50).unwrap();
     let e = InfluencePlan::builder(grid)
-        .tolerance(1e-15)
+        .plan_tolerance(1e-15)
         .build()
         .unwrap_err();
     assert!(

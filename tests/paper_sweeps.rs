@@ -236,7 +236,7 @@ fn every_point_is_its_captions_scene_on_1_mm_cells() {
             // Planned and built (a few seconds for all: the largest grid has 3948 cells).
             run.scene
                 .clone()
-                .build_with(&planner)
+                .build_with_planner(&planner)
                 .unwrap_or_else(|e| panic!("{name} point {}: {e}", run.point));
         }
         assert_eq!(varied.len(), points, "{name}");

@@ -17,7 +17,7 @@ fn setup() -> (Grid, InfluencePlan, RodLoad) {
     let block = Block::new(0.016, 0.004, 0.008).unwrap();
     let grid = Grid::new(block, 8, 2).unwrap();
     let plan = InfluencePlan::builder(grid)
-        .tolerance(1e-11)
+        .plan_tolerance(1e-11)
         .build()
         .unwrap();
     let rod = RodLoad::new(&block, 3e-3, 1e-3).unwrap();
@@ -207,11 +207,16 @@ fn probes_and_displacements_match_a_finite_volume_solve() {
     let z_p = 2e-3;
     let probe = StressProbe::new(
         &plan,
-        &ProbeSpec::default().plane(z_p).tolerance(1e-13),
+        &ProbeSpec::default()
+            .with_plane(z_p)
+            .with_tolerance(1e-13)
+            .unwrap(),
         Some(&rod),
     )
     .unwrap();
-    let input = ProbeInput::new(&phi_x, &phi_z).loads(f_top, f_lat, f_n);
+    let input = ProbeInput::new(&phi_x, &phi_z)
+        .with_loads(f_top, f_lat, f_n)
+        .unwrap();
     let crate_plane = &probe.evaluate(&input).unwrap().planes[0];
 
     // Crate bottom displacements: (ΔA/M) Ĝ φ + lateral term (constants dropped).
@@ -267,12 +272,14 @@ fn force_balance_through_every_plane() {
     let heights = [0.0, 1e-3, 2e-3, 2.5e-3, 3.7e-3, 4e-3, 6e-3, 8e-3];
     let mut spec = ProbeSpec::default();
     for z in heights {
-        spec = spec.plane(z);
+        spec = spec.with_plane(z);
     }
     let probe = StressProbe::new(&plan, &spec, Some(&rod)).unwrap();
     let phi_x = tractions(&grid, -(f_top + f_lat), 3);
     let phi_z = tractions(&grid, f_n, 4);
-    let input = ProbeInput::new(&phi_x, &phi_z).loads(f_top, f_lat, f_n);
+    let input = ProbeInput::new(&phi_x, &phi_z)
+        .with_loads(f_top, f_lat, f_n)
+        .unwrap();
     let out = probe.evaluate(&input).unwrap();
     for (plane, z) in out.planes.iter().zip(heights) {
         // The slab above z carries the top load and the part of the band above z.
@@ -295,18 +302,20 @@ fn planes_at_the_interface_and_the_top_give_the_tractions() {
     let probe = StressProbe::new(
         &plan,
         &ProbeSpec::default()
-            .plane(0.0)
-            .plane(block.lz())
-            .point(Point::new(0.003, 0.001, 0.0))
-            .point(Point::new(0.004, 0.001, 0.0)) // on the edge between two cells
-            .point(Point::new(0.003, 0.001, block.lz())),
+            .with_plane(0.0)
+            .with_plane(block.lz())
+            .with_point(Point::new(0.003, 0.001, 0.0))
+            .with_point(Point::new(0.004, 0.001, 0.0)) // on the edge between two cells
+            .with_point(Point::new(0.003, 0.001, block.lz())),
         Some(&rod),
     )
     .unwrap();
     let (f_top, f_lat, f_n) = (1.5, 2.5, 20.0);
     let phi_x = tractions(&grid, -(f_top + f_lat), 5);
     let phi_z = tractions(&grid, f_n, 6);
-    let input = ProbeInput::new(&phi_x, &phi_z).loads(f_top, f_lat, f_n);
+    let input = ProbeInput::new(&phi_x, &phi_z)
+        .with_loads(f_top, f_lat, f_n)
+        .unwrap();
     let out = probe.evaluate(&input).unwrap();
     let area = block.lx() * block.ly();
     for i in 0..grid.len() {
@@ -330,17 +339,24 @@ fn point_probes_averaged_over_a_cell_give_the_plane() {
     let (x0, y0) = (2.0 * grid.dx(), grid.dy());
     let xs = rule(x0, x0 + grid.dx(), 1, 6);
     let ys = rule(y0, y0 + grid.dy(), 1, 6);
-    let mut spec = ProbeSpec::default().plane(z).tolerance(1e-13);
+    let mut spec = ProbeSpec::default()
+        .with_plane(z)
+        .with_tolerance(1e-13)
+        .unwrap();
     for &(x, _) in &xs {
         for &(y, _) in &ys {
-            spec = spec.point(Point::new(x, y, z));
+            spec = spec.with_point(Point::new(x, y, z));
         }
     }
     let probe = StressProbe::new(&plan, &spec, None).unwrap();
     let phi_x = tractions(&grid, -3.0, 7);
     let phi_z = tractions(&grid, 10.0, 8);
     let out = probe
-        .evaluate(&ProbeInput::new(&phi_x, &phi_z).loads(3.0, 0.0, 10.0))
+        .evaluate(
+            &ProbeInput::new(&phi_x, &phi_z)
+                .with_loads(3.0, 0.0, 10.0)
+                .unwrap(),
+        )
         .unwrap();
     let mut shear = 0.0;
     let mut normal = 0.0;
@@ -365,11 +381,11 @@ fn probe_errors_are_typed() {
     let (grid, plan, _) = setup();
     let lz = grid.block().lz();
     for spec in [
-        ProbeSpec::default().plane(-1e-3),
-        ProbeSpec::default().plane(lz * 1.01),
-        ProbeSpec::default().plane(f64::NAN),
-        ProbeSpec::default().point(Point::new(0.02, 0.001, 0.001)),
-        ProbeSpec::default().point(Point::new(0.001, 0.001, f64::INFINITY)),
+        ProbeSpec::default().with_plane(-1e-3),
+        ProbeSpec::default().with_plane(lz * 1.01),
+        ProbeSpec::default().with_plane(f64::NAN),
+        ProbeSpec::default().with_point(Point::new(0.02, 0.001, 0.001)),
+        ProbeSpec::default().with_point(Point::new(0.001, 0.001, f64::INFINITY)),
     ] {
         assert!(
             matches!(
@@ -380,14 +396,10 @@ fn probe_errors_are_typed() {
         );
     }
     assert!(matches!(
-        StressProbe::new(
-            &plan,
-            &ProbeSpec::default().plane(1e-3).tolerance(0.0),
-            None
-        ),
+        ProbeSpec::default().with_plane(1e-3).with_tolerance(0.0),
         Err(Error::InvalidTolerance { .. })
     ));
-    let probe = StressProbe::new(&plan, &ProbeSpec::default().plane(1e-3), None).unwrap();
+    let probe = StressProbe::new(&plan, &ProbeSpec::default().with_plane(1e-3), None).unwrap();
     let phi = vec![1.0; grid.len()];
     let short = vec![1.0; 3];
     assert!(matches!(
@@ -395,15 +407,19 @@ fn probe_errors_are_typed() {
         Err(Error::LengthMismatch { .. })
     ));
     assert!(matches!(
-        probe.evaluate(&ProbeInput::new(&phi, &phi).loads(0.0, 1.0, 1.0)),
+        probe.evaluate(
+            &ProbeInput::new(&phi, &phi)
+                .with_loads(0.0, 1.0, 1.0)
+                .unwrap()
+        ),
         Err(Error::InvalidParameter { .. })
     ));
     assert!(matches!(
-        probe.evaluate(&ProbeInput::new(&phi, &phi).loads(f64::NAN, 0.0, 1.0)),
+        ProbeInput::new(&phi, &phi).with_loads(f64::NAN, 0.0, 1.0),
         Err(Error::NonFinite { .. })
     ));
     assert!(matches!(
-        probe.evaluate(&ProbeInput::new(&phi, &phi).friction_coefficient(-0.1)),
+        ProbeInput::new(&phi, &phi).with_friction_coefficient(-0.1),
         Err(Error::InvalidParameter { .. })
     ));
 }
@@ -423,7 +439,7 @@ fn the_driver_reports_probes_only_when_requested() {
     assert!(e.to_string().contains("SceneBuilder::probes"), "{e}");
 
     let scene = base
-        .probes(ProbeSpec::default().plane(0.0).plane(2e-3))
+        .probes(ProbeSpec::default().with_plane(0.0).with_plane(2e-3))
         .build()
         .unwrap();
     let mut d = scene.driver().unwrap();
@@ -444,6 +460,6 @@ fn the_driver_reports_probes_only_when_requested() {
     // Through z = 2 mm (below the rod band [4, 8] mm) the whole shear force passes.
     let total: f64 = s.planes[1].shear.iter().sum::<f64>() * scene.grid().cell_area();
     assert!((total - d.force()).abs() < 1e-9 * d.force());
-    let profile = s.planes[1].profile(0.5);
+    let profile = s.planes[1].profile();
     assert_eq!(profile.shear.len(), scene.grid().nx());
 }

@@ -212,7 +212,7 @@ proptest! {
     /// `Ĝ` is the reciprocity of `G` through its cell averages).
     #[test]
     fn galerkin_operator_equals_independent_assemblies(grid in grids(12, 6), seed in any::<u64>()) {
-        let plan = InfluencePlan::builder(grid).tolerance(PLAN_TOL).build().unwrap();
+        let plan = InfluencePlan::builder(grid).plan_tolerance(PLAN_TOL).build().unwrap();
         let n = grid.len();
         let dense = plan.dense().unwrap();
         let (reference, error) = reference_operator(&grid);
@@ -312,13 +312,13 @@ proptest! {
         // by construction.
         let z_min = (0.05 * grid.dx().max(grid.dy())).min(lz);
         let heights: Vec<f64> = planes.iter().map(|t| z_min + t * (lz - z_min)).collect();
-        let spec = heights.iter().fold(ProbeSpec::default(), |s, z| s.plane(*z));
+        let spec = heights.iter().fold(ProbeSpec::default(), |s, z| s.with_plane(*z));
         let probe = StressProbe::new(&plan, &spec, Some(&rod)).unwrap();
         let mut rng = seed;
         let phi_x = tractions(&grid, -(f_top + f_lat), &mut rng);
         let phi_z = tractions(&grid, f_n, &mut rng);
         let out = probe
-            .evaluate(&ProbeInput::new(&phi_x, &phi_z).loads(f_top, f_lat, f_n))
+            .evaluate(&ProbeInput::new(&phi_x, &phi_z).with_loads(f_top, f_lat, f_n).unwrap())
             .unwrap();
         let area = grid.cell_area();
         // Probe accuracy (ProbeSpec::tolerance = 1e-10): transfer factors to 1e-10 times
@@ -376,7 +376,7 @@ fn check_normal(
     tol: f64,
 ) -> std::result::Result<(), TestCaseError> {
     let u0 = iface.heights();
-    let c_z = iface.law().c_z;
+    let c_z = iface.law().c_z();
     let fmax = max_abs(traction);
     let u: Vec<f64> = matvec(&c.c, traction).iter().map(|x| x + offset).collect();
     let compliance_max = u0.iter().fold(0.0f64, |m, h| m.max(h / c_z));
@@ -446,7 +446,7 @@ fn check_tangential(
     tol: f64,
 ) -> std::result::Result<(), TestCaseError> {
     let u0 = iface.heights();
-    let c_x = iface.law().c_x;
+    let c_x = iface.law().c_x();
     let states = iface.states();
     let compliance: Vec<f64> = (0..u0.len())
         .map(|i| {
@@ -546,7 +546,7 @@ fn check_equilibria(
     let heights = Heights::truncated_gaussian(&grid, HeightDistribution::default(), seed).unwrap();
     let fresh = Interface::new(grid, heights, SpringLaw::default()).unwrap();
     let plan = InfluencePlan::builder(grid)
-        .tolerance(PLAN_TOL)
+        .plan_tolerance(PLAN_TOL)
         .build()
         .unwrap();
     let c = reference_compliance(&grid, material.modulus());
@@ -562,7 +562,7 @@ fn check_equilibria(
         let mut iface = fresh.clone();
         let mut solver = EquilibriumSolver::builder(plan.clone())
             .material(material)
-            .options(SolverOptions::default().backend(backend))
+            .solver_options(SolverOptions::default().with_backend(backend).unwrap())
             .build()
             .unwrap();
         let mut history = Vec::new();

@@ -74,7 +74,7 @@ fn check_state(driver: &Driver) -> Result<(), TestCaseError> {
     prop_assert!(all_finite(phi));
     prop_assert!(all_finite(driver.normal_displacement().unwrap()));
     prop_assert!(all_finite(driver.shear_traction().unwrap()));
-    prop_assert!(all_finite(&driver.real_contact_area().unwrap()));
+    prop_assert!(all_finite(&driver.cell_contact_area().unwrap()));
     prop_assert!(driver.breaking_loads().iter().all(|b| !b.is_nan()));
     let f_n = driver.normal_load();
     let cell = driver.grid().cell_area();
@@ -94,7 +94,7 @@ fn check_state(driver: &Driver) -> Result<(), TestCaseError> {
     // loosest solver tolerance is 1e-6; `solver.tolerance = 1` gave errors of order 1).
     let u = driver.normal_displacement().unwrap();
     let h = driver.interface().heights();
-    let c_z = driver.interface().law().c_z;
+    let c_z = driver.interface().law().c_z();
     let scale = h.iter().chain(u).fold(0.0f64, |m, v| m.max(v.abs()));
     let worst = (0..u.len()).fold(0.0f64, |m, i| {
         m.max(match driver.site_states()[i] {
@@ -109,7 +109,7 @@ fn check_state(driver: &Driver) -> Result<(), TestCaseError> {
     );
     let ratio = driver.force() / (driver.friction_coefficient() * f_n);
     prop_assert!(ratio.is_finite() && ratio >= 0.0, "F/(μF_N) = {ratio}");
-    let area = driver.total_contact_area().unwrap();
+    let area = driver.real_contact_area().unwrap();
     prop_assert!(area.is_finite() && area >= 0.0, "A_R = {area}");
     if !driver.area_exceeds_nominal().unwrap() {
         prop_assert!(
@@ -246,7 +246,7 @@ proptest! {
         (dx, dy, by_size) in (wild(1e-3), wild(1e-3), any::<bool>()),
         (nx, ny) in (count(), count()),
         (young, poisson, mu) in (wild(3e9), wild(0.3), wild(0.5)),
-        (c_x, c_z) in (wild(SpringLaw::default().c_x), wild(SpringLaw::default().c_z)),
+        (c_x, c_z) in (wild(SpringLaw::default().c_x()), wild(SpringLaw::default().c_z())),
         (mean, sd, seed) in (wild(1e-6), wild(1e-6), any::<u64>()),
         (load, drive_kind, a, b) in (wild(60.0), 0..5u8, wild(5e-3), wild(2e-3)),
         (plan_tol, solver_tol) in (wild(1e-6), wild(1e-13)),
@@ -257,13 +257,26 @@ proptest! {
         // group), so that most draws reach the solver rather than fail at the first check.
         let wild_mask = (1u32 << wild_group) | (1u32 << second);
         let pick = |bit: u32, wild: f64, tame: f64| if wild_mask & (1 << bit) != 0 { wild } else { tame };
-        let mut material = Material::default();
-        material.young_modulus = pick(0, young, 3e9);
-        material.poisson_ratio = pick(1, poisson, 0.35);
-        material.friction_coefficient = pick(2, mu, 0.5);
-        let mut law = SpringLaw::default();
-        law.c_x = pick(3, c_x, law.c_x);
-        law.c_z = pick(3, c_z, law.c_z);
+        // The value types refuse invalid values when made (a typed error: the property
+        // holds); the scene checks the rest.
+        let parts = (|| -> precursors::Result<_> {
+            let material = Material::new(pick(0, young, 3e9), pick(1, poisson, 0.35), pick(2, mu, 0.5))?;
+            let law = SpringLaw::new(
+                pick(3, c_x, SpringLaw::default().c_x()),
+                pick(3, c_z, SpringLaw::default().c_z()),
+            )?;
+            let distribution = HeightDistribution::new(pick(8, mean, 1e-6), pick(8, sd, 1e-6))?;
+            let mut solver = SolverOptions::default().with_tolerance(pick(11, solver_tol, 1e-13))?;
+            if wild_mask & (1 << 14) != 0 {
+                solver = solver
+                    .with_max_active_set_iterations(active_set)?
+                    .with_max_linear_iterations(linear)?;
+            }
+            Ok((material, law, distribution, solver))
+        })();
+        let Ok((material, law, distribution, solver)) = parts else {
+            return Ok(());
+        };
         let lateral = Lateral::Rod { height: pick(4, a, 5e-3), half_width: pick(4, b, 2e-3) };
         let drive = match drive_kind {
             0 => Drive::Force(ForceLoad::Top),
@@ -277,20 +290,13 @@ proptest! {
             .material(material)
             .springs(law)
             .heights(HeightSource::Random {
-                distribution: HeightDistribution::new(pick(8, mean, 1e-6), pick(8, sd, 1e-6)),
+                distribution,
                 seed,
             })
             .normal_load(pick(9, load, 60.0))
             .drive(drive)
             .plan_tolerance(pick(10, plan_tol, 1e-6))
-            .solver({
-                let mut solver = SolverOptions::default().tolerance(pick(11, solver_tol, 1e-13));
-                if wild_mask & (1 << 14) != 0 {
-                    solver.max_active_set_iterations = active_set;
-                    solver.max_linear_iterations = linear;
-                }
-                solver
-            })
+            .solver_options(solver)
             .max_cells(MAX_CELLS);
         builder = if by_size {
             builder.cell_size(pick(12, dx, 1e-3), pick(12, dy, 1e-3))
@@ -398,8 +404,8 @@ mod file {
             })
             .probes(
                 precursors::probe::ProbeSpec::default()
-                    .plane(1e-3)
-                    .point(Point::new(0.01, 0.002, 0.002)),
+                    .with_plane(1e-3)
+                    .with_point(Point::new(0.01, 0.002, 0.002)),
             )
             .max_cells(MAX_CELLS);
         serde_json::from_str(&builder.to_json().unwrap()).unwrap()

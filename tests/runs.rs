@@ -145,7 +145,7 @@ fn a_sweep_leaves_a_run_held_elsewhere_to_its_holder() {
     let holder_scene = sweep.runs()[3].scene.clone().build().unwrap();
     let holder = RunTables::create(&held, &holder_scene.driver().unwrap()).unwrap();
     let first = sweep
-        .execute(&dir, &SweepOptions::new().jobs(2), |_| {})
+        .execute(&dir, &SweepOptions::new().with_jobs(2).unwrap(), |_| {})
         .unwrap();
     assert_eq!(
         (

@@ -15,19 +15,19 @@ fn scratch(name: &str) -> PathBuf {
 
 /// A builder with every option away from its default.
 fn everything() -> SceneBuilder {
-    let mut material = Material::default();
-    material.young_modulus = 2.5e9;
-    material.poisson_ratio = 0.3;
-    material.friction_coefficient = 0.7;
-    let mut law = SpringLaw::default();
-    law.c_x = 1.1e12;
-    law.c_z = 2.2e8;
-    let mut solver = SolverOptions::default()
-        .backend(Backend::Spectral)
-        .tolerance(1e-11)
-        .parallelism(Parallelism::Threads(2));
-    solver.max_active_set_iterations = 77;
-    solver.max_linear_iterations = 999;
+    let material = Material::new(2.5e9, 0.3, 0.7).unwrap();
+    let law = SpringLaw::new(1.1e12, 2.2e8).unwrap();
+    let solver = SolverOptions::default()
+        .with_backend(Backend::Spectral)
+        .unwrap()
+        .with_tolerance(1e-11)
+        .unwrap()
+        .with_parallelism(Parallelism::Threads(2))
+        .unwrap()
+        .with_max_active_set_iterations(77)
+        .unwrap()
+        .with_max_linear_iterations(999)
+        .unwrap();
     Scene::builder()
         .block(0.030, 0.006, 0.020)
         .cells(15, 3)
@@ -44,14 +44,15 @@ fn everything() -> SceneBuilder {
                 half_width: 1.5e-3,
             },
         })
-        .solver(solver)
+        .solver_options(solver)
         .plan_tolerance(1e-7)
         .probes(
             probe::ProbeSpec::default()
-                .plane(2e-3)
-                .plane(0.0)
-                .point(Point::new(0.01, 0.003, 0.001))
-                .tolerance(1e-9),
+                .with_plane(2e-3)
+                .with_plane(0.0)
+                .with_point(Point::new(0.01, 0.003, 0.001))
+                .with_tolerance(1e-9)
+                .unwrap(),
         )
 }
 
@@ -74,7 +75,7 @@ fn every_option_round_trips_exactly() {
         .chain([
             everything().cell_size(2e-3, 2e-3),
             everything().heights(HeightSource::Random {
-                distribution: HeightDistribution::new(2e-6, 0.5e-6),
+                distribution: HeightDistribution::new(2e-6, 0.5e-6).unwrap(),
                 seed: u64::MAX,
             }),
             Scene::builder(),
@@ -117,8 +118,7 @@ fn missing_keys_take_the_calibration_defaults() {
         r#"{"material": {"friction_coefficient": 0.6}, "heights": {"kind": "gaussian", "seed": 9}}"#,
     )
     .unwrap();
-    let mut material = Material::default();
-    material.friction_coefficient = 0.6;
+    let material = Material::default().with_friction_coefficient(0.6).unwrap();
     assert_eq!(partial, Scene::builder().material(material).seed(9));
 }
 
@@ -280,7 +280,11 @@ fn solver_threads_take_counts_and_names() {
         );
         let builder = SceneBuilder::from_json_str(&text).unwrap();
         let scene = builder.clone().build().unwrap();
-        assert_eq!(scene.solver().parallelism, want, "threads = {value}");
+        assert_eq!(
+            scene.solver_options().parallelism(),
+            want,
+            "threads = {value}"
+        );
         let again = SceneBuilder::from_json_str(&builder.to_json().unwrap()).unwrap();
         assert_eq!(again, builder, "threads = {value}");
     }
@@ -356,10 +360,7 @@ fn the_cell_limit_and_dense_threads_in_scene_files() {
     );
     assert!(!Scene::builder().to_json().unwrap().contains("max_cells"));
     let dense = r#"{"solver": {"backend": "dense", "threads": 2}}"#;
-    let e = SceneBuilder::from_json_str(dense)
-        .unwrap()
-        .build()
-        .unwrap_err();
+    let e = SceneBuilder::from_json_str(dense).unwrap_err();
     assert!(matches!(e, Error::DenseThreads { threads: 2, .. }), "{e}");
     let auto = r#"{"solver": {"backend": "auto", "threads": 2}}"#;
     let scene = SceneBuilder::from_json_str(auto).unwrap().build().unwrap();
@@ -398,7 +399,7 @@ fn arrays_are_refused_where_the_format_has_objects() {
         r#"{"probes": {"planes": [0.001], "points": [[0.01, 0.002, 0.002]]}}"#,
     )
     .unwrap();
-    assert_eq!(b.build().unwrap().probes().points.len(), 1);
+    assert_eq!(b.build().unwrap().probes().points().len(), 1);
     use precursors::sweep::Sweep;
     for (text, place) in [
         (

@@ -9,7 +9,7 @@ use precursors::*;
 
 fn solver(plan: &green::InfluencePlan, backend: Backend) -> EquilibriumSolver {
     EquilibriumSolver::builder(plan.clone())
-        .options(SolverOptions::default().backend(backend))
+        .solver_options(SolverOptions::default().with_backend(backend).unwrap())
         .build()
         .unwrap()
 }
@@ -32,7 +32,7 @@ fn assert_kkt(c: &[f64], iface: &Interface, eq: &NormalEquilibrium, tol: f64) {
         );
         match iface.states()[i] {
             SiteState::Attached => {
-                let spring = law.c_z / u0[i] * (u0[i] - u[i]);
+                let spring = law.c_z() / u0[i] * (u0[i] - u[i]);
                 assert!(
                     (spring - eq.traction[i]).abs() <= tol * f_scale,
                     "site {i}: spring law"
@@ -175,7 +175,7 @@ fn tangential_response_matches_bordered_lu() {
             .collect();
         let d: Vec<f64> = set
             .iter()
-            .map(|&i| (eq.displacement[i] / iface.heights()[i]).exp() / iface.law().c_x)
+            .map(|&i| (eq.displacement[i] / iface.heights()[i]).exp() / iface.law().c_x())
             .collect();
         let b: Vec<f64> = set.iter().map(|&i| -e[i]).collect();
         let (phi, _) = bordered_solve(&c, n, &set, &d, &b, -1.0 / s.grid.cell_area());
@@ -191,7 +191,7 @@ fn tangential_response_matches_bordered_lu() {
             );
         }
         let loads = iface
-            .breaking_loads(&eq.traction, &t.traction, m.friction_coefficient)
+            .breaking_loads(&eq.traction, &t.traction, m.friction_coefficient())
             .unwrap();
         for ((load, g), f) in loads.iter().zip(&t.traction).zip(&eq.traction) {
             if *g != 0.0 {
@@ -242,12 +242,16 @@ fn solver_errors_are_typed() {
     let big = scene(150, 150, 1e-4, 0.01, 1);
     assert!(matches!(
         EquilibriumSolver::builder(big.plan)
-            .options(SolverOptions::default().backend(Backend::Dense))
+            .solver_options(
+                SolverOptions::default()
+                    .with_backend(Backend::Dense)
+                    .unwrap()
+            )
             .build(),
         Err(Error::TooLargeForDense { .. })
     ));
     assert!(EquilibriumSolver::builder(s.plan.clone())
-        .options(SolverOptions::default().tolerance(-1.0))
+        .solver_options(SolverOptions::default().with_tolerance(-1.0).unwrap())
         .build()
         .is_err());
 }

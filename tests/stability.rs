@@ -44,7 +44,7 @@ fn condition(c: &[f64], n: usize, set: &[usize], d: &[f64]) -> f64 {
 fn run(case: Case) {
     let n = case.grid.len();
     let plan = InfluencePlan::builder(case.grid)
-        .tolerance(1e-8)
+        .plan_tolerance(1e-8)
         .build()
         .unwrap();
     let m = Material::default();
@@ -58,7 +58,7 @@ fn run(case: Case) {
                 .for_each(|i| iface.break_site(i).unwrap());
         }
         let mut solver = EquilibriumSolver::builder(plan.clone())
-            .options(SolverOptions::default().backend(backend))
+            .solver_options(SolverOptions::default().with_backend(backend).unwrap())
             .build()
             .unwrap();
         let eq = solver.solve_normal(&iface, case.normal_load).unwrap();
@@ -93,7 +93,7 @@ fn run(case: Case) {
         assert!((shear + 1.0).abs() <= 1e-10, "{}: shear balance", case.name);
         // exp(-(u_z-u0)/u0) overflows for compressions beyond ~700 u0 (soft springs):
         // the report is a typed error, never an infinity.
-        let area_note = match iface.real_contact_area(&eq.displacement) {
+        let area_note = match iface.cell_contact_area(&eq.displacement) {
             Ok(a) => {
                 let area: f64 = a.iter().sum();
                 assert!(area.is_finite() && area > 0.0);
@@ -107,11 +107,11 @@ fn run(case: Case) {
             .collect();
         let dz: Vec<f64> = set
             .iter()
-            .map(|&i| case.heights[i] / case.law.c_z)
+            .map(|&i| case.heights[i] / case.law.c_z())
             .collect();
         let dx: Vec<f64> = set
             .iter()
-            .map(|&i| (eq.displacement[i] / case.heights[i]).exp() / case.law.c_x)
+            .map(|&i| (eq.displacement[i] / case.heights[i]).exp() / case.law.c_x())
             .collect();
         println!(
             "| {} | {:?} | {} / {} | {:.1e} | {:.1e} | {:.1e} | {:.1e} | {:.1e} | {} + {} | {} |",
@@ -225,7 +225,7 @@ fn stability_penetration_below_the_substrate() {
         eq.displacement.iter().all(|u| *u < 0.0),
         "every site below the substrate plane"
     );
-    let area = iface.real_contact_area(&eq.displacement).unwrap();
+    let area = iface.cell_contact_area(&eq.displacement).unwrap();
     assert!(
         area.iter().all(|a| *a > g.cell_area()),
         "contact area exceeds the cell"

@@ -325,7 +325,7 @@ fn complete_runs_are_skipped_and_a_cut_one_is_redone() {
     std::fs::write(complete.join("stray"), "x").unwrap();
     let reports = std::sync::Mutex::new(Vec::new());
     let second = sweep
-        .execute(&dir, &SweepOptions::new().jobs(2), |r| {
+        .execute(&dir, &SweepOptions::new().with_jobs(2).unwrap(), |r| {
             reports.lock().unwrap().push((r.index, r.skipped))
         })
         .unwrap();
@@ -360,18 +360,30 @@ fn tables_do_not_depend_on_jobs_or_shards() {
     let two = scratch("jobs2");
     let sharded = scratch("shards");
     sweep
-        .execute(&one, &SweepOptions::new().jobs(1), |_| {})
+        .execute(&one, &SweepOptions::new().with_jobs(1).unwrap(), |_| {})
         .unwrap();
     sweep
-        .execute(&two, &SweepOptions::new().jobs(2), |_| {})
+        .execute(&two, &SweepOptions::new().with_jobs(2).unwrap(), |_| {})
         .unwrap();
     let a = sweep
-        .execute(&sharded, &SweepOptions::new().shard(0, 2).jobs(2), |_| {})
+        .execute(
+            &sharded,
+            &SweepOptions::new()
+                .with_shard(0, 2)
+                .unwrap()
+                .with_jobs(2)
+                .unwrap(),
+            |_| {},
+        )
         .unwrap();
     // Half the sweep: the merge counts the other half missing.
     assert_eq!(merge(&sharded).unwrap().runs_missing, 4);
     let b = sweep
-        .execute(&sharded, &SweepOptions::new().shard(1, 2), |_| {})
+        .execute(
+            &sharded,
+            &SweepOptions::new().with_shard(1, 2).unwrap(),
+            |_| {},
+        )
         .unwrap();
     assert_eq!((a.runs, b.runs, a.completed + b.completed), (4, 4, 8));
     for dir in [&one, &two, &sharded] {

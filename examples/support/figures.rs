@@ -91,7 +91,7 @@ pub fn mean_precursor_curve(
 ) -> Result<Vec<f64>> {
     let scene = builder.clone().build()?;
     let lx = scene.grid().block().lx();
-    let mu_fn = scene.material().friction_coefficient * scene.normal_load();
+    let mu_fn = scene.material().friction_coefficient() * scene.normal_load();
     let mut mean = vec![0.0; grid.len()];
     for &seed in seeds {
         let curve = precursor_curve(&builder.clone().seed(seed))?;

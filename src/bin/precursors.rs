@@ -635,7 +635,9 @@ fn run_sweep(
     let bar = std::sync::Mutex::new(Progress::new(progress));
     let done = std::sync::atomic::AtomicUsize::new(0);
     let ran = std::sync::atomic::AtomicUsize::new(0);
-    let options = SweepOptions::new().jobs(jobs).shard(shard.0, shard.1);
+    let options = SweepOptions::new()
+        .with_jobs(jobs)?
+        .with_shard(shard.0, shard.1)?;
     let summary = sweep.execute(out, &options, |report| {
         let d = done.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1;
         let here = usize::from(!report.skipped && !report.held_elsewhere);

@@ -91,7 +91,7 @@ impl Driver {
     /// let scene = Scene::builder().block(0.020, 0.004, 0.010).normal_load(80.0).build()?;
     /// let mut driver = scene.driver()?;
     /// driver.step()?;
-    /// driver.add_probes(&ProbeSpec::default().plane(2e-3))?;
+    /// driver.add_probes(&ProbeSpec::default().with_plane(2e-3))?;
     /// let plane = &driver.stresses()?.planes[0];
     /// assert_eq!((plane.nx, plane.ny), (20, 4));
     /// # Ok::<(), precursors::Error>(())
@@ -125,8 +125,8 @@ impl Driver {
         }
         let force = self.force();
         let input = ProbeInput::new(self.shear_traction()?, self.normal_traction()?)
-            .loads(force * self.split.0, force * self.split.1, self.normal_load)
-            .friction_coefficient(self.friction);
+            .with_loads(force * self.split.0, force * self.split.1, self.normal_load)?
+            .with_friction_coefficient(self.friction)?;
         let mut all = Stresses {
             planes: Vec::new(),
             points: Vec::new(),
@@ -139,22 +139,27 @@ impl Driver {
         Ok(all)
     }
 
-    /// Real contact area per cell (m²).
+    /// The real contact area `A_R` (m²): the total over the interface, the paper's
+    /// `A_R` (its value at zero shear is the calibration target of
+    /// [`crate::calibration::fit_normal_stiffness`]). Per cell:
+    /// [`Driver::cell_contact_area`]; per column: [`Driver::column_contact_area`].
     ///
     /// # Errors
     /// [`Error::NotSolved`] before the first [`Driver::step`]; [`Error::NonFinite`] on
     /// overflow.
-    pub fn real_contact_area(&self) -> Result<Vec<f64>> {
-        self.interface
-            .real_contact_area(&self.normal()?.displacement)
+    pub fn real_contact_area(&self) -> Result<f64> {
+        Ok(self.cell_contact_area()?.iter().sum())
     }
 
-    /// Total real contact area (m²).
+    /// The real contact area of each cell (m², in cell order `i = iy·Nx + ix`;
+    /// [`crate::Interface::cell_contact_area`] at the current displacements). The total
+    /// is [`Driver::real_contact_area`].
     ///
     /// # Errors
     /// As [`Driver::real_contact_area`].
-    pub fn total_contact_area(&self) -> Result<f64> {
-        Ok(self.real_contact_area()?.iter().sum())
+    pub fn cell_contact_area(&self) -> Result<Vec<f64>> {
+        self.interface
+            .cell_contact_area(&self.normal()?.displacement)
     }
 
     /// The nominal area `Lx·Ly` of the interface (m²).
@@ -174,7 +179,7 @@ impl Driver {
     /// # Errors
     /// As [`Driver::real_contact_area`] before the first event.
     pub fn area_exceeds_nominal(&self) -> Result<bool> {
-        match self.total_contact_area() {
+        match self.real_contact_area() {
             Ok(total) => Ok(total > self.nominal_area() * (1.0 + NOMINAL_AREA_SLACK)),
             Err(Error::NonFinite {
                 name: "real contact area",
@@ -189,7 +194,7 @@ impl Driver {
     /// # Errors
     /// As [`Driver::real_contact_area`].
     pub fn column_contact_area(&self) -> Result<Vec<f64>> {
-        let area = self.real_contact_area()?;
+        let area = self.cell_contact_area()?;
         let nx = self.grid.nx();
         let mut columns = vec![0.0; nx];
         for row in area.chunks_exact(nx) {
@@ -203,9 +208,16 @@ impl Driver {
         &self.initial_columns
     }
 
-    /// Precursor length `ℓ` (m): the extent, from the trailing edge `x = 0`, of the run of
-    /// columns whose real contact area is below its value at zero shear (docs/model.md
-    /// section 5; paper Fig. 2b). A multiple of `Δx`.
+    /// The block (lengths `Lx`, `Ly`, `Lz` in m): e.g. the precursor length relative to
+    /// the block, `ℓ/Lx = driver.precursor_length()? / driver.block().lx()`.
+    pub fn block(&self) -> &crate::geometry::Block {
+        self.grid.block()
+    }
+
+    /// Precursor length `ℓ` in metres (not relative to `Lx`: divide by
+    /// [`Driver::block`]`().lx()` for the paper's `ℓ/Lx`): the extent, from the trailing
+    /// edge `x = 0`, of the run of columns whose real contact area is below its value at
+    /// zero shear (docs/model.md section 5; paper Fig. 2b). A multiple of `Δx`.
     ///
     /// # Errors
     /// As [`Driver::real_contact_area`].
@@ -219,7 +231,7 @@ impl Driver {
         Ok(run as f64 * self.grid.dx())
     }
 
-    /// A noise-robust precursor length (m): the extent, from the trailing edge, of the
+    /// A noise-robust precursor length (m, as [`Driver::precursor_length`]): the extent, from the trailing edge, of the
     /// run of columns whose real contact area fell below `(1 - drop)` times its value at
     /// zero shear. `drop` (dimensionless, in `[0, 1)`) is the relative fall that counts;
     /// `drop = 0` is the paper's definition ([`Driver::precursor_length`]) exactly; a
@@ -230,7 +242,7 @@ impl Driver {
     /// # Errors
     /// [`Error::InvalidParameter`] for a `drop` outside `[0, 1)` (or NaN); as
     /// [`Driver::real_contact_area`] before the first event.
-    pub fn precursor_length_with(&self, drop: f64) -> Result<f64> {
+    pub fn precursor_length_with_threshold(&self, drop: f64) -> Result<f64> {
         if !(0.0..1.0).contains(&drop) {
             return Err(Error::InvalidParameter {
                 name: "drop",

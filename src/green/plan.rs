@@ -34,11 +34,14 @@ pub struct InfluencePlanBuilder {
 }
 
 impl InfluencePlanBuilder {
-    /// The largest relative error accepted on an eigenvalue (default `1e-8`). The
-    /// eigenvalues are computed to about 1e-13 whatever it is (same cost); the build
-    /// fails with [`Error::SeriesNotConverged`] when an eigenvalue's error estimate exceeds
-    /// it, which happens for tolerances below about `2e-13`.
-    pub fn tolerance(mut self, tolerance: f64) -> Self {
+    /// The plan tolerance: the largest relative error accepted on an eigenvalue
+    /// (dimensionless, default `1e-8`; the scene's [`crate::SceneBuilder::plan_tolerance`],
+    /// scene-file key `plan_tolerance`; the solver's linear tolerance is another,
+    /// [`crate::SolverOptions::tolerance`]). The eigenvalues are computed to about 1e-13
+    /// whatever it is (same cost); the build fails with [`Error::SeriesNotConverged`] when an
+    /// eigenvalue's error estimate exceeds it, which happens for tolerances below about
+    /// `2e-13`.
+    pub fn plan_tolerance(mut self, tolerance: f64) -> Self {
         self.tolerance = tolerance;
         self
     }
@@ -192,9 +195,9 @@ impl InfluencePlan {
         &self.inner.grid
     }
 
-    /// The tolerance the plan was built with: the largest relative error it accepted on
-    /// an eigenvalue ([`InfluencePlanBuilder::tolerance`]).
-    pub fn tolerance(&self) -> f64 {
+    /// The plan tolerance the plan was built with: the largest relative error it accepted
+    /// on an eigenvalue ([`InfluencePlanBuilder::plan_tolerance`]).
+    pub fn plan_tolerance(&self) -> f64 {
         self.inner.tolerance
     }
 
@@ -204,8 +207,9 @@ impl InfluencePlan {
     }
 
     /// `λ(p', m')` (m⁻¹), the coefficient of `cos(p'·)cos(p'·)cos(m'·)cos(m'·)` in `Ĝ`
-    /// (module docs); `p' < Nx`, `m' < Ny`. `None` outside the grid.
-    pub fn lambda(&self, p: usize, m: usize) -> Option<f64> {
+    /// (module docs); `p' < Nx`, `m' < Ny`. `None` outside the grid. The public form is
+    /// [`InfluencePlan::eigenvalue`] (the same number in the orthonormal basis).
+    pub(crate) fn lambda(&self, p: usize, m: usize) -> Option<f64> {
         (p < self.inner.grid.nx() && m < self.inner.grid.ny())
             .then(|| self.inner.lambda[m * self.inner.grid.nx() + p])
     }

@@ -1,11 +1,11 @@
-//! A cache of influence plans: one plan per geometry and tolerance, shared.
+//! A cache of influence plans: one plan per geometry and plan tolerance, shared.
 
 use super::plan::InfluencePlan;
 use crate::error::Result;
 use crate::geometry::Grid;
 use std::sync::{Arc, Mutex};
 
-/// Plans influence operators once per grid and tolerance and hands out shared clones.
+/// Plans influence operators once per grid and plan tolerance and hands out shared clones.
 ///
 /// Planning a grid costs `O(N)` work (its eigenvalues and DCT plans: milliseconds for the
 /// paper's 140 x 7 calibration grid, a fraction of a second at `N = 1e5`,
@@ -16,8 +16,8 @@ use std::sync::{Arc, Mutex};
 /// ```
 /// use precursors::{green::Planner, Scene};
 /// let planner = Planner::new();
-/// let a = Scene::builder().seed(1).build_with(&planner)?;
-/// let b = Scene::builder().seed(2).build_with(&planner)?;   // same geometry: no new plan
+/// let a = Scene::builder().seed(1).build_with_planner(&planner)?;
+/// let b = Scene::builder().seed(2).build_with_planner(&planner)?;   // same geometry: no new plan
 /// assert!(a.plan().same_plan(b.plan()) && planner.len() == 1);
 /// # Ok::<(), precursors::Error>(())
 /// ```
@@ -32,8 +32,10 @@ impl Planner {
         Self::default()
     }
 
-    /// The plan of `grid` with relative tolerance `tolerance` ([`InfluencePlan::builder`]),
-    /// planned on the first request and shared afterwards.
+    /// The plan of `grid` with the plan tolerance `plan_tolerance` (dimensionless: the
+    /// largest relative error accepted on an eigenvalue,
+    /// [`crate::green::InfluencePlanBuilder::plan_tolerance`]), planned on the first
+    /// request and shared afterwards.
     ///
     /// Grids above [`DEFAULT_MAX_CELLS`](super::DEFAULT_MAX_CELLS) cells are refused;
     /// [`Planner::plan_with_max_cells`] raises the limit.
@@ -41,8 +43,8 @@ impl Planner {
     /// # Errors
     /// Those of [`crate::green::InfluencePlanBuilder::build`]: [`crate::Error::GridTooLarge`],
     /// [`crate::Error::InvalidTolerance`], [`crate::Error::SeriesNotConverged`].
-    pub fn plan(&self, grid: Grid, tolerance: f64) -> Result<InfluencePlan> {
-        self.plan_with_max_cells(grid, tolerance, super::DEFAULT_MAX_CELLS)
+    pub fn plan(&self, grid: Grid, plan_tolerance: f64) -> Result<InfluencePlan> {
+        self.plan_with_max_cells(grid, plan_tolerance, super::DEFAULT_MAX_CELLS)
     }
 
     /// [`Planner::plan`] with a limit of `max_cells` cells instead of the default
@@ -54,18 +56,19 @@ impl Planner {
     pub fn plan_with_max_cells(
         &self,
         grid: Grid,
-        tolerance: f64,
+        plan_tolerance: f64,
         max_cells: usize,
     ) -> Result<InfluencePlan> {
-        let same =
-            |p: &InfluencePlan| *p.grid() == grid && p.tolerance().to_bits() == tolerance.to_bits();
+        let same = |p: &InfluencePlan| {
+            *p.grid() == grid && p.plan_tolerance().to_bits() == plan_tolerance.to_bits()
+        };
         if let Some(plan) = self.lock().iter().find(|p| same(p)) {
             return Ok(plan.clone());
         }
         // Planned outside the lock (other geometries stay available meanwhile); a plan
         // of the same geometry planned meanwhile by another thread wins.
         let plan = InfluencePlan::builder(grid)
-            .tolerance(tolerance)
+            .plan_tolerance(plan_tolerance)
             .max_cells(max_cells)
             .build()?;
         let mut plans = self.lock();

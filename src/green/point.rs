@@ -47,17 +47,23 @@ pub enum SummationAxis {
 }
 
 /// Options of a point evaluation.
+///
+/// The fields are private: options are valid by construction (the defaults, then the
+/// `with_` modifiers).
+///
+/// ```
+/// use precursors::green::{SeriesOptions, SummationAxis};
+/// let opts = SeriesOptions::default().with_tolerance(1e-8)?.with_axis(SummationAxis::Z);
+/// assert_eq!((opts.tolerance(), opts.axis()), (1e-8, SummationAxis::Z));
+/// assert!(SeriesOptions::default().with_max_terms(0).is_err());
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct SeriesOptions {
-    /// Absolute tolerance on the result, in the units of the result
-    /// (m⁻¹ for `G`, m⁻² for `∂G/∂z`). Default `1e-10`.
-    pub tolerance: f64,
-    /// Axis summed in closed form by the rapid representation. Default [`SummationAxis::Auto`].
-    pub axis: SummationAxis,
-    /// Largest number of terms a single evaluation may sum before it reports
-    /// [`Error::SeriesNotConverged`]. Default `5e7`.
-    pub max_terms: u64,
+    tolerance: f64,
+    axis: SummationAxis,
+    max_terms: u64,
 }
 
 impl Default for SeriesOptions {
@@ -71,36 +77,53 @@ impl Default for SeriesOptions {
 }
 
 impl SeriesOptions {
-    /// Default options with the given absolute tolerance.
-    #[must_use]
-    pub fn with_tolerance(tolerance: f64) -> Self {
-        Self {
-            tolerance,
-            ..Self::default()
-        }
+    /// Absolute tolerance on the result, in the units of the result (m⁻¹ for `G`, m⁻² for
+    /// `∂G/∂z`). Default `1e-10`.
+    pub fn tolerance(&self) -> f64 {
+        self.tolerance
     }
+
+    /// Axis summed in closed form by the rapid representation. Default
+    /// [`SummationAxis::Auto`].
+    pub fn axis(&self) -> SummationAxis {
+        self.axis
+    }
+
+    /// Largest number of terms a single evaluation may sum before it reports
+    /// [`Error::SeriesNotConverged`]. Default `5e7`.
+    pub fn max_terms(&self) -> u64 {
+        self.max_terms
+    }
+
+    /// The same options with another absolute tolerance (units of the result, finite and
+    /// `> 0`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidTolerance`] for a tolerance that is not finite and `> 0`.
+    pub fn with_tolerance(self, tolerance: f64) -> Result<Self> {
+        check_tolerance(tolerance)?;
+        Ok(Self { tolerance, ..self })
+    }
+
     /// The same options with another summation axis.
     #[must_use]
-    pub fn axis(mut self, axis: SummationAxis) -> Self {
-        self.axis = axis;
-        self
+    pub fn with_axis(self, axis: SummationAxis) -> Self {
+        Self { axis, ..self }
     }
-    /// The same options with another term budget.
-    #[must_use]
-    pub fn max_terms(mut self, max_terms: u64) -> Self {
-        self.max_terms = max_terms;
-        self
-    }
-    fn check(&self) -> Result<()> {
-        check_tolerance(self.tolerance)?;
-        if self.max_terms == 0 {
+
+    /// The same options with another term budget (`≥ 1`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidCount`] for 0.
+    pub fn with_max_terms(self, max_terms: u64) -> Result<Self> {
+        if max_terms == 0 {
             return Err(Error::InvalidCount {
                 name: "max_terms",
                 value: 0,
                 reason: "a series needs at least one term",
             });
         }
-        Ok(())
+        Ok(Self { max_terms, ..self })
     }
 }
 
@@ -150,19 +173,23 @@ impl GreenFunction {
     /// `G(r, r')` (m⁻¹) by the rapid representation, to absolute tolerance `tol` (m⁻¹).
     ///
     /// # Errors
-    /// As [`GreenFunction::value_with`].
+    /// [`Error::InvalidTolerance`] for a `tol` that is not finite and `> 0`; otherwise as
+    /// [`GreenFunction::value_with_options`].
     pub fn value(&self, target: Point, source: Point, tol: f64) -> Result<Estimate> {
-        self.value_with(target, source, &SeriesOptions::with_tolerance(tol))
+        self.value_with_options(
+            target,
+            source,
+            &SeriesOptions::default().with_tolerance(tol)?,
+        )
     }
 
     /// `G(r, r')` (m⁻¹) by the rapid representation with explicit options.
     ///
     /// # Errors
-    /// [`Error::InvalidTolerance`]; [`Error::InvalidCount`] for a term budget of zero;
     /// [`Error::OutsideBlock`] for a point outside the block; [`Error::SingularPoint`] when
     /// target and source coincide; [`Error::InvalidChoice`] for a forced axis along which
     /// they do not differ; [`Error::SeriesNotConverged`] past the term budget.
-    pub fn value_with(
+    pub fn value_with_options(
         &self,
         target: Point,
         source: Point,
@@ -174,16 +201,25 @@ impl GreenFunction {
     /// `∂G/∂z (r, r')` (m⁻²), derivative in the target's height, to absolute tolerance `tol`.
     ///
     /// # Errors
-    /// As [`GreenFunction::value_with`].
+    /// As [`GreenFunction::value`].
     pub fn dz(&self, target: Point, source: Point, tol: f64) -> Result<Estimate> {
-        self.dz_with(target, source, &SeriesOptions::with_tolerance(tol))
+        self.dz_with_options(
+            target,
+            source,
+            &SeriesOptions::default().with_tolerance(tol)?,
+        )
     }
 
     /// `∂G/∂z (r, r')` (m⁻²) with explicit options.
     ///
     /// # Errors
-    /// As [`GreenFunction::value_with`].
-    pub fn dz_with(&self, target: Point, source: Point, opts: &SeriesOptions) -> Result<Estimate> {
+    /// As [`GreenFunction::value_with_options`].
+    pub fn dz_with_options(
+        &self,
+        target: Point,
+        source: Point,
+        opts: &SeriesOptions,
+    ) -> Result<Estimate> {
         self.rapid(target, source, opts, true)
     }
 
@@ -199,7 +235,6 @@ impl GreenFunction {
         opts: &SeriesOptions,
         dz: bool,
     ) -> Result<Estimate> {
-        opts.check()?;
         self.check_points(target, source)?;
         let a = target.coords();
         let alpha = source.coords();
@@ -244,14 +279,13 @@ impl GreenFunction {
     /// [`Error::SeriesNotConverged`] for tight tolerances.
     ///
     /// # Errors
-    /// As [`GreenFunction::value_with`]; [`Error::SeriesNotConverged`] is common here.
+    /// As [`GreenFunction::value_with_options`]; [`Error::SeriesNotConverged`] is common here.
     pub fn raw_series(
         &self,
         target: Point,
         source: Point,
         opts: &SeriesOptions,
     ) -> Result<Estimate> {
-        opts.check()?;
         self.check_points(target, source)?;
         let a = target.coords();
         let alpha = source.coords();

@@ -300,7 +300,7 @@ mod tests {
         ] {
             let block = Block::new(nx as f64 * 1e-3, ny as f64 * 1e-3, 0.075).unwrap();
             let plan = InfluencePlan::builder(Grid::new(block, nx, ny).unwrap())
-                .tolerance(1e-3)
+                .plan_tolerance(1e-3)
                 .build()
                 .unwrap();
             let p = Partition::of(&plan);

@@ -218,52 +218,64 @@ pub(super) fn geometry(builder: &SceneBuilder) -> Result<()> {
     Ok(())
 }
 
+/// The solver's iteration budgets (`solver.max_active_set_iterations`,
+/// `solver.max_linear_iterations`) within their ranges.
+pub(super) fn solver_iterations(active_set: usize, linear: usize) -> Result<()> {
+    count_within(
+        "solver.max_active_set_iterations",
+        active_set,
+        ACTIVE_SET_ITERATIONS,
+        "a normal equilibrium needs at least one iteration, and more than 1e6 is a hang",
+    )?;
+    count_within(
+        "solver.max_linear_iterations",
+        linear,
+        LINEAR_ITERATIONS,
+        "a linear solve needs at least one iteration, and more than 1e7 is a hang",
+    )
+}
+
 /// Everything but the geometry (after the builder's own checks of signs and finiteness).
 pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
     const HUGE: &str = "beyond it the model's products overflow or underflow f64";
     let m = builder.material;
-    within("material.young_modulus", m.young_modulus, YOUNG, "Pa", HUGE)?;
+    within(
+        "material.young_modulus",
+        m.young_modulus(),
+        YOUNG,
+        "Pa",
+        HUGE,
+    )?;
     within(
         "material.poisson_ratio",
-        m.poisson_ratio,
+        m.poisson_ratio(),
         POISSON,
         "",
         "1 + ν must be at least 1e-6 (M = E/(1 + ν))",
     )?;
     within(
         "material.friction_coefficient",
-        m.friction_coefficient,
+        m.friction_coefficient(),
         FRICTION,
         "",
         HUGE,
     )?;
-    within("springs.c_x", builder.law.c_x, C_X, "N/m³", HUGE)?;
-    within("springs.c_z", builder.law.c_z, C_Z, "N/m²", HUGE)?;
+    within("springs.c_x", builder.law.c_x(), C_X, "N/m³", HUGE)?;
+    within("springs.c_z", builder.law.c_z(), C_Z, "N/m²", HUGE)?;
     within("normal_load", builder.normal_load, NORMAL_LOAD, "N", HUGE)?;
     heights(&builder.heights)?;
     drive(builder)?;
     let o = builder.solver;
     within(
         "solver.tolerance",
-        o.tolerance,
+        o.tolerance(),
         SOLVER_TOLERANCE,
         "",
         "no linear solve reaches a backward error below 1e-15, and above 1e-6 the \
          events and loads are wrong without notice (docs/accuracy.md)",
     )?;
     resolution(builder)?;
-    count_within(
-        "solver.max_active_set_iterations",
-        o.max_active_set_iterations,
-        ACTIVE_SET_ITERATIONS,
-        "a normal equilibrium needs at least one iteration, and more than 1e6 is a hang",
-    )?;
-    count_within(
-        "solver.max_linear_iterations",
-        o.max_linear_iterations,
-        LINEAR_ITERATIONS,
-        "a linear solve needs at least one iteration, and more than 1e7 is a hang",
-    )?;
+    solver_iterations(o.max_active_set_iterations(), o.max_linear_iterations())?;
     if builder.plan_tolerance > PLAN_TOLERANCE_MAX {
         return Err(out_of_range(
             "plan_tolerance",
@@ -276,18 +288,16 @@ pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
         ));
     }
     let probes = &builder.probes;
-    if probes.tolerance.is_finite() && probes.tolerance > 0.0 {
-        within(
-            "probes.tolerance",
-            probes.tolerance,
-            PROBE_TOLERANCE,
-            "",
-            "below 1e-15 the alias sums cannot reach it, above 1e-2 the stresses are noise",
-        )?;
-    }
+    within(
+        "probes.tolerance",
+        probes.tolerance(),
+        PROBE_TOLERANCE,
+        "",
+        "below 1e-15 the alias sums cannot reach it, above 1e-2 the stresses are noise",
+    )?;
     for (key, count) in [
-        ("probes.planes", probes.planes.len()),
-        ("probes.points", probes.points.len()),
+        ("probes.planes", probes.planes().len()),
+        ("probes.points", probes.points().len()),
     ] {
         count_within(
             key,
@@ -298,13 +308,13 @@ pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
     }
     // The last site attached carries the whole normal load: its tangential stiffness and
     // area grow like e^{F_N/(ΔA c_z)}.
-    let exponent = builder.normal_load / (grid.cell_area() * builder.law.c_z);
+    let exponent = builder.normal_load / (grid.cell_area() * builder.law.c_z());
     if exponent.is_nan() || exponent > MAX_EXPONENT {
         return Err(out_of_range(
             "normal_load",
             builder.normal_load,
             NORMAL_LOAD.0,
-            MAX_EXPONENT * grid.cell_area() * builder.law.c_z,
+            MAX_EXPONENT * grid.cell_area() * builder.law.c_z(),
             "N (at most 650 ΔA c_z)",
             "the last site attached carries the whole normal load, and its stiffness \
              c_x·exp(F_N/(ΔA c_z) - 1) and contact area overflow beyond 650 ΔA c_z",
@@ -324,13 +334,15 @@ const MAX_GAP_ERROR: f64 = 1e-3;
 fn resolution(builder: &SceneBuilder) -> Result<()> {
     let (lx, ly, lz) = builder.lengths;
     let mean_height = match &builder.heights {
-        HeightSource::Random { distribution, .. } if distribution.mean > 0.0 => distribution.mean,
-        HeightSource::Random { distribution, .. } => distribution.std_dev,
+        HeightSource::Random { distribution, .. } if distribution.mean() > 0.0 => {
+            distribution.mean()
+        }
+        HeightSource::Random { distribution, .. } => distribution.std_dev(),
         HeightSource::Values(v) => v.iter().sum::<f64>() / v.len() as f64,
     };
     let r = builder.normal_load / (lx * ly) * lx.max(ly).max(lz)
         / (builder.material.modulus() * mean_height);
-    let tolerance = builder.solver.tolerance;
+    let tolerance = builder.solver.tolerance();
     if (tolerance * r).is_nan() || tolerance * r > MAX_GAP_ERROR {
         let most = MAX_GAP_ERROR / r;
         if most >= SOLVER_TOLERANCE.0 {
@@ -360,7 +372,7 @@ fn resolution(builder: &SceneBuilder) -> Result<()> {
     // p = F_N/(Lx Ly c_z) under the mean pressure; resolved to tolerance·R of the height,
     // its relative error is about tolerance·R/p. With springs far stiffer than the load
     // (p of 1e-14 at c_z = 1e19 N/m²) the areas were rounding noise written with exit 0.
-    let p = builder.normal_load / (lx * ly * builder.law.c_z);
+    let p = builder.normal_load / (lx * ly * builder.law.c_z());
     if (tolerance * r / p).is_nan() || tolerance * r > MAX_AREA_ERROR * p {
         let most = MAX_AREA_ERROR * p / r;
         if most >= SOLVER_TOLERANCE.0 {
@@ -377,7 +389,7 @@ fn resolution(builder: &SceneBuilder) -> Result<()> {
         }
         return Err(out_of_range(
             "springs.c_z",
-            builder.law.c_z,
+            builder.law.c_z(),
             C_Z.0,
             builder.normal_load * MAX_AREA_ERROR / (lx * ly * SOLVER_TOLERANCE.0 * r),
             "N/m² (the springs' compression under the mean pressure, F_N/(Lx Ly c_z), at \
@@ -398,7 +410,7 @@ fn heights(source: &HeightSource) -> Result<()> {
     const WHY: &str = "asperity heights beyond it overflow or underflow the compliances";
     match source {
         HeightSource::Random { distribution, .. } => {
-            let (mean, sd) = (distribution.mean, distribution.std_dev);
+            let (mean, sd) = (distribution.mean(), distribution.std_dev());
             if mean.is_finite() && mean != 0.0 {
                 within("heights.mean", mean.abs(), HEIGHT, "m (in magnitude)", WHY)?;
             }
@@ -486,14 +498,14 @@ pub(super) fn memory_bytes(builder: &SceneBuilder, grid: &Grid) -> f64 {
     let n = grid.len() as f64;
     let cost = crate::GridCost::of(grid.nx(), grid.ny()).memory_bytes;
     // Each probe keeps a kernel of N values and returns a field of N values.
-    let probes = (builder.probes.planes.len() + builder.probes.points.len()) as f64 * 16.0 * n;
+    let probes = (builder.probes.planes().len() + builder.probes.points().len()) as f64 * 16.0 * n;
     // Given heights are copied into the interface.
     let heights = match &builder.heights {
         HeightSource::Values(v) => 8.0 * v.len() as f64,
         HeightSource::Random { .. } => 0.0,
     };
     // An explicit dense backend above the size `Auto` solves densely (GridCost's own).
-    let dense = match builder.solver.backend {
+    let dense = match builder.solver.backend() {
         crate::Backend::Dense if grid.len() > crate::solver::AUTO_DENSE_LIMIT => {
             crate::green::dense_bytes(n)
         }

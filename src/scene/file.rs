@@ -177,11 +177,11 @@ impl From<ThreadsSpec> for Parallelism {
 }
 
 fn default_mean() -> f64 {
-    HeightDistribution::default().mean
+    HeightDistribution::default().mean()
 }
 
 fn default_std_dev() -> f64 {
-    HeightDistribution::default().std_dev
+    HeightDistribution::default().std_dev()
 }
 
 impl Default for SceneFile {
@@ -242,15 +242,15 @@ impl From<&SceneBuilder> for SceneFile {
         };
         let heights = match &b.heights {
             HeightSource::Random { distribution, seed } => HeightsSpec::Gaussian {
-                mean: distribution.mean,
-                std_dev: distribution.std_dev,
+                mean: distribution.mean(),
+                std_dev: distribution.std_dev(),
                 seed: *seed,
             },
             HeightSource::Values(values) => HeightsSpec::Values {
                 values: values.clone(),
             },
         };
-        let backend = match b.solver.backend {
+        let backend = match b.solver.backend() {
             Backend::Dense => BackendSpec::Dense,
             Backend::Spectral => BackendSpec::Spectral,
             _ => BackendSpec::Auto,
@@ -262,30 +262,30 @@ impl From<&SceneBuilder> for SceneFile {
                 Cells::Count(nx, ny) => CellsSpec::Count { nx, ny },
             },
             material: MaterialSpec {
-                young_modulus: b.material.young_modulus,
-                poisson_ratio: b.material.poisson_ratio,
-                friction_coefficient: b.material.friction_coefficient,
+                young_modulus: b.material.young_modulus(),
+                poisson_ratio: b.material.poisson_ratio(),
+                friction_coefficient: b.material.friction_coefficient(),
             },
             springs: SpringsSpec {
-                c_x: b.law.c_x,
-                c_z: b.law.c_z,
-                area_law: b.law.area_law,
+                c_x: b.law.c_x(),
+                c_z: b.law.c_z(),
+                area_law: b.law.area_law(),
             },
             heights,
             normal_load: b.normal_load,
             drive,
             solver: SolverSpec {
                 backend,
-                tolerance: b.solver.tolerance,
-                max_active_set_iterations: b.solver.max_active_set_iterations,
-                max_linear_iterations: b.solver.max_linear_iterations,
-                threads: b.solver.parallelism.into(),
+                tolerance: b.solver.tolerance(),
+                max_active_set_iterations: b.solver.max_active_set_iterations(),
+                max_linear_iterations: b.solver.max_linear_iterations(),
+                threads: b.solver.parallelism().into(),
             },
             plan_tolerance: b.plan_tolerance,
             probes: ProbesSpec {
-                planes: b.probes.planes.clone(),
-                points: b.probes.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
-                tolerance: b.probes.tolerance,
+                planes: b.probes.planes().to_vec(),
+                points: b.probes.points().iter().map(|p| [p.x, p.y, p.z]).collect(),
+                tolerance: b.probes.tolerance(),
             },
             max_cells: b.max_cells,
         }
@@ -295,22 +295,20 @@ impl From<&SceneBuilder> for SceneFile {
 impl SceneFile {
     /// The builder; a heights file is read relative to `base`.
     fn into_builder(self, base: &Path) -> Result<SceneBuilder> {
-        let mut material = Material::default();
-        material.young_modulus = self.material.young_modulus;
-        material.poisson_ratio = self.material.poisson_ratio;
-        material.friction_coefficient = self.material.friction_coefficient;
-        let law = SpringLaw {
-            c_x: self.springs.c_x,
-            c_z: self.springs.c_z,
-            area_law: self.springs.area_law,
-        };
+        let material = Material::new(
+            self.material.young_modulus,
+            self.material.poisson_ratio,
+            self.material.friction_coefficient,
+        )?;
+        let law = SpringLaw::new(self.springs.c_x, self.springs.c_z)?
+            .with_area_law(self.springs.area_law);
         let heights = match self.heights {
             HeightsSpec::Gaussian {
                 mean,
                 std_dev,
                 seed,
             } => HeightSource::Random {
-                distribution: HeightDistribution::new(mean, std_dev),
+                distribution: HeightDistribution::new(mean, std_dev)?,
                 seed,
             },
             HeightsSpec::Values { values } => HeightSource::Values(values),
@@ -343,15 +341,28 @@ impl SceneFile {
                 lateral: lateral.into(),
             },
         };
-        let mut solver = SolverOptions::default().backend(match self.solver.backend {
-            BackendSpec::Auto => Backend::Auto,
-            BackendSpec::Dense => Backend::Dense,
-            BackendSpec::Spectral => Backend::Spectral,
+        // Iteration counts out of range name their key (a count of 0 included).
+        super::bounds::solver_iterations(
+            self.solver.max_active_set_iterations,
+            self.solver.max_linear_iterations,
+        )?;
+        let solver = SolverOptions::default()
+            .with_parallelism(self.solver.threads.into())?
+            .with_backend(match self.solver.backend {
+                BackendSpec::Auto => Backend::Auto,
+                BackendSpec::Dense => Backend::Dense,
+                BackendSpec::Spectral => Backend::Spectral,
+            })?
+            .with_tolerance(self.solver.tolerance)?
+            .with_max_active_set_iterations(self.solver.max_active_set_iterations)?
+            .with_max_linear_iterations(self.solver.max_linear_iterations)?;
+        let probes = self.probes.planes.iter().fold(
+            ProbeSpec::default().with_tolerance(self.probes.tolerance)?,
+            |spec, &z| spec.with_plane(z),
+        );
+        let probes = self.probes.points.iter().fold(probes, |spec, [x, y, z]| {
+            spec.with_point(Point::new(*x, *y, *z))
         });
-        solver.tolerance = self.solver.tolerance;
-        solver.max_active_set_iterations = self.solver.max_active_set_iterations;
-        solver.max_linear_iterations = self.solver.max_linear_iterations;
-        solver.parallelism = self.solver.threads.into();
         Ok(SceneBuilder {
             lengths: (self.block.lx, self.block.ly, self.block.lz),
             cells: match self.cells {
@@ -365,17 +376,7 @@ impl SceneFile {
             drive,
             solver,
             plan_tolerance: self.plan_tolerance,
-            probes: {
-                let mut probes = ProbeSpec::default().tolerance(self.probes.tolerance);
-                probes.planes = self.probes.planes;
-                probes.points = self
-                    .probes
-                    .points
-                    .iter()
-                    .map(|[x, y, z]| Point::new(*x, *y, *z))
-                    .collect();
-                probes
-            },
+            probes,
             max_cells: self.max_cells,
         })
     }

@@ -242,7 +242,7 @@ impl EquilibriumSolver {
         let mut u = solved.grid_product;
         u.iter_mut().for_each(|x| *x += offset);
         let scale_u = self.norm_scale(&f, diag) + it.u0_max + offset.abs();
-        let eps_u = 10.0 * self.options.tolerance * scale_u;
+        let eps_u = 10.0 * self.options.tolerance() * scale_u;
         let negative: Vec<usize> = (0..set.len()).filter(|&a| f[a] < 0.0).collect();
         let violated: Vec<usize> = it
             .available
@@ -343,15 +343,15 @@ impl NormalIteration<'_> {
     /// Counts one more iteration.
     ///
     /// # Errors
-    /// [`Error::SolverNotConverged`] past `options.max_active_set_iterations`.
+    /// [`Error::SolverNotConverged`] past `options.max_active_set_iterations()`.
     fn count(&mut self, options: &SolverOptions) -> Result<()> {
         self.iteration += 1;
-        if self.iteration > options.max_active_set_iterations {
+        if self.iteration > options.max_active_set_iterations() {
             return Err(Error::SolverNotConverged {
                 what: "normal equilibrium (active set)",
                 iterations: self.iteration - 1,
                 residual: f64::INFINITY,
-                tolerance: options.tolerance,
+                tolerance: options.tolerance(),
             });
         }
         Ok(())

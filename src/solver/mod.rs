@@ -91,8 +91,9 @@ impl EquilibriumSolverBuilder {
         self
     }
 
-    /// Solver options.
-    pub fn options(mut self, options: SolverOptions) -> Self {
+    /// Solver options (the same method name as
+    /// [`crate::SceneBuilder::solver_options`]).
+    pub fn solver_options(mut self, options: SolverOptions) -> Self {
         self.options = options;
         self
     }
@@ -100,17 +101,13 @@ impl EquilibriumSolverBuilder {
     /// Validates and prepares the backend (assembles `C` for the dense one).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for an invalid material; [`Error::InvalidTolerance`]
-    /// for an invalid tolerance; [`Error::InvalidCount`] for `Parallelism::Threads(0)`;
-    /// [`Error::DenseThreads`] for an explicit [`Backend::Dense`] with
-    /// `Parallelism::Threads(n > 1)`; [`Error::TooLargeForDense`] for the dense backend
-    /// on a grid above [`crate::green::DENSE_LIMIT`] cells.
+    /// [`Error::TooLargeForDense`] for the dense backend on a grid above
+    /// [`crate::green::DENSE_LIMIT`] cells (the material and the options are valid by
+    /// construction).
     pub fn build(self) -> Result<EquilibriumSolver> {
-        self.material.validate()?;
-        self.options.validate()?;
         let grid = *self.plan.grid();
         let n = grid.len();
-        let backend = match self.options.backend {
+        let backend = match self.options.backend() {
             Backend::Auto if n <= AUTO_DENSE_LIMIT => Backend::Dense,
             Backend::Auto => Backend::Spectral,
             b => b,
@@ -220,8 +217,8 @@ impl EquilibriumSolver {
         self.material
     }
 
-    /// The options.
-    pub fn options(&self) -> SolverOptions {
+    /// The solver options ([`EquilibriumSolverBuilder::solver_options`]).
+    pub fn solver_options(&self) -> SolverOptions {
         self.options
     }
 
@@ -231,8 +228,8 @@ impl EquilibriumSolver {
     /// [`Error::InvalidCount`] for `Parallelism::Threads(0)`; [`Error::DenseThreads`] for
     /// `Parallelism::Threads(n > 1)` when the options ask for [`Backend::Dense`].
     pub fn set_parallelism(&mut self, parallelism: Parallelism) -> Result<()> {
-        options::check_threads(self.options.backend, parallelism)?;
-        self.options.parallelism = parallelism;
+        options::check_threads(self.options.backend(), parallelism)?;
+        self.options.set_parallelism(parallelism);
         Ok(())
     }
 
@@ -244,7 +241,7 @@ impl EquilibriumSolver {
             Core::Dense(_) => 1,
             Core::Spectral(s) => s.parts(),
         };
-        self.options.parallelism.threads().min(parts).max(1)
+        self.options.parallelism().threads().min(parts).max(1)
     }
 
     /// Forgets factors and warm starts (the next solve starts cold).
@@ -362,14 +359,14 @@ impl EquilibriumSolver {
         // Exploring a cold set only needs the signs of f and u0 - u_z right away from
         // zero: a loose tolerance, the final set is confirmed at the user's one.
         let tolerance = if explore {
-            self.options.tolerance.max(EXPLORE_TOLERANCE)
+            self.options.tolerance().max(EXPLORE_TOLERANCE)
         } else {
-            self.options.tolerance
+            self.options.tolerance()
         };
         let effort = Effort {
             tolerance,
-            max_iterations: self.options.max_linear_iterations,
-            parallelism: self.options.parallelism,
+            max_iterations: self.options.max_linear_iterations(),
+            parallelism: self.options.parallelism(),
         };
         let solved = match &mut self.core {
             // A cold or much-changed set: find the attached set with the cheap spectral

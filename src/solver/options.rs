@@ -33,31 +33,30 @@ impl std::fmt::Display for Backend {
     }
 }
 
-/// Options of the equilibrium solvers.
+/// Options of the equilibrium solvers (scene-file object `solver`).
+///
+/// The fields are private: options are valid by construction (the defaults, then the
+/// `with_` modifiers, each validating what it changes).
+///
+/// ```
+/// use precursors::{Backend, Parallelism, SolverOptions};
+/// let options = SolverOptions::default()
+///     .with_backend(Backend::Spectral)?
+///     .with_tolerance(1e-12)?
+///     .with_parallelism(Parallelism::Threads(2))?;
+/// assert_eq!((options.backend(), options.tolerance()), (Backend::Spectral, 1e-12));
+/// assert!(SolverOptions::default().with_tolerance(0.0).is_err());
+/// assert!(SolverOptions::default().with_max_linear_iterations(0).is_err());
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct SolverOptions {
-    /// Backend (default [`Backend::Auto`]).
-    pub backend: Backend,
-    /// Normwise backward error `‖A f + U 1 - b‖∞ / (‖A‖ ‖f‖∞ + ‖b‖∞ + |U|)` at which a
-    /// linear solve stops (default `1e-13`).
-    pub tolerance: f64,
-    /// Active-set iterations allowed per normal equilibrium (default `1000`).
-    pub max_active_set_iterations: usize,
-    /// Conjugate-gradient iterations allowed per linear solve (default `20000`).
-    pub max_linear_iterations: usize,
-    /// The threads a solve may use (default [`Parallelism::Sequential`]). The spectral
-    /// backend shares each solve's work over the parts of the grid (fixed by the grid);
-    /// the results are the same bit for bit for every choice (tested), only the wall time
-    /// changes (docs/performance.md). The dense backend is one part: it runs on the
-    /// calling thread. So an explicit [`Backend::Dense`] with
-    /// [`Parallelism::Threads`]`(n > 1)` is refused ([`Error::DenseThreads`]: use the
-    /// spectral backend for threads), while [`Backend::Auto`], which picks the dense
-    /// backend up to [`AUTO_DENSE_LIMIT`] cells, accepts any parallelism and runs such
-    /// small grids on the calling thread ([`crate::EquilibriumSolver::threads`] and
-    /// [`crate::Driver::threads`] tell the threads actually used). To run several scenes
-    /// at once (seeds), give each [`Parallelism::Sequential`] and one scene per core.
-    pub parallelism: Parallelism,
+    backend: Backend,
+    tolerance: f64,
+    max_active_set_iterations: usize,
+    max_linear_iterations: usize,
+    parallelism: Parallelism,
 }
 
 impl Default for SolverOptions {
@@ -73,33 +72,121 @@ impl Default for SolverOptions {
 }
 
 impl SolverOptions {
-    /// With the given backend.
-    #[must_use]
-    pub fn backend(mut self, backend: Backend) -> Self {
-        self.backend = backend;
-        self
+    /// The backend (default [`Backend::Auto`]; scene-file key `solver.backend`).
+    pub fn backend(&self) -> Backend {
+        self.backend
     }
 
-    /// With the given linear tolerance (dimensionless).
-    #[must_use]
-    pub fn tolerance(mut self, tolerance: f64) -> Self {
-        self.tolerance = tolerance;
-        self
+    /// The linear tolerance (dimensionless, default `1e-13`; scene-file key
+    /// `solver.tolerance`): the normwise backward error
+    /// `‖A f + U 1 - b‖∞ / (‖A‖ ‖f‖∞ + ‖b‖∞ + |U|)` at which a linear solve stops. (The
+    /// influence operator's eigenvalues have their own tolerance, the scene's
+    /// [`crate::SceneBuilder::plan_tolerance`].)
+    pub fn tolerance(&self) -> f64 {
+        self.tolerance
     }
 
-    /// With the given parallelism (see the field `parallelism`).
-    #[must_use]
-    pub fn parallelism(mut self, parallelism: Parallelism) -> Self {
+    /// Active-set iterations allowed per normal equilibrium (default `1000`; scene-file key
+    /// `solver.max_active_set_iterations`).
+    pub fn max_active_set_iterations(&self) -> usize {
+        self.max_active_set_iterations
+    }
+
+    /// Conjugate-gradient iterations allowed per linear solve (default `20000`; scene-file
+    /// key `solver.max_linear_iterations`).
+    pub fn max_linear_iterations(&self) -> usize {
+        self.max_linear_iterations
+    }
+
+    /// The threads a solve may use (default [`Parallelism::Sequential`]; scene-file key
+    /// `solver.threads`). The spectral backend shares each solve's work over the parts of
+    /// the grid (fixed by the grid); the results are the same bit for bit for every choice
+    /// (tested), only the wall time changes (docs/performance.md). The dense backend is
+    /// one part: it runs on the calling thread. So an explicit [`Backend::Dense`] with
+    /// [`Parallelism::Threads`]`(n > 1)` is refused ([`Error::DenseThreads`]: use the
+    /// spectral backend for threads), while [`Backend::Auto`], which picks the dense
+    /// backend up to [`AUTO_DENSE_LIMIT`] cells, accepts any parallelism and runs such
+    /// small grids on the calling thread ([`crate::EquilibriumSolver::threads`] and
+    /// [`crate::Driver::threads`] tell the threads actually used). To run several scenes
+    /// at once (seeds), give each [`Parallelism::Sequential`] and one scene per core.
+    pub fn parallelism(&self) -> Parallelism {
+        self.parallelism
+    }
+
+    /// The same options with another backend.
+    ///
+    /// # Errors
+    /// [`Error::DenseThreads`] for [`Backend::Dense`] with a parallelism of more than one
+    /// thread.
+    pub fn with_backend(self, backend: Backend) -> Result<Self> {
+        check_threads(backend, self.parallelism)?;
+        Ok(Self { backend, ..self })
+    }
+
+    /// The same options with another linear tolerance (dimensionless, finite and `> 0`;
+    /// see [`SolverOptions::tolerance`]).
+    ///
+    /// # Errors
+    /// [`Error::InvalidTolerance`] for a tolerance that is not finite and `> 0`.
+    pub fn with_tolerance(self, tolerance: f64) -> Result<Self> {
+        check_tolerance(tolerance)?;
+        Ok(Self { tolerance, ..self })
+    }
+
+    /// The same options with another active-set iteration budget (`≥ 1`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidCount`] for 0.
+    pub fn with_max_active_set_iterations(self, iterations: usize) -> Result<Self> {
+        check_iterations("max_active_set_iterations", iterations)?;
+        Ok(Self {
+            max_active_set_iterations: iterations,
+            ..self
+        })
+    }
+
+    /// The same options with another conjugate-gradient iteration budget (`≥ 1`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidCount`] for 0.
+    pub fn with_max_linear_iterations(self, iterations: usize) -> Result<Self> {
+        check_iterations("max_linear_iterations", iterations)?;
+        Ok(Self {
+            max_linear_iterations: iterations,
+            ..self
+        })
+    }
+
+    /// The same options with another parallelism (see [`SolverOptions::parallelism`]).
+    ///
+    /// # Errors
+    /// [`Error::InvalidCount`] for `Threads(0)`; [`Error::DenseThreads`] for more than one
+    /// thread with an explicit [`Backend::Dense`].
+    pub fn with_parallelism(self, parallelism: Parallelism) -> Result<Self> {
+        check_threads(self.backend, parallelism)?;
+        Ok(Self {
+            parallelism,
+            ..self
+        })
+    }
+
+    /// The same options with another parallelism, unchecked: for the solver and driver,
+    /// whose `set_parallelism` checks it against the backend first.
+    pub(crate) fn set_parallelism(&mut self, parallelism: Parallelism) {
         self.parallelism = parallelism;
-        self
     }
+}
 
-    /// Checks the options: the tolerance, the thread count and the thread count with an
-    /// explicit dense backend.
-    pub(crate) fn validate(&self) -> Result<()> {
-        check_tolerance(self.tolerance)?;
-        check_threads(self.backend, self.parallelism)
+/// An iteration budget of at least one.
+fn check_iterations(name: &'static str, iterations: usize) -> Result<()> {
+    if iterations == 0 {
+        return Err(Error::InvalidCount {
+            name,
+            value: 0,
+            reason: "a solve needs at least one iteration",
+        });
     }
+    Ok(())
 }
 
 /// Refuses a thread count the backend cannot honour: `Threads(0)`, and an explicit

@@ -149,7 +149,8 @@ fn read_run(dir: &Path, run: &SweepRun) -> Result<RunData> {
     }
     let events_path = dir.join("events.csv");
     let text = read(&events_path)?;
-    let mu_fn = run.scene.current_material().friction_coefficient * run.scene.current_normal_load();
+    let mu_fn =
+        run.scene.current_material().friction_coefficient() * run.scene.current_normal_load();
     let mut avalanches = Vec::new();
     let mut slip = None;
     let (kind, force, ruptures) = (

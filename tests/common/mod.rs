@@ -76,7 +76,7 @@ pub fn scene(nx: usize, ny: usize, cell: f64, lz: f64, seed: u64) -> TestScene {
     let block = Block::new(nx as f64 * cell, ny as f64 * cell, lz).unwrap();
     let grid = Grid::new(block, nx, ny).unwrap();
     let plan = green::InfluencePlan::builder(grid)
-        .tolerance(1e-9)
+        .plan_tolerance(1e-9)
         .build()
         .unwrap();
     let heights = Heights::truncated_gaussian(&grid, HeightDistribution::default(), seed).unwrap();

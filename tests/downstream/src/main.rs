@@ -11,7 +11,7 @@ fn main() -> Result<(), Error> {
         .cell_size(1e-3, 1e-3)
         .normal_load(500.0)
         .seed(3)
-        .probes(ProbeSpec::default().plane(1e-3))
+        .probes(ProbeSpec::default().with_plane(1e-3))
         .build()?;
     let mut driver = scene.driver()?;
     let (mut ruptures, mut stable) = (0usize, 0usize);
@@ -21,7 +21,7 @@ fn main() -> Result<(), Error> {
             Event::Rupture { .. } => ruptures += 1,
             Event::Stable { .. } => {
                 stable += 1;
-                let area = driver.total_contact_area()?;
+                let area = driver.real_contact_area()?;
                 let ell = driver.precursor_length()?;
                 let planes = &driver.stresses()?.planes;
                 assert!(area > 0.0 && ell >= 0.0 && planes.len() == 1);
