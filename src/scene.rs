@@ -29,8 +29,8 @@ use crate::probe::{ProbeSpec, StressProbe};
 use crate::solver::SolverOptions;
 
 mod bounds;
-#[cfg(feature = "serde")]
 pub(crate) mod file;
+pub(crate) mod schema;
 
 /// Relative tolerance of the lateral load table.
 const LATERAL_TOLERANCE: f64 = 1e-12;
@@ -363,141 +363,6 @@ impl SceneBuilder {
     pub fn max_cells(mut self, max_cells: usize) -> Self {
         self.max_cells = max_cells;
         self
-    }
-
-    /// The first option (by its scene-file key path, e.g. `block.lx`, `normal_load`,
-    /// `drive.lateral.height`) in which `other` describes another run, `None` for the
-    /// same run: every option equal but those of [`SceneBuilder::identity`] (the solver's
-    /// parallelism, the cell limit and the probes), which do not change the events (checkpoints resume
-    /// across them).
-    pub(crate) fn run_difference(&self, other: &SceneBuilder) -> Option<String> {
-        let (mine, theirs) = (self.run_keys(), other.run_keys());
-        for (key, value) in &mine {
-            match theirs.iter().find(|(k, _)| k == key) {
-                Some((_, v)) if v == value => {}
-                _ => return Some(key.clone()),
-            }
-        }
-        if let Some((key, _)) = theirs
-            .iter()
-            .find(|(k, _)| !mine.iter().any(|(m, _)| m == k))
-        {
-            return Some(key.clone());
-        }
-        // A field the key list does not name (a safety net: the keys cover the builder).
-        (self.identity() != other.identity()).then(|| "scene".to_string())
-    }
-
-    /// Every option that identifies the run as `(key path, value)`, with the scene
-    /// format's key names (`docs/scene-format.md`) and values written exactly (`{:?}`
-    /// of an `f64` round-trips); the solver's parallelism, the cell limit and the probes are left out.
-    /// Checkpoints store a digest of it.
-    pub(crate) fn run_keys(&self) -> Vec<(String, String)> {
-        fn put(keys: &mut Vec<(String, String)>, key: &str, value: String) {
-            keys.push((key.to_string(), value));
-        }
-        fn lateral(keys: &mut Vec<(String, String)>, prefix: &str, l: Lateral) {
-            match l {
-                Lateral::Rod { height, half_width } => {
-                    put(keys, &format!("{prefix}.kind"), "rod".into());
-                    put(keys, &format!("{prefix}.height"), format!("{height:?}"));
-                    put(
-                        keys,
-                        &format!("{prefix}.half_width"),
-                        format!("{half_width:?}"),
-                    );
-                }
-                Lateral::Side => put(keys, &format!("{prefix}.kind"), "side".into()),
-            }
-        }
-        let k = &mut Vec::new();
-        let (lx, ly, lz) = self.lengths;
-        put(k, "block.lx", format!("{lx:?}"));
-        put(k, "block.ly", format!("{ly:?}"));
-        put(k, "block.lz", format!("{lz:?}"));
-        match self.cells {
-            Cells::Size(dx, dy) => {
-                put(k, "cells.kind", "size".into());
-                put(k, "cells.dx", format!("{dx:?}"));
-                put(k, "cells.dy", format!("{dy:?}"));
-            }
-            Cells::Count(nx, ny) => {
-                put(k, "cells.kind", "count".into());
-                put(k, "cells.nx", format!("{nx}"));
-                put(k, "cells.ny", format!("{ny}"));
-            }
-        }
-        let m = self.material;
-        put(
-            k,
-            "material.young_modulus",
-            format!("{:?}", m.young_modulus),
-        );
-        put(
-            k,
-            "material.poisson_ratio",
-            format!("{:?}", m.poisson_ratio),
-        );
-        let mu = m.friction_coefficient;
-        put(k, "material.friction_coefficient", format!("{mu:?}"));
-        put(k, "springs.c_x", format!("{:?}", self.law.c_x));
-        put(k, "springs.c_z", format!("{:?}", self.law.c_z));
-        let area_law = format!("{:?}", self.law.area_law).to_lowercase();
-        put(k, "springs.area_law", area_law);
-        match &self.heights {
-            HeightSource::Random { distribution, seed } => {
-                put(k, "heights.kind", "gaussian".into());
-                put(k, "heights.mean", format!("{:?}", distribution.mean));
-                put(k, "heights.std_dev", format!("{:?}", distribution.std_dev));
-                put(k, "heights.seed", format!("{seed}"));
-            }
-            HeightSource::Values(values) => {
-                put(k, "heights.kind", "values".into());
-                put(k, "heights.values", format!("{values:?}"));
-            }
-        }
-        put(k, "normal_load", format!("{:?}", self.normal_load));
-        match self.drive {
-            Drive::Force(ForceLoad::Top) => put(k, "drive.kind", "top".into()),
-            Drive::Force(ForceLoad::Lateral(l)) => lateral(k, "drive", l),
-            Drive::Force(ForceLoad::Mixed { ratio, lateral: l }) => {
-                put(k, "drive.kind", "mixed".into());
-                put(k, "drive.ratio", format!("{ratio:?}"));
-                lateral(k, "drive.lateral", l);
-            }
-            Drive::Spring {
-                stiffness,
-                lateral: l,
-            } => {
-                put(k, "drive.kind", "spring".into());
-                put(k, "drive.stiffness", format!("{stiffness:?}"));
-                lateral(k, "drive.lateral", l);
-            }
-        }
-        let o = self.solver;
-        put(
-            k,
-            "solver.backend",
-            format!("{:?}", o.backend).to_lowercase(),
-        );
-        put(k, "solver.tolerance", format!("{:?}", o.tolerance));
-        let n = o.max_active_set_iterations;
-        put(k, "solver.max_active_set_iterations", format!("{n}"));
-        let n = o.max_linear_iterations;
-        put(k, "solver.max_linear_iterations", format!("{n}"));
-        put(k, "plan_tolerance", format!("{:?}", self.plan_tolerance));
-        std::mem::take(k)
-    }
-
-    /// The scene's identity: this builder without the options that do not change the
-    /// events, the solver's parallelism (results are bit for bit the same for every
-    /// choice), the cell limit and the probes (observers, which a driver may add at any time).
-    pub(crate) fn identity(&self) -> SceneBuilder {
-        let mut identity = self.clone();
-        identity.solver.parallelism = SolverOptions::default().parallelism;
-        identity.probes = ProbeSpec::default();
-        identity.max_cells = crate::green::DEFAULT_MAX_CELLS;
-        identity
     }
 
     /// The largest relative error accepted on the influence operator's eigenvalues
