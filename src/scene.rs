@@ -548,7 +548,6 @@ impl SceneBuilder {
     /// # Errors
     /// As [`SceneBuilder::build`].
     pub fn build_with(self, planner: &Planner) -> Result<Scene> {
-        let builder = self.clone();
         let (lx, ly, lz) = self.lengths;
         let (block, grid, heights, lateral) = self.checked()?;
         let plan = planner.plan_with_max_cells(grid, self.plan_tolerance, self.max_cells)?;
@@ -580,39 +579,37 @@ impl SceneBuilder {
         } else {
             Some(StressProbe::new(&plan, &self.probes, rod.as_ref())?)
         };
-        Ok(Scene {
+        Ok(Scene(std::sync::Arc::new(Built {
             probe,
             rod,
             grid,
-            material: self.material,
             interface,
-            normal_load: self.normal_load,
-            drive: self.drive,
-            solver: self.solver,
             plan,
             lateral_response,
-            builder,
-        })
+            builder: self,
+        })))
     }
 }
 
-/// A validated simulation set-up; [`Scene::driver`] runs it.
+/// A validated simulation set-up; [`Scene::driver`] runs it. A clone is cheap (the scene
+/// is shared: its drivers hold it).
 #[derive(Debug, Clone)]
-pub struct Scene {
+pub struct Scene(std::sync::Arc<Built>);
+
+/// What a scene holds: what it was built from (its one form of the set-up: material,
+/// loads, drive, solver options, probes) and what it built from it.
+#[derive(Debug)]
+struct Built {
+    /// What the scene was built from (a checkpoint records it).
+    builder: SceneBuilder,
     grid: Grid,
-    material: Material,
     interface: Interface,
-    normal_load: f64,
-    drive: Drive,
-    solver: SolverOptions,
     plan: InfluencePlan,
     lateral_response: Option<Vec<f64>>,
     /// The lateral load, if the drive has one (the probes' lateral term).
     rod: Option<RodLoad>,
     /// The default probes, planned at build.
     probe: Option<StressProbe>,
-    /// What the scene was built from (a checkpoint records it).
-    builder: SceneBuilder,
 }
 
 impl Scene {
@@ -624,74 +621,74 @@ impl Scene {
     /// The builder this scene was built from (for instance to write it as a scene file
     /// with the `serde` feature, or to vary one parameter).
     pub fn to_builder(&self) -> SceneBuilder {
-        self.builder.clone()
+        self.0.builder.clone()
     }
 
     /// The grid (and through it the block).
     pub fn grid(&self) -> &Grid {
-        &self.grid
+        &self.0.grid
     }
 
     /// The material.
     pub fn material(&self) -> Material {
-        self.material
+        self.0.builder.material
     }
 
     /// The interface in its initial state (every site attached).
     pub fn interface(&self) -> &Interface {
-        &self.interface
+        &self.0.interface
     }
 
     /// The normal load `F_N` (N).
     pub fn normal_load(&self) -> f64 {
-        self.normal_load
+        self.0.builder.normal_load
     }
 
     /// The drive.
     pub fn drive(&self) -> Drive {
-        self.drive
+        self.0.builder.drive
     }
 
     /// The solver options ([`SceneBuilder::solver`]).
     pub fn solver(&self) -> SolverOptions {
-        self.solver
+        self.0.builder.solver
     }
 
     /// The spring constants ([`SceneBuilder::springs`]).
     pub fn springs(&self) -> SpringLaw {
-        self.interface.law()
+        self.0.interface.law()
     }
 
     /// Where the heights came from ([`SceneBuilder::heights`], [`SceneBuilder::seed`]);
     /// the heights themselves are [`Interface::heights`] of [`Scene::interface`].
     pub fn heights(&self) -> &HeightSource {
-        &self.builder.heights
+        &self.0.builder.heights
     }
 
     /// The planned influence operator.
     pub fn plan(&self) -> &InfluencePlan {
-        &self.plan
+        &self.0.plan
     }
 
     /// The stress probes every driver of the scene starts with ([`SceneBuilder::probes`];
     /// empty by default).
     pub fn probes(&self) -> &ProbeSpec {
-        &self.builder.probes
+        &self.0.builder.probes
     }
 
     /// The default probes as planned at build (`None` when there are none).
     pub(crate) fn stress_probe(&self) -> Option<&StressProbe> {
-        self.probe.as_ref()
+        self.0.probe.as_ref()
     }
 
     /// The lateral load of the drive, if any (the probes' lateral stress term).
     pub(crate) fn lateral_load(&self) -> Option<&RodLoad> {
-        self.rod.as_ref()
+        self.0.rod.as_ref()
     }
 
     /// `(F_top, F_lat)` (N) per newton of the driven force `F`.
     pub(crate) fn load_split(&self) -> (f64, f64) {
-        match self.drive {
+        match self.drive() {
             Drive::Force(ForceLoad::Top) => (1.0, 0.0),
             Drive::Force(ForceLoad::Mixed { ratio, .. }) => {
                 (ratio / (1.0 + ratio), 1.0 / (1.0 + ratio))
@@ -702,7 +699,7 @@ impl Scene {
 
     /// Whether the scene built the lateral load table (only drives with a lateral part).
     pub fn has_lateral_table(&self) -> bool {
-        self.lateral_response.is_some()
+        self.0.lateral_response.is_some()
     }
 
     /// Displacement `e` (m/N) of each cell per newton of the driven force in the absence
@@ -710,12 +707,12 @@ impl Scene {
     /// newton of spring force under displacement control. `None` for a top shear (a
     /// constant, absorbed by `⟨u_x⟩`).
     pub(crate) fn unit_load_displacement(&self) -> Vec<f64> {
-        match (&self.lateral_response, self.drive) {
+        match (&self.0.lateral_response, self.drive()) {
             (Some(e), Drive::Force(ForceLoad::Mixed { ratio, .. })) => {
                 e.iter().map(|v| v / (1.0 + ratio)).collect()
             }
             (Some(e), _) => e.clone(),
-            (None, _) => vec![0.0; self.grid.len()],
+            (None, _) => vec![0.0; self.0.grid.len()],
         }
     }
 }
@@ -733,14 +730,14 @@ mod leaves_out {
     #[test]
     fn a_top_drive_has_no_lateral_load_and_no_probes_no_transfer() {
         let top = small().drive(Drive::Force(ForceLoad::Top)).build().unwrap();
-        assert!(top.rod.is_none() && top.lateral_response.is_none());
-        assert!(top.probe.is_none());
+        assert!(top.0.rod.is_none() && top.0.lateral_response.is_none());
+        assert!(top.0.probe.is_none());
         let rod = small()
             .probes(ProbeSpec::default().plane(2e-3))
             .build()
             .unwrap();
-        assert!(rod.rod.is_some() && rod.lateral_response.is_some());
-        assert!(rod.probe.is_some());
+        assert!(rod.0.rod.is_some() && rod.0.lateral_response.is_some());
+        assert!(rod.0.probe.is_some());
     }
 
     #[test]

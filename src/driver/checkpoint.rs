@@ -380,7 +380,7 @@ impl Scene {
             driver.breaking = driver.interface.breaking_loads(
                 &normal.traction,
                 &response.traction,
-                driver.friction,
+                driver.friction_coefficient(),
             )?;
         }
         driver.normal = checkpoint.normal.clone();
