@@ -590,12 +590,12 @@ impl Sweep {
                 });
             }
         });
-        let mut errors = errors.into_inner().unwrap_or_else(|p| p.into_inner());
+        let mut errors = crate::lock::into_inner(errors);
         errors.sort_by_key(|(i, _)| *i);
         if let Some((_, e)) = errors.into_iter().next() {
             return Err(e);
         }
-        let reports = reports.into_inner().unwrap_or_else(|p| p.into_inner());
+        let reports = crate::lock::into_inner(reports);
         let skipped = reports.iter().filter(|r| r.skipped).count();
         let held_elsewhere = reports.iter().filter(|r| r.held_elsewhere).count();
         Ok(SweepSummary {

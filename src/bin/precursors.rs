@@ -8,6 +8,11 @@
 //! ```
 
 use clap::{Parser, Subcommand};
+// The crate's byte and second formatters, compiled in from their one file (they are not
+// part of the library's API).
+#[path = "../format.rs"]
+mod format;
+use format::{format_bytes, format_seconds};
 use precursors::output::{counts, RunTables};
 use precursors::sweep::{Sweep, SweepOptions};
 use precursors::{Checkpoint, Driver, Error, Event, GridCost, SceneBuilder};
@@ -489,10 +494,10 @@ fn info(path: &Path) -> Result<(), Failure> {
         metres(grid.dx()),
         metres(grid.dy()),
         file["solver"]["threads"],
-        bytes(cost.memory_bytes),
-        seconds(cost.plan_seconds),
-        seconds(cost.solve_seconds),
-        seconds(run),
+        format_bytes(cost.memory_bytes),
+        format_seconds(cost.plan_seconds),
+        format_seconds(cost.solve_seconds),
+        format_seconds(run),
     );
     print_out(&text)
 }
@@ -519,23 +524,6 @@ fn metres(m: f64) -> String {
         format!("{rounded}")
     } else {
         format!("{rounded:e}")
-    }
-}
-
-fn bytes(b: f64) -> String {
-    match b {
-        b if b >= 1e9 => format!("{:.3} GB", b / 1e9),
-        b if b >= 1e6 => format!("{:.3} MB", b / 1e6),
-        b if b >= 1e3 => format!("{:.3} kB", b / 1e3),
-        b => format!("{b:.0} B"),
-    }
-}
-
-fn seconds(s: f64) -> String {
-    match s {
-        s if s >= 3600.0 => format!("{:.2} h", s / 3600.0),
-        s if s >= 60.0 => format!("{:.2} min", s / 60.0),
-        s => format!("{s:.3} s"),
     }
 }
 

@@ -7,7 +7,7 @@
 //! scene fills the gaps) and unknown keys are refused: a misspelt key must not silently
 //! fall back to a default.
 
-use super::schema::{schema_enum, schema_leaf, schema_struct};
+use super::schema::{observes, schema_enum, schema_leaf, schema_struct, Schema};
 use super::{Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder};
 use crate::interface::AreaLaw;
 use crate::solver::{Backend, Parallelism};
@@ -470,10 +470,10 @@ pub(crate) enum Shape {
 }
 
 /// The shape of a scene file's key path (dotted, `""` for the top level), from the
-/// schema ([`super::schema::object_at`]).
+/// schema ([`object_at`]).
 #[cfg(feature = "serde")]
 pub(crate) fn scene_shape(path: &str) -> Shape {
-    if super::schema::object_at(path) {
+    if object_at(path) {
         Shape::Object
     } else {
         Shape::Any
@@ -663,7 +663,7 @@ impl SceneFile {
     pub(crate) fn set(&mut self, key: &str, value: &serde_json::Value) -> Result<(), KeyError> {
         check_value_shape(key, value)?;
         let segments: Vec<&str> = key.split('.').collect();
-        super::schema::Schema::set(self, "", &segments, value)
+        Schema::set(self, "", &segments, value)
     }
 
     /// The scene as JSON, every key written.
@@ -762,5 +762,151 @@ impl<'de> Deserialize<'de> for SceneBuilder {
         SceneFile::deserialize(deserializer)?
             .into_builder(Path::new("."))
             .map_err(serde::de::Error::custom)
+    }
+}
+
+/// Every key of `scene` with its exact value, in the file's order (observers included).
+pub(crate) fn all_keys(scene: &SceneBuilder) -> Vec<(String, String)> {
+    let mut keys = Vec::new();
+    SceneFile::from(scene).keys("", &mut keys);
+    keys
+}
+
+/// The scene's identity: every key that identifies the run (all but the [`OBSERVERS`](super::schema::OBSERVERS))
+/// with its exact value, as `(key path, value)` in the file's order. Checkpoints store a
+/// digest of it.
+pub(crate) fn identity(scene: &SceneBuilder) -> Vec<(String, String)> {
+    let mut keys = all_keys(scene);
+    keys.retain(|(key, _)| !observes(key));
+    keys
+}
+
+/// The first key of the identity (in `a`'s order, then keys only `b` has) in which `b`
+/// describes another run than `a`, `None` for the same run.
+pub(crate) fn first_difference(a: &SceneBuilder, b: &SceneBuilder) -> Option<String> {
+    let (mine, theirs) = (identity(a), identity(b));
+    mine.iter()
+        .find(|key_value| !theirs.contains(key_value))
+        .or_else(|| {
+            theirs
+                .iter()
+                .find(|(k, _)| !mine.iter().any(|(m, _)| m == k))
+        })
+        .map(|(key, _)| key.clone())
+}
+
+/// Whether the scene file has an object at the dotted `path` (`""`: the top level; `#`
+/// steps into an array's elements).
+#[cfg(feature = "serde")]
+pub(crate) fn object_at(path: &str) -> bool {
+    if path.is_empty() {
+        return true;
+    }
+    let segments: Vec<&str> = path.split('.').collect();
+    <SceneFile as Schema>::object_at(&segments)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::ProbeSpec;
+    use crate::scene::{Drive, ForceLoad, HeightSource, Lateral};
+    use crate::solver::{Parallelism, SolverOptions};
+
+    /// Scenes with every kind of every enum of the file.
+    fn scenes() -> Vec<SceneBuilder> {
+        let rod = Lateral::Rod {
+            height: 3e-3,
+            half_width: 1e-3,
+        };
+        let base = SceneBuilder::default().block(0.02, 0.004, 0.01);
+        vec![
+            base.clone(),
+            base.clone()
+                .cells(20, 4)
+                .drive(Drive::Force(ForceLoad::Top)),
+            base.clone()
+                .drive(Drive::Force(ForceLoad::Lateral(Lateral::Side))),
+            base.clone().drive(Drive::Force(ForceLoad::Mixed {
+                ratio: 0.5,
+                lateral: rod,
+            })),
+            base.clone()
+                .drive(Drive::Spring {
+                    stiffness: 4e6,
+                    lateral: Lateral::Side,
+                })
+                .heights(HeightSource::Values(vec![1e-6; 80])),
+            base.solver(SolverOptions::default().parallelism(Parallelism::Threads(3)))
+                .max_cells(5000)
+                .probes(ProbeSpec::default().plane(1e-3)),
+        ]
+    }
+
+    #[test]
+    fn the_identity_is_every_key_but_the_observers() {
+        for scene in scenes() {
+            let all = all_keys(&scene);
+            let identity = identity(&scene);
+            assert!(identity.iter().all(|k| all.contains(k)));
+            let left_out: Vec<&str> = all
+                .iter()
+                .filter(|k| !identity.contains(k))
+                .map(|(k, _)| k.as_str())
+                .collect();
+            assert!(left_out.contains(&"solver.threads"), "{left_out:?}");
+            assert!(left_out
+                .iter()
+                .all(|k| *k == "solver.threads" || *k == "max_cells" || k.starts_with("probes.")));
+        }
+    }
+
+    #[test]
+    fn an_observer_does_not_change_the_identity_and_every_other_key_does() {
+        let a = SceneBuilder::default();
+        let b = a
+            .clone()
+            .solver(SolverOptions::default().parallelism(Parallelism::Threads(2)))
+            .max_cells(10)
+            .probes(ProbeSpec::default().plane(1e-3));
+        assert_eq!(first_difference(&a, &b), None);
+        assert_eq!(
+            first_difference(&a, &a.clone().normal_load(1.0)).as_deref(),
+            Some("normal_load")
+        );
+        assert_eq!(
+            first_difference(&a, &a.clone().seed(4)).as_deref(),
+            Some("heights.seed")
+        );
+        let top = a.clone().drive(Drive::Force(ForceLoad::Top));
+        assert_eq!(first_difference(&a, &top).as_deref(), Some("drive.kind"));
+        // A key only the second has.
+        assert_eq!(first_difference(&top, &a).as_deref(), Some("drive.kind"));
+    }
+
+    #[cfg(feature = "serde")]
+    #[test]
+    fn the_objects_of_the_file() {
+        for path in [
+            "",
+            "block",
+            "cells",
+            "heights",
+            "drive",
+            "drive.lateral",
+            "probes",
+        ] {
+            assert!(object_at(path), "{path}");
+        }
+        for path in [
+            "normal_load",
+            "block.lx",
+            "drive.height",
+            "probes.points",
+            "x",
+            "block.x",
+        ] {
+            assert!(!object_at(path), "{path}");
+        }
     }
 }

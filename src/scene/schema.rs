@@ -1,15 +1,15 @@
 //! The scene's schema: the one definition of the scene's keys, from which the scene file
 //! (`docs/scene-format.md`), the checkpoint's scene identity and the sweeps' axes derive.
 //!
-//! The types of the scene file (`scene/file.rs`) are declared through [`schema_struct!`]
-//! and [`schema_enum!`]: one field list gives the serde form (the file; feature `serde`),
-//! the walk of every key with its exact value ([`Schema::keys`]: the checkpoint's identity,
-//! without the [`OBSERVERS`]), the typed setter of a dotted key ([`Schema::set`]: a sweep's
-//! axes; feature `serde`) and where the file has objects ([`Schema::object_at`]: the shape
-//! check that refuses positional arrays).
+//! The types of the scene file (`scene/file.rs`) are declared through `schema_struct!`
+//! and `schema_enum!`: one field list gives the serde form (the file; feature `serde`),
+//! the walk of every key with its exact value ([`Schema::keys`]: with the [`OBSERVERS`]
+//! left out, the checkpoint's identity, `file::identity`), the typed setter of a dotted
+//! key ([`Schema::set`]: a sweep's axes; feature `serde`) and where the file has objects
+//! ([`Schema::object_at`]: the shape check that refuses positional arrays). This file
+//! holds the machinery and the leaves; `scene/file.rs` the file's types and what derives
+//! from them.
 
-use super::file::SceneFile;
-use super::SceneBuilder;
 use crate::interface::AreaLaw;
 
 /// The keys of the scene file that do not change a run's events: the solver's parallelism
@@ -162,7 +162,7 @@ macro_rules! schema_struct {
 
         impl $crate::scene::schema::Schema for $name {
             fn keys(&self, path: &str, out: &mut Vec<(String, String)>) {
-                use $crate::scene::schema::{join};
+                use $crate::scene::schema::join;
                 $( self.$field.keys(&join(path, stringify!($field)), out); )*
             }
 
@@ -222,7 +222,7 @@ macro_rules! schema_enum {
 
         impl $crate::scene::schema::Schema for $name {
             fn keys(&self, path: &str, out: &mut Vec<(String, String)>) {
-                use $crate::scene::schema::{join};
+                use $crate::scene::schema::join;
                 out.push((join(path, "kind"), self.kind().to_string()));
                 match self {
                     $( $name::$variant { $($field),* } => {
@@ -292,155 +292,10 @@ macro_rules! schema_enum {
 
 pub(crate) use {schema_enum, schema_leaf, schema_struct};
 
-/// Every key of `scene` with its exact value, in the file's order (observers included).
-pub(crate) fn all_keys(scene: &SceneBuilder) -> Vec<(String, String)> {
-    let mut keys = Vec::new();
-    SceneFile::from(scene).keys("", &mut keys);
-    keys
-}
-
 /// Whether `key` is one of the [`OBSERVERS`] or below one.
-fn observes(key: &str) -> bool {
+pub(crate) fn observes(key: &str) -> bool {
     OBSERVERS.iter().any(|o| {
         key.strip_prefix(o)
             .is_some_and(|rest| rest.is_empty() || rest.starts_with('.'))
     })
-}
-
-/// The scene's identity: every key that identifies the run (all but the [`OBSERVERS`])
-/// with its exact value, as `(key path, value)` in the file's order. Checkpoints store a
-/// digest of it.
-pub(crate) fn identity(scene: &SceneBuilder) -> Vec<(String, String)> {
-    let mut keys = all_keys(scene);
-    keys.retain(|(key, _)| !observes(key));
-    keys
-}
-
-/// The first key of the identity (in `a`'s order, then keys only `b` has) in which `b`
-/// describes another run than `a`, `None` for the same run.
-pub(crate) fn first_difference(a: &SceneBuilder, b: &SceneBuilder) -> Option<String> {
-    let (mine, theirs) = (identity(a), identity(b));
-    mine.iter()
-        .find(|key_value| !theirs.contains(key_value))
-        .or_else(|| {
-            theirs
-                .iter()
-                .find(|(k, _)| !mine.iter().any(|(m, _)| m == k))
-        })
-        .map(|(key, _)| key.clone())
-}
-
-/// Whether the scene file has an object at the dotted `path` (`""`: the top level; `#`
-/// steps into an array's elements).
-#[cfg(feature = "serde")]
-pub(crate) fn object_at(path: &str) -> bool {
-    if path.is_empty() {
-        return true;
-    }
-    let segments: Vec<&str> = path.split('.').collect();
-    SceneFile::object_at(&segments)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::scene::{Drive, ForceLoad, HeightSource, Lateral};
-    use crate::solver::{Parallelism, SolverOptions};
-
-    /// Scenes with every kind of every enum of the file.
-    fn scenes() -> Vec<SceneBuilder> {
-        let rod = Lateral::Rod {
-            height: 3e-3,
-            half_width: 1e-3,
-        };
-        let base = SceneBuilder::default().block(0.02, 0.004, 0.01);
-        vec![
-            base.clone(),
-            base.clone()
-                .cells(20, 4)
-                .drive(Drive::Force(ForceLoad::Top)),
-            base.clone()
-                .drive(Drive::Force(ForceLoad::Lateral(Lateral::Side))),
-            base.clone().drive(Drive::Force(ForceLoad::Mixed {
-                ratio: 0.5,
-                lateral: rod,
-            })),
-            base.clone()
-                .drive(Drive::Spring {
-                    stiffness: 4e6,
-                    lateral: Lateral::Side,
-                })
-                .heights(HeightSource::Values(vec![1e-6; 80])),
-            base.solver(SolverOptions::default().parallelism(Parallelism::Threads(3)))
-                .max_cells(5000)
-                .probes(crate::ProbeSpec::default().plane(1e-3)),
-        ]
-    }
-
-    #[test]
-    fn the_identity_is_every_key_but_the_observers() {
-        for scene in scenes() {
-            let all = all_keys(&scene);
-            let identity = identity(&scene);
-            assert!(identity.iter().all(|k| all.contains(k)));
-            let left_out: Vec<&str> = all
-                .iter()
-                .filter(|k| !identity.contains(k))
-                .map(|(k, _)| k.as_str())
-                .collect();
-            assert!(left_out.contains(&"solver.threads"), "{left_out:?}");
-            assert!(left_out
-                .iter()
-                .all(|k| *k == "solver.threads" || *k == "max_cells" || k.starts_with("probes.")));
-        }
-    }
-
-    #[test]
-    fn an_observer_does_not_change_the_identity_and_every_other_key_does() {
-        let a = SceneBuilder::default();
-        let b = a
-            .clone()
-            .solver(SolverOptions::default().parallelism(Parallelism::Threads(2)))
-            .max_cells(10)
-            .probes(crate::ProbeSpec::default().plane(1e-3));
-        assert_eq!(first_difference(&a, &b), None);
-        assert_eq!(
-            first_difference(&a, &a.clone().normal_load(1.0)).as_deref(),
-            Some("normal_load")
-        );
-        assert_eq!(
-            first_difference(&a, &a.clone().seed(4)).as_deref(),
-            Some("heights.seed")
-        );
-        let top = a.clone().drive(Drive::Force(ForceLoad::Top));
-        assert_eq!(first_difference(&a, &top).as_deref(), Some("drive.kind"));
-        // A key only the second has.
-        assert_eq!(first_difference(&top, &a).as_deref(), Some("drive.kind"));
-    }
-
-    #[cfg(feature = "serde")]
-    #[test]
-    fn the_objects_of_the_file() {
-        for path in [
-            "",
-            "block",
-            "cells",
-            "heights",
-            "drive",
-            "drive.lateral",
-            "probes",
-        ] {
-            assert!(object_at(path), "{path}");
-        }
-        for path in [
-            "normal_load",
-            "block.lx",
-            "drive.height",
-            "probes.points",
-            "x",
-            "block.x",
-        ] {
-            assert!(!object_at(path), "{path}");
-        }
-    }
 }
