@@ -484,19 +484,14 @@ impl Sweep {
         let scene = run.scene.clone().build_with(&self.planner)?;
         let built = started.elapsed().as_secs_f64();
         let mut driver = scene.driver()?;
-        let mut tables = RunTables::start(&dir, &driver, None)?;
-        let mut slip = None;
-        let mut ruptures = 0usize;
-        while let Some(event) = driver.step()? {
-            tables.record(&driver, &event)?;
-            match event {
-                crate::Event::GlobalSlip { load } => slip = Some(load.force),
-                crate::Event::Rupture { .. } => ruptures += 1,
-                _ => {}
-            }
-        }
-        let stable_states = tables.stable_states();
-        tables.finish()?;
+        let tables = RunTables::start(&dir, &driver, None)?;
+        let (mut slip, mut ruptures, mut stable_states) = (None, 0usize, 0usize);
+        tables.run_to_slip(&mut driver, None, |event, _| match event {
+            crate::Event::GlobalSlip { load } => slip = Some(load.force),
+            crate::Event::Rupture { .. } => ruptures += 1,
+            crate::Event::Stable { .. } => stable_states += 1,
+            _ => {}
+        })?;
         let seconds = started.elapsed().as_secs_f64();
         let mu_fn = driver.friction_coefficient() * driver.normal_load();
         let meta = serde_json::json!({

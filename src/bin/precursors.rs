@@ -15,7 +15,7 @@ mod format;
 use format::{format_bytes, format_seconds};
 use precursors::output::{counts, RunTables};
 use precursors::sweep::{Sweep, SweepOptions};
-use precursors::{Checkpoint, Driver, Error, Event, GridCost, SceneBuilder};
+use precursors::{Checkpoint, Driver, Error, GridCost, SceneBuilder};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -382,7 +382,7 @@ fn run(
     every: u64,
     progress: bool,
 ) -> Result<(), Failure> {
-    let (scene, mut driver, mut tables) = match start {
+    let (scene, mut driver, tables) = match start {
         Start::Scene(path) => {
             writable_dir(out)?;
             let scene = SceneBuilder::from_json_file(path)?.build()?;
@@ -426,17 +426,14 @@ fn run(
             eta(elapsed * (1.0 - x) / x.max(1e-9)),
         )
     };
-    while let Some(event) = driver.step()? {
-        tables.record(&driver, &event)?;
-        if let (Event::Stable { .. }, Some(path)) = (&event, checkpoint) {
-            if (tables.stable_states() as u64).is_multiple_of(every) {
-                tables.flush()?;
-                driver.checkpoint().write_to(path)?;
-            }
-        }
-        bar.show(false, |elapsed| line(&driver, elapsed));
-    }
-    let [events_path, curve_path, map_path] = tables.finish()?;
+    // clap takes N >= 1 only.
+    let every =
+        std::num::NonZeroU64::new(every).ok_or_else(|| usage("--every must be >= 1".into()))?;
+    let checkpoint = checkpoint.map(|path| (path, every));
+    let [events_path, curve_path, map_path] =
+        tables.run_to_slip(&mut driver, checkpoint, |_, driver| {
+            bar.show(false, |elapsed| line(driver, elapsed))
+        })?;
     bar.show(true, |elapsed| line(&driver, elapsed));
     bar.finish();
     say!(
