@@ -12,6 +12,7 @@ import sys
 
 # Bottom to top. A module may import only from rows above its own.
 LAYERS = [
+    ["format"],
     ["error"],
     ["cost", "lock"],
     ["geometry"],

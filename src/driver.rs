@@ -153,15 +153,12 @@ enum Phase {
 /// Runs a [`Scene`] quasi-statically; an iterator of [`Event`]s.
 #[derive(Debug)]
 pub struct Driver {
-    /// The scene it runs (checkpoints record its builder).
+    /// The scene it runs, shared (its set-up is read from it; checkpoints record its
+    /// builder).
     scene: Scene,
-    grid: Grid,
-    friction: f64,
-    normal_load: f64,
-    drive: Drive,
+    /// The scene's unit-load displacement `e` (m/N) per cell, derived once
+    /// ([`Scene::unit_load_displacement`]): the tangential solves' right-hand side.
     unit_load: Vec<f64>,
-    /// `(F_top, F_lat)` per newton of `F`.
-    split: (f64, f64),
     /// The scene's probes, then those added by [`Driver::add_probes`], in order.
     probes: Vec<StressProbe>,
     interface: Interface,
@@ -220,12 +217,7 @@ impl Scene {
         let n = self.grid().len();
         Ok(Driver {
             scene: self.clone(),
-            grid: *self.grid(),
-            friction: self.material().friction_coefficient(),
-            normal_load: self.normal_load(),
-            drive: self.drive(),
             unit_load: self.unit_load_displacement(),
-            split: self.load_split(),
             probes: self.stress_probe().into_iter().cloned().collect(),
             interface: self.interface().clone(),
             solver,
@@ -346,7 +338,7 @@ impl Driver {
             }
             Phase::Stable => {
                 let (site, threshold) = self.weakest()?;
-                self.control = match self.drive {
+                self.control = match self.scene.drive() {
                     Drive::Spring { stiffness, .. } => {
                         // F = K_S U_S / (1 + K_S Û): invert for the U_S that makes F = λ.
                         threshold * (1.0 + stiffness * self.response()?.offset_per_newton)
@@ -363,9 +355,10 @@ impl Driver {
                 let force = self.force();
                 let u_z = &self.normal()?.displacement;
                 let u_x = &self.response()?.displacement;
-                let cell = self.grid.cell_area();
+                let grid = *self.grid();
+                let cell = grid.cell_area();
                 let mut best: Option<(usize, f64)> = None;
-                for i in 0..self.grid.len() {
+                for i in 0..grid.len() {
                     if self.interface.states()[i] != SiteState::Attached {
                         continue;
                     }
@@ -390,13 +383,13 @@ impl Driver {
                     Some((i, energy)) => {
                         let load = self.load();
                         self.pending.push_back(Event::Rupture {
-                            site: Site::new(&self.grid, i),
+                            site: Site::new(&grid, i),
                             load,
                             energy,
                         });
                         self.avalanche_ruptures += 1;
                         self.interface.break_site(i)?;
-                        if self.interface.broken_count() == self.grid.len() {
+                        if self.interface.broken_count() == grid.len() {
                             self.pending.push_back(Event::GlobalSlip { load });
                             self.phase = Phase::Done;
                             return Ok(());
@@ -418,7 +411,7 @@ impl Driver {
         let clock = std::time::Instant::now();
         let normal = self
             .solver
-            .solve_normal(&self.interface, self.normal_load)?;
+            .solve_normal(&self.interface, self.scene.normal_load())?;
         self.interface.set_states(&normal.states)?;
         self.stats.normal_seconds += clock.elapsed().as_secs_f64();
         self.stats.normal_solves += 1;
@@ -426,7 +419,7 @@ impl Driver {
         self.stats.normal_iterations += normal.report.linear_iterations;
         if self.normal.is_some() {
             for (i, (old, new)) in before.iter().zip(self.interface.states()).enumerate() {
-                let site = Site::new(&self.grid, i);
+                let site = Site::new(self.scene.grid(), i);
                 match (old, new) {
                     (SiteState::Attached, SiteState::Detached) => {
                         self.pending.push_back(Event::Detach { site })
@@ -445,7 +438,7 @@ impl Driver {
         self.stats.tangential_seconds += clock.elapsed().as_secs_f64();
         self.stats.tangential_solves += 1;
         self.stats.tangential_iterations += response.report.linear_iterations;
-        if let Drive::Spring { stiffness, .. } = self.drive {
+        if let Drive::Spring { stiffness, .. } = self.scene.drive() {
             let denominator = 1.0 + stiffness * response.offset_per_newton;
             if denominator.is_nan() || denominator <= 0.0 {
                 return Err(Error::InvalidParameter {
@@ -456,9 +449,11 @@ impl Driver {
                 });
             }
         }
-        self.breaking =
-            self.interface
-                .breaking_loads(&normal.traction, &response.traction, self.friction)?;
+        self.breaking = self.interface.breaking_loads(
+            &normal.traction,
+            &response.traction,
+            self.friction_coefficient(),
+        )?;
         self.normal = Some(normal);
         self.response = Some(response);
         Ok(())
@@ -495,7 +490,7 @@ impl Driver {
 
     /// The shear force `F` (N) in the current state.
     pub fn force(&self) -> f64 {
-        match self.drive {
+        match self.scene.drive() {
             Drive::Force(_) => self.control,
             Drive::Spring { stiffness, .. } => match &self.response {
                 Some(r) => stiffness * self.control / (1.0 + stiffness * r.offset_per_newton),
@@ -508,7 +503,7 @@ impl Driver {
     pub fn load(&self) -> Load {
         Load {
             force: self.force(),
-            drive_displacement: match self.drive {
+            drive_displacement: match self.scene.drive() {
                 Drive::Spring { .. } => Some(self.control),
                 Drive::Force(_) => None,
             },
@@ -538,7 +533,7 @@ impl Driver {
 
     /// The normal load `F_N` (N).
     pub fn normal_load(&self) -> f64 {
-        self.normal_load
+        self.scene.normal_load()
     }
 
     /// The scene this driver runs (its set-up, not the current state: see
@@ -555,7 +550,7 @@ impl Driver {
     /// The local friction coefficient `μ` (dimensionless) of the Coulomb rule, for
     /// instance for [`crate::PlaneStress::profile`].
     pub fn friction_coefficient(&self) -> f64 {
-        self.friction
+        self.scene.material().friction_coefficient()
     }
 
     /// Cumulative solver work since this driver was created or resumed (counts and wall
@@ -571,7 +566,7 @@ impl Driver {
 
     /// The grid.
     pub fn grid(&self) -> &Grid {
-        &self.grid
+        self.scene.grid()
     }
 }
 

@@ -83,6 +83,7 @@ pub mod calibration;
 mod cost;
 pub mod driver;
 pub mod error;
+mod format;
 pub mod geometry;
 pub mod green;
 pub mod interface;

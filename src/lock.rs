@@ -188,6 +188,36 @@ fn shorten(text: &str, max: usize) -> String {
     }
 }
 
+/// The guard of a mutex, also when a thread panicked while holding it: the crate's
+/// shared buffers and pools stay usable after a panic (a panicking part poisons no
+/// result: the solve or run panics as a whole), so a poisoned lock is taken as it is.
+/// The one copy of the poison-tolerant guards (`read`, `write`, `into_inner` beside it).
+pub(crate) fn lock<T>(mutex: &std::sync::Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    mutex
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// The read guard of an `RwLock`, poisoned or not ([`lock`]).
+pub(crate) fn read<T>(lock: &std::sync::RwLock<T>) -> std::sync::RwLockReadGuard<'_, T> {
+    lock.read()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// The write guard of an `RwLock`, poisoned or not ([`lock`]).
+pub(crate) fn write<T>(lock: &std::sync::RwLock<T>) -> std::sync::RwLockWriteGuard<'_, T> {
+    lock.write()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// The value of a mutex, poisoned or not ([`lock`]).
+#[cfg_attr(not(feature = "serde"), allow(dead_code))]
+pub(crate) fn into_inner<T>(mutex: std::sync::Mutex<T>) -> T {
+    mutex
+        .into_inner()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -690,6 +690,53 @@ impl RunTables {
         Ok(())
     }
 
+    /// Runs `driver` to global slip writing its tables (feature `serde`): each event
+    /// [recorded](RunTables::record), then `observe` called with it and the driver in the
+    /// state right after it; with `checkpoint = Some((path, every))`, at every `every`-th
+    /// stable state recorded by this writer, the tables [flushed](RunTables::flush) and a
+    /// checkpoint written over `path` ([`crate::Checkpoint::write_to`]), so a resume finds
+    /// every row up to it; at global slip, the tables [finished](RunTables::finish).
+    /// Returns the tables' paths. The one run loop of the program's `run` and `resume` and
+    /// of a sweep's runs.
+    ///
+    /// ```
+    /// use precursors::{output::RunTables, Event, Scene};
+    /// let scene = Scene::builder().block(0.012, 0.002, 0.010).normal_load(50.0).build()?;
+    /// let mut driver = scene.driver()?;
+    /// # let out = std::env::temp_dir().join(format!("precursors-doc-run-{}", std::process::id()));
+    /// let tables = RunTables::create(&out, &driver)?;
+    /// let mut ruptures = 0;
+    /// let [events, _curve, _map] = tables.run_to_slip(&mut driver, None, |event, _| {
+    ///     ruptures += matches!(event, Event::Rupture { .. }) as usize;
+    /// })?;
+    /// assert!(events.is_file() && ruptures > 0);
+    /// # std::fs::remove_dir_all(&out).ok();
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// The first error of [`Driver::step`], [`RunTables::record`], [`RunTables::flush`],
+    /// [`crate::Checkpoint::write_to`] or [`RunTables::finish`].
+    #[cfg(feature = "serde")]
+    pub fn run_to_slip(
+        mut self,
+        driver: &mut Driver,
+        checkpoint: Option<(&Path, std::num::NonZeroU64)>,
+        mut observe: impl FnMut(&Event, &Driver),
+    ) -> Result<[PathBuf; 3]> {
+        while let Some(event) = driver.step()? {
+            self.record(driver, &event)?;
+            if let (Event::Stable { .. }, Some((path, every))) = (&event, checkpoint) {
+                if (self.stable_states() as u64).is_multiple_of(every.get()) {
+                    self.flush()?;
+                    driver.checkpoint().write_to(path)?;
+                }
+            }
+            observe(&event, driver);
+        }
+        self.finish()
+    }
+
     /// Ends a run that reached global slip: the tables are flushed, synced and renamed
     /// from `NAME.partial` to `NAME` (replacing those of an earlier run), and the
     /// directory's lock (if this writer took it) is released. Returns the tables' paths.

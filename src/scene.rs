@@ -29,8 +29,8 @@ use crate::probe::{ProbeSpec, StressProbe};
 use crate::solver::SolverOptions;
 
 mod bounds;
-#[cfg(feature = "serde")]
 pub(crate) mod file;
+pub(crate) mod schema;
 
 /// Relative tolerance of the lateral load table.
 const LATERAL_TOLERANCE: f64 = 1e-12;
@@ -366,147 +366,6 @@ impl SceneBuilder {
         self
     }
 
-    /// The first option (by its scene-file key path, e.g. `block.lx`, `normal_load`,
-    /// `drive.lateral.height`) in which `other` describes another run, `None` for the
-    /// same run: every option equal but those of [`SceneBuilder::identity`] (the solver's
-    /// parallelism, the cell limit and the probes), which do not change the events (checkpoints resume
-    /// across them).
-    pub(crate) fn run_difference(&self, other: &SceneBuilder) -> Option<String> {
-        let (mine, theirs) = (self.run_keys(), other.run_keys());
-        for (key, value) in &mine {
-            match theirs.iter().find(|(k, _)| k == key) {
-                Some((_, v)) if v == value => {}
-                _ => return Some(key.clone()),
-            }
-        }
-        if let Some((key, _)) = theirs
-            .iter()
-            .find(|(k, _)| !mine.iter().any(|(m, _)| m == k))
-        {
-            return Some(key.clone());
-        }
-        // A field the key list does not name (a safety net: the keys cover the builder).
-        (self.identity() != other.identity()).then(|| "scene".to_string())
-    }
-
-    /// Every option that identifies the run as `(key path, value)`, with the scene
-    /// format's key names (`docs/scene-format.md`) and values written exactly (`{:?}`
-    /// of an `f64` round-trips); the solver's parallelism, the cell limit and the probes are left out.
-    /// Checkpoints store a digest of it.
-    pub(crate) fn run_keys(&self) -> Vec<(String, String)> {
-        fn put(keys: &mut Vec<(String, String)>, key: &str, value: String) {
-            keys.push((key.to_string(), value));
-        }
-        fn lateral(keys: &mut Vec<(String, String)>, prefix: &str, l: Lateral) {
-            match l {
-                Lateral::Rod { height, half_width } => {
-                    put(keys, &format!("{prefix}.kind"), "rod".into());
-                    put(keys, &format!("{prefix}.height"), format!("{height:?}"));
-                    put(
-                        keys,
-                        &format!("{prefix}.half_width"),
-                        format!("{half_width:?}"),
-                    );
-                }
-                Lateral::Side => put(keys, &format!("{prefix}.kind"), "side".into()),
-            }
-        }
-        let k = &mut Vec::new();
-        let (lx, ly, lz) = self.lengths;
-        put(k, "block.lx", format!("{lx:?}"));
-        put(k, "block.ly", format!("{ly:?}"));
-        put(k, "block.lz", format!("{lz:?}"));
-        match self.cells {
-            Cells::Size(dx, dy) => {
-                put(k, "cells.kind", "size".into());
-                put(k, "cells.dx", format!("{dx:?}"));
-                put(k, "cells.dy", format!("{dy:?}"));
-            }
-            Cells::Count(nx, ny) => {
-                put(k, "cells.kind", "count".into());
-                put(k, "cells.nx", format!("{nx}"));
-                put(k, "cells.ny", format!("{ny}"));
-            }
-        }
-        let m = self.material;
-        put(
-            k,
-            "material.young_modulus",
-            format!("{:?}", m.young_modulus()),
-        );
-        put(
-            k,
-            "material.poisson_ratio",
-            format!("{:?}", m.poisson_ratio()),
-        );
-        let mu = m.friction_coefficient();
-        put(k, "material.friction_coefficient", format!("{mu:?}"));
-        put(k, "springs.c_x", format!("{:?}", self.law.c_x()));
-        put(k, "springs.c_z", format!("{:?}", self.law.c_z()));
-        let area_law = format!("{:?}", self.law.area_law()).to_lowercase();
-        put(k, "springs.area_law", area_law);
-        match &self.heights {
-            HeightSource::Random { distribution, seed } => {
-                put(k, "heights.kind", "gaussian".into());
-                put(k, "heights.mean", format!("{:?}", distribution.mean()));
-                put(
-                    k,
-                    "heights.std_dev",
-                    format!("{:?}", distribution.std_dev()),
-                );
-                put(k, "heights.seed", format!("{seed}"));
-            }
-            HeightSource::Values(values) => {
-                put(k, "heights.kind", "values".into());
-                put(k, "heights.values", format!("{values:?}"));
-            }
-        }
-        put(k, "normal_load", format!("{:?}", self.normal_load));
-        match self.drive {
-            Drive::Force(ForceLoad::Top) => put(k, "drive.kind", "top".into()),
-            Drive::Force(ForceLoad::Lateral(l)) => lateral(k, "drive", l),
-            Drive::Force(ForceLoad::Mixed { ratio, lateral: l }) => {
-                put(k, "drive.kind", "mixed".into());
-                put(k, "drive.ratio", format!("{ratio:?}"));
-                lateral(k, "drive.lateral", l);
-            }
-            Drive::Spring {
-                stiffness,
-                lateral: l,
-            } => {
-                put(k, "drive.kind", "spring".into());
-                put(k, "drive.stiffness", format!("{stiffness:?}"));
-                lateral(k, "drive.lateral", l);
-            }
-        }
-        let o = self.solver;
-        put(
-            k,
-            "solver.backend",
-            format!("{:?}", o.backend()).to_lowercase(),
-        );
-        put(k, "solver.tolerance", format!("{:?}", o.tolerance()));
-        let n = o.max_active_set_iterations();
-        put(k, "solver.max_active_set_iterations", format!("{n}"));
-        let n = o.max_linear_iterations();
-        put(k, "solver.max_linear_iterations", format!("{n}"));
-        put(k, "plan_tolerance", format!("{:?}", self.plan_tolerance));
-        std::mem::take(k)
-    }
-
-    /// The scene's identity: this builder without the options that do not change the
-    /// events, the solver's parallelism (results are bit for bit the same for every
-    /// choice), the cell limit and the probes (observers, which a driver may add at any time).
-    pub(crate) fn identity(&self) -> SceneBuilder {
-        let mut identity = self.clone();
-        identity
-            .solver
-            .set_parallelism(SolverOptions::default().parallelism());
-        identity.probes = ProbeSpec::default();
-        identity.max_cells = crate::green::DEFAULT_MAX_CELLS;
-        identity
-    }
-
     /// The plan tolerance (scene-file key `plan_tolerance`): the largest relative error
     /// accepted on the influence operator's eigenvalues (dimensionless, default `1e-8`, as
     /// [`crate::green::InfluencePlanBuilder::plan_tolerance`]; not the solver's linear
@@ -684,7 +543,6 @@ impl SceneBuilder {
     /// # Errors
     /// As [`SceneBuilder::build`].
     pub fn build_with_planner(self, planner: &Planner) -> Result<Scene> {
-        let builder = self.clone();
         let (lx, ly, lz) = self.lengths;
         let (block, grid, heights, lateral) = self.checked()?;
         let plan = planner.plan_with_max_cells(grid, self.plan_tolerance, self.max_cells)?;
@@ -716,39 +574,37 @@ impl SceneBuilder {
         } else {
             Some(StressProbe::new(&plan, &self.probes, rod.as_ref())?)
         };
-        Ok(Scene {
+        Ok(Scene(std::sync::Arc::new(Built {
             probe,
             rod,
             grid,
-            material: self.material,
             interface,
-            normal_load: self.normal_load,
-            drive: self.drive,
-            solver: self.solver,
             plan,
             lateral_response,
-            builder,
-        })
+            builder: self,
+        })))
     }
 }
 
-/// A validated simulation set-up; [`Scene::driver`] runs it.
+/// A validated simulation set-up; [`Scene::driver`] runs it. A clone is cheap (the scene
+/// is shared: its drivers hold it).
 #[derive(Debug, Clone)]
-pub struct Scene {
+pub struct Scene(std::sync::Arc<Built>);
+
+/// What a scene holds: what it was built from (its one form of the set-up: material,
+/// loads, drive, solver options, probes) and what it built from it.
+#[derive(Debug)]
+struct Built {
+    /// What the scene was built from (a checkpoint records it).
+    builder: SceneBuilder,
     grid: Grid,
-    material: Material,
     interface: Interface,
-    normal_load: f64,
-    drive: Drive,
-    solver: SolverOptions,
     plan: InfluencePlan,
     lateral_response: Option<Vec<f64>>,
     /// The lateral load, if the drive has one (the probes' lateral term).
     rod: Option<RodLoad>,
     /// The default probes, planned at build.
     probe: Option<StressProbe>,
-    /// What the scene was built from (a checkpoint records it).
-    builder: SceneBuilder,
 }
 
 impl Scene {
@@ -760,74 +616,74 @@ impl Scene {
     /// The builder this scene was built from (for instance to write it as a scene file
     /// with the `serde` feature, or to vary one parameter).
     pub fn to_builder(&self) -> SceneBuilder {
-        self.builder.clone()
+        self.0.builder.clone()
     }
 
     /// The grid (and through it the block).
     pub fn grid(&self) -> &Grid {
-        &self.grid
+        &self.0.grid
     }
 
     /// The material.
     pub fn material(&self) -> Material {
-        self.material
+        self.0.builder.material
     }
 
     /// The interface in its initial state (every site attached).
     pub fn interface(&self) -> &Interface {
-        &self.interface
+        &self.0.interface
     }
 
     /// The normal load `F_N` (N).
     pub fn normal_load(&self) -> f64 {
-        self.normal_load
+        self.0.builder.normal_load
     }
 
     /// The drive.
     pub fn drive(&self) -> Drive {
-        self.drive
+        self.0.builder.drive
     }
 
     /// The solver options ([`SceneBuilder::solver_options`]).
     pub fn solver_options(&self) -> SolverOptions {
-        self.solver
+        self.0.builder.solver
     }
 
     /// The spring constants ([`SceneBuilder::springs`]).
     pub fn springs(&self) -> SpringLaw {
-        self.interface.law()
+        self.0.interface.law()
     }
 
     /// Where the heights came from ([`SceneBuilder::heights`], [`SceneBuilder::seed`]);
     /// the heights themselves are [`Interface::heights`] of [`Scene::interface`].
     pub fn heights(&self) -> &HeightSource {
-        &self.builder.heights
+        &self.0.builder.heights
     }
 
     /// The planned influence operator.
     pub fn plan(&self) -> &InfluencePlan {
-        &self.plan
+        &self.0.plan
     }
 
     /// The stress probes every driver of the scene starts with ([`SceneBuilder::probes`];
     /// empty by default).
     pub fn probes(&self) -> &ProbeSpec {
-        &self.builder.probes
+        &self.0.builder.probes
     }
 
     /// The default probes as planned at build (`None` when there are none).
     pub(crate) fn stress_probe(&self) -> Option<&StressProbe> {
-        self.probe.as_ref()
+        self.0.probe.as_ref()
     }
 
     /// The lateral load of the drive, if any (the probes' lateral stress term).
     pub(crate) fn lateral_load(&self) -> Option<&RodLoad> {
-        self.rod.as_ref()
+        self.0.rod.as_ref()
     }
 
     /// `(F_top, F_lat)` (N) per newton of the driven force `F`.
     pub(crate) fn load_split(&self) -> (f64, f64) {
-        match self.drive {
+        match self.drive() {
             Drive::Force(ForceLoad::Top) => (1.0, 0.0),
             Drive::Force(ForceLoad::Mixed { ratio, .. }) => {
                 (ratio / (1.0 + ratio), 1.0 / (1.0 + ratio))
@@ -838,7 +694,7 @@ impl Scene {
 
     /// Whether the scene built the lateral load table (only drives with a lateral part).
     pub fn has_lateral_table(&self) -> bool {
-        self.lateral_response.is_some()
+        self.0.lateral_response.is_some()
     }
 
     /// Displacement `e` (m/N) of each cell per newton of the driven force in the absence
@@ -846,12 +702,12 @@ impl Scene {
     /// newton of spring force under displacement control. `None` for a top shear (a
     /// constant, absorbed by `⟨u_x⟩`).
     pub(crate) fn unit_load_displacement(&self) -> Vec<f64> {
-        match (&self.lateral_response, self.drive) {
+        match (&self.0.lateral_response, self.drive()) {
             (Some(e), Drive::Force(ForceLoad::Mixed { ratio, .. })) => {
                 e.iter().map(|v| v / (1.0 + ratio)).collect()
             }
             (Some(e), _) => e.clone(),
-            (None, _) => vec![0.0; self.grid.len()],
+            (None, _) => vec![0.0; self.0.grid.len()],
         }
     }
 }
@@ -869,14 +725,14 @@ mod leaves_out {
     #[test]
     fn a_top_drive_has_no_lateral_load_and_no_probes_no_transfer() {
         let top = small().drive(Drive::Force(ForceLoad::Top)).build().unwrap();
-        assert!(top.rod.is_none() && top.lateral_response.is_none());
-        assert!(top.probe.is_none());
+        assert!(top.0.rod.is_none() && top.0.lateral_response.is_none());
+        assert!(top.0.probe.is_none());
         let rod = small()
             .probes(ProbeSpec::default().with_plane(2e-3))
             .build()
             .unwrap();
-        assert!(rod.rod.is_some() && rod.lateral_response.is_some());
-        assert!(rod.probe.is_some());
+        assert!(rod.0.rod.is_some() && rod.0.lateral_response.is_some());
+        assert!(rod.0.probe.is_some());
     }
 
     #[test]

@@ -39,9 +39,8 @@ use crate::driver::write_atomically;
 use crate::error::Error;
 use crate::lock::{Attempt, DirLock, LOCK_FILE};
 use crate::output::RunTables;
-use crate::scene::file::{
-    builder_from_value, check_shape, normalized_value, read_json_text, scene_shape, Shape,
-};
+use crate::scene::file::{check_shape, read_json_text, scene_shape, SceneFile, Shape};
+use crate::scene::schema::KeyError;
 use crate::scene::{HeightSource, SceneBuilder};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -352,45 +351,30 @@ fn key_error(key: &str, reason: impl Into<String>) -> SweepError {
     }
 }
 
-/// Sets `key` (dotted path) in `scene` to `value`: every segment must exist.
-fn set_path(scene: &mut Value, key: &str, value: &Value) -> Result<()> {
-    let mut node = scene;
-    let segments: Vec<&str> = key.split('.').collect();
-    for (depth, segment) in segments.iter().enumerate() {
-        let here = segments[..depth].join(".");
-        let object = node.as_object_mut().ok_or_else(|| {
-            key_error(
-                key,
-                format!("`{here}` is not an object of the scene: it has no key `{segment}`"),
-            )
-        })?;
-        if !object.contains_key(*segment) {
-            let mut known: Vec<&String> = object.keys().collect();
-            known.sort();
-            let known: Vec<&str> = known.iter().map(|k| k.as_str()).collect();
-            let place = if here.is_empty() {
-                "the scene".to_string()
-            } else {
-                format!("`{here}`")
-            };
-            return Err(key_error(
-                key,
-                format!(
-                    "not a scene key: {place} has no `{segment}` (it has: {})",
-                    known.join(", ")
-                ),
-            ));
-        }
-        let next = object
-            .get_mut(*segment)
-            .ok_or_else(|| key_error(key, "missing"))?;
-        if depth + 1 == segments.len() {
-            *next = value.clone();
-            return Ok(());
-        }
-        node = next;
+/// Sets the scene key `key` to `value` in `scene` (typed, through the scene's schema): a
+/// key that is not the scene's is [`SweepError::Axis`] naming `key`; a value the key does
+/// not take is `invalid`'s error, given the reason.
+fn set_key(
+    scene: &mut SceneFile,
+    key: &str,
+    value: &Value,
+    invalid: impl FnOnce(String) -> SweepError,
+) -> Result<()> {
+    match scene.set(key, value) {
+        Ok(()) => Ok(()),
+        Err(e @ KeyError::Value(_)) => Err(invalid(e.to_string())),
+        Err(e) => Err(key_error(key, e.to_string())),
     }
-    Err(key_error(key, "an empty key"))
+}
+
+/// The error of a sweep file at `path` (`None`: text given directly) without a position.
+fn file_error(path: Option<&Path>, reason: String) -> SweepError {
+    SweepError::File {
+        path: path.map(Path::to_path_buf),
+        line: 0,
+        column: 0,
+        source: reason.into(),
+    }
 }
 
 impl Sweep {
@@ -431,176 +415,20 @@ impl Sweep {
         Self::from_spec(spec, Some(path), path.parent().unwrap_or(Path::new(".")))
     }
 
+    /// The sweep of a read file: its base scene with every key, its counts and size
+    /// checked, each axis's steps checked alone on the base scene, then every run's scene.
     fn from_spec(mut spec: SweepSpec, path: Option<&Path>, base_dir: &Path) -> Result<Sweep> {
-        let file_error = |reason: String| SweepError::File {
-            path: path.map(Path::to_path_buf),
-            line: 0,
-            column: 0,
-            source: reason.into(),
-        };
-        let base_error = |reason: String| file_error(format!("base scene: {reason}"));
-        spec.base = normalized_value(spec.base.clone(), base_dir).map_err(base_error)?;
-        if spec.realizations == 0 {
-            return Err(Error::InvalidCount {
-                name: "realizations",
-                value: 0,
-                reason: "a sweep needs at least one realization per point",
-            }
-            .into());
-        }
-        let random = matches!(
-            builder_from_value(spec.base.clone())
-                .map_err(base_error)?
-                .current_heights(),
-            HeightSource::Random { .. }
-        );
-        if spec.realizations > 1 && !random {
-            return Err(Error::InvalidCount {
-                name: "realizations",
-                value: spec.realizations as u64,
-                reason: "realizations differ by the seed of random heights, but the base \
-                         scene's heights are values (give one realization)",
-            }
-            .into());
-        }
-        let axes = read_axes(&spec, file_error)?;
-        // The size of the sweep before any scene is checked or any run built.
-        let points = axes
-            .iter()
-            .try_fold(1u128, |p, a| p.checked_mul(a.steps.len() as u128));
-        let runs = points.and_then(|p| p.checked_mul(spec.realizations as u128));
-        match (points, runs) {
-            (Some(_), Some(runs)) if runs <= MAX_RUNS as u128 => {
-                let base = builder_from_value(spec.base.clone()).map_err(base_error)?;
-                let heights = match base.current_heights() {
-                    HeightSource::Values(v) => 8 * v.len(),
-                    HeightSource::Random { .. } => 0,
-                };
-                // Each run holds its scene, heights included, its values as text and its
-                // coordinates; twice that while it is built.
-                let text: usize = axes
-                    .iter()
-                    .map(|a| {
-                        let longest = a.steps.iter().map(|s| describe_step(s).len()).max();
-                        a.keys.iter().map(|k| k.len() + 48).sum::<usize>() + longest.unwrap_or(0)
-                    })
-                    .sum();
-                let per_run = std::mem::size_of::<SweepRun>() + heights + text + 64;
-                crate::green::check_memory(
-                    || format!("the list of the sweep's {runs} runs"),
-                    2.0 * runs as f64 * per_run as f64,
-                    "split the sweep into several sweeps, or give the heights as random",
-                )?;
-            }
-            _ => {
-                return Err(SweepError::TooLarge {
-                    points: axes
-                        .iter()
-                        .fold(1u128, |p, a| p.saturating_mul(a.steps.len() as u128)),
-                    realizations: spec.realizations,
-                    runs: points.map_or(u128::MAX, |p| p.saturating_mul(spec.realizations as u128)),
-                    limit: MAX_RUNS,
-                })
-            }
-        }
-        // Each axis on its own: the keys exist, each step gives a valid scene.
-        for (a, axis) in axes.iter().enumerate() {
-            let name = axis.name();
-            for (k, key) in axis.keys.iter().enumerate() {
-                let earlier = axes[..a].iter().flat_map(|b| &b.keys);
-                if earlier.chain(&axis.keys[..k]).any(|b| b == key) {
-                    return Err(key_error(key, "the key is on two axes, or twice on one"));
-                }
-                if key == "heights" || key.starts_with("heights.seed") {
-                    return Err(key_error(
-                        key,
-                        "the sweep derives the heights' seeds from `seed` and the run's \
-                         coordinates (give `realizations`); sweep `heights.mean` or \
-                         `heights.std_dev` instead",
-                    ));
-                }
-            }
-            if axis.steps.is_empty() {
-                return Err(key_error(&name, "the axis has no values"));
-            }
-            for (i, step) in axis.steps.iter().enumerate() {
-                let mut scene = spec.base.clone();
-                for (key, value) in axis.keys.iter().zip(step) {
-                    set_path(&mut scene, key, value)?;
-                }
-                let value = describe_step(step);
-                let builder = builder_from_value(scene).map_err(|reason| {
-                    key_error(
-                        &name,
-                        format!("value {value} (#{i}) is not valid here: {reason}"),
-                    )
-                })?;
-                builder.check().map_err(|e| {
-                    key_error(
-                        &name,
-                        format!("value {value} (#{i}) gives an invalid scene: {e}"),
-                    )
-                })?;
-            }
-        }
-        let shape: Vec<usize> = axes.iter().map(|a| a.steps.len()).collect();
-        let points = shape.iter().product::<usize>();
-        let mut runs = Vec::with_capacity(points * spec.realizations);
-        for point in 0..points {
-            let mut coordinates = vec![0; shape.len()];
-            let mut rest = point;
-            for (a, n) in shape.iter().enumerate().rev() {
-                coordinates[a] = rest % n;
-                rest /= n;
-            }
-            let mut scene = spec.base.clone();
-            let mut values = Vec::with_capacity(shape.len());
-            for (axis, &c) in axes.iter().zip(&coordinates) {
-                for (key, value) in axis.keys.iter().zip(&axis.steps[c]) {
-                    set_path(&mut scene, key, value)?;
-                    values.push((key.clone(), value.to_string()));
-                }
-            }
-            let describe = || {
-                values
-                    .iter()
-                    .map(|(k, v)| format!("{k} = {v}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            };
-            let keys = || axes.iter().map(Axis::name).collect::<Vec<_>>().join(", ");
-            for realization in 0..spec.realizations {
-                let seed = derive_seed(spec.seed, &coordinates, realization);
-                let mut scene_value = scene.clone();
-                if random {
-                    set_path(&mut scene_value, "heights.seed", &Value::from(seed))?;
-                }
-                let builder = builder_from_value(scene_value).map_err(|reason| {
-                    key_error(
-                        &keys(),
-                        format!("the point {} is not valid: {reason}", describe()),
-                    )
-                })?;
-                if realization == 0 {
-                    builder.check().map_err(|e| {
-                        key_error(
-                            &keys(),
-                            format!("the point {} gives an invalid scene: {e}", describe()),
-                        )
-                    })?;
-                }
-                runs.push(SweepRun {
-                    index: runs.len(),
-                    point,
-                    coordinates: coordinates.clone(),
-                    realization,
-                    seed,
-                    values: values.clone(),
-                    scene: builder,
-                    dir_name: format!("p{point:04}-r{realization:04}"),
-                });
-            }
-        }
+        let base_error = |reason: String| file_error(path, format!("base scene: {reason}"));
+        let base =
+            SceneFile::from_value(&spec.base, base_dir).map_err(|e| base_error(e.to_string()))?;
+        spec.base = base.to_value().map_err(|e| base_error(e.to_string()))?;
+        let base_builder = base.to_builder().map_err(|e| base_error(e.to_string()))?;
+        let random = check_realizations(spec.realizations, &base_builder)?;
+        let axes = read_axes(&spec, |reason| file_error(path, reason))?;
+        check_size(&axes, spec.realizations, &base_builder)?;
+        check_axes(&axes, &base)?;
+        let points = axes.iter().map(|a| a.steps.len()).product::<usize>();
+        let runs = runs_of(&spec, &axes, &base, random)?;
         Ok(Sweep {
             spec,
             axes,
@@ -693,19 +521,14 @@ impl Sweep {
         let scene = run.scene.clone().build_with_planner(&self.planner)?;
         let built = started.elapsed().as_secs_f64();
         let mut driver = scene.driver()?;
-        let mut tables = RunTables::start(&dir, &driver, None)?;
-        let mut slip = None;
-        let mut ruptures = 0usize;
-        while let Some(event) = driver.step()? {
-            tables.record(&driver, &event)?;
-            match event {
-                crate::Event::GlobalSlip { load } => slip = Some(load.force),
-                crate::Event::Rupture { .. } => ruptures += 1,
-                _ => {}
-            }
-        }
-        let stable_states = tables.stable_states();
-        tables.finish()?;
+        let tables = RunTables::start(&dir, &driver, None)?;
+        let (mut slip, mut ruptures, mut stable_states) = (None, 0usize, 0usize);
+        tables.run_to_slip(&mut driver, None, |event, _| match event {
+            crate::Event::GlobalSlip { load } => slip = Some(load.force),
+            crate::Event::Rupture { .. } => ruptures += 1,
+            crate::Event::Stable { .. } => stable_states += 1,
+            _ => {}
+        })?;
         let seconds = started.elapsed().as_secs_f64();
         let mu_fn = driver.friction_coefficient() * driver.normal_load();
         let meta = serde_json::json!({
@@ -799,12 +622,12 @@ impl Sweep {
                 });
             }
         });
-        let mut errors = errors.into_inner().unwrap_or_else(|p| p.into_inner());
+        let mut errors = crate::lock::into_inner(errors);
         errors.sort_by_key(|(i, _)| *i);
         if let Some((_, e)) = errors.into_iter().next() {
             return Err(e);
         }
-        let reports = reports.into_inner().unwrap_or_else(|p| p.into_inner());
+        let reports = crate::lock::into_inner(reports);
         let skipped = reports.iter().filter(|r| r.skipped).count();
         let held_elsewhere = reports.iter().filter(|r| r.held_elsewhere).count();
         Ok(SweepSummary {
@@ -860,6 +683,216 @@ fn empty_but_lock(dir: &Path) -> Result<()> {
         removed.map_err(|e| Error::io("removing from the cut run directory", &path, e))?;
     }
     Ok(())
+}
+
+/// Whether the base scene's heights are random (realizations differ by their seed).
+///
+/// # Errors
+/// [`Error::InvalidCount`] for zero realizations, or several with heights that are not
+/// random.
+fn check_realizations(realizations: usize, base: &SceneBuilder) -> Result<bool> {
+    if realizations == 0 {
+        return Err(Error::InvalidCount {
+            name: "realizations",
+            value: 0,
+            reason: "a sweep needs at least one realization per point",
+        }
+        .into());
+    }
+    let random = matches!(base.current_heights(), HeightSource::Random { .. });
+    if realizations > 1 && !random {
+        return Err(Error::InvalidCount {
+            name: "realizations",
+            value: realizations as u64,
+            reason: "realizations differ by the seed of random heights, but the base \
+                     scene's heights are values (give one realization)",
+        }
+        .into());
+    }
+    Ok(random)
+}
+
+/// The size of the sweep, before any scene is checked or any run built: at most
+/// [`MAX_RUNS`] runs, whose list fits in the memory available.
+///
+/// # Errors
+/// [`SweepError::TooLarge`]; [`Error::OutOfMemory`].
+fn check_size(axes: &[Axis], realizations: usize, base: &SceneBuilder) -> Result<()> {
+    let points = axes
+        .iter()
+        .try_fold(1u128, |p, a| p.checked_mul(a.steps.len() as u128));
+    let runs = points.and_then(|p| p.checked_mul(realizations as u128));
+    let runs = match (points, runs) {
+        (Some(_), Some(runs)) if runs <= MAX_RUNS as u128 => runs,
+        _ => {
+            return Err(SweepError::TooLarge {
+                points: axes
+                    .iter()
+                    .fold(1u128, |p, a| p.saturating_mul(a.steps.len() as u128)),
+                realizations,
+                runs: points.map_or(u128::MAX, |p| p.saturating_mul(realizations as u128)),
+                limit: MAX_RUNS,
+            })
+        }
+    };
+    let heights = match base.current_heights() {
+        HeightSource::Values(v) => 8 * v.len(),
+        HeightSource::Random { .. } => 0,
+    };
+    // Each run holds its scene, heights included, its values as text and its
+    // coordinates; twice that while it is built.
+    let text: usize = axes
+        .iter()
+        .map(|a| {
+            let longest = a.steps.iter().map(|s| describe_step(s).len()).max();
+            a.keys.iter().map(|k| k.len() + 48).sum::<usize>() + longest.unwrap_or(0)
+        })
+        .sum();
+    let per_run = std::mem::size_of::<SweepRun>() + heights + text + 64;
+    crate::green::check_memory(
+        || format!("the list of the sweep's {runs} runs"),
+        2.0 * runs as f64 * per_run as f64,
+        "split the sweep into several sweeps, or give the heights as random",
+    )?;
+    Ok(())
+}
+
+/// Each axis on its own: its keys are scene keys, on no other axis and not the heights'
+/// seed; it has values; each step gives a valid scene when set on the base scene.
+///
+/// # Errors
+/// [`Error::SweepKey`] naming the key (or the axis's keys).
+fn check_axes(axes: &[Axis], base: &SceneFile) -> Result<()> {
+    for (a, axis) in axes.iter().enumerate() {
+        let name = axis.name();
+        for (k, key) in axis.keys.iter().enumerate() {
+            let earlier = axes[..a].iter().flat_map(|b| &b.keys);
+            if earlier.chain(&axis.keys[..k]).any(|b| b == key) {
+                return Err(key_error(key, "the key is on two axes, or twice on one"));
+            }
+            if key == "heights" || key.starts_with("heights.seed") {
+                return Err(key_error(
+                    key,
+                    "the sweep derives the heights' seeds from `seed` and the run's \
+                     coordinates (give `realizations`); sweep `heights.mean` or \
+                     `heights.std_dev` instead",
+                ));
+            }
+        }
+        if axis.steps.is_empty() {
+            return Err(key_error(&name, "the axis has no values"));
+        }
+        for (i, step) in axis.steps.iter().enumerate() {
+            let value = describe_step(step);
+            let invalid = |reason: String| {
+                key_error(
+                    &name,
+                    format!("value {value} (#{i}) is not valid here: {reason}"),
+                )
+            };
+            let mut scene = base.clone();
+            for (key, value) in axis.keys.iter().zip(step) {
+                set_key(&mut scene, key, value, invalid)?;
+            }
+            let builder = scene.to_builder().map_err(|e| invalid(e.to_string()))?;
+            builder.check().map_err(|e| {
+                key_error(
+                    &name,
+                    format!("value {value} (#{i}) gives an invalid scene: {e}"),
+                )
+            })?;
+        }
+    }
+    Ok(())
+}
+
+/// The index of the value on each axis of the point `point` (row-major: the last axis
+/// fastest).
+fn coordinates_of(axes: &[Axis], point: usize) -> Vec<usize> {
+    let mut coordinates = vec![0; axes.len()];
+    let mut rest = point;
+    for (a, axis) in axes.iter().enumerate().rev() {
+        let n = axis.steps.len();
+        coordinates[a] = rest % n;
+        rest /= n;
+    }
+    coordinates
+}
+
+/// Every run of the sweep, in run order: the points' scenes (each checked once), their
+/// realizations' seeds.
+///
+/// # Errors
+/// [`Error::SweepKey`] naming all the axes' keys for a point whose combination of values
+/// is not a valid scene.
+fn runs_of(
+    spec: &SweepSpec,
+    axes: &[Axis],
+    base: &SceneFile,
+    random: bool,
+) -> Result<Vec<SweepRun>> {
+    let points = axes.iter().map(|a| a.steps.len()).product::<usize>();
+    let mut runs = Vec::with_capacity(points * spec.realizations);
+    let keys = || axes.iter().map(Axis::name).collect::<Vec<_>>().join(", ");
+    for point in 0..points {
+        let coordinates = coordinates_of(axes, point);
+        let mut scene = base.clone();
+        let mut values = Vec::with_capacity(axes.len());
+        let describe = |values: &[(String, String)]| {
+            values
+                .iter()
+                .map(|(k, v)| format!("{k} = {v}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        for (axis, &c) in axes.iter().zip(&coordinates) {
+            for (key, value) in axis.keys.iter().zip(&axis.steps[c]) {
+                values.push((key.clone(), value.to_string()));
+                set_key(&mut scene, key, value, |reason| {
+                    key_error(
+                        &keys(),
+                        format!("the point {} is not valid: {reason}", describe(&values)),
+                    )
+                })?;
+            }
+        }
+        for realization in 0..spec.realizations {
+            let seed = derive_seed(spec.seed, &coordinates, realization);
+            let mut scene = scene.clone();
+            let invalid = |reason: String| {
+                key_error(
+                    &keys(),
+                    format!("the point {} is not valid: {reason}", describe(&values)),
+                )
+            };
+            if random {
+                set_key(&mut scene, "heights.seed", &Value::from(seed), invalid)?;
+            }
+            let builder = scene.to_builder().map_err(|e| invalid(e.to_string()))?;
+            if realization == 0 {
+                builder.check().map_err(|e| {
+                    key_error(
+                        &keys(),
+                        format!(
+                            "the point {} gives an invalid scene: {e}",
+                            describe(&values)
+                        ),
+                    )
+                })?;
+            }
+            runs.push(SweepRun {
+                index: runs.len(),
+                point,
+                coordinates: coordinates.clone(),
+                realization,
+                seed,
+                values: values.clone(),
+                scene: builder,
+                dir_name: format!("p{point:04}-r{realization:04}"),
+            });
+        }
+    }
+    Ok(runs)
 }
 
 /// A step of an axis as errors show it: the value of a plain axis, the array of a linked one.

@@ -8,10 +8,15 @@
 //! ```
 
 use clap::{Parser, Subcommand};
+// The crate's byte and second formatters, compiled in from their one file (they are not
+// part of the library's API).
+#[path = "../format.rs"]
+mod format;
+use format::{format_bytes, format_seconds};
 use precursors::output::{counts, RunTables};
 use precursors::plot::PlotError;
 use precursors::sweep::{Sweep, SweepError, SweepOptions};
-use precursors::{Checkpoint, Driver, Error, Event, GridCost, SceneBuilder};
+use precursors::{Checkpoint, Driver, Error, GridCost, SceneBuilder};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -443,7 +448,7 @@ fn run(
     every: u64,
     progress: bool,
 ) -> Result<(), Failure> {
-    let (scene, mut driver, mut tables) = match start {
+    let (scene, mut driver, tables) = match start {
         Start::Scene(path) => {
             writable_dir(out)?;
             let scene = SceneBuilder::from_json_file(path)?.build()?;
@@ -487,17 +492,14 @@ fn run(
             eta(elapsed * (1.0 - x) / x.max(1e-9)),
         )
     };
-    while let Some(event) = driver.step()? {
-        tables.record(&driver, &event)?;
-        if let (Event::Stable { .. }, Some(path)) = (&event, checkpoint) {
-            if (tables.stable_states() as u64).is_multiple_of(every) {
-                tables.flush()?;
-                driver.checkpoint().write_to(path)?;
-            }
-        }
-        bar.show(false, |elapsed| line(&driver, elapsed));
-    }
-    let [events_path, curve_path, map_path] = tables.finish()?;
+    // clap takes N >= 1 only.
+    let every =
+        std::num::NonZeroU64::new(every).ok_or_else(|| usage("--every must be >= 1".into()))?;
+    let checkpoint = checkpoint.map(|path| (path, every));
+    let [events_path, curve_path, map_path] =
+        tables.run_to_slip(&mut driver, checkpoint, |_, driver| {
+            bar.show(false, |elapsed| line(driver, elapsed))
+        })?;
     bar.show(true, |elapsed| line(&driver, elapsed));
     bar.finish();
     say!(
@@ -555,10 +557,10 @@ fn info(path: &Path) -> Result<(), Failure> {
         metres(grid.dx()),
         metres(grid.dy()),
         file["solver"]["threads"],
-        bytes(cost.memory_bytes),
-        seconds(cost.plan_seconds),
-        seconds(cost.solve_seconds),
-        seconds(run),
+        format_bytes(cost.memory_bytes),
+        format_seconds(cost.plan_seconds),
+        format_seconds(cost.solve_seconds),
+        format_seconds(run),
     );
     print_out(&text)
 }
@@ -585,23 +587,6 @@ fn metres(m: f64) -> String {
         format!("{rounded}")
     } else {
         format!("{rounded:e}")
-    }
-}
-
-fn bytes(b: f64) -> String {
-    match b {
-        b if b >= 1e9 => format!("{:.3} GB", b / 1e9),
-        b if b >= 1e6 => format!("{:.3} MB", b / 1e6),
-        b if b >= 1e3 => format!("{:.3} kB", b / 1e3),
-        b => format!("{b:.0} B"),
-    }
-}
-
-fn seconds(s: f64) -> String {
-    match s {
-        s if s >= 3600.0 => format!("{:.2} h", s / 3600.0),
-        s if s >= 60.0 => format!("{:.2} min", s / 60.0),
-        s => format!("{s:.3} s"),
     }
 }
 

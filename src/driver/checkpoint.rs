@@ -11,7 +11,7 @@
 use super::{Driver, Phase};
 use crate::error::{Error, Result};
 use crate::interface::SiteState;
-use crate::scene::{Scene, SceneBuilder};
+use crate::scene::{file, Scene, SceneBuilder};
 use crate::solver::{NormalEquilibrium, SolverState, TangentialResponse};
 use crate::Event;
 
@@ -31,10 +31,10 @@ fn fnv1a(text: &str) -> u64 {
     })
 }
 
-/// The digest of a scene: each option's key path and a hash of its exact value.
+/// The digest of a scene: each key of its identity ([`file::identity`]) and a hash of
+/// its exact value.
 fn digest(scene: &SceneBuilder) -> Vec<(String, u64)> {
-    scene
-        .run_keys()
+    file::identity(scene)
         .into_iter()
         .map(|(key, value)| (key, fnv1a(&value)))
         .collect()
@@ -56,7 +56,7 @@ pub(crate) fn scene_mismatch(
     b: &SceneBuilder,
     b_is: &str,
 ) -> Option<Error> {
-    let key = a.run_difference(b)?;
+    let key = file::first_difference(a, b)?;
     Some(Error::CheckpointSceneMismatch {
         reason: format!(
             "{a_is} has {}, {b_is} has {}",
@@ -69,7 +69,7 @@ pub(crate) fn scene_mismatch(
 
 /// The value of `key` in `scene`, shortened for a message.
 fn value_of(scene: &SceneBuilder, key: &str) -> String {
-    match scene.run_keys().into_iter().find(|(k, _)| k == key) {
+    match file::identity(scene).into_iter().find(|(k, _)| k == key) {
         None => "no such key".into(),
         Some((_, v)) if v.chars().count() > 48 => {
             format!("{}...", v.chars().take(45).collect::<String>())
@@ -380,7 +380,7 @@ impl Scene {
             driver.breaking = driver.interface.breaking_loads(
                 &normal.traction,
                 &response.traction,
-                driver.friction,
+                driver.friction_coefficient(),
             )?;
         }
         driver.normal = checkpoint.normal.clone();

@@ -18,7 +18,7 @@ impl Driver {
     /// The spring force `K_S (U_S - ⟨u_x⟩)` (N) under displacement control, `None` under
     /// force control.
     pub fn spring_force(&self) -> Option<f64> {
-        matches!(self.drive, Drive::Spring { .. }).then(|| self.force())
+        matches!(self.scene.drive(), Drive::Spring { .. }).then(|| self.force())
     }
 
     /// The interface (site states, heights, spring law).
@@ -124,9 +124,11 @@ impl Driver {
             return Err(Error::NoProbes);
         }
         let force = self.force();
+        // (F_top, F_lat) per newton of F.
+        let split = self.scene.load_split();
         let input = ProbeInput::new(self.shear_traction()?, self.normal_traction()?)
-            .with_loads(force * self.split.0, force * self.split.1, self.normal_load)?
-            .with_friction_coefficient(self.friction)?;
+            .with_loads(force * split.0, force * split.1, self.normal_load())?
+            .with_friction_coefficient(self.friction_coefficient())?;
         let mut all = Stresses {
             planes: Vec::new(),
             points: Vec::new(),
@@ -164,7 +166,7 @@ impl Driver {
 
     /// The nominal area `Lx·Ly` of the interface (m²).
     pub fn nominal_area(&self) -> f64 {
-        let block = self.grid.block();
+        let block = self.grid().block();
         block.lx() * block.ly()
     }
 
@@ -195,7 +197,7 @@ impl Driver {
     /// As [`Driver::real_contact_area`].
     pub fn column_contact_area(&self) -> Result<Vec<f64>> {
         let area = self.cell_contact_area()?;
-        let nx = self.grid.nx();
+        let nx = self.grid().nx();
         let mut columns = vec![0.0; nx];
         for row in area.chunks_exact(nx) {
             columns.iter_mut().zip(row).for_each(|(c, a)| *c += a);
@@ -211,7 +213,7 @@ impl Driver {
     /// The block (lengths `Lx`, `Ly`, `Lz` in m): e.g. the precursor length relative to
     /// the block, `ℓ/Lx = driver.precursor_length()? / driver.block().lx()`.
     pub fn block(&self) -> &crate::geometry::Block {
-        self.grid.block()
+        self.grid().block()
     }
 
     /// Precursor length `ℓ` in metres (not relative to `Lx`: divide by
@@ -228,7 +230,7 @@ impl Driver {
             .zip(&self.initial_columns)
             .take_while(|(now, then)| now < then)
             .count();
-        Ok(run as f64 * self.grid.dx())
+        Ok(run as f64 * self.grid().dx())
     }
 
     /// A noise-robust precursor length (m, as [`Driver::precursor_length`]): the extent, from the trailing edge, of the
@@ -257,6 +259,6 @@ impl Driver {
             .zip(&self.initial_columns)
             .take_while(|(now, then)| **now < keep * **then)
             .count();
-        Ok(run as f64 * self.grid.dx())
+        Ok(run as f64 * self.grid().dx())
     }
 }

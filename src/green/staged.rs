@@ -217,17 +217,8 @@ impl Staging {
     }
 }
 
-pub(crate) fn read<T>(lock: &RwLock<T>) -> std::sync::RwLockReadGuard<'_, T> {
-    lock.read().unwrap_or_else(|e| e.into_inner())
-}
-
-pub(crate) fn write<T>(lock: &RwLock<T>) -> std::sync::RwLockWriteGuard<'_, T> {
-    lock.write().unwrap_or_else(|e| e.into_inner())
-}
-
-fn lock<T>(lock: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    lock.lock().unwrap_or_else(|e| e.into_inner())
-}
+/// The poison-tolerant guards of the parts' buffers (their one copy is in `lock.rs`).
+pub(crate) use crate::lock::{lock, read, write};
 
 #[cfg(test)]
 mod tests {

@@ -1,155 +1,210 @@
-//! The JSON scene format (feature `serde`; specification: `docs/scene-format.md`).
+//! The scene file's types (`docs/scene-format.md`): the scene's schema, declared once
+//! through [`schema_struct!`] and [`schema_enum!`] (`scene/schema.rs`), and with the
+//! `serde` feature the JSON scene format read and written through them.
 //!
 //! The file's layout is a private mirror of [`SceneBuilder`], so the Rust API and the
 //! file format can evolve separately. Every key is optional (the paper's calibration
 //! scene fills the gaps) and unknown keys are refused: a misspelt key must not silently
 //! fall back to a default.
 
+use super::schema::{observes, schema_enum, schema_leaf, schema_struct, Schema};
 use super::{Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder};
-use crate::error::{Error, Result};
-use crate::geometry::Point;
-use crate::interface::{AreaLaw, HeightDistribution, Material, SpringLaw};
-use crate::probe::ProbeSpec;
-use crate::solver::{Backend, Parallelism, SolverOptions};
-use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+use crate::interface::AreaLaw;
+use crate::solver::{Backend, Parallelism};
+use std::path::PathBuf;
+#[cfg(feature = "serde")]
+use {
+    super::schema::KeyError,
+    crate::error::{Error, Result},
+    crate::geometry::Point,
+    crate::interface::{HeightDistribution, Material, SpringLaw},
+    crate::probe::ProbeSpec,
+    crate::solver::SolverOptions,
+    serde::{Deserialize, Serialize},
+    std::path::Path,
+};
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-struct SceneFile {
-    block: BlockSpec,
-    cells: CellsSpec,
-    material: MaterialSpec,
-    springs: SpringsSpec,
-    heights: HeightsSpec,
-    normal_load: f64,
-    drive: DriveSpec,
-    solver: SolverSpec,
-    plan_tolerance: f64,
-    probes: ProbesSpec,
-    /// Written only when it is not the default, so files of scenes within the default
-    /// limit stay as they were.
-    #[serde(skip_serializing_if = "is_default_max_cells")]
-    max_cells: usize,
+schema_struct! {
+    /// A scene file: every key of a scene (`docs/scene-format.md`).
+    #[derive(Debug, Clone, PartialEq)]
+    #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+    #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+    pub(crate) struct SceneFile {
+        block: BlockSpec,
+        cells: CellsSpec,
+        material: MaterialSpec,
+        springs: SpringsSpec,
+        heights: HeightsSpec,
+        normal_load: f64,
+        drive: DriveSpec,
+        solver: SolverSpec,
+        plan_tolerance: f64,
+        probes: ProbesSpec,
+        /// Written only when it is not the default, so files of scenes within the default
+        /// limit stay as they were.
+        #[cfg_attr(feature = "serde", serde(skip_serializing_if = "is_default_max_cells"))]
+        max_cells: usize,
+    }
 }
 
+#[cfg(feature = "serde")]
 fn is_default_max_cells(max_cells: &usize) -> bool {
     *max_cells == crate::green::DEFAULT_MAX_CELLS
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-struct ProbesSpec {
-    planes: Vec<f64>,
-    points: Vec<[f64; 3]>,
-    tolerance: f64,
+schema_struct! {
+    #[derive(Debug, Clone, PartialEq)]
+    #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+    #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+    struct ProbesSpec {
+        planes: Vec<f64>,
+        points: Vec<[f64; 3]>,
+        tolerance: f64,
+    }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct BlockSpec {
-    lx: f64,
-    ly: f64,
-    lz: f64,
+schema_struct! {
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+    #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+    struct BlockSpec {
+        lx: f64,
+        ly: f64,
+        lz: f64,
+    }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
-enum CellsSpec {
-    Size { dx: f64, dy: f64 },
-    Count { nx: usize, ny: usize },
+schema_enum! {
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+    #[cfg_attr(feature = "serde", serde(tag = "kind", deny_unknown_fields))]
+    enum CellsSpec {
+        Size = "size" { dx: f64, dy: f64 },
+        Count = "count" { nx: usize, ny: usize },
+    }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-struct MaterialSpec {
-    young_modulus: f64,
-    poisson_ratio: f64,
-    friction_coefficient: f64,
+schema_struct! {
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+    #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+    struct MaterialSpec {
+        young_modulus: f64,
+        poisson_ratio: f64,
+        friction_coefficient: f64,
+    }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-struct SpringsSpec {
-    c_x: f64,
-    c_z: f64,
-    area_law: AreaLaw,
+schema_struct! {
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+    #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+    struct SpringsSpec {
+        c_x: f64,
+        c_z: f64,
+        area_law: AreaLaw,
+    }
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
-enum HeightsSpec {
-    Gaussian {
-        #[serde(default = "default_mean")]
-        mean: f64,
-        #[serde(default = "default_std_dev")]
-        std_dev: f64,
-        #[serde(default)]
-        seed: u64,
-    },
-    Values {
-        values: Vec<f64>,
-    },
-    File {
-        path: PathBuf,
-    },
+schema_enum! {
+    #[derive(Debug, Clone, PartialEq)]
+    #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+    #[cfg_attr(feature = "serde", serde(tag = "kind", deny_unknown_fields))]
+    // Heights files are read by the file format only (feature `serde`).
+    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
+    enum HeightsSpec {
+        Gaussian = "gaussian" {
+            #[cfg_attr(feature = "serde", serde(default = "default_mean"))]
+            mean: f64,
+            #[cfg_attr(feature = "serde", serde(default = "default_std_dev"))]
+            std_dev: f64,
+            #[cfg_attr(feature = "serde", serde(default))]
+            seed: u64,
+        },
+        Values = "values" {
+            values: Vec<f64>,
+        },
+        File = "file" {
+            path: PathBuf,
+        },
+    }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
-enum LateralSpec {
-    Rod { height: f64, half_width: f64 },
-    Side {},
+schema_enum! {
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+    #[cfg_attr(feature = "serde", serde(tag = "kind", deny_unknown_fields))]
+    enum LateralSpec {
+        Rod = "rod" { height: f64, half_width: f64 },
+        Side = "side" {},
+    }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
-enum DriveSpec {
-    Top {},
-    Rod {
-        height: f64,
-        half_width: f64,
-    },
-    Side {},
-    Mixed {
-        ratio: f64,
-        lateral: LateralSpec,
-    },
-    Spring {
-        stiffness: f64,
-        lateral: LateralSpec,
-    },
+schema_enum! {
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+    #[cfg_attr(feature = "serde", serde(tag = "kind", deny_unknown_fields))]
+    enum DriveSpec {
+        Top = "top" {},
+        Rod = "rod" {
+            height: f64,
+            half_width: f64,
+        },
+        Side = "side" {},
+        Mixed = "mixed" {
+            ratio: f64,
+            lateral: LateralSpec,
+        },
+        Spring = "spring" {
+            stiffness: f64,
+            lateral: LateralSpec,
+        },
+    }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 enum BackendSpec {
     Auto,
     Dense,
     Spectral,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-struct SolverSpec {
-    backend: BackendSpec,
-    tolerance: f64,
-    max_active_set_iterations: usize,
-    max_linear_iterations: usize,
-    threads: ThreadsSpec,
+schema_leaf!(BackendSpec, |v| format!("{v:?}").to_lowercase());
+
+schema_struct! {
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+    #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+    struct SolverSpec {
+        backend: BackendSpec,
+        tolerance: f64,
+        max_active_set_iterations: usize,
+        max_linear_iterations: usize,
+        threads: ThreadsSpec,
+    }
 }
 
 /// `solver.threads`: a count (`1`: the calling thread only; `0`: every core), `"all"`
 /// (every core) or `"current"` (the caller's rayon pool).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(untagged))]
 enum ThreadsSpec {
     Count(usize),
     Name(ThreadsName),
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+schema_leaf!(ThreadsSpec, |v| match v {
+    ThreadsSpec::Count(n) => format!("{n}"),
+    ThreadsSpec::Name(name) => format!("{name:?}").to_lowercase(),
+});
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[cfg_attr(not(feature = "serde"), allow(dead_code))]
 enum ThreadsName {
     All,
     Current,
@@ -176,10 +231,12 @@ impl From<ThreadsSpec> for Parallelism {
     }
 }
 
+#[cfg(feature = "serde")]
 fn default_mean() -> f64 {
     HeightDistribution::default().mean()
 }
 
+#[cfg(feature = "serde")]
 fn default_std_dev() -> f64 {
     HeightDistribution::default().std_dev()
 }
@@ -213,6 +270,7 @@ impl From<Lateral> for LateralSpec {
     }
 }
 
+#[cfg(feature = "serde")]
 impl From<LateralSpec> for Lateral {
     fn from(l: LateralSpec) -> Self {
         match l {
@@ -224,8 +282,22 @@ impl From<LateralSpec> for Lateral {
 
 impl From<&SceneBuilder> for SceneFile {
     fn from(b: &SceneBuilder) -> Self {
-        let (lx, ly, lz) = b.lengths;
-        let drive = match b.drive {
+        // Every field of the builder, by name: a field added to the builder and not to
+        // the file does not compile.
+        let SceneBuilder {
+            lengths: (lx, ly, lz),
+            cells,
+            material,
+            law,
+            heights,
+            normal_load,
+            drive,
+            solver,
+            plan_tolerance,
+            probes,
+            max_cells,
+        } = b;
+        let drive = match *drive {
             Drive::Force(ForceLoad::Top) => DriveSpec::Top {},
             Drive::Force(ForceLoad::Lateral(Lateral::Rod { height, half_width })) => {
                 DriveSpec::Rod { height, half_width }
@@ -240,7 +312,7 @@ impl From<&SceneBuilder> for SceneFile {
                 lateral: lateral.into(),
             },
         };
-        let heights = match &b.heights {
+        let heights = match heights {
             HeightSource::Random { distribution, seed } => HeightsSpec::Gaussian {
                 mean: distribution.mean(),
                 std_dev: distribution.std_dev(),
@@ -250,48 +322,53 @@ impl From<&SceneBuilder> for SceneFile {
                 values: values.clone(),
             },
         };
-        let backend = match b.solver.backend() {
+        let backend = match solver.backend() {
             Backend::Dense => BackendSpec::Dense,
             Backend::Spectral => BackendSpec::Spectral,
             _ => BackendSpec::Auto,
         };
         SceneFile {
-            block: BlockSpec { lx, ly, lz },
-            cells: match b.cells {
+            block: BlockSpec {
+                lx: *lx,
+                ly: *ly,
+                lz: *lz,
+            },
+            cells: match *cells {
                 Cells::Size(dx, dy) => CellsSpec::Size { dx, dy },
                 Cells::Count(nx, ny) => CellsSpec::Count { nx, ny },
             },
             material: MaterialSpec {
-                young_modulus: b.material.young_modulus(),
-                poisson_ratio: b.material.poisson_ratio(),
-                friction_coefficient: b.material.friction_coefficient(),
+                young_modulus: material.young_modulus(),
+                poisson_ratio: material.poisson_ratio(),
+                friction_coefficient: material.friction_coefficient(),
             },
             springs: SpringsSpec {
-                c_x: b.law.c_x(),
-                c_z: b.law.c_z(),
-                area_law: b.law.area_law(),
+                c_x: law.c_x(),
+                c_z: law.c_z(),
+                area_law: law.area_law(),
             },
             heights,
-            normal_load: b.normal_load,
+            normal_load: *normal_load,
             drive,
             solver: SolverSpec {
                 backend,
-                tolerance: b.solver.tolerance(),
-                max_active_set_iterations: b.solver.max_active_set_iterations(),
-                max_linear_iterations: b.solver.max_linear_iterations(),
-                threads: b.solver.parallelism().into(),
+                tolerance: solver.tolerance(),
+                max_active_set_iterations: solver.max_active_set_iterations(),
+                max_linear_iterations: solver.max_linear_iterations(),
+                threads: solver.parallelism().into(),
             },
-            plan_tolerance: b.plan_tolerance,
+            plan_tolerance: *plan_tolerance,
             probes: ProbesSpec {
-                planes: b.probes.planes().to_vec(),
-                points: b.probes.points().iter().map(|p| [p.x, p.y, p.z]).collect(),
-                tolerance: b.probes.tolerance(),
+                planes: probes.planes().to_vec(),
+                points: probes.points().iter().map(|p| [p.x, p.y, p.z]).collect(),
+                tolerance: probes.tolerance(),
             },
-            max_cells: b.max_cells,
+            max_cells: *max_cells,
         }
     }
 }
 
+#[cfg(feature = "serde")]
 impl SceneFile {
     /// The builder; a heights file is read relative to `base`.
     fn into_builder(self, base: &Path) -> Result<SceneBuilder> {
@@ -386,28 +463,33 @@ impl SceneFile {
 /// fields by position, which the format does not document: refused), an array of
 /// objects, or anything (checked by the format's types).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg(feature = "serde")]
 pub(crate) enum Shape {
     Object,
     Objects,
     Any,
 }
 
-/// The shape of a scene file's key path (dotted, `""` for the top level).
+/// The shape of a scene file's key path (dotted, `""` for the top level), from the
+/// schema ([`object_at`]).
+#[cfg(feature = "serde")]
 pub(crate) fn scene_shape(path: &str) -> Shape {
-    match path {
-        "" | "block" | "cells" | "material" | "springs" | "heights" | "drive" | "drive.lateral"
-        | "solver" | "probes" => Shape::Object,
-        _ => Shape::Any,
+    if object_at(path) {
+        Shape::Object
+    } else {
+        Shape::Any
     }
 }
 
 /// A walk of a JSON document that checks the objects of `shape` (no allocation beyond the
 /// keys: the values are skipped).
+#[cfg(feature = "serde")]
 pub(crate) struct Shaped<'a> {
     pub(crate) path: String,
     pub(crate) shape: &'a dyn Fn(&str) -> Shape,
 }
 
+#[cfg(feature = "serde")]
 impl<'de> serde::de::DeserializeSeed<'de> for Shaped<'_> {
     type Value = ();
 
@@ -420,6 +502,7 @@ impl<'de> serde::de::DeserializeSeed<'de> for Shaped<'_> {
     }
 }
 
+#[cfg(feature = "serde")]
 impl<'de> serde::de::Visitor<'de> for Shaped<'_> {
     type Value = ();
 
@@ -480,6 +563,7 @@ impl<'de> serde::de::Visitor<'de> for Shaped<'_> {
 }
 
 /// Checks the objects of `text` against `shape` (as [`Shaped`]).
+#[cfg(feature = "serde")]
 pub(crate) fn check_shape(text: &str, shape: &dyn Fn(&str) -> Shape) -> serde_json::Result<()> {
     use serde::de::DeserializeSeed;
     let mut d = serde_json::Deserializer::from_str(text);
@@ -491,15 +575,15 @@ pub(crate) fn check_shape(text: &str, shape: &dyn Fn(&str) -> Shape) -> serde_js
     d.end()
 }
 
-/// Checks the objects of a scene-file JSON value ([`scene_shape`]).
-fn check_value_shape(value: &serde_json::Value) -> Result<(), String> {
+/// Checks the objects of a scene-file JSON value at the key path `path` ([`scene_shape`]).
+#[cfg(feature = "serde")]
+fn check_value_shape(path: &str, value: &serde_json::Value) -> Result<(), KeyError> {
     use serde::de::DeserializeSeed;
-    Shaped {
-        path: String::new(),
+    Ok(Shaped {
+        path: path.to_string(),
         shape: &scene_shape,
     }
-    .deserialize(value)
-    .map_err(|e| e.to_string())
+    .deserialize(value)?)
 }
 
 /// The text of a JSON file (`what`: `"scene file"`, `"sweep file"`): its size checked
@@ -510,6 +594,7 @@ fn check_value_shape(value: &serde_json::Value) -> Result<(), String> {
 /// # Errors
 /// [`Error::Io`] when the file cannot be read; [`Error::OutOfMemory`]; `content_error`'s
 /// error for bytes that are not UTF-8.
+#[cfg(feature = "serde")]
 pub(crate) fn read_json_text<E: From<Error>>(
     path: &Path,
     operation: &'static str,
@@ -524,6 +609,7 @@ pub(crate) fn read_json_text<E: From<Error>>(
 }
 
 /// The line and column (1-based) of the first byte that is not UTF-8, and a message.
+#[cfg(feature = "serde")]
 pub(crate) fn not_utf8(bytes: &[u8], e: std::str::Utf8Error) -> (usize, usize, String) {
     let valid = &bytes[..e.valid_up_to()];
     let line = valid.iter().filter(|b| **b == b'\n').count() + 1;
@@ -542,6 +628,7 @@ pub(crate) fn not_utf8(bytes: &[u8], e: std::str::Utf8Error) -> (usize, usize, S
 }
 
 /// A JSON error of the scene file at `path` (`None`: text given directly).
+#[cfg(feature = "serde")]
 fn json_error(path: Option<&Path>, e: serde_json::Error) -> Error {
     Error::SceneFile {
         path: path.map(Path::to_path_buf),
@@ -551,26 +638,65 @@ fn json_error(path: Option<&Path>, e: serde_json::Error) -> Error {
     }
 }
 
-/// A scene-file JSON object read and written back with every key (the form a sweep's
-/// axes edit by dotted path); heights files are read relative to `base` and written as
-/// values.
-pub(crate) fn normalized_value(
-    value: serde_json::Value,
-    base: &Path,
-) -> Result<serde_json::Value, String> {
-    check_value_shape(&value)?;
-    let file: SceneFile = serde_json::from_value(value).map_err(|e| e.to_string())?;
-    let builder = file.into_builder(base).map_err(|e| e.to_string())?;
-    serde_json::to_value(SceneFile::from(&builder)).map_err(|e| e.to_string())
+#[cfg(feature = "serde")]
+impl SceneFile {
+    /// The scene file of a JSON object (a sweep's base scene), with every key: heights
+    /// files read relative to `base` and held as values (the form a sweep's axes set keys
+    /// in).
+    ///
+    /// # Errors
+    /// [`KeyError::Value`] for a value outside the format; the scene's errors for a
+    /// heights file.
+    pub(crate) fn from_value(
+        value: &serde_json::Value,
+        base: &Path,
+    ) -> std::result::Result<SceneFile, SceneValueError> {
+        check_value_shape("", value)?;
+        let file = SceneFile::deserialize(value).map_err(KeyError::from)?;
+        Ok(SceneFile::from(&file.into_builder(base)?))
+    }
+
+    /// Sets the dotted `key` (a sweep's axis) to `value`, read as the file reads it.
+    ///
+    /// # Errors
+    /// [`KeyError`]: not a key of the scene, a key below a value that is not an object, a
+    /// value the key does not take (or an array where the file has an object).
+    pub(crate) fn set(&mut self, key: &str, value: &serde_json::Value) -> Result<(), KeyError> {
+        check_value_shape(key, value)?;
+        let segments: Vec<&str> = key.split('.').collect();
+        Schema::set(self, "", &segments, value)
+    }
+
+    /// The scene as JSON, every key written.
+    ///
+    /// # Errors
+    /// [`KeyError::Value`] if serialisation fails (it does not for a scene's values).
+    pub(crate) fn to_value(&self) -> Result<serde_json::Value, KeyError> {
+        Ok(serde_json::to_value(self)?)
+    }
+
+    /// The builder of the scene (heights given as values: no file is read).
+    ///
+    /// # Errors
+    /// Those of a heights file named in it.
+    pub(crate) fn to_builder(&self) -> Result<SceneBuilder> {
+        self.clone().into_builder(Path::new("."))
+    }
 }
 
-/// The builder of a scene-file JSON object (heights given as values: no file is read).
-pub(crate) fn builder_from_value(value: serde_json::Value) -> Result<SceneBuilder, String> {
-    check_value_shape(&value)?;
-    let file: SceneFile = serde_json::from_value(value).map_err(|e| e.to_string())?;
-    file.into_builder(Path::new(".")).map_err(|e| e.to_string())
+/// Why a sweep's base scene is not a scene.
+#[derive(Debug, thiserror::Error)]
+#[cfg(feature = "serde")]
+pub(crate) enum SceneValueError {
+    /// A value outside the format.
+    #[error(transparent)]
+    Key(#[from] KeyError),
+    /// A heights file that cannot be read.
+    #[error(transparent)]
+    Scene(#[from] Error),
 }
 
+#[cfg(feature = "serde")]
 impl SceneBuilder {
     /// Reads a scene from JSON text (`docs/scene-format.md`; feature `serde`). A heights
     /// file named in it is read relative to the current directory. Nothing is validated
@@ -618,6 +744,7 @@ impl SceneBuilder {
     }
 }
 
+#[cfg(feature = "serde")]
 impl Serialize for SceneBuilder {
     fn serialize<S: serde::Serializer>(
         &self,
@@ -627,6 +754,7 @@ impl Serialize for SceneBuilder {
     }
 }
 
+#[cfg(feature = "serde")]
 impl<'de> Deserialize<'de> for SceneBuilder {
     /// Heights files are read relative to the current directory.
     fn deserialize<D: serde::Deserializer<'de>>(
@@ -635,5 +763,159 @@ impl<'de> Deserialize<'de> for SceneBuilder {
         SceneFile::deserialize(deserializer)?
             .into_builder(Path::new("."))
             .map_err(serde::de::Error::custom)
+    }
+}
+
+/// Every key of `scene` with its exact value, in the file's order (observers included).
+pub(crate) fn all_keys(scene: &SceneBuilder) -> Vec<(String, String)> {
+    let mut keys = Vec::new();
+    SceneFile::from(scene).keys("", &mut keys);
+    keys
+}
+
+/// The scene's identity: every key that identifies the run (all but the [`OBSERVERS`](super::schema::OBSERVERS))
+/// with its exact value, as `(key path, value)` in the file's order. Checkpoints store a
+/// digest of it.
+pub(crate) fn identity(scene: &SceneBuilder) -> Vec<(String, String)> {
+    let mut keys = all_keys(scene);
+    keys.retain(|(key, _)| !observes(key));
+    keys
+}
+
+/// The first key of the identity (in `a`'s order, then keys only `b` has) in which `b`
+/// describes another run than `a`, `None` for the same run.
+pub(crate) fn first_difference(a: &SceneBuilder, b: &SceneBuilder) -> Option<String> {
+    let (mine, theirs) = (identity(a), identity(b));
+    mine.iter()
+        .find(|key_value| !theirs.contains(key_value))
+        .or_else(|| {
+            theirs
+                .iter()
+                .find(|(k, _)| !mine.iter().any(|(m, _)| m == k))
+        })
+        .map(|(key, _)| key.clone())
+}
+
+/// Whether the scene file has an object at the dotted `path` (`""`: the top level; `#`
+/// steps into an array's elements).
+#[cfg(feature = "serde")]
+pub(crate) fn object_at(path: &str) -> bool {
+    if path.is_empty() {
+        return true;
+    }
+    let segments: Vec<&str> = path.split('.').collect();
+    <SceneFile as Schema>::object_at(&segments)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::ProbeSpec;
+    use crate::scene::{Drive, ForceLoad, HeightSource, Lateral};
+    use crate::solver::{Parallelism, SolverOptions};
+
+    /// Scenes with every kind of every enum of the file.
+    fn scenes() -> Vec<SceneBuilder> {
+        let rod = Lateral::Rod {
+            height: 3e-3,
+            half_width: 1e-3,
+        };
+        let base = SceneBuilder::default().block(0.02, 0.004, 0.01);
+        vec![
+            base.clone(),
+            base.clone()
+                .cells(20, 4)
+                .drive(Drive::Force(ForceLoad::Top)),
+            base.clone()
+                .drive(Drive::Force(ForceLoad::Lateral(Lateral::Side))),
+            base.clone().drive(Drive::Force(ForceLoad::Mixed {
+                ratio: 0.5,
+                lateral: rod,
+            })),
+            base.clone()
+                .drive(Drive::Spring {
+                    stiffness: 4e6,
+                    lateral: Lateral::Side,
+                })
+                .heights(HeightSource::Values(vec![1e-6; 80])),
+            base.solver_options(
+                SolverOptions::default()
+                    .with_parallelism(Parallelism::Threads(3))
+                    .unwrap(),
+            )
+            .max_cells(5000)
+            .probes(ProbeSpec::default().with_plane(1e-3)),
+        ]
+    }
+
+    #[test]
+    fn the_identity_is_every_key_but_the_observers() {
+        for scene in scenes() {
+            let all = all_keys(&scene);
+            let identity = identity(&scene);
+            assert!(identity.iter().all(|k| all.contains(k)));
+            let left_out: Vec<&str> = all
+                .iter()
+                .filter(|k| !identity.contains(k))
+                .map(|(k, _)| k.as_str())
+                .collect();
+            assert!(left_out.contains(&"solver.threads"), "{left_out:?}");
+            assert!(left_out
+                .iter()
+                .all(|k| *k == "solver.threads" || *k == "max_cells" || k.starts_with("probes.")));
+        }
+    }
+
+    #[test]
+    fn an_observer_does_not_change_the_identity_and_every_other_key_does() {
+        let a = SceneBuilder::default();
+        let b = a
+            .clone()
+            .solver_options(
+                SolverOptions::default()
+                    .with_parallelism(Parallelism::Threads(2))
+                    .unwrap(),
+            )
+            .max_cells(10)
+            .probes(ProbeSpec::default().with_plane(1e-3));
+        assert_eq!(first_difference(&a, &b), None);
+        assert_eq!(
+            first_difference(&a, &a.clone().normal_load(1.0)).as_deref(),
+            Some("normal_load")
+        );
+        assert_eq!(
+            first_difference(&a, &a.clone().seed(4)).as_deref(),
+            Some("heights.seed")
+        );
+        let top = a.clone().drive(Drive::Force(ForceLoad::Top));
+        assert_eq!(first_difference(&a, &top).as_deref(), Some("drive.kind"));
+        // A key only the second has.
+        assert_eq!(first_difference(&top, &a).as_deref(), Some("drive.kind"));
+    }
+
+    #[cfg(feature = "serde")]
+    #[test]
+    fn the_objects_of_the_file() {
+        for path in [
+            "",
+            "block",
+            "cells",
+            "heights",
+            "drive",
+            "drive.lateral",
+            "probes",
+        ] {
+            assert!(object_at(path), "{path}");
+        }
+        for path in [
+            "normal_load",
+            "block.lx",
+            "drive.height",
+            "probes.points",
+            "x",
+            "block.x",
+        ] {
+            assert!(!object_at(path), "{path}");
+        }
     }
 }

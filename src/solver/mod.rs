@@ -406,19 +406,9 @@ impl EquilibriumSolver {
     }
 }
 
-/// Shared pool guards and locks of the parts' buffers (a panicking part poisons no
-/// result: the solve panics as a whole).
-pub(crate) fn read<T>(lock: &std::sync::RwLock<T>) -> std::sync::RwLockReadGuard<'_, T> {
-    lock.read().unwrap_or_else(|e| e.into_inner())
-}
-
-pub(crate) fn write<T>(lock: &std::sync::RwLock<T>) -> std::sync::RwLockWriteGuard<'_, T> {
-    lock.write().unwrap_or_else(|e| e.into_inner())
-}
-
-pub(crate) fn lock<T>(lock: &std::sync::Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    lock.lock().unwrap_or_else(|e| e.into_inner())
-}
+/// The poison-tolerant guards of the parts' buffers and the shared pools (their one copy
+/// is in `lock.rs`).
+pub(crate) use crate::lock::{lock, read, write};
 
 #[cfg(test)]
 mod tests;

@@ -241,9 +241,7 @@ struct Work<'a, S> {
     vectors: &'a [Mutex<Vectors>],
 }
 
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|e| e.into_inner())
-}
+use crate::lock::lock;
 
 impl<S: SetSystem> Tasks for Work<'_, S> {
     type Phase = Phase;
