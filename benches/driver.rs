@@ -7,7 +7,8 @@
 //! minute: the example times it). Results: docs/performance.md.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use precursors::{Backend, Event, Parallelism, Scene, SolverOptions};
+use precursors::solver::{Backend, Parallelism, SolverOptions};
+use precursors::{Event, Scene};
 use std::ops::ControlFlow;
 use std::time::Duration;
 

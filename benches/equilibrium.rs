@@ -10,6 +10,7 @@
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use precursors::green::InfluencePlan;
+use precursors::solver::{Backend, EquilibriumSolver, Parallelism, SolverOptions};
 use precursors::*;
 use std::time::{Duration, Instant};
 

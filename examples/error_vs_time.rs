@@ -20,9 +20,8 @@
 #[path = "support/report.rs"]
 mod report;
 
-use precursors::{
-    Drive, Event, ForceLoad, Lateral, Parallelism, Scene, SceneBuilder, SolverOptions,
-};
+use precursors::solver::{Parallelism, SolverOptions};
+use precursors::{Drive, Event, ForceLoad, Lateral, Scene, SceneBuilder};
 use std::io::Write;
 use std::process::ExitCode;
 use std::time::Instant;

@@ -22,8 +22,8 @@ mod report;
 mod figures;
 
 use precursors::plot::{Chart, Corner, Style};
-use precursors::probe::{ProbeSpec, Profile};
 use precursors::Event;
+use precursors::{ProbeSpec, Profile};
 use std::process::ExitCode;
 
 /// The precursor length (m) taken as the first front (see the module docs).

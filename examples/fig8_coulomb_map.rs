@@ -18,8 +18,8 @@ mod report;
 mod figures;
 
 use precursors::plot::{Map, Palette};
-use precursors::probe::ProbeSpec;
 use precursors::Event;
+use precursors::ProbeSpec;
 use std::process::ExitCode;
 
 const THRESHOLD: f64 = 5e-3;

@@ -17,8 +17,8 @@ mod report;
 mod figures;
 
 use precursors::plot::{Chart, Colours, Corner};
-use precursors::probe::ProbeSpec;
 use precursors::Event;
+use precursors::ProbeSpec;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {

@@ -17,7 +17,8 @@
 #[path = "support/report.rs"]
 mod report;
 
-use precursors::{Event, Parallelism, Scene, SolverOptions};
+use precursors::solver::{Parallelism, SolverOptions};
+use precursors::{Event, Scene};
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -117,7 +118,7 @@ fn run() -> report::Outcome {
         driver.grid().len(),
         driver.grid().nx(),
         driver.grid().ny(),
-        precursors::SolverOptions::default().backend()
+        precursors::solver::SolverOptions::default().backend()
     );
     println!(
         "wall {elapsed:.2} s (scene build {:.3} s); {events} events: {ruptures} ruptures, \

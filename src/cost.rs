@@ -3,7 +3,7 @@
 
 use crate::error::{Error, Result};
 
-/// Largest grid the [`crate::Backend::Auto`] choice solves densely (cells). Defined here,
+/// Largest grid the [`crate::solver::Backend::Auto`] choice solves densely (cells). Defined here,
 /// below the solver, because the cost estimate needs it too.
 pub const AUTO_DENSE_LIMIT: usize = 2500;
 
@@ -47,7 +47,7 @@ pub struct GridCost {
     /// `Nx·Ny` (exact).
     pub cells: u128,
     /// Peak memory of a scene and its driver (bytes): 240 B per cell, plus the two
-    /// `N x N` matrices of the dense backend when [`crate::Backend::Auto`] picks it.
+    /// `N x N` matrices of the dense backend when [`crate::solver::Backend::Auto`] picks it.
     pub memory_bytes: f64,
     /// Time to plan the operator (s): 1.5 µs per cell.
     pub plan_seconds: f64,

@@ -262,7 +262,7 @@ pub enum Error {
     /// `Parallelism::Threads(n)` (`Driver::step`, `EquilibriumSolver`).
     #[error("could not start a pool of {threads} solver threads: {}", Bounded(&source.to_string()))]
     ThreadPool {
-        /// Threads requested ([`crate::SolverOptions::parallelism`]).
+        /// Threads requested ([`crate::solver::SolverOptions::parallelism`]).
         threads: usize,
         /// What the thread pool reported.
         #[source]
@@ -326,10 +326,10 @@ pub enum Error {
         reason: &'static str,
     },
     /// An equilibrium solve stopped before reaching the solver's tolerance
-    /// ([`crate::SolverOptions`]): the projected CG of a normal or tangential set solve past
+    /// ([`crate::solver::SolverOptions`]): the projected CG of a normal or tangential set solve past
     /// its iteration limit, or the active set of the normal equilibrium past
     /// `max_active_set_iterations` (residual `inf`). Returned by
-    /// [`crate::EquilibriumSolver::solve_normal`], [`crate::EquilibriumSolver::solve_tangential`],
+    /// [`crate::solver::EquilibriumSolver::solve_normal`], [`crate::solver::EquilibriumSolver::solve_tangential`],
     /// [`crate::Driver::step`] and the calibration's area. Not a series of the Green function:
     /// that is [`Error::SeriesNotConverged`].
     #[error(
@@ -477,7 +477,7 @@ pub enum Error {
     },
     /// A run's CSV table (`events.csv`, `curve.csv`, `contact_map.csv`) cannot be
     /// continued: a damaged row before the last one, another header, an index that is not
-    /// a whole number ([`crate::output::rows_to_keep`]), or rows that do not reach the
+    /// a whole number, or rows that do not reach the
     /// checkpoint's event or do not agree with the other tables
     /// ([`crate::output::RunTables::resume`]).
     #[error(

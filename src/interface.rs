@@ -595,7 +595,7 @@ impl Interface {
     }
 
     /// Sets every site's state, e.g. to those of a normal equilibrium
-    /// ([`crate::NormalEquilibrium::states`]).
+    /// ([`crate::solver::NormalEquilibrium::states`]).
     ///
     /// # Errors
     /// [`Error::LengthMismatch`] when `states` does not hold one state per site;
@@ -621,7 +621,7 @@ impl Interface {
     /// The Coulomb rule: the shear load (N) at which each site reaches the threshold
     /// `|φ_x| = μ φ_z`, `λ_i = μ φ_z,i / |φ_x,i(1)|` (paper Eq. lambda_Amonton_dscrt), from
     /// the normal tractions (Pa) and the shear tractions per newton of load (Pa/N,
-    /// [`crate::TangentialResponse::traction`]). `+∞` for sites that carry no shear
+    /// [`crate::solver::TangentialResponse::traction`]). `+∞` for sites that carry no shear
     /// (detached, broken, or exactly unloaded).
     ///
     /// # Errors

@@ -13,18 +13,38 @@
 //!
 //! [model]: https://github.com/precursors-model/precursors/blob/main/docs/model.md
 //!
-//! This release provides the geometry, the [`green`] module (point evaluation of `G`
-//! and `∂G/∂z`, the analytic load terms, the Galerkin influence operator of the grid,
-//! planned once per geometry and applied through the 2-D DCT), the [`interface`] springs
-//! the [`solver`] of the normal and tangential equilibria (dense and spectral
-//! backends), the [`scene`] builder and the quasi-static [`driver`], an iterator of
-//! [`Event`]s (ruptures, detachments, attachments, load steps, stable states, global
-//! slip).
+//! Where things are (each item has one path):
+//!
+//! * the crate root: the model as a user runs it. A [`Scene`] (from a [`SceneBuilder`]:
+//!   [`Block`], [`Grid`], [`Material`], [`SpringLaw`], [`Heights`], [`Drive`], probes)
+//!   gives a [`Driver`], an iterator of [`Event`]s (ruptures, detachments, attachments,
+//!   load steps, stable states, global slip) with the observables between them (real
+//!   contact area, precursor length, tractions, [`Stresses`] on planes and at points) and
+//!   [`Checkpoint`]s; one [`Error`] type for all of it.
+//! * [`green`]: the box's Neumann Green function (`G` and `∂G/∂z` at points, the load
+//!   terms) and the Galerkin influence operator of a grid, planned once per geometry and
+//!   applied matrix-free through the 2-D DCT.
+//! * [`solver`]: the normal and tangential equilibria (dense and spectral backends), their
+//!   options and reports, usable without a driver.
+//! * [`calibration`]: fits of the paper's two adjustable spring constants.
+//! * [`output`]: the tables of a run directory, as the program writes them.
+//! * `sweep` (feature `serde`): studies over scene keys and realizations, run in a
+//!   directory and merged into ensemble tables; `plot` (feature `plot`): figures.
 //!
 //! Features: `serde` (JSON scene files and checkpoints), `nalgebra` (heights from and
 //! fields to `nalgebra` matrices and vectors, row `iy` and column `ix`), `plot` (module
 //! `plot`: figures with axes, units, legends and colour bars as PNG or SVG), `cli` (the
-//! program `precursors`, docs/cli.md).
+//! program `precursors`, [docs/cli.md][cli]).
+//!
+//! **Stability.** From 1.0 the crate follows semantic versioning: the public API (one
+//! path per item, listed in `api/public-api.txt` and checked in CI), the scene-file format,
+//! the checkpoint layout (version 3) and the run and sweep directory layouts change
+//! incompatibly only in a new major version; event sequences may change at rounding
+//! level in a minor release, with a CHANGELOG entry. What is and is not covered, and the
+//! MSRV policy: [docs/compatibility.md][compat].
+//!
+//! [cli]: https://github.com/precursors-model/precursors/blob/main/docs/cli.md
+//! [compat]: https://github.com/precursors-model/precursors/blob/main/docs/compatibility.md
 //!
 //! A scene driven from zero shear to global slip, event by event: the real contact area,
 //! the precursor length `ℓ` and the Coulomb stress on a plane inside the block, read
@@ -39,7 +59,7 @@
 //!     .cell_size(1e-3, 1e-3)                            // 30 x 7 cells (m)
 //!     .normal_load(750.0)                               // F_N (N); rod drive, PMMA
 //!     .seed(1)                                          // the heights' realization
-//!     .probes(ProbeSpec::default().with_plane(2e-3))         // stresses at z = 2 mm
+//!     .probes(ProbeSpec::default().with_plane(2e-3))    // stresses at z = 2 mm
 //!     .build()?;
 //! let mut driver = scene.driver()?;
 //! let (lx, mu_fn) = (0.030, scene.material().friction_coefficient() * 750.0);
@@ -81,25 +101,36 @@
 
 pub mod calibration;
 mod cost;
-pub mod driver;
-pub mod error;
+mod driver;
+mod error;
 mod format;
-pub mod geometry;
+mod geometry;
 pub mod green;
-pub mod interface;
+mod interface;
 mod lock;
 #[cfg(feature = "nalgebra")]
 mod matrix;
 pub mod output;
 #[cfg(feature = "plot")]
 pub mod plot;
-pub mod probe;
-pub mod scene;
+mod probe;
+mod scene;
 pub mod solver;
 #[cfg(feature = "serde")]
 pub mod sweep;
 
+pub use cost::GridCost;
+pub use driver::{Checkpoint, Driver, Event, Load, Site, SolveStats};
 pub use error::{Error, Result};
+pub use geometry::{Block, Grid, Point};
+pub use interface::{
+    AreaLaw, HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw,
+};
+pub use probe::{
+    CellStress, PlaneStress, PointStress, ProbeInput, ProbeSpec, Profile, StressProbe, Stresses,
+};
+pub use scene::{Drive, ForceLoad, HeightSource, Lateral, Scene, SceneBuilder};
+
 /// The `nalgebra` this crate converts to and from (feature `nalgebra`): heights from an
 /// `Ny x Nx` `DMatrix` (row `iy`, column `ix`: [`Heights::from_dmatrix`]), fields to a
 /// `DMatrix` ([`Grid::field_to_dmatrix`]) or to a `DVector` in the cell order
@@ -111,17 +142,3 @@ pub use nalgebra;
 #[doc = include_str!("../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
-pub use driver::{Checkpoint, Driver, Event, Load, Site, SolveStats};
-pub use geometry::{Block, Grid, Point};
-pub use green::GridCost;
-pub use interface::{
-    AreaLaw, HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw,
-};
-pub use probe::{
-    CellStress, PlaneStress, PointStress, ProbeInput, ProbeSpec, Profile, StressProbe, Stresses,
-};
-pub use scene::{Drive, ForceLoad, HeightSource, Lateral, Scene, SceneBuilder};
-pub use solver::{
-    Backend, EquilibriumSolver, NormalEquilibrium, Parallelism, SolveReport, SolverOptions,
-    TangentialResponse,
-};

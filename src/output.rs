@@ -7,7 +7,7 @@
 //! * `curve.csv`, one row per stable state ([`CURVE_HEADER`]): `event,force_N,
 //!   force_over_mu_FN,drive_displacement_m,real_contact_area_m2,precursor_length_m,
 //!   precursor_over_Lx,broken,attached,area_exceeds_nominal`;
-//! * `contact_map.csv` ([`contact_map_header`]): the map over x and F of the paper's
+//! * `contact_map.csv` (header `event,force_over_mu_FN`, then `area_m2_ix0`, `area_m2_ix1`, ...): the map over x and F of the paper's
 //!   Fig. 2b inset, one row per load level `F/(μF_N)` = 0, 0.005, 0.01, ...
 //!   ([`CONTACT_MAP_STEP`]) from the first stable state up to global slip: the real
 //!   contact area of each column `ix` (m², summed over y) in the stable state in effect
@@ -35,7 +35,7 @@
 //! **Resume.** [`RunTables::resume`] continues the tables of a run from a checkpoint taken
 //! at a stable state: it checks, before it writes anything, that the directory's recorded
 //! scene is the checkpoint's, that the three tables have their headers and whole rows
-//! (a last row cut by a crash is dropped: [`rows_to_keep`]), that `events.csv` numbers its
+//! (a last row cut by a crash is dropped), that `events.csv` numbers its
 //! rows 1, 2, 3, ... up to at least the checkpoint's event, and that `curve.csv` and
 //! `contact_map.csv` hold the stable states and load levels reached by then; then it
 //! rewrites the `.partial` tables with the rows up to the checkpoint's event.
@@ -70,7 +70,7 @@ pub const PARTIAL_SUFFIX: &str = ".partial";
 pub const SCENE_RECORD: &str = "scene.json";
 
 /// The header of `contact_map.csv` for a grid of `nx` columns.
-pub fn contact_map_header(nx: usize) -> String {
+pub(crate) fn contact_map_header(nx: usize) -> String {
     let mut header = String::from("event,force_over_mu_FN");
     for ix in 0..nx {
         header.push_str(&format!(",area_m2_ix{ix}"));
@@ -122,26 +122,6 @@ fn index_of(line: usize, row: &str) -> std::result::Result<usize, String> {
         .unwrap_or("")
         .parse()
         .map_err(|e| format!("line {line}: the event index is not a whole number ({e})"))
-}
-
-/// The text a resumed table starts from: `header`, then the rows of `old` whose first
-/// column (an event index) is at most `keep`. A last row cut by a crash (no trailing
-/// newline, or not as many fields as the header) is dropped.
-///
-/// # Errors
-/// [`Error::CorruptTable`] (with the line number) for the same damage on an earlier row,
-/// an index that is not a whole number, or another header: the table was not written by
-/// this run.
-pub fn rows_to_keep(old: &str, header: &str, keep: usize) -> Result<String> {
-    let corrupt = |reason: String| Error::CorruptTable { path: None, reason };
-    let mut text = format!("{header}\n");
-    for (line, row) in complete_rows(old, header).map_err(corrupt)? {
-        if index_of(line, row).map_err(corrupt)? <= keep {
-            text.push_str(row);
-            text.push('\n');
-        }
-    }
-    Ok(text)
 }
 
 /// What a resumed run starts from: the three tables' texts up to the checkpoint's event,
@@ -839,7 +819,7 @@ fn first_level_at_or_above(x: f64) -> u64 {
 }
 
 /// Broken and attached sites of `states`.
-pub fn counts(states: &[SiteState]) -> (usize, usize) {
+pub(crate) fn counts(states: &[SiteState]) -> (usize, usize) {
     let broken = states.iter().filter(|s| **s == SiteState::Broken).count();
     let attached = states.iter().filter(|s| **s == SiteState::Attached).count();
     (broken, attached)
@@ -872,4 +852,45 @@ fn write_event(out: &mut impl Write, index: usize, event: &Event, exceeds: bool)
         ruptures.map(|r| r.to_string()).unwrap_or_default(),
         u8::from(exceeds)
     )
+}
+
+/// The rows a resume reads back (`RunTables::resume`).
+#[cfg(test)]
+mod tests {
+    use super::{complete_rows, index_of};
+
+    const HEADER: &str = "index,kind,force_N";
+
+    fn rows(text: &str) -> Result<Vec<&str>, String> {
+        Ok(complete_rows(text, HEADER)?
+            .into_iter()
+            .map(|(_, r)| r)
+            .collect())
+    }
+
+    #[test]
+    fn a_row_cut_by_a_crash_is_dropped_and_other_damage_refused() {
+        let full = "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n3,rupture,1.5\n";
+        assert_eq!(
+            rows(full).unwrap(),
+            ["1,stable,0.0", "2,load_raised,1.5", "3,rupture,1.5"]
+        );
+        // A crash cut the last row: within its index ("12" of "1234"), within a field,
+        // or after the last field but before the newline. Each is dropped.
+        let kept = "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n";
+        for cut in ["2", "2,load_r", "3,rupture,1.5", "3,rupture"] {
+            let damaged = format!("{kept}{cut}");
+            assert_eq!(rows(&damaged).unwrap().len(), 2, "cut {cut:?}");
+        }
+        // A complete last line with too few fields (a crash between two writes of a row).
+        assert_eq!(rows(&format!("{kept}3,rupture\n")).unwrap().len(), 2);
+        // The same damage before the last row, another header: refused.
+        assert!(rows("index,kind,force_N\n1,stable\n2,stable,1.0\n").is_err());
+        assert!(rows("event,force_N\n1,0.0\n").is_err());
+        // A bad index is refused where the index is read.
+        assert!(index_of(2, "x,stable,0.0").is_err());
+        assert_eq!(index_of(2, "12,stable,0.0"), Ok(12));
+        // An empty file has no rows.
+        assert!(rows("").unwrap().is_empty());
+    }
 }

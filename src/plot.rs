@@ -4,7 +4,7 @@
 //! Latin, Greek, super- and subscripts, `ℓ`, `−`, `≈`, `≤`, `∑`, `⟨ ⟩`; `assets/fonts`), so that no
 //! system font is needed.
 //!
-//! [`Chart`] and [`Map`] are the building blocks; [`figures`] draws the standard figures
+//! [`Chart`] and [`Map`] are the building blocks; [`draw`] draws the standard figures
 //! of a run or of a sweep directory (`precursors plot DIR`).
 //!
 //! Non-finite values are not drawn: a line is cut at a point with a `NaN` or infinite
@@ -24,9 +24,10 @@
 //! ```
 
 mod error;
-pub mod figures;
+mod figures;
 
 pub use error::PlotError;
+pub use figures::{draw, Drawn, Format};
 
 use crate::error::Error;
 use plotters::coord::types::RangedCoordf64;

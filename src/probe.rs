@@ -24,7 +24,7 @@
 //!
 //! ```
 //! use precursors::{Point, Scene};
-//! use precursors::probe::ProbeSpec;
+//! use precursors::ProbeSpec;
 //! let scene = Scene::builder()
 //!     .block(0.020, 0.004, 0.010)
 //!     .normal_load(80.0)
@@ -42,7 +42,7 @@
 
 use crate::error::{check_slice, check_tolerance, Error, Result};
 use crate::geometry::{Grid, Point};
-use crate::green::loads::top_stress_influence;
+use crate::green::top_stress_influence;
 use crate::green::{InfluencePlan, PlaneTransfer, RodLoad};
 use rustdct::DctPlanner;
 use std::f64::consts::PI;

@@ -3,7 +3,7 @@
 //!
 //! A scene computes only what it needs: the lateral load table (paper Eq. `G_x_lat`) only
 //! for a drive with a lateral part, the dense matrix only when the solver backend is dense
-//! (by default: [`Backend::Auto`](crate::Backend::Auto) up to
+//! (by default: [`Backend::Auto`](crate::solver::Backend::Auto) up to
 //! [`AUTO_DENSE_LIMIT`](crate::solver::AUTO_DENSE_LIMIT) cells).
 //!
 //! ```
@@ -369,7 +369,7 @@ impl SceneBuilder {
     /// The plan tolerance (scene-file key `plan_tolerance`): the largest relative error
     /// accepted on the influence operator's eigenvalues (dimensionless, default `1e-8`, as
     /// [`crate::green::InfluencePlanBuilder::plan_tolerance`]; not the solver's linear
-    /// tolerance, [`crate::SolverOptions::tolerance`]): they are computed to about
+    /// tolerance, [`crate::solver::SolverOptions::tolerance`]): they are computed to about
     /// 1e-13 whatever it is (`docs/accuracy.md`). The lateral load
     /// table is always summed to `1e-12` relative (closed forms, cheap).
     pub fn plan_tolerance(mut self, plan_tolerance: f64) -> Self {
@@ -742,7 +742,7 @@ mod leaves_out {
         let scene = small()
             .solver_options(
                 SolverOptions::default()
-                    .with_backend(crate::Backend::Spectral)
+                    .with_backend(crate::solver::Backend::Spectral)
                     .unwrap(),
             )
             .build()

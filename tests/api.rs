@@ -5,11 +5,13 @@
 //! literal cell order, and the same quantities through the pre-existing paths (scene
 //! probes, uninterrupted runs).
 
-use precursors::{Backend, Point};
+use precursors::solver::Backend;
+use precursors::solver::SolverOptions;
+use precursors::Point;
 use precursors::{
     CellStress, Checkpoint, Driver, Error, Event, HeightSource, Heights, Material, PlaneStress,
-    PointStress, ProbeInput, ProbeSpec, Profile, Scene, SceneBuilder, SolverOptions, SpringLaw,
-    StressProbe, Stresses,
+    PointStress, ProbeInput, ProbeSpec, Profile, Scene, SceneBuilder, SpringLaw, StressProbe,
+    Stresses,
 };
 use std::ops::ControlFlow;
 

@@ -3,6 +3,7 @@
 //! (at a stable state, inside an avalanche, with events still queued). The reference is
 //! the uninterrupted run itself.
 
+use precursors::solver::{Backend, Parallelism, SolverOptions};
 use precursors::*;
 
 /// Every remaining event of `driver`, and its normal tractions at the end.
@@ -568,50 +569,5 @@ pub(crate) mod json {
             scene.resume(&c),
             Err(Error::InvalidCheckpoint { .. })
         ));
-    }
-}
-
-/// The tables of a run on resume (`precursors::output`, used by `precursors run`/`resume`).
-mod tables {
-    use precursors::output::rows_to_keep;
-
-    const HEADER: &str = "index,kind,force_N";
-
-    #[test]
-    fn rows_after_the_checkpoint_and_a_cut_last_row_are_dropped() {
-        let rows = "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n3,rupture,1.5\n";
-        // Rows up to the checkpoint's event are kept, later ones dropped.
-        assert_eq!(
-            rows_to_keep(rows, HEADER, 2).unwrap(),
-            "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n"
-        );
-        assert_eq!(rows_to_keep(rows, HEADER, 9).unwrap(), rows);
-        // A crash cut the last row: within its index ("12" of "1234"), within a field,
-        // or after the last field but before the newline. Each is dropped.
-        let kept = "index,kind,force_N\n1,stable,0.0\n2,load_raised,1.5\n";
-        for cut in ["2", "2,load_r", "3,rupture,1.5", "3,rupture"] {
-            let damaged = format!("{kept}{cut}");
-            assert_eq!(
-                rows_to_keep(&damaged, HEADER, 1000).unwrap(),
-                kept,
-                "cut {cut:?}"
-            );
-        }
-        // A complete last line with too few fields (a crash between two writes of a row).
-        assert_eq!(
-            rows_to_keep(&format!("{kept}3,rupture\n"), HEADER, 1000).unwrap(),
-            kept
-        );
-        // The same damage before the last row, another header, a bad index: refused.
-        assert!(rows_to_keep("index,kind,force_N\n1,stable\n2,stable,1.0\n", HEADER, 9).is_err());
-        assert!(rows_to_keep("event,force_N\n1,0.0\n", HEADER, 9).is_err());
-        assert!(rows_to_keep(
-            "index,kind,force_N\nx,stable,0.0\n2,stable,1.0\n",
-            HEADER,
-            9
-        )
-        .is_err());
-        // An empty file starts with the header.
-        assert_eq!(rows_to_keep("", HEADER, 3).unwrap(), "index,kind,force_N\n");
     }
 }

@@ -5,6 +5,7 @@
 
 use crate::common::{bordered_solve, compliance_matrix};
 use precursors::green::RodLoad;
+use precursors::solver::{Backend, EquilibriumSolver, Parallelism, SolverOptions};
 use precursors::*;
 use std::ops::ControlFlow;
 

@@ -165,8 +165,8 @@ fn a_core_failure_under_a_sweep_is_nested_and_its_source() {
 #[cfg(feature = "plot")]
 mod plot {
     use super::scratch;
-    use precursors::plot::figures::{draw, Format};
     use precursors::plot::PlotError;
+    use precursors::plot::{draw, Format};
     use precursors::sweep::SweepError;
     use precursors::Error;
     use std::error::Error as _;

@@ -117,7 +117,7 @@ fn heights_outside_the_block_are_refused() {
         Err(Error::OutsideBlock { .. })
     ));
     assert!(matches!(
-        precursors::green::loads::top_stress_influence(&b, f64::NAN),
+        precursors::green::top_stress_influence(&b, f64::NAN),
         Err(Error::OutsideBlock { .. })
     ));
 }
@@ -149,8 +149,8 @@ fn operator_inputs_are_checked() {
 #[test]
 fn zero_solver_threads_are_refused() {
     // Refused when the options are made (there is no later point to refuse them at).
-    let built =
-        precursors::SolverOptions::default().with_parallelism(precursors::Parallelism::Threads(0));
+    let built = precursors::solver::SolverOptions::default()
+        .with_parallelism(precursors::solver::Parallelism::Threads(0));
     match built {
         Err(Error::InvalidCount { name, value, .. }) => {
             assert_eq!(name, "threads");
@@ -163,8 +163,8 @@ fn zero_solver_threads_are_refused() {
         let scene = precursors::Scene::builder()
             .block(0.010, 0.005, 0.010)
             .solver_options(
-                precursors::SolverOptions::default()
-                    .with_parallelism(precursors::Parallelism::Threads(threads))
+                precursors::solver::SolverOptions::default()
+                    .with_parallelism(precursors::solver::Parallelism::Threads(threads))
                     .unwrap(),
             )
             .build()
@@ -366,7 +366,8 @@ fn grids_above_the_cell_limit_are_refused_quickly() {
 /// says what to do; `Backend::Auto` accepts any parallelism and reports the threads used.
 #[test]
 fn threads_with_the_dense_backend() {
-    use precursors::{Backend, Parallelism, Scene, SolverOptions};
+    use precursors::solver::{Backend, Parallelism, SolverOptions};
+    use precursors::Scene;
     let options = |backend, parallelism| {
         SolverOptions::default()
             .with_backend(backend)
@@ -474,7 +475,7 @@ fn counts_are_reported_as_integers() {
 /// the message gives the range. The bounds are the table's (the reference), not read
 /// from the code.
 mod ranges {
-    use precursors::probe::ProbeSpec;
+    use precursors::solver::SolverOptions;
     use precursors::*;
 
     /// A small valid scene: 20 x 4 cells of 1 mm on a 20 x 4 x 10 mm block.

@@ -1,9 +1,7 @@
 //! Interface springs: seeded heights (pinned values and the truncated-Gaussian moments in
 //! closed form), validation, the spring laws and the real contact area.
 
-use precursors::interface::{
-    AreaLaw, HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw,
-};
+use precursors::{AreaLaw, HeightDistribution, Heights, Interface, Material, SiteState, SpringLaw};
 use precursors::{Block, Error, Grid};
 
 fn grid(nx: usize, ny: usize) -> Grid {

@@ -7,10 +7,8 @@
 
 use precursors::calibration::FitOptions;
 use precursors::green::SeriesOptions;
-use precursors::{
-    Backend, Error, HeightDistribution, Material, Parallelism, ProbeInput, ProbeSpec,
-    SolverOptions, SpringLaw,
-};
+use precursors::solver::{Backend, Parallelism, SolverOptions};
+use precursors::{Error, HeightDistribution, Material, ProbeInput, ProbeSpec, SpringLaw};
 
 fn invalid_parameter(r: Result<impl std::fmt::Debug, Error>, field: &str) -> bool {
     matches!(r, Err(Error::InvalidParameter { name, .. }) if name == field)

@@ -4,6 +4,7 @@
 //! `docs/validation-solvers.md`.
 
 use precursors::green::InfluencePlan;
+use precursors::solver::EquilibriumSolver;
 use precursors::*;
 
 /// Total real contact area (m²) at zero shear, averaged over `seeds` realizations.

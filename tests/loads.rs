@@ -2,7 +2,7 @@
 //! loaded face (an independent computation: Gauss–Legendre over the rapid point series).
 
 use crate::common::{rel, rule};
-use precursors::green::loads::{top_influence, top_stress_influence};
+use precursors::green::{top_influence, top_stress_influence};
 use precursors::green::{GreenFunction, RodLoad};
 use precursors::{Block, Grid, Point};
 

@@ -7,7 +7,7 @@
 //! goes) and by reading the SVG's text.
 
 use precursors::output::{RunTables, CONTACT_MAP_STEP};
-use precursors::plot::figures::{draw, Format};
+use precursors::plot::{draw, Format};
 use precursors::plot::{Chart, Corner, Map, Palette, PlotError, Style};
 use precursors::{Drive, Error, Event, Lateral, Scene};
 use std::path::{Path, PathBuf};

@@ -8,8 +8,8 @@
 
 use crate::common::rule;
 use precursors::green::{InfluencePlan, RodLoad};
-use precursors::probe::{ProbeInput, ProbeSpec, StressProbe};
 use precursors::*;
+use precursors::{ProbeInput, ProbeSpec, StressProbe};
 use rustdct::DctPlanner;
 
 /// 16 x 4 x 8 mm, 8 x 2 cells of 2 mm; rod band [2, 4] mm.

@@ -17,8 +17,9 @@
 
 use crate::common::rule;
 use precursors::green::{GreenFunction, InfluencePlan, RodLoad};
-use precursors::probe::{ProbeInput, ProbeSpec, StressProbe};
+use precursors::solver::{Backend, EquilibriumSolver, SolverOptions};
 use precursors::*;
+use precursors::{ProbeInput, ProbeSpec, StressProbe};
 use proptest::prelude::*;
 use std::f64::consts::PI;
 

@@ -6,6 +6,7 @@
 //! fail with a guard of the code under test removed (the commit message lists them).
 
 use precursors::green::InfluencePlan;
+use precursors::solver::SolverOptions;
 use precursors::*;
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
@@ -403,7 +404,7 @@ mod file {
                 },
             })
             .probes(
-                precursors::probe::ProbeSpec::default()
+                precursors::ProbeSpec::default()
                     .with_plane(1e-3)
                     .with_point(Point::new(0.01, 0.002, 0.002)),
             )

@@ -3,6 +3,7 @@
 //! calibration scene's, mistakes are typed errors, and the documented examples and the
 //! files in `examples/scenes/` stay valid.
 
+use precursors::solver::{Backend, Parallelism, SolverOptions};
 use precursors::*;
 use std::path::{Path, PathBuf};
 
@@ -47,7 +48,7 @@ fn everything() -> SceneBuilder {
         .solver_options(solver)
         .plan_tolerance(1e-7)
         .probes(
-            probe::ProbeSpec::default()
+            ProbeSpec::default()
                 .with_plane(2e-3)
                 .with_plane(0.0)
                 .with_point(Point::new(0.01, 0.003, 0.001))
@@ -592,8 +593,7 @@ fn files_too_large_for_memory_are_refused_before_reading() {
         let run = dir.join("run");
         std::fs::create_dir_all(&run).unwrap();
         std::fs::rename(huge("curve.csv"), run.join("curve.csv")).unwrap();
-        let e = precursors::plot::figures::draw(&run, &[precursors::plot::figures::Format::Png])
-            .unwrap_err();
+        let e = precursors::plot::draw(&run, &[precursors::plot::Format::Png]).unwrap_err();
         assert!(
             matches!(
                 e,

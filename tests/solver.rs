@@ -5,6 +5,7 @@
 
 use crate::common::{bordered_solve, compliance_matrix, max_rel_diff, scene};
 use precursors::green::RodLoad;
+use precursors::solver::{Backend, EquilibriumSolver, NormalEquilibrium, SolverOptions};
 use precursors::*;
 
 fn solver(plan: &green::InfluencePlan, backend: Backend) -> EquilibriumSolver {

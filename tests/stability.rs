@@ -6,6 +6,7 @@
 
 use crate::common::compliance_matrix;
 use precursors::green::InfluencePlan;
+use precursors::solver::{Backend, EquilibriumSolver, SolverOptions};
 use precursors::*;
 
 struct Case {

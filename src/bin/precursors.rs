@@ -13,7 +13,7 @@ use clap::{Parser, Subcommand};
 #[path = "../format.rs"]
 mod format;
 use format::{format_bytes, format_seconds};
-use precursors::output::{counts, RunTables};
+use precursors::output::RunTables;
 use precursors::plot::PlotError;
 use precursors::sweep::{Sweep, SweepError, SweepOptions};
 use precursors::{Checkpoint, Driver, Error, GridCost, SceneBuilder};
@@ -480,7 +480,7 @@ fn run(
     let first_event = driver.event_count();
     let mut bar = Progress::new(progress);
     let line = |driver: &Driver, elapsed: f64| {
-        let (broken, _) = counts(driver.site_states());
+        let broken = driver.interface().broken_count();
         let x = driver.force() / mu_fn;
         let done = (driver.event_count() - first_event) as f64;
         format!(
@@ -657,7 +657,7 @@ fn run_sweep(
 }
 
 fn plot(dir: &Path, format: FormatArg) -> Result<(), Failure> {
-    use precursors::plot::figures::{draw, Format};
+    use precursors::plot::{draw, Format};
     let formats: &[Format] = match format {
         FormatArg::Png => &[Format::Png],
         FormatArg::Svg => &[Format::Svg],

@@ -37,7 +37,7 @@ impl InfluencePlanBuilder {
     /// The plan tolerance: the largest relative error accepted on an eigenvalue
     /// (dimensionless, default `1e-8`; the scene's [`crate::SceneBuilder::plan_tolerance`],
     /// scene-file key `plan_tolerance`; the solver's linear tolerance is another,
-    /// [`crate::SolverOptions::tolerance`]). The eigenvalues are computed to about 1e-13
+    /// [`crate::solver::SolverOptions::tolerance`]). The eigenvalues are computed to about 1e-13
     /// whatever it is (same cost); the build fails with [`Error::SeriesNotConverged`] when an
     /// eigenvalue's error estimate exceeds it, which happens for tolerances below about
     /// `2e-13`.
@@ -48,7 +48,7 @@ impl InfluencePlanBuilder {
 
     /// The most cells [`InfluencePlanBuilder::build`] accepts (default
     /// [`DEFAULT_MAX_CELLS`](super::DEFAULT_MAX_CELLS) = `1e6`): a larger grid is refused
-    /// with [`Error::GridTooLarge`] and its estimated cost ([`GridCost`](super::GridCost))
+    /// with [`Error::GridTooLarge`] and its estimated cost ([`GridCost`](crate::GridCost))
     /// before anything is allocated. Raise it for a grid whose cost you accept.
     pub fn max_cells(mut self, max_cells: usize) -> Self {
         self.max_cells = max_cells;

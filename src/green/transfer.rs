@@ -147,7 +147,7 @@ impl PlaneTransfer {
 
     /// Cell-averaged stress on the plane (Pa) due to the bottom tractions `traction` (Pa):
     /// `σ(z) = -T(z) φ`, so that `σ_xz` follows from `φ_x` and `σ_zz` from `φ_z`; at
-    /// `z = 0` it is `-φ`. External load terms are not included (see [`crate::green::loads`]).
+    /// `z = 0` it is `-φ`. External load terms are not included (see [`crate::green::top_stress_influence`] and [`crate::green::RodLoad`]).
     ///
     /// # Errors
     /// [`Error::LengthMismatch`] when `traction` or `out` does not hold one value per cell;

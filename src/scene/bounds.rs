@@ -506,7 +506,7 @@ pub(super) fn memory_bytes(builder: &SceneBuilder, grid: &Grid) -> f64 {
     };
     // An explicit dense backend above the size `Auto` solves densely (GridCost's own).
     let dense = match builder.solver.backend() {
-        crate::Backend::Dense if grid.len() > crate::solver::AUTO_DENSE_LIMIT => {
+        crate::solver::Backend::Dense if grid.len() > crate::solver::AUTO_DENSE_LIMIT => {
             crate::green::dense_bytes(n)
         }
         _ => 0.0,

@@ -106,7 +106,7 @@ impl SolverOptions {
     /// [`Parallelism::Threads`]`(n > 1)` is refused ([`Error::DenseThreads`]: use the
     /// spectral backend for threads), while [`Backend::Auto`], which picks the dense
     /// backend up to [`AUTO_DENSE_LIMIT`] cells, accepts any parallelism and runs such
-    /// small grids on the calling thread ([`crate::EquilibriumSolver::threads`] and
+    /// small grids on the calling thread ([`crate::solver::EquilibriumSolver::threads`] and
     /// [`crate::Driver::threads`] tell the threads actually used). To run several scenes
     /// at once (seeds), give each [`Parallelism::Sequential`] and one scene per core.
     pub fn parallelism(&self) -> Parallelism {

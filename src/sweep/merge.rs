@@ -32,7 +32,7 @@ pub struct MergeSummary {
 /// half-width of a two-sided 95 % band is `t · s/√n`, `df = n - 1`): tabulated for
 /// `df <= 30`, above by the Cornish-Fisher expansion `z + (z³ + z)/(4 df)` (error below
 /// 3e-3); `NaN` for `df = 0`.
-pub fn t_quantile_975(df: usize) -> f64 {
+pub(crate) fn t_quantile_975(df: usize) -> f64 {
     const TABLE: [f64; 30] = [
         12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
         2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
@@ -260,7 +260,8 @@ pub(crate) fn ensemble_curves(dir: &Path, grid: &[f64]) -> Result<Vec<EnsembleCu
 ///   over the realizations, each taking the value of its last stable state at or below
 ///   the load (a realization with none yet is left out; `runs` counts those in). `A_R(0)`
 ///   is the real contact area of the run's first stable state (zero shear). The band is
-///   Student's t: `mean ± t(0.975, n-1)·s/√n` ([`t_quantile_975`]), empty below two runs;
+///   Student's t: `mean ± t(0.975, n-1)·s/√n` (the tabulated quantile up to 30 degrees
+///   of freedom), empty below two runs;
 /// * `slip.csv`: the global-slip load `F/(μF_N)` and the load of the last stable state
 ///   before it: mean, band, min, max of each;
 /// * `avalanches.csv`: the distribution of the ruptures per stable state (avalanche
@@ -401,4 +402,21 @@ pub fn merge(dir: &Path) -> Result<MergeSummary, SweepError> {
         runs_missing: missing,
         files,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::t_quantile_975;
+
+    /// Against the table of Student's t (two-sided 95 %; e.g. NIST/SEMATECH e-Handbook,
+    /// table 1.3.6.7.2) and the normal quantile 1.95996 for large samples.
+    #[test]
+    fn student_t_quantiles_match_the_table() {
+        assert_eq!(t_quantile_975(1), 12.706);
+        assert_eq!(t_quantile_975(9), 2.262);
+        assert_eq!(t_quantile_975(30), 2.042);
+        assert!((t_quantile_975(60) - 2.000).abs() < 3e-3);
+        assert!((t_quantile_975(1_000_000) - 1.95996).abs() < 1e-4);
+        assert!(t_quantile_975(0).is_nan());
+    }
 }
