@@ -810,7 +810,7 @@ pub(crate) fn object_at(path: &str) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::ProbeSpec;
+    use crate::probe::ProbeSpec;
     use crate::scene::{Drive, ForceLoad, HeightSource, Lateral};
     use crate::solver::{Parallelism, SolverOptions};
 
@@ -916,6 +916,153 @@ mod tests {
             "block.x",
         ] {
             assert!(!object_at(path), "{path}");
+        }
+    }
+
+    /// The flattened keys of a JSON object (dotted paths to its non-object values).
+    #[cfg(feature = "serde")]
+    fn flattened(value: &serde_json::Value, path: &str, out: &mut Vec<String>) {
+        match value.as_object() {
+            Some(map) => {
+                for (k, v) in map {
+                    flattened(v, &crate::scene::schema::join(path, k), out);
+                }
+            }
+            None => out.push(path.to_string()),
+        }
+    }
+
+    /// The checkpoint's identity of the default scene, written out by hand from
+    /// docs/scene-format.md: checkpoints of earlier versions hold a digest of exactly
+    /// these keys and values.
+    #[test]
+    fn the_identity_of_the_default_scene_is_pinned() {
+        let expected = [
+            ("block.lx", "0.14"),
+            ("block.ly", "0.007"),
+            ("block.lz", "0.075"),
+            ("cells.kind", "size"),
+            ("cells.dx", "0.001"),
+            ("cells.dy", "0.001"),
+            ("material.young_modulus", "3833000000.0"),
+            ("material.poisson_ratio", "0.38"),
+            ("material.friction_coefficient", "0.5"),
+            ("springs.c_x", "1650000000000.0"),
+            ("springs.c_z", "165000000.0"),
+            ("springs.area_law", "paper"),
+            ("heights.kind", "gaussian"),
+            ("heights.mean", "1e-6"),
+            ("heights.std_dev", "1e-6"),
+            ("heights.seed", "0"),
+            ("normal_load", "3500.0"),
+            ("drive.kind", "rod"),
+            ("drive.height", "0.006"),
+            ("drive.half_width", "0.002"),
+            ("solver.backend", "auto"),
+            ("solver.tolerance", "1e-13"),
+            ("solver.max_active_set_iterations", "1000"),
+            ("solver.max_linear_iterations", "20000"),
+            ("plan_tolerance", "1e-8"),
+        ];
+        let identity = identity(&SceneBuilder::default());
+        let identity: Vec<(&str, &str)> = identity
+            .iter()
+            .map(|(k, v)| (k.as_str(), v.as_str()))
+            .collect();
+        assert_eq!(identity, expected);
+    }
+
+    /// A scene file -> scene -> checkpoint: the checkpoint's scene has the file's
+    /// identity, and the identity's keys are the file's keys but the observers.
+    #[cfg(feature = "serde")]
+    #[test]
+    fn a_scene_file_its_checkpoint_and_its_identity_have_one_key_set() {
+        let text = r#"{ "block": { "lx": 0.012, "ly": 0.002, "lz": 0.010 },
+                        "cells": { "kind": "count", "nx": 12, "ny": 2 },
+                        "normal_load": 50.0,
+                        "drive": { "kind": "spring", "stiffness": 4e6,
+                                   "lateral": { "kind": "rod", "height": 0.003, "half_width": 0.001 } },
+                        "solver": { "threads": 2 },
+                        "probes": { "planes": [0.001] } }"#;
+        let builder = SceneBuilder::from_json_str(text).unwrap();
+        let scene = builder.clone().build().unwrap();
+        let mut driver = scene.driver().unwrap();
+        driver.step().unwrap();
+        let checkpoint = driver.checkpoint();
+        assert_eq!(identity(checkpoint.scene()), identity(&builder));
+        let mut keys = Vec::new();
+        flattened(
+            &serde_json::from_str(&builder.to_json().unwrap()).unwrap(),
+            "",
+            &mut keys,
+        );
+        keys.retain(|k| !observes(k));
+        keys.sort();
+        let mut from_identity: Vec<String> =
+            identity(&builder).into_iter().map(|(k, _)| k).collect();
+        from_identity.sort();
+        assert_eq!(keys, from_identity);
+        for key in ["drive.lateral.height", "cells.nx", "drive.stiffness"] {
+            assert!(keys.iter().any(|k| k == key), "{key}");
+        }
+    }
+
+    /// Every key a sweep can set (every key of the file) round-trips through the schema:
+    /// set to its own value it changes nothing; set to another value it changes that key
+    /// alone.
+    #[cfg(feature = "serde")]
+    #[test]
+    fn every_key_a_sweep_can_set_round_trips() {
+        for scene in scenes() {
+            let file = SceneFile::from(&scene);
+            let json = file.to_value().unwrap();
+            let before = all_keys(&scene);
+            for (key, exact) in &before {
+                // A key the file leaves out at its default (`max_cells`): its exact value.
+                let written = key.split('.').fold(&json, |v, k| &v[k]);
+                let parsed;
+                let value = if written.is_null() {
+                    parsed = serde_json::from_str::<serde_json::Value>(exact).unwrap();
+                    &parsed
+                } else {
+                    written
+                };
+                let mut same = file.clone();
+                same.set(key, value)
+                    .unwrap_or_else(|e| panic!("{key}: {e}"));
+                assert_eq!(same, file, "{key}");
+                let other = match value {
+                    serde_json::Value::Number(n) if n.is_f64() => {
+                        serde_json::json!(n.as_f64().unwrap() * 3.0 + 1.0)
+                    }
+                    serde_json::Value::Number(n) => serde_json::json!(n.as_u64().unwrap() + 1),
+                    _ => continue,
+                };
+                let mut changed = file.clone();
+                changed.set(key, &other).unwrap();
+                let after = all_keys(&changed.to_builder().unwrap());
+                let differing: Vec<&str> = before
+                    .iter()
+                    .zip(&after)
+                    .filter(|(a, b)| a != b)
+                    .map(|(a, _)| a.0.as_str())
+                    .collect();
+                assert_eq!(differing, [key.as_str()], "{key}");
+            }
+            // Not keys of the scene: typed errors naming the place.
+            let mut f = file.clone();
+            assert!(matches!(
+                f.set("block.lxx", &serde_json::json!(1.0)),
+                Err(KeyError::NotAKey { .. })
+            ));
+            assert!(matches!(
+                f.set("normal_load.x", &serde_json::json!(1.0)),
+                Err(KeyError::NotAnObject { .. })
+            ));
+            assert!(matches!(
+                f.set("normal_load", &serde_json::json!("heavy")),
+                Err(KeyError::Value(_))
+            ));
         }
     }
 }

@@ -282,29 +282,8 @@ pub(crate) fn ensemble_curves(dir: &Path, grid: &[f64]) -> Result<Vec<EnsembleCu
 /// [`Error::NonFiniteCell`] for a `NaN`, an infinity or an empty cell where a number
 /// belongs in one (with the file, line and column).
 pub fn merge(dir: &Path) -> Result<MergeSummary, SweepError> {
-    let sweep_path = dir.join(SWEEP_FILE);
-    if !sweep_path.is_file() {
-        return Err(SweepError::Directory {
-            path: dir.to_path_buf(),
-            reason: format!("no {SWEEP_FILE}: not the output directory of a sweep"),
-        });
-    }
-    let sweep = Sweep::from_json_file(&sweep_path)?;
-    let keys: Vec<String> = sweep.keys().iter().map(|k| cell(k)).collect();
-    let key_header = keys.iter().map(|k| format!("{k},")).collect::<String>();
-    let mut curves = format!(
-        "point,{key_header}force_over_mu_FN,runs,precursor_over_Lx_mean,precursor_over_Lx_lo,\
-         precursor_over_Lx_hi,area_ratio_mean,area_ratio_lo,area_ratio_hi\n"
-    );
-    let mut slips = format!(
-        "point,{key_header}runs,slip_over_mu_FN_mean,slip_over_mu_FN_lo,slip_over_mu_FN_hi,\
-         slip_over_mu_FN_min,slip_over_mu_FN_max,last_stable_over_mu_FN_mean,\
-         last_stable_over_mu_FN_lo,last_stable_over_mu_FN_hi,last_stable_over_mu_FN_min,\
-         last_stable_over_mu_FN_max\n"
-    );
-    let mut avalanches = format!("point,{key_header}ruptures,count,fraction\n");
-    let mut runs_csv =
-        format!("run,point,realization,seed,{key_header}stable_states,slip_over_mu_FN\n");
+    let sweep = read_sweep(dir)?;
+    let mut tables = Tables::new(&sweep.keys());
     let (mut merged, mut missing) = (0, 0);
     for point in 0..sweep.points() {
         let runs: Vec<&SweepRun> = sweep.runs().iter().filter(|r| r.point == point).collect();
@@ -314,35 +293,101 @@ pub fn merge(dir: &Path) -> Result<MergeSummary, SweepError> {
             .iter()
             .map(|(_, v)| format!("{},", cell(v)))
             .collect();
+        let data = tables.read_runs(dir, &runs, &values)?;
+        merged += data.len();
+        missing += runs.len() - data.len();
+        tables.add_point(point, &values, &data);
+    }
+    Ok(MergeSummary {
+        points: sweep.points(),
+        runs_merged: merged,
+        runs_missing: missing,
+        files: tables.write(dir)?,
+    })
+}
+
+/// The sweep of the output directory `dir` (its copy [`SWEEP_FILE`]).
+///
+/// # Errors
+/// [`SweepError::Directory`] when `dir` holds no `sweep.json`; its errors as a sweep file.
+fn read_sweep(dir: &Path) -> Result<Sweep, SweepError> {
+    let sweep_path = dir.join(SWEEP_FILE);
+    if !sweep_path.is_file() {
+        return Err(SweepError::Directory {
+            path: dir.to_path_buf(),
+            reason: format!("no {SWEEP_FILE}: not the output directory of a sweep"),
+        });
+    }
+    Sweep::from_json_file(&sweep_path)
+}
+
+/// The text of the four merged tables, row by row.
+struct Tables {
+    curves: String,
+    slips: String,
+    avalanches: String,
+    runs: String,
+}
+
+impl Tables {
+    /// The tables with their headers (the axes' `keys` as columns).
+    fn new(keys: &[&str]) -> Tables {
+        let key_header = keys
+            .iter()
+            .map(|k| format!("{},", cell(k)))
+            .collect::<String>();
+        Tables {
+            curves: format!(
+                "point,{key_header}force_over_mu_FN,runs,precursor_over_Lx_mean,\
+                 precursor_over_Lx_lo,precursor_over_Lx_hi,area_ratio_mean,area_ratio_lo,\
+                 area_ratio_hi\n"
+            ),
+            slips: format!(
+                "point,{key_header}runs,slip_over_mu_FN_mean,slip_over_mu_FN_lo,\
+                 slip_over_mu_FN_hi,slip_over_mu_FN_min,slip_over_mu_FN_max,\
+                 last_stable_over_mu_FN_mean,last_stable_over_mu_FN_lo,\
+                 last_stable_over_mu_FN_hi,last_stable_over_mu_FN_min,\
+                 last_stable_over_mu_FN_max\n"
+            ),
+            avalanches: format!("point,{key_header}ruptures,count,fraction\n"),
+            runs: format!("run,point,realization,seed,{key_header}stable_states,slip_over_mu_FN\n"),
+        }
+    }
+
+    /// The data of the complete runs of one point (`values`: its axes' cells), each run's
+    /// row of `runs.csv` written (empty counts for a run not complete).
+    fn read_runs(&mut self, dir: &Path, runs: &[&SweepRun], values: &str) -> Result<Vec<RunData>> {
         let mut data = Vec::new();
-        for run in &runs {
+        for run in runs {
             let run_dir = dir.join(&run.dir_name);
+            let (point, realization, seed) = (run.point, run.realization, run.seed);
             if !run_dir.join(DONE_FILE).is_file() {
-                missing += 1;
                 let _ = writeln!(
-                    runs_csv,
-                    "{},{point},{},{},{values},,",
-                    run.index, run.realization, run.seed
+                    self.runs,
+                    "{},{point},{realization},{seed},{values},,",
+                    run.index
                 );
                 continue;
             }
             let d = read_run(&run_dir, run)?;
             let _ = writeln!(
-                runs_csv,
-                "{},{point},{},{},{values}{},{}",
+                self.runs,
+                "{},{point},{realization},{seed},{values}{},{}",
                 run.index,
-                run.realization,
-                run.seed,
                 d.curve.len(),
                 d.slip.map(num).unwrap_or_default()
             );
             data.push(d);
-            merged += 1;
         }
+        Ok(data)
+    }
+
+    /// The rows of one point in `curves.csv`, `slip.csv` and `avalanches.csv`.
+    fn add_point(&mut self, point: usize, values: &str, data: &[RunData]) {
         for &f in &LOAD_GRID {
-            let (runs, (em, el, eh), (am, al, ah)) = bands_at(&data, f);
+            let (runs, (em, el, eh), (am, al, ah)) = bands_at(data, f);
             let _ = writeln!(
-                curves,
+                self.curves,
                 "{point},{values}{f:.2},{runs},{},{},{},{},{},{}",
                 num(em),
                 num(el),
@@ -358,7 +403,7 @@ pub fn merge(dir: &Path) -> Result<MergeSummary, SweepError> {
             .filter_map(|d| d.curve.last().map(|c| c.0))
             .collect();
         let _ = writeln!(
-            slips,
+            self.slips,
             "{point},{values}{},{},{}",
             s.len(),
             stats(&s),
@@ -377,31 +422,30 @@ pub fn merge(dir: &Path) -> Result<MergeSummary, SweepError> {
         }
         for (size, count) in counts {
             let _ = writeln!(
-                avalanches,
+                self.avalanches,
                 "{point},{values}{size},{count},{}",
                 num(count as f64 / sizes.len() as f64)
             );
         }
     }
-    let mut files = Vec::new();
-    for (name, text) in [
-        ("curves.csv", curves),
-        ("slip.csv", slips),
-        ("avalanches.csv", avalanches),
-        ("runs.csv", runs_csv),
-    ] {
-        // Atomically: a full disk or a kill leaves the old table or the new one, never an
-        // empty or half one that looks complete.
-        let path = dir.join(name);
-        write_atomically(&path, text.as_bytes(), "writing")?;
-        files.push(path);
+
+    /// Writes the four tables into `dir`; returns their paths.
+    fn write(self, dir: &Path) -> Result<Vec<PathBuf>> {
+        let mut files = Vec::new();
+        for (name, text) in [
+            ("curves.csv", self.curves),
+            ("slip.csv", self.slips),
+            ("avalanches.csv", self.avalanches),
+            ("runs.csv", self.runs),
+        ] {
+            // Atomically: a full disk or a kill leaves the old table or the new one, never
+            // an empty or half one that looks complete.
+            let path = dir.join(name);
+            write_atomically(&path, text.as_bytes(), "writing")?;
+            files.push(path);
+        }
+        Ok(files)
     }
-    Ok(MergeSummary {
-        points: sweep.points(),
-        runs_merged: merged,
-        runs_missing: missing,
-        files,
-    })
 }
 
 #[cfg(test)]
