@@ -138,6 +138,24 @@ impl FitOptions {
 }
 
 /// A fitted constant.
+///
+/// ```
+/// use precursors::calibration::{fit_normal_stiffness, FitOptions};
+/// use precursors::{Error, Scene};
+/// // 10 x 4 mm of the paper's PMMA under 100 N, one realization of the heights.
+/// let base = Scene::builder().block(0.010, 0.004, 0.010).normal_load(100.0).seed(3);
+/// let options = FitOptions::default().with_tolerance(1e-6)?;
+/// // c_z (N/m²) such that A_R = 12 mm² at zero shear (the paper's α F_N).
+/// let target = 12e-6;                                            // m²
+/// let fit = fit_normal_stiffness(&base, target, (1e6, 1e11), &options)?;
+/// assert!(fit.value > 1e6 && fit.value < 1e11);                  // N/m²
+/// assert!(fit.misfit.abs() < 1e-6 * target);                     // area - target (m²)
+/// assert!(fit.evaluations <= options.max_evaluations());
+/// // A bracket whose ends give areas on the same side of the target is refused.
+/// let e = fit_normal_stiffness(&base, target, (1e10, 1e11), &options).unwrap_err();
+/// assert!(matches!(e, Error::InvalidParameter { .. }));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct Fit {

@@ -34,6 +34,24 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 ///
 /// `Error` is neither `Clone` nor `PartialEq`, as the `std::io::Error` it keeps: match on
 /// the variant, e.g. `matches!(e, Error::GridDoesNotDivide { axis: "x", .. })`.
+///
+/// ```
+/// use precursors::{Block, Error, Grid};
+/// // A negative block length (m) is refused with its name and value.
+/// let e = Block::new(0.14, -0.007, 0.075).unwrap_err();
+/// match &e {
+///     Error::InvalidLength { name, value } => assert_eq!((*name, *value), ("Ly", -0.007)),
+///     other => panic!("another error: {other}"),
+/// }
+/// assert!(e.to_string().starts_with("Ly = -0.007 m is invalid"));
+/// // 4 mm cells do not divide Lx = 140 mm into whole cells: 35 do, 140 / 3 does not.
+/// let block = Block::new(0.14, 0.007, 0.075)?;
+/// assert!(Grid::from_cell_size(block, 4e-3, 1e-3).is_ok());
+/// let e = Grid::from_cell_size(block, 3e-3, 1e-3).unwrap_err();
+/// let Error::GridDoesNotDivide { axis, ratio, .. } = &e else { panic!("another error: {e}") };
+/// assert!(*axis == "x" && (ratio - 140.0 / 3.0).abs() < 1e-9);  // Lx / Δx = 46.67 cells
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum Error {

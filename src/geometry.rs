@@ -3,6 +3,17 @@
 use crate::error::{check_length, Error, Result};
 
 /// The elastic block: lengths in metres, bottom face at `z = 0`.
+///
+/// ```
+/// use precursors::{Block, Error};
+/// let block = Block::new(0.14, 0.007, 0.075)?;       // the paper's PMMA block: 140 x 7 x 75 mm
+/// assert_eq!(block.lengths(), [0.14, 0.007, 0.075]);
+/// assert!((block.volume() / 7.35e-5 - 1.0).abs() < 1e-12);   // Lx Ly Lz (m³)
+/// // A side must be finite and > 0.
+/// let e = Block::new(-0.01, 0.007, 0.075).unwrap_err();
+/// assert!(matches!(e, Error::InvalidLength { name: "Lx", value } if value == -0.01));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Block {
     lx: f64,
@@ -80,6 +91,24 @@ impl Block {
 }
 
 /// A point `(x, y, z)` of the block (m).
+///
+/// The points at which [`GreenFunction`](crate::green::GreenFunction) is evaluated:
+///
+/// ```
+/// use precursors::{green::GreenFunction, Block, Error, Point};
+/// let green = GreenFunction::new(Block::new(0.010, 0.004, 0.005)?); // 10 x 4 x 5 mm
+/// let target = Point::new(2e-3, 1e-3, 0.0);           // on the bottom face (m)
+/// let source = Point { z: 3e-3, ..target };            // 3 mm above it
+/// assert_eq!((source.x, source.y, source.z), (2e-3, 1e-3, 3e-3));
+/// // G is symmetric in target and source (m⁻¹).
+/// let (g, h) = (green.value(target, source, 1e-8)?, green.value(source, target, 1e-8)?);
+/// assert!((g.value - h.value).abs() < 1e-7);
+/// // A point beyond Lx = 10 mm lies outside the block.
+/// let outside = Point::new(0.012, 1e-3, 0.0);
+/// let e = green.value(outside, source, 1e-8).unwrap_err();
+/// assert!(matches!(e, Error::OutsideBlock { name: "x", .. }));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Point {
     /// x (m).
@@ -104,6 +133,23 @@ impl Point {
 ///
 /// Cell `(ix, iy)` has centre `((ix + 1/2) Δx, (iy + 1/2) Δy)` and flat index
 /// `i = iy * Nx + ix` (the paper's order, Eq. `ij`, counted from 0).
+///
+/// ```
+/// use precursors::{Block, Error, Grid};
+/// let block = Block::new(0.010, 0.004, 0.005)?;          // 10 x 4 x 5 mm
+/// let grid = Grid::from_cell_size(block, 1e-3, 1e-3)?;    // 1 mm cells
+/// assert_eq!((grid.nx(), grid.ny(), grid.len()), (10, 4, 40));
+/// assert!((grid.cell_area() / 1e-6 - 1.0).abs() < 1e-12); // ΔA = 1 mm² (m²)
+/// assert_eq!(grid.index(3, 2), Some(2 * 10 + 3));         // i = iy·Nx + ix
+/// let (x, y) = grid.centre(3, 2).unwrap();                // ((ix + ½)Δx, (iy + ½)Δy) (m)
+/// assert!((x - 3.5e-3).abs() < 1e-15 && (y - 2.5e-3).abs() < 1e-15);
+/// assert_eq!(grid.index(10, 0), None);                    // past the end of row 0
+/// // 3 mm cells do not divide Lx = 10 mm.
+/// let e = Grid::from_cell_size(block, 3e-3, 1e-3).unwrap_err();
+/// assert!(matches!(e, Error::GridDoesNotDivide { axis: "x", .. }));
+/// assert_eq!(Grid::new(block, 10, 4)?, grid);             // the same grid by counts
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Grid {
     block: Block,

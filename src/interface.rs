@@ -146,6 +146,24 @@ impl Material {
 
 /// The real contact area of an attached site (docs/model.md section 3). It enters the
 /// outputs only (total area, precursor length), never the equilibria or the events.
+///
+/// ```
+/// use precursors::{AreaLaw, Block, Grid, Heights, Interface, SpringLaw};
+/// let grid = Grid::new(Block::new(0.002, 0.001, 0.005)?, 2, 1)?;   // two 1 mm² cells
+/// let heights = Heights::from_values(&grid, vec![1e-6; 2])?;        // u0 = 1 µm
+/// let u_z = [-0.5e-6, 0.5e-6];       // the first cell pressed 0.5 µm below the mean plane (m)
+/// let paper = Interface::new(grid, heights.clone(), SpringLaw::default())?;
+/// let law = SpringLaw::default().with_area_law(AreaLaw::Capped);
+/// let capped = Interface::new(grid, heights, law)?;
+/// let (a, b) = (paper.cell_contact_area(&u_z)?, capped.cell_contact_area(&u_z)?);
+/// let cell = grid.cell_area();                                      // ΔA = 1e-6 m²
+/// // Paper: ΔA/(e-1) [e^1.5 - 1] ≈ 2.026 ΔA, more than the cell; capped at ΔA.
+/// assert!((a[0] / cell - 2.0263).abs() < 1e-4 && b[0] == cell);
+/// // Below ΔA the laws agree: ΔA/(e-1) [e^0.5 - 1] ≈ 0.378 ΔA.
+/// assert!(a[1] == b[1] && (a[1] / cell - 0.3775).abs() < 1e-4);
+/// assert_eq!(AreaLaw::default(), AreaLaw::Paper);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
@@ -368,6 +386,27 @@ const MIN_MEAN_OVER_SD: f64 = -3.0;
 
 /// Rest heights `u0_i > 0` (m) of the springs, one per cell in the paper's order
 /// `i = iy * Nx + ix`.
+///
+/// ```
+/// use precursors::{Block, Error, Grid, HeightDistribution, Heights};
+/// let grid = Grid::new(Block::new(0.010, 0.004, 0.005)?, 10, 4)?;   // 40 cells
+/// // The paper's substrate: a Gaussian of mean 1 µm and standard deviation 1 µm cut at 0.
+/// let heights = Heights::truncated_gaussian(&grid, HeightDistribution::default(), 7)?;
+/// assert_eq!(heights.len(), 40);
+/// assert!(heights.values().iter().all(|&u0| u0 > 0.0));
+/// // The same seed gives the same heights.
+/// assert_eq!(heights, Heights::truncated_gaussian(&grid, HeightDistribution::default(), 7)?);
+/// // A measured topography: one height (m) per cell, each > 0.
+/// let flat = Heights::from_values(&grid, vec![1e-6; 40])?;
+/// assert_eq!(flat.values()[39], 1e-6);
+/// let e = Heights::from_values(&grid, vec![1e-6; 39]).unwrap_err();
+/// assert!(matches!(e, Error::LengthMismatch { expected: 40, found: 39, .. }));
+/// let mut dented = vec![1e-6; 40];
+/// dented[5] = 0.0;
+/// let e = Heights::from_values(&grid, dented).unwrap_err();
+/// assert!(matches!(e, Error::NonPositiveHeight { index: 5, .. }));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Heights {
     values: Vec<f64>,
@@ -494,6 +533,23 @@ fn check_heights(values: &[f64]) -> Result<()> {
 }
 
 /// State of one interfacial spring.
+///
+/// ```
+/// use precursors::{Block, Error, Grid, Heights, Interface, SiteState, SpringLaw};
+/// use SiteState::{Attached, Broken, Detached};
+/// let grid = Grid::new(Block::new(0.003, 0.001, 0.005)?, 3, 1)?;   // three 1 mm cells
+/// let heights = Heights::from_values(&grid, vec![1e-6; 3])?;        // u0 = 1 µm
+/// let mut interface = Interface::new(grid, heights, SpringLaw::default())?;
+/// interface.set_states(&[Attached, Detached, Attached])?;           // e.g. a normal solve's
+/// interface.break_site(2)?;                                         // Coulomb slip of site 2
+/// assert_eq!(interface.states(), &[Attached, Detached, Broken]);
+/// // Only attached sites resist shear: k_x = c_x e^{-u_z/u0} = c_x at u_z = 0 (N/m³).
+/// assert_eq!(interface.tangential_stiffness(&[0.0; 3])?, vec![1.65e12, 0.0, 0.0]);
+/// // A broken site never re-attaches (only `heal` starts a fresh contact).
+/// let e = interface.set_states(&[Attached; 3]).unwrap_err();
+/// assert!(matches!(e, Error::BrokenSite { index: 2 }));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
@@ -507,6 +563,28 @@ pub enum SiteState {
 }
 
 /// The springs of the bottom face: heights, law and the state of every site.
+///
+/// ```
+/// use precursors::{Block, Grid, Heights, Interface, SpringLaw};
+/// let grid = Grid::new(Block::new(0.004, 0.002, 0.005)?, 4, 2)?;   // eight 1 mm² cells
+/// let heights = Heights::from_values(&grid, [1e-6, 2e-6].repeat(4))?; // u0 (m)
+/// let mut interface = Interface::new(grid, heights, SpringLaw::default())?;
+/// assert_eq!(interface.attached_count(), 8);                        // all attached at first
+/// // k_z = c_z / u0 (N/m³) with the paper's c_z = 1.65e8 N/m².
+/// let k_z = interface.normal_stiffness();
+/// assert_eq!((k_z[0], k_z[1]), (1.65e8 / 1e-6, 1.65e8 / 2e-6));
+/// // At u_z = 0 each site touches over its whole cell: A_R,i = ΔA (m²).
+/// let area = interface.cell_contact_area(&[0.0; 8])?;
+/// assert!(area.iter().all(|a| (a / grid.cell_area() - 1.0).abs() < 1e-12));
+/// // The Coulomb rule: a site breaks at λ = μ φ_z / |φ_x(1 N)| (N).
+/// let loads = interface.breaking_loads(&[1e3; 8], &[10.0; 8], 0.5)?; // Pa, Pa/N, μ
+/// assert_eq!(loads[0], 50.0);
+/// interface.break_site(3)?;
+/// assert_eq!((interface.attached_count(), interface.broken_count()), (7, 1));
+/// interface.heal();                                                 // a fresh contact
+/// assert_eq!(interface.attached_count(), 8);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Interface {
     grid: Grid,

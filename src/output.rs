@@ -378,6 +378,29 @@ fn level_text(k: u64) -> String {
 
 /// The three tables of a run in a directory: `events.csv`, `curve.csv` and
 /// `contact_map.csv`, written as `NAME.partial` until [`RunTables::finish`].
+///
+/// ```
+/// use precursors::output::{RunTables, CURVE_HEADER};
+/// use precursors::Scene;
+/// let dir = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// // 10 x 4 cells of 1 mm under 100 N, driven by the paper's rod to global slip.
+/// let scene = Scene::builder().block(0.010, 0.004, 0.010).normal_load(100.0).build()?;
+/// let mut driver = scene.driver()?;
+/// let mut tables = RunTables::create(&dir, &driver)?;
+/// while let Some(event) = driver.step()? {
+///     tables.record(&driver, &event)?;
+/// }
+/// let stable_states = tables.stable_states();
+/// assert!(!tables.paths()[1].exists());           // only curve.csv.partial until finish
+/// let [events, curve, map] = tables.finish()?;
+/// let text = std::fs::read_to_string(&curve)?;
+/// assert_eq!(text.lines().next(), Some(CURVE_HEADER));
+/// assert_eq!(text.lines().count(), 1 + stable_states); // one row per stable state
+/// assert!(events.is_file() && map.is_file());
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug)]
 pub struct RunTables {
     events: BufWriter<File>,
@@ -684,6 +707,7 @@ impl RunTables {
     /// let scene = Scene::builder().block(0.012, 0.002, 0.010).normal_load(50.0).build()?;
     /// let mut driver = scene.driver()?;
     /// # let out = std::env::temp_dir().join(format!("precursors-doc-run-{}", std::process::id()));
+    /// # std::fs::create_dir_all(&out).unwrap();
     /// let tables = RunTables::create(&out, &driver)?;
     /// let mut ruptures = 0;
     /// let [events, _curve, _map] = tables.run_to_slip(&mut driver, None, |event, _| {

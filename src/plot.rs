@@ -69,6 +69,23 @@ trait Draw {
 }
 
 /// The corner of the plotting area that holds a chart's legend.
+///
+/// ```
+/// use precursors::plot::{Chart, Corner};
+/// let dir = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// // A curve falling from 1 to 0.5 leaves the lower left corner free.
+/// let area: Vec<_> = (0..=10).map(|k| (k as f64 / 10.0, 1.0 - k as f64 / 20.0)).collect();
+/// Chart::new("Real contact area", "F/(μF_N)", "A_R/A_R(0)")
+///     .line("seed 1", &area)
+///     .legend(Corner::LowerLeft)
+///     .save(dir.join("area.svg"))?;
+/// let svg = std::fs::read_to_string(dir.join("area.svg"))?;
+/// assert!(svg.contains("seed 1"));                         // the legend's entry
+/// assert_eq!(Corner::default(), Corner::UpperLeft);
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub enum Corner {
@@ -84,6 +101,27 @@ pub enum Corner {
 }
 
 /// How a chart colours its series.
+///
+/// ```
+/// use precursors::plot::{Chart, Colours};
+/// let dir = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// // The shear traction profile φ_x(x) (kPa) at three increasing loads: blue to red.
+/// let profile = |f: f64| -> Vec<(f64, f64)> {
+///     (0..=20).map(|k| (k as f64 / 20.0, f * (-4.0 * k as f64 / 20.0).exp())).collect()
+/// };
+/// Chart::new("Shear traction", "x/Lx", "φ_x (kPa)")
+///     .line("F = 10 N", &profile(1.0))
+///     .line("F = 20 N", &profile(2.0))
+///     .line("F = 30 N", &profile(3.0))
+///     .colours(Colours::Ordered)
+///     .save(dir.join("profiles.svg"))?;
+/// let svg = std::fs::read_to_string(dir.join("profiles.svg"))?;
+/// assert!(svg.contains("#2166AC") && svg.contains("#B2182B")); // first blue, last red
+/// assert_eq!(Colours::default(), Colours::Distinct);           // Tableau 10 in turn
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub enum Colours {
@@ -99,6 +137,30 @@ pub enum Colours {
 /// colouring ([`Colours`]), solid. A reference curve, say a zero line or a published
 /// value, is typically grey and dashed:
 /// `Style::new().colour(120, 120, 120).dashed()`.
+///
+/// ```
+/// use precursors::plot::{Chart, PlotError, Style};
+/// let dir = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// let ell = [(0.0, 0.0), (0.4, 0.1), (0.8, 0.5), (1.0, 1.0)];      // (F/(μF_N), ℓ/Lx)
+/// Chart::new("Precursor length", "F/(μF_N)", "ℓ/Lx")
+///     .steps("model", &ell)
+///     .line("slip at ℓ = Lx", &[(0.0, 1.0), (1.0, 1.0)])
+///     .style(Style::new().colour(120, 120, 120).dashed())           // grey, dashed
+///     .save(dir.join("length.svg"))?;
+/// let svg = std::fs::read_to_string(dir.join("length.svg"))?;
+/// // The reference is grey (#787878); the model keeps the first colour (#1F77B4).
+/// assert!(svg.contains("#787878") && svg.contains("#1F77B4"));
+/// // Dashes are for lines: dashed markers are refused.
+/// let e = Chart::new("Precursor length", "F/(μF_N)", "ℓ/Lx")
+///     .markers("model", &ell)
+///     .style(Style::new().dashed())
+///     .save(dir.join("refused.svg"))
+///     .unwrap_err();
+/// assert!(matches!(e, PlotError::Figure { .. }));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub struct Style {
@@ -128,6 +190,23 @@ impl Style {
 }
 
 /// The colour scale of a [`Map`].
+///
+/// ```
+/// use precursors::plot::{Map, Palette};
+/// let dir = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// // A signed shear stress τ (kPa) on 3 x 1 cells, centred on zero by the range.
+/// Map::new(3, 1, vec![-2.0, 0.0, 2.0])?
+///     .labels("Shear stress", "x (mm)", "y (mm)", "τ (kPa)")
+///     .x_range(0.0, 3.0)
+///     .colour_scale(Palette::Diverging, Some((-2.0, 2.0)))
+///     .save(dir.join("tau.svg"))?;
+/// let svg = std::fs::read_to_string(dir.join("tau.svg"))?;
+/// // Blue at -2 kPa, white at 0, red at +2 kPa.
+/// assert!(svg.contains("#2166AC") && svg.contains("#F7F7F7") && svg.contains("#B2182B"));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum Palette {
@@ -216,6 +295,30 @@ struct Series {
 /// A line chart: lines, staircases, markers and shaded bands over linear axes, with a
 /// title, axis labels (give the units in them, e.g. `"x (mm)"`), tick values and a legend
 /// of the labelled series.
+///
+/// ```
+/// use precursors::plot::{Chart, Corner};
+/// let dir = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// // ℓ/Lx at the stable states of a run (a staircase) with its 95 % band from a sweep.
+/// let ell = [(0.0, 0.0), (0.6, 0.1), (0.8, 0.3), (0.95, 0.7), (1.0, 1.0)];
+/// let band: Vec<_> = ell.iter().map(|&(f, l)| (f, l, 0.8 * l, 1.2 * l)).collect();
+/// Chart::new("Precursor length", "F/(μF_N)", "ℓ/Lx")
+///     .x_range(0.0, 1.0)
+///     .y_range(0.0, 1.2)
+///     .size(640, 480)
+///     .band("mean over seeds, 95 %", &band)
+///     .steps("seed 1", &ell)
+///     .legend(Corner::UpperLeft)
+///     .save(dir.join("precursors.png"))?;
+/// let png = std::fs::read(dir.join("precursors.png"))?;
+/// assert_eq!(&png[1..4], b"PNG");                              // PNG, 640 x 480 pixels
+/// let width = u32::from_be_bytes([png[16], png[17], png[18], png[19]]);
+/// let height = u32::from_be_bytes([png[20], png[21], png[22], png[23]]);
+/// assert_eq!((width, height), (640, 480));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct Chart {
     title: String,
@@ -497,6 +600,28 @@ impl Draw for ChartDrawing<'_> {
 
 /// A map of values on a regular grid of cells over `[x0, x1] x [y0, y1]`, with a colour
 /// bar labelled with the quantity and its unit.
+///
+/// ```
+/// use precursors::plot::{Map, Palette, PlotError};
+/// use precursors::Error;
+/// let dir = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// // Real contact area per cell (µm²) of a 4 x 2 mm face, row 0 at y = 0.
+/// let area = vec![0.0, 120.0, 340.0, 80.0, 10.0, 260.0, 500.0, 40.0];
+/// Map::new(4, 2, area)?
+///     .labels("Real contact area", "x (mm)", "y (mm)", "A_R (µm²)")
+///     .x_range(0.0, 4.0)
+///     .y_range(0.0, 2.0)
+///     .colour_scale(Palette::Sequential, Some((0.0, 500.0)))     // 0 to 500 µm²
+///     .save(dir.join("area.svg"))?;
+/// let svg = std::fs::read_to_string(dir.join("area.svg"))?;
+/// assert!(svg.contains("#FFFFD9") && svg.contains("#081D58")); // light at 0, dark at 500
+/// // 7 values do not fill 4 x 2 cells.
+/// let e = Map::new(4, 2, vec![0.0; 7]).unwrap_err();
+/// assert!(matches!(e, PlotError::Core(Error::LengthMismatch { expected: 8, found: 7, .. })));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct Map {
     title: String,

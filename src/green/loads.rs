@@ -40,6 +40,29 @@ pub fn top_stress_influence(block: &Block, z: f64) -> Result<f64> {
 
 /// A shear load on the trailing face `x = 0`, uniform over `y ∈ [0, Ly]` and
 /// `z ∈ [h - Δh, h + Δh]`: the paper's rod. `h = Δh = Lz/2` is the uniform side load.
+///
+/// ```
+/// use precursors::{green::RodLoad, Block, Error, Grid};
+/// let block = Block::new(0.010, 0.004, 0.005)?;             // 10 x 4 x 5 mm
+/// let grid = Grid::new(block, 10, 4)?;                       // 1 mm cells
+/// // A rod 1 mm wide (Δh = 0.5 mm) at h = 1 mm on the trailing face x = 0.
+/// let rod = RodLoad::new(&block, 1e-3, 0.5e-3)?;
+/// let cells = rod.influence_cells(&grid, 1e-10)?;            // per newton, per column (m⁻¹)
+/// assert_eq!(cells.len(), 10);
+/// assert!(cells[0] > cells[1] && cells[1] > cells[9]);      // largest next to the rod
+/// // The uniform side load, h = Δh = Lz/2: its column averages only tilt the face (their
+/// // sum is 0) and its influence at x = Lx/2 is -Lx/(24 Ly Lz) (m⁻¹).
+/// let side = RodLoad::uniform_side(&block);
+/// assert_eq!(side, RodLoad::new(&block, 2.5e-3, 2.5e-3)?);
+/// let side_cells = side.influence_cells(&grid, 1e-10)?;
+/// assert!(side_cells.iter().sum::<f64>().abs() < 1e-8 * side_cells[0]);
+/// let middle = side.influence_at(0.005, 1e-10)?;
+/// assert!((middle.value + 0.010 / (24.0 * 0.004 * 0.005)).abs() < 1e-9);
+/// // A band must lie on the face: [4.3, 5.3] mm leaves Lz = 5 mm.
+/// let e = RodLoad::new(&block, 4.8e-3, 0.5e-3).unwrap_err();
+/// assert!(matches!(e, Error::RodBandOutsideFace { high, lz, .. } if high > lz));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RodLoad {
     block: Block,

@@ -25,6 +25,20 @@ use std::sync::Arc;
 pub const DENSE_LIMIT: usize = 20_000;
 
 /// Builder of an [`InfluencePlan`].
+///
+/// ```
+/// use precursors::{green::InfluencePlan, Block, Error, Grid};
+/// let grid = Grid::new(Block::new(0.010, 0.004, 0.005)?, 10, 4)?;    // 40 cells of 1 mm²
+/// let plan = InfluencePlan::builder(grid).plan_tolerance(1e-10).build()?;
+/// assert_eq!(plan.plan_tolerance(), 1e-10);
+/// assert!(plan.max_relative_error() <= 1e-10);          // every eigenvalue within it
+/// // A cap on the grid's size, checked before anything is computed.
+/// let e = InfluencePlan::builder(grid).max_cells(20).build().unwrap_err();
+/// assert!(matches!(e, Error::GridTooLarge { nx: 10, ny: 4, limit: 20, .. }));
+/// let e = InfluencePlan::builder(grid).plan_tolerance(0.0).build().unwrap_err();
+/// assert!(matches!(e, Error::InvalidTolerance { .. }));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 #[must_use]
 pub struct InfluencePlanBuilder {
@@ -99,6 +113,28 @@ impl InfluencePlanBuilder {
 /// A plan is cheap to clone: clones share the eigenvalues and the planned transforms
 /// (`Arc`), so one plan serves every scene, solver and probe of its geometry
 /// ([`crate::Scene::builder`]'s `plan`, [`Planner`](super::Planner)).
+///
+/// ```
+/// use precursors::{green::InfluencePlan, Block, Grid};
+/// let grid = Grid::new(Block::new(0.010, 0.004, 0.005)?, 10, 4)?;    // 40 cells of 1 mm²
+/// let plan = InfluencePlan::builder(grid).build()?;
+/// let n = grid.len();
+/// let dense = plan.dense()?;                              // Ĝ, 40 x 40, row-major (m⁻¹)
+/// let scale = dense[0];
+/// assert!((dense[3 * n + 17] - dense[17 * n + 3]).abs() < 1e-10 * scale); // symmetric
+/// // 1 Pa on cell 17: the matrix-free product is the dense column, largest at the cell.
+/// let mut traction = vec![0.0; n];
+/// traction[17] = 1.0;
+/// let mut u = vec![0.0; n];
+/// plan.apply(&traction, &mut u)?;
+/// assert!((u[3] - dense[3 * n + 17]).abs() < 1e-10 * scale);
+/// assert!(u.iter().all(|&v| v <= u[17]));
+/// // The mean mode's eigenvalue is Lz / (3 ΔA) (m⁻¹).
+/// let mean = plan.eigenvalue(0, 0).unwrap();
+/// assert!((mean / (0.005 / (3.0 * grid.cell_area())) - 1.0).abs() < 1e-9);
+/// assert!(plan.clone().same_plan(&plan));                 // clones share one plan
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Clone)]
 pub struct InfluencePlan {
     inner: Arc<PlanData>,

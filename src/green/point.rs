@@ -22,6 +22,18 @@ use crate::geometry::{Block, Point};
 use std::f64::consts::PI;
 
 /// A value with an estimate of its truncation error, in the units of the value.
+///
+/// ```
+/// use precursors::{green::RodLoad, Block};
+/// let block = Block::new(0.010, 0.004, 0.005)?;              // 10 x 4 x 5 mm
+/// // The uniform side load per newton at x = Lx/2 of the bottom face, to 1e-10 m⁻¹.
+/// let estimate = RodLoad::uniform_side(&block).influence_at(0.005, 1e-10)?;
+/// assert!(estimate.error <= 1e-10);
+/// // The exact value is -Lx/(24 Ly Lz) (m⁻¹): within the estimated error (and rounding).
+/// let exact = -0.010 / (24.0 * 0.004 * 0.005);
+/// assert!((estimate.value - exact).abs() <= estimate.error + 1e-12 * exact.abs());
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Estimate {
     /// The value.
@@ -31,6 +43,28 @@ pub struct Estimate {
 }
 
 /// Which coordinate's series the rapid representation sums in closed form.
+///
+/// Every axis along which the target and the source differ gives the same `G`; `Auto`
+/// picks the one needing fewest terms.
+///
+/// ```
+/// use precursors::green::{GreenFunction, SeriesOptions, SummationAxis};
+/// use precursors::{Block, Error, Point};
+/// let green = GreenFunction::new(Block::new(0.010, 0.004, 0.005)?);   // 10 x 4 x 5 mm
+/// let (target, source) = (Point::new(3e-3, 1e-3, 0.0), Point::new(6e-3, 3e-3, 2e-3));
+/// let options = SeriesOptions::default().with_tolerance(1e-9)?;       // m⁻¹
+/// let g = |axis| green.value_with_options(target, source, &options.with_axis(axis));
+/// let auto = g(SummationAxis::Auto)?.value;
+/// for axis in [SummationAxis::X, SummationAxis::Y, SummationAxis::Z] {
+///     assert!((g(axis)?.value - auto).abs() < 3e-9);
+/// }
+/// // Along an axis where both points share their coordinate the sum does not converge.
+/// let level = Point { z: 0.0, ..source };
+/// let forced = options.with_axis(SummationAxis::Z);
+/// let e = green.value_with_options(target, level, &forced).unwrap_err();
+/// assert!(matches!(e, Error::InvalidChoice { .. }));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub enum SummationAxis {
@@ -132,6 +166,23 @@ impl SeriesOptions {
 /// Units: `G` in m⁻¹, `∂G/∂z` in m⁻²; coordinates in m. The target is `r = (x, y, z)`,
 /// the source `r' = (ξ, η, ζ)`; [`GreenFunction::dz`] differentiates with respect to the
 /// target's `z`.
+///
+/// ```
+/// use precursors::{green::GreenFunction, Block, Error, Point};
+/// let green = GreenFunction::new(Block::new(0.010, 0.004, 0.005)?);   // 10 x 4 x 5 mm
+/// let bottom = Point::new(3e-3, 1e-3, 0.0);              // on the bottom face (m)
+/// let inside = Point::new(6e-3, 3e-3, 2e-3);             // 2 mm above it
+/// let g = green.value(bottom, inside, 1e-8)?;            // G (m⁻¹) to 1e-8 m⁻¹
+/// assert!(g.error <= 1e-8);
+/// // G is symmetric in target and source...
+/// assert!((g.value - green.value(inside, bottom, 1e-8)?.value).abs() < 2e-8);
+/// // ...and satisfies the Neumann condition on the faces: ∂G/∂z = 0 at z = 0 (m⁻²).
+/// assert!(green.dz(bottom, inside, 1e-6)?.value.abs() < 1e-6);
+/// // It is singular where target and source coincide.
+/// let e = green.value(inside, inside, 1e-8).unwrap_err();
+/// assert!(matches!(e, Error::SingularPoint { .. }));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GreenFunction {
     block: Block,

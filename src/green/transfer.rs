@@ -14,6 +14,26 @@ use std::sync::Arc;
 /// `sinh κ(Lz-z)/sinh κLz`, the mean by `(Lz-z)/Lz` (docs/model.md section 1); averaging
 /// over source and target cells makes the map diagonal in the DCT-II basis with factors
 /// `Σ_{aliases} (2w_p S_p²)(2w_m S_m²)·transfer(κ)`, which are exactly 1 at `z = 0`.
+///
+/// ```
+/// use precursors::{green::InfluencePlan, Block, Grid};
+/// let grid = Grid::new(Block::new(0.010, 0.004, 0.005)?, 10, 4)?;    // Lz = 5 mm
+/// let plan = InfluencePlan::builder(grid).build()?;
+/// let plane = plan.plane_transfer(2e-3, 1e-10)?;          // the plane z = 2 mm
+/// // A uniform 1 kPa traction reaches z scaled by (Lz - z)/Lz = 3/5: σ = -600 Pa.
+/// let mut sigma = vec![0.0; grid.len()];
+/// plane.stress(&vec![1e3; grid.len()], &mut sigma)?;
+/// assert!(sigma.iter().all(|s| (s + 600.0).abs() < 1e-6));
+/// // Modes that vary along the face fade faster with height.
+/// let (mean, first) = (plane.factor_of_mode(0, 0).unwrap(), plane.factor_of_mode(1, 0).unwrap());
+/// assert!((mean - 0.6).abs() < 1e-10 && first < mean);
+/// // At z = 0 the transfer is the identity: σ = -φ.
+/// let mut traction = vec![0.0; grid.len()];
+/// traction[7] = 1e3;
+/// plan.plane_transfer(0.0, 1e-10)?.stress(&traction, &mut sigma)?;
+/// assert!((sigma[7] + 1e3).abs() < 1e-9 && sigma[8].abs() < 1e-9);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Clone)]
 pub struct PlaneTransfer {
     grid: Grid,

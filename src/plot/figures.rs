@@ -16,6 +16,23 @@ use crate::sweep::{merge, MergeSummary, SWEEP_FILE};
 use std::path::{Path, PathBuf};
 
 /// A file format for the figures.
+///
+/// ```
+/// use precursors::plot::{draw, Format};
+/// use precursors::{output::RunTables, Scene};
+/// let dir = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// // A run to global slip (10 x 4 cells of 1 mm, 100 N) writes its tables into `dir`.
+/// let scene = Scene::builder().block(0.010, 0.004, 0.010).normal_load(100.0).build()?;
+/// let mut driver = scene.driver()?;
+/// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
+/// let drawn = draw(&dir, &[Format::Png, Format::Svg])?;
+/// let extension = |k: usize| drawn.files[k].extension().unwrap().to_owned();
+/// assert_eq!(drawn.files.len(), 6);                 // three figures in each format
+/// assert_eq!((extension(0), extension(5)), ("png".into(), "svg".into()));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum Format {
@@ -35,6 +52,27 @@ impl Format {
 }
 
 /// What [`draw`] did.
+///
+/// ```
+/// use precursors::plot::{draw, Format, PlotError};
+/// use precursors::{output::RunTables, Scene};
+/// let dir = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// // A run to global slip (10 x 4 cells of 1 mm, 100 N) writes its tables into `dir`.
+/// let scene = Scene::builder().block(0.010, 0.004, 0.010).normal_load(100.0).build()?;
+/// let mut driver = scene.driver()?;
+/// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
+/// let drawn = draw(&dir, &[Format::Svg])?;
+/// let names: Vec<_> = drawn.files.iter().map(|f| f.file_name().unwrap().to_owned()).collect();
+/// assert_eq!(names, ["precursor_length.svg", "contact_area.svg", "contact_map.svg"]);
+/// assert!(drawn.merge.is_none() && drawn.notes.is_empty());  // a run: no merge, nothing left out
+/// // A directory that is neither a run's nor a sweep's.
+/// let empty = dir.join("empty");
+/// std::fs::create_dir(&empty)?;
+/// assert!(matches!(draw(&empty, &[Format::Svg]), Err(PlotError::Figure { .. })));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct Drawn {
