@@ -704,6 +704,7 @@ impl RunTables {
     /// let scene = Scene::builder().block(0.012, 0.002, 0.010).normal_load(50.0).build()?;
     /// let mut driver = scene.driver()?;
     /// # let out = std::env::temp_dir().join(format!("precursors-doc-run-{}", std::process::id()));
+    /// # std::fs::create_dir_all(&out).unwrap();
     /// let tables = RunTables::create(&out, &driver)?;
     /// let mut ruptures = 0;
     /// let [events, _curve, _map] = tables.run_to_slip(&mut driver, None, |event, _| {
