@@ -574,22 +574,26 @@ impl SceneBuilder {
         } else {
             Some(StressProbe::new(&plan, &self.probes, rod.as_ref())?)
         };
-        Ok(Scene(std::sync::Arc::new(Built {
-            probe,
-            rod,
-            grid,
-            interface,
-            plan,
-            lateral_response,
-            builder: self,
-        })))
+        Ok(Scene {
+            inner: std::sync::Arc::new(Built {
+                probe,
+                rod,
+                grid,
+                interface,
+                plan,
+                lateral_response,
+                builder: self,
+            }),
+        })
     }
 }
 
 /// A validated simulation set-up; [`Scene::driver`] runs it. A clone is cheap (the scene
 /// is shared: its drivers hold it).
 #[derive(Debug, Clone)]
-pub struct Scene(std::sync::Arc<Built>);
+pub struct Scene {
+    inner: std::sync::Arc<Built>,
+}
 
 /// What a scene holds: what it was built from (its one form of the set-up: material,
 /// loads, drive, solver options, probes) and what it built from it.
@@ -616,69 +620,69 @@ impl Scene {
     /// The builder this scene was built from (for instance to write it as a scene file
     /// with the `serde` feature, or to vary one parameter).
     pub fn to_builder(&self) -> SceneBuilder {
-        self.0.builder.clone()
+        self.inner.builder.clone()
     }
 
     /// The grid (and through it the block).
     pub fn grid(&self) -> &Grid {
-        &self.0.grid
+        &self.inner.grid
     }
 
     /// The material.
     pub fn material(&self) -> Material {
-        self.0.builder.material
+        self.inner.builder.material
     }
 
     /// The interface in its initial state (every site attached).
     pub fn interface(&self) -> &Interface {
-        &self.0.interface
+        &self.inner.interface
     }
 
     /// The normal load `F_N` (N).
     pub fn normal_load(&self) -> f64 {
-        self.0.builder.normal_load
+        self.inner.builder.normal_load
     }
 
     /// The drive.
     pub fn drive(&self) -> Drive {
-        self.0.builder.drive
+        self.inner.builder.drive
     }
 
     /// The solver options ([`SceneBuilder::solver_options`]).
     pub fn solver_options(&self) -> SolverOptions {
-        self.0.builder.solver
+        self.inner.builder.solver
     }
 
     /// The spring constants ([`SceneBuilder::springs`]).
     pub fn springs(&self) -> SpringLaw {
-        self.0.interface.law()
+        self.inner.interface.law()
     }
 
     /// Where the heights came from ([`SceneBuilder::heights`], [`SceneBuilder::seed`]);
     /// the heights themselves are [`Interface::heights`] of [`Scene::interface`].
     pub fn heights(&self) -> &HeightSource {
-        &self.0.builder.heights
+        &self.inner.builder.heights
     }
 
     /// The planned influence operator.
     pub fn plan(&self) -> &InfluencePlan {
-        &self.0.plan
+        &self.inner.plan
     }
 
     /// The stress probes every driver of the scene starts with ([`SceneBuilder::probes`];
     /// empty by default).
     pub fn probes(&self) -> &ProbeSpec {
-        &self.0.builder.probes
+        &self.inner.builder.probes
     }
 
     /// The default probes as planned at build (`None` when there are none).
     pub(crate) fn stress_probe(&self) -> Option<&StressProbe> {
-        self.0.probe.as_ref()
+        self.inner.probe.as_ref()
     }
 
     /// The lateral load of the drive, if any (the probes' lateral stress term).
     pub(crate) fn lateral_load(&self) -> Option<&RodLoad> {
-        self.0.rod.as_ref()
+        self.inner.rod.as_ref()
     }
 
     /// `(F_top, F_lat)` (N) per newton of the driven force `F`.
@@ -694,7 +698,7 @@ impl Scene {
 
     /// Whether the scene built the lateral load table (only drives with a lateral part).
     pub fn has_lateral_table(&self) -> bool {
-        self.0.lateral_response.is_some()
+        self.inner.lateral_response.is_some()
     }
 
     /// Displacement `e` (m/N) of each cell per newton of the driven force in the absence
@@ -702,12 +706,12 @@ impl Scene {
     /// newton of spring force under displacement control. `None` for a top shear (a
     /// constant, absorbed by `⟨u_x⟩`).
     pub(crate) fn unit_load_displacement(&self) -> Vec<f64> {
-        match (&self.0.lateral_response, self.drive()) {
+        match (&self.inner.lateral_response, self.drive()) {
             (Some(e), Drive::Force(ForceLoad::Mixed { ratio, .. })) => {
                 e.iter().map(|v| v / (1.0 + ratio)).collect()
             }
             (Some(e), _) => e.clone(),
-            (None, _) => vec![0.0; self.0.grid.len()],
+            (None, _) => vec![0.0; self.inner.grid.len()],
         }
     }
 }
@@ -725,14 +729,14 @@ mod leaves_out {
     #[test]
     fn a_top_drive_has_no_lateral_load_and_no_probes_no_transfer() {
         let top = small().drive(Drive::Force(ForceLoad::Top)).build().unwrap();
-        assert!(top.0.rod.is_none() && top.0.lateral_response.is_none());
-        assert!(top.0.probe.is_none());
+        assert!(top.inner.rod.is_none() && top.inner.lateral_response.is_none());
+        assert!(top.inner.probe.is_none());
         let rod = small()
             .probes(ProbeSpec::default().with_plane(2e-3))
             .build()
             .unwrap();
-        assert!(rod.0.rod.is_some() && rod.0.lateral_response.is_some());
-        assert!(rod.0.probe.is_some());
+        assert!(rod.inner.rod.is_some() && rod.inner.lateral_response.is_some());
+        assert!(rod.inner.probe.is_some());
     }
 
     #[test]
