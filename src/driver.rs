@@ -273,7 +273,11 @@ impl Driver {
     /// ```
     /// use precursors::{Event, Scene};
     /// use std::ops::ControlFlow;
-    /// let scene = Scene::builder().block(0.012, 0.002, 0.010).normal_load(50.0).build()?;
+    /// let scene = Scene::builder()
+    ///     .block(0.012, 0.002, 0.010)
+    ///     .normal_load(50.0)
+    ///     .seed(0)
+    ///     .build()?;
     /// let mut driver = scene.driver()?;
     /// // Stop at the first rupture and report its site.
     /// let first = driver.run(|event, _| match event {

@@ -704,7 +704,11 @@ impl RunTables {
     ///
     /// ```
     /// use precursors::{output::RunTables, Event, Scene};
-    /// let scene = Scene::builder().block(0.012, 0.002, 0.010).normal_load(50.0).build()?;
+    /// let scene = Scene::builder()
+    ///     .block(0.012, 0.002, 0.010)
+    ///     .normal_load(50.0)
+    ///     .seed(0)
+    ///     .build()?;
     /// let mut driver = scene.driver()?;
     /// # let out = std::env::temp_dir().join(format!("precursors-doc-run-{}", std::process::id()));
     /// # std::fs::create_dir_all(&out).unwrap();

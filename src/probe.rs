@@ -28,6 +28,7 @@
 //! let scene = Scene::builder()
 //!     .block(0.020, 0.004, 0.010)
 //!     .normal_load(80.0)
+//!     .seed(0)
 //!     .probes(ProbeSpec::default().with_plane(2e-3).with_point(Point::new(0.005, 0.002, 2e-3)))
 //!     .build()?;
 //! let mut driver = scene.driver()?;

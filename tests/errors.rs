@@ -484,6 +484,7 @@ mod ranges {
             .block(0.020, 0.004, 0.010)
             .cells(20, 4)
             .normal_load(60.0)
+            .seed(0)
     }
 
     fn material(e: f64, nu: f64, mu: f64) -> SceneBuilder {

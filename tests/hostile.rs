@@ -1834,6 +1834,7 @@ fn small_scene(edit: impl FnOnce(&mut Value)) -> Value {
     let mut scene = json!({
         "block": {"lx": 0.03, "ly": 0.005, "lz": 0.02},
         "cells": {"kind": "size", "dx": 0.001, "dy": 0.001},
+        "heights": {"kind": "gaussian", "seed": 0},
         "normal_load": 500.0,
         "drive": {"kind": "rod", "height": 0.004, "half_width": 0.001},
     });

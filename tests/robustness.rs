@@ -396,6 +396,7 @@ mod file {
             .block(0.020, 0.004, 0.010)
             .cells(20, 4)
             .normal_load(60.0)
+            .seed(0)
             .drive(Drive::Spring {
                 stiffness: 4e6,
                 lateral: Lateral::Rod {
@@ -605,6 +606,7 @@ fn the_contact_map_refuses_loads_beyond_the_friction_limit() {
         .block(0.02, 0.004, 0.01)
         .cells(20, 4)
         .normal_load(60.0)
+        .seed(0)
         .build()
         .unwrap();
     let mu_fn = 0.5 * 60.0;

@@ -123,6 +123,21 @@ fn missing_keys_take_the_calibration_defaults() {
     assert_eq!(partial, Scene::builder().material(material).seed(9));
 }
 
+/// The default heights are the calibration scene's, seed 1 (README, docs/scene-format.md),
+/// in the builder, in `HeightSource::default` and for a file's `heights` without a seed.
+#[test]
+fn the_default_seed_is_the_calibration_scenes() {
+    let seed_one = HeightSource::Random {
+        distribution: HeightDistribution::default(),
+        seed: 1,
+    };
+    assert_eq!(HeightSource::default(), seed_one);
+    assert_eq!(Scene::builder(), Scene::builder().seed(1));
+    assert_ne!(Scene::builder(), Scene::builder().seed(0));
+    let file = SceneBuilder::from_json_str(r#"{"heights": {"kind": "gaussian"}}"#).unwrap();
+    assert_eq!(file, Scene::builder().heights(seed_one));
+}
+
 #[test]
 fn mistakes_are_typed_errors() {
     let cases = [

@@ -17,6 +17,7 @@ fn scratch(name: &str) -> PathBuf {
 /// A tiny base scene: 30 x 5 = 150 cells (a run to global slip: about 10 ms).
 const BASE: &str = r#"{ "block": { "lx": 0.03, "ly": 0.005, "lz": 0.02 },
     "cells": { "kind": "size", "dx": 0.001, "dy": 0.001 },
+    "heights": { "kind": "gaussian", "seed": 0 },
     "normal_load": 500.0,
     "drive": { "kind": "rod", "height": 0.004, "half_width": 0.001 } }"#;
 

@@ -88,7 +88,11 @@ impl Driver {
     ///
     /// ```
     /// use precursors::{ProbeSpec, Scene};
-    /// let scene = Scene::builder().block(0.020, 0.004, 0.010).normal_load(80.0).build()?;
+    /// let scene = Scene::builder()
+    ///     .block(0.020, 0.004, 0.010)
+    ///     .normal_load(80.0)
+    ///     .seed(0)
+    ///     .build()?;
     /// let mut driver = scene.driver()?;
     /// driver.step()?;
     /// driver.add_probes(&ProbeSpec::default().with_plane(2e-3))?;

@@ -118,7 +118,7 @@ schema_enum! {
             mean: f64,
             #[cfg_attr(feature = "serde", serde(default = "default_std_dev"))]
             std_dev: f64,
-            #[cfg_attr(feature = "serde", serde(default))]
+            #[cfg_attr(feature = "serde", serde(default = "default_seed"))]
             seed: u64,
         },
         Values = "values" {
@@ -239,6 +239,11 @@ fn default_mean() -> f64 {
 #[cfg(feature = "serde")]
 fn default_std_dev() -> f64 {
     HeightDistribution::default().std_dev()
+}
+
+#[cfg(feature = "serde")]
+fn default_seed() -> u64 {
+    crate::scene::DEFAULT_SEED
 }
 
 impl Default for SceneFile {
