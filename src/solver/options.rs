@@ -39,7 +39,7 @@ impl std::fmt::Display for Backend {
 /// `with_` modifiers, each validating what it changes).
 ///
 /// ```
-/// use precursors::{Backend, Parallelism, SolverOptions};
+/// use precursors::solver::{Backend, Parallelism, SolverOptions};
 /// let options = SolverOptions::default()
 ///     .with_backend(Backend::Spectral)?
 ///     .with_tolerance(1e-12)?
