@@ -54,6 +54,30 @@ pub use checkpoint::Checkpoint;
 pub(crate) use checkpoint::{sync_dir, write_atomically};
 
 /// A site of the interface grid.
+///
+/// ```
+/// use precursors::{Event, Scene};
+/// let scene = Scene::builder()
+///     .block(0.010, 0.004, 0.010)       // Lx, Ly, Lz (m)
+///     .cells(10, 4)                     // 1 mm cells
+///     .normal_load(40.0)                // F_N (N)
+///     .seed(1)
+///     .build()?;
+/// let grid = *scene.grid();
+/// let mut broken = Vec::new();
+/// for event in scene.driver()? {
+///     if let Event::Rupture { site, .. } = event? {
+///         // The paper's cell order: i = iy·Nx + ix, column ix from the trailing edge.
+///         assert_eq!(site.index, site.iy * grid.nx() + site.ix);
+///         assert_eq!(grid.index(site.ix, site.iy), Some(site.index));
+///         broken.push(site.index);
+///     }
+/// }
+/// // Every spring breaks once, irreversibly, before the block slides.
+/// broken.sort_unstable();
+/// assert_eq!(broken, (0..grid.len()).collect::<Vec<_>>());
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
@@ -77,6 +101,33 @@ impl Site {
 }
 
 /// The applied load at an event.
+///
+/// Under displacement control the load carries the drive displacement `U_S`, and its force
+/// is the driving spring's, `F = K_S (U_S - ⟨u_x⟩)`:
+///
+/// ```
+/// use precursors::{Drive, Event, Lateral, Scene};
+/// let k_s = 4e6;                                    // K_S (N/m), the paper's spring
+/// let scene = Scene::builder()
+///     .block(0.010, 0.004, 0.010)                   // Lx, Ly, Lz (m)
+///     .cells(10, 4)                                 // 1 mm cells
+///     .normal_load(40.0)                            // F_N (N)
+///     .drive(Drive::Spring { stiffness: k_s, lateral: Lateral::Side })
+///     .build()?;
+/// let mut driver = scene.driver()?;
+/// while let Some(event) = driver.step()? {
+///     if let Event::LoadRaised { load } = event {
+///         let u_s = load.drive_displacement.expect("a spring drive"); // U_S (m)
+///         let mean_u_x = driver.mean_shear_displacement()?;          // ⟨u_x⟩ (m)
+///         assert!((load.force - k_s * (u_s - mean_u_x)).abs() <= 1e-9 * load.force);
+///         assert_eq!(driver.spring_force(), Some(load.force));
+///     }
+/// }
+/// // Under force control there is no drive displacement.
+/// let force = scene.to_builder().drive(Drive::default()).build()?;
+/// assert_eq!(force.driver()?.load().drive_displacement, None);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
@@ -90,6 +141,35 @@ pub struct Load {
 }
 
 /// What happened.
+///
+/// ```
+/// use precursors::{Event, Scene};
+/// let scene = Scene::builder()
+///     .block(0.010, 0.004, 0.010)       // Lx, Ly, Lz (m)
+///     .cells(10, 4)                     // 1 mm cells
+///     .normal_load(40.0)                // F_N (N); the paper's rod drive
+///     .build()?;
+/// let events: Vec<Event> = scene.driver()?.collect::<Result<_, _>>()?;
+/// // First the normal equilibrium at zero shear, last global slip.
+/// assert!(matches!(events[0], Event::Stable { load, ruptures: 0 } if load.force == 0.0));
+/// assert!(matches!(events.last(), Some(Event::GlobalSlip { .. })));
+/// // At a stable state no site is over threshold: the load is only ever raised (N).
+/// let raised: Vec<f64> = events
+///     .iter()
+///     .filter_map(|e| match e {
+///         Event::LoadRaised { load } => Some(load.force),
+///         _ => None,
+///     })
+///     .collect();
+/// assert!(raised.windows(2).all(|w| w[0] <= w[1]));
+/// // A rupture releases the elastic energy ½ k_x u_x² ΔA > 0 (J) of its spring.
+/// for event in &events {
+///     if let Event::Rupture { energy, .. } = event {
+///         assert!(*energy > 0.0);
+///     }
+/// }
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
@@ -151,6 +231,32 @@ enum Phase {
 }
 
 /// Runs a [`Scene`] quasi-statically; an iterator of [`Event`]s.
+///
+/// ```
+/// use precursors::{Error, Event, Scene};
+/// let scene = Scene::builder()
+///     .block(0.010, 0.004, 0.010)       // Lx, Ly, Lz (m)
+///     .cells(10, 4)                     // 1 mm cells: ΔA = 1 mm²
+///     .normal_load(40.0)                // F_N (N)
+///     .seed(5)
+///     .build()?;
+/// let mut driver = scene.driver()?;
+/// assert!(matches!(driver.normal_traction(), Err(Error::NotSolved { .. })));
+/// // The first step solves the normal equilibrium at zero shear.
+/// assert!(matches!(driver.step()?, Some(Event::Stable { ruptures: 0, .. })));
+/// // The tractions carry the normal load: ΔA Σ φ_z = F_N (N).
+/// let cell = driver.grid().cell_area();
+/// let carried: f64 = driver.normal_traction()?.iter().map(|phi| phi * cell).sum();
+/// assert!((carried - 40.0).abs() < 1e-9 * 40.0);
+/// assert!(driver.real_contact_area()? > 0.0);                   // A_R (m²)
+/// // On to global slip; then the iterator is done.
+/// for event in &mut driver {
+///     event?;
+/// }
+/// assert_eq!(driver.step()?, None);
+/// assert_eq!(driver.interface().broken_count(), 40);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug)]
 pub struct Driver {
     /// The scene it runs, shared (its set-up is read from it; checkpoints record its
@@ -183,6 +289,32 @@ pub struct Driver {
 
 /// Cumulative solver work of a driver since it was created or resumed
 /// ([`Driver::solve_stats`]): where a run spends its time.
+///
+/// ```
+/// use precursors::{Event, Scene, SolveStats};
+/// use std::ops::ControlFlow;
+/// let scene = Scene::builder()
+///     .block(0.010, 0.004, 0.010)       // Lx, Ly, Lz (m)
+///     .cells(10, 4)                     // 1 mm cells
+///     .normal_load(40.0)                // F_N (N)
+///     .build()?;
+/// let mut driver = scene.driver()?;
+/// assert_eq!(driver.solve_stats(), SolveStats::default()); // nothing solved yet
+/// let mut ruptures = 0;
+/// driver.run(|event, _| {
+///     ruptures += matches!(event, Event::Rupture { .. }) as usize;
+///     ControlFlow::<()>::Continue(())
+/// })?;
+/// // One normal and one tangential equilibrium at zero shear and after every rupture
+/// // but the last (global slip).
+/// let stats = driver.solve_stats();
+/// assert_eq!(stats.normal_solves, ruptures);
+/// assert_eq!(stats.tangential_solves, ruptures);
+/// assert!(stats.normal_active_set_iterations >= stats.normal_solves);
+/// println!("{:.3} s in normal solves, {:.3} s in tangential ones",
+///          stats.normal_seconds, stats.tangential_seconds);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 #[non_exhaustive]
 pub struct SolveStats {

@@ -36,6 +36,24 @@ pub(crate) mod schema;
 const LATERAL_TOLERANCE: f64 = 1e-12;
 
 /// Where a lateral shear acts on the trailing face `x = 0`.
+///
+/// ```
+/// use precursors::{Drive, Error, Lateral, Scene};
+/// let base = Scene::builder()
+///     .block(0.010, 0.004, 0.010)       // Lx, Ly, Lz (m)
+///     .cells(10, 4)                     // 1 mm cells
+///     .normal_load(40.0);               // F_N (N)
+/// // The paper's rod: a band z ∈ [4, 8] mm of the trailing face.
+/// let rod = Lateral::Rod { height: 6e-3, half_width: 2e-3 };
+/// assert!(base.clone().drive(Drive::Force(rod.into())).build()?.has_lateral_table());
+/// // A band reaching above the top face (z up to 11 mm > Lz = 10 mm) is refused.
+/// let high = Lateral::Rod { height: 9e-3, half_width: 2e-3 };
+/// let refused = base.clone().drive(Drive::Force(high.into())).build();
+/// assert!(matches!(refused, Err(Error::RodBandOutsideFace { .. })));
+/// // The whole trailing face (h = Δh = Lz/2 = 5 mm).
+/// base.drive(Drive::Force(Lateral::Side.into())).build()?;
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub enum Lateral {
@@ -51,6 +69,34 @@ pub enum Lateral {
 }
 
 /// How the total shear force `F = F_top + F_lat` is split under force control.
+///
+/// ```
+/// use precursors::{Drive, Error, Event, ForceLoad, Lateral, Scene};
+/// let base = Scene::builder()
+///     .block(0.010, 0.004, 0.010)       // Lx, Ly, Lz (m)
+///     .cells(10, 4)                     // 1 mm cells
+///     .normal_load(40.0);               // F_N (N)
+/// // A uniform top shear: no lateral load, and Amontons' law, the block slides at μ F_N.
+/// let top = base.clone().drive(Drive::Force(ForceLoad::Top)).build()?;
+/// assert!(!top.has_lateral_table());
+/// let mut slip = 0.0;
+/// for event in top.driver()? {
+///     if let Event::GlobalSlip { load } = event? {
+///         slip = load.force;                                    // F (N)
+///     }
+/// }
+/// let mu_fn = top.material().friction_coefficient() * 40.0;     // μ F_N = 20 N
+/// assert!((slip / mu_fn - 1.0).abs() < 1e-9);
+/// // F_top = 3 F_lat (the paper's n = 3), the lateral part on the rod.
+/// let rod = Lateral::Rod { height: 6e-3, half_width: 2e-3 };
+/// let mixed = ForceLoad::Mixed { ratio: 3.0, lateral: rod };
+/// assert!(base.clone().drive(Drive::Force(mixed)).build()?.has_lateral_table());
+/// assert_eq!(ForceLoad::from(rod), ForceLoad::Lateral(rod));
+/// let negative = ForceLoad::Mixed { ratio: -1.0, lateral: rod };
+/// let refused = base.drive(Drive::Force(negative)).build();
+/// assert!(matches!(refused, Err(Error::InvalidParameter { name: "drive.ratio", .. })));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub enum ForceLoad {
@@ -74,6 +120,28 @@ impl From<Lateral> for ForceLoad {
 }
 
 /// The shear drive: the quasi-static control parameter.
+///
+/// ```
+/// use precursors::{Drive, Error, Event, ForceLoad, Lateral, Scene};
+/// // The default: the paper's rod at h = 6 mm, Δh = 2 mm, under force control.
+/// let rod = Lateral::Rod { height: 6e-3, half_width: 2e-3 };
+/// assert_eq!(Drive::default(), Drive::Force(ForceLoad::Lateral(rod)));
+/// // Displacement control: the paper's driving spring K_S = 4e6 N/m on the trailing face.
+/// let spring = Drive::Spring { stiffness: 4e6, lateral: Lateral::Side };
+/// let base = Scene::builder()
+///     .block(0.010, 0.004, 0.010)       // Lx, Ly, Lz (m)
+///     .cells(10, 4)                     // 1 mm cells
+///     .normal_load(40.0);               // F_N (N)
+/// let mut driver = base.clone().drive(spring).build()?.driver()?;
+/// driver.step()?;                                           // zero shear
+/// let Some(Event::LoadRaised { load }) = driver.step()? else { unreachable!() };
+/// assert!(load.drive_displacement.is_some_and(|u_s| u_s > 0.0)); // U_S (m)
+/// // A spring without stiffness is refused, naming its scene-file key.
+/// let limp = Drive::Spring { stiffness: 0.0, lateral: Lateral::Side };
+/// let refused = base.drive(limp).build();
+/// assert!(matches!(refused, Err(Error::InvalidParameter { name: "drive.stiffness", .. })));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub enum Drive {
@@ -101,6 +169,32 @@ impl Default for Drive {
 }
 
 /// Where the asperity heights come from.
+///
+/// ```
+/// use precursors::{Error, HeightSource, Scene};
+/// // The default: the paper's truncated Gaussian (mean 1 µm, sd 1 µm), seed 0.
+/// assert!(matches!(HeightSource::default(), HeightSource::Random { seed: 0, .. }));
+/// // Given heights (m), one per cell in the order i = iy·Nx + ix: 1 to 2 µm along x.
+/// let values: Vec<f64> = (0..40).map(|i| 1e-6 * (1.0 + (i % 10) as f64 / 9.0)).collect();
+/// let base = Scene::builder()
+///     .block(0.010, 0.004, 0.010)       // Lx, Ly, Lz (m)
+///     .cells(10, 4)                     // 1 mm cells: 40 heights
+///     .normal_load(40.0);               // F_N (N)
+/// let scene = base.clone().heights(values.clone().into()).build()?;
+/// assert_eq!(scene.interface().heights(), &values[..]);
+/// // One height short of the grid is refused.
+/// let short = base.heights(HeightSource::Values(values[..39].to_vec())).build();
+/// assert!(short.is_err());
+/// // The same heights from a text file: one per line, `#` comments.
+/// let dir = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// let path = dir.join("heights.txt");
+/// let lines: String = values.iter().map(|h| format!("{h}\n")).collect();
+/// std::fs::write(&path, format!("# heights (m), i = iy·Nx + ix\n{lines}"))?;
+/// assert_eq!(HeightSource::from_file(&path)?, HeightSource::Values(values));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub enum HeightSource {
@@ -254,6 +348,27 @@ enum Cells {
 /// Builder of a [`Scene`]; every field has the paper's default (calibration scene,
 /// seed 1). With the `serde` feature it reads and writes the JSON scene format
 /// (`docs/scene-format.md`): `SceneBuilder::from_json_file`, `SceneBuilder::to_json`.
+///
+/// ```
+/// use precursors::{Error, Material, Scene};
+/// // The defaults are the paper's calibration scene: its grid, checked without planning.
+/// let grid = Scene::builder().grid()?;
+/// assert_eq!((grid.nx(), grid.ny()), (140, 7));                // 1 mm cells
+/// // A small block of a softer material.
+/// let builder = Scene::builder()
+///     .block(0.010, 0.004, 0.010)                              // Lx, Ly, Lz (m)
+///     .cells(10, 4)                                            // Nx, Ny
+///     .material(Material::new(2e9, 0.35, 0.6)?)                // E (Pa), ν, μ
+///     .normal_load(40.0)                                       // F_N (N)
+///     .seed(3);                                                // the heights' realization
+/// assert_eq!(builder.check()?.len(), 40);                      // everything but the plan
+/// let scene = builder.clone().build()?;
+/// assert_eq!(scene.material().friction_coefficient(), 0.6);
+/// // An invalid value is refused at build, naming it.
+/// let refused = builder.normal_load(-1.0).build();
+/// assert!(matches!(refused, Err(Error::InvalidParameter { name: "normal_load", .. })));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 #[must_use]
 pub struct SceneBuilder {
@@ -595,6 +710,27 @@ impl SceneBuilder {
 
 /// A validated simulation set-up; [`Scene::driver`] runs it. A clone is cheap (the scene
 /// is shared: its drivers hold it).
+///
+/// ```
+/// use precursors::{Drive, ForceLoad, Scene};
+/// let scene = Scene::builder()
+///     .block(0.010, 0.004, 0.010)       // Lx, Ly, Lz (m)
+///     .cells(10, 4)                     // 1 mm cells
+///     .normal_load(40.0)                // F_N (N)
+///     .build()?;
+/// assert_eq!(scene.grid().len(), 40);
+/// assert_eq!(scene.material().friction_coefficient(), 0.5);   // PMMA, the paper's μ
+/// assert_eq!(scene.interface().attached_count(), 40);         // every site in contact
+/// assert!(scene.has_lateral_table());                          // the default rod drive
+/// // A variant: the same set-up under a top shear.
+/// let top = scene.to_builder().drive(Drive::Force(ForceLoad::Top)).build()?;
+/// assert!(!top.has_lateral_table() && top.normal_load() == 40.0);
+/// assert_eq!(top.interface().heights(), scene.interface().heights()); // same seed
+/// // Drivers of one scene run the same events.
+/// let (a, b) = (scene.driver()?, scene.clone().driver()?);
+/// assert!(a.zip(b).all(|(a, b)| a.ok() == b.ok()));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct Scene {
     inner: std::sync::Arc<Built>,

@@ -165,6 +165,27 @@ fn read_axes(spec: &SweepSpec, file_error: impl Fn(String) -> SweepError) -> Res
 }
 
 /// One run of a sweep: a parameter point, a realization, its seed and its scene.
+///
+/// ```
+/// use precursors::sweep::{derive_seed, Sweep};
+/// // Two normal loads F_N (N) on a 10 x 4 grid of 1 mm cells, two realizations each.
+/// let sweep = Sweep::from_json_str(r#"{
+///     "base": { "block": { "lx": 0.01, "ly": 0.004, "lz": 0.01 },
+///               "cells": { "kind": "count", "nx": 10, "ny": 4 } },
+///     "axes": [ { "key": "normal_load", "values": [40.0, 60.0] } ],
+///     "realizations": 2,
+///     "seed": 7
+/// }"#)?;
+/// let run = &sweep.runs()[3];                  // the second load's second realization
+/// assert_eq!((run.point, run.realization), (1, 1));
+/// assert_eq!(run.index, run.point * sweep.realizations() + run.realization);
+/// assert_eq!(run.coordinates, [1]);
+/// assert_eq!(run.values, [("normal_load".to_string(), "60.0".to_string())]);
+/// assert_eq!(run.seed, derive_seed(7, &run.coordinates, run.realization));
+/// assert_eq!(run.dir_name, "p0001-r0001");
+/// assert_eq!(run.scene.clone().build()?.normal_load(), 60.0); // F_N (N)
+/// # Ok::<(), precursors::sweep::SweepError>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct SweepRun {
@@ -190,6 +211,33 @@ pub struct SweepRun {
 
 /// A sweep, validated: every run's scene passed the checks [`SceneBuilder::build`] makes
 /// before planning.
+///
+/// A sweep over two normal loads `F_N` (N) of a 10 x 4 grid of 1 mm cells, run into a
+/// directory and merged into ensemble tables:
+///
+/// ```
+/// use precursors::sweep::{merge, Sweep, SweepOptions};
+/// let sweep = Sweep::from_json_str(r#"{
+///     "base": { "block": { "lx": 0.01, "ly": 0.004, "lz": 0.01 },
+///               "cells": { "kind": "count", "nx": 10, "ny": 4 },
+///               "normal_load": 40.0 },
+///     "axes": [ { "key": "normal_load", "values": [40.0, 60.0] } ],
+///     "seed": 7
+/// }"#)?;
+/// assert_eq!((sweep.points(), sweep.realizations()), (2, 1));
+/// assert_eq!(sweep.keys(), ["normal_load"]);
+/// // Its JSON form (the directory's copy, sweep.json) reads back as the same sweep.
+/// assert_eq!(Sweep::from_json_str(&sweep.to_json()?)?.runs(), sweep.runs());
+/// let out = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
+/// let summary = sweep.execute(&out, &SweepOptions::new(), |run| {
+///     println!("run {} done: {} events in {:.3} s", run.index, run.events, run.seconds)
+/// })?;
+/// assert_eq!(summary.completed, 2);
+/// let merged = merge(&out)?;
+/// assert_eq!((merged.points, merged.runs_merged), (2, 2));
+/// std::fs::remove_dir_all(&out).ok();
+/// # Ok::<(), precursors::sweep::SweepError>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct Sweep {
     spec: SweepSpec,
@@ -201,6 +249,32 @@ pub struct Sweep {
 }
 
 /// How [`Sweep::execute`] runs its share.
+///
+/// Two shares of a sweep run one after the other (or on two machines) into one directory:
+///
+/// ```
+/// use precursors::sweep::{merge, Sweep, SweepOptions};
+/// use precursors::Error;
+/// let options = SweepOptions::new();
+/// assert_eq!((options.jobs(), options.shard()), (1, (0, 1)));     // one job, everything
+/// assert!(matches!(options.with_jobs(0), Err(Error::InvalidCount { .. })));
+/// assert!(matches!(options.with_shard(2, 2), Err(Error::InvalidCount { .. })));
+/// let sweep = Sweep::from_json_str(r#"{
+///     "base": { "block": { "lx": 0.01, "ly": 0.004, "lz": 0.01 },
+///               "cells": { "kind": "count", "nx": 10, "ny": 4 },
+///               "normal_load": 40.0 },
+///     "axes": [ { "key": "normal_load", "values": [40.0, 60.0] } ],
+///     "seed": 7
+/// }"#)?;
+/// let out = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
+/// for k in 0..2 {
+///     let share = SweepOptions::new().with_jobs(2)?.with_shard(k, 2)?;
+///     assert_eq!(sweep.execute(&out, &share, |_| {})?.runs, 1);  // run k of 2
+/// }
+/// assert_eq!(merge(&out)?.runs_merged, 2);
+/// std::fs::remove_dir_all(&out).ok();
+/// # Ok::<(), precursors::sweep::SweepError>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub struct SweepOptions {
@@ -282,6 +356,27 @@ fn check_shard(k: usize, n: usize) -> crate::Result<()> {
 }
 
 /// What one run did ([`Sweep::run_one`]).
+///
+/// ```
+/// use precursors::sweep::{Sweep, DONE_FILE};
+/// let sweep = Sweep::from_json_str(r#"{
+///     "base": { "block": { "lx": 0.01, "ly": 0.004, "lz": 0.01 },
+///               "cells": { "kind": "count", "nx": 10, "ny": 4 },
+///               "normal_load": 40.0 },
+///     "axes": [ { "key": "normal_load", "values": [40.0, 60.0] } ],
+///     "seed": 7
+/// }"#)?;
+/// let out = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
+/// let run = &sweep.runs()[1];                                    // F_N = 60 N
+/// let report = sweep.run_one(run, &out)?;
+/// assert!(!report.skipped && !report.held_elsewhere && report.events > 0);
+/// assert!(out.join(&run.dir_name).join(DONE_FILE).is_file());   // marked complete
+/// // A complete run is not run again.
+/// let again = sweep.run_one(run, &out)?;
+/// assert!(again.skipped && again.events == 0 && again.index == 1);
+/// std::fs::remove_dir_all(&out).ok();
+/// # Ok::<(), precursors::sweep::SweepError>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct RunReport {
@@ -299,6 +394,26 @@ pub struct RunReport {
 }
 
 /// What [`Sweep::execute`] did.
+///
+/// ```
+/// use precursors::sweep::{Sweep, SweepOptions};
+/// let sweep = Sweep::from_json_str(r#"{
+///     "base": { "block": { "lx": 0.01, "ly": 0.004, "lz": 0.01 },
+///               "cells": { "kind": "count", "nx": 10, "ny": 4 },
+///               "normal_load": 40.0 },
+///     "axes": [ { "key": "normal_load", "values": [40.0, 60.0] } ],
+///     "seed": 7
+/// }"#)?;
+/// let out = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
+/// let first = sweep.execute(&out, &SweepOptions::new(), |_| {})?;
+/// assert_eq!((first.runs, first.completed, first.skipped), (2, 2, 0));
+/// // Executed again (say after a crash), complete runs are skipped.
+/// let second = sweep.execute(&out, &SweepOptions::new(), |_| {})?;
+/// assert_eq!((second.completed, second.skipped, second.held_elsewhere), (0, 2, 0));
+/// assert!(second.seconds >= 0.0);                                 // wall time (s)
+/// std::fs::remove_dir_all(&out).ok();
+/// # Ok::<(), precursors::sweep::SweepError>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct SweepSummary {

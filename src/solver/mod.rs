@@ -76,6 +76,27 @@ enum Core {
 }
 
 /// Builder of an [`EquilibriumSolver`].
+///
+/// ```
+/// use precursors::green::InfluencePlan;
+/// use precursors::solver::{Backend, EquilibriumSolver, Parallelism, SolverOptions};
+/// use precursors::{Block, Grid, Material};
+/// let grid = Grid::new(Block::new(0.010, 0.004, 0.010)?, 10, 4)?; // 1 mm cells
+/// let plan = InfluencePlan::builder(grid).build()?;
+/// let rubber = Material::new(5e6, 0.49, 1.0)?;                   // E (Pa), ν, μ
+/// let options = SolverOptions::default()
+///     .with_backend(Backend::Spectral)?
+///     .with_parallelism(Parallelism::Threads(2))?;
+/// let solver = EquilibriumSolver::builder(plan)
+///     .material(rubber)
+///     .solver_options(options)
+///     .build()?;
+/// assert_eq!(solver.backend(), Backend::Spectral);
+/// assert!((solver.material().modulus() - 5e6 / 1.49).abs() < 1e-6); // M = E/(1+ν) (Pa)
+/// // 40 cells are one part of the grid: the solves run on the calling thread.
+/// assert_eq!(solver.threads(), 1);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 #[must_use]
 pub struct EquilibriumSolverBuilder {
@@ -160,6 +181,32 @@ impl EquilibriumSolverBuilder {
 
 /// Solves the interface equilibria of one geometry; build once, reuse for every load
 /// and every state (factors and warm starts are kept between solves).
+///
+/// The equilibria of a small interface under `F_N = 40 N`, then one newton of top shear:
+///
+/// ```
+/// use precursors::green::InfluencePlan;
+/// use precursors::solver::{Backend, EquilibriumSolver};
+/// use precursors::{Block, Grid, HeightDistribution, Heights, Interface, SpringLaw};
+/// let grid = Grid::new(Block::new(0.010, 0.004, 0.010)?, 10, 4)?; // 1 mm cells: ΔA = 1 mm²
+/// let plan = InfluencePlan::builder(grid).build()?;
+/// let heights = Heights::truncated_gaussian(&grid, HeightDistribution::default(), 1)?;
+/// let mut interface = Interface::new(grid, heights, SpringLaw::default())?;
+/// let mut solver = EquilibriumSolver::builder(plan).build()?;    // PMMA, default options
+/// assert_eq!(solver.backend(), Backend::Dense);                  // Auto on 40 cells
+/// let normal = solver.solve_normal(&interface, 40.0)?;
+/// let carried = normal.traction.iter().sum::<f64>() * grid.cell_area();
+/// assert!((carried - 40.0).abs() < 1e-9 * 40.0);                 // ΔA Σ φ_z = F_N (N)
+/// interface.set_states(&normal.states)?;
+/// let top = vec![0.0; grid.len()];                               // e = 0 (m/N): top shear
+/// let shear = solver.solve_tangential(&interface, &normal.displacement, &top)?;
+/// let resisted = shear.traction.iter().sum::<f64>() * grid.cell_area();
+/// assert!((resisted + 1.0).abs() < 1e-9);                        // ΔA Σ φ_x = -1 N
+/// // Solving again from the warm start gives the same equilibrium.
+/// let again = solver.solve_normal(&interface, 40.0)?;
+/// assert_eq!(again.states, normal.states);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 pub struct EquilibriumSolver {
     grid: Grid,
     material: Material,

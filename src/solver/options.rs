@@ -8,6 +8,24 @@ use crate::interface::SiteState;
 pub use crate::cost::AUTO_DENSE_LIMIT;
 
 /// Which linear-algebra backend solves the equilibria.
+///
+/// ```
+/// use precursors::solver::{Backend, SolverOptions, AUTO_DENSE_LIMIT};
+/// use precursors::Scene;
+/// let base = Scene::builder()
+///     .block(0.010, 0.004, 0.010)       // Lx, Ly, Lz (m)
+///     .cells(10, 4)                     // 40 cells
+///     .normal_load(40.0);               // F_N (N)
+/// // Auto: dense up to AUTO_DENSE_LIMIT cells, spectral above.
+/// assert!(40 <= AUTO_DENSE_LIMIT);
+/// assert_eq!(base.clone().build()?.driver()?.backend(), Backend::Dense);
+/// let spectral = SolverOptions::default().with_backend(Backend::Spectral)?;
+/// let scene = base.solver_options(spectral).build()?;
+/// assert_eq!(scene.driver()?.backend(), Backend::Spectral);
+/// // As a scene file spells it (`solver.backend`).
+/// assert_eq!(Backend::Spectral.to_string(), "spectral");
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
@@ -205,6 +223,24 @@ pub(crate) fn check_threads(backend: Backend, parallelism: Parallelism) -> Resul
 }
 
 /// How a solve went.
+///
+/// ```
+/// use precursors::solver::{Backend, EquilibriumSolver};
+/// use precursors::green::InfluencePlan;
+/// use precursors::{Block, Grid, HeightDistribution, Heights, Interface, SpringLaw};
+/// let grid = Grid::new(Block::new(0.010, 0.004, 0.010)?, 10, 4)?; // 1 mm cells: ΔA = 1 mm²
+/// let plan = InfluencePlan::builder(grid).build()?;
+/// let heights = Heights::truncated_gaussian(&grid, HeightDistribution::default(), 1)?;
+/// let interface = Interface::new(grid, heights, SpringLaw::default())?;
+/// let mut solver = EquilibriumSolver::builder(plan).build()?;
+/// let report = solver.solve_normal(&interface, 40.0)?.report; // F_N = 40 N
+/// assert_eq!(report.backend, Backend::Dense);                  // Auto, resolved
+/// assert!(report.active_set_iterations >= 1);
+/// assert!(report.force_balance_error < 1e-12);                 // |ΔA Σ φ_z - F_N| / F_N
+/// assert!(report.complementarity < 1e-9);        // φ_z ≥ 0 on contact, u_z ≥ u0 off it
+/// println!("{} flips, {} CG iterations", report.flips, report.linear_iterations);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
@@ -230,6 +266,35 @@ pub struct SolveReport {
 }
 
 /// The normal equilibrium at a given normal load.
+///
+/// ```
+/// use precursors::solver::EquilibriumSolver;
+/// use precursors::SiteState;
+/// use precursors::green::InfluencePlan;
+/// use precursors::{Block, Grid, HeightDistribution, Heights, Interface, SpringLaw};
+/// let grid = Grid::new(Block::new(0.010, 0.004, 0.010)?, 10, 4)?; // 1 mm cells: ΔA = 1 mm²
+/// let plan = InfluencePlan::builder(grid).build()?;
+/// let heights = Heights::truncated_gaussian(&grid, HeightDistribution::default(), 1)?;
+/// let mut interface = Interface::new(grid, heights, SpringLaw::default())?;
+/// let mut solver = EquilibriumSolver::builder(plan).build()?;
+/// let normal = solver.solve_normal(&interface, 40.0)?;           // F_N = 40 N
+/// // The tractions carry the load: ΔA Σ φ_z = F_N (N).
+/// let carried = normal.traction.iter().sum::<f64>() * grid.cell_area();
+/// assert!((carried - normal.normal_load).abs() < 1e-9 * 40.0);
+/// // The spring law on contact, φ_z = k_z (u0 - u_z); no traction off contact.
+/// let k_z = interface.normal_stiffness();                        // N/m³
+/// let largest = normal.traction.iter().fold(0.0f64, |m, p| m.max(*p));
+/// for i in 0..grid.len() {
+///     let (phi, u_z) = (normal.traction[i], normal.displacement[i]);
+///     let u0 = interface.heights()[i];
+///     match normal.states[i] {
+///         SiteState::Attached => assert!((phi - k_z[i] * (u0 - u_z)).abs() <= 1e-6 * largest),
+///         _ => assert_eq!(phi, 0.0),
+///     }
+/// }
+/// interface.set_states(&normal.states)?;                         // the solver changes nothing
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
@@ -253,6 +318,37 @@ pub struct NormalEquilibrium {
 }
 
 /// The tangential response to one newton of shear at a fixed attached set.
+///
+/// ```
+/// use precursors::solver::EquilibriumSolver;
+/// use precursors::SiteState;
+/// use precursors::green::InfluencePlan;
+/// use precursors::{Block, Grid, HeightDistribution, Heights, Interface, SpringLaw};
+/// let grid = Grid::new(Block::new(0.010, 0.004, 0.010)?, 10, 4)?; // 1 mm cells: ΔA = 1 mm²
+/// let plan = InfluencePlan::builder(grid).build()?;
+/// let heights = Heights::truncated_gaussian(&grid, HeightDistribution::default(), 1)?;
+/// let mut interface = Interface::new(grid, heights, SpringLaw::default())?;
+/// let mut solver = EquilibriumSolver::builder(plan).build()?;
+/// let normal = solver.solve_normal(&interface, 40.0)?;           // F_N = 40 N
+/// interface.set_states(&normal.states)?;
+/// // A uniform top shear: no displacement without the springs, e = 0.
+/// let e = vec![0.0; grid.len()];
+/// let shear = solver.solve_tangential(&interface, &normal.displacement, &e)?;
+/// // The springs resist the newton: ΔA Σ φ_x = -1 N.
+/// let resisted = shear.traction.iter().sum::<f64>() * grid.cell_area();
+/// assert!((resisted + 1.0).abs() < 1e-9);
+/// // The spring law on contact, φ_x = -k_x u_x, per newton (Pa/N, m/N).
+/// let k_x = interface.tangential_stiffness(&normal.displacement)?; // N/m³
+/// let largest = shear.traction.iter().fold(0.0f64, |m, g| m.max(g.abs()));
+/// for i in 0..grid.len() {
+///     if interface.states()[i] == SiteState::Attached {
+///         let (g, u) = (shear.traction[i], shear.displacement[i]);
+///         assert!((g + k_x[i] * u).abs() <= 1e-6 * largest);
+///     }
+/// }
+/// assert_eq!(shear.report.active_set_iterations, 1);             // a linear solve
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]

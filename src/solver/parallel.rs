@@ -26,6 +26,33 @@ use std::time::{Duration, Instant};
 /// How many threads the solvers may use. The results are the same, bit for bit, for
 /// every choice (the parts of the grid are fixed by the grid); only the wall time
 /// changes.
+///
+/// ```
+/// use precursors::solver::{Backend, Parallelism, SolverOptions};
+/// use precursors::{Error, Event, Scene};
+/// assert_eq!(Parallelism::default(), Parallelism::Sequential);
+/// assert_eq!(Parallelism::Threads(4).threads(), 4);           // the caller and 3 helpers
+/// assert!(Parallelism::all_cores().threads() >= 1);
+/// // No thread at all is refused; so are threads on the dense backend (one part).
+/// let none = SolverOptions::default().with_parallelism(Parallelism::Threads(0));
+/// assert!(matches!(none, Err(Error::InvalidCount { .. })));
+/// let dense = SolverOptions::default().with_backend(Backend::Dense)?;
+/// let refused = dense.with_parallelism(Parallelism::Threads(2));
+/// assert!(matches!(refused, Err(Error::DenseThreads { threads: 2, .. })));
+/// // The same events, bit for bit, whatever the threads.
+/// let scene = Scene::builder()
+///     .block(0.010, 0.004, 0.010)       // Lx, Ly, Lz (m)
+///     .cells(10, 4)                     // 1 mm cells
+///     .normal_load(40.0)                // F_N (N)
+///     .solver_options(SolverOptions::default().with_backend(Backend::Spectral)?)
+///     .build()?;
+/// let one: Vec<Event> = scene.driver()?.collect::<Result<_, _>>()?;
+/// let mut driver = scene.driver()?;
+/// driver.set_parallelism(Parallelism::Threads(2))?;
+/// let two: Vec<Event> = driver.collect::<Result<_, _>>()?;
+/// assert_eq!(one, two);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]

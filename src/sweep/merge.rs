@@ -15,6 +15,30 @@ pub const LOAD_GRID: [f64; 19] = [
 ];
 
 /// What [`merge`] wrote.
+///
+/// ```
+/// use precursors::sweep::{merge, Sweep, SweepOptions};
+/// let sweep = Sweep::from_json_str(r#"{
+///     "base": { "block": { "lx": 0.01, "ly": 0.004, "lz": 0.01 },
+///               "cells": { "kind": "count", "nx": 10, "ny": 4 },
+///               "normal_load": 40.0 },
+///     "axes": [ { "key": "normal_load", "values": [40.0, 60.0] } ],
+///     "seed": 7
+/// }"#)?;
+/// let out = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
+/// // Half the sweep (share 0 of 2: the run at F_N = 40 N), merged so far.
+/// sweep.execute(&out, &SweepOptions::new().with_shard(0, 2)?, |_| {})?;
+/// let partial = merge(&out)?;
+/// assert_eq!((partial.points, partial.runs_merged, partial.runs_missing), (2, 1, 1));
+/// // The other half, and the merge again.
+/// sweep.execute(&out, &SweepOptions::new().with_shard(1, 2)?, |_| {})?;
+/// let full = merge(&out)?;
+/// assert_eq!((full.runs_merged, full.runs_missing), (2, 0));
+/// let names: Vec<_> = full.files.iter().filter_map(|f| f.file_name()?.to_str()).collect();
+/// assert_eq!(names, ["curves.csv", "slip.csv", "avalanches.csv", "runs.csv"]);
+/// std::fs::remove_dir_all(&out).ok();
+/// # Ok::<(), precursors::sweep::SweepError>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct MergeSummary {
