@@ -1,0 +1,77 @@
+"""precursors: the scalar elastic model of frictional precursors (Taloni, Benassi,
+Sandfeld, Zapperi), from Python.
+
+The Rust crate ``precursors`` behind numpy arrays: scenes, the quasi-static driver and its
+events, the state between events as ``(Ny, Nx)`` float64 arrays (row ``iy``, column
+``ix``), stress probes, checkpoints, runs, sweeps, merges and figures. Units are SI.
+"""
+
+from pathlib import Path
+from typing import Dict, Union
+
+import numpy as np
+
+from ._errors import (
+    NotConvergedError,
+    PrecursorsError,
+    PrecursorsOSError,
+    PrecursorsValueError,
+)
+from ._precursors import (
+    ATTACHED,
+    BROKEN,
+    DETACHED,
+    Checkpoint,
+    Driver,
+    Event,
+    PlaneStress,
+    PointStress,
+    Scene,
+    __version__,
+    merge_files as _merge_files,
+    plot,
+    run,
+    sweep,
+)
+from ._tables import read_table
+
+__all__ = [
+    "ATTACHED",
+    "BROKEN",
+    "DETACHED",
+    "Checkpoint",
+    "Driver",
+    "Event",
+    "NotConvergedError",
+    "PlaneStress",
+    "PointStress",
+    "PrecursorsError",
+    "PrecursorsOSError",
+    "PrecursorsValueError",
+    "Scene",
+    "__version__",
+    "merge",
+    "plot",
+    "read_table",
+    "read_tables",
+    "run",
+    "sweep",
+]
+
+
+def read_tables(directory: Union[str, Path]) -> Dict[str, Dict[str, np.ndarray]]:
+    """The tables of a run directory (``events``, ``curve``, ``contact_map``; those that
+    are complete) as dicts of columns (see ``read_table``)."""
+    directory = Path(directory)
+    return {
+        name: read_table(directory / f"{name}.csv")
+        for name in ("events", "curve", "contact_map")
+        if (directory / f"{name}.csv").is_file()
+    }
+
+
+def merge(directory: Union[str, Path]) -> Dict[str, Dict[str, np.ndarray]]:
+    """Merges the runs of a sweep directory (as ``precursors merge``: the ensemble
+    statistics as CSV files in it) and returns the merged tables, by file name without
+    ``.csv``, as dicts of columns."""
+    return {Path(p).stem: read_table(p) for p in _merge_files(directory)}

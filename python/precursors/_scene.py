@@ -1,0 +1,103 @@
+"""The keyword form of a scene, mapped onto the scene-file format (one schema: the
+crate's, docs/scene-format.md), and the JSON text of a scene dict."""
+
+import json
+from typing import Any, Dict, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+
+def _plain(value: Any) -> Any:
+    # numpy scalars and arrays as JSON numbers and lists.
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"{type(value).__name__} is not a scene-file value")
+
+
+def dumps(scene: Any) -> str:
+    """A dict in the scene-file format as its JSON text."""
+    return json.dumps(scene, default=_plain, allow_nan=True)
+
+
+def scene_dict(
+    *,
+    block: Optional[Tuple[float, float, float]] = None,
+    cells: Optional[Tuple[int, int]] = None,
+    cell_size: Optional[Tuple[float, float]] = None,
+    normal_load: Optional[float] = None,
+    seed: Optional[int] = None,
+    heights: Any = None,
+    young_modulus: Optional[float] = None,
+    poisson_ratio: Optional[float] = None,
+    friction_coefficient: Optional[float] = None,
+    c_x: Optional[float] = None,
+    c_z: Optional[float] = None,
+    drive: Union[str, Dict[str, Any], None] = None,
+    rod: Optional[Tuple[float, float]] = None,
+    backend: Optional[str] = None,
+    threads: Union[int, str, None] = None,
+    probe_planes: Optional[Sequence[float]] = None,
+    probe_points: Optional[Sequence[Tuple[float, float, float]]] = None,
+) -> Dict[str, Any]:
+    """The scene-file dict of the keywords of ``precursors.Scene(...)``; a keyword left
+    out is a key left out (the calibration scene's value)."""
+    scene: Dict[str, Any] = {}
+    if block is not None:
+        lx, ly, lz = block
+        scene["block"] = {"lx": lx, "ly": ly, "lz": lz}
+    if cells is not None and cell_size is not None:
+        raise TypeError("give cells=(nx, ny) or cell_size=(dx, dy), not both")
+    if cells is not None:
+        nx, ny = cells
+        scene["cells"] = {"kind": "count", "nx": nx, "ny": ny}
+    if cell_size is not None:
+        dx, dy = cell_size
+        scene["cells"] = {"kind": "size", "dx": dx, "dy": dy}
+    if normal_load is not None:
+        scene["normal_load"] = normal_load
+    if heights is not None and seed is not None:
+        raise TypeError("give heights=array or seed=n, not both")
+    if seed is not None:
+        scene["heights"] = {"kind": "gaussian", "seed": seed}
+    if heights is not None:
+        # (Ny, Nx), row iy and column ix: C order is the crate's cell order iy*Nx + ix.
+        values = np.asarray(heights, dtype=np.float64)
+        scene["heights"] = {"kind": "values", "values": values.ravel(order="C")}
+    material = {
+        k: v
+        for k, v in (
+            ("young_modulus", young_modulus),
+            ("poisson_ratio", poisson_ratio),
+            ("friction_coefficient", friction_coefficient),
+        )
+        if v is not None
+    }
+    if material:
+        scene["material"] = material
+    springs = {k: v for k, v in (("c_x", c_x), ("c_z", c_z)) if v is not None}
+    if springs:
+        scene["springs"] = springs
+    if rod is not None and drive not in (None, "rod"):
+        raise TypeError("rod=(height, half_width) goes with drive='rod'")
+    if isinstance(drive, dict):
+        scene["drive"] = drive
+    elif rod is not None:
+        height, half_width = rod
+        scene["drive"] = {"kind": "rod", "height": height, "half_width": half_width}
+    elif drive == "rod":
+        pass  # the default drive: the paper's rod
+    elif drive is not None:
+        scene["drive"] = {"kind": drive}
+    solver = {k: v for k, v in (("backend", backend), ("threads", threads)) if v is not None}
+    if solver:
+        scene["solver"] = solver
+    probes: Dict[str, Any] = {}
+    if probe_planes is not None:
+        probes["planes"] = list(probe_planes)
+    if probe_points is not None:
+        probes["points"] = [list(p) for p in probe_points]
+    if probes:
+        scene["probes"] = probes
+    return scene

@@ -1,0 +1,1063 @@
+//! The native part of the Python package `precursors` (`precursors._precursors`): the
+//! crate's public API behind PyO3 classes. The pure-Python part (`python/precursors/`)
+//! holds the exception classes, the keyword form of a scene, the table reader and the
+//! stubs. Units are the crate's (SI); arrays are float64 numpy arrays of shape `(Ny, Nx)`
+//! (row `iy`, column `ix`), always fresh copies of the driver's state.
+
+use std::error::Error as StdError;
+use std::path::PathBuf;
+
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict, PyList};
+
+use precursors::output::RunTables;
+use precursors::solver::Parallelism;
+use precursors::sweep::{Sweep, SweepError, SweepOptions};
+
+// ---------------------------------------------------------------------------------------
+// Errors: the crate's error, its Display text with its causes, as an instance of one of
+// the package's classes (python/precursors/_errors.py).
+
+/// Which Python class an error of the crate maps to.
+#[derive(Clone, Copy)]
+enum Class {
+    /// Bad input (`ValueError` too).
+    Value,
+    /// A file or directory (`OSError` too).
+    Os,
+    /// A solve or a series that did not converge.
+    NotConverged,
+    /// Anything else: `PrecursorsError` itself.
+    Base,
+}
+
+impl Class {
+    fn name(self) -> &'static str {
+        match self {
+            Class::Value => "PrecursorsValueError",
+            Class::Os => "PrecursorsOSError",
+            Class::NotConverged => "NotConvergedError",
+            Class::Base => "PrecursorsError",
+        }
+    }
+}
+
+fn core_class(e: &precursors::Error) -> Class {
+    use precursors::Error as E;
+    match e {
+        E::Io { .. } | E::RunDirectory { .. } | E::DirectoryLocked { .. } => Class::Os,
+        E::SolverNotConverged { .. } | E::SeriesNotConverged { .. } | E::FitNotConverged { .. } => {
+            Class::NotConverged
+        }
+        E::InvalidParameter { .. }
+        | E::InvalidLength { .. }
+        | E::InvalidCount { .. }
+        | E::InvalidChoice { .. }
+        | E::InvalidTolerance { .. }
+        | E::OutOfRange { .. }
+        | E::EmptyGrid { .. }
+        | E::EmptyInput { .. }
+        | E::EmptyContact { .. }
+        | E::GridDoesNotDivide { .. }
+        | E::GridTooLarge { .. }
+        | E::NonFinite { .. }
+        | E::NonPositiveHeight { .. }
+        | E::LengthMismatch { .. }
+        | E::ShapeMismatch { .. }
+        | E::OutsideBlock { .. }
+        | E::RodBandOutsideFace { .. }
+        | E::SingularPoint { .. }
+        | E::SiteOutOfRange { .. }
+        | E::DenseThreads { .. }
+        | E::TooLargeForDense { .. }
+        | E::NoProbes
+        | E::SceneFile { .. }
+        | E::HeightsFile { .. }
+        | E::CheckpointFile { .. }
+        | E::CheckpointSceneMismatch { .. }
+        | E::InvalidCheckpoint { .. }
+        | E::CorruptTable { .. }
+        | E::NonFiniteCell { .. }
+        | E::LoadBeyondFriction { .. } => Class::Value,
+        _ => Class::Base,
+    }
+}
+
+fn sweep_class(e: &SweepError) -> Class {
+    match e {
+        SweepError::Core(e) => core_class(e),
+        SweepError::Directory { .. } => Class::Os,
+        SweepError::File { .. } | SweepError::Axis { .. } | SweepError::TooLarge { .. } => {
+            Class::Value
+        }
+        _ => Class::Base,
+    }
+}
+
+fn plot_class(e: &precursors::plot::PlotError) -> Class {
+    use precursors::plot::PlotError as P;
+    match e {
+        P::Core(e) => core_class(e),
+        P::Sweep(e) => sweep_class(e),
+        _ => Class::Base,
+    }
+}
+
+/// The variant's name (`OutOfRange`), from its `Debug` form; a nesting variant
+/// (`Core(..)`, `Sweep(..)`) gives the name of what it holds.
+fn kind(debug: &str) -> String {
+    let mut rest = debug;
+    loop {
+        let end = rest
+            .find(|c: char| !(c.is_alphanumeric() || c == '_'))
+            .unwrap_or(rest.len());
+        let name = &rest[..end];
+        if (name == "Core" || name == "Sweep") && rest[end..].starts_with('(') {
+            rest = &rest[end + 1..];
+        } else {
+            return name.to_string();
+        }
+    }
+}
+
+/// The error's Display text followed by its causes' (`source()`), a cause skipped when
+/// the text already ends with it (the crate's outer errors repeat the nested one).
+fn message(e: &(dyn StdError + 'static)) -> String {
+    let mut text = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        let s = c.to_string();
+        if !text.ends_with(&s) {
+            text.push_str(": ");
+            text.push_str(&s);
+        }
+        cause = c.source();
+    }
+    text
+}
+
+/// A failure of the crate, ready to become a Python exception.
+struct Failure {
+    class: Class,
+    kind: String,
+    message: String,
+}
+
+impl From<precursors::Error> for Failure {
+    fn from(e: precursors::Error) -> Self {
+        Failure {
+            class: core_class(&e),
+            kind: kind(&format!("{e:?}")),
+            message: message(&e),
+        }
+    }
+}
+
+impl From<SweepError> for Failure {
+    fn from(e: SweepError) -> Self {
+        Failure {
+            class: sweep_class(&e),
+            kind: kind(&format!("{e:?}")),
+            message: message(&e),
+        }
+    }
+}
+
+impl From<precursors::plot::PlotError> for Failure {
+    fn from(e: precursors::plot::PlotError) -> Self {
+        Failure {
+            class: plot_class(&e),
+            kind: kind(&format!("{e:?}")),
+            message: message(&e),
+        }
+    }
+}
+
+impl From<Failure> for PyErr {
+    fn from(f: Failure) -> PyErr {
+        Python::attach(|py| {
+            let raised = (|| -> PyResult<PyErr> {
+                let class = py.import("precursors._errors")?.getattr(f.class.name())?;
+                let value = class.call1((f.message.as_str(),))?;
+                value.setattr("kind", f.kind.as_str())?;
+                Ok(PyErr::from_value(value))
+            })();
+            raised.unwrap_or_else(|e| e)
+        })
+    }
+}
+
+/// `result.or_raise()?`: the crate's error as the package's exception.
+trait OrRaise<T> {
+    fn or_raise(self) -> PyResult<T>;
+}
+
+impl<T, E: Into<Failure>> OrRaise<T> for Result<T, E> {
+    fn or_raise(self) -> PyResult<T> {
+        self.map_err(|e| PyErr::from(e.into()))
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Helpers.
+
+/// A field of the grid, in the cell order `i = iy·Nx + ix`, as a `(Ny, Nx)` array.
+fn field<'py>(
+    py: Python<'py>,
+    grid: &precursors::Grid,
+    values: Vec<f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let array = Array2::from_shape_vec((grid.ny(), grid.nx()), values)
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+    Ok(array.into_pyarray(py))
+}
+
+/// `threads=` as the scene file's `solver.threads` reads a count: 1 the calling thread
+/// only, 0 every core, `n` a pool of `n`.
+fn parallelism(threads: usize) -> Parallelism {
+    match threads {
+        0 => Parallelism::all_cores(),
+        1 => Parallelism::Sequential,
+        n => Parallelism::Threads(n),
+    }
+}
+
+/// A dict in the scene-file format as JSON text, through `precursors._scene.dumps`
+/// (numpy scalars and arrays become numbers and lists).
+fn dumps(py: Python<'_>, value: &Bound<'_, PyAny>) -> PyResult<String> {
+    py.import("precursors._scene")?
+        .call_method1("dumps", (value,))?
+        .extract()
+}
+
+fn build(py: Python<'_>, builder: precursors::SceneBuilder) -> PyResult<Scene> {
+    // Planning the operator takes a while on large grids: without the GIL.
+    let inner = py.detach(|| builder.build()).or_raise()?;
+    Ok(Scene { inner })
+}
+
+// ---------------------------------------------------------------------------------------
+// Scene.
+
+/// A validated scene: the block, the grid, the material, the springs, the heights, the
+/// normal load and the drive (the crate's `Scene`). Build one from a scene file
+/// (`Scene.from_file`), a dict in the scene-file format (`Scene.from_dict`) or keywords
+/// (`Scene(block=(0.14, 0.007, 0.075), cell_size=(0.001, 0.001), normal_load=3500.0)`).
+#[pyclass(module = "precursors", frozen)]
+struct Scene {
+    inner: precursors::Scene,
+}
+
+#[pymethods]
+impl Scene {
+    /// The keyword form: see `precursors.Scene` (python/precursors/_scene.py maps the
+    /// keywords onto the scene-file format; missing keys take the calibration scene's
+    /// values).
+    #[new]
+    #[pyo3(signature = (**kwargs))]
+    fn new(py: Python<'_>, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        let dict = py
+            .import("precursors._scene")?
+            .getattr("scene_dict")?
+            .call((), kwargs)?;
+        Self::from_dict(py, &dict)
+    }
+
+    /// The scene of a JSON scene file (docs/scene-format.md).
+    #[staticmethod]
+    fn from_file(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let builder = py
+            .detach(|| precursors::SceneBuilder::from_json_file(&path))
+            .or_raise()?;
+        build(py, builder)
+    }
+
+    /// The scene of a dict in the scene-file format (the same keys and rules as a file).
+    #[staticmethod]
+    fn from_dict(py: Python<'_>, scene: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let text = dumps(py, scene)?;
+        Self::from_json(py, &text)
+    }
+
+    /// The scene of a scene file's text.
+    #[staticmethod]
+    fn from_json(py: Python<'_>, text: &str) -> PyResult<Self> {
+        let builder = precursors::SceneBuilder::from_json_str(text).or_raise()?;
+        build(py, builder)
+    }
+
+    /// The scene file of this scene (every key, heights as values).
+    fn to_json(&self) -> PyResult<String> {
+        self.inner.to_builder().to_json().or_raise()
+    }
+
+    /// `to_json()` as a dict.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        py.import("json")?.call_method1("loads", (self.to_json()?,))
+    }
+
+    /// The grid and its estimated cost (the crate's `GridCost`): `nx`, `ny`, `cells`,
+    /// `dx`, `dy` (m), `block` (m), `normal_load` (N), `backend`, `memory_bytes`,
+    /// `plan_seconds` and `solve_seconds` (one cold normal + tangential solve, one
+    /// thread; estimates).
+    fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let grid = self.inner.grid();
+        let cost = precursors::GridCost::of(grid.nx(), grid.ny());
+        let block = grid.block();
+        let d = PyDict::new(py);
+        d.set_item("nx", grid.nx())?;
+        d.set_item("ny", grid.ny())?;
+        d.set_item("cells", grid.len())?;
+        d.set_item("dx", grid.dx())?;
+        d.set_item("dy", grid.dy())?;
+        d.set_item("block", (block.lx(), block.ly(), block.lz()))?;
+        d.set_item("normal_load", self.inner.normal_load())?;
+        d.set_item(
+            "backend",
+            self.inner.solver_options().backend().to_string(),
+        )?;
+        d.set_item("memory_bytes", cost.memory_bytes)?;
+        d.set_item("plan_seconds", cost.plan_seconds)?;
+        d.set_item("solve_seconds", cost.solve_seconds)?;
+        Ok(d)
+    }
+
+    /// `(Ny, Nx)`: the shape of every field of the interface.
+    #[getter]
+    fn shape(&self) -> (usize, usize) {
+        (self.inner.grid().ny(), self.inner.grid().nx())
+    }
+
+    /// `(Lx, Ly, Lz)` (m).
+    #[getter]
+    fn block(&self) -> (f64, f64, f64) {
+        let b = self.inner.grid().block();
+        (b.lx(), b.ly(), b.lz())
+    }
+
+    /// `(dx, dy)`: the cell size (m).
+    #[getter]
+    fn cell_size(&self) -> (f64, f64) {
+        (self.inner.grid().dx(), self.inner.grid().dy())
+    }
+
+    /// `F_N` (N).
+    #[getter]
+    fn normal_load(&self) -> f64 {
+        self.inner.normal_load()
+    }
+
+    /// A driver at zero shear. `threads`: 1 the calling thread, 0 every core, `n` a pool
+    /// of `n` (the same events for every choice); `None` keeps the scene's
+    /// `solver.threads`.
+    #[pyo3(signature = (*, threads=None))]
+    fn driver(&self, py: Python<'_>, threads: Option<usize>) -> PyResult<Driver> {
+        let inner = py.detach(|| self.inner.driver()).or_raise()?;
+        Driver::with_threads(inner, threads)
+    }
+
+    /// A driver continuing from `checkpoint` (taken on this scene, probes aside).
+    #[pyo3(signature = (checkpoint, *, threads=None))]
+    fn resume(
+        &self,
+        py: Python<'_>,
+        checkpoint: &Checkpoint,
+        threads: Option<usize>,
+    ) -> PyResult<Driver> {
+        let inner = py
+            .detach(|| self.inner.resume(&checkpoint.inner))
+            .or_raise()?;
+        Driver::with_threads(inner, threads)
+    }
+
+    fn __repr__(&self) -> String {
+        let g = self.inner.grid();
+        let b = g.block();
+        format!(
+            "Scene({} x {} cells, block {} x {} x {} m, F_N = {} N)",
+            g.nx(),
+            g.ny(),
+            b.lx(),
+            b.ly(),
+            b.lz(),
+            self.inner.normal_load()
+        )
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Events.
+
+/// One event of the quasi-static protocol (the crate's `Event`): `kind` is one of
+/// `"load_raised"`, `"rupture"`, `"detach"`, `"attach"`, `"stable"`, `"global_slip"` (the
+/// names of `events.csv`); `index` counts the driver's events (1 for the first).
+/// Attributes a kind does not have are `None`.
+#[pyclass(module = "precursors", frozen, eq)]
+#[derive(PartialEq)]
+struct Event {
+    /// The event's kind.
+    #[pyo3(get)]
+    kind: &'static str,
+    /// The driver's event count after this event (events.csv's `index`).
+    #[pyo3(get)]
+    index: usize,
+    /// The site `i = iy·Nx + ix` (rupture, detach, attach).
+    #[pyo3(get)]
+    site: Option<usize>,
+    /// The site's column (along x, from the trailing edge).
+    #[pyo3(get)]
+    ix: Option<usize>,
+    /// The site's row (along y).
+    #[pyo3(get)]
+    iy: Option<usize>,
+    /// The shear force `F` (N) (load_raised, rupture, stable, global_slip).
+    #[pyo3(get)]
+    force: Option<f64>,
+    /// The drive displacement `U_S` (m) under displacement control.
+    #[pyo3(get)]
+    drive_displacement: Option<f64>,
+    /// The energy released by a rupture (J).
+    #[pyo3(get)]
+    energy: Option<f64>,
+    /// The ruptures of the avalanche that a stable state ends.
+    #[pyo3(get)]
+    ruptures: Option<usize>,
+}
+
+impl Event {
+    fn new(event: &precursors::Event, index: usize) -> Self {
+        use precursors::Event as E;
+        let (kind, site, load, energy, ruptures) = match *event {
+            E::LoadRaised { load } => ("load_raised", None, Some(load), None, None),
+            E::Rupture { site, load, energy } => {
+                ("rupture", Some(site), Some(load), Some(energy), None)
+            }
+            E::Detach { site } => ("detach", Some(site), None, None, None),
+            E::Attach { site } => ("attach", Some(site), None, None, None),
+            E::Stable { load, ruptures } => ("stable", None, Some(load), None, Some(ruptures)),
+            E::GlobalSlip { load } => ("global_slip", None, Some(load), None, None),
+            _ => ("unknown", None, None, None, None),
+        };
+        Event {
+            kind,
+            index,
+            site: site.map(|s| s.index),
+            ix: site.map(|s| s.ix),
+            iy: site.map(|s| s.iy),
+            force: load.map(|l| l.force),
+            drive_displacement: load.and_then(|l| l.drive_displacement),
+            energy,
+            ruptures,
+        }
+    }
+}
+
+#[pymethods]
+impl Event {
+    fn __repr__(&self) -> String {
+        let mut text = format!("Event(index={}, kind='{}'", self.index, self.kind);
+        if let (Some(ix), Some(iy)) = (self.ix, self.iy) {
+            text += &format!(", ix={ix}, iy={iy}");
+        }
+        if let Some(f) = self.force {
+            text += &format!(", force={f:?}");
+        }
+        if let Some(u) = self.drive_displacement {
+            text += &format!(", drive_displacement={u:?}");
+        }
+        if let Some(e) = self.energy {
+            text += &format!(", energy={e:?}");
+        }
+        if let Some(r) = self.ruptures {
+            text += &format!(", ruptures={r}");
+        }
+        text + ")"
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Driver.
+
+/// The quasi-static protocol of a scene (the crate's `Driver`): iterate it for its
+/// events (`for event in driver`), or `step()` / `run(until=...)`; read the state between
+/// events. The solver runs without the GIL. Every array is a new float64 copy.
+#[pyclass(module = "precursors")]
+struct Driver {
+    inner: precursors::Driver,
+}
+
+impl Driver {
+    fn with_threads(mut inner: precursors::Driver, threads: Option<usize>) -> PyResult<Self> {
+        if let Some(n) = threads {
+            inner.set_parallelism(parallelism(n)).or_raise()?;
+        }
+        Ok(Driver { inner })
+    }
+
+    /// The next event, solved without the GIL.
+    fn next_event(&mut self, py: Python<'_>) -> PyResult<Option<Event>> {
+        let driver = &mut self.inner;
+        let event = py.detach(|| driver.step()).or_raise()?;
+        Ok(event.map(|e| Event::new(&e, self.inner.event_count())))
+    }
+}
+
+/// `until=` of `Driver.run`.
+enum Until {
+    Slip,
+    Kind(String),
+    Force(f64),
+}
+
+#[pymethods]
+impl Driver {
+    fn __iter__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+
+    fn __next__(&mut self, py: Python<'_>) -> PyResult<Option<Event>> {
+        self.next_event(py)
+    }
+
+    /// The next event, or `None` after global slip.
+    fn step(&mut self, py: Python<'_>) -> PyResult<Option<Event>> {
+        self.next_event(py)
+    }
+
+    /// Runs events until `until` and returns the last one (`None` if the run had already
+    /// ended): `None` runs to global slip, a kind (`"stable"`, `"rupture"`, ...) stops
+    /// after the first event of that kind, a number stops after the first event whose
+    /// force `F` reaches it (N). Ctrl-C stops between events with `KeyboardInterrupt`
+    /// (the driver stays usable).
+    #[pyo3(signature = (until=None))]
+    fn run(&mut self, py: Python<'_>, until: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Event>> {
+        let until = match until {
+            None => Until::Slip,
+            Some(u) if u.is_instance_of::<pyo3::types::PyString>() => Until::Kind(u.extract()?),
+            Some(u) => {
+                let force: f64 = u.extract()?;
+                if !force.is_finite() {
+                    return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                        "until = {force} is not a finite force (N)"
+                    )));
+                }
+                Until::Force(force)
+            }
+        };
+        if let Until::Kind(kind) = &until {
+            const KINDS: [&str; 6] = [
+                "load_raised",
+                "rupture",
+                "detach",
+                "attach",
+                "stable",
+                "global_slip",
+            ];
+            if !KINDS.contains(&kind.as_str()) {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "until = {kind:?} is not an event kind: one of {KINDS:?}"
+                )));
+            }
+        }
+        let mut last = None;
+        while let Some(event) = self.next_event(py)? {
+            let stop = match &until {
+                Until::Slip => false,
+                Until::Kind(kind) => event.kind == kind.as_str(),
+                Until::Force(force) => event.force.is_some_and(|f| f >= *force),
+            };
+            last = Some(event);
+            if stop {
+                break;
+            }
+            // Ctrl-C between events.
+            py.check_signals()?;
+        }
+        Ok(last)
+    }
+
+    /// A checkpoint of the state (resume it with `Scene.resume`, or the program's
+    /// `precursors resume`).
+    fn checkpoint(&self) -> Checkpoint {
+        Checkpoint {
+            inner: self.inner.checkpoint(),
+        }
+    }
+
+    /// The driver's scene.
+    #[getter]
+    fn scene(&self) -> Scene {
+        Scene {
+            inner: self.inner.scene().clone(),
+        }
+    }
+
+    /// Events so far.
+    #[getter]
+    fn event_count(&self) -> usize {
+        self.inner.event_count()
+    }
+
+    /// The shear force `F` (N).
+    #[getter]
+    fn force(&self) -> f64 {
+        self.inner.force()
+    }
+
+    /// The drive displacement `U_S` (m) under displacement control, else `None`.
+    #[getter]
+    fn drive_displacement(&self) -> Option<f64> {
+        self.inner.load().drive_displacement
+    }
+
+    /// The driving spring's force (N), `None` under force control.
+    #[getter]
+    fn spring_force(&self) -> Option<f64> {
+        self.inner.spring_force()
+    }
+
+    /// `F_N` (N).
+    #[getter]
+    fn normal_load(&self) -> f64 {
+        self.inner.normal_load()
+    }
+
+    /// `μ`.
+    #[getter]
+    fn friction_coefficient(&self) -> f64 {
+        self.inner.friction_coefficient()
+    }
+
+    /// `Lx·Ly` (m²).
+    #[getter]
+    fn nominal_area(&self) -> f64 {
+        self.inner.nominal_area()
+    }
+
+    /// The real contact area `A_R` (m²).
+    #[getter]
+    fn real_contact_area(&self) -> PyResult<f64> {
+        self.inner.real_contact_area().or_raise()
+    }
+
+    /// The precursor length `ℓ` (m).
+    #[getter]
+    fn precursor_length(&self) -> PyResult<f64> {
+        self.inner.precursor_length().or_raise()
+    }
+
+    /// `ℓ` (m) with another threshold of the column contact area's drop.
+    fn precursor_length_with_threshold(&self, drop: f64) -> PyResult<f64> {
+        self.inner.precursor_length_with_threshold(drop).or_raise()
+    }
+
+    /// The mean shear displacement `⟨u_x⟩` (m).
+    #[getter]
+    fn mean_shear_displacement(&self) -> PyResult<f64> {
+        self.inner.mean_shear_displacement().or_raise()
+    }
+
+    /// The threads a solve uses.
+    #[getter]
+    fn threads(&self) -> usize {
+        self.inner.threads()
+    }
+
+    /// `(Ny, Nx)`.
+    #[getter]
+    fn shape(&self) -> (usize, usize) {
+        (self.inner.grid().ny(), self.inner.grid().nx())
+    }
+
+    /// The normal traction `φ_z` of each cell (Pa), `(Ny, Nx)`.
+    #[getter]
+    fn normal_traction<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let v = self.inner.normal_traction().or_raise()?.to_vec();
+        field(py, self.inner.grid(), v)
+    }
+
+    /// The shear traction `φ_x` of each cell (Pa), `(Ny, Nx)`.
+    #[getter]
+    fn shear_traction<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let v = self.inner.shear_traction().or_raise()?.to_vec();
+        field(py, self.inner.grid(), v)
+    }
+
+    /// The normal displacement `u_z` of each cell (m), `(Ny, Nx)`.
+    #[getter]
+    fn normal_displacement<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let v = self.inner.normal_displacement().or_raise()?.to_vec();
+        field(py, self.inner.grid(), v)
+    }
+
+    /// The shear displacement `u_x` of each cell (m), `(Ny, Nx)`.
+    #[getter]
+    fn shear_displacement<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let v = self.inner.shear_displacement().or_raise()?.to_vec();
+        field(py, self.inner.grid(), v)
+    }
+
+    /// The real contact area of each cell (m²), `(Ny, Nx)`.
+    #[getter]
+    fn cell_contact_area<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let v = self.inner.cell_contact_area().or_raise()?;
+        field(py, self.inner.grid(), v)
+    }
+
+    /// The real contact area of each column `ix` (m²), `(Nx,)`.
+    #[getter]
+    fn column_contact_area<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(PyArray1::from_vec(
+            py,
+            self.inner.column_contact_area().or_raise()?,
+        ))
+    }
+
+    /// The shear force `F` (N) at which each site breaks under the Coulomb rule,
+    /// `(Ny, Nx)`.
+    #[getter]
+    fn breaking_loads<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        field(py, self.inner.grid(), self.inner.breaking_loads().to_vec())
+    }
+
+    /// The state of each site, `(Ny, Nx)` uint8: `ATTACHED` (0), `DETACHED` (1), `BROKEN`
+    /// (2).
+    #[getter]
+    fn site_states<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<u8>>> {
+        let grid = self.inner.grid();
+        let codes: Vec<u8> = self
+            .inner
+            .site_states()
+            .iter()
+            .map(|s| match s {
+                precursors::SiteState::Attached => 0,
+                precursors::SiteState::Detached => 1,
+                _ => 2,
+            })
+            .collect();
+        let array = Array2::from_shape_vec((grid.ny(), grid.nx()), codes)
+            .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+        Ok(array.into_pyarray(py))
+    }
+
+    /// Adds stress probes: planes at heights `z` (m) and points `(x, y, z)` (m) inside
+    /// the block, read by `stresses()` from now on.
+    #[pyo3(signature = (*, planes=Vec::new(), points=Vec::new(), tolerance=None))]
+    fn add_probes(
+        &mut self,
+        py: Python<'_>,
+        planes: Vec<f64>,
+        points: Vec<(f64, f64, f64)>,
+        tolerance: Option<f64>,
+    ) -> PyResult<()> {
+        let mut spec = precursors::ProbeSpec::default();
+        for z in planes {
+            spec = spec.with_plane(z);
+        }
+        for (x, y, z) in points {
+            spec = spec.with_point(precursors::Point::new(x, y, z));
+        }
+        if let Some(t) = tolerance {
+            spec = spec.with_tolerance(t).or_raise()?;
+        }
+        let driver = &mut self.inner;
+        py.detach(|| driver.add_probes(&spec)).or_raise()
+    }
+
+    /// The stresses at the probes (the scene's and those added): a dict with `planes`
+    /// (a list of `PlaneStress`) and `points` (a list of `PointStress`).
+    fn stresses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let driver = &self.inner;
+        let stresses = py.detach(|| driver.stresses()).or_raise()?;
+        let planes = PyList::empty(py);
+        for plane in stresses.planes {
+            planes.append(PlaneStress::new(py, plane)?)?;
+        }
+        let points = PyList::empty(py);
+        for p in stresses.points {
+            points.append(PointStress {
+                point: (p.point.x, p.point.y, p.point.z),
+                shear: p.shear,
+                normal: p.normal,
+                coulomb: p.coulomb,
+            })?;
+        }
+        let d = PyDict::new(py);
+        d.set_item("planes", planes)?;
+        d.set_item("points", points)?;
+        Ok(d)
+    }
+
+    fn __repr__(&self) -> String {
+        let g = self.inner.grid();
+        format!(
+            "Driver({} x {} cells, {} events, F = {} N, {} backend, {} thread(s))",
+            g.nx(),
+            g.ny(),
+            self.inner.event_count(),
+            self.inner.force(),
+            self.inner.backend(),
+            self.inner.threads()
+        )
+    }
+}
+
+/// The stresses on a plane `z = const` (Pa, cell averages), each `(Ny, Nx)`; `profile()`
+/// their y-averages along x.
+#[pyclass(module = "precursors", frozen)]
+struct PlaneStress {
+    /// The plane's height (m).
+    #[pyo3(get)]
+    z: f64,
+    /// `τ = σ_xz` (Pa), `(Ny, Nx)`.
+    #[pyo3(get)]
+    shear: Py<PyArray2<f64>>,
+    /// `σ = σ_zz` (Pa), `(Ny, Nx)`.
+    #[pyo3(get)]
+    normal: Py<PyArray2<f64>>,
+    /// `|τ| - μ|σ|` (Pa), `(Ny, Nx)`.
+    #[pyo3(get)]
+    coulomb: Py<PyArray2<f64>>,
+    profile: precursors::Profile,
+}
+
+impl PlaneStress {
+    fn new(py: Python<'_>, plane: precursors::PlaneStress) -> PyResult<Self> {
+        let profile = plane.profile();
+        let shape = (plane.ny, plane.nx);
+        let array = |v: Vec<f64>| -> PyResult<Py<PyArray2<f64>>> {
+            let a = Array2::from_shape_vec(shape, v)
+                .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+            Ok(a.into_pyarray(py).unbind())
+        };
+        Ok(PlaneStress {
+            z: plane.z,
+            shear: array(plane.shear)?,
+            normal: array(plane.normal)?,
+            coulomb: array(plane.coulomb)?,
+            profile,
+        })
+    }
+}
+
+#[pymethods]
+impl PlaneStress {
+    /// The y-averaged profiles along x (Pa), each `(Nx,)`: `shear`, `normal`,
+    /// `coulomb_of_means` (`|τ̄| - μ|σ̄|`, the paper's `τ_C(x, z)`) and `mean_coulomb`.
+    fn profile<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        let p = &self.profile;
+        d.set_item("shear", PyArray1::from_slice(py, &p.shear))?;
+        d.set_item("normal", PyArray1::from_slice(py, &p.normal))?;
+        d.set_item(
+            "coulomb_of_means",
+            PyArray1::from_slice(py, &p.coulomb_of_means),
+        )?;
+        d.set_item("mean_coulomb", PyArray1::from_slice(py, &p.mean_coulomb))?;
+        Ok(d)
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        let shape = self.shear.bind(py).shape().to_vec();
+        format!("PlaneStress(z={:?} m, shape={shape:?})", self.z)
+    }
+}
+
+/// The stresses at a point (Pa).
+#[pyclass(module = "precursors", frozen)]
+struct PointStress {
+    /// `(x, y, z)` (m).
+    #[pyo3(get)]
+    point: (f64, f64, f64),
+    /// `τ = σ_xz` (Pa).
+    #[pyo3(get)]
+    shear: f64,
+    /// `σ = σ_zz` (Pa).
+    #[pyo3(get)]
+    normal: f64,
+    /// `|τ| - μ|σ|` (Pa).
+    #[pyo3(get)]
+    coulomb: f64,
+}
+
+#[pymethods]
+impl PointStress {
+    fn __repr__(&self) -> String {
+        format!(
+            "PointStress(point={:?} m, shear={:?} Pa, normal={:?} Pa, coulomb={:?} Pa)",
+            self.point, self.shear, self.normal, self.coulomb
+        )
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Checkpoints.
+
+/// A driver's state after an event (the crate's `Checkpoint`): to and from files and
+/// bytes (the checkpoint file's JSON, which the program's `precursors resume` reads).
+#[pyclass(module = "precursors", frozen)]
+struct Checkpoint {
+    inner: precursors::Checkpoint,
+}
+
+#[pymethods]
+impl Checkpoint {
+    /// The checkpoint of a file (written by `write_to` or `precursors run --checkpoint`).
+    #[staticmethod]
+    fn read_from(path: PathBuf) -> PyResult<Self> {
+        let inner = precursors::Checkpoint::read_from(path).or_raise()?;
+        Ok(Checkpoint { inner })
+    }
+
+    /// Writes the checkpoint to `path` atomically.
+    fn write_to(&self, path: PathBuf) -> PyResult<()> {
+        self.inner.write_to(path).or_raise()
+    }
+
+    /// The checkpoint file's bytes (UTF-8 JSON).
+    fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        Ok(PyBytes::new(py, self.inner.to_json().or_raise()?.as_bytes()))
+    }
+
+    /// The checkpoint of `to_bytes()`'s bytes.
+    #[staticmethod]
+    fn from_bytes(data: &[u8]) -> PyResult<Self> {
+        let text = std::str::from_utf8(data).map_err(|e| {
+            PyErr::from(Failure::from(precursors::Error::InvalidCheckpoint {
+                reason: format!("the bytes are not UTF-8 text: {e}"),
+            }))
+        })?;
+        let inner = precursors::Checkpoint::from_json_str(text).or_raise()?;
+        Ok(Checkpoint { inner })
+    }
+
+    /// The events before the checkpoint.
+    #[getter]
+    fn event_count(&self) -> usize {
+        self.inner.event_count()
+    }
+
+    /// The scene the checkpoint was taken on (built: resume with `scene.resume(cp)`).
+    fn scene(&self, py: Python<'_>) -> PyResult<Scene> {
+        build(py, self.inner.scene().clone())
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Checkpoint(event_count={})", self.inner.event_count())
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Runs, sweeps, merges, figures.
+
+/// Runs `scene` to global slip writing its tables into `out` (created if missing), as
+/// `precursors run` does: `events.csv`, `curve.csv`, `contact_map.csv` keep their
+/// `.partial` names until global slip. Returns their paths. Ctrl-C stops between events
+/// with `KeyboardInterrupt`, the tables left `.partial`.
+#[pyfunction]
+#[pyo3(signature = (scene, out, *, threads=None))]
+fn run(py: Python<'_>, scene: &Scene, out: PathBuf, threads: Option<usize>) -> PyResult<Vec<PathBuf>> {
+    std::fs::create_dir_all(&out)
+        .map_err(|source| precursors::Error::Io {
+            operation: "creating the output directory",
+            path: out.clone(),
+            source,
+        })
+        .or_raise()?;
+    let mut driver = Driver::with_threads(py.detach(|| scene.inner.driver()).or_raise()?, threads)?
+        .inner;
+    let mut tables = RunTables::create(&out, &driver).or_raise()?;
+    loop {
+        let slipped = py
+            .detach(|| -> precursors::Result<bool> {
+                match driver.step()? {
+                    Some(event) => tables.record(&driver, &event).map(|()| false),
+                    None => Ok(true),
+                }
+            })
+            .or_raise()?;
+        if slipped {
+            break;
+        }
+        if let Err(interrupt) = py.check_signals() {
+            // The rows so far on disk, under their .partial names.
+            let _ = tables.flush();
+            return Err(interrupt);
+        }
+    }
+    Ok(py.detach(|| tables.finish()).or_raise()?.to_vec())
+}
+
+/// Runs the sweep file `file` into `out` on `jobs` parallel runs (`precursors sweep`);
+/// returns the summary (`runs`, `completed`, `skipped`, `held_elsewhere`, `seconds`).
+#[pyfunction]
+#[pyo3(signature = (file, out, *, jobs=1))]
+fn sweep<'py>(py: Python<'py>, file: PathBuf, out: PathBuf, jobs: usize) -> PyResult<Bound<'py, PyDict>> {
+    let summary = py
+        .detach(|| -> Result<_, SweepError> {
+            let sweep = Sweep::from_json_file(&file)?;
+            let options = SweepOptions::new().with_jobs(jobs)?;
+            sweep.execute(&out, &options, |_| {})
+        })
+        .or_raise()?;
+    let d = PyDict::new(py);
+    d.set_item("runs", summary.runs)?;
+    d.set_item("completed", summary.completed)?;
+    d.set_item("skipped", summary.skipped)?;
+    d.set_item("held_elsewhere", summary.held_elsewhere)?;
+    d.set_item("seconds", summary.seconds)?;
+    Ok(d)
+}
+
+/// Merges the runs of the sweep directory `dir` (`precursors merge`); returns the paths
+/// of the merged tables (`precursors.merge` reads them into arrays).
+#[pyfunction]
+fn merge_files(py: Python<'_>, dir: PathBuf) -> PyResult<Vec<PathBuf>> {
+    let summary = py
+        .detach(|| precursors::sweep::merge(&dir))
+        .or_raise()?;
+    Ok(summary.files)
+}
+
+/// Draws the figures of a run or sweep directory into it (`precursors plot`); `formats`
+/// of `"png"`, `"svg"`. Returns the paths of the figures.
+#[pyfunction]
+#[pyo3(signature = (dir, *, formats=vec!["png".to_string()]))]
+fn plot(py: Python<'_>, dir: PathBuf, formats: Vec<String>) -> PyResult<Vec<PathBuf>> {
+    let formats = formats
+        .iter()
+        .map(|f| match f.as_str() {
+            "png" => Ok(precursors::plot::Format::Png),
+            "svg" => Ok(precursors::plot::Format::Svg),
+            other => Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "format {other:?} is not one of \"png\", \"svg\""
+            ))),
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    let drawn = py
+        .detach(|| precursors::plot::draw(&dir, &formats))
+        .or_raise()?;
+    Ok(drawn.files)
+}
+
+/// The native module; `precursors/__init__.py` re-exports it.
+#[pymodule]
+fn _precursors(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Scene>()?;
+    m.add_class::<Driver>()?;
+    m.add_class::<Event>()?;
+    m.add_class::<Checkpoint>()?;
+    m.add_class::<PlaneStress>()?;
+    m.add_class::<PointStress>()?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(merge_files, m)?)?;
+    m.add_function(wrap_pyfunction!(plot, m)?)?;
+    m.add("ATTACHED", 0u8)?;
+    m.add("DETACHED", 1u8)?;
+    m.add("BROKEN", 2u8)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
