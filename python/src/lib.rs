@@ -314,10 +314,7 @@ impl Scene {
         d.set_item("dy", grid.dy())?;
         d.set_item("block", (block.lx(), block.ly(), block.lz()))?;
         d.set_item("normal_load", self.inner.normal_load())?;
-        d.set_item(
-            "backend",
-            self.inner.solver_options().backend().to_string(),
-        )?;
+        d.set_item("backend", self.inner.solver_options().backend().to_string())?;
         d.set_item("memory_bytes", cost.memory_bytes)?;
         d.set_item("plan_seconds", cost.plan_seconds)?;
         d.set_item("solve_seconds", cost.solve_seconds)?;
@@ -918,7 +915,10 @@ impl Checkpoint {
 
     /// The checkpoint file's bytes (UTF-8 JSON).
     fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
-        Ok(PyBytes::new(py, self.inner.to_json().or_raise()?.as_bytes()))
+        Ok(PyBytes::new(
+            py,
+            self.inner.to_json().or_raise()?.as_bytes(),
+        ))
     }
 
     /// The checkpoint of `to_bytes()`'s bytes.
@@ -958,7 +958,12 @@ impl Checkpoint {
 /// with `KeyboardInterrupt`, the tables left `.partial`.
 #[pyfunction]
 #[pyo3(signature = (scene, out, *, threads=None))]
-fn run(py: Python<'_>, scene: &Scene, out: PathBuf, threads: Option<usize>) -> PyResult<Vec<PathBuf>> {
+fn run(
+    py: Python<'_>,
+    scene: &Scene,
+    out: PathBuf,
+    threads: Option<usize>,
+) -> PyResult<Vec<PathBuf>> {
     std::fs::create_dir_all(&out)
         .map_err(|source| precursors::Error::Io {
             operation: "creating the output directory",
@@ -966,8 +971,8 @@ fn run(py: Python<'_>, scene: &Scene, out: PathBuf, threads: Option<usize>) -> P
             source,
         })
         .or_raise()?;
-    let mut driver = Driver::with_threads(py.detach(|| scene.inner.driver()).or_raise()?, threads)?
-        .inner;
+    let mut driver =
+        Driver::with_threads(py.detach(|| scene.inner.driver()).or_raise()?, threads)?.inner;
     let mut tables = RunTables::create(&out, &driver).or_raise()?;
     loop {
         let slipped = py
@@ -994,7 +999,12 @@ fn run(py: Python<'_>, scene: &Scene, out: PathBuf, threads: Option<usize>) -> P
 /// returns the summary (`runs`, `completed`, `skipped`, `held_elsewhere`, `seconds`).
 #[pyfunction]
 #[pyo3(signature = (file, out, *, jobs=1))]
-fn sweep<'py>(py: Python<'py>, file: PathBuf, out: PathBuf, jobs: usize) -> PyResult<Bound<'py, PyDict>> {
+fn sweep<'py>(
+    py: Python<'py>,
+    file: PathBuf,
+    out: PathBuf,
+    jobs: usize,
+) -> PyResult<Bound<'py, PyDict>> {
     let summary = py
         .detach(|| -> Result<_, SweepError> {
             let sweep = Sweep::from_json_file(&file)?;
@@ -1015,9 +1025,7 @@ fn sweep<'py>(py: Python<'py>, file: PathBuf, out: PathBuf, jobs: usize) -> PyRe
 /// of the merged tables (`precursors.merge` reads them into arrays).
 #[pyfunction]
 fn merge_files(py: Python<'_>, dir: PathBuf) -> PyResult<Vec<PathBuf>> {
-    let summary = py
-        .detach(|| precursors::sweep::merge(&dir))
-        .or_raise()?;
+    let summary = py.detach(|| precursors::sweep::merge(&dir)).or_raise()?;
     Ok(summary.files)
 }
 

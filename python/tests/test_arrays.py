@@ -8,6 +8,9 @@ import numpy as np
 
 import precursors
 from precursors import read_table
+from test_events import table_value
+
+_table = np.vectorize(table_value, otypes=[np.float64])
 
 
 def test_arrays_are_float64_copies_shaped_ny_nx(calibration):
@@ -26,7 +29,7 @@ def test_arrays_are_float64_copies_shaped_ny_nx(calibration):
         a = getattr(driver, name)
         assert a.shape == (ny, nx) and a.dtype == np.float64, name
         a[...] = np.nan  # a copy: the driver's state does not change
-        assert np.isfinite(getattr(driver, name)).all(), name
+        assert not np.isnan(getattr(driver, name)).any(), name  # (inf: a site that cannot break)
     assert driver.column_contact_area.shape == (nx,)
     assert driver.site_states.shape == (ny, nx) and driver.site_states.dtype == np.uint8
 
@@ -44,12 +47,14 @@ def test_column_areas_and_curve_match_the_program(calibration, program_run):
     assert len(table["event"]) > 100
     for row, index in enumerate(table["event"].astype(int)):
         want = np.array([table[f"area_m2_ix{ix}"][row] for ix in range(nx)])
-        assert np.array_equal(columns[index], want)
+        # Every digit the table holds (13 significant).
+        assert np.array_equal(_table(columns[index]), want)
         # Summing the (Ny, Nx) map over its rows (y) gives the columns: orientation.
-        np.testing.assert_allclose(cells[index].sum(axis=0), want, rtol=1e-12, atol=0)
+        np.testing.assert_allclose(cells[index].sum(axis=0), want, rtol=1e-11, atol=0)
     table = read_table(program_run / "curve.csv")
     for row, index in enumerate(table["event"].astype(int)):
-        assert curve[index] == (table["real_contact_area_m2"][row], table["precursor_length_m"][row])
+        want = (table["real_contact_area_m2"][row], table["precursor_length_m"][row])
+        assert tuple(table_value(v) for v in curve[index]) == want
 
 
 def test_ruptured_site_is_broken_at_row_iy_column_ix(calibration):

@@ -23,15 +23,19 @@ def _interrupt(body: str, tmp_path: Path, ready) -> subprocess.CompletedProcess:
         text=True,
         cwd=tmp_path,
     )
-    deadline = time.monotonic() + 120
-    while not ready() and child.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.05)
-    assert child.poll() is None, child.communicate()
-    sent = time.monotonic()
-    child.send_signal(signal.SIGINT)
-    out, err = child.communicate(timeout=60)
-    # Between events: well before the run would have ended.
-    assert time.monotonic() - sent < 30
+    try:
+        deadline = time.monotonic() + 120
+        while not ready() and child.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert child.poll() is None, child.communicate()
+        sent = time.monotonic()
+        child.send_signal(signal.SIGINT)
+        # Between events: well before the run would have ended (minutes).
+        out, err = child.communicate(timeout=30)
+        assert time.monotonic() - sent < 30
+    finally:
+        child.kill()
+        child.wait()
     return subprocess.CompletedProcess(child.args, child.returncode, out, err)
 
 
