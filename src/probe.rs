@@ -260,23 +260,45 @@ impl<'a> ProbeInput<'a> {
 
 /// Stresses on one plane, per cell in the paper's order `i = iy·Nx + ix` (Pa).
 ///
-/// Read a cell with [`PlaneStress::at`] (`None` out of range); with the `nalgebra`
-/// feature, a field as an `Ny x Nx` matrix with `Grid::field_to_dmatrix`.
+/// Read a cell with [`PlaneStress::at`] (`None` out of range), a whole field with
+/// [`PlaneStress::shear`], [`PlaneStress::normal`], [`PlaneStress::coulomb`]; with the
+/// `nalgebra` feature, a field as an `Ny x Nx` matrix with `Grid::field_to_dmatrix`. The
+/// fields are read-only: the shape `Nx x Ny`, the three fields and `μ` belong together
+/// ([`PlaneStress::at`] and [`PlaneStress::profile`] rely on it).
+///
+/// ```
+/// use precursors::{ProbeSpec, Scene};
+/// let scene = Scene::builder()
+///     .block(0.020, 0.004, 0.010)
+///     .normal_load(80.0)
+///     .probes(ProbeSpec::default().with_plane(2e-3))
+///     .build()?;
+/// let mut driver = scene.driver()?;
+/// driver.step()?;
+/// let stresses = driver.stresses()?;
+/// let plane = &stresses.planes[0];
+/// assert_eq!((plane.z(), plane.nx(), plane.ny()), (2e-3, 20, 4));
+/// assert_eq!(plane.shear().len(), 20 * 4);
+/// let cell = plane.at(3, 1).unwrap();
+/// assert_eq!(cell.normal, plane.normal()[plane.index(3, 1).unwrap()]);
+/// assert_eq!(plane.profile().normal.len(), 20);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct PlaneStress {
     /// Height of the plane (m).
-    pub z: f64,
+    z: f64,
     /// Cells along x `Nx` (the length of a row).
-    pub nx: usize,
+    nx: usize,
     /// Cells along y `Ny` (the number of rows).
-    pub ny: usize,
+    ny: usize,
     /// Shear stress `τ = σ_xz` (Pa), cell averages.
-    pub shear: Vec<f64>,
+    shear: Vec<f64>,
     /// Normal stress `σ = σ_zz` (Pa, negative in compression), cell averages.
-    pub normal: Vec<f64>,
+    normal: Vec<f64>,
     /// Coulomb stress `τ_C = |τ| - μ|σ|` (Pa) of the cell averages.
-    pub coulomb: Vec<f64>,
+    coulomb: Vec<f64>,
     /// The `μ` of the Coulomb stresses (the driver's, or [`ProbeInput`]'s).
     friction_coefficient: f64,
 }
@@ -308,6 +330,38 @@ pub struct CellStress {
 }
 
 impl PlaneStress {
+    /// Height `z` of the plane (m).
+    pub fn z(&self) -> f64 {
+        self.z
+    }
+
+    /// Cells along x, `Nx` (the length of a row).
+    pub fn nx(&self) -> usize {
+        self.nx
+    }
+
+    /// Cells along y, `Ny` (the number of rows).
+    pub fn ny(&self) -> usize {
+        self.ny
+    }
+
+    /// Shear stress `τ = σ_xz` (Pa), cell averages in the order `i = iy·Nx + ix`.
+    pub fn shear(&self) -> &[f64] {
+        &self.shear
+    }
+
+    /// Normal stress `σ = σ_zz` (Pa, negative in compression), cell averages in the
+    /// order `i = iy·Nx + ix`.
+    pub fn normal(&self) -> &[f64] {
+        &self.normal
+    }
+
+    /// Coulomb stress `τ_C = |τ| - μ|σ|` (Pa) of the cell averages, in the order
+    /// `i = iy·Nx + ix`, with `μ` = [`PlaneStress::friction_coefficient`].
+    pub fn coulomb(&self) -> &[f64] {
+        &self.coulomb
+    }
+
     /// The index `i = iy·Nx + ix` of cell `(ix, iy)`, `None` unless `ix < Nx` and
     /// `iy < Ny`.
     pub fn index(&self, ix: usize, iy: usize) -> Option<usize> {
