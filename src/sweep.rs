@@ -419,7 +419,7 @@ fn check_shard(k: usize, n: usize) -> crate::Result<()> {
 /// let run = &sweep.runs()[1];                                    // F_N = 60 N
 /// let report = sweep.run_one(run, &out)?;
 /// assert!(!report.skipped && !report.held_elsewhere && report.events > 0);
-/// assert!(out.join(&run.dir_name).join(DONE_FILE).is_file());   // marked complete
+/// assert!(out.join(run.dir_name()).join(DONE_FILE).is_file());   // marked complete
 /// // A complete run is not run again.
 /// let again = sweep.run_one(run, &out)?;
 /// assert!(again.skipped && again.events == 0 && again.index == 1);
@@ -484,6 +484,15 @@ pub struct SweepSummary {
 /// coordinate `c` (the value's index on the axis) in axis order and then for the
 /// realization. Stable across versions (a test pins its values): a sweep re-run later,
 /// or extended by realizations, draws the same heights for the same runs.
+///
+/// ```
+/// use precursors::sweep::derive_seed;
+/// let a = derive_seed(7, &[1, 0], 0);
+/// assert_eq!(a, derive_seed(7, &[1, 0], 0));                 // the same run, the same seed
+/// assert_ne!(a, derive_seed(7, &[1, 0], 1));                 // another realization
+/// assert_ne!(a, derive_seed(7, &[0, 1], 0));                 // another point
+/// assert_ne!(a, derive_seed(8, &[1, 0], 0));                 // another sweep seed
+/// ```
 pub fn derive_seed(seed: u64, coordinates: &[usize], realization: usize) -> u64 {
     let mut s = seed;
     for &c in coordinates.iter().chain(std::iter::once(&realization)) {
