@@ -203,6 +203,23 @@ fn check_bracket(name: &'static str, bracket: (f64, f64)) -> Result<()> {
 /// The real contact area at zero shear (m²), averaged over the realizations of
 /// `options`.
 ///
+/// With no seeds, the builder's own heights: the area its driver reaches at the first
+/// stable state.
+///
+/// ```
+/// use precursors::calibration::{normal_contact_area, FitOptions};
+/// use precursors::Scene;
+/// let builder = Scene::builder().block(0.020, 0.004, 0.010).normal_load(100.0);
+/// let area = normal_contact_area(&builder, &FitOptions::default())?;
+/// let mut driver = builder.clone().build()?.driver()?;
+/// driver.step()?;
+/// assert_eq!(area, driver.real_contact_area()?);         // A_R (m²)
+/// // Two realizations: the mean of their areas.
+/// let two = normal_contact_area(&builder, &FitOptions::default().with_seeds(&[1, 2]))?;
+/// assert!(two > 0.0 && two < 0.020 * 0.004);
+/// # Ok::<(), precursors::Error>(())
+/// ```
+///
 /// # Errors
 /// Those of
 /// [`SceneBuilder::build`](crate::SceneBuilder::build) and of the normal solve
@@ -232,6 +249,19 @@ fn normal_area_with(
 /// `target_area` (m², the paper's `α F_N`). Errors: [`Error::InvalidParameter`] when the
 /// bracket does not enclose the target (with the areas at its ends in the message's
 /// value), [`Error::FitNotConverged`] past `max_evaluations`.
+///
+/// The module's example recovers a `c_z`; a bracket that does not enclose the target is
+/// refused:
+///
+/// ```
+/// use precursors::calibration::{fit_normal_stiffness, FitOptions};
+/// use precursors::{Error, Scene};
+/// let base = Scene::builder().block(0.020, 0.004, 0.010).normal_load(100.0);
+/// // An area larger than the block's face (m²) no stiffness reaches.
+/// let e = fit_normal_stiffness(&base, 1.0, (1e7, 1e10), &FitOptions::default());
+/// assert!(matches!(e, Err(Error::InvalidParameter { .. })));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for a target area that is not finite and `> 0`, a bracket
@@ -319,6 +349,19 @@ pub fn fit_normal_stiffness(
 /// The precursor curve of one scene: `(F, ℓ)` (N, m) at every stable state up to global
 /// slip.
 ///
+/// ```
+/// use precursors::calibration::{length_at, precursor_curve};
+/// use precursors::Scene;
+/// let builder = Scene::builder().block(0.020, 0.004, 0.010).normal_load(100.0);
+/// let curve = precursor_curve(&builder)?;                 // (F in N, ℓ in m)
+/// assert!(curve.windows(2).all(|w| w[0].0 <= w[1].0));   // the load only grows
+/// assert!(curve.iter().all(|&(_, l)| (0.0..=0.020).contains(&l)));
+/// let (f, l) = curve[curve.len() / 2];
+/// assert_eq!(length_at(&curve, f), l);
+/// assert_eq!(length_at(&curve, -1.0), 0.0);               // before the first state
+/// # Ok::<(), precursors::Error>(())
+/// ```
+///
 /// # Errors
 /// Those of [`SceneBuilder::build`](crate::SceneBuilder::build) and of the run
 /// ([`Driver::step`](crate::Driver::step)).
@@ -341,6 +384,13 @@ fn curve_with(builder: &SceneBuilder, planner: &Planner) -> Result<Vec<(f64, f64
 
 /// `ℓ` (m) at force `force` (N) on a curve from [`precursor_curve`]: the value of the last
 /// stable state at or below the force (the state holds until the next threshold).
+///
+/// ```
+/// use precursors::calibration::length_at;
+/// let curve = [(1.0, 0.0), (2.0, 3e-3), (4.0, 5e-3)];     // (F in N, ℓ in m)
+/// assert_eq!(length_at(&curve, 3.0), 3e-3);
+/// assert_eq!(length_at(&curve, 0.5), 0.0);
+/// ```
 pub fn length_at(curve: &[(f64, f64)], force: f64) -> f64 {
     curve
         .iter()
@@ -351,6 +401,19 @@ pub fn length_at(curve: &[(f64, f64)], force: f64) -> f64 {
 
 /// Mean squared misfit (m²) of the realization-averaged precursor curve against the
 /// target points `(F, ℓ)` (N, m).
+///
+/// A curve's own points are matched exactly:
+///
+/// ```
+/// use precursors::calibration::{precursor_curve, precursor_misfit, FitOptions};
+/// use precursors::Scene;
+/// let builder = Scene::builder().block(0.020, 0.004, 0.010).normal_load(100.0);
+/// let curve = precursor_curve(&builder)?;
+/// assert_eq!(precursor_misfit(&builder, &curve, &FitOptions::default())?, 0.0);
+/// let off: Vec<_> = curve.iter().map(|&(f, l)| (f, l + 1e-3)).collect();
+/// assert!((precursor_misfit(&builder, &off, &FitOptions::default())? - 1e-6).abs() < 1e-12);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 ///
 /// # Errors
 /// [`Error::EmptyInput`] with no target point; [`Error::NonFinite`] for a target point
@@ -409,6 +472,24 @@ fn misfit_with(
 /// `scan_points` values, then golden sections around the best one down to the relative
 /// `tolerance` (or `max_evaluations`). Among equally good values (the misfit is piecewise
 /// constant) the one found first is kept.
+///
+/// A curve made with `c_x = 2e11` N/m³ is recovered to the options' tolerance (the misfit
+/// is piecewise constant, so the fit returns a value near the target's, not the target):
+///
+/// ```
+/// use precursors::calibration::{fit_tangential_stiffness, precursor_curve, FitOptions};
+/// use precursors::{Scene, SpringLaw};
+/// let base = Scene::builder().block(0.020, 0.004, 0.010).normal_load(100.0);
+/// let law = SpringLaw::default().with_c_x(2e11)?;
+/// let targets = precursor_curve(&base.clone().springs(law))?;
+/// let options = FitOptions::default().with_tolerance(1e-2)?;
+/// let fit = fit_tangential_stiffness(&base, &targets, (1e10, 1e13), &options)?;
+/// // Found within the relative tolerance's reach of 2e11, the lengths within a fraction of
+/// // a 1 mm cell (misfit in m²).
+/// assert!((fit.value / 2e11 - 1.0).abs() < 0.05);
+/// assert!(fit.misfit < 0.1 * 1e-3 * 1e-3);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for a bracket that is not `0 < low < high`; those of

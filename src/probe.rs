@@ -36,7 +36,7 @@
 //! let stresses = driver.stresses()?;
 //! let plane = &stresses.planes[0];
 //! // Force balance through the plane: ∫ σ_zz dA = -F_N.
-//! let total: f64 = plane.normal.iter().sum::<f64>() * scene.grid().cell_area();
+//! let total: f64 = plane.normal().iter().sum::<f64>() * scene.grid().cell_area();
 //! assert!((total + 80.0).abs() < 1e-9 * 80.0);
 //! # Ok::<(), precursors::Error>(())
 //! ```
@@ -260,28 +260,72 @@ impl<'a> ProbeInput<'a> {
 
 /// Stresses on one plane, per cell in the paper's order `i = iy·Nx + ix` (Pa).
 ///
-/// Read a cell with [`PlaneStress::at`] (`None` out of range); with the `nalgebra`
-/// feature, a field as an `Ny x Nx` matrix with `Grid::field_to_dmatrix`.
+/// Read a cell with [`PlaneStress::at`] (`None` out of range), a whole field with
+/// [`PlaneStress::shear`], [`PlaneStress::normal`], [`PlaneStress::coulomb`]; with the
+/// `nalgebra` feature, a field as an `Ny x Nx` matrix with `Grid::field_to_dmatrix`. The
+/// fields are read-only: the shape `Nx x Ny`, the three fields and `μ` belong together
+/// ([`PlaneStress::at`] and [`PlaneStress::profile`] rely on it).
+///
+/// ```
+/// use precursors::{ProbeSpec, Scene};
+/// let scene = Scene::builder()
+///     .block(0.020, 0.004, 0.010)
+///     .normal_load(80.0)
+///     .probes(ProbeSpec::default().with_plane(2e-3))
+///     .build()?;
+/// let mut driver = scene.driver()?;
+/// driver.step()?;
+/// let stresses = driver.stresses()?;
+/// let plane = &stresses.planes[0];
+/// assert_eq!((plane.z(), plane.nx(), plane.ny()), (2e-3, 20, 4));
+/// assert_eq!(plane.shear().len(), 20 * 4);
+/// let cell = plane.at(3, 1).unwrap();
+/// assert_eq!(cell.normal, plane.normal()[plane.index(3, 1).unwrap()]);
+/// assert_eq!(plane.profile().normal.len(), 20);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct PlaneStress {
     /// Height of the plane (m).
-    pub z: f64,
+    z: f64,
     /// Cells along x `Nx` (the length of a row).
-    pub nx: usize,
+    nx: usize,
     /// Cells along y `Ny` (the number of rows).
-    pub ny: usize,
+    ny: usize,
     /// Shear stress `τ = σ_xz` (Pa), cell averages.
-    pub shear: Vec<f64>,
+    shear: Vec<f64>,
     /// Normal stress `σ = σ_zz` (Pa, negative in compression), cell averages.
-    pub normal: Vec<f64>,
+    normal: Vec<f64>,
     /// Coulomb stress `τ_C = |τ| - μ|σ|` (Pa) of the cell averages.
-    pub coulomb: Vec<f64>,
+    coulomb: Vec<f64>,
     /// The `μ` of the Coulomb stresses (the driver's, or [`ProbeInput`]'s).
     friction_coefficient: f64,
 }
 
 /// Profiles along x, averaged over y (one value per column, Pa).
+///
+/// The y-average of a plane: each column's mean of the plane's cells.
+///
+/// ```
+/// use precursors::{Point, ProbeSpec, Scene};
+/// let scene = Scene::builder()
+///     .block(0.020, 0.004, 0.010)
+///     .normal_load(80.0)
+///     .probes(ProbeSpec::default().with_plane(2e-3).with_point(Point::new(0.010, 0.002, 1e-3)))
+///     .build()?;
+/// let mut driver = scene.driver()?;
+/// driver.step()?;                               // the normal equilibrium under F_N = 80 N
+/// let stresses = driver.stresses()?;
+/// let plane = &stresses.planes[0];
+/// let profile = plane.profile();
+/// assert_eq!(profile.normal.len(), plane.nx());
+/// let column_3: f64 = (0..plane.ny()).map(|iy| plane.at(3, iy).unwrap().normal).sum();
+/// assert!((profile.normal[3] - column_3 / plane.ny() as f64).abs() < 1e-9 * column_3.abs());
+/// // Under a normal load only, no column is past the Coulomb threshold.
+/// assert!(profile.coulomb_of_means.iter().all(|&c| c < 0.0));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct Profile {
@@ -296,6 +340,25 @@ pub struct Profile {
 }
 
 /// The stresses of one cell of a plane (Pa, cell averages).
+///
+/// ```
+/// use precursors::{Point, ProbeSpec, Scene};
+/// let scene = Scene::builder()
+///     .block(0.020, 0.004, 0.010)
+///     .normal_load(80.0)
+///     .probes(ProbeSpec::default().with_plane(2e-3).with_point(Point::new(0.010, 0.002, 1e-3)))
+///     .build()?;
+/// let mut driver = scene.driver()?;
+/// driver.step()?;                               // the normal equilibrium under F_N = 80 N
+/// let stresses = driver.stresses()?;
+/// let plane = &stresses.planes[0];
+/// let cell = plane.at(5, 2).unwrap();            // ix = 5, iy = 2
+/// assert_eq!(cell.normal, plane.normal()[2 * plane.nx() + 5]);
+/// let mu = plane.friction_coefficient();
+/// assert!((cell.coulomb - (cell.shear.abs() - mu * cell.normal.abs())).abs() < 1e-6);
+/// assert!(plane.at(plane.nx(), 0).is_none());    // out of range
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct CellStress {
@@ -308,6 +371,38 @@ pub struct CellStress {
 }
 
 impl PlaneStress {
+    /// Height `z` of the plane (m).
+    pub fn z(&self) -> f64 {
+        self.z
+    }
+
+    /// Cells along x, `Nx` (the length of a row).
+    pub fn nx(&self) -> usize {
+        self.nx
+    }
+
+    /// Cells along y, `Ny` (the number of rows).
+    pub fn ny(&self) -> usize {
+        self.ny
+    }
+
+    /// Shear stress `τ = σ_xz` (Pa), cell averages in the order `i = iy·Nx + ix`.
+    pub fn shear(&self) -> &[f64] {
+        &self.shear
+    }
+
+    /// Normal stress `σ = σ_zz` (Pa, negative in compression), cell averages in the
+    /// order `i = iy·Nx + ix`.
+    pub fn normal(&self) -> &[f64] {
+        &self.normal
+    }
+
+    /// Coulomb stress `τ_C = |τ| - μ|σ|` (Pa) of the cell averages, in the order
+    /// `i = iy·Nx + ix`, with `μ` = [`PlaneStress::friction_coefficient`].
+    pub fn coulomb(&self) -> &[f64] {
+        &self.coulomb
+    }
+
     /// The index `i = iy·Nx + ix` of cell `(ix, iy)`, `None` unless `ix < Nx` and
     /// `iy < Ny`.
     pub fn index(&self, ix: usize, iy: usize) -> Option<usize> {
@@ -364,6 +459,22 @@ impl PlaneStress {
 }
 
 /// Stresses at one point (Pa).
+///
+/// ```
+/// use precursors::{Point, ProbeSpec, Scene};
+/// let scene = Scene::builder()
+///     .block(0.020, 0.004, 0.010)
+///     .normal_load(80.0)
+///     .probes(ProbeSpec::default().with_plane(2e-3).with_point(Point::new(0.010, 0.002, 1e-3)))
+///     .build()?;
+/// let mut driver = scene.driver()?;
+/// driver.step()?;                               // the normal equilibrium under F_N = 80 N
+/// let stresses = driver.stresses()?;
+/// let p = &stresses.points[0];
+/// assert_eq!(p.point, Point::new(0.010, 0.002, 1e-3));
+/// assert!(p.normal < 0.0 && p.coulomb < 0.0);       // compressed, below the threshold
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct PointStress {
@@ -378,6 +489,26 @@ pub struct PointStress {
 }
 
 /// Everything the probes measured in one state.
+///
+/// The block carries `F_N` on every plane: the normal stresses of a plane sum, over the
+/// cells, to `-F_N` (force balance of the slab above it).
+///
+/// ```
+/// use precursors::{Point, ProbeSpec, Scene};
+/// let scene = Scene::builder()
+///     .block(0.020, 0.004, 0.010)
+///     .normal_load(80.0)
+///     .probes(ProbeSpec::default().with_plane(2e-3).with_point(Point::new(0.010, 0.002, 1e-3)))
+///     .build()?;
+/// let mut driver = scene.driver()?;
+/// driver.step()?;                               // the normal equilibrium under F_N = 80 N
+/// let stresses = driver.stresses()?;
+/// assert_eq!((stresses.planes.len(), stresses.points.len()), (1, 1));
+/// let cell_area = 1e-3 * 1e-3;                      // 1 mm cells (m²)
+/// let force: f64 = stresses.planes[0].normal().iter().sum::<f64>() * cell_area;
+/// assert!((force + 80.0).abs() < 1e-6 * 80.0);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct Stresses {
@@ -407,6 +538,25 @@ struct PointProbe {
 
 /// Stress probes planned once for a geometry (and a lateral load, if any); evaluated on
 /// any state by [`StressProbe::evaluate`].
+///
+/// Uniform bottom tractions that balance a top shear `F` and a normal load `F_N` leave the
+/// block in a uniform stress state, `τ = F/(Lx Ly)` and `σ = -F_N/(Lx Ly)` on every plane
+/// (the elementary equilibrium of a box, independent of the Green function):
+///
+/// ```
+/// use precursors::{green::InfluencePlan, Block, Grid, ProbeInput, ProbeSpec, StressProbe};
+/// let block = Block::new(0.010, 0.004, 0.006)?;
+/// let grid = Grid::new(block, 10, 4)?;
+/// let plan = InfluencePlan::builder(grid).build()?;
+/// let probe = StressProbe::new(&plan, &ProbeSpec::default().with_plane(3e-3), None)?;
+/// let (force, normal_load, area) = (2.0, 50.0, 0.010 * 0.004);
+/// let (phi_x, phi_z) = (vec![-force / area; 40], vec![normal_load / area; 40]);
+/// let input = ProbeInput::new(&phi_x, &phi_z).with_loads(force, 0.0, normal_load)?;
+/// let plane = &probe.evaluate(&input)?.planes[0];
+/// assert!(plane.shear().iter().all(|&t| (t - force / area).abs() < 1e-8 * force / area));
+/// assert!(plane.normal().iter().all(|&s| (s + normal_load / area).abs() < 1e-8 * normal_load / area));
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct StressProbe {
     grid: Grid,

@@ -172,8 +172,8 @@ impl Default for Drive {
 ///
 /// ```
 /// use precursors::{Error, HeightSource, Scene};
-/// // The default: the paper's truncated Gaussian (mean 1 µm, sd 1 µm), seed 0.
-/// assert!(matches!(HeightSource::default(), HeightSource::Random { seed: 0, .. }));
+/// // The default: the paper's truncated Gaussian (mean 1 µm, sd 1 µm), seed 1.
+/// assert!(matches!(HeightSource::default(), HeightSource::Random { seed: 1, .. }));
 /// // Given heights (m), one per cell in the order i = iy·Nx + ix: 1 to 2 µm along x.
 /// let values: Vec<f64> = (0..40).map(|i| 1e-6 * (1.0 + (i % 10) as f64 / 9.0)).collect();
 /// let base = Scene::builder()
@@ -862,6 +862,7 @@ impl Scene {
 #[cfg(test)]
 mod leaves_out {
     use super::*;
+    use crate::green::built;
 
     fn small() -> SceneBuilder {
         Scene::builder()
@@ -881,6 +882,64 @@ mod leaves_out {
             .unwrap();
         assert!(rod.inner.rod.is_some() && rod.inner.lateral_response.is_some());
         assert!(rod.inner.probe.is_some());
+    }
+
+    #[test]
+    fn scenes_of_one_geometry_share_one_plan() {
+        let planner = Planner::new();
+        built::take();
+        for seed in 1..=3 {
+            small()
+                .seed(seed)
+                .normal_load(40.0 * seed as f64)
+                .build_with_planner(&planner)
+                .unwrap();
+        }
+        assert_eq!(built::take().plans, 1);
+        // Another geometry gets its own plan; without a planner, each build plans.
+        small().cells(5, 2).build_with_planner(&planner).unwrap();
+        small().build().unwrap();
+        assert_eq!(built::take().plans, 2);
+    }
+
+    #[test]
+    fn a_scene_builds_only_the_load_series_and_transfers_it_uses() {
+        let planes = || ProbeSpec::default().with_plane(2e-3).with_plane(5e-3);
+        let top = || small().drive(Drive::Force(ForceLoad::Top));
+        let cases = [
+            (top(), (0, 0)),
+            (top().probes(planes()), (0, 2)),
+            // The rod's displacements; with probes, also its stresses on each plane.
+            (small(), (1, 0)),
+            (small().probes(planes()), (3, 2)),
+        ];
+        built::take();
+        for (builder, (load_series, transfers)) in cases {
+            builder.build().unwrap();
+            let b = built::take();
+            assert_eq!(
+                (b.plans, b.load_series, b.transfers),
+                (1, load_series, transfers)
+            );
+        }
+    }
+
+    #[test]
+    fn a_driver_builds_no_plan_series_or_transfer_of_its_own() {
+        let scene = small()
+            .probes(ProbeSpec::default().with_plane(2e-3))
+            .build()
+            .unwrap();
+        built::take();
+        let mut driver = scene.driver().unwrap();
+        for _ in 0..50 {
+            if driver.step().unwrap().is_none() {
+                break;
+            }
+        }
+        driver.stresses().unwrap();
+        let b = built::take();
+        assert_eq!((b.plans, b.load_series, b.transfers), (0, 0, 0));
     }
 
     #[test]

@@ -166,6 +166,10 @@ fn read_axes(spec: &SweepSpec, file_error: impl Fn(String) -> SweepError) -> Res
 
 /// One run of a sweep: a parameter point, a realization, its seed and its scene.
 ///
+/// Read-only: [`Sweep::run_one`] runs the scene in the directory `dir_name` under the
+/// sweep's output directory, and the seed, the values and the directory name belong to
+/// the scene (a run is taken from [`Sweep::runs`] or [`Sweep::shard`]).
+///
 /// ```
 /// use precursors::sweep::{derive_seed, Sweep};
 /// // Two normal loads F_N (N) on a 10 x 4 grid of 1 mm cells, two realizations each.
@@ -177,13 +181,13 @@ fn read_axes(spec: &SweepSpec, file_error: impl Fn(String) -> SweepError) -> Res
 ///     "seed": 7
 /// }"#)?;
 /// let run = &sweep.runs()[3];                  // the second load's second realization
-/// assert_eq!((run.point, run.realization), (1, 1));
-/// assert_eq!(run.index, run.point * sweep.realizations() + run.realization);
-/// assert_eq!(run.coordinates, [1]);
-/// assert_eq!(run.values, [("normal_load".to_string(), "60.0".to_string())]);
-/// assert_eq!(run.seed, derive_seed(7, &run.coordinates, run.realization));
-/// assert_eq!(run.dir_name, "p0001-r0001");
-/// assert_eq!(run.scene.clone().build()?.normal_load(), 60.0); // F_N (N)
+/// assert_eq!((run.point(), run.realization()), (1, 1));
+/// assert_eq!(run.index(), run.point() * sweep.realizations() + run.realization());
+/// assert_eq!(run.coordinates(), [1]);
+/// assert_eq!(run.values(), [("normal_load".to_string(), "60.0".to_string())]);
+/// assert_eq!(run.seed(), derive_seed(7, run.coordinates(), run.realization()));
+/// assert_eq!(run.dir_name(), "p0001-r0001");
+/// assert_eq!(run.scene().clone().build()?.normal_load(), 60.0); // F_N (N)
 /// # Ok::<(), precursors::sweep::SweepError>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
@@ -191,22 +195,67 @@ fn read_axes(spec: &SweepSpec, file_error: impl Fn(String) -> SweepError) -> Res
 pub struct SweepRun {
     /// Position in the sweep's run order (points in axis order, the last axis fastest;
     /// realizations innermost): `point · realizations + realization`.
-    pub index: usize,
+    index: usize,
     /// The parameter point (row-major over the axes).
-    pub point: usize,
+    point: usize,
     /// The index of the value on each axis.
-    pub coordinates: Vec<usize>,
+    coordinates: Vec<usize>,
     /// The realization (`0 .. realizations`).
-    pub realization: usize,
+    realization: usize,
     /// The heights' seed ([`derive_seed`]).
-    pub seed: u64,
+    seed: u64,
     /// Each key and its value, the value as JSON text (`"0.02"`, `"{\"kind\":\"side\"}"`),
     /// in the order of [`Sweep::keys`] (a linked axis gives one pair per key).
-    pub values: Vec<(String, String)>,
+    values: Vec<(String, String)>,
     /// The run's scene.
-    pub scene: SceneBuilder,
+    scene: SceneBuilder,
     /// The run's directory under the sweep's output directory: `p{point:04}-r{realization:04}`.
-    pub dir_name: String,
+    dir_name: String,
+}
+
+impl SweepRun {
+    /// Position in the sweep's run order (points in axis order, the last axis fastest;
+    /// realizations innermost): `point · realizations + realization`.
+    pub fn index(&self) -> usize {
+        self.index
+    }
+
+    /// The parameter point (row-major over the axes).
+    pub fn point(&self) -> usize {
+        self.point
+    }
+
+    /// The index of the value on each axis.
+    pub fn coordinates(&self) -> &[usize] {
+        &self.coordinates
+    }
+
+    /// The realization (`0 .. realizations`).
+    pub fn realization(&self) -> usize {
+        self.realization
+    }
+
+    /// The heights' seed ([`derive_seed`]).
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// Each key and its value, the value as JSON text (`"0.02"`, `"{\"kind\":\"side\"}"`),
+    /// in the order of [`Sweep::keys`] (a linked axis gives one pair per key).
+    pub fn values(&self) -> &[(String, String)] {
+        &self.values
+    }
+
+    /// The run's scene.
+    pub fn scene(&self) -> &SceneBuilder {
+        &self.scene
+    }
+
+    /// The run's directory under the sweep's output directory:
+    /// `p{point:04}-r{realization:04}`.
+    pub fn dir_name(&self) -> &str {
+        &self.dir_name
+    }
 }
 
 /// A sweep, validated: every run's scene passed the checks [`SceneBuilder::build`] makes
@@ -370,7 +419,7 @@ fn check_shard(k: usize, n: usize) -> crate::Result<()> {
 /// let run = &sweep.runs()[1];                                    // F_N = 60 N
 /// let report = sweep.run_one(run, &out)?;
 /// assert!(!report.skipped && !report.held_elsewhere && report.events > 0);
-/// assert!(out.join(&run.dir_name).join(DONE_FILE).is_file());   // marked complete
+/// assert!(out.join(run.dir_name()).join(DONE_FILE).is_file());   // marked complete
 /// // A complete run is not run again.
 /// let again = sweep.run_one(run, &out)?;
 /// assert!(again.skipped && again.events == 0 && again.index == 1);
@@ -435,6 +484,15 @@ pub struct SweepSummary {
 /// coordinate `c` (the value's index on the axis) in axis order and then for the
 /// realization. Stable across versions (a test pins its values): a sweep re-run later,
 /// or extended by realizations, draws the same heights for the same runs.
+///
+/// ```
+/// use precursors::sweep::derive_seed;
+/// let a = derive_seed(7, &[1, 0], 0);
+/// assert_eq!(a, derive_seed(7, &[1, 0], 0));                 // the same run, the same seed
+/// assert_ne!(a, derive_seed(7, &[1, 0], 1));                 // another realization
+/// assert_ne!(a, derive_seed(7, &[0, 1], 0));                 // another point
+/// assert_ne!(a, derive_seed(8, &[1, 0], 0));                 // another sweep seed
+/// ```
 pub fn derive_seed(seed: u64, coordinates: &[usize], realization: usize) -> u64 {
     let mut s = seed;
     for &c in coordinates.iter().chain(std::iter::once(&realization)) {

@@ -51,11 +51,11 @@ fn same_bits(a: &Stresses, b: &Stresses) -> bool {
     a.planes.len() == b.planes.len()
         && a.points.len() == b.points.len()
         && a.planes.iter().zip(&b.planes).all(|(p, q)| {
-            p.z.to_bits() == q.z.to_bits()
-                && (p.nx, p.ny) == (q.nx, q.ny)
-                && bits(&p.shear) == bits(&q.shear)
-                && bits(&p.normal) == bits(&q.normal)
-                && bits(&p.coulomb) == bits(&q.coulomb)
+            p.z().to_bits() == q.z().to_bits()
+                && (p.nx(), p.ny()) == (q.nx(), q.ny())
+                && bits(p.shear()) == bits(q.shear())
+                && bits(p.normal()) == bits(q.normal())
+                && bits(p.coulomb()) == bits(q.coulomb())
         })
         && a.points.iter().zip(&b.points).all(|(p, q)| {
             p.point == q.point
@@ -83,10 +83,10 @@ fn probe_types_are_named_from_the_crate_root() {
     let input: ProbeInput<'_> = ProbeInput::new(&phi, &phi)
         .with_friction_coefficient(0.5)
         .unwrap();
-    assert_eq!(probe.evaluate(&input).unwrap().planes[0].shear, phi);
+    assert_eq!(probe.evaluate(&input).unwrap().planes[0].shear(), phi);
     assert!(points.is_empty());
     assert_eq!(profile.shear.len(), 12);
-    assert_eq!(cell.shear, plane.shear[0]);
+    assert_eq!(cell.shear, plane.shear()[0]);
 }
 
 #[test]
@@ -115,7 +115,7 @@ fn plane_cells_are_read_by_column_and_row() {
     step_to(&mut driver, load_raised, 1);
     let stresses = driver.stresses().unwrap();
     let plane = &stresses.planes[0];
-    assert_eq!((plane.nx, plane.ny), (5, 3));
+    assert_eq!((plane.nx(), plane.ny()), (5, 3));
     let shear = driver.shear_traction().unwrap();
     let normal = driver.normal_traction().unwrap();
     let mu = driver.friction_coefficient();
@@ -158,7 +158,7 @@ fn plane_stresses_carry_the_friction_coefficient() {
     let plane = &stresses.planes[0];
     assert_eq!(plane.friction_coefficient(), 0.7);
     let profile = plane.profile();
-    for ix in 0..plane.nx {
+    for ix in 0..plane.nx() {
         let expected = profile.shear[ix].abs() - 0.7 * profile.normal[ix].abs();
         assert_eq!(profile.coulomb_of_means[ix], expected);
     }
@@ -357,7 +357,7 @@ fn probes_added_to_a_driver_equal_scene_probes_bit_for_bit() {
         .unwrap();
     let s = a.stresses().unwrap();
     assert_eq!(
-        s.planes.iter().map(|p| p.z).collect::<Vec<_>>(),
+        s.planes.iter().map(|p| p.z()).collect::<Vec<_>>(),
         [0.0, 2e-3, 5e-3]
     );
     // A probe outside the block is refused and adds nothing.

@@ -132,7 +132,7 @@ fn driver_fields_and_plane_stresses_as_matrices() {
         .unwrap();
     let stresses = driver.stresses().unwrap();
     let plane = &stresses.planes[0];
-    let plane_shear = g.field_to_dmatrix(&plane.shear).unwrap();
+    let plane_shear = g.field_to_dmatrix(plane.shear()).unwrap();
     for iy in 0..3 {
         for ix in 0..5 {
             let i = 5 * iy + ix;

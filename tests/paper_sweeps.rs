@@ -107,7 +107,7 @@ fn every_sweep_file_expands_to_its_documented_runs() {
 
 /// A run's scene as the scene file's JSON (every key written).
 fn scene(run: &SweepRun) -> Value {
-    serde_json::from_str(&run.scene.to_json().unwrap()).unwrap()
+    serde_json::from_str(&run.scene().to_json().unwrap()).unwrap()
 }
 
 fn num(v: &Value, path: &str) -> f64 {
@@ -217,13 +217,13 @@ fn every_point_is_its_captions_scene_on_1_mm_cells() {
             let s = scene(run);
             // Realizations differ by the seed only.
             assert_eq!(s["heights"]["kind"], "gaussian", "{name}");
-            assert_eq!(s["heights"]["seed"], run.seed, "{name}");
-            if run.realization > 0 {
+            assert_eq!(s["heights"]["seed"], run.seed(), "{name}");
+            if run.realization() > 0 {
                 continue;
             }
             varied.push(check_caption(name, &s));
             // 1 mm cells (the paper's), within the grid-size guard.
-            let grid = run.scene.grid().unwrap_or_else(|e| panic!("{name}: {e}"));
+            let grid = run.scene().grid().unwrap_or_else(|e| panic!("{name}: {e}"));
             let block = grid.block();
             assert_eq!(
                 (grid.nx(), grid.ny()),
@@ -234,10 +234,10 @@ fn every_point_is_its_captions_scene_on_1_mm_cells() {
                 "{name}"
             );
             // Planned and built (a few seconds for all: the largest grid has 3948 cells).
-            run.scene
+            run.scene()
                 .clone()
                 .build_with_planner(&planner)
-                .unwrap_or_else(|e| panic!("{name} point {}: {e}", run.point));
+                .unwrap_or_else(|e| panic!("{name} point {}: {e}", run.point()));
         }
         assert_eq!(varied.len(), points, "{name}");
         assert_eq!(sweep.runs().len(), points * realizations, "{name}");

@@ -254,7 +254,7 @@ fn probes_and_displacements_match_a_finite_volume_solve() {
         results.push([bx, bz, x.stress(&grid, z_p, m), z.stress(&grid, z_p, m)]);
     }
     let names = ["u_x(z=0)", "u_z(z=0)", "tau(z=2mm)", "sigma(z=2mm)"];
-    let crate_values = [&ux, &uz, &crate_plane.shear, &crate_plane.normal];
+    let crate_values = [&ux[..], &uz[..], crate_plane.shear(), crate_plane.normal()];
     for q in 0..4 {
         let fine = &results[1][q];
         let extrapolated = richardson(&results[0][q], fine);
@@ -284,8 +284,8 @@ fn force_balance_through_every_plane() {
     for (plane, z) in out.planes.iter().zip(heights) {
         // The slab above z carries the top load and the part of the band above z.
         let above = ((4e-3 - z) / 2e-3).clamp(0.0, 1.0);
-        let shear: f64 = plane.shear.iter().sum::<f64>() * grid.cell_area();
-        let normal: f64 = plane.normal.iter().sum::<f64>() * grid.cell_area();
+        let shear: f64 = plane.shear().iter().sum::<f64>() * grid.cell_area();
+        let normal: f64 = plane.normal().iter().sum::<f64>() * grid.cell_area();
         let expected = f_top + f_lat * above;
         assert!(
             (shear - expected).abs() < 1e-9 * f_lat,
@@ -319,10 +319,10 @@ fn planes_at_the_interface_and_the_top_give_the_tractions() {
     let out = probe.evaluate(&input).unwrap();
     let area = block.lx() * block.ly();
     for i in 0..grid.len() {
-        assert!((out.planes[0].shear[i] + phi_x[i]).abs() < 1e-12 * phi_x[i].abs());
-        assert!((out.planes[0].normal[i] + phi_z[i]).abs() < 1e-12 * phi_z[i].abs());
-        assert!((out.planes[1].shear[i] - f_top / area).abs() < 1e-9 * f_top / area);
-        assert!((out.planes[1].normal[i] + f_n / area).abs() < 1e-9 * f_n / area);
+        assert!((out.planes[0].shear()[i] + phi_x[i]).abs() < 1e-12 * phi_x[i].abs());
+        assert!((out.planes[0].normal()[i] + phi_z[i]).abs() < 1e-12 * phi_z[i].abs());
+        assert!((out.planes[1].shear()[i] - f_top / area).abs() < 1e-9 * f_top / area);
+        assert!((out.planes[1].normal()[i] + f_n / area).abs() < 1e-9 * f_n / area);
     }
     let c = grid.index(1, 0).unwrap();
     assert!((out.points[0].shear + phi_x[c]).abs() < 1e-12 * phi_x[c].abs());
@@ -372,8 +372,8 @@ fn point_probes_averaged_over_a_cell_give_the_plane() {
     let c = grid.index(2, 1).unwrap();
     let plane = &out.planes[0];
     // The stress is smooth at z = 1.5 mm: 6-point rules integrate it to ~1e-10.
-    assert!((shear / cell_area - plane.shear[c]).abs() < 1e-8 * plane.shear[c].abs());
-    assert!((normal / cell_area - plane.normal[c]).abs() < 1e-8 * plane.normal[c].abs());
+    assert!((shear / cell_area - plane.shear()[c]).abs() < 1e-8 * plane.shear()[c].abs());
+    assert!((normal / cell_area - plane.normal()[c]).abs() < 1e-8 * plane.normal()[c].abs());
 }
 
 #[test]
@@ -454,11 +454,11 @@ fn the_driver_reports_probes_only_when_requested() {
     let normal = d.normal_traction().unwrap();
     // Exactly, at z = 0 (no transform is applied there).
     for i in 0..scene.grid().len() {
-        assert_eq!(s.planes[0].shear[i], -shear[i]);
-        assert_eq!(s.planes[0].normal[i], -normal[i]);
+        assert_eq!(s.planes[0].shear()[i], -shear[i]);
+        assert_eq!(s.planes[0].normal()[i], -normal[i]);
     }
     // Through z = 2 mm (below the rod band [4, 8] mm) the whole shear force passes.
-    let total: f64 = s.planes[1].shear.iter().sum::<f64>() * scene.grid().cell_area();
+    let total: f64 = s.planes[1].shear().iter().sum::<f64>() * scene.grid().cell_area();
     assert!((total - d.force()).abs() < 1e-9 * d.force());
     let profile = s.planes[1].profile();
     assert_eq!(profile.shear.len(), scene.grid().nx());

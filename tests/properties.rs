@@ -329,8 +329,8 @@ proptest! {
         let tol = 1e-9 * (face * (max_abs(&phi_x) + max_abs(&phi_z)) + f_lat * (1.0 + block.lx() / lz) + f_top + f_n);
         for (plane, z) in out.planes.iter().zip(&heights) {
             let above = ((hi - z) / (hi - lo)).clamp(0.0, 1.0);
-            let shear: f64 = plane.shear.iter().sum::<f64>() * area;
-            let normal: f64 = plane.normal.iter().sum::<f64>() * area;
+            let shear: f64 = plane.shear().iter().sum::<f64>() * area;
+            let normal: f64 = plane.normal().iter().sum::<f64>() * area;
             let expected = f_top + f_lat * above;
             prop_assert!((shear - expected).abs() <= tol, "z = {}: ∫τ = {} vs {}", z, shear, expected);
             prop_assert!((normal + f_n).abs() <= tol, "z = {}: ∫σ = {} vs {}", z, normal, -f_n);

@@ -141,9 +141,9 @@ fn a_sweep_leaves_a_run_held_elsewhere_to_its_holder() {
     let dir = scratch("held");
     // Another writer holds run 3's directory (here: this process, through the tables of
     // a run; the lock is per open file, so the sweep's threads are refused it too).
-    let held = dir.join(&sweep.runs()[3].dir_name);
+    let held = dir.join(sweep.runs()[3].dir_name());
     std::fs::create_dir_all(&held).unwrap();
-    let holder_scene = sweep.runs()[3].scene.clone().build().unwrap();
+    let holder_scene = sweep.runs()[3].scene().clone().build().unwrap();
     let holder = RunTables::create(&held, &holder_scene.driver().unwrap()).unwrap();
     let first = sweep
         .execute(&dir, &SweepOptions::new().with_jobs(2).unwrap(), |_| {})

@@ -137,16 +137,16 @@ fn linked_axes_move_their_keys_together() {
     assert_eq!((sweep.points(), sweep.runs().len()), (2, 4));
     assert_eq!(sweep.keys(), ["block.lz", "drive.height"]);
     let run = &sweep.runs()[2];
-    assert_eq!((run.point, run.coordinates.clone()), (1, vec![1]));
-    assert_eq!(run.seed, derive_seed(11, &[1], 0));
+    assert_eq!((run.point(), run.coordinates().to_vec()), (1, vec![1]));
+    assert_eq!(run.seed(), derive_seed(11, &[1], 0));
     assert_eq!(
-        run.values,
+        run.values(),
         [
             ("block.lz".to_string(), "0.03".to_string()),
             ("drive.height".to_string(), "0.012".to_string())
         ]
     );
-    let json = run.scene.to_json().unwrap();
+    let json = run.scene().to_json().unwrap();
     assert!(
         json.contains("\"lz\": 0.03") && json.contains("\"height\": 0.012"),
         "{json}"
@@ -156,7 +156,7 @@ fn linked_axes_move_their_keys_together() {
     let sweep = Sweep::from_json_str(&sweep_text(&both, 1)).unwrap();
     assert_eq!(sweep.points(), 4);
     assert_eq!(sweep.keys(), ["block.lz", "drive.height", "normal_load"]);
-    assert_eq!(sweep.runs()[1].coordinates, vec![0, 1]);
+    assert_eq!(sweep.runs()[1].coordinates(), vec![0, 1]);
     // A plain sweep's copy does not mention `keys` (directories of older sweeps still
     // match it).
     assert!(!Sweep::from_json_str(&small())
@@ -248,16 +248,22 @@ fn seeds_are_derived_stably_from_the_base_seed_and_the_coordinates() {
     assert_eq!(sweep.runs().len(), 8);
     let mut seeds = Vec::new();
     for run in sweep.runs() {
-        assert_eq!(run.index, run.point * 2 + run.realization);
-        assert_eq!(run.seed, derive_seed(11, &run.coordinates, run.realization));
+        assert_eq!(run.index(), run.point() * 2 + run.realization());
+        assert_eq!(
+            run.seed(),
+            derive_seed(11, run.coordinates(), run.realization())
+        );
         // The scene draws its heights from it.
-        let json = run.scene.to_json().unwrap();
-        assert!(json.contains(&format!("\"seed\": {}", run.seed)), "{json}");
-        seeds.push(run.seed);
+        let json = run.scene().to_json().unwrap();
+        assert!(
+            json.contains(&format!("\"seed\": {}", run.seed())),
+            "{json}"
+        );
+        seeds.push(run.seed());
     }
     // The last axis is the fastest; every run has its own seed.
-    assert_eq!(sweep.runs()[2].coordinates, vec![0, 1]);
-    assert_eq!(sweep.runs()[4].coordinates, vec![1, 0]);
+    assert_eq!(sweep.runs()[2].coordinates(), vec![0, 1]);
+    assert_eq!(sweep.runs()[4].coordinates(), vec![1, 0]);
     seeds.sort_unstable();
     seeds.dedup();
     assert_eq!(seeds.len(), 8);
@@ -314,13 +320,13 @@ fn complete_runs_are_skipped_and_a_cut_one_is_redone() {
     merge(&dir).unwrap();
     let before = tables(&dir);
     // A run killed before its marker: the marker missing, a table cut, a stray file.
-    let cut = dir.join(&sweep.runs()[5].dir_name);
+    let cut = dir.join(sweep.runs()[5].dir_name());
     std::fs::remove_file(cut.join(DONE_FILE)).unwrap();
     let curve = std::fs::read_to_string(cut.join("curve.csv")).unwrap();
     std::fs::write(cut.join("curve.csv"), &curve[..curve.len() / 2]).unwrap();
     std::fs::write(cut.join("stray"), "x").unwrap();
     // A complete run is not touched: a file put there survives.
-    let complete = dir.join(&sweep.runs()[2].dir_name);
+    let complete = dir.join(sweep.runs()[2].dir_name());
     std::fs::write(complete.join("stray"), "x").unwrap();
     let reports = std::sync::Mutex::new(Vec::new());
     let second = sweep
@@ -417,7 +423,8 @@ fn merged_bands_are_student_t() {
         .runs()
         .iter()
         .map(|run| {
-            let curve = std::fs::read_to_string(dir.join(&run.dir_name).join("curve.csv")).unwrap();
+            let curve =
+                std::fs::read_to_string(dir.join(run.dir_name()).join("curve.csv")).unwrap();
             let last = curve.lines().last().unwrap();
             last.split(',').nth(2).unwrap().parse().unwrap()
         })

@@ -823,17 +823,17 @@ struct PlaneStress {
 impl PlaneStress {
     fn new(py: Python<'_>, plane: precursors::PlaneStress) -> PyResult<Self> {
         let profile = plane.profile();
-        let shape = (plane.ny, plane.nx);
+        let shape = (plane.ny(), plane.nx());
         let array = |v: Vec<f64>| -> PyResult<Py<PyArray2<f64>>> {
             let a = Array2::from_shape_vec(shape, v)
                 .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
             Ok(a.into_pyarray(py).unbind())
         };
         Ok(PlaneStress {
-            z: plane.z,
-            shear: array(plane.shear)?,
-            normal: array(plane.normal)?,
-            coulomb: array(plane.coulomb)?,
+            z: plane.z(),
+            shear: array(plane.shear().to_vec())?,
+            normal: array(plane.normal().to_vec())?,
+            coulomb: array(plane.coulomb().to_vec())?,
             profile,
         })
     }

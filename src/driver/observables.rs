@@ -97,7 +97,7 @@ impl Driver {
     /// driver.step()?;
     /// driver.add_probes(&ProbeSpec::default().with_plane(2e-3))?;
     /// let plane = &driver.stresses()?.planes[0];
-    /// assert_eq!((plane.nx, plane.ny), (20, 4));
+    /// assert_eq!((plane.nx(), plane.ny()), (20, 4));
     /// # Ok::<(), precursors::Error>(())
     /// ```
     ///

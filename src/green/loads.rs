@@ -23,6 +23,16 @@ const MAX_TERMS: u64 = 20_000_000;
 ///
 /// A top shear `F_top` adds `F_top/M` times this to `u_x`; the normal load, a traction
 /// `-F_N/(Lx Ly)`, adds `-F_N/M` times this to `u_z`.
+///
+/// ```
+/// use precursors::{green::top_influence, Block};
+/// let thin = Block::new(0.010, 0.004, 0.005)?;
+/// let thick = Block::new(0.010, 0.004, 0.010)?;
+/// // Uniform over the bottom, negative, proportional to the height Lz (m⁻¹).
+/// assert!(top_influence(&thin) < 0.0);
+/// assert!((top_influence(&thick) / top_influence(&thin) - 2.0).abs() < 1e-12);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 pub fn top_influence(block: &Block) -> f64 {
     -block.lz() / (6.0 * block.lx() * block.ly())
 }
@@ -33,6 +43,19 @@ pub fn top_influence(block: &Block) -> f64 {
 ///
 /// # Errors
 /// [`Error::OutsideBlock`] for `z` outside `[0, Lz]`.
+///
+/// At the top face the stress is the whole load over the face, `1/(Lx Ly)` per newton;
+/// at the bottom the top load adds nothing (the bottom tractions carry it):
+///
+/// ```
+/// use precursors::{green::top_stress_influence, Block};
+/// let block = Block::new(0.010, 0.004, 0.005)?;
+/// let face = 1.0 / (0.010 * 0.004);                          // m⁻²
+/// assert!((top_stress_influence(&block, 0.005)? - face).abs() < 1e-9 * face);
+/// assert_eq!(top_stress_influence(&block, 0.0)?, 0.0);
+/// assert!(top_stress_influence(&block, 0.006).is_err());    // above the block
+/// # Ok::<(), precursors::Error>(())
+/// ```
 pub fn top_stress_influence(block: &Block, z: f64) -> Result<f64> {
     let z = block.check_height(z)?;
     Ok(z / (block.lz() * block.lx() * block.ly()))
@@ -171,6 +194,8 @@ impl RodLoad {
     /// [`Error::InvalidTolerance`]; [`Error::InvalidParameter`] for a grid on another
     /// block; [`Error::SeriesNotConverged`] when a series does not reach `tol`.
     pub fn influence_cells(&self, grid: &Grid, tol: f64) -> Result<Vec<f64>> {
+        #[cfg(test)]
+        super::built::count(|b| b.load_series += 1);
         check_tolerance(tol)?;
         self.check_grid(grid)?;
         let lx = self.block.lx();
@@ -273,6 +298,8 @@ impl RodLoad {
     /// [`Error::InvalidTolerance`]; [`Error::OutsideBlock`] for `z` outside `[0, Lz]`;
     /// [`Error::InvalidParameter`] for a grid on another block; [`Error::SeriesNotConverged`].
     pub fn stress_influence_cells(&self, grid: &Grid, z: f64, tol: f64) -> Result<Vec<f64>> {
+        #[cfg(test)]
+        super::built::count(|b| b.load_series += 1);
         check_tolerance(tol)?;
         self.check_grid(grid)?;
         let z = self.block.check_height(z)?;

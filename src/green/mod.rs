@@ -30,3 +30,45 @@ pub use planner::Planner;
 pub use point::{Estimate, GreenFunction, SeriesOptions, SummationAxis};
 pub(crate) use staged::{Partition, Staging};
 pub use transfer::PlaneTransfer;
+
+/// What the green module built on this thread, counted for the tests of "What a scene
+/// leaves out" (docs/architecture.md): they fail when a scene builds a plan, a load
+/// series or a plane transfer it does not use. Test builds only.
+#[cfg(test)]
+pub(crate) mod built {
+    use std::cell::Cell;
+
+    thread_local! {
+        static COUNTS: Cell<Built> = const { Cell::new(Built { plans: 0, load_series: 0, transfers: 0 }) };
+    }
+
+    /// Counts since the last [`take`].
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub(crate) struct Built {
+        /// Influence operators planned (eigenvalues and DCT plans).
+        pub plans: usize,
+        /// Lateral-load series tabulated over the cells (displacements or stresses).
+        pub load_series: usize,
+        /// Plane transfers of bottom tractions to a height.
+        pub transfers: usize,
+    }
+
+    pub(crate) fn count(f: impl FnOnce(&mut Built)) {
+        COUNTS.with(|c| {
+            let mut b = c.get();
+            f(&mut b);
+            c.set(b);
+        });
+    }
+
+    /// The counts so far, reset to zero.
+    pub(crate) fn take() -> Built {
+        COUNTS.with(|c| {
+            c.replace(Built {
+                plans: 0,
+                load_series: 0,
+                transfers: 0,
+            })
+        })
+    }
+}

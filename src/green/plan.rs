@@ -79,6 +79,8 @@ impl InfluencePlanBuilder {
         let grid = self.grid;
         super::check_cells(grid.nx(), grid.ny(), self.max_cells)?;
         let tol = check_tolerance(self.tolerance)?;
+        #[cfg(test)]
+        super::built::count(|b| b.plans += 1);
         let (lambda, errors, nodes) = eigenvalues(&grid);
         let mut max_rel_error: f64 = 0.0;
         for (&value, &error) in lambda.iter().zip(&errors) {

@@ -69,6 +69,8 @@ impl InfluencePlan {
     /// [`Error::InvalidTolerance`],
     /// [`Error::OutsideBlock`] for `z` outside `[0, Lz]`, [`Error::SeriesNotConverged`].
     pub fn plane_transfer(&self, z: f64, tol: f64) -> Result<PlaneTransfer> {
+        #[cfg(test)]
+        super::built::count(|b| b.transfers += 1);
         PlaneTransfer::new(self, z, tol)
     }
 }

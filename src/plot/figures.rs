@@ -94,6 +94,21 @@ pub struct Drawn {
 /// [`Error::CorruptTable`] for a damaged table, [`Error::NonFiniteCell`] for a `NaN`, an
 /// infinity or an empty cell where a number belongs (with the file, line and column); in
 /// [`PlotError::Sweep`]: a sweep's errors as [`crate::sweep::merge`].
+///
+/// [`Drawn`]'s example draws a run's figures as SVG; here as PNG:
+///
+/// ```
+/// use precursors::{output::RunTables, plot::{draw, Format}, Scene};
+/// let dir = std::env::temp_dir().join(format!("precursors-doc-draw-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// let scene = Scene::builder().block(0.010, 0.004, 0.010).normal_load(100.0).build()?;
+/// let mut driver = scene.driver()?;
+/// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
+/// let drawn = draw(&dir, &[Format::Png])?;
+/// assert!(drawn.files.iter().all(|f| f.extension().unwrap() == "png" && f.is_file()));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn draw(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
     if dir.join(SWEEP_FILE).is_file() {
         draw_sweep(dir, formats)

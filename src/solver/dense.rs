@@ -9,7 +9,8 @@
 //! from the last response (the spectral backend's path) costs less than keeping a second
 //! factor up to date (docs/performance.md, "The cost of one event").
 
-use super::set::{Effort, SetProblem, SetSolve};
+use super::pcg::Effort;
+use super::set::{SetProblem, SetSolve};
 use super::spectral::SpectralCore;
 use super::system::{ExactInverse, Preconditioner};
 use crate::error::{Error, Result};

@@ -49,7 +49,8 @@ use crate::geometry::Grid;
 use crate::green::{InfluencePlan, Partition};
 use crate::interface::{Interface, Material};
 use dense::{DenseCore, FactorState};
-use set::{Effort, SetProblem, SetSolve};
+use pcg::Effort;
+use set::{SetProblem, SetSolve};
 use spectral::{Precond, SpectralCore};
 use system::Compliance;
 

@@ -50,12 +50,17 @@ pub(crate) struct PcgOutcome {
     pub converged: bool,
 }
 
-/// What one solve asks for.
+/// The limits of one solve: the solver's [`SolverOptions`](super::SolverOptions) as they
+/// are, or with a looser tolerance while the active set explores a cold set, or fewer
+/// iterations for a stale dense factor (docs/architecture.md, "The solver's settings").
+/// Made per set solve by `EquilibriumSolver::solve_set`, stored nowhere.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct PcgSettings {
-    pub total: f64,
+pub(crate) struct Effort {
+    /// The normwise backward error to reach.
     pub tolerance: f64,
+    /// Iterations at most.
     pub max_iterations: usize,
+    /// The threads the solve may use (the results do not depend on them).
     pub parallelism: Parallelism,
 }
 
@@ -65,14 +70,16 @@ pub(crate) struct PcgSettings {
 #[derive(Debug, Default)]
 pub(crate) struct PcgVectors(Vec<Mutex<Vectors>>);
 
-/// Solves in place: `f` holds the warm start on entry and the solution on exit. The last
-/// operator product the system ran is `A f` of the returned `f` (a spectral system keeps
-/// `C f` on the grid: the displacements need no product of their own).
+/// Solves in place with `1ᵀ f = total`: `f` holds the warm start on entry and the
+/// solution on exit. The last operator product the system ran is `A f` of the returned `f`
+/// (a spectral system keeps `C f` on the grid: the displacements need no product of their
+/// own).
 pub(crate) fn projected_pcg<S: SetSystem>(
     sys: &S,
     b: &[f64],
     f: &mut [f64],
-    settings: PcgSettings,
+    total: f64,
+    effort: Effort,
     vectors: &mut PcgVectors,
 ) -> Result<PcgOutcome> {
     let n = f.len();
@@ -102,14 +109,15 @@ pub(crate) fn projected_pcg<S: SetSystem>(
         vectors: &vectors.0,
     };
     let norm_b = max_abs(b);
-    let outcome = with_crew(settings.parallelism, parts, &work, |crew| {
+    let outcome = with_crew(effort.parallelism, parts, &work, |crew| {
         Leader {
             crew,
             sys,
             n: n as f64,
             norm_a: sys.norm_bound(),
             norm_b,
-            settings,
+            total,
+            effort,
             pending: Pre::default(),
             s1: 0.0,
             offset: 0.0,
@@ -292,7 +300,9 @@ struct Leader<'c, 'a, S: SetSystem> {
     n: f64,
     norm_a: f64,
     norm_b: f64,
-    settings: PcgSettings,
+    /// `1ᵀ f` to keep.
+    total: f64,
+    effort: Effort,
     /// Local updates waiting for the next phase.
     pending: Pre,
     /// `1ᵀ M⁻¹ 1`.
@@ -328,7 +338,7 @@ impl<S: SetSystem> Leader<'_, '_, S> {
     /// `f += (total - Σf)/n` (applied with the next phase).
     fn fix_sum(&mut self) {
         let [s, _, _] = self.phase(Main::SumF);
-        self.pending.shift_f = Some((self.settings.total - s) / self.n);
+        self.pending.shift_f = Some((self.total - s) / self.n);
     }
 
     /// `r = A f + U - b`.
@@ -370,12 +380,12 @@ impl<S: SetSystem> Leader<'_, '_, S> {
             offset: self.offset,
             iterations,
             residual,
-            converged: residual <= self.settings.tolerance,
+            converged: residual <= self.effort.tolerance,
         }
     }
 
     fn solve(mut self) -> PcgOutcome {
-        let tol = self.settings.tolerance;
+        let tol = self.effort.tolerance;
         self.fix_sum();
         // w = M⁻¹ 1.
         self.pending.fill_r_one = true;
@@ -393,7 +403,7 @@ impl<S: SetSystem> Leader<'_, '_, S> {
         self.pending.keep_best = true;
         let mut best = (residual, self.offset);
         let mut confirmed = false;
-        while iterations < self.settings.max_iterations {
+        while iterations < self.effort.max_iterations {
             iterations += 1;
             let pq = self.staged(self.sys.product_stages(), |stage, carry| Main::Direction {
                 stage,

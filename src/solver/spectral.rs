@@ -3,8 +3,8 @@
 //! no `N x N` matrix is ever formed. The dense backend uses the same product.
 
 use super::fsai::{Entries, Fsai};
-use super::pcg::{projected_pcg, PcgVectors};
-use super::set::{Effort, SetProblem, SetSolve};
+use super::pcg::{projected_pcg, Effort, PcgVectors};
+use super::set::{SetProblem, SetSolve};
 use super::system::{Compliance, FsaiBuffers, Preconditioner, StagedSystem};
 use crate::error::Result;
 use crate::green::{InfluencePlan, Partition, SpectralTable, Staging};
@@ -216,8 +216,14 @@ impl SpectralCore {
             precond,
         );
         let mut vectors = super::lock(&self.vectors);
-        let settings = effort.settings(problem.total);
-        let outcome = projected_pcg(&system, problem.b, &mut f, settings, &mut vectors)?;
+        let outcome = projected_pcg(
+            &system,
+            problem.b,
+            &mut f,
+            problem.total,
+            effort,
+            &mut vectors,
+        )?;
         let mut grid_product = vec![0.0; self.plan.grid().len()];
         system.grid_product(system.input_sum(&f), &mut grid_product);
         Ok(SetSolve {

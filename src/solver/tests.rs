@@ -2,7 +2,8 @@
 //! the parts-and-phases model against thread counts.
 
 use super::parallel::Parallelism;
-use super::set::{Effort, SetProblem};
+use super::pcg::Effort;
+use super::set::SetProblem;
 use super::spectral::{Precond, SpectralCore};
 use super::system::Compliance;
 use crate::green::{InfluencePlan, Partition};

@@ -305,6 +305,18 @@ pub(crate) fn ensemble_curves(dir: &Path, grid: &[f64]) -> Result<Vec<EnsembleCu
 /// cannot be read or written, [`Error::CorruptTable`] for a run's damaged table,
 /// [`Error::NonFiniteCell`] for a `NaN`, an infinity or an empty cell where a number
 /// belongs in one (with the file, line and column).
+///
+/// [`Sweep`]'s example runs a sweep and merges it; a directory without `sweep.json` is
+/// refused:
+///
+/// ```
+/// use precursors::sweep::{merge, SweepError};
+/// let dir = std::env::temp_dir().join(format!("precursors-doc-merge-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// assert!(matches!(merge(&dir), Err(SweepError::Directory { .. })));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn merge(dir: &Path) -> Result<MergeSummary, SweepError> {
     let sweep = read_sweep(dir)?;
     let mut tables = Tables::new(&sweep.keys());
