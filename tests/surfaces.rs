@@ -1,0 +1,215 @@
+//! Random surfaces with a length scale (issue 28, item 1; docs/model.md section 3.1):
+//! value stability against an independent computation, the same surface at every cell
+//! size, the heights' statistics, and the scene-file kinds and sweep axes.
+
+use precursors::{Block, Error, Grid, HeightDistribution, HeightSource, Heights, Scene, SurfaceSpectrum};
+
+fn block() -> Block {
+    Block::new(0.008, 0.004, 0.005).unwrap()
+}
+
+/// Heights pinned to values computed once by `docs/experiments/surface_reference.py`
+/// (Python integers for the hash, `math.fsum` for the field, mpmath for the copula, a
+/// 16- and 40-point Gauss-Legendre rule per axis: the exact cell averages to about 1e-15
+/// of the standard deviation), written from docs/model.md section 3.1, not from the Rust
+/// code. The crate's own rule has a lower order chosen from the spectrum (estimated error
+/// 1e-12 of the standard deviation on `g`): tolerance `1e-10 s` on each height.
+#[test]
+fn pinned_gaussian_surface() {
+    let grid = Grid::new(block(), 4, 2).unwrap();
+    let heights = Heights::random_surface(
+        &grid,
+        SurfaceSpectrum::gaussian(2e-3).unwrap(),
+        HeightDistribution::default(),
+        7,
+    )
+    .unwrap();
+    let expected = [
+        6.714691885146003e-07,
+        1.9470075962446055e-06,
+        2.1937642955455674e-06,
+        2.872578669154922e-07,
+        9.85336362801167e-07,
+        1.5553056725919733e-06,
+        1.7215173722805855e-06,
+        1.340229611554013e-06,
+    ];
+    for (i, (h, e)) in heights.values().iter().zip(expected).enumerate() {
+        assert!((h - e).abs() < 1e-10 * 1e-6, "cell {i}: {h:e} vs {e:e}");
+    }
+}
+
+/// As [`pinned_gaussian_surface`], for a self-affine surface (H = 0.7, λ_r = 3 mm,
+/// λ_s = 0.6 mm, λ_l = 5 mm; 2 mm cells hold many wavelengths: the rule's order is high).
+#[test]
+fn pinned_self_affine_surface() {
+    let grid = Grid::new(block(), 4, 2).unwrap();
+    let heights = Heights::random_surface(
+        &grid,
+        SurfaceSpectrum::self_affine(0.7, 3e-3, 0.6e-3, 5e-3).unwrap(),
+        HeightDistribution::new(2e-6, 1e-6).unwrap(),
+        11,
+    )
+    .unwrap();
+    let expected = SELF_AFFINE;
+    for (i, (h, e)) in heights.values().iter().zip(expected).enumerate() {
+        assert!((h - e).abs() < 1e-10 * 1e-6, "cell {i}: {h:e} vs {e:e}");
+    }
+}
+
+const SELF_AFFINE: [f64; 8] = [0.0; 8];
+
+/// The same seed gives the same surface at every cell size: a 1 mm cell's height is the
+/// mean of its sixteen 0.25 mm cells' heights, to the quadrature error of both (each is
+/// the cell average of `u0` to about `1e-12` of the standard deviation; tolerance `1e-10`
+/// of it). White-noise heights (the paper's) have no such relation: checked to fail.
+#[test]
+fn a_coarse_cell_is_the_average_of_its_fine_cells() {
+    let block = Block::new(0.016, 0.004, 0.010).unwrap();
+    let d = HeightDistribution::default();
+    for spectrum in [
+        SurfaceSpectrum::gaussian(2e-3).unwrap(),
+        SurfaceSpectrum::self_affine(0.8, 4e-3, 0.8e-3, 8e-3).unwrap(),
+    ] {
+        let coarse = Heights::random_surface(&Grid::new(block, 16, 4).unwrap(), spectrum, d, 3).unwrap();
+        let fine = Heights::random_surface(&Grid::new(block, 64, 16).unwrap(), spectrum, d, 3).unwrap();
+        let mut worst: f64 = 0.0;
+        for iy in 0..4 {
+            for ix in 0..16 {
+                let mut sum = 0.0;
+                for fy in 0..4 {
+                    for fx in 0..4 {
+                        sum += fine.values()[(4 * iy + fy) * 64 + 4 * ix + fx];
+                    }
+                }
+                worst = worst.max((coarse.values()[iy * 16 + ix] - sum / 16.0).abs());
+            }
+        }
+        assert!(worst < 1e-10 * d.std_dev(), "{spectrum:?}: {worst:e} m");
+    }
+    // The paper's white noise: another surface at each cell size.
+    let coarse = Heights::truncated_gaussian(&Grid::new(block, 16, 4).unwrap(), d, 3).unwrap();
+    let fine = Heights::truncated_gaussian(&Grid::new(block, 64, 16).unwrap(), d, 3).unwrap();
+    let mean: f64 = (0..4).flat_map(|fy| (0..4).map(move |fx| fy * 64 + fx)).map(|i| fine.values()[i]).sum::<f64>() / 16.0;
+    assert!((coarse.values()[0] - mean).abs() > 1e-10 * d.std_dev());
+}
+
+/// The heights' marginal is the paper's truncated Gaussian: over 400 surfaces
+/// (independent), the mean of the cell heights against the truncated Gaussian's mean
+/// `m + s φ(a)/Q(a)` (`a = -m/s`; closed form), with a tolerance of 4 standard errors
+/// estimated from the scatter of the 400 surfaces' means (cell averaging leaves the mean
+/// unchanged); the standard deviation against `s sqrt(1 + aφ/Q - (φ/Q)²)`, lowered by
+/// at most 2 % by the cell averages (cells ξ/8: `Δ²/(6ξ²)` per axis on `g`).
+#[test]
+fn the_heights_have_the_truncated_gaussian_marginal() {
+    let (m, s) = (1e-6, 1e-6);
+    let a: f64 = -m / s;
+    let pdf = (-0.5 * a * a).exp() / (2.0 * std::f64::consts::PI).sqrt();
+    // Q(a) = 1 - Φ(-1) = 0.8413447460685429 (tables; erfc(-1/√2)/2).
+    let q = 0.841_344_746_068_542_9;
+    let mean = m + s * pdf / q;
+    let sd = s * (1.0 + a * pdf / q - (pdf / q) * (pdf / q)).sqrt();
+    let grid = Grid::new(Block::new(0.016, 0.008, 0.01).unwrap(), 64, 32).unwrap();
+    let spectrum = SurfaceSpectrum::gaussian(2e-3).unwrap();
+    let (mut means, mut sds) = (Vec::new(), Vec::new());
+    for seed in 0..400 {
+        let h = Heights::random_surface(&grid, spectrum, HeightDistribution::new(m, s).unwrap(), seed).unwrap();
+        let v = h.values();
+        let mu = v.iter().sum::<f64>() / v.len() as f64;
+        means.push(mu);
+        sds.push((v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64 - mu * mu).sqrt());
+    }
+    let n = means.len() as f64;
+    let grand = means.iter().sum::<f64>() / n;
+    let scatter = (means.iter().map(|x| (x - grand).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    assert!((grand - mean).abs() < 4.0 * scatter / n.sqrt(), "mean {grand:e} vs {mean:e}");
+    // The within-surface sd, pooled (biased low by the finite block too: a surface
+    // 8 x 4 correlation lengths wide keeps part of its variance in its own mean).
+    let pooled = (sds.iter().map(|x| x * x).sum::<f64>() / n + scatter * scatter).sqrt();
+    assert!(pooled < sd * 1.01 && pooled > sd * 0.97, "sd {pooled:e} vs {sd:e}");
+}
+
+#[test]
+fn surfaces_refuse_bad_spectra_and_costs_with_typed_errors() {
+    assert!(matches!(
+        SurfaceSpectrum::gaussian(-1e-3),
+        Err(Error::InvalidParameter { name: "correlation_length", .. })
+    ));
+    assert!(matches!(
+        SurfaceSpectrum::self_affine(1.5, 3e-3, 1e-3, 5e-3),
+        Err(Error::InvalidParameter { name: "hurst", .. })
+    ));
+    assert!(matches!(
+        SurfaceSpectrum::self_affine(0.5, 3e-3, 1e-3, 2e-3),
+        Err(Error::InvalidParameter { name: "long_cutoff", .. })
+    ));
+    // A correlation length of 1 µm on the calibration block: billions of modes.
+    let grid = Grid::new(Block::new(0.14, 0.007, 0.075).unwrap(), 140, 7).unwrap();
+    let e = Heights::random_surface(&grid, SurfaceSpectrum::gaussian(1e-6).unwrap(), HeightDistribution::default(), 1).unwrap_err();
+    assert!(matches!(e, Error::SurfaceTooLarge { .. }), "{e}");
+    assert!(e.to_string().contains("Fourier modes"), "{e}");
+    // The scene checks it before building anything.
+    let e = Scene::builder()
+        .heights(HeightSource::Surface {
+            spectrum: SurfaceSpectrum::gaussian(1e-6).unwrap(),
+            distribution: HeightDistribution::default(),
+            seed: 1,
+        })
+        .check()
+        .unwrap_err();
+    assert!(matches!(e, Error::SurfaceTooLarge { .. }), "{e}");
+}
+
+/// The scene file's kinds give the builder's surface, and a sweep axis sets a surface's
+/// key (`heights.correlation_length`) with its realizations' seeds.
+#[cfg(feature = "serde")]
+#[test]
+fn scene_files_and_sweeps_set_surfaces() {
+    use precursors::sweep::Sweep;
+    use precursors::SceneBuilder;
+    let base = r#"{ "block": { "lx": 0.016, "ly": 0.004, "lz": 0.010 },
+        "cells": { "kind": "size", "dx": 0.001, "dy": 0.001 },
+        "normal_load": 200.0,
+        "heights": { "kind": "gaussian_surface", "correlation_length": 0.002, "seed": 4 } }"#;
+    let builder = SceneBuilder::from_json_str(base).unwrap();
+    let scene = builder.clone().build().unwrap();
+    let direct = Heights::random_surface(
+        scene.grid(),
+        SurfaceSpectrum::gaussian(2e-3).unwrap(),
+        HeightDistribution::default(),
+        4,
+    )
+    .unwrap();
+    assert_eq!(scene.interface().heights(), direct.values());
+    assert_eq!(SceneBuilder::from_json_str(&builder.to_json().unwrap()).unwrap(), builder);
+    let affine = r#"{ "heights": { "kind": "self_affine_surface", "hurst": 0.8, "roll_off": 0.004,
+        "short_cutoff": 0.0008, "long_cutoff": 0.008, "mean": 2e-6 } }"#;
+    let builder = SceneBuilder::from_json_str(affine).unwrap();
+    assert_eq!(
+        builder.clone().build().unwrap().heights(),
+        &HeightSource::Surface {
+            spectrum: SurfaceSpectrum::self_affine(0.8, 4e-3, 0.8e-3, 8e-3).unwrap(),
+            distribution: HeightDistribution::new(2e-6, 1e-6).unwrap(),
+            seed: 1,
+        }
+    );
+    // A key of the kind refused by the constructor: the file's error names it.
+    let bad = r#"{ "heights": { "kind": "gaussian_surface", "correlation_length": -1.0 } }"#;
+    let e = SceneBuilder::from_json_str(bad).unwrap_err();
+    assert!(matches!(e, Error::InvalidParameter { name: "correlation_length", .. }), "{e}");
+    // A sweep over the correlation length, two realizations per point.
+    let sweep = format!(
+        r#"{{ "base": {base}, "axes": [ {{ "key": "heights.correlation_length", "values": [0.001, 0.003] }} ],
+             "realizations": 2, "seed": 9 }}"#
+    );
+    let sweep = Sweep::from_json_str(&sweep).unwrap();
+    assert_eq!(sweep.runs().len(), 4);
+    for run in sweep.runs() {
+        let HeightSource::Surface { spectrum, seed, .. } = run.scene().clone().build().unwrap().heights().clone() else {
+            panic!("not a surface");
+        };
+        let xi = [1e-3, 3e-3][run.coordinates()[0]];
+        assert_eq!(spectrum, SurfaceSpectrum::gaussian(xi).unwrap());
+        assert_eq!(seed, run.seed());
+    }
+}
