@@ -57,7 +57,16 @@ fn pinned_self_affine_surface() {
     }
 }
 
-const SELF_AFFINE: [f64; 8] = [0.0; 8];
+const SELF_AFFINE: [f64; 8] = [
+    2.034404033938086e-06,
+    2.0575341142468805e-06,
+    2.2363011772725003e-06,
+    1.6894640390260155e-06,
+    1.5114426551789947e-06,
+    2.2686760810689726e-06,
+    1.945880037678425e-06,
+    1.9138280237856916e-06,
+];
 
 /// The same seed gives the same surface at every cell size: a 1 mm cell's height is the
 /// mean of its sixteen 0.25 mm cells' heights, to the quadrature error of both (each is
@@ -211,5 +220,36 @@ fn scene_files_and_sweeps_set_surfaces() {
         let xi = [1e-3, 3e-3][run.coordinates()[0]];
         assert_eq!(spectrum, SurfaceSpectrum::gaussian(xi).unwrap());
         assert_eq!(seed, run.seed());
+    }
+}
+
+/// The convergence study's files (docs/convergence.md): each parses and expands to 20
+/// runs on the calibration geometry with the grid its name says, and realization `r` has
+/// the same seed in every file, so the Gaussian surface is the same at every cell size.
+#[cfg(feature = "serde")]
+#[test]
+fn the_convergence_sweeps_share_their_surfaces_across_cell_sizes() {
+    use precursors::sweep::Sweep;
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/sweeps/convergence");
+    let mut seeds = None;
+    for (name, nx, ny) in [("2mm", 70, 4), ("1mm", 140, 7), ("0.5mm", 280, 14), ("0.25mm", 560, 28)] {
+        for (prefix, surface) in [("convergence_", true), ("convergence_white_", false)] {
+            let path = dir.join(format!("{prefix}{name}.json"));
+            let sweep = Sweep::from_json_file(&path).unwrap_or_else(|e| panic!("{path:?}: {e}"));
+            assert_eq!(sweep.runs().len(), 20, "{path:?}");
+            let scene = sweep.runs()[0].scene();
+            let grid = scene.grid().unwrap();
+            assert_eq!((grid.nx(), grid.ny()), (nx, ny), "{path:?}");
+            let b = grid.block();
+            assert_eq!((b.lx(), b.ly(), b.lz()), (0.14, 0.007, 0.075));
+            let json: serde_json::Value = serde_json::from_str(&scene.to_json().unwrap()).unwrap();
+            let kind = if surface { "gaussian_surface" } else { "gaussian" };
+            assert_eq!(json["heights"]["kind"], kind, "{path:?}");
+            let these: Vec<u64> = sweep.runs().iter().map(|r| r.seed()).collect();
+            match &seeds {
+                None => seeds = Some(these),
+                Some(s) => assert_eq!(s, &these, "{path:?}"),
+            }
+        }
     }
 }
