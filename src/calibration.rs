@@ -25,7 +25,7 @@
 use crate::driver::Event;
 use crate::error::{check_tolerance, Error, Result};
 use crate::green::Planner;
-use crate::scene::{HeightSource, SceneBuilder};
+use crate::scene::SceneBuilder;
 
 /// Options of the fits.
 ///

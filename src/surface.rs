@@ -4,8 +4,11 @@
 //!
 //! * **Modes.** `k = (2π p/Px, 2π q/Py)` on a period `P` larger than the block (at least
 //!   `2L`, and `L` plus the spectrum's correlation reach, so that the block sees no
-//!   periodicity), restricted to the half plane (`q > 0`, or `q = 0` and `p > 0`) and to
-//!   the wavenumbers the spectrum needs (a cut-off set by the spectrum, never by the grid).
+//!   periodicity), restricted to the half plane (`q > 0`, or `q = 0` and `p ≥ 0`; the
+//!   mean mode with half the weight, as it stands for itself and not for `±k`) and to the
+//!   wavenumbers the spectrum needs (a cut-off set by the spectrum, never by the grid).
+//!   The field's covariance is then the prescription's periodisation over `P` (Poisson
+//!   summation), up to the cut-off.
 //! * **Coefficients.** Mode `(p, q)`'s pair of standard normals comes from a counter-based
 //!   hash of `(seed, p, q)` (SplitMix64 mixing, Box-Muller), so a mode's value does not
 //!   depend on the grid, on the other modes or on any order of evaluation; every function
@@ -299,13 +302,14 @@ impl Modes {
         for q in 0..=qm {
             for (column, v) in variance[q * width..(q + 1) * width].iter_mut().enumerate() {
                 let p = column as i64 - pm as i64;
-                if q == 0 && p <= 0 {
+                if q == 0 && p < 0 {
                     continue;
                 }
                 let (fx, fy) = (p as f64 / px, q as f64 / py);
                 let k = TAU * libm::sqrt(fx * fx + fy * fy);
                 if k <= kc {
-                    *v = spectrum.density(k);
+                    // The mean mode stands for itself; every other for itself and -k.
+                    *v = spectrum.density(k) * if p == 0 && q == 0 { 0.5 } else { 1.0 };
                     total += *v;
                 }
             }
@@ -914,7 +918,7 @@ mod tests {
 
     #[test]
     fn limits_are_typed_errors() {
-        let e = Modes::new(0.14, 0.007, &SurfaceSpectrum::gaussian(1e-6).unwrap()).unwrap_err();
+        let e = Modes::new(0.14, 0.007, &SurfaceSpectrum::gaussian(1e-6).unwrap()).err().unwrap();
         assert!(matches!(e, Error::SurfaceTooLarge { what: "Fourier modes", .. }), "{e}");
         let grid = Grid::new(Block::new(0.14, 0.007, 0.075).unwrap(), 2, 1).unwrap();
         let e = Plan::new(&grid, &SurfaceSpectrum::gaussian(1e-4).unwrap()).err().unwrap();

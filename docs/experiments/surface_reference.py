@@ -62,7 +62,8 @@ def self_affine(h, lr, ls, ll):
 
 
 def modes(lx, ly, spec):
-    """(kx, ky, a², p, q) of the half-plane modes within the cut-off, a² normalised."""
+    """(kx, ky, a², p, q) of the half-plane modes (q > 0, or q = 0 and p >= 0) within the
+    cut-off, a² normalised."""
     px = max(2 * lx, lx + spec["reach"])
     py = max(2 * ly, ly + spec["reach"])
     kc = spec["cutoff"]
@@ -70,12 +71,13 @@ def modes(lx, ly, spec):
     out = []
     for q in range(qm + 1):
         for p in range(-pm, pm + 1):
-            if q == 0 and p <= 0:
+            if q == 0 and p < 0:
                 continue
             kx, ky = 2 * math.pi * p / px, 2 * math.pi * q / py
             k = math.hypot(kx, ky)
             if k <= kc:
-                s = spec["density"](k)
+                # The mean mode (p, q) = (0, 0) stands for itself, the others for +-k.
+                s = spec["density"](k) * (0.5 if p == q == 0 else 1.0)
                 if s > 0:
                     out.append([kx, ky, s, p, q])
     total = math.fsum(m[2] for m in out)
