@@ -477,23 +477,7 @@ impl Heights {
         seed: u64,
     ) -> Result<Self> {
         let plan = Plan::new(grid, &spectrum)?;
-        let values = plan.cell_averages(grid, &Truncated::new(dist.mean, dist.std_dev), seed, None);
-        Self::check_values(grid, &values)?;
-        Ok(Self { values })
-    }
-
-    /// [`Heights::random_surface`] with given Gauss-Legendre orders (tests of the rule).
-    #[cfg(test)]
-    pub(crate) fn random_surface_with_orders(
-        grid: &Grid,
-        spectrum: SurfaceSpectrum,
-        dist: HeightDistribution,
-        seed: u64,
-        orders: (usize, usize),
-    ) -> Result<Self> {
-        let plan = Plan::new(grid, &spectrum)?;
-        let marginal = Truncated::new(dist.mean, dist.std_dev);
-        let values = plan.cell_averages(grid, &marginal, seed, Some(orders));
+        let values = plan.cell_averages(grid, &Truncated::new(dist.mean, dist.std_dev), seed)?;
         Self::check_values(grid, &values)?;
         Ok(Self { values })
     }

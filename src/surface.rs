@@ -81,6 +81,10 @@ const GAUSSIAN_CUTOFF: f64 = 1e-16;
 /// units of its standard deviation.
 const QUADRATURE_TOLERANCE: f64 = 1e-12;
 
+/// The cell averages' target: two successive rules agree to this fraction of the
+/// heights' standard deviation.
+pub(crate) const CELL_TOLERANCE: f64 = 1e-10;
+
 /// The largest Gauss-Legendre order per axis.
 pub(crate) const MAX_ORDER: usize = 64;
 
@@ -689,16 +693,66 @@ impl Plan {
         self.orders
     }
 
-    /// The cell averages of `marginal.quantile(g)` (m) for the surface `seed`, in cell
-    /// order `i = iy·Nx + ix`, with the plan's orders or others.
+    /// The cell averages of `u0 = marginal.quantile(g)` (m) for the surface `seed`, in
+    /// cell order `i = iy·Nx + ix`, to [`CELL_TOLERANCE`] of the standard deviation: the
+    /// plan's orders (from `g`'s spectrum) are raised by half until two successive rules
+    /// agree to it (the copula is not linear: `u0` has shorter wavelengths than `g`,
+    /// more so where `g` is steep against the cell), and the higher one is returned.
+    ///
+    /// # Errors
+    /// [`Error::SurfaceTooLarge`] when the rules reach [`MAX_ORDER`] or [`MAX_WORK`]
+    /// before they agree.
     pub(crate) fn cell_averages(
         &self,
         grid: &Grid,
         marginal: &Truncated,
         seed: u64,
-        orders: Option<(usize, usize)>,
+    ) -> Result<Vec<f64>> {
+        let (mut ox, mut oy) = self.orders;
+        let mut previous = self.cell_averages_with(grid, marginal, seed, (ox, oy));
+        loop {
+            if ox == MAX_ORDER && oy == MAX_ORDER {
+                return Err(Error::SurfaceTooLarge {
+                    what: "Gauss-Legendre points per cell and axis (the cell averages did \
+                           not converge within the limit)",
+                    needed: MAX_ORDER as f64 + 1.0,
+                    limit: MAX_ORDER as f64,
+                    hint: "the cells are too large against the surface's shortest \
+                           wavelength: use smaller cells or a smoother surface",
+                });
+            }
+            (ox, oy) = ((ox + ox / 2 + 2).min(MAX_ORDER), (oy + oy / 2 + 2).min(MAX_ORDER));
+            let work = self.modes.work(grid.nx() * ox, grid.ny() * oy);
+            if !(work <= MAX_WORK as f64) {
+                return Err(Error::SurfaceTooLarge {
+                    what: "complex multiply-adds (the cell averages' rule)",
+                    needed: work,
+                    limit: MAX_WORK as f64,
+                    hint: "the grid has too many cells or the surface too many modes: use \
+                           fewer cells or a smoother surface",
+                });
+            }
+            let next = self.cell_averages_with(grid, marginal, seed, (ox, oy));
+            let change = previous
+                .iter()
+                .zip(&next)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            if change <= CELL_TOLERANCE * marginal.std_dev {
+                return Ok(next);
+            }
+            previous = next;
+        }
+    }
+
+    /// The cell averages of `u0` with the rules of these orders along x and y.
+    pub(crate) fn cell_averages_with(
+        &self,
+        grid: &Grid,
+        marginal: &Truncated,
+        seed: u64,
+        orders: (usize, usize),
     ) -> Vec<f64> {
-        let (ox, oy) = orders.unwrap_or(self.orders);
+        let (ox, oy) = orders;
         let (tx, wx) = gauss_legendre(ox);
         let (ty, wy) = gauss_legendre(oy);
         let points = |n: usize, step: f64, t: &[f64]| -> Vec<f64> {

@@ -10,10 +10,10 @@ fn block() -> Block {
 
 /// Heights pinned to values computed once by `docs/experiments/surface_reference.py`
 /// (Python integers for the hash, `math.fsum` for the field, mpmath for the copula, a
-/// 16- and 40-point Gauss-Legendre rule per axis: the exact cell averages to about 1e-15
+/// 16- and 64-point Gauss-Legendre rule per axis: the exact cell averages to about 1e-12
 /// of the standard deviation), written from docs/model.md section 3.1, not from the Rust
-/// code. The crate's own rule has a lower order chosen from the spectrum (estimated error
-/// 1e-12 of the standard deviation on `g`): tolerance `1e-10 s` on each height.
+/// code. The crate's own rule stops when two successive orders agree to `1e-10 s`:
+/// tolerance `2e-10 s` on each height.
 #[test]
 fn pinned_gaussian_surface() {
     let grid = Grid::new(block(), 4, 2).unwrap();
@@ -25,17 +25,17 @@ fn pinned_gaussian_surface() {
     )
     .unwrap();
     let expected = [
-        6.714691885146003e-07,
-        1.9470075962446055e-06,
-        2.1937642955455674e-06,
-        2.872578669154922e-07,
-        9.85336362801167e-07,
-        1.5553056725919733e-06,
-        1.7215173722805855e-06,
-        1.340229611554013e-06,
+        8.54041804480647e-07,
+        2.1563771961157247e-06,
+        2.399535660238577e-06,
+        4.028937031629137e-07,
+        1.1852332574718672e-06,
+        1.7679769464152444e-06,
+        1.9310915715644653e-06,
+        1.5343090436483465e-06,
     ];
     for (i, (h, e)) in heights.values().iter().zip(expected).enumerate() {
-        assert!((h - e).abs() < 1e-10 * 1e-6, "cell {i}: {h:e} vs {e:e}");
+        assert!((h - e).abs() < 2e-10 * 1e-6, "cell {i}: {h:e} vs {e:e}");
     }
 }
 
@@ -53,7 +53,7 @@ fn pinned_self_affine_surface() {
     .unwrap();
     let expected = SELF_AFFINE;
     for (i, (h, e)) in heights.values().iter().zip(expected).enumerate() {
-        assert!((h - e).abs() < 1e-10 * 1e-6, "cell {i}: {h:e} vs {e:e}");
+        assert!((h - e).abs() < 2e-10 * 1e-6, "cell {i}: {h:e} vs {e:e}");
     }
 }
 
@@ -70,8 +70,8 @@ const SELF_AFFINE: [f64; 8] = [
 
 /// The same seed gives the same surface at every cell size: a 1 mm cell's height is the
 /// mean of its sixteen 0.25 mm cells' heights, to the quadrature error of both (each is
-/// the cell average of `u0` to about `1e-12` of the standard deviation; tolerance `1e-10`
-/// of it). White-noise heights (the paper's) have no such relation: checked to fail.
+/// the cell average of `u0` to about `1e-10` of the standard deviation, where two
+/// successive rules agree; tolerance `4e-10` of it). White-noise heights (the paper's) have no such relation: checked to fail.
 #[test]
 fn a_coarse_cell_is_the_average_of_its_fine_cells() {
     let block = Block::new(0.016, 0.004, 0.010).unwrap();
@@ -94,7 +94,7 @@ fn a_coarse_cell_is_the_average_of_its_fine_cells() {
                 worst = worst.max((coarse.values()[iy * 16 + ix] - sum / 16.0).abs());
             }
         }
-        assert!(worst < 1e-10 * d.std_dev(), "{spectrum:?}: {worst:e} m");
+        assert!(worst < 4e-10 * d.std_dev(), "{spectrum:?}: {worst:e} m");
     }
     // The paper's white noise: another surface at each cell size.
     let coarse = Heights::truncated_gaussian(&Grid::new(block, 16, 4).unwrap(), d, 3).unwrap();

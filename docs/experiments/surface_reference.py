@@ -155,5 +155,5 @@ if __name__ == "__main__":
         print(f"    {v!r},")
     print("pinned_self_affine_surface (8 x 4 mm, 4 x 2 cells, H 0.7, 3 / 0.6 / 5 mm, seed 11,"
           " mean 2 um, sd 1 um):")
-    for v in heights(0.008, 0.004, 4, 2, self_affine(0.7, 3e-3, 0.6e-3, 5e-3), 2e-6, 1e-6, 11, 40):
+    for v in heights(0.008, 0.004, 4, 2, self_affine(0.7, 3e-3, 0.6e-3, 5e-3), 2e-6, 1e-6, 11, 64):
         print(f"    {v!r},")
