@@ -11,9 +11,10 @@
 //!   stiffness `dF_N/d⟨u_z⟩ = -Lx Ly c_z/u0`, whatever the cell size;
 //! * top shear: the uniform shear traction solves the tangential problem exactly too, so
 //!   every site reaches `|φ_x| = μ φ_z` at once: global slip at `F = μ F_N` exactly;
-//! * rod drive: no closed form. The first-rupture and global-slip loads at 2, 1 and 0.5 mm
-//!   must converge: the differences shrink at each halving, and the 0.5 mm value lies
-//!   within the Richardson estimate of its error of the extrapolated limit.
+//! * rod drive: the first-rupture load has no closed form; at 2, 1 and 0.5 mm it must
+//!   converge at the operator's order, checked by Richardson extrapolation. Global slip
+//!   comes when the last attached site carries the whole normal load and shear: exactly
+//!   `μ F_N`.
 
 use precursors::{Drive, Event, ForceLoad, HeightSource, Lateral, Scene, SceneBuilder};
 
@@ -87,6 +88,11 @@ fn a_uniform_surface_under_a_top_shear_slips_at_mu_fn_at_every_cell_size() {
     }
 }
 
+/// Under the rod the first rupture (the trailing column) depends on the cell size through
+/// the operator alone: at 2, 1 and 0.5 mm its load must converge at the order of the
+/// Galerkin operator on smooth data (observed order in `[1.5, 2.5]`; measured 1.94), the
+/// 0.5 mm value within 0.5 % of the Richardson limit (measured 0.2 %). Global slip comes
+/// when the last attached site carries `F_N` and `F` alone: `F = μ F_N` at every cell size.
 #[test]
 fn a_uniform_surface_under_a_rod_converges_with_the_cell_size() {
     let rod = Drive::Force(ForceLoad::Lateral(Lateral::Rod {
@@ -97,15 +103,13 @@ fn a_uniform_surface_under_a_rod_converges_with_the_cell_size() {
         .into_iter()
         .map(|cell| rupture_and_slip(uniform(cell).drive(rod)))
         .collect();
-    eprintln!("rod drive, cells 2 / 1 / 0.5 mm: (first rupture, global slip) = {runs:?}");
-    for (name, values) in [
-        ("first rupture", runs.iter().map(|r| r.0).collect::<Vec<_>>()),
-        ("global slip", runs.iter().map(|r| r.1).collect::<Vec<_>>()),
-    ] {
-        let (d1, d2) = (values[1] - values[0], values[2] - values[1]);
-        let order = (d1 / d2).abs().log2();
-        let limit = values[2] + d2 / (2f64.powf(order) - 1.0);
-        eprintln!("{name}: {values:?}, observed order {order:.2}, Richardson limit {limit}");
-        assert!(d2.abs() < d1.abs(), "{name}: {values:?} does not converge");
+    let first: Vec<f64> = runs.iter().map(|r| r.0).collect();
+    let (d1, d2) = (first[1] - first[0], first[2] - first[1]);
+    let order = (d1 / d2).log2();
+    let limit = first[2] + d2 / (2f64.powf(order) - 1.0);
+    assert!((1.5..=2.5).contains(&order), "first rupture {first:?}: order {order}");
+    assert!((first[2] / limit - 1.0).abs() < 5e-3, "{first:?}: limit {limit}");
+    for (cell, (_, slip)) in [2e-3, 1e-3, 0.5e-3].iter().zip(&runs) {
+        assert!((slip / (0.5 * FN) - 1.0).abs() < 1e-9, "{cell}: global slip {slip}");
     }
 }
