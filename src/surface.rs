@@ -636,7 +636,10 @@ impl Truncated {
             let mut d = d0;
             for _ in 0..4 {
                 let w = -a * d;
-                let s = 1.0 + 0.5 * w + (w * w - d * d) / 6.0 + (w * w * w / 6.0 - 0.5 * w * d * d) / 4.0;
+                let s = 1.0
+                    + 0.5 * w
+                    + (w * w - d * d) / 6.0
+                    + (w * w * w / 6.0 - 0.5 * w * d * d) / 4.0;
                 d = d0 / s;
             }
             d
@@ -721,7 +724,10 @@ impl Plan {
                            wavelength: use smaller cells or a smoother surface",
                 });
             }
-            (ox, oy) = ((ox + ox / 2 + 2).min(MAX_ORDER), (oy + oy / 2 + 2).min(MAX_ORDER));
+            (ox, oy) = (
+                (ox + ox / 2 + 2).min(MAX_ORDER),
+                (oy + oy / 2 + 2).min(MAX_ORDER),
+            );
             let work = self.modes.work(grid.nx() * ox, grid.ny() * oy);
             if !(work <= MAX_WORK as f64) {
                 return Err(Error::SurfaceTooLarge {
@@ -799,21 +805,37 @@ mod tests {
         for n in 1..=12 {
             let (t, w) = gauss_legendre(n);
             for degree in 0..2 * n {
-                let rule: f64 = t.iter().zip(&w).map(|(t, w)| w * t.powi(degree as i32)).sum();
+                let rule: f64 = t
+                    .iter()
+                    .zip(&w)
+                    .map(|(t, w)| w * t.powi(degree as i32))
+                    .sum();
                 // ∫_{-1}^{1} t^d dt = 2/(d+1) for even d, 0 for odd d.
-                let exact = if degree % 2 == 0 { 2.0 / (degree as f64 + 1.0) } else { 0.0 };
-                assert!((rule - exact).abs() < 1e-14, "n {n} degree {degree}: {rule}");
+                let exact = if degree % 2 == 0 {
+                    2.0 / (degree as f64 + 1.0)
+                } else {
+                    0.0
+                };
+                assert!(
+                    (rule - exact).abs() < 1e-14,
+                    "n {n} degree {degree}: {rule}"
+                );
             }
         }
     }
 
     #[test]
     fn the_normal_quantile_inverts_the_cdf_to_rounding() {
-        for p in [1e-300, 1e-100, 1e-20, 1e-8, 1e-3, 0.02, 0.1, 0.3, 0.4999, 0.5] {
+        for p in [
+            1e-300, 1e-100, 1e-20, 1e-8, 1e-3, 0.02, 0.1, 0.3, 0.4999, 0.5,
+        ] {
             let z = lower_quantile(p);
             assert!(z <= 0.0);
             let back = normal_cdf(z);
-            assert!(((back - p) / p).abs() < 1e-14 * z.abs().max(1.0), "{p}: {back}");
+            assert!(
+                ((back - p) / p).abs() < 1e-14 * z.abs().max(1.0),
+                "{p}: {back}"
+            );
         }
     }
 
@@ -870,7 +892,10 @@ mod tests {
                 }
                 let (c, v) = (c / seeds as f64, v / seeds as f64);
                 let sd = ((1.0 + expected * expected) / seeds as f64).sqrt();
-                assert!((c - expected).abs() < 4.0 * sd, "r {r} x {along_x}: {c} vs {expected}");
+                assert!(
+                    (c - expected).abs() < 4.0 * sd,
+                    "r {r} x {along_x}: {c} vs {expected}"
+                );
                 assert!((v - 1.0).abs() < 4.0 * (2.0 / seeds as f64).sqrt(), "{v}");
             }
         }
@@ -886,7 +911,10 @@ mod tests {
         let spectrum = SurfaceSpectrum::self_affine(h, lr, ls, ll).unwrap();
         let (lx, ly) = (0.008, 0.004);
         let modes = Modes::new(lx, ly, &spectrum).unwrap();
-        let (px, py) = ((2.0 * lx as f64).max(lx + ll), (2.0 * ly as f64).max(ly + ll));
+        let (px, py) = (
+            (2.0 * lx as f64).max(lx + ll),
+            (2.0 * ly as f64).max(ly + ll),
+        );
         let covariance = |rx: f64, ry: f64| {
             let (mut num, mut den) = (0.0, 0.0);
             for q in 0..200i64 {
@@ -899,7 +927,11 @@ mod tests {
                     if k < TAU / ll || k > TAU / ls {
                         continue;
                     }
-                    let s = if k <= TAU / lr { 1.0 } else { (k * lr / TAU).powf(-2.0 * (1.0 + h)) };
+                    let s = if k <= TAU / lr {
+                        1.0
+                    } else {
+                        (k * lr / TAU).powf(-2.0 * (1.0 + h))
+                    };
                     num += s * (kx * rx + ky * ry).cos();
                     den += s;
                 }
@@ -917,7 +949,10 @@ mod tests {
             }
             let c = c / seeds as f64;
             let sd = ((1.0 + expected * expected) / seeds as f64).sqrt();
-            assert!((c - expected).abs() < 4.0 * sd, "({rx}, {ry}): {c} vs {expected}");
+            assert!(
+                (c - expected).abs() < 4.0 * sd,
+                "({rx}, {ry}): {c} vs {expected}"
+            );
         }
     }
 
@@ -966,16 +1001,32 @@ mod tests {
         ];
         for (m, s, g, expected) in cases {
             let u0 = Truncated::new(m, s).quantile(g);
-            assert!(((u0 - expected) / expected).abs() < 1e-11, "{m} {s} {g}: {u0:e} vs {expected:e}");
+            assert!(
+                ((u0 - expected) / expected).abs() < 1e-11,
+                "{m} {s} {g}: {u0:e} vs {expected:e}"
+            );
         }
     }
 
     #[test]
     fn limits_are_typed_errors() {
-        let e = Modes::new(0.14, 0.007, &SurfaceSpectrum::gaussian(1e-6).unwrap()).err().unwrap();
-        assert!(matches!(e, Error::SurfaceTooLarge { what: "Fourier modes", .. }), "{e}");
+        let e = Modes::new(0.14, 0.007, &SurfaceSpectrum::gaussian(1e-6).unwrap())
+            .err()
+            .unwrap();
+        assert!(
+            matches!(
+                e,
+                Error::SurfaceTooLarge {
+                    what: "Fourier modes",
+                    ..
+                }
+            ),
+            "{e}"
+        );
         let grid = Grid::new(Block::new(0.14, 0.007, 0.075).unwrap(), 2, 1).unwrap();
-        let e = Plan::new(&grid, &SurfaceSpectrum::gaussian(1e-4).unwrap()).err().unwrap();
+        let e = Plan::new(&grid, &SurfaceSpectrum::gaussian(1e-4).unwrap())
+            .err()
+            .unwrap();
         assert!(matches!(e, Error::SurfaceTooLarge { .. }), "{e}");
     }
 
@@ -985,7 +1036,12 @@ mod tests {
         let spectrum = SurfaceSpectrum::gaussian(2e-3).unwrap();
         let coarse = Plan::new(&Grid::new(block, 8, 2).unwrap(), &spectrum).unwrap();
         let fine = Plan::new(&Grid::new(block, 32, 8).unwrap(), &spectrum).unwrap();
-        assert!(coarse.orders().0 > fine.orders().0, "{:?} {:?}", coarse.orders(), fine.orders());
+        assert!(
+            coarse.orders().0 > fine.orders().0,
+            "{:?} {:?}",
+            coarse.orders(),
+            fine.orders()
+        );
         assert!(coarse.modes().len() == fine.modes().len());
     }
 }

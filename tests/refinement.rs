@@ -60,13 +60,19 @@ fn a_uniform_surface_has_the_closed_form_normal_state_at_every_cell_size() {
             let phi = load / area;
             let a_r = area / (std::f64::consts::E - 1.0) * ((phi / c_z).exp() - 1.0);
             let got = driver.real_contact_area().unwrap();
-            assert!((got / a_r - 1.0).abs() < 1e-9, "{cell}: A_R(0) {got} vs {a_r}");
+            assert!(
+                (got / a_r - 1.0).abs() < 1e-9,
+                "{cell}: A_R(0) {got} vs {a_r}"
+            );
             let u = driver.normal_displacement().unwrap();
             let mean = u.iter().sum::<f64>() / u.len() as f64;
             let expected = U0 * (1.0 - phi / c_z);
             // Every site, not only the mean: the state is uniform.
             for v in u {
-                assert!((v - expected).abs() < 1e-9 * U0, "{cell}: u_z {v} vs {expected}");
+                assert!(
+                    (v - expected).abs() < 1e-9 * U0,
+                    "{cell}: u_z {v} vs {expected}"
+                );
             }
             means.push(mean);
         }
@@ -74,7 +80,10 @@ fn a_uniform_surface_has_the_closed_form_normal_state_at_every_cell_size() {
         // while every site stays attached).
         let stiffness = (0.5 * FN) / (means[1] - means[0]);
         let expected = -area * c_z / U0;
-        assert!((stiffness / expected - 1.0).abs() < 1e-6, "{cell}: {stiffness} vs {expected}");
+        assert!(
+            (stiffness / expected - 1.0).abs() < 1e-6,
+            "{cell}: {stiffness} vs {expected}"
+        );
     }
 }
 
@@ -83,8 +92,14 @@ fn a_uniform_surface_under_a_top_shear_slips_at_mu_fn_at_every_cell_size() {
     for cell in [2e-3, 1e-3, 0.5e-3] {
         let (first, slip) = rupture_and_slip(uniform(cell).drive(Drive::Force(ForceLoad::Top)));
         let mu_fn = 0.5 * FN;
-        assert!((first / mu_fn - 1.0).abs() < 1e-9, "{cell}: first rupture {first}");
-        assert!((slip / mu_fn - 1.0).abs() < 1e-9, "{cell}: global slip {slip}");
+        assert!(
+            (first / mu_fn - 1.0).abs() < 1e-9,
+            "{cell}: first rupture {first}"
+        );
+        assert!(
+            (slip / mu_fn - 1.0).abs() < 1e-9,
+            "{cell}: global slip {slip}"
+        );
     }
 }
 
@@ -107,9 +122,18 @@ fn a_uniform_surface_under_a_rod_converges_with_the_cell_size() {
     let (d1, d2) = (first[1] - first[0], first[2] - first[1]);
     let order = (d1 / d2).log2();
     let limit = first[2] + d2 / (2f64.powf(order) - 1.0);
-    assert!((1.5..=2.5).contains(&order), "first rupture {first:?}: order {order}");
-    assert!((first[2] / limit - 1.0).abs() < 5e-3, "{first:?}: limit {limit}");
+    assert!(
+        (1.5..=2.5).contains(&order),
+        "first rupture {first:?}: order {order}"
+    );
+    assert!(
+        (first[2] / limit - 1.0).abs() < 5e-3,
+        "{first:?}: limit {limit}"
+    );
     for (cell, (_, slip)) in [2e-3, 1e-3, 0.5e-3].iter().zip(&runs) {
-        assert!((slip / (0.5 * FN) - 1.0).abs() < 1e-9, "{cell}: global slip {slip}");
+        assert!(
+            (slip / (0.5 * FN) - 1.0).abs() < 1e-9,
+            "{cell}: global slip {slip}"
+        );
     }
 }

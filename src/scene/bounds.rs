@@ -446,7 +446,13 @@ fn surface_lengths(spectrum: &SurfaceSpectrum) -> Result<()> {
     match *spectrum {
         SurfaceSpectrum::Gaussian {
             correlation_length, ..
-        } => within("heights.correlation_length", correlation_length, LENGTH, "m", WHY),
+        } => within(
+            "heights.correlation_length",
+            correlation_length,
+            LENGTH,
+            "m",
+            WHY,
+        ),
         SurfaceSpectrum::SelfAffine {
             roll_off,
             short_cutoff,
