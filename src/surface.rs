@@ -285,7 +285,7 @@ impl Modes {
         let pm = (kc * px / TAU).floor();
         let qm = (kc * py / TAU).floor();
         let count = (2.0 * pm + 1.0) * (qm + 1.0);
-        if !(count <= MAX_MODES as f64) {
+        if count.is_nan() || count > MAX_MODES as f64 {
             return Err(Error::SurfaceTooLarge {
                 what: "Fourier modes",
                 needed: count,
@@ -318,7 +318,7 @@ impl Modes {
                 }
             }
         }
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             return Err(Error::SurfaceTooLarge {
                 what: "Fourier modes in the spectrum's band (it holds none: the band is \
                        narrower than the modes' spacing 2π/P)",
@@ -577,7 +577,7 @@ fn lower_quantile(p: f64) -> f64 {
             / (1.0 + 1.432_788 * t + 0.189_269 * t * t + 0.001_308 * t * t * t));
     for _ in 0..8 {
         let density = normal_pdf(z);
-        if !(density > 0.0) {
+        if density.is_nan() || density <= 0.0 {
             break;
         }
         let r = (normal_cdf(z) - p) / density;
@@ -671,7 +671,7 @@ impl Plan {
         let orders = modes.orders(grid.dx(), grid.dy())?;
         let (nx, ny) = (grid.nx() * orders.0, grid.ny() * orders.1);
         let work = modes.work(nx, ny);
-        if !(work <= MAX_WORK as f64) {
+        if work.is_nan() || work > MAX_WORK as f64 {
             return Err(Error::SurfaceTooLarge {
                 what: "complex multiply-adds",
                 needed: work,
@@ -729,7 +729,7 @@ impl Plan {
                 (oy + oy / 2 + 2).min(MAX_ORDER),
             );
             let work = self.modes.work(grid.nx() * ox, grid.ny() * oy);
-            if !(work <= MAX_WORK as f64) {
+            if work.is_nan() || work > MAX_WORK as f64 {
                 return Err(Error::SurfaceTooLarge {
                     what: "complex multiply-adds (the cell averages' rule)",
                     needed: work,
@@ -911,10 +911,7 @@ mod tests {
         let spectrum = SurfaceSpectrum::self_affine(h, lr, ls, ll).unwrap();
         let (lx, ly) = (0.008, 0.004);
         let modes = Modes::new(lx, ly, &spectrum).unwrap();
-        let (px, py) = (
-            (2.0 * lx as f64).max(lx + ll),
-            (2.0 * ly as f64).max(ly + ll),
-        );
+        let (px, py) = ((2.0 * lx).max(lx + ll), (2.0 * ly).max(ly + ll));
         let covariance = |rx: f64, ry: f64| {
             let (mut num, mut den) = (0.0, 0.0);
             for q in 0..200i64 {
