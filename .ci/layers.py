@@ -16,7 +16,7 @@ LAYERS = [
     ["error"],
     ["cost", "lock"],
     ["geometry"],
-    ["green"],
+    ["green", "surface"],
     ["interface"],
     ["solver"],
     ["probe"],

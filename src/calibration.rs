@@ -25,8 +25,7 @@
 use crate::driver::Event;
 use crate::error::{check_tolerance, Error, Result};
 use crate::green::Planner;
-use crate::interface::HeightDistribution;
-use crate::scene::{HeightSource, SceneBuilder};
+use crate::scene::SceneBuilder;
 
 /// Options of the fits.
 ///
@@ -61,8 +60,9 @@ impl Default for FitOptions {
 }
 
 impl FitOptions {
-    /// Seeds of the height realizations averaged over (paper Gaussian heights with the
-    /// builder's distribution); empty: the builder's own heights only (default).
+    /// Seeds of the height realizations averaged over (the builder's random heights, paper
+    /// Gaussian or a random surface, with each seed; the paper's Gaussian heights when
+    /// the builder's are given values); empty: the builder's own heights only (default).
     pub fn seeds(&self) -> &[u64] {
         &self.seeds
     }
@@ -173,18 +173,11 @@ fn realizations(builder: &SceneBuilder, options: &FitOptions) -> Vec<SceneBuilde
     if options.seeds.is_empty() {
         return vec![builder.clone()];
     }
-    let distribution = match builder.current_heights() {
-        HeightSource::Random { distribution, .. } => *distribution,
-        _ => HeightDistribution::default(),
-    };
+    let source = builder.current_heights();
     options
         .seeds
         .iter()
-        .map(|&seed| {
-            builder
-                .clone()
-                .heights(HeightSource::Random { distribution, seed })
-        })
+        .map(|&seed| builder.clone().heights(source.reseeded(seed)))
         .collect()
 }
 

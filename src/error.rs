@@ -569,6 +569,24 @@ pub enum Error {
         /// Why values outside it are refused.
         reason: &'static str,
     },
+    /// A random surface whose synthesis would exceed the crate's limits
+    /// (`Heights::random_surface`; a scene's heights of kind `gaussian_surface` or
+    /// `self_affine_surface`, refused by `SceneBuilder::check`/`build`): too many Fourier
+    /// modes (a correlation length or short cut-off tiny against the block), cells so large
+    /// against the shortest wavelength that their averages need more Gauss-Legendre points
+    /// than the limit, or too much work in all; or a band of the spectrum that holds no
+    /// mode at all.
+    #[error("the random surface needs {} {what}, the limit is {}: {hint}", Num(*needed), Num(*limit))]
+    SurfaceTooLarge {
+        /// What is counted.
+        what: &'static str,
+        /// How many the surface needs.
+        needed: f64,
+        /// The limit.
+        limit: f64,
+        /// What to change.
+        hint: &'static str,
+    },
     /// The memory a scene or sweep would need exceeds what the machine has available
     /// (Linux: `MemAvailable` of `/proc/meminfo`), refused before anything is allocated:
     /// `SceneBuilder::check`/`build`, a file too large to read (scene, checkpoint, sweep,

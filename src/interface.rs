@@ -11,6 +11,7 @@
 
 use crate::error::{check_slice, Error, Result};
 use crate::geometry::Grid;
+use crate::surface::{Plan, SurfaceSpectrum, Truncated};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
@@ -438,6 +439,46 @@ impl Heights {
                 }
             })
             .collect();
+        Ok(Self { values })
+    }
+
+    /// Heights of a Gaussian random surface with a length scale (docs/model.md section
+    /// 3.1): a field `g` of unit variance with the power spectrum `spectrum`, synthesised
+    /// from Fourier modes whose coefficients depend only on `(seed, mode)`, mapped onto
+    /// the truncated Gaussian `dist` (the paper's marginal) by `u0 = F⁻¹(Φ(g))`, and
+    /// averaged over each cell. The same seed gives the same surface at every cell size
+    /// (a coarse cell's height is the mean of its fine cells' to about `1e-12` of the
+    /// standard deviation) and the same heights bit for bit on every machine.
+    ///
+    /// ```
+    /// use precursors::{Block, Grid, HeightDistribution, Heights, SurfaceSpectrum};
+    /// let block = Block::new(0.016, 0.004, 0.010)?;                 // Lx, Ly, Lz (m)
+    /// let xi = SurfaceSpectrum::gaussian(2e-3)?;                     // ξ = 2 mm
+    /// let d = HeightDistribution::default();                         // the paper's marginal
+    /// let coarse = Heights::random_surface(&Grid::new(block, 8, 2)?, xi, d, 7)?;  // 2 mm
+    /// let fine = Heights::random_surface(&Grid::new(block, 16, 4)?, xi, d, 7)?;   // 1 mm
+    /// assert!(coarse.values().iter().all(|&u0| u0 > 0.0));
+    /// // Coarse cell (0, 0) is fine cells (0, 0), (1, 0), (0, 1), (1, 1).
+    /// let f = fine.values();
+    /// let mean = (f[0] + f[1] + f[16] + f[17]) / 4.0;
+    /// assert!((coarse.values()[0] - mean).abs() < 1e-15);             // m
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::SurfaceTooLarge`] when the spectrum needs too many modes for the block,
+    /// or the cells too many quadrature points; [`Error::OutOfMemory`];
+    /// [`Error::NonPositiveHeight`] if a cell's height rounds to 0 (a field value beyond
+    /// about 37 standard deviations: it does not happen).
+    pub fn random_surface(
+        grid: &Grid,
+        spectrum: SurfaceSpectrum,
+        dist: HeightDistribution,
+        seed: u64,
+    ) -> Result<Self> {
+        let plan = Plan::new(grid, &spectrum)?;
+        let values = plan.cell_averages(grid, &Truncated::new(dist.mean, dist.std_dev), seed)?;
+        Self::check_values(grid, &values)?;
         Ok(Self { values })
     }
 

@@ -116,6 +116,7 @@ pub mod plot;
 mod probe;
 mod scene;
 pub mod solver;
+mod surface;
 #[cfg(feature = "serde")]
 pub mod sweep;
 
@@ -130,6 +131,7 @@ pub use probe::{
     CellStress, PlaneStress, PointStress, ProbeInput, ProbeSpec, Profile, StressProbe, Stresses,
 };
 pub use scene::{Drive, ForceLoad, HeightSource, Lateral, Scene, SceneBuilder};
+pub use surface::SurfaceSpectrum;
 
 /// The `nalgebra` this crate converts to and from (feature `nalgebra`): heights from an
 /// `Ny x Nx` `DMatrix` (row `iy`, column `ix`: [`Heights::from_dmatrix`]), fields to a

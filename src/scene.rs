@@ -27,6 +27,7 @@ use crate::green::{InfluencePlan, Planner, RodLoad};
 use crate::interface::{AreaLaw, HeightDistribution, Heights, Interface, Material, SpringLaw};
 use crate::probe::{ProbeSpec, StressProbe};
 use crate::solver::SolverOptions;
+use crate::surface::SurfaceSpectrum;
 
 mod bounds;
 pub(crate) mod file;
@@ -207,9 +208,66 @@ pub enum HeightSource {
     },
     /// Given heights (m), one per cell in the paper's order `i = iy·Nx + ix`.
     Values(Vec<f64>),
+    /// A Gaussian random surface with a length scale, averaged over each cell
+    /// ([`Heights::random_surface`]): the same seed gives the same surface at every cell
+    /// size. Scene-file kinds `gaussian_surface` and `self_affine_surface`.
+    ///
+    /// ```
+    /// use precursors::{HeightDistribution, HeightSource, Scene, SurfaceSpectrum};
+    /// let surface = HeightSource::Surface {
+    ///     spectrum: SurfaceSpectrum::gaussian(2e-3)?,          // ξ = 2 mm
+    ///     distribution: HeightDistribution::default(),          // mean 1 µm, sd 1 µm, cut at 0
+    ///     seed: 3,
+    /// };
+    /// let scene = Scene::builder()
+    ///     .block(0.010, 0.004, 0.010)       // Lx, Ly, Lz (m)
+    ///     .cells(10, 4)                     // 1 mm cells
+    ///     .normal_load(40.0)                // F_N (N)
+    ///     .heights(surface)
+    ///     .build()?;
+    /// assert!(scene.interface().heights().iter().all(|&u0| u0 > 0.0));
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    Surface {
+        /// The power spectrum of the surface.
+        spectrum: SurfaceSpectrum,
+        /// The heights' marginal: the Gaussian before truncation at 0 (m).
+        distribution: HeightDistribution,
+        /// Seed of the surface's Fourier coefficients.
+        seed: u64,
+    },
 }
 
 impl HeightSource {
+    /// The same random source with another seed; the paper's Gaussian heights with this
+    /// seed for given values (a calibration's realizations).
+    pub(crate) fn reseeded(&self, seed: u64) -> HeightSource {
+        match self {
+            HeightSource::Random { distribution, .. } => HeightSource::Random {
+                distribution: *distribution,
+                seed,
+            },
+            HeightSource::Surface {
+                spectrum,
+                distribution,
+                ..
+            } => HeightSource::Surface {
+                spectrum: *spectrum,
+                distribution: *distribution,
+                seed,
+            },
+            HeightSource::Values(_) => HeightSource::Random {
+                distribution: HeightDistribution::default(),
+                seed,
+            },
+        }
+    }
+
+    /// Whether the heights are drawn from a seed (realizations differ by it).
+    pub(crate) fn is_random(&self) -> bool {
+        !matches!(self, HeightSource::Values(_))
+    }
+
     /// Heights (m) read from a text file: one value per line in the paper's cell order
     /// `i = iy·Nx + ix`; blank lines and lines starting with `#` are skipped. Each value
     /// must be finite and `> 0`; the count is checked against the grid at
@@ -586,8 +644,12 @@ impl SceneBuilder {
                 reason: "the normal load must be finite and > 0 N",
             });
         }
-        if let HeightSource::Values(v) = &self.heights {
-            Heights::check_values(&grid, v)?;
+        match &self.heights {
+            HeightSource::Values(v) => Heights::check_values(&grid, v)?,
+            HeightSource::Surface { spectrum, .. } => {
+                crate::surface::Plan::new(&grid, spectrum)?;
+            }
+            HeightSource::Random { .. } => {}
         }
         match self.drive {
             Drive::Force(ForceLoad::Mixed { ratio, .. })
@@ -644,6 +706,11 @@ impl SceneBuilder {
                 Heights::truncated_gaussian(&grid, *distribution, *seed)?
             }
             HeightSource::Values(v) => Heights::from_values(&grid, v.clone())?,
+            HeightSource::Surface {
+                spectrum,
+                distribution,
+                seed,
+            } => Heights::random_surface(&grid, *spectrum, *distribution, *seed)?,
         };
         Ok((block, grid, heights, self.lateral()))
     }

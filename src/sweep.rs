@@ -872,7 +872,7 @@ fn check_realizations(realizations: usize, base: &SceneBuilder) -> Result<bool> 
         }
         .into());
     }
-    let random = matches!(base.current_heights(), HeightSource::Random { .. });
+    let random = base.current_heights().is_random();
     if realizations > 1 && !random {
         return Err(Error::InvalidCount {
             name: "realizations",
@@ -910,7 +910,7 @@ fn check_size(axes: &[Axis], realizations: usize, base: &SceneBuilder) -> Result
     };
     let heights = match base.current_heights() {
         HeightSource::Values(v) => 8 * v.len(),
-        HeightSource::Random { .. } => 0,
+        _ => 0,
     };
     // Each run holds its scene, heights included, its values as text and its
     // coordinates; twice that while it is built.

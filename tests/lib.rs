@@ -27,6 +27,7 @@ mod paper_sweeps;
 mod plot;
 mod probe;
 mod properties;
+mod refinement;
 mod robustness;
 #[cfg(feature = "serde")]
 mod runs;
@@ -34,5 +35,6 @@ mod runs;
 mod scene_file;
 mod solver;
 mod stability;
+mod surfaces;
 #[cfg(feature = "serde")]
 mod sweep;

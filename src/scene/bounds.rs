@@ -15,6 +15,7 @@
 use super::{Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder};
 use crate::error::{Error, Num, Result};
 use crate::geometry::Grid;
+use crate::surface::SurfaceSpectrum;
 
 /// Block lengths `Lx, Ly, Lz` (m).
 pub(crate) const LENGTH: (f64, f64) = (1e-9, 1e9);
@@ -334,10 +335,14 @@ const MAX_GAP_ERROR: f64 = 1e-3;
 fn resolution(builder: &SceneBuilder) -> Result<()> {
     let (lx, ly, lz) = builder.lengths;
     let mean_height = match &builder.heights {
-        HeightSource::Random { distribution, .. } if distribution.mean() > 0.0 => {
+        HeightSource::Random { distribution, .. } | HeightSource::Surface { distribution, .. }
+            if distribution.mean() > 0.0 =>
+        {
             distribution.mean()
         }
-        HeightSource::Random { distribution, .. } => distribution.std_dev(),
+        HeightSource::Random { distribution, .. } | HeightSource::Surface { distribution, .. } => {
+            distribution.std_dev()
+        }
         HeightSource::Values(v) => v.iter().sum::<f64>() / v.len() as f64,
     };
     let r = builder.normal_load / (lx * ly) * lx.max(ly).max(lz)
@@ -409,7 +414,10 @@ const MAX_AREA_ERROR: f64 = 5e-2;
 fn heights(source: &HeightSource) -> Result<()> {
     const WHY: &str = "asperity heights beyond it overflow or underflow the compliances";
     match source {
-        HeightSource::Random { distribution, .. } => {
+        HeightSource::Random { distribution, .. } | HeightSource::Surface { distribution, .. } => {
+            if let HeightSource::Surface { spectrum, .. } = source {
+                surface_lengths(spectrum)?;
+            }
             let (mean, sd) = (distribution.mean(), distribution.std_dev());
             if mean.is_finite() && mean != 0.0 {
                 within("heights.mean", mean.abs(), HEIGHT, "m (in magnitude)", WHY)?;
@@ -429,6 +437,33 @@ fn heights(source: &HeightSource) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The lengths of a surface's spectrum (m) within [`LENGTH`] (the synthesis' own limits,
+/// modes and quadrature points, are checked against the grid by `surface::Plan`).
+fn surface_lengths(spectrum: &SurfaceSpectrum) -> Result<()> {
+    const WHY: &str = "a surface's lengths must lie within the range of the block's";
+    match *spectrum {
+        SurfaceSpectrum::Gaussian {
+            correlation_length, ..
+        } => within(
+            "heights.correlation_length",
+            correlation_length,
+            LENGTH,
+            "m",
+            WHY,
+        ),
+        SurfaceSpectrum::SelfAffine {
+            roll_off,
+            short_cutoff,
+            long_cutoff,
+            ..
+        } => {
+            within("heights.roll_off", roll_off, LENGTH, "m", WHY)?;
+            within("heights.short_cutoff", short_cutoff, LENGTH, "m", WHY)?;
+            within("heights.long_cutoff", long_cutoff, LENGTH, "m", WHY)
+        }
+    }
 }
 
 fn drive(builder: &SceneBuilder) -> Result<()> {
@@ -502,7 +537,8 @@ pub(super) fn memory_bytes(builder: &SceneBuilder, grid: &Grid) -> f64 {
     // Given heights are copied into the interface.
     let heights = match &builder.heights {
         HeightSource::Values(v) => 8.0 * v.len() as f64,
-        HeightSource::Random { .. } => 0.0,
+        // Drawn heights: the surface's synthesis checks its own memory.
+        HeightSource::Random { .. } | HeightSource::Surface { .. } => 0.0,
     };
     // An explicit dense backend above the size `Auto` solves densely (GridCost's own).
     let dense = match builder.solver.backend() {

@@ -11,6 +11,7 @@ use super::schema::{observes, schema_enum, schema_leaf, schema_struct, Schema};
 use super::{Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder};
 use crate::interface::AreaLaw;
 use crate::solver::{Backend, Parallelism};
+use crate::surface::SurfaceSpectrum;
 use std::path::PathBuf;
 #[cfg(feature = "serde")]
 use {
@@ -126,6 +127,27 @@ schema_enum! {
         },
         File = "file" {
             path: PathBuf,
+        },
+        GaussianSurface = "gaussian_surface" {
+            correlation_length: f64,
+            #[cfg_attr(feature = "serde", serde(default = "default_mean"))]
+            mean: f64,
+            #[cfg_attr(feature = "serde", serde(default = "default_std_dev"))]
+            std_dev: f64,
+            #[cfg_attr(feature = "serde", serde(default = "default_seed"))]
+            seed: u64,
+        },
+        SelfAffineSurface = "self_affine_surface" {
+            hurst: f64,
+            roll_off: f64,
+            short_cutoff: f64,
+            long_cutoff: f64,
+            #[cfg_attr(feature = "serde", serde(default = "default_mean"))]
+            mean: f64,
+            #[cfg_attr(feature = "serde", serde(default = "default_std_dev"))]
+            std_dev: f64,
+            #[cfg_attr(feature = "serde", serde(default = "default_seed"))]
+            seed: u64,
         },
     }
 }
@@ -326,6 +348,32 @@ impl From<&SceneBuilder> for SceneFile {
             HeightSource::Values(values) => HeightsSpec::Values {
                 values: values.clone(),
             },
+            HeightSource::Surface {
+                spectrum,
+                distribution,
+                seed,
+            } => match *spectrum {
+                SurfaceSpectrum::Gaussian { correlation_length } => HeightsSpec::GaussianSurface {
+                    correlation_length,
+                    mean: distribution.mean(),
+                    std_dev: distribution.std_dev(),
+                    seed: *seed,
+                },
+                SurfaceSpectrum::SelfAffine {
+                    hurst,
+                    roll_off,
+                    short_cutoff,
+                    long_cutoff,
+                } => HeightsSpec::SelfAffineSurface {
+                    hurst,
+                    roll_off,
+                    short_cutoff,
+                    long_cutoff,
+                    mean: distribution.mean(),
+                    std_dev: distribution.std_dev(),
+                    seed: *seed,
+                },
+            },
         };
         let backend = match solver.backend() {
             Backend::Dense => BackendSpec::Dense,
@@ -394,6 +442,29 @@ impl SceneFile {
                 seed,
             },
             HeightsSpec::Values { values } => HeightSource::Values(values),
+            HeightsSpec::GaussianSurface {
+                correlation_length,
+                mean,
+                std_dev,
+                seed,
+            } => HeightSource::Surface {
+                spectrum: SurfaceSpectrum::gaussian(correlation_length)?,
+                distribution: HeightDistribution::new(mean, std_dev)?,
+                seed,
+            },
+            HeightsSpec::SelfAffineSurface {
+                hurst,
+                roll_off,
+                short_cutoff,
+                long_cutoff,
+                mean,
+                std_dev,
+                seed,
+            } => HeightSource::Surface {
+                spectrum: SurfaceSpectrum::self_affine(hurst, roll_off, short_cutoff, long_cutoff)?,
+                distribution: HeightDistribution::new(mean, std_dev)?,
+                seed,
+            },
             HeightsSpec::File { path } => {
                 // The file is bounded by the grid's cells before it is read (when the grid
                 // is valid; otherwise by the memory available).
@@ -843,6 +914,17 @@ mod tests {
                     lateral: Lateral::Side,
                 })
                 .heights(HeightSource::Values(vec![1e-6; 80])),
+            base.clone().heights(HeightSource::Surface {
+                spectrum: SurfaceSpectrum::gaussian(2e-3).unwrap(),
+                distribution: crate::HeightDistribution::new(2e-6, 1e-6).unwrap(),
+                seed: 5,
+            }),
+            // Half of each value stays valid: λ_s < λ_r/2, λ_l/2 ≥ λ_r.
+            base.clone().heights(HeightSource::Surface {
+                spectrum: SurfaceSpectrum::self_affine(0.7, 3e-3, 0.6e-3, 8e-3).unwrap(),
+                distribution: crate::HeightDistribution::default(),
+                seed: 6,
+            }),
             base.solver_options(
                 SolverOptions::default()
                     .with_parallelism(Parallelism::Threads(3))
