@@ -25,9 +25,11 @@
 
 mod error;
 mod figures;
+mod movie;
 
 pub use error::PlotError;
 pub use figures::{draw, Drawn, Format};
+pub use movie::{Movie, MovieKind, MovieReport};
 
 use crate::error::Error;
 use plotters::coord::types::RangedCoordf64;
@@ -636,6 +638,11 @@ pub struct Map {
     colour_range: Option<(f64, f64)>,
     palette: Palette,
     size: (u32, u32),
+    /// The rows' edges (`rows + 1` increasing values) when they are not evenly spaced
+    /// over the y range (a movie's planes).
+    row_edges: Option<Vec<f64>>,
+    /// Lines drawn over the cells in black (a movie's precursor front), in axis units.
+    overlay: Vec<Vec<(f64, f64)>>,
 }
 
 impl Map {
@@ -679,6 +686,8 @@ impl Map {
             colour_range: None,
             palette: Palette::Sequential,
             size: (900, 560),
+            row_edges: None,
+            overlay: Vec::new(),
         })
     }
 
@@ -772,11 +781,23 @@ impl Draw for MapDrawing<'_> {
                     } else {
                         grey
                     };
-                    let (x0, y0) = (x.0 + col as f64 * dx, y.0 + r as f64 * dy);
-                    Rectangle::new([(x0, y0), (x0 + dx, y0 + dy)], fill.filled())
+                    let x0 = x.0 + col as f64 * dx;
+                    let (y0, y1) = match &me.row_edges {
+                        Some(edges) => (edges[r], edges[r + 1]),
+                        None => (y.0 + r as f64 * dy, y.0 + (r + 1) as f64 * dy),
+                    };
+                    Rectangle::new([(x0, y0), (x0 + dx, y1)], fill.filled())
                 })
             }))
             .map_err(|e| e.to_string())?;
+        for line in &me.overlay {
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    line.clone(),
+                    BLACK.stroke_width(3),
+                )))
+                .map_err(|e| e.to_string())?;
+        }
         draw_axes(&mut chart, (&me.x_label, x), (&me.y_label, y), false)?;
         // The colour bar: a one-column chart of the colour scale, its values on the right.
         let mut scale = ChartBuilder::on(&bar)
@@ -863,8 +884,8 @@ const LARGEST_SIDE: u32 = 16384;
 /// Draws in memory through the backend that `path`'s extension names, then writes the
 /// file atomically (temporary file and rename, as checkpoints): a full disk or a kill
 /// never leaves a half or empty figure under its name.
-fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
-    register_font()?;
+/// Refuses a figure size outside 200 x 150 to [`LARGEST_SIDE`] squared.
+fn check_size(path: &Path, size: (u32, u32)) -> Result<()> {
     let fail = |reason: String| PlotError::Figure {
         path: Some(path.to_path_buf()),
         reason,
@@ -881,6 +902,16 @@ fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
             size.0, size.1
         )));
     }
+    Ok(())
+}
+
+fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
+    register_font()?;
+    let fail = |reason: String| PlotError::Figure {
+        path: Some(path.to_path_buf()),
+        reason,
+    };
+    check_size(path, size)?;
     let extension = path
         .extension()
         .and_then(|e| e.to_str())

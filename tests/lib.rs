@@ -18,6 +18,8 @@ mod laws;
 mod loads;
 #[cfg(feature = "nalgebra")]
 mod matrix;
+#[cfg(feature = "plot")]
+mod movie;
 #[cfg(feature = "cli")]
 mod messages;
 mod operator;
