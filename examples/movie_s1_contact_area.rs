@@ -6,7 +6,7 @@
 //! Each run records its fields (`SceneBuilder::record_fields`: the cells' contact area of
 //! every stable state) into `movie_s1_<drive>/` (the run tables, `scene.json` and
 //! `fields.csv`, as `precursors run` writes them), then `plot::Movie` draws
-//! `movie_s1_<drive>.gif`: at most 150 frames, one colour scale per movie (μm² per cell),
+//! `movie_s1_<drive>.gif`: at most 150 frames, one colour scale per movie (mm² per cell),
 //! the precursor front `x = ℓ` as a black line, each frame titled with `F/(μF_N)` and
 //! `ℓ/Lx`. The same movie from the command line: `precursors movie movie_s1_<drive>`.
 //! Run: `cargo run --release --example movie_s1_contact_area [output directory]`.
@@ -64,7 +64,7 @@ fn run() -> report::Outcome {
         }
         println!(
             "{name:>4}: wrote {gif}: {} frames of {} stable states (one in {} and the last), \
-             A_R per cell from 0 to {:.1} μm² (saturating)",
+             A_R per cell from 0 to {:.3} mm² (saturating)",
             report.frames, report.states, report.stride, report.colour_range.1
         );
     }

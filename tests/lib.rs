@@ -18,10 +18,10 @@ mod laws;
 mod loads;
 #[cfg(feature = "nalgebra")]
 mod matrix;
-#[cfg(feature = "plot")]
-mod movie;
 #[cfg(feature = "cli")]
 mod messages;
+#[cfg(feature = "plot")]
+mod movie;
 mod operator;
 #[cfg(feature = "serde")]
 mod paper_sweeps;

@@ -13,8 +13,7 @@ use precursors::{Error, Event, ProbeSpec, Scene, SceneBuilder};
 use std::path::{Path, PathBuf};
 
 fn scratch(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("precursors-{}-movie-{name}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("precursors-{}-movie-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
@@ -57,7 +56,11 @@ fn recording_fields_changes_no_table_and_records_the_drivers_fields() {
     // The reference: a driver of the scene with the planes as its own probes, read at
     // the 1st, 4th, 7th, ... stable state.
     let probed = builder()
-        .probes(PLANES.iter().fold(ProbeSpec::default(), |s, &z| s.with_plane(z)))
+        .probes(
+            PLANES
+                .iter()
+                .fold(ProbeSpec::default(), |s, &z| s.with_plane(z)),
+        )
         .build()
         .unwrap();
     let mut driver = probed.driver().unwrap();
@@ -84,7 +87,11 @@ fn recording_fields_changes_no_table_and_records_the_drivers_fields() {
                 .iter()
                 .map(|v| format!("{v:.12e}"))
                 .collect();
-            expected.push(format!("{head},area_m2,{iy},{:.12e},{}", 0.0, cells.join(",")));
+            expected.push(format!(
+                "{head},area_m2,{iy},{:.12e},{}",
+                0.0,
+                cells.join(",")
+            ));
         }
         for (k, plane) in driver.stresses().unwrap().planes.iter().enumerate() {
             let cells: Vec<String> = plane
@@ -177,10 +184,10 @@ const HIGH: [u8; 3] = [8, 29, 88];
 
 /// A run directory of a 10 x 4-cell scene holding a hand-written `fields.csv`: five
 /// states; in state `s` the columns `ix <= s` hold `v_s` in every row (0 elsewhere), `v_0
-/// = 1 μm²`, `v_s = 2 μm²` after; one plane with `τ_C = +1 MPa` on columns `ix <= s`, −1 MPa
+/// = 1 mm²`, `v_s = 2 mm²` after; one plane with `τ_C = +1 MPa` on columns `ix <= s`, −1 MPa
 /// elsewhere. Returns the directory and the events of the states.
-fn handwritten() -> (PathBuf, Vec<usize>) {
-    let dir = scratch("handwritten");
+fn handwritten(name: &str) -> (PathBuf, Vec<usize>) {
+    let dir = scratch(name);
     let builder = Scene::builder()
         .block(0.010, 0.004, 0.010)
         .cell_size(1e-3, 1e-3)
@@ -193,8 +200,12 @@ fn handwritten() -> (PathBuf, Vec<usize>) {
     text.push('\n');
     let events: Vec<usize> = (0..5).map(|s| 1 + 7 * s).collect();
     for (s, &event) in events.iter().enumerate() {
-        let v = if s == 0 { 1e-12 } else { 2e-12 };
-        let head = format!("{event},{:.12e},{:.12e}", 0.1 * s as f64 + 0.5, 0.1 * (s + 1) as f64);
+        let v = if s == 0 { 1e-6 } else { 2e-6 };
+        let head = format!(
+            "{event},{:.12e},{:.12e}",
+            0.1 * s as f64 + 0.5,
+            0.1 * (s + 1) as f64
+        );
         for iy in 0..4 {
             text.push_str(&format!("{head},area_m2,{iy},0"));
             for ix in 0..10 {
@@ -237,9 +248,11 @@ fn near(frame: &[u8], rgb: [u8; 3]) -> usize {
 
 #[test]
 fn a_movie_has_one_frame_per_state_in_order_on_one_colour_scale() {
-    let (dir, events) = handwritten();
+    let (dir, events) = handwritten("hand1");
     let path = dir.join("s1.gif");
-    let report = Movie::new(&dir, MovieKind::ContactArea).save(&path).unwrap();
+    let report = Movie::new(&dir, MovieKind::ContactArea)
+        .save(&path)
+        .unwrap();
     assert_eq!((report.frames, report.states, report.stride), (5, 5, 1));
     assert_eq!(report.events, events);
     assert_eq!(report.colour_range, (0.0, 2.0));
@@ -284,9 +297,11 @@ fn a_movie_has_one_frame_per_state_in_order_on_one_colour_scale() {
 
 #[test]
 fn a_coulomb_movie_is_red_where_tau_c_is_positive_and_frames_are_titled() {
-    let (dir, _) = handwritten();
+    let (dir, _) = handwritten("hand2");
     let path = dir.join("s2.gif");
-    let report = Movie::new(&dir, MovieKind::CoulombStress).save(&path).unwrap();
+    let report = Movie::new(&dir, MovieKind::CoulombStress)
+        .save(&path)
+        .unwrap();
     // Symmetric about 0: ±1 MPa are the ends of the diverging palette.
     assert_eq!(report.colour_range, (-1.0, 1.0));
     let (red, blue) = ([178, 24, 43], [33, 102, 172]);
@@ -294,15 +309,27 @@ fn a_coulomb_movie_is_red_where_tau_c_is_positive_and_frames_are_titled() {
     for (s, frame) in frames.iter().enumerate() {
         // One plane: a column is about 64 x 440 pixels.
         let (r, b) = (near(frame, red), near(frame, blue));
-        assert!(r > (s + 1) * 20_000 && r < (s + 2) * 30_000, "frame {s}: {r} red");
+        assert!(
+            r > (s + 1) * 20_000 && r < (s + 2) * 30_000,
+            "frame {s}: {r} red"
+        );
         assert!(b > (9 - s) * 20_000, "frame {s}: {b} blue");
     }
     // A frame as SVG: its title says the load and the precursor length of its state.
     let svg = dir.join("frame.svg");
-    Movie::new(&dir, MovieKind::CoulombStress).save_frame(2, &svg).unwrap();
+    Movie::new(&dir, MovieKind::CoulombStress)
+        .save_frame(2, &svg)
+        .unwrap();
     let text = std::fs::read_to_string(&svg).unwrap();
-    assert!(text.contains("F/(μF_N) = 0.700, ℓ/Lx = 0.300"), "{text}");
-    assert!(text.contains("τ_C = |τ| − μ|σ| (MPa)"));
+    let texts: Vec<&str> = text
+        .split("<text")
+        .skip(1)
+        .filter_map(|t| Some(t.split_once('>')?.1.split_once("</text>")?.0.trim()))
+        .collect();
+    // The title typeset: `F_N` as F with the subscript N.
+    let title = ["F/(μF", "N", ") = 0.700, ℓ/Lx = 0.300  (event 15)"];
+    assert!(texts.windows(3).any(|w| w == title), "{texts:?}");
+    assert!(texts.contains(&"τ_C = |τ| − μ|σ| (MPa)"), "{texts:?}");
     let e = Movie::new(&dir, MovieKind::CoulombStress)
         .save_frame(5, &svg)
         .unwrap_err();
@@ -335,8 +362,12 @@ fn a_directory_without_recorded_fields_is_refused_saying_how_to_record_them() {
     assert!(!dir.join("s2.gif").exists());
     // Bad options are refused, typed.
     for e in [
-        Movie::new(&dir, MovieKind::ContactArea).every(0).unwrap_err(),
-        Movie::new(&dir, MovieKind::ContactArea).max_frames(1).unwrap_err(),
+        Movie::new(&dir, MovieKind::ContactArea)
+            .every(0)
+            .unwrap_err(),
+        Movie::new(&dir, MovieKind::ContactArea)
+            .max_frames(1)
+            .unwrap_err(),
         Movie::new(&dir, MovieKind::ContactArea)
             .frame_duration(0.0)
             .unwrap_err(),
@@ -357,7 +388,7 @@ fn a_directory_without_recorded_fields_is_refused_saying_how_to_record_them() {
 #[test]
 fn the_program_draws_the_movies_and_refuses_a_directory_without_fields() {
     use std::process::Command;
-    let (dir, _) = handwritten();
+    let (dir, _) = handwritten("hand3");
     let out = Command::new(env!("CARGO_BIN_EXE_precursors"))
         .args(["movie", "--max-frames", "3"])
         .arg(&dir)

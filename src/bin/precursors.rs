@@ -769,8 +769,7 @@ fn movie(
     };
     if out.is_some() && kinds.len() > 1 {
         return Err(usage(
-            "--out names one movie: give --field contact-area or --field coulomb-stress"
-                .into(),
+            "--out names one movie: give --field contact-area or --field coulomb-stress".into(),
         ));
     }
     for (kind, name) in kinds {

@@ -15,8 +15,8 @@
 
 use super::{axis_range, paint, register_font, Map, MapDrawing, Palette, PlotError, Result};
 use crate::error::{table_number, Error};
-use crate::output::{fields_header, FIELDS_TABLE, FIELD_AREA, FIELD_COULOMB, PARTIAL_SUFFIX};
 use crate::output::SCENE_RECORD;
+use crate::output::{fields_header, FIELDS_TABLE, FIELD_AREA, FIELD_COULOMB, PARTIAL_SUFFIX};
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -29,7 +29,7 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub enum MovieKind {
-    /// Movie S1: the real contact area `A_R` per cell over the interface (μm²), the
+    /// Movie S1: the real contact area `A_R` per cell over the interface (mm²), the
     /// precursor front `x = ℓ` drawn as a vertical line (the default).
     #[default]
     ContactArea,
@@ -58,7 +58,7 @@ pub struct MovieReport {
     pub stride: usize,
     /// The events (indices of `events.csv`) of the states drawn, in order.
     pub events: Vec<usize>,
-    /// The colour scale of every frame (μm² for the contact area, MPa for `τ_C`).
+    /// The colour scale of every frame (mm² for the contact area, MPa for `τ_C`).
     pub colour_range: (f64, f64),
 }
 
@@ -198,7 +198,7 @@ impl Movie {
         Ok(self)
     }
 
-    /// A fixed colour scale (μm² for the contact area, MPa for `τ_C`) instead of the
+    /// A fixed colour scale (mm² for the contact area, MPa for `τ_C`) instead of the
     /// one from the run (contact area: 0 to the 98th percentile of the cells' values over
     /// the movie; `τ_C`: symmetric about 0, to the 98th percentile of `|τ_C|`; both
     /// saturating beyond). Checked
@@ -258,8 +258,8 @@ impl Movie {
             reason: format!("encoding the GIF: {e}"),
         };
         {
-            let mut encoder = gif::Encoder::new(&mut bytes, width as u16, height as u16, &[])
-                .map_err(fail)?;
+            let mut encoder =
+                gif::Encoder::new(&mut bytes, width as u16, height as u16, &[]).map_err(fail)?;
             encoder.set_repeat(gif::Repeat::Infinite).map_err(fail)?;
             let states = report.events.len();
             for (k, state) in self.frames(&recording, &report).enumerate() {
@@ -341,7 +341,7 @@ impl Movie {
     }
 
     /// The colour scale of the whole movie: `A_R` from 0 to the 98th percentile of the
-    /// cells' values (μm²), `τ_C` symmetric about 0 to the 98th percentile of `|τ_C|`
+    /// cells' values (mm²), `τ_C` symmetric about 0 to the 98th percentile of `|τ_C|`
     /// (MPa); both saturate beyond.
     fn automatic_range(&self, recording: &Recording) -> (f64, f64) {
         match self.kind {
@@ -361,7 +361,7 @@ impl Movie {
                 let values = recording
                     .states
                     .iter()
-                    .flat_map(|s| s.area.iter().map(|a| a * 1e12));
+                    .flat_map(|s| s.area.iter().map(|a| a * 1e6));
                 let top = percentile_98(values.collect());
                 (0.0, if top > 0.0 { top } else { 1.0 })
             }
@@ -397,9 +397,9 @@ impl Movie {
                 map
             }
             _ => {
-                let values: Vec<f64> = state.area.iter().map(|a| a * 1e12).collect();
+                let values: Vec<f64> = state.area.iter().map(|a| a * 1e6).collect();
                 let mut map = Map::new(r.nx, r.ny, values)?
-                    .labels(&title, "x (mm)", "y (mm)", "A_R per cell (μm²)")
+                    .labels(&title, "x (mm)", "y (mm)", "A_R per cell (mm²)")
                     .x_range(0.0, lx)
                     .y_range(0.0, ly)
                     .colour_scale(Palette::Sequential, Some(range));
@@ -553,7 +553,9 @@ fn read_recording(dir: &Path) -> Result<Recording> {
             .into());
         }
         let event: usize = cells[0].parse().map_err(|e| {
-            corrupt(format!("line {line}: the event index is not a whole number ({e})"))
+            corrupt(format!(
+                "line {line}: the event index is not a whole number ({e})"
+            ))
         })?;
         let within = n % per_state;
         let (field, index) = if within < ny {

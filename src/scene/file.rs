@@ -897,12 +897,10 @@ mod tests {
                 .map(|(k, _)| k.as_str())
                 .collect();
             assert!(left_out.contains(&"solver.threads"), "{left_out:?}");
-            assert!(left_out
-                .iter()
-                .all(|k| *k == "solver.threads"
-                    || *k == "max_cells"
-                    || k.starts_with("probes.")
-                    || k.starts_with("fields.")));
+            assert!(left_out.iter().all(|k| *k == "solver.threads"
+                || *k == "max_cells"
+                || k.starts_with("probes.")
+                || k.starts_with("fields.")));
         }
     }
 
