@@ -558,6 +558,7 @@ fn run(
     let every =
         std::num::NonZeroU64::new(every).ok_or_else(|| usage("--every must be >= 1".into()))?;
     let checkpoint = checkpoint.map(|path| (path, every));
+    let fields_path = tables.fields_path().map(Path::to_path_buf);
     let [events_path, curve_path, map_path] =
         tables.run_to_slip(&mut driver, checkpoint, |_, driver| {
             bar.show(false, |elapsed| line(driver, elapsed))
@@ -572,6 +573,9 @@ fn run(
         curve_path.display(),
         map_path.display()
     );
+    if let Some(path) = fields_path {
+        say!("recorded the fields in {} (`precursors movie`)", path.display());
+    }
     Ok(())
 }
 
@@ -793,13 +797,14 @@ fn movie(
         match outcome {
             Ok(report) => say!(
                 "wrote {}: {} frames of {} recorded states (one in {} and the last), \
-                 colour scale {} to {}",
+                 colour scale {:.4} to {:.4} {}",
                 path.display(),
                 report.frames,
                 report.states,
                 report.stride,
                 report.colour_range.0,
-                report.colour_range.1
+                report.colour_range.1,
+                if kind == MovieKind::ContactArea { "mm²" } else { "MPa" }
             ),
             // `all`: the Coulomb stress movie of a run that recorded no planes is skipped.
             Err(precursors::plot::PlotError::NoFields { reason, .. })
