@@ -552,7 +552,10 @@ struct FieldsTable {
     every: usize,
     planes: Vec<f64>,
     /// The recorded planes, planned on the scene's operator (`None` without planes).
-    probe: Option<StressProbe>,
+    /// Asserted unwind-safe so that `RunTables` stays so (as in 1.0): the probe is only
+    /// read after it is built (its transforms' plans are immutable), so a panic cannot
+    /// leave it half changed.
+    probe: Option<std::panic::AssertUnwindSafe<StressProbe>>,
     /// Stable states of the run so far (those kept on resume included).
     stable: usize,
 }
@@ -587,7 +590,11 @@ impl FieldsTable {
                 ProbeSpec::default().with_tolerance(scene.probes().tolerance())?,
                 |spec, &z| spec.with_plane(z),
             );
-            Some(StressProbe::new(scene.plan(), &spec, scene.lateral_load())?)
+            Some(std::panic::AssertUnwindSafe(StressProbe::new(
+                scene.plan(),
+                &spec,
+                scene.lateral_load(),
+            )?))
         };
         let (path, partial) = Self::paths(dir);
         Ok(Some(Self {
@@ -621,7 +628,7 @@ impl FieldsTable {
             row(FIELD_AREA, iy, 0.0, cells);
         }
         if let Some(probe) = &self.probe {
-            let stresses = driver.stresses_at(std::slice::from_ref(probe))?;
+            let stresses = driver.stresses_at(std::slice::from_ref(&probe.0))?;
             for (k, (plane, &z)) in stresses.planes.iter().zip(&self.planes).enumerate() {
                 row(FIELD_COULOMB, k, z, &plane.profile().coulomb_of_means);
             }

@@ -574,7 +574,10 @@ fn run(
         map_path.display()
     );
     if let Some(path) = fields_path {
-        say!("recorded the fields in {} (`precursors movie`)", path.display());
+        say!(
+            "recorded the fields in {} (`precursors movie`)",
+            path.display()
+        );
     }
     Ok(())
 }
@@ -804,7 +807,11 @@ fn movie(
                 report.stride,
                 report.colour_range.0,
                 report.colour_range.1,
-                if kind == MovieKind::ContactArea { "mm²" } else { "MPa" }
+                if kind == MovieKind::ContactArea {
+                    "mm²"
+                } else {
+                    "MPa"
+                }
             ),
             // `all`: the Coulomb stress movie of a run that recorded no planes is skipped.
             Err(precursors::plot::PlotError::NoFields { reason, .. })
