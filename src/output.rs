@@ -17,6 +17,17 @@
 //!   driving spring's slip), a level's row is the state in effect when the load first
 //!   passed it.
 //!
+//! * `fields.csv` ([`FIELDS_TABLE`]), only when the scene records fields
+//!   ([`crate::SceneBuilder::record_fields`], scene-file key `fields`): the fields of the
+//!   1st, `(1 + every)`-th, `(1 + 2·every)`-th, ... stable state, for the movies (`precursors
+//!   movie`), header `event,force_over_mu_FN,precursor_over_Lx,field,row,z_m,value_ix0,
+//!   ...,value_ix{Nx-1}`. Each recorded state has `Ny` rows of field `area_m2` (row `iy`,
+//!   `z_m` 0: the real contact area of the cells `(ix, iy)`, m²), then one row of field
+//!   `coulomb_Pa` per recorded plane (row `k`, `z_m` its height: the y-averaged Coulomb
+//!   stress `τ_C(x, z) = |⟨τ⟩_y| - μ|⟨σ⟩_y|` of each column, Pa, as
+//!   [`crate::Profile::coulomb_of_means`]). About `(Ny + planes)·Nx·20` bytes per recorded
+//!   state: `every` bounds the size.
+//!
 //! `area_exceeds_nominal` is 1 when the total real contact area of the state after the
 //! event exceeds the nominal area `Lx·Ly` (the paper's unbounded area law), 0 otherwise.
 //! Numbers are written with 13 significant digits (`{:.12e}`), so the tables of two runs
@@ -38,12 +49,15 @@
 //! (a last row cut by a crash is dropped), that `events.csv` numbers its
 //! rows 1, 2, 3, ... up to at least the checkpoint's event, and that `curve.csv` and
 //! `contact_map.csv` hold the stable states and load levels reached by then; then it
-//! rewrites the `.partial` tables with the rows up to the checkpoint's event.
+//! rewrites the `.partial` tables with the rows up to the checkpoint's event. With fields
+//! recorded, `fields.csv` must hold exactly the recorded states up to the checkpoint's
+//! event (the same `every` and planes), and is cut back the same way.
 
 use crate::driver::{sync_dir, write_atomically, Driver, Event};
 use crate::error::{Error, Result};
 use crate::interface::SiteState;
 use crate::lock::DirLock;
+use crate::probe::{ProbeSpec, StressProbe};
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -68,6 +82,24 @@ pub const PARTIAL_SUFFIX: &str = ".partial";
 /// The record of a run's scene in its directory (feature `serde`: the scene file of
 /// `SceneBuilder::to_json`), written when the run starts, checked on resume.
 pub const SCENE_RECORD: &str = "scene.json";
+
+/// The table of the fields a run records for the movies (written only when the scene
+/// records fields: [`crate::SceneBuilder::record_fields`]; layout in the module's docs).
+pub const FIELDS_TABLE: &str = "fields.csv";
+
+/// The `field` of the rows of `fields.csv` that hold the real contact area of a row `iy`
+/// of cells (m²), and of those that hold the y-averaged Coulomb stress on a plane (Pa).
+pub(crate) const FIELD_AREA: &str = "area_m2";
+pub(crate) const FIELD_COULOMB: &str = "coulomb_Pa";
+
+/// The header of `fields.csv` for a grid of `nx` columns.
+pub(crate) fn fields_header(nx: usize) -> String {
+    let mut header = String::from("event,force_over_mu_FN,precursor_over_Lx,field,row,z_m");
+    for ix in 0..nx {
+        header.push_str(&format!(",value_ix{ix}"));
+    }
+    header
+}
 
 /// The header of `contact_map.csv` for a grid of `nx` columns.
 pub(crate) fn contact_map_header(nx: usize) -> String {
@@ -131,6 +163,8 @@ struct Continuation {
     texts: [String; 3],
     next_level: u64,
     in_effect: bool,
+    /// The events of the stable states up to the checkpoint's.
+    stable: Vec<usize>,
 }
 
 /// Checks the three tables (`old[t]`: the text of table `t` in [`TABLE_NAMES`] order,
@@ -368,7 +402,91 @@ fn continuation(
         ],
         next_level,
         in_effect: k > 0,
+        stable,
     })
+}
+
+/// What the fields of a resumed run start from: `fields.csv`'s text (`old`, `None` when
+/// missing; `path` for the messages) checked against the states the scene records up to
+/// the checkpoint's event (the `every`-th of the stable states `stable`, `ny` rows of
+/// area and one per plane of `planes` each) and cut back to them. Nothing is written.
+fn fields_continuation(
+    old: Option<&str>,
+    path: &Path,
+    stable: &[usize],
+    recording: (usize, &[f64]),
+    (nx, ny): (usize, usize),
+) -> Result<String> {
+    let (every, planes) = recording;
+    let corrupt = |reason: String| Error::CorruptTable {
+        path: Some(path.to_path_buf()),
+        reason,
+    };
+    let header = fields_header(nx);
+    let expected: Vec<usize> = stable.iter().step_by(every).copied().collect();
+    let rows = complete_rows(old.unwrap_or(""), &header).map_err(corrupt)?;
+    let per_state = ny + planes.len();
+    let last = stable.last().copied().unwrap_or(0);
+    let mut kept = 0;
+    for (n, &(line, row)) in rows.iter().enumerate() {
+        let event = index_of(line, row).map_err(corrupt)?;
+        if event > last {
+            break;
+        }
+        let (state, within) = (n / per_state, n % per_state);
+        match expected.get(state) {
+            Some(&e) if e == event => {}
+            Some(&e) => {
+                return Err(corrupt(format!(
+                    "line {line} holds event {event}, but the scene records the stable state                      of event {e} there (every {every}-th stable state from the first): the                      table was recorded with another `fields.every`"
+                )))
+            }
+            None => {
+                return Err(corrupt(format!(
+                    "line {line}: event {event} is not a stable state the scene records"
+                )))
+            }
+        }
+        let mut cells = row.split(',').skip(3);
+        let (field, index, z) = (cells.next(), cells.next(), cells.next());
+        let (want_field, want_index) = if within < ny {
+            (FIELD_AREA, within)
+        } else {
+            (FIELD_COULOMB, within - ny)
+        };
+        if field != Some(want_field) || index != Some(want_index.to_string().as_str()) {
+            return Err(corrupt(format!(
+                "line {line}: a state's rows are {ny} of {FIELD_AREA} (rows 0 to {}), then                  one of {FIELD_COULOMB} per recorded plane ({}): row {want_index} of                  {want_field} belongs here (another grid or other planes?)",
+                ny.saturating_sub(1),
+                planes.len()
+            )));
+        }
+        if field == Some(FIELD_COULOMB) {
+            let recorded = format!("{:.12e}", planes[want_index]);
+            if z != Some(recorded.as_str()) {
+                return Err(corrupt(format!(
+                    "line {line}: plane {want_index} is at z = {} m, the scene records it at                      {} m: the table was recorded with other `fields.planes`",
+                    z.unwrap_or(""),
+                    planes[want_index]
+                )));
+            }
+        }
+        kept += 1;
+    }
+    let states = kept / per_state;
+    if kept % per_state != 0 || states < expected.len() {
+        let missing = expected.get(states).copied().unwrap_or(last);
+        return Err(corrupt(format!(
+            "it holds {states} whole recorded states up to the checkpoint's event {last},              the scene records {}: the fields from event {missing} on are missing (recorded              with another `fields.every`, or without fields: run the scene again to record              them)",
+            expected.len()
+        )));
+    }
+    let mut text = format!("{header}\n");
+    for (_, row) in &rows[..kept] {
+        text.push_str(row);
+        text.push('\n');
+    }
+    Ok(text)
 }
 
 /// A map level as the table writes it.
@@ -418,8 +536,107 @@ pub struct RunTables {
     in_effect: Option<MapState>,
     /// Global slip was recorded.
     slipped: bool,
+    /// `fields.csv`, when the scene records fields.
+    fields: Option<FieldsTable>,
     /// The directory's lock, `None` when the caller holds it (a sweep's run).
     _lock: Option<DirLock>,
+}
+
+/// `fields.csv` of a run that records fields ([`crate::SceneBuilder::record_fields`]).
+#[derive(Debug)]
+struct FieldsTable {
+    file: BufWriter<File>,
+    /// The table's name (after [`RunTables::finish`]) and the file written until then.
+    path: PathBuf,
+    partial: PathBuf,
+    every: usize,
+    planes: Vec<f64>,
+    /// The recorded planes, planned on the scene's operator (`None` without planes).
+    /// Asserted unwind-safe so that `RunTables` stays so (as in 1.0): the probe is only
+    /// read after it is built (its transforms' plans are immutable), so a panic cannot
+    /// leave it half changed.
+    probe: Option<std::panic::AssertUnwindSafe<StressProbe>>,
+    /// Stable states of the run so far (those kept on resume included).
+    stable: usize,
+}
+
+impl FieldsTable {
+    /// `dir/fields.csv` and `dir/fields.csv.partial`.
+    fn paths(dir: &Path) -> (PathBuf, PathBuf) {
+        (
+            dir.join(FIELDS_TABLE),
+            dir.join(format!("{FIELDS_TABLE}{PARTIAL_SUFFIX}")),
+        )
+    }
+
+    /// The writer of `driver`'s fields into `file` (`stable`: the stable states before
+    /// its first row); `None` when its scene records none.
+    fn new(
+        driver: &Driver,
+        dir: &Path,
+        file: impl FnOnce(&Path) -> Result<File>,
+        stable: usize,
+    ) -> Result<Option<Self>> {
+        let scene = driver.scene();
+        let every = scene.fields_every();
+        if every == 0 {
+            return Ok(None);
+        }
+        let planes = scene.field_planes().to_vec();
+        let probe = if planes.is_empty() {
+            None
+        } else {
+            let spec = planes.iter().fold(
+                ProbeSpec::default().with_tolerance(scene.probes().tolerance())?,
+                |spec, &z| spec.with_plane(z),
+            );
+            Some(std::panic::AssertUnwindSafe(StressProbe::new(
+                scene.plan(),
+                &spec,
+                scene.lateral_load(),
+            )?))
+        };
+        let (path, partial) = Self::paths(dir);
+        Ok(Some(Self {
+            file: BufWriter::new(file(&partial)?),
+            path,
+            partial,
+            every,
+            planes,
+            probe,
+            stable,
+        }))
+    }
+
+    /// The rows of the stable state `index` just reached (load `x = F/(μF_N)`, precursor
+    /// `ℓ/Lx`), when it is one the scene records.
+    fn record(&mut self, driver: &Driver, index: usize, x: f64, ell: f64) -> Result<()> {
+        self.stable += 1;
+        if !(self.stable - 1).is_multiple_of(self.every) {
+            return Ok(());
+        }
+        let mut text = String::new();
+        let mut row = |field: &str, k: usize, z: f64, values: &[f64]| {
+            text.push_str(&format!("{index},{x:.12e},{ell:.12e},{field},{k},{z:.12e}"));
+            for v in values {
+                text.push_str(&format!(",{v:.12e}"));
+            }
+            text.push('\n');
+        };
+        let area = driver.cell_contact_area()?;
+        for (iy, cells) in area.chunks_exact(driver.grid().nx()).enumerate() {
+            row(FIELD_AREA, iy, 0.0, cells);
+        }
+        if let Some(probe) = &self.probe {
+            let stresses = driver.stresses_at(std::slice::from_ref(&probe.0))?;
+            for (k, (plane, &z)) in stresses.planes.iter().zip(&self.planes).enumerate() {
+                row(FIELD_COULOMB, k, z, &plane.profile().coulomb_of_means);
+            }
+        }
+        self.file
+            .write_all(text.as_bytes())
+            .map_err(|e| Error::io("writing table", &self.partial, e))
+    }
 }
 
 /// A stable state as `contact_map.csv` needs it.
@@ -482,6 +699,21 @@ impl RunTables {
             files.push(file);
         }
         let [events, curve, map]: [BufWriter<File>; 3] = files.try_into().expect("three tables");
+        // An earlier run's fields never pass for this run's.
+        remove_fields(dir)?;
+        let nx = driver.grid().nx();
+        let fields = FieldsTable::new(
+            driver,
+            dir,
+            |path| {
+                let mut file =
+                    File::create(path).map_err(|e| Error::io("creating table", path, e))?;
+                writeln!(file, "{}", fields_header(nx))
+                    .map_err(|e| Error::io("writing table", path, e))?;
+                Ok(file)
+            },
+            0,
+        )?;
         Ok(Self {
             events,
             curve,
@@ -493,6 +725,7 @@ impl RunTables {
             next_level: 0,
             in_effect: None,
             slipped: false,
+            fields,
             _lock: lock,
         })
     }
@@ -557,6 +790,33 @@ impl RunTables {
         } else {
             None
         };
+        let scene = driver.scene();
+        let fields_text = if scene.fields_every() > 0 {
+            let (path, partial) = FieldsTable::paths(dir);
+            let mut old = None;
+            let mut read = partial.clone();
+            for p in [&partial, &path] {
+                crate::cost::check_file_size(p)?;
+                match fs::read_to_string(p) {
+                    Ok(text) => {
+                        old = Some(text);
+                        read = p.clone();
+                        break;
+                    }
+                    Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+                    Err(e) => return Err(Error::io("reading table", p, e)),
+                }
+            }
+            Some(fields_continuation(
+                old.as_deref(),
+                &read,
+                &plan.stable,
+                (scene.fields_every(), scene.field_planes()),
+                (driver.grid().nx(), driver.grid().ny()),
+            )?)
+        } else {
+            None
+        };
         // Checked: now the directory is written.
         remove_stale_temporaries(dir)?;
         let mut files = Vec::with_capacity(3);
@@ -569,6 +829,26 @@ impl RunTables {
             files.push(BufWriter::new(file));
         }
         let [events, curve, map]: [BufWriter<File>; 3] = files.try_into().expect("three tables");
+        // Without fields recorded now, those of the run before the checkpoint would not
+        // cover the run: removed.
+        if fields_text.is_none() {
+            remove_fields(dir)?;
+        }
+        let fields = match fields_text {
+            Some(text) => FieldsTable::new(
+                driver,
+                dir,
+                |path| {
+                    write_atomically(path, text.as_bytes(), "writing table")?;
+                    OpenOptions::new()
+                        .append(true)
+                        .open(path)
+                        .map_err(|e| Error::io("opening table", path, e))
+                },
+                plan.stable.len(),
+            )?,
+            None => None,
+        };
         Ok(Self {
             events,
             curve,
@@ -580,6 +860,7 @@ impl RunTables {
             next_level: plan.next_level,
             in_effect,
             slipped: false,
+            fields,
             _lock: Some(lock),
         })
     }
@@ -588,6 +869,13 @@ impl RunTables {
     /// [`RunTables::finish`]ed; until then they are written with [`PARTIAL_SUFFIX`]).
     pub fn paths(&self) -> [&Path; 3] {
         [&self.paths[0], &self.paths[1], &self.paths[2]]
+    }
+
+    /// The path of `fields.csv` ([`FIELDS_TABLE`]; written as `fields.csv.partial` until
+    /// [`RunTables::finish`]), `None` when the scene records no fields
+    /// ([`crate::SceneBuilder::record_fields`]).
+    pub fn fields_path(&self) -> Option<&Path> {
+        self.fields.as_ref().map(|f| f.path.as_path())
     }
 
     /// Stable states recorded by this writer (not counting rows kept on resume).
@@ -625,6 +913,9 @@ impl RunTables {
             )
             .map_err(|e| Error::io("writing table", &self.partials[1], e))?;
             let x = load.force / mu_fn;
+            if let Some(fields) = &mut self.fields {
+                fields.record(driver, index, x, ell / driver.grid().block().lx())?;
+            }
             self.map_rows_below(x, true)?;
             self.in_effect = Some(MapState {
                 event: index,
@@ -689,6 +980,13 @@ impl RunTables {
                 .flush()
                 .and_then(|()| table.get_ref().sync_data())
                 .map_err(|e| Error::io("writing table", path, e))?;
+        }
+        if let Some(fields) = &mut self.fields {
+            fields
+                .file
+                .flush()
+                .and_then(|()| fields.file.get_ref().sync_data())
+                .map_err(|e| Error::io("writing table", &fields.partial, e))?;
         }
         Ok(())
     }
@@ -765,6 +1063,10 @@ impl RunTables {
         self.flush()?;
         // events.csv last: a crash between the renames leaves it .partial, so a resume
         // or a rerun still sees the run as not finished.
+        if let Some(fields) = &self.fields {
+            fs::rename(&fields.partial, &fields.path)
+                .map_err(|e| Error::io("renaming table", &fields.path, e))?;
+        }
         for t in [2, 1, 0] {
             fs::rename(&self.partials[t], &self.paths[t])
                 .map_err(|e| Error::io("renaming table", &self.paths[t], e))?;
@@ -781,7 +1083,10 @@ fn remove_stale_temporaries(dir: &Path) -> Result<()> {
     let prefixes: Vec<String> = TABLE_NAMES
         .iter()
         .map(|n| format!(".{n}{PARTIAL_SUFFIX}.tmp"))
-        .chain([format!(".{SCENE_RECORD}.tmp")])
+        .chain([
+            format!(".{SCENE_RECORD}.tmp"),
+            format!(".{FIELDS_TABLE}{PARTIAL_SUFFIX}.tmp"),
+        ])
         .collect();
     let entries = fs::read_dir(dir).map_err(|e| Error::io("reading directory", dir, e))?;
     for entry in entries {
@@ -795,6 +1100,20 @@ fn remove_stale_temporaries(dir: &Path) -> Result<()> {
                 }
                 _ => {}
             }
+        }
+    }
+    Ok(())
+}
+
+/// Removes `fields.csv` and `fields.csv.partial` from `dir` (where they exist).
+fn remove_fields(dir: &Path) -> Result<()> {
+    let (path, partial) = FieldsTable::paths(dir);
+    for path in [path, partial] {
+        match fs::remove_file(&path) {
+            Err(e) if e.kind() != io::ErrorKind::NotFound => {
+                return Err(Error::io("removing the earlier run's table", &path, e))
+            }
+            _ => {}
         }
     }
     Ok(())

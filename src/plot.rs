@@ -5,7 +5,8 @@
 //! system font is needed.
 //!
 //! [`Chart`] and [`Map`] are the building blocks; [`draw`] draws the standard figures
-//! of a run or of a sweep directory (`precursors plot DIR`).
+//! of a run or of a sweep directory (`precursors plot DIR`); [`Movie`] the paper's
+//! movies of a run's recorded fields as animated GIFs (`precursors movie DIR`).
 //!
 //! Non-finite values are not drawn: a line is cut at a point with a `NaN` or infinite
 //! coordinate (a band where its bounds are not finite), and a map cell holding one is
@@ -25,9 +26,11 @@
 
 mod error;
 mod figures;
+mod movie;
 
 pub use error::PlotError;
 pub use figures::{draw, Drawn, Format};
+pub use movie::{Movie, MovieKind, MovieReport};
 
 use crate::error::Error;
 use plotters::coord::types::RangedCoordf64;
@@ -636,6 +639,11 @@ pub struct Map {
     colour_range: Option<(f64, f64)>,
     palette: Palette,
     size: (u32, u32),
+    /// The rows' edges (`rows + 1` increasing values) when they are not evenly spaced
+    /// over the y range (a movie's planes).
+    row_edges: Option<Vec<f64>>,
+    /// Lines drawn over the cells in black (a movie's precursor front), in axis units.
+    overlay: Vec<Vec<(f64, f64)>>,
 }
 
 impl Map {
@@ -679,6 +687,8 @@ impl Map {
             colour_range: None,
             palette: Palette::Sequential,
             size: (900, 560),
+            row_edges: None,
+            overlay: Vec::new(),
         })
     }
 
@@ -772,11 +782,23 @@ impl Draw for MapDrawing<'_> {
                     } else {
                         grey
                     };
-                    let (x0, y0) = (x.0 + col as f64 * dx, y.0 + r as f64 * dy);
-                    Rectangle::new([(x0, y0), (x0 + dx, y0 + dy)], fill.filled())
+                    let x0 = x.0 + col as f64 * dx;
+                    let (y0, y1) = match &me.row_edges {
+                        Some(edges) => (edges[r], edges[r + 1]),
+                        None => (y.0 + r as f64 * dy, y.0 + (r + 1) as f64 * dy),
+                    };
+                    Rectangle::new([(x0, y0), (x0 + dx, y1)], fill.filled())
                 })
             }))
             .map_err(|e| e.to_string())?;
+        for line in &me.overlay {
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    line.clone(),
+                    BLACK.stroke_width(3),
+                )))
+                .map_err(|e| e.to_string())?;
+        }
         draw_axes(&mut chart, (&me.x_label, x), (&me.y_label, y), false)?;
         // The colour bar: a one-column chart of the colour scale, its values on the right.
         let mut scale = ChartBuilder::on(&bar)
@@ -819,9 +841,15 @@ fn axes<'a, DB: DrawingBackend>(
     y: (f64, f64),
 ) -> std::result::Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String>
 {
-    ChartBuilder::on(area)
-        .caption(title, (FAMILY, 22.0).into_font())
-        .margin(16)
+    // The title typeset by hand (plotters' caption has no subscripts), in the room a
+    // caption of this size takes.
+    let mut builder = ChartBuilder::on(area);
+    builder.margin(16).margin_top(16 + 34);
+    if !title.is_empty() {
+        let (width, _) = area.dim_in_pixel();
+        typeset(area, title, width as i32 / 2, 12, 22.0)?;
+    }
+    builder
         .x_label_area_size(52)
         .y_label_area_size(72)
         .build_cartesian_2d(x.0..x.1, y.0..y.1)
@@ -863,8 +891,80 @@ const LARGEST_SIDE: u32 = 16384;
 /// Draws in memory through the backend that `path`'s extension names, then writes the
 /// file atomically (temporary file and rename, as checkpoints): a full disk or a kill
 /// never leaves a half or empty figure under its name.
-fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
-    register_font()?;
+/// Draws `text` centred on `centre` (pixels), its top at `top`, with `X_Y` (one
+/// character) and `X_{...}` typeset as subscripts (`F_N`, `A_R`, `τ_C`): smaller, lowered.
+fn typeset<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    text: &str,
+    centre: i32,
+    top: i32,
+    size: f64,
+) -> std::result::Result<(), String> {
+    let pieces = subscripts(text);
+    let font = |sub: bool| {
+        (FAMILY, if sub { 0.7 * size } else { size })
+            .into_font()
+            .color(&BLACK)
+    };
+    let widths = pieces
+        .iter()
+        .map(|(piece, sub)| {
+            area.estimate_text_size(piece, &font(*sub))
+                .map(|(w, _)| w as i32)
+                .map_err(|e| e.to_string())
+        })
+        .collect::<std::result::Result<Vec<i32>, String>>()?;
+    let mut x = centre - widths.iter().sum::<i32>() / 2;
+    for ((piece, sub), width) in pieces.iter().zip(widths) {
+        let y = if *sub {
+            top + (0.45 * size) as i32
+        } else {
+            top
+        };
+        area.draw(&Text::new(piece.clone(), (x, y), font(*sub)))
+            .map_err(|e| e.to_string())?;
+        x += width;
+    }
+    Ok(())
+}
+
+/// `text` cut into pieces, each `(text, is a subscript)`: `_X` makes the one character `X`
+/// a subscript, `_{...}` the braces' text; an `_` at the end, or before a space, stays.
+fn subscripts(text: &str) -> Vec<(String, bool)> {
+    let mut pieces: Vec<(String, bool)> = Vec::new();
+    let mut normal = String::new();
+    let mut chars = text.chars().peekable();
+    while let Some(c) = chars.next() {
+        let sub = match (c, chars.peek()) {
+            ('_', Some('{')) => {
+                chars.next();
+                let inner: String = chars.by_ref().take_while(|&c| c != '}').collect();
+                Some(inner)
+            }
+            ('_', Some(&next)) if !next.is_whitespace() => {
+                chars.next();
+                Some(next.to_string())
+            }
+            _ => None,
+        };
+        match sub {
+            Some(sub) => {
+                if !normal.is_empty() {
+                    pieces.push((std::mem::take(&mut normal), false));
+                }
+                pieces.push((sub, true));
+            }
+            None => normal.push(c),
+        }
+    }
+    if !normal.is_empty() {
+        pieces.push((normal, false));
+    }
+    pieces
+}
+
+/// Refuses a figure size outside 200 x 150 to [`LARGEST_SIDE`] squared.
+fn check_size(path: &Path, size: (u32, u32)) -> Result<()> {
     let fail = |reason: String| PlotError::Figure {
         path: Some(path.to_path_buf()),
         reason,
@@ -881,6 +981,16 @@ fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
             size.0, size.1
         )));
     }
+    Ok(())
+}
+
+fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
+    register_font()?;
+    let fail = |reason: String| PlotError::Figure {
+        path: Some(path.to_path_buf()),
+        reason,
+    };
+    check_size(path, size)?;
     let extension = path
         .extension()
         .and_then(|e| e.to_str())
@@ -1036,6 +1146,31 @@ fn staircase(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn subscripts_are_cut_where_the_underscores_say() {
+        let piece = |t: &str, sub: bool| (t.to_string(), sub);
+        assert_eq!(
+            subscripts("F/(μF_N) = 0.5"),
+            [
+                piece("F/(μF", false),
+                piece("N", true),
+                piece(") = 0.5", false)
+            ]
+        );
+        assert_eq!(
+            subscripts("τ_{C,max} at z_P"),
+            [
+                piece("τ", false),
+                piece("C,max", true),
+                piece(" at z", false),
+                piece("P", true)
+            ]
+        );
+        // Left as written: no character after it, or a space.
+        assert_eq!(subscripts("a_ b_"), [piece("a_ b_", false)]);
+        assert!(subscripts("").is_empty());
+    }
 
     #[test]
     fn ticks_have_the_decimals_the_span_needs() {

@@ -441,6 +441,15 @@ pub struct SceneBuilder {
     plan_tolerance: f64,
     probes: ProbeSpec,
     max_cells: usize,
+    fields: FieldRecording,
+}
+
+/// What a run records of its fields ([`SceneBuilder::record_fields`]): every `every`-th
+/// stable state (0: none), the planes of the Coulomb stress profiles.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct FieldRecording {
+    pub(crate) every: usize,
+    pub(crate) planes: Vec<f64>,
 }
 
 impl Default for SceneBuilder {
@@ -457,6 +466,7 @@ impl Default for SceneBuilder {
             plan_tolerance: 1e-8,
             probes: ProbeSpec::default(),
             max_cells: crate::green::DEFAULT_MAX_CELLS,
+            fields: FieldRecording::default(),
         }
     }
 }
@@ -565,6 +575,36 @@ impl SceneBuilder {
         self
     }
 
+    /// Records the fields of the run's stable states for the movies (`precursors movie`,
+    /// `crate::plot::Movie`, feature `plot`): the run tables ([`crate::output::RunTables`])
+    /// then write `fields.csv` ([`crate::output::FIELDS_TABLE`]) with, at the 1st, the
+    /// `(1 + every)`-th, the `(1 + 2·every)`-th, ... stable state, the real contact area
+    /// `A_R` of each cell (m²) and the y-averaged Coulomb stress `τ_C(x, z)` (Pa) on each
+    /// of `planes` (heights `z` in m above the interface, within `[0, Lz]`). `every = 0`
+    /// (the default) records nothing; `planes` may be empty (the contact area only).
+    /// Recording observes: it changes neither the events nor the scene's identity (a
+    /// checkpoint resumes across it; the resumed tables are checked against it).
+    ///
+    /// ```
+    /// use precursors::Scene;
+    /// let scene = Scene::builder()
+    ///     .block(0.010, 0.004, 0.010)
+    ///     .record_fields(5, &[0.0, 0.005])
+    ///     .build()?;
+    /// assert_eq!(scene.fields_every(), 5);
+    /// assert_eq!(scene.field_planes(), [0.0, 0.005]);
+    /// // Outside the block: refused when the scene is built.
+    /// assert!(Scene::builder().block(0.010, 0.004, 0.010).record_fields(1, &[0.02]).build().is_err());
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    pub fn record_fields(mut self, every: usize, planes: &[f64]) -> Self {
+        self.fields = FieldRecording {
+            every,
+            planes: planes.to_vec(),
+        };
+        self
+    }
+
     /// The spring constants set so far (the builder's getters are the crate's; users
     /// read them from the built [`Scene::springs`]: a getter cannot share its setter's
     /// name on the builder).
@@ -582,6 +622,12 @@ impl SceneBuilder {
     #[cfg_attr(not(feature = "serde"), allow(dead_code))]
     pub(crate) fn current_normal_load(&self) -> f64 {
         self.normal_load
+    }
+
+    /// The fields recording set so far (see [`SceneBuilder::current_springs`]).
+    #[cfg_attr(not(feature = "plot"), allow(dead_code))]
+    pub(crate) fn current_fields(&self) -> &FieldRecording {
+        &self.fields
     }
 
     /// The heights source set so far (see [`SceneBuilder::current_springs`]).
@@ -672,6 +718,9 @@ impl SceneBuilder {
         }
         if let Some(Lateral::Rod { height, half_width }) = self.lateral() {
             RodLoad::new(&block, height, half_width)?;
+        }
+        for &z in &self.fields.planes {
+            block.check_height(z)?;
         }
         if !self.probes.is_empty() {
             for &z in self.probes.planes() {
@@ -881,6 +930,18 @@ impl Scene {
     /// empty by default).
     pub fn probes(&self) -> &ProbeSpec {
         &self.inner.builder.probes
+    }
+
+    /// Every how many stable states a run records its fields
+    /// ([`SceneBuilder::record_fields`]; 0: none, the default).
+    pub fn fields_every(&self) -> usize {
+        self.inner.builder.fields.every
+    }
+
+    /// The heights `z` (m) of the planes whose y-averaged Coulomb stress a run records
+    /// ([`SceneBuilder::record_fields`]; empty by default).
+    pub fn field_planes(&self) -> &[f64] {
+        &self.inner.builder.fields.planes
     }
 
     /// The default probes as planned at build (`None` when there are none).

@@ -20,6 +20,8 @@ mod loads;
 mod matrix;
 #[cfg(feature = "cli")]
 mod messages;
+#[cfg(feature = "plot")]
+mod movie;
 mod operator;
 #[cfg(feature = "serde")]
 mod paper_sweeps;

@@ -125,6 +125,47 @@ enum Command {
         #[arg(long, value_enum, default_value_t = FormatArg::Png)]
         format: FormatArg,
     },
+    /// Draws a run's recorded fields (the scene key "fields") as an animated GIF:
+    /// the real contact area per cell (Movie S1, DIR/contact_area.gif) or the y-averaged
+    /// Coulomb stress over the recorded planes (Movie S2, DIR/coulomb_stress.gif).
+    Movie {
+        /// A run's output directory (with fields.csv).
+        dir: PathBuf,
+        /// Which movie(s).
+        #[arg(long, value_enum, default_value_t = MovieArg::All)]
+        field: MovieArg,
+        /// Draws every K-th recorded state (and the last).
+        #[arg(long, value_name = "K", default_value_t = 1,
+              value_parser = clap::value_parser!(u64).range(1..))]
+        every: u64,
+        /// At most N frames (K is raised until they fit).
+        #[arg(long, value_name = "N", default_value_t = 200,
+              value_parser = clap::value_parser!(u64).range(2..100_000))]
+        max_frames: u64,
+        /// Frame width in pixels.
+        #[arg(long, default_value_t = 900)]
+        width: u32,
+        /// Frame height in pixels.
+        #[arg(long, default_value_t = 560)]
+        height: u32,
+        /// Seconds per frame.
+        #[arg(long, value_name = "SECONDS", default_value_t = 0.1)]
+        frame_duration: f64,
+        /// The output file (one movie only) [default: DIR/contact_area.gif,
+        /// DIR/coulomb_stress.gif].
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+    },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, clap::ValueEnum)]
+enum MovieArg {
+    /// Movie S1: the real contact area per cell.
+    ContactArea,
+    /// Movie S2: the y-averaged Coulomb stress over the recorded planes.
+    CoulombStress,
+    /// Both (S2 only when planes were recorded).
+    All,
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -336,6 +377,27 @@ fn main() -> ExitCode {
         } => run_sweep(&sweep, &out, jobs, shard, progress),
         Command::Merge { dir } => merge(&dir),
         Command::Plot { dir, format } => plot(&dir, format),
+        Command::Movie {
+            dir,
+            field,
+            every,
+            max_frames,
+            width,
+            height,
+            frame_duration,
+            out,
+        } => movie(
+            &dir,
+            field,
+            MovieOptions {
+                every,
+                max_frames,
+                size: (width, height),
+                frame_duration,
+            },
+            out.as_deref(),
+            progress,
+        ),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
@@ -496,6 +558,7 @@ fn run(
     let every =
         std::num::NonZeroU64::new(every).ok_or_else(|| usage("--every must be >= 1".into()))?;
     let checkpoint = checkpoint.map(|path| (path, every));
+    let fields_path = tables.fields_path().map(Path::to_path_buf);
     let [events_path, curve_path, map_path] =
         tables.run_to_slip(&mut driver, checkpoint, |_, driver| {
             bar.show(false, |elapsed| line(driver, elapsed))
@@ -510,6 +573,12 @@ fn run(
         curve_path.display(),
         map_path.display()
     );
+    if let Some(path) = fields_path {
+        say!(
+            "recorded the fields in {} (`precursors movie`)",
+            path.display()
+        );
+    }
     Ok(())
 }
 
@@ -679,6 +748,81 @@ fn plot(dir: &Path, format: FormatArg) -> Result<(), Failure> {
         Some(summary) if summary.runs_missing > 0 => Err(incomplete(summary, dir)),
         _ => Ok(()),
     }
+}
+
+/// The options of `precursors movie` shared by its movies.
+struct MovieOptions {
+    every: u64,
+    max_frames: u64,
+    size: (u32, u32),
+    frame_duration: f64,
+}
+
+fn movie(
+    dir: &Path,
+    field: MovieArg,
+    options: MovieOptions,
+    out: Option<&Path>,
+    progress: bool,
+) -> Result<(), Failure> {
+    use precursors::plot::{Movie, MovieKind};
+    let kinds: Vec<(MovieKind, &str)> = match field {
+        MovieArg::ContactArea => vec![(MovieKind::ContactArea, "contact_area.gif")],
+        MovieArg::CoulombStress => vec![(MovieKind::CoulombStress, "coulomb_stress.gif")],
+        MovieArg::All => vec![
+            (MovieKind::ContactArea, "contact_area.gif"),
+            (MovieKind::CoulombStress, "coulomb_stress.gif"),
+        ],
+    };
+    if out.is_some() && kinds.len() > 1 {
+        return Err(usage(
+            "--out names one movie: give --field contact-area or --field coulomb-stress".into(),
+        ));
+    }
+    for (kind, name) in kinds {
+        let path = out.map_or_else(|| dir.join(name), Path::to_path_buf);
+        let movie = Movie::new(dir, kind)
+            .every(usize::try_from(options.every).unwrap_or(usize::MAX))?
+            .max_frames(usize::try_from(options.max_frames).unwrap_or(usize::MAX))?
+            .size(options.size.0, options.size.1)
+            .frame_duration(options.frame_duration)?;
+        let mut bar = Progress::new(progress);
+        let outcome = movie.save_with_progress(&path, |drawn, frames| {
+            bar.show(drawn == frames, |elapsed| {
+                let left = elapsed / drawn as f64 * (frames - drawn) as f64;
+                format!(
+                    "{name}: frame {drawn}/{frames}, {elapsed:.0} s, about {} left",
+                    eta(left)
+                )
+            });
+        });
+        bar.finish();
+        match outcome {
+            Ok(report) => say!(
+                "wrote {}: {} frames of {} recorded states (one in {} and the last), \
+                 colour scale {:.4} to {:.4} {}",
+                path.display(),
+                report.frames,
+                report.states,
+                report.stride,
+                report.colour_range.0,
+                report.colour_range.1,
+                if kind == MovieKind::ContactArea {
+                    "mm²"
+                } else {
+                    "MPa"
+                }
+            ),
+            // `all`: the Coulomb stress movie of a run that recorded no planes is skipped.
+            Err(precursors::plot::PlotError::NoFields { reason, .. })
+                if field == MovieArg::All && kind == MovieKind::CoulombStress =>
+            {
+                say!("note: no {name}: {reason}");
+            }
+            Err(e) => return Err(e.into()),
+        }
+    }
+    Ok(())
 }
 
 /// The failure of a merge or plot of a sweep with runs not complete.

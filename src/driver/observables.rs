@@ -127,6 +127,12 @@ impl Driver {
         if self.probes.is_empty() {
             return Err(Error::NoProbes);
         }
+        self.stresses_at(&self.probes)
+    }
+
+    /// The stresses at `probes` (planned on this driver's scene) in the current state, as
+    /// [`Driver::stresses`] reads its own: the run tables' recorded fields use it.
+    pub(crate) fn stresses_at(&self, probes: &[StressProbe]) -> Result<Stresses> {
         let force = self.force();
         // (F_top, F_lat) per newton of F.
         let split = self.scene.load_split();
@@ -137,7 +143,7 @@ impl Driver {
             planes: Vec::new(),
             points: Vec::new(),
         };
-        for probe in &self.probes {
+        for probe in probes {
             let stresses = probe.evaluate(&input)?;
             all.planes.extend(stresses.planes);
             all.points.extend(stresses.points);

@@ -299,6 +299,7 @@ pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
     for (key, count) in [
         ("probes.planes", probes.planes().len()),
         ("probes.points", probes.points().len()),
+        ("fields.planes", builder.fields.planes.len()),
     ] {
         count_within(
             key,

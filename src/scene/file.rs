@@ -45,6 +45,28 @@ schema_struct! {
         /// limit stay as they were.
         #[cfg_attr(feature = "serde", serde(skip_serializing_if = "is_default_max_cells"))]
         max_cells: usize,
+        /// Written only when fields are recorded, so files of other scenes stay as they
+        /// were.
+        #[cfg_attr(feature = "serde", serde(skip_serializing_if = "FieldsSpec::is_off"))]
+        fields: FieldsSpec,
+    }
+}
+
+schema_struct! {
+    /// `fields`: what a run records for the movies (`SceneBuilder::record_fields`).
+    #[derive(Debug, Clone, PartialEq)]
+    #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+    #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+    struct FieldsSpec {
+        every: usize,
+        planes: Vec<f64>,
+    }
+}
+
+#[cfg(feature = "serde")]
+impl FieldsSpec {
+    fn is_off(&self) -> bool {
+        self.every == 0 && self.planes.is_empty()
     }
 }
 
@@ -287,6 +309,7 @@ default_from_builder!(MaterialSpec, material);
 default_from_builder!(SpringsSpec, springs);
 default_from_builder!(SolverSpec, solver);
 default_from_builder!(ProbesSpec, probes);
+default_from_builder!(FieldsSpec, fields);
 
 impl From<Lateral> for LateralSpec {
     fn from(l: Lateral) -> Self {
@@ -323,6 +346,7 @@ impl From<&SceneBuilder> for SceneFile {
             plan_tolerance,
             probes,
             max_cells,
+            fields,
         } = b;
         let drive = match *drive {
             Drive::Force(ForceLoad::Top) => DriveSpec::Top {},
@@ -417,6 +441,10 @@ impl From<&SceneBuilder> for SceneFile {
                 tolerance: probes.tolerance(),
             },
             max_cells: *max_cells,
+            fields: FieldsSpec {
+                every: fields.every,
+                planes: fields.planes.clone(),
+            },
         }
     }
 }
@@ -531,6 +559,10 @@ impl SceneFile {
             plan_tolerance: self.plan_tolerance,
             probes,
             max_cells: self.max_cells,
+            fields: super::FieldRecording {
+                every: self.fields.every,
+                planes: self.fields.planes,
+            },
         })
     }
 }
@@ -947,9 +979,10 @@ mod tests {
                 .map(|(k, _)| k.as_str())
                 .collect();
             assert!(left_out.contains(&"solver.threads"), "{left_out:?}");
-            assert!(left_out
-                .iter()
-                .all(|k| *k == "solver.threads" || *k == "max_cells" || k.starts_with("probes.")));
+            assert!(left_out.iter().all(|k| *k == "solver.threads"
+                || *k == "max_cells"
+                || k.starts_with("probes.")
+                || k.starts_with("fields.")));
         }
     }
 
@@ -964,7 +997,8 @@ mod tests {
                     .unwrap(),
             )
             .max_cells(10)
-            .probes(ProbeSpec::default().with_plane(1e-3));
+            .probes(ProbeSpec::default().with_plane(1e-3))
+            .record_fields(3, &[1e-3]);
         assert_eq!(first_difference(&a, &b), None);
         assert_eq!(
             first_difference(&a, &a.clone().normal_load(1.0)).as_deref(),
@@ -991,6 +1025,7 @@ mod tests {
             "drive",
             "drive.lateral",
             "probes",
+            "fields",
         ] {
             assert!(object_at(path), "{path}");
         }

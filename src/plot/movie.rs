@@ -1,0 +1,620 @@
+//! The paper's Supplementary Movies drawn from a run directory (`precursors movie DIR`):
+//! the fields a run recorded (`fields.csv`, [`crate::output::FIELDS_TABLE`]; the scene
+//! key `fields`, [`crate::SceneBuilder::record_fields`]) as an animated GIF, one frame per
+//! recorded stable state (or every k-th), on one colour scale for the whole movie.
+//!
+//! * [`MovieKind::ContactArea`] (Movie S1): the real contact area `A_R` of each cell over
+//!   the interface (x right, y up), the front `x = ℓ` as a vertical black line.
+//! * [`MovieKind::CoulombStress`] (Movie S2): the y-averaged Coulomb stress `τ_C(x, z)`
+//!   over the x-z slab of the recorded planes, the boundary of the region `τ_C > 0` (the
+//!   `τ_C = 0` contour, drawn along the cells' edges) and the interface's precursor `ℓ`
+//!   (a black bar along the bottom from `x = 0` to `x = ℓ`).
+//!
+//! The GIF is encoded in memory (each frame quantised to its own 256 colours) and written
+//! atomically: no half movie is left on a full disk.
+
+use super::{axis_range, paint, register_font, Map, MapDrawing, Palette, PlotError, Result};
+use crate::error::{table_number, Error};
+use crate::output::SCENE_RECORD;
+use crate::output::{fields_header, FIELDS_TABLE, FIELD_AREA, FIELD_COULOMB, PARTIAL_SUFFIX};
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Which of the paper's movies [`Movie`] draws.
+///
+/// ```
+/// use precursors::plot::MovieKind;
+/// assert_eq!(MovieKind::default(), MovieKind::ContactArea);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum MovieKind {
+    /// Movie S1: the real contact area `A_R` per cell over the interface (mm²), the
+    /// precursor front `x = ℓ` drawn as a vertical line (the default).
+    #[default]
+    ContactArea,
+    /// Movie S2: the y-averaged Coulomb stress `τ_C(x, z)` (MPa) over the recorded planes,
+    /// its zero contour and the interface's `ℓ` drawn; needs recorded planes
+    /// (`fields.planes`).
+    CoulombStress,
+}
+
+/// What [`Movie::save`] drew.
+///
+/// ```
+/// use precursors::plot::MovieReport;
+/// fn say(report: &MovieReport) -> String {
+///     format!("{} frames of {} recorded states (every {}-th)", report.frames, report.states, report.stride)
+/// }
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct MovieReport {
+    /// Frames drawn.
+    pub frames: usize,
+    /// Stable states recorded in `fields.csv`.
+    pub states: usize,
+    /// Every how many recorded states a frame is drawn (the last state always is).
+    pub stride: usize,
+    /// The events (indices of `events.csv`) of the states drawn, in order.
+    pub events: Vec<usize>,
+    /// The colour scale of every frame (mm² for the contact area, MPa for `τ_C`).
+    pub colour_range: (f64, f64),
+}
+
+/// One recorded stable state.
+#[derive(Debug, Clone)]
+struct State {
+    event: usize,
+    load: f64,
+    ell: f64,
+    /// `A_R` per cell (m², cell order `iy·Nx + ix`).
+    area: Vec<f64>,
+    /// `τ_C` per plane and column (Pa, order `k·Nx + ix`).
+    coulomb: Vec<f64>,
+}
+
+/// The recorded fields of a run directory.
+#[derive(Debug)]
+struct Recording {
+    nx: usize,
+    ny: usize,
+    /// `Lx, Ly` (m).
+    lx: f64,
+    ly: f64,
+    planes: Vec<f64>,
+    states: Vec<State>,
+}
+
+/// An animated GIF of the fields a run recorded: Movie S1 or S2 of the paper
+/// ([`MovieKind`]), one frame per recorded stable state (every
+/// [`Movie::every`]-th, at most [`Movie::max_frames`]: a longer run is drawn every k-th
+/// state with k raised until the frames fit, the last state always drawn), each titled
+/// `F/(μF_N) = …, ℓ/Lx = …`, on one colour scale for the whole movie (a colour bar with its
+/// unit), with the precursor front drawn. Text is in the embedded font.
+///
+/// ```
+/// use precursors::output::RunTables;
+/// use precursors::plot::{Movie, MovieKind, PlotError};
+/// use precursors::Scene;
+/// let dir = std::env::temp_dir().join(format!("precursors-doc-movie-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// // Record the fields of every 2nd stable state, with two planes for τ_C.
+/// let scene = Scene::builder()
+///     .block(0.010, 0.004, 0.010)
+///     .normal_load(100.0)
+///     .record_fields(2, &[0.0, 0.005])
+///     .build()?;
+/// let mut driver = scene.driver()?;
+/// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
+/// let report = Movie::new(&dir, MovieKind::CoulombStress)
+///     .max_frames(5)?
+///     .size(480, 300)
+///     .save(dir.join("s2.gif"))?;
+/// assert!(report.frames <= 5 && report.frames >= 2);
+/// assert!(std::fs::read(dir.join("s2.gif"))?.starts_with(b"GIF89a"));
+/// // Without recorded fields: refused, saying how to record them.
+/// std::fs::remove_file(dir.join("fields.csv"))?;
+/// let e = Movie::new(&dir, MovieKind::ContactArea).save(dir.join("s1.gif")).unwrap_err();
+/// assert!(matches!(e, PlotError::NoFields { .. }) && e.to_string().contains("\"fields\""));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct Movie {
+    dir: PathBuf,
+    kind: MovieKind,
+    every: usize,
+    max_frames: usize,
+    size: (u32, u32),
+    delay: u16,
+    colour_range: Option<(f64, f64)>,
+}
+
+/// The default bound on a movie's frames.
+const MAX_FRAMES: usize = 200;
+
+impl Movie {
+    /// The movie `kind` of the run directory `dir` (which holds `scene.json` and
+    /// `fields.csv`): every recorded state, at most 200 frames, 900 x 560 pixels, 0.1 s
+    /// per frame, the colour scale from the whole run.
+    pub fn new(dir: impl AsRef<Path>, kind: MovieKind) -> Self {
+        Self {
+            dir: dir.as_ref().to_path_buf(),
+            kind,
+            every: 1,
+            max_frames: MAX_FRAMES,
+            size: (900, 560),
+            delay: 10,
+            colour_range: None,
+        }
+    }
+
+    /// Draws every `every`-th recorded state (and the last).
+    ///
+    /// # Errors
+    /// [`PlotError::Figure`] for `every = 0`.
+    pub fn every(mut self, every: usize) -> Result<Self> {
+        if every == 0 {
+            return Err(self.refuse("a movie draws every k-th recorded state, k >= 1: not 0"));
+        }
+        self.every = every;
+        Ok(self)
+    }
+
+    /// At most `frames` frames (default 200): a run with more recorded states is drawn
+    /// every k-th state, k the smallest that fits (the last state always drawn).
+    ///
+    /// # Errors
+    /// [`PlotError::Figure`] for fewer than 2 frames.
+    pub fn max_frames(mut self, frames: usize) -> Result<Self> {
+        if frames < 2 {
+            return Err(self.refuse(&format!(
+                "a movie has at least 2 frames (its first and last states): not {frames}"
+            )));
+        }
+        self.max_frames = frames;
+        Ok(self)
+    }
+
+    /// The frame size in pixels (default 900 x 560; from 200 x 150 to 16384 x 16384).
+    pub fn size(mut self, width: u32, height: u32) -> Self {
+        self.size = (width, height);
+        self
+    }
+
+    /// Seconds each frame is shown (default 0.1; GIF counts hundredths: from 0.01 to 655 s).
+    ///
+    /// # Errors
+    /// [`PlotError::Figure`] outside that range (or not finite).
+    pub fn frame_duration(mut self, seconds: f64) -> Result<Self> {
+        let hundredths = (seconds * 100.0).round();
+        if !(1.0..=65535.0).contains(&hundredths) {
+            return Err(self.refuse(&format!(
+                "a frame's duration is 0.01 to 655 s (GIF counts hundredths): not {seconds} s"
+            )));
+        }
+        self.delay = hundredths as u16;
+        Ok(self)
+    }
+
+    /// A fixed colour scale (mm² for the contact area, MPa for `τ_C`) instead of the
+    /// one from the run (contact area: 0 to the 98th percentile of the cells' values over
+    /// the movie; `τ_C`: symmetric about 0, to the 98th percentile of `|τ_C|`; both
+    /// saturating beyond). Checked
+    /// when the movie is drawn (finite, increasing).
+    pub fn colour_range(mut self, low: f64, high: f64) -> Self {
+        self.colour_range = Some((low, high));
+        self
+    }
+
+    fn refuse(&self, reason: &str) -> PlotError {
+        PlotError::Figure {
+            path: Some(self.dir.clone()),
+            reason: reason.to_string(),
+        }
+    }
+
+    /// Draws the movie into `path` (an animated GIF; the name must end in `.gif`).
+    ///
+    /// # Errors
+    /// As [`Movie::save_with_progress`].
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<MovieReport> {
+        self.save_with_progress(path, |_, _| {})
+    }
+
+    /// [`Movie::save`], calling `progress(drawn, frames)` after each frame drawn (a
+    /// progress bar).
+    ///
+    /// # Errors
+    /// [`PlotError::NoFields`] when the directory has no recorded fields (no
+    /// `fields.csv`, or, for [`MovieKind::CoulombStress`], no planes recorded); in
+    /// [`PlotError::Core`]: [`Error::Io`] (a file that cannot be read or written: the GIF is
+    /// written atomically), [`Error::CorruptTable`] or [`Error::NonFiniteCell`] for a
+    /// damaged `fields.csv`, the scene record's errors; [`PlotError::Figure`] for a name
+    /// not ending in `.gif`, a size or colour range out of range.
+    pub fn save_with_progress(
+        &self,
+        path: impl AsRef<Path>,
+        mut progress: impl FnMut(usize, usize),
+    ) -> Result<MovieReport> {
+        let path = path.as_ref();
+        let is_gif = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("gif"));
+        if !is_gif {
+            return Err(PlotError::Figure {
+                path: Some(path.to_path_buf()),
+                reason: "a movie is an animated GIF: the file name must end in .gif".into(),
+            });
+        }
+        super::check_size(path, self.size)?;
+        let (recording, report) = self.plan()?;
+        let (width, height) = self.size;
+        let mut bytes = Vec::new();
+        let fail = |e: gif::EncodingError| PlotError::Figure {
+            path: Some(path.to_path_buf()),
+            reason: format!("encoding the GIF: {e}"),
+        };
+        {
+            let mut encoder =
+                gif::Encoder::new(&mut bytes, width as u16, height as u16, &[]).map_err(fail)?;
+            encoder.set_repeat(gif::Repeat::Infinite).map_err(fail)?;
+            let states = report.events.len();
+            for (k, state) in self.frames(&recording, &report).enumerate() {
+                let map = self.frame_map(&recording, state, report.colour_range)?;
+                let pixels = map_pixels(&map, path)?;
+                // NeuQuant at speed 10: a few ms per frame, colours within a few units.
+                let mut frame =
+                    gif::Frame::from_rgb_speed(width as u16, height as u16, &pixels, 10);
+                frame.delay = self.delay;
+                encoder.write_frame(&frame).map_err(fail)?;
+                progress(k + 1, states);
+            }
+        }
+        crate::driver::write_atomically(path, &bytes, "writing movie")?;
+        Ok(report)
+    }
+
+    /// Draws frame `frame` (0-based, of the frames [`Movie::save`] draws) as a still PNG
+    /// or SVG (chosen by the extension), e.g. to show a few frames in a document.
+    ///
+    /// # Errors
+    /// As [`Movie::save_with_progress`]; [`PlotError::Figure`] for a frame past the last.
+    pub fn save_frame(&self, frame: usize, path: impl AsRef<Path>) -> Result<MovieReport> {
+        let (recording, report) = self.plan()?;
+        let Some(state) = self.frames(&recording, &report).nth(frame) else {
+            return Err(self.refuse(&format!(
+                "the movie has {} frames (0 to {}): no frame {frame}",
+                report.frames,
+                report.frames - 1
+            )));
+        };
+        self.frame_map(&recording, state, report.colour_range)?
+            .save(path)?;
+        Ok(report)
+    }
+
+    /// The recording, the frames' states and the colour scale.
+    fn plan(&self) -> Result<(Recording, MovieReport)> {
+        let recording = read_recording(&self.dir)?;
+        if self.kind == MovieKind::CoulombStress && recording.planes.is_empty() {
+            return Err(PlotError::NoFields {
+                dir: self.dir.clone(),
+                reason: format!(
+                    "its {FIELDS_TABLE} holds the contact area only: the scene recorded no \
+                     planes of the Coulomb stress (`fields.planes`)"
+                ),
+            });
+        }
+        let n = recording.states.len();
+        // The smallest stride (a multiple of nothing: any k >= every) whose frames, the
+        // last state added, fit.
+        let mut stride = self.every;
+        while frame_count(n, stride) > self.max_frames {
+            stride = stride.max(n.div_ceil(self.max_frames - 1)).max(stride + 1);
+        }
+        let indices = frame_indices(n, stride);
+        let range = match self.colour_range {
+            Some(range) => axis_range(&self.dir, "colour", Some(range), std::iter::empty())?,
+            None => self.automatic_range(&recording),
+        };
+        let report = MovieReport {
+            frames: indices.len(),
+            states: n,
+            stride,
+            events: indices.iter().map(|&i| recording.states[i].event).collect(),
+            colour_range: range,
+        };
+        Ok((recording, report))
+    }
+
+    fn frames<'a>(
+        &self,
+        recording: &'a Recording,
+        report: &MovieReport,
+    ) -> impl Iterator<Item = &'a State> {
+        frame_indices(recording.states.len(), report.stride)
+            .into_iter()
+            .map(move |i| &recording.states[i])
+    }
+
+    /// The colour scale of the whole movie: `A_R` from 0 to the 98th percentile of the
+    /// cells' values (mm²), `τ_C` symmetric about 0 to the 98th percentile of `|τ_C|`
+    /// (MPa); both saturate beyond.
+    fn automatic_range(&self, recording: &Recording) -> (f64, f64) {
+        match self.kind {
+            MovieKind::CoulombStress => {
+                let magnitudes = recording
+                    .states
+                    .iter()
+                    .flat_map(|s| s.coulomb.iter().map(|v| v.abs() / 1e6));
+                let top = percentile_98(magnitudes.collect());
+                let top = if top > 0.0 { top } else { 1.0 };
+                (-top, top)
+            }
+            _ => {
+                // Not the largest: near global slip the last attached sites of the paper's
+                // area law reach areas far beyond their cell's, which would leave every
+                // other cell at the bottom of the scale.
+                let values = recording
+                    .states
+                    .iter()
+                    .flat_map(|s| s.area.iter().map(|a| a * 1e6));
+                let top = percentile_98(values.collect());
+                (0.0, if top > 0.0 { top } else { 1.0 })
+            }
+        }
+    }
+
+    /// The map of one frame.
+    fn frame_map(&self, r: &Recording, state: &State, range: (f64, f64)) -> Result<Map> {
+        let (lx, ly) = (r.lx * 1e3, r.ly * 1e3);
+        let title = format!(
+            "F/(μF_N) = {:.3}, ℓ/Lx = {:.3}  (event {})",
+            state.load, state.ell, state.event
+        );
+        let ell = state.ell * lx;
+        let map = match self.kind {
+            MovieKind::CoulombStress => {
+                let np = r.planes.len();
+                let values: Vec<f64> = state.coulomb.iter().map(|v| v / 1e6).collect();
+                let edges = plane_edges(&r.planes);
+                let mut overlay = zero_contour(&values, r.nx, &edges, lx);
+                // The interface's precursor: a bar along the bottom, a tick at its tip.
+                let (bottom, top) = (edges[0], edges[np]);
+                let tick = 0.04 * (top - bottom);
+                overlay.push(vec![(0.0, bottom), (ell, bottom)]);
+                overlay.push(vec![(ell, bottom), (ell, bottom + tick)]);
+                let mut map = Map::new(r.nx, np, values)?
+                    .labels(&title, "x (mm)", "z (mm)", "τ_C = |τ| − μ|σ| (MPa)")
+                    .x_range(0.0, lx)
+                    .y_range(bottom, top)
+                    .colour_scale(Palette::Diverging, Some(range));
+                map.row_edges = Some(edges);
+                map.overlay = overlay;
+                map
+            }
+            _ => {
+                let values: Vec<f64> = state.area.iter().map(|a| a * 1e6).collect();
+                let mut map = Map::new(r.nx, r.ny, values)?
+                    .labels(&title, "x (mm)", "y (mm)", "A_R per cell (mm²)")
+                    .x_range(0.0, lx)
+                    .y_range(0.0, ly)
+                    .colour_scale(Palette::Sequential, Some(range));
+                map.overlay = vec![vec![(ell, 0.0), (ell, ly)]];
+                map
+            }
+        };
+        Ok(map.size(self.size.0, self.size.1))
+    }
+}
+
+/// The 98th percentile of `values` (the value at rank `⌊0.98·n⌋` of the sorted values;
+/// 0 for none).
+fn percentile_98(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values
+        .get((values.len() as f64 * 0.98) as usize)
+        .or(values.last())
+        .copied()
+        .unwrap_or(0.0)
+}
+
+/// Frames of `n` states drawn every `stride`-th, the last added.
+fn frame_count(n: usize, stride: usize) -> usize {
+    frame_indices(n, stride).len()
+}
+
+fn frame_indices(n: usize, stride: usize) -> Vec<usize> {
+    let mut indices: Vec<usize> = (0..n).step_by(stride.max(1)).collect();
+    if n > 0 && indices.last() != Some(&(n - 1)) {
+        indices.push(n - 1);
+    }
+    indices
+}
+
+/// The rows' edges (mm) of planes at heights `planes` (m, increasing): midway between
+/// neighbours, half a spacing beyond the first and the last (1 mm for a single plane).
+fn plane_edges(planes: &[f64]) -> Vec<f64> {
+    let z: Vec<f64> = planes.iter().map(|z| z * 1e3).collect();
+    let n = z.len();
+    if n == 1 {
+        return vec![z[0] - 0.5, z[0] + 0.5];
+    }
+    let mut edges = Vec::with_capacity(n + 1);
+    edges.push(z[0] - (z[1] - z[0]) / 2.0);
+    for k in 1..n {
+        edges.push((z[k - 1] + z[k]) / 2.0);
+    }
+    edges.push(z[n - 1] + (z[n - 1] - z[n - 2]) / 2.0);
+    edges
+}
+
+/// The boundary of the region `τ_C > 0` along the cells' edges: a segment between every
+/// two neighbouring cells of opposite sign (`values`: rows of `nx` columns, the rows'
+/// `edges`, the x range `0..lx`).
+fn zero_contour(values: &[f64], nx: usize, edges: &[f64], lx: f64) -> Vec<Vec<(f64, f64)>> {
+    let dx = lx / nx as f64;
+    let positive = |r: usize, c: usize| values[r * nx + c] > 0.0;
+    let rows = values.len() / nx;
+    let mut lines = Vec::new();
+    for r in 0..rows {
+        for c in 0..nx {
+            if c + 1 < nx && positive(r, c) != positive(r, c + 1) {
+                let x = (c + 1) as f64 * dx;
+                lines.push(vec![(x, edges[r]), (x, edges[r + 1])]);
+            }
+            if r + 1 < rows && positive(r, c) != positive(r + 1, c) {
+                let z = edges[r + 1];
+                lines.push(vec![(c as f64 * dx, z), ((c + 1) as f64 * dx, z)]);
+            }
+        }
+    }
+    lines
+}
+
+/// A map's RGB pixels at its size.
+fn map_pixels(map: &Map, path: &Path) -> Result<Vec<u8>> {
+    register_font()?;
+    let x = axis_range(path, "x", Some(map.x_range), std::iter::empty())?;
+    let y = axis_range(path, "y", Some(map.y_range), std::iter::empty())?;
+    let c = axis_range(path, "colour", map.colour_range, map.values.iter().copied())?;
+    let size = map.size;
+    let mut pixels = vec![0u8; 3 * size.0 as usize * size.1 as usize];
+    paint(
+        BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area(),
+        &MapDrawing { map, x, y, c },
+    )
+    .map_err(|reason| PlotError::Figure {
+        path: Some(path.to_path_buf()),
+        reason,
+    })?;
+    Ok(pixels)
+}
+
+/// The fields recorded in `dir`: its scene record gives the grid and the planes,
+/// `fields.csv` the states.
+fn read_recording(dir: &Path) -> Result<Recording> {
+    let table = dir.join(FIELDS_TABLE);
+    let no_fields = |reason: String| PlotError::NoFields {
+        dir: dir.to_path_buf(),
+        reason,
+    };
+    if !table.is_file() {
+        let partial = dir.join(format!("{FIELDS_TABLE}{PARTIAL_SUFFIX}"));
+        return Err(no_fields(if partial.is_file() {
+            format!(
+                "its run has not reached global slip ({FIELDS_TABLE}{PARTIAL_SUFFIX}): resume it \
+                 (`precursors resume`) to finish the table"
+            )
+        } else {
+            format!("it holds no {FIELDS_TABLE}")
+        }));
+    }
+    let record = dir.join(SCENE_RECORD);
+    if !record.is_file() {
+        return Err(no_fields(format!(
+            "it holds {FIELDS_TABLE} but no {SCENE_RECORD}, the record of the run's scene"
+        )));
+    }
+    let builder = crate::SceneBuilder::from_json_file(&record)?;
+    let grid = builder.grid()?;
+    let (nx, ny) = (grid.nx(), grid.ny());
+    let planes = builder.current_fields().planes.clone();
+    crate::cost::check_file_size(&table)?;
+    let text =
+        std::fs::read_to_string(&table).map_err(|e| Error::io("reading table", &table, e))?;
+    let corrupt = |reason: String| Error::CorruptTable {
+        path: Some(table.clone()),
+        reason,
+    };
+    let header = fields_header(nx);
+    let mut lines = text.lines();
+    if lines.next() != Some(header.as_str()) {
+        return Err(corrupt(format!(
+            "line 1 is not the header of {FIELDS_TABLE} for the {nx} columns of the scene in \
+             {SCENE_RECORD}"
+        ))
+        .into());
+    }
+    let per_state = ny + planes.len();
+    let mut states: Vec<State> = Vec::new();
+    for (n, row) in lines.enumerate() {
+        let line = n + 2;
+        let cells: Vec<&str> = row.split(',').collect();
+        if cells.len() != 6 + nx {
+            return Err(corrupt(format!(
+                "line {line} has {} fields, the header {}",
+                cells.len(),
+                6 + nx
+            ))
+            .into());
+        }
+        let event: usize = cells[0].parse().map_err(|e| {
+            corrupt(format!(
+                "line {line}: the event index is not a whole number ({e})"
+            ))
+        })?;
+        let within = n % per_state;
+        let (field, index) = if within < ny {
+            (FIELD_AREA, within)
+        } else {
+            (FIELD_COULOMB, within - ny)
+        };
+        if cells[3] != field || cells[4] != index.to_string() {
+            return Err(corrupt(format!(
+                "line {line}: row {index} of {field} belongs here ({ny} rows of {FIELD_AREA}, \
+                 then one of {FIELD_COULOMB} per plane of {SCENE_RECORD}, for each state)"
+            ))
+            .into());
+        }
+        let mut values = Vec::with_capacity(nx);
+        for (ix, text) in cells[6..].iter().enumerate() {
+            values.push(table_number(&table, line, &format!("value_ix{ix}"), text)?);
+        }
+        if within == 0 {
+            states.push(State {
+                event,
+                load: table_number(&table, line, "force_over_mu_FN", cells[1])?,
+                ell: table_number(&table, line, "precursor_over_Lx", cells[2])?,
+                area: Vec::with_capacity(nx * ny),
+                coulomb: Vec::with_capacity(nx * planes.len()),
+            });
+        }
+        let state = states.last_mut().expect("a state was started");
+        if state.event != event {
+            return Err(corrupt(format!(
+                "line {line}: event {event} inside the rows of event {}",
+                state.event
+            ))
+            .into());
+        }
+        if field == FIELD_AREA {
+            state.area.extend(values);
+        } else {
+            state.coulomb.extend(values);
+        }
+    }
+    if states.is_empty() {
+        return Err(no_fields(format!("its {FIELDS_TABLE} holds no state")));
+    }
+    let last = states.last().expect("not empty");
+    if last.area.len() + last.coulomb.len() != nx * per_state {
+        return Err(corrupt(format!(
+            "the last state (event {}) is cut: its rows are not all there",
+            last.event
+        ))
+        .into());
+    }
+    let block = grid.block();
+    Ok(Recording {
+        nx,
+        ny,
+        lx: block.lx(),
+        ly: block.ly(),
+        planes,
+        states,
+    })
+}

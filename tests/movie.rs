@@ -1,0 +1,412 @@
+//! The recorded fields (`fields.csv`, scene key `fields`) and the movies drawn from them
+//! (feature `plot`).
+//!
+//! The recording is checked against the driver's own observables read at the same states
+//! by a second driver (the cells' contact area, the y-averaged Coulomb stress of probes
+//! the driver plans itself) and must leave the other tables byte for byte as they are;
+//! the movies against a hand-written `fields.csv` whose colours and frame order follow
+//! from the palette's documented stops (not from the code that draws them).
+
+use precursors::output::{RunTables, FIELDS_TABLE};
+use precursors::plot::{Movie, MovieKind, PlotError};
+use precursors::{Error, Event, ProbeSpec, Scene, SceneBuilder};
+use std::path::{Path, PathBuf};
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("precursors-{}-movie-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A 20 x 4-cell scene driven by the rod (the default drive) to global slip.
+fn builder() -> SceneBuilder {
+    Scene::builder()
+        .block(0.02, 0.004, 0.01)
+        .cell_size(1e-3, 1e-3)
+        .normal_load(300.0)
+        .seed(5)
+}
+
+const PLANES: [f64; 3] = [0.0, 0.002, 0.006];
+
+fn run(scene: &Scene, dir: &Path) {
+    let mut driver = scene.driver().unwrap();
+    RunTables::create(dir, &driver)
+        .unwrap()
+        .run_to_slip(&mut driver, None, |_, _| {})
+        .unwrap();
+}
+
+#[test]
+fn recording_fields_changes_no_table_and_records_the_drivers_fields() {
+    let plain = scratch("plain");
+    let recorded = scratch("recorded");
+    run(&builder().build().unwrap(), &plain);
+    let every = 3;
+    let scene = builder().record_fields(every, &PLANES).build().unwrap();
+    run(&scene, &recorded);
+    for name in ["events.csv", "curve.csv", "contact_map.csv"] {
+        let a = std::fs::read(plain.join(name)).unwrap();
+        let b = std::fs::read(recorded.join(name)).unwrap();
+        assert!(a == b, "{name} differs when fields are recorded");
+    }
+    assert!(!plain.join(FIELDS_TABLE).exists());
+
+    // The reference: a driver of the scene with the planes as its own probes, read at
+    // the 1st, 4th, 7th, ... stable state.
+    let probed = builder()
+        .probes(
+            PLANES
+                .iter()
+                .fold(ProbeSpec::default(), |s, &z| s.with_plane(z)),
+        )
+        .build()
+        .unwrap();
+    let mut driver = probed.driver().unwrap();
+    let mut expected: Vec<String> = Vec::new();
+    let mut stable = 0;
+    let mu_fn = driver.friction_coefficient() * driver.normal_load();
+    while let Some(event) = driver.step().unwrap() {
+        let Event::Stable { load, .. } = event else {
+            continue;
+        };
+        stable += 1;
+        if (stable - 1) % every != 0 {
+            continue;
+        }
+        let head = format!(
+            "{},{:.12e},{:.12e}",
+            driver.event_count(),
+            load.force / mu_fn,
+            driver.precursor_length().unwrap() / 0.02
+        );
+        let area = driver.cell_contact_area().unwrap();
+        for iy in 0..4 {
+            let cells: Vec<String> = area[iy * 20..(iy + 1) * 20]
+                .iter()
+                .map(|v| format!("{v:.12e}"))
+                .collect();
+            expected.push(format!(
+                "{head},area_m2,{iy},{:.12e},{}",
+                0.0,
+                cells.join(",")
+            ));
+        }
+        for (k, plane) in driver.stresses().unwrap().planes.iter().enumerate() {
+            let cells: Vec<String> = plane
+                .profile()
+                .coulomb_of_means
+                .iter()
+                .map(|v| format!("{v:.12e}"))
+                .collect();
+            expected.push(format!(
+                "{head},coulomb_Pa,{k},{:.12e},{}",
+                PLANES[k],
+                cells.join(",")
+            ));
+        }
+    }
+    let text = std::fs::read_to_string(recorded.join(FIELDS_TABLE)).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    assert!(header.starts_with("event,force_over_mu_FN,precursor_over_Lx,field,row,z_m,value_ix0,"));
+    assert_eq!(header.split(',').count(), 6 + 20);
+    let rows: Vec<&str> = lines.collect();
+    assert!(stable > 3 * every, "{stable} stable states");
+    assert_eq!(rows.len(), expected.len());
+    for (row, want) in rows.iter().zip(&expected) {
+        assert_eq!(row, want);
+    }
+    std::fs::remove_dir_all(&plain).unwrap();
+    std::fs::remove_dir_all(&recorded).unwrap();
+}
+
+#[test]
+fn resumed_fields_end_as_the_uninterrupted_ones_and_another_recording_is_refused() {
+    let scene = builder().record_fields(2, &PLANES).build().unwrap();
+    let whole = scratch("whole");
+    run(&scene, &whole);
+    // The same run killed 30 events after a checkpoint at its 12th stable state.
+    let cut = scratch("cut");
+    let mut driver = scene.driver().unwrap();
+    let mut tables = RunTables::create(&cut, &driver).unwrap();
+    let mut checkpoint = None;
+    let mut stable = 0;
+    let mut after = 0;
+    while let Some(event) = driver.step().unwrap() {
+        tables.record(&driver, &event).unwrap();
+        if checkpoint.is_some() {
+            after += 1;
+            if after == 30 {
+                break;
+            }
+        } else if matches!(event, Event::Stable { .. }) {
+            stable += 1;
+            if stable == 12 {
+                tables.flush().unwrap();
+                checkpoint = Some(driver.checkpoint());
+            }
+        }
+    }
+    tables.flush().unwrap();
+    drop(tables);
+    let checkpoint = checkpoint.unwrap();
+    // Recorded every 3rd state instead: the table does not match, refused.
+    let other = builder().record_fields(3, &PLANES).build().unwrap();
+    let driver = other.resume(&checkpoint).unwrap();
+    match RunTables::resume(&cut, &driver) {
+        Err(Error::CorruptTable { path, reason }) => {
+            assert!(path.unwrap().ends_with("fields.csv.partial"));
+            assert!(reason.contains("fields.every"), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let mut driver = scene.resume(&checkpoint).unwrap();
+    let mut tables = RunTables::resume(&cut, &driver).unwrap();
+    while let Some(event) = driver.step().unwrap() {
+        tables.record(&driver, &event).unwrap();
+    }
+    tables.finish().unwrap();
+    for name in ["events.csv", FIELDS_TABLE] {
+        let a = std::fs::read(whole.join(name)).unwrap();
+        let b = std::fs::read(cut.join(name)).unwrap();
+        assert!(a == b, "{name} differs after resume");
+    }
+    std::fs::remove_dir_all(&whole).unwrap();
+    std::fs::remove_dir_all(&cut).unwrap();
+}
+
+/// The palette's documented stops (docs: `Palette::Sequential`).
+const LOW: [u8; 3] = [255, 255, 217];
+const MID: [u8; 3] = [65, 182, 196];
+const HIGH: [u8; 3] = [8, 29, 88];
+
+/// A run directory of a 10 x 4-cell scene holding a hand-written `fields.csv`: five
+/// states; in state `s` the columns `ix <= s` hold `v_s` in every row (0 elsewhere), `v_0
+/// = 1 mm²`, `v_s = 2 mm²` after; one plane with `τ_C = +1 MPa` on columns `ix <= s`, −1 MPa
+/// elsewhere. Returns the directory and the events of the states.
+fn handwritten(name: &str) -> (PathBuf, Vec<usize>) {
+    let dir = scratch(name);
+    let builder = Scene::builder()
+        .block(0.010, 0.004, 0.010)
+        .cell_size(1e-3, 1e-3)
+        .record_fields(1, &[0.001]);
+    std::fs::write(dir.join("scene.json"), builder.to_json().unwrap()).unwrap();
+    let mut text = String::from("event,force_over_mu_FN,precursor_over_Lx,field,row,z_m");
+    for ix in 0..10 {
+        text.push_str(&format!(",value_ix{ix}"));
+    }
+    text.push('\n');
+    let events: Vec<usize> = (0..5).map(|s| 1 + 7 * s).collect();
+    for (s, &event) in events.iter().enumerate() {
+        let v = if s == 0 { 1e-6 } else { 2e-6 };
+        let head = format!(
+            "{event},{:.12e},{:.12e}",
+            0.1 * s as f64 + 0.5,
+            0.1 * (s + 1) as f64
+        );
+        for iy in 0..4 {
+            text.push_str(&format!("{head},area_m2,{iy},0"));
+            for ix in 0..10 {
+                text.push_str(&format!(",{:e}", if ix <= s { v } else { 0.0 }));
+            }
+            text.push('\n');
+        }
+        text.push_str(&format!("{head},coulomb_Pa,0,1e-3"));
+        for ix in 0..10 {
+            text.push_str(if ix <= s { ",1e6" } else { ",-1e6" });
+        }
+        text.push('\n');
+    }
+    std::fs::write(dir.join(FIELDS_TABLE), text).unwrap();
+    (dir, events)
+}
+
+/// The RGBA frames of a GIF.
+fn decode_frames(path: &Path) -> Vec<Vec<u8>> {
+    let mut options = gif::DecodeOptions::new();
+    options.set_color_output(gif::ColorOutput::RGBA);
+    let mut decoder = options
+        .read_info(std::io::BufReader::new(std::fs::File::open(path).unwrap()))
+        .unwrap();
+    let mut out = Vec::new();
+    while let Some(frame) = decoder.read_next_frame().unwrap() {
+        assert_eq!((frame.width, frame.height), (900, 560));
+        out.push(frame.buffer.to_vec());
+    }
+    out
+}
+
+/// Pixels within 6 per channel of `rgb` (the GIF's quantisation moves colours a little).
+fn near(frame: &[u8], rgb: [u8; 3]) -> usize {
+    frame
+        .chunks_exact(4)
+        .filter(|p| (0..3).all(|c| (p[c] as i32 - rgb[c] as i32).abs() <= 6))
+        .count()
+}
+
+#[test]
+fn a_movie_has_one_frame_per_state_in_order_on_one_colour_scale() {
+    let (dir, events) = handwritten("hand1");
+    let path = dir.join("s1.gif");
+    let report = Movie::new(&dir, MovieKind::ContactArea)
+        .save(&path)
+        .unwrap();
+    assert_eq!((report.frames, report.states, report.stride), (5, 5, 1));
+    assert_eq!(report.events, events);
+    assert_eq!(report.colour_range, (0.0, 2.0));
+    let frames = decode_frames(&path);
+    assert_eq!(frames.len(), 5);
+    // The plot area is about 660 x 445 pixels (the frame less its margins, title, axes
+    // and colour bar): a column of 4 cells about 66 x 445, 29 000 pixels.
+    let column = 20_000;
+    let (least, most) = (26_000, 32_000);
+    // Frame 0: one column at half the scale (the middle stop), nothing at its top: on a
+    // scale per frame it would be the top colour.
+    assert!(near(&frames[0], MID) > column, "{}", near(&frames[0], MID));
+    assert!(near(&frames[0], HIGH) < column / 10);
+    // Frame s: s + 1 columns at the top of the scale, in order.
+    for (s, frame) in frames.iter().enumerate().skip(1) {
+        let high = near(frame, HIGH);
+        let low = near(frame, LOW);
+        assert!(
+            high > (s + 1) * least && high < (s + 1) * most,
+            "frame {s}: {high} pixels of the top colour"
+        );
+        assert!(low > (9 - s) * column, "frame {s}: {low} pixels of zero");
+    }
+    // Every 2nd state, at most 3 frames: the stride rises to 2, the last state kept.
+    let report = Movie::new(&dir, MovieKind::ContactArea)
+        .every(2)
+        .unwrap()
+        .max_frames(3)
+        .unwrap()
+        .save(&path)
+        .unwrap();
+    assert_eq!(report.events, [events[0], events[2], events[4]]);
+    assert_eq!(decode_frames(&path).len(), 3);
+    let report = Movie::new(&dir, MovieKind::ContactArea)
+        .max_frames(2)
+        .unwrap()
+        .save(&path)
+        .unwrap();
+    assert_eq!(report.events, [events[0], events[4]]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_coulomb_movie_is_red_where_tau_c_is_positive_and_frames_are_titled() {
+    let (dir, _) = handwritten("hand2");
+    let path = dir.join("s2.gif");
+    let report = Movie::new(&dir, MovieKind::CoulombStress)
+        .save(&path)
+        .unwrap();
+    // Symmetric about 0: ±1 MPa are the ends of the diverging palette.
+    assert_eq!(report.colour_range, (-1.0, 1.0));
+    let (red, blue) = ([178, 24, 43], [33, 102, 172]);
+    let frames = decode_frames(&path);
+    for (s, frame) in frames.iter().enumerate() {
+        // One plane: a column is about 64 x 440 pixels.
+        let (r, b) = (near(frame, red), near(frame, blue));
+        assert!(
+            r > (s + 1) * 20_000 && r < (s + 2) * 30_000,
+            "frame {s}: {r} red"
+        );
+        assert!(b > (9 - s) * 20_000, "frame {s}: {b} blue");
+    }
+    // A frame as SVG: its title says the load and the precursor length of its state.
+    let svg = dir.join("frame.svg");
+    Movie::new(&dir, MovieKind::CoulombStress)
+        .save_frame(2, &svg)
+        .unwrap();
+    let text = std::fs::read_to_string(&svg).unwrap();
+    let texts: Vec<&str> = text
+        .split("<text")
+        .skip(1)
+        .filter_map(|t| Some(t.split_once('>')?.1.split_once("</text>")?.0.trim()))
+        .collect();
+    // The title typeset: `F_N` as F with the subscript N.
+    let title = ["F/(μF", "N", ") = 0.700, ℓ/Lx = 0.300  (event 15)"];
+    assert!(texts.windows(3).any(|w| w == title), "{texts:?}");
+    assert!(texts.contains(&"τ_C = |τ| − μ|σ| (MPa)"), "{texts:?}");
+    let e = Movie::new(&dir, MovieKind::CoulombStress)
+        .save_frame(5, &svg)
+        .unwrap_err();
+    assert!(matches!(e, PlotError::Figure { .. }), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_directory_without_recorded_fields_is_refused_saying_how_to_record_them() {
+    let dir = scratch("without");
+    run(&builder().build().unwrap(), &dir);
+    let e = Movie::new(&dir, MovieKind::ContactArea)
+        .save(dir.join("s1.gif"))
+        .unwrap_err();
+    let text = e.to_string();
+    assert!(matches!(e, PlotError::NoFields { .. }), "{e:?}");
+    assert!(text.contains("no fields.csv"), "{text}");
+    assert!(text.contains("\"fields\": {\"every\": 1"), "{text}");
+    assert!(text.contains("precursors run"), "{text}");
+    // The contact area only: the Coulomb stress movie is refused, naming the key.
+    let scene = builder().record_fields(4, &[]).build().unwrap();
+    run(&scene, &dir);
+    Movie::new(&dir, MovieKind::ContactArea)
+        .save(dir.join("s1.gif"))
+        .unwrap();
+    let e = Movie::new(&dir, MovieKind::CoulombStress)
+        .save(dir.join("s2.gif"))
+        .unwrap_err();
+    assert!(e.to_string().contains("fields.planes"), "{e}");
+    assert!(!dir.join("s2.gif").exists());
+    // Bad options are refused, typed.
+    for e in [
+        Movie::new(&dir, MovieKind::ContactArea)
+            .every(0)
+            .unwrap_err(),
+        Movie::new(&dir, MovieKind::ContactArea)
+            .max_frames(1)
+            .unwrap_err(),
+        Movie::new(&dir, MovieKind::ContactArea)
+            .frame_duration(0.0)
+            .unwrap_err(),
+        Movie::new(&dir, MovieKind::ContactArea)
+            .save(dir.join("s1.png"))
+            .unwrap_err(),
+        Movie::new(&dir, MovieKind::ContactArea)
+            .colour_range(1.0, 1.0)
+            .save(dir.join("s1.gif"))
+            .unwrap_err(),
+    ] {
+        assert!(matches!(e, PlotError::Figure { .. }), "{e}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[cfg(feature = "cli")]
+#[test]
+fn the_program_draws_the_movies_and_refuses_a_directory_without_fields() {
+    use std::process::Command;
+    let (dir, _) = handwritten("hand3");
+    let out = Command::new(env!("CARGO_BIN_EXE_precursors"))
+        .args(["movie", "--max-frames", "3"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("3 frames of 5 recorded states"), "{stderr}");
+    assert_eq!(decode_frames(&dir.join("contact_area.gif")).len(), 3);
+    assert_eq!(decode_frames(&dir.join("coulomb_stress.gif")).len(), 3);
+    std::fs::remove_file(dir.join(FIELDS_TABLE)).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_precursors"))
+        .arg("movie")
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(stderr.contains("\"fields\""), "{stderr}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
