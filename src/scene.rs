@@ -264,6 +264,7 @@ impl HeightSource {
     }
 
     /// Whether the heights are drawn from a seed (realizations differ by it).
+    #[cfg(feature = "serde")]
     pub(crate) fn is_random(&self) -> bool {
         !matches!(self, HeightSource::Values(_))
     }
