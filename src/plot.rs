@@ -29,7 +29,7 @@ mod figures;
 mod movie;
 
 pub use error::PlotError;
-pub use figures::{draw, Drawn, Format};
+pub use figures::{draw, draw_with_size, Drawn, Format};
 pub use movie::{Movie, MovieKind, MovieReport};
 
 use crate::error::Error;
@@ -886,7 +886,7 @@ fn draw_axes<DB: DrawingBackend>(
 }
 
 /// The largest picture side (pixels): a PNG is drawn in memory first, 3 bytes a pixel.
-const LARGEST_SIDE: u32 = 16384;
+pub(crate) const LARGEST_SIDE: u32 = 16384;
 
 /// Draws in memory through the backend that `path`'s extension names, then writes the
 /// file atomically (temporary file and rename, as checkpoints): a full disk or a kill
@@ -901,19 +901,32 @@ fn typeset<DB: DrawingBackend>(
     size: f64,
 ) -> std::result::Result<(), String> {
     let pieces = subscripts(text);
-    let font = |sub: bool| {
+    let font = |size: f64, sub: bool| {
         (FAMILY, if sub { 0.7 * size } else { size })
             .into_font()
             .color(&BLACK)
     };
-    let widths = pieces
-        .iter()
-        .map(|(piece, sub)| {
-            area.estimate_text_size(piece, &font(*sub))
-                .map(|(w, _)| w as i32)
-                .map_err(|e| e.to_string())
-        })
-        .collect::<std::result::Result<Vec<i32>, String>>()?;
+    let widths = |size: f64| {
+        pieces
+            .iter()
+            .map(|(piece, sub)| {
+                area.estimate_text_size(piece, &font(size, *sub))
+                    .map(|(w, _)| w as i32)
+                    .map_err(|e| e.to_string())
+            })
+            .collect::<std::result::Result<Vec<i32>, String>>()
+    };
+    // A title wider than its area is set smaller (a text running off the left edge would
+    // be shifted by the backend and overlap its subscripts).
+    let room = (2 * centre - 16).max(1) as f64;
+    let natural = widths(size)?.iter().sum::<i32>() as f64;
+    let size = if natural > room {
+        size * room / natural
+    } else {
+        size
+    };
+    let font = |sub: bool| font(size, sub);
+    let widths = widths(size)?;
     let mut x = centre - widths.iter().sum::<i32>() / 2;
     for ((piece, sub), width) in pieces.iter().zip(widths) {
         let y = if *sub {

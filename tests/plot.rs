@@ -401,3 +401,100 @@ fn a_run_directory_gets_its_three_figures() {
     assert!(drawn.notes[0].contains("contact_map.csv is missing"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The `<text>` elements of an SVG: (attributes, content).
+fn svg_texts(path: &Path) -> Vec<(String, String)> {
+    let svg = std::fs::read_to_string(path).unwrap();
+    svg.split("<text")
+        .skip(1)
+        .map(|rest| {
+            let (attributes, tail) = rest.split_once('>').unwrap();
+            let content = tail.split_once("</text>").unwrap().0.trim_matches('\n');
+            (attributes.to_string(), content.to_string())
+        })
+        .collect()
+}
+
+#[test]
+fn run_figures_say_the_scene_mark_global_slip_and_reach_one_on_the_load_axis() {
+    let dir = scratch("scene-title");
+    let mut driver = scene().driver().unwrap();
+    RunTables::create(&dir, &driver)
+        .unwrap()
+        .run_to_slip(&mut driver, None, |_, _| {})
+        .unwrap();
+    let drawn = draw(&dir, &[Format::Svg]).unwrap();
+    let texts = |name: &str| {
+        svg_texts(
+            &drawn
+                .files
+                .iter()
+                .find(|f| f.ends_with(name))
+                .unwrap()
+                .clone(),
+        )
+    };
+    // The title names the scene of `scene()` (40 x 5 x 20 mm, 700 N, rod at 4 mm, seed 3),
+    // not the directory; `F_N` typeset: `N` a text of its own, smaller.
+    let title: String = texts("precursor_length.svg")
+        .iter()
+        .take(3)
+        .map(|(_, t)| t.as_str())
+        .collect();
+    assert_eq!(
+        title,
+        "Precursor length: 40 x 5 x 20 mm, FN = 700 N, rod at h = 4 mm, seed 3"
+    );
+    // Global slip: the load of events.csv's last row over μF_N (μ = 0.5, F_N = 700 N).
+    let events = std::fs::read_to_string(dir.join("events.csv")).unwrap();
+    let last: Vec<&str> = events.lines().last().unwrap().split(',').collect();
+    assert_eq!(last[1], "global_slip");
+    let slip = last[4].parse::<f64>().unwrap() / (0.5 * 700.0);
+    let legend = format!("global slip at F/(μF_N) = {slip:.3}");
+    assert!(
+        texts("precursor_length.svg")
+            .iter()
+            .any(|(_, t)| *t == legend),
+        "no legend {legend:?}"
+    );
+    // The contact map's load axis has a tick at 1.0 although its last row lies below.
+    let map = std::fs::read_to_string(dir.join("contact_map.csv")).unwrap();
+    let last_row: f64 = map
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .nth(1)
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        last_row + CONTACT_MAP_STEP / 2.0 < 1.0,
+        "last row at {last_row}"
+    );
+    assert!(texts("contact_map.svg")
+        .iter()
+        .any(|(a, t)| t == "1.0" && a.contains("text-anchor=\"end\"")));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn figures_take_the_size_asked_for_within_limits() {
+    let dir = scratch("size");
+    let mut driver = scene().driver().unwrap();
+    RunTables::create(&dir, &driver)
+        .unwrap()
+        .run_to_slip(&mut driver, None, |_, _| {})
+        .unwrap();
+    let drawn = precursors::plot::draw_with_size(&dir, &[Format::Png], (1200, 840)).unwrap();
+    for file in &drawn.files {
+        let (_, width, height) = decode(file);
+        assert_eq!((width, height), (1200, 840), "{}", file.display());
+    }
+    for size in [(199, 560), (800, 16385)] {
+        let error = precursors::plot::draw_with_size(&dir, &[Format::Png], size).unwrap_err();
+        assert!(matches!(error, PlotError::Figure { .. }));
+        assert!(error.to_string().contains("[200, 16384]"), "{error}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -124,6 +124,12 @@ enum Command {
         /// File format(s).
         #[arg(long, value_enum, default_value_t = FormatArg::Png)]
         format: FormatArg,
+        /// Figure width in pixels (200 to 16384; 2400 x 1680 prints 8 x 5.6 in at 300 dpi).
+        #[arg(long, default_value_t = 800)]
+        width: u32,
+        /// Figure height in pixels (200 to 16384).
+        #[arg(long, default_value_t = 560)]
+        height: u32,
     },
     /// Draws a run's recorded fields (the scene key "fields") as an animated GIF:
     /// the real contact area per cell (Movie S1, DIR/contact_area.gif) or the y-averaged
@@ -376,7 +382,12 @@ fn main() -> ExitCode {
             shard,
         } => run_sweep(&sweep, &out, jobs, shard, progress),
         Command::Merge { dir } => merge(&dir),
-        Command::Plot { dir, format } => plot(&dir, format),
+        Command::Plot {
+            dir,
+            format,
+            width,
+            height,
+        } => plot(&dir, format, (width, height)),
         Command::Movie {
             dir,
             field,
@@ -725,14 +736,14 @@ fn run_sweep(
     Ok(())
 }
 
-fn plot(dir: &Path, format: FormatArg) -> Result<(), Failure> {
-    use precursors::plot::{draw, Format};
+fn plot(dir: &Path, format: FormatArg, size: (u32, u32)) -> Result<(), Failure> {
+    use precursors::plot::{draw_with_size, Format};
     let formats: &[Format] = match format {
         FormatArg::Png => &[Format::Png],
         FormatArg::Svg => &[Format::Svg],
         FormatArg::Both => &[Format::Png, Format::Svg],
     };
-    let drawn = draw(dir, formats)?;
+    let drawn = draw_with_size(dir, formats, size)?;
     if let Some(summary) = &drawn.merge {
         for file in &summary.files {
             say!("wrote {}", file.display());

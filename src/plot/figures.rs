@@ -110,10 +110,50 @@ pub struct Drawn {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn draw(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
+    draw_with_size(dir, formats, (800, 560))
+}
+
+/// [`draw`] with the figures' size in pixels `(width, height)` (for print: a PNG of
+/// 2400 x 1680 is 8 x 5.6 inches at 300 dpi; [`draw`] uses 800 x 560). The SVG figures
+/// take the size as their view box.
+///
+/// ```
+/// use precursors::{output::RunTables, plot::{draw_with_size, Format}, Scene};
+/// let dir = std::env::temp_dir().join(format!("precursors-doc-size-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// let scene = Scene::builder().block(0.010, 0.004, 0.010).normal_load(100.0).build()?;
+/// let mut driver = scene.driver()?;
+/// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
+/// let drawn = draw_with_size(&dir, &[Format::Svg], (1600, 1120))?;
+/// let svg = std::fs::read_to_string(&drawn.files[0])?;
+/// assert!(svg.contains("width=\"1600\"") && svg.contains("height=\"1120\""));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+///
+/// # Errors
+/// As [`draw`]; [`PlotError::Figure`] also for a side below 200 or above 16384 pixels.
+pub fn draw_with_size(
+    dir: &Path,
+    formats: &[Format],
+    size: (u32, u32),
+) -> Result<Drawn, PlotError> {
+    let (width, height) = size;
+    if !(200..=super::LARGEST_SIDE).contains(&width)
+        || !(200..=super::LARGEST_SIDE).contains(&height)
+    {
+        return Err(PlotError::Figure {
+            path: None,
+            reason: format!(
+                "a figure of {width} x {height} pixels: each side must lie in [200, {}]",
+                super::LARGEST_SIDE
+            ),
+        });
+    }
     if dir.join(SWEEP_FILE).is_file() {
-        draw_sweep(dir, formats)
+        draw_sweep(dir, formats, size)
     } else if dir.join("curve.csv").is_file() {
-        draw_run(dir, formats)
+        draw_run(dir, formats, size)
     } else if dir
         .join(format!("curve.csv{}", crate::output::PARTIAL_SUFFIX))
         .is_file()
@@ -143,6 +183,173 @@ fn name(dir: &Path) -> String {
         .ok()
         .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
         .unwrap_or_else(|| dir.display().to_string())
+}
+
+/// The scene of a run directory in a few words (block, `F_N`, drive, heights' seed), from
+/// its `scene.json`; the directory's name when it has none.
+fn run_title(dir: &Path) -> String {
+    match crate::SceneBuilder::from_json_file(dir.join("scene.json")) {
+        Ok(scene) => describe(&crate::scene::file::all_keys(&scene)),
+        Err(_) => name(dir),
+    }
+}
+
+/// The scene of a sweep in a few words: its first run's keys but the axes' and the seed,
+/// and the realizations; the directory's name when the sweep file cannot be read.
+fn sweep_title(dir: &Path) -> String {
+    let Ok(sweep) = crate::sweep::Sweep::from_json_file(dir.join(SWEEP_FILE)) else {
+        return name(dir);
+    };
+    let Some(first) = sweep.runs().first() else {
+        return name(dir);
+    };
+    let mut keys = crate::scene::file::all_keys(first.scene());
+    keys.retain(|(key, _)| {
+        key != "heights.seed" && !first.values().iter().any(|(axis, _)| axis == key)
+    });
+    let realizations = sweep.runs().len() / sweep.points().max(1);
+    format!("{}, {realizations} realizations", describe(&keys))
+}
+
+/// `v` with at most four decimals, trailing zeros dropped (`140`, `19.4`, `0.5`).
+fn short(v: f64) -> String {
+    let text = format!("{v:.4}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    if text == "-0" {
+        "0".into()
+    } else {
+        text.to_string()
+    }
+}
+
+/// `v` clipped to `[low, high]`; a `NaN` (no band: fewer than two runs) stays `NaN`.
+fn clip(v: f64, low: f64, high: f64) -> f64 {
+    if v.is_nan() {
+        v
+    } else {
+        v.clamp(low, high)
+    }
+}
+
+/// A force in N or kN.
+fn newtons(f: f64) -> String {
+    if f.abs() >= 1e3 {
+        format!("{} kN", short(f / 1e3))
+    } else {
+        format!("{} N", short(f))
+    }
+}
+
+/// A scene's keys (the scene file's, `crate::scene::file::all_keys`) in a few words:
+/// `140 x 7 x 75 mm, F_N = 3.5 kN, rod at h = 6 mm, seed 1`.
+fn describe(keys: &[(String, String)]) -> String {
+    let get = |k: &str| {
+        keys.iter()
+            .find(|(key, _)| key == k)
+            .map(|(_, v)| v.as_str())
+    };
+    let num = |k: &str| get(k).and_then(|v| v.parse::<f64>().ok());
+    let mm = |k: &str| num(k).map(|v| short(v * 1e3));
+    let mut parts = Vec::new();
+    match (mm("block.lx"), mm("block.ly"), mm("block.lz")) {
+        (Some(lx), Some(ly), Some(lz)) => parts.push(format!("{lx} x {ly} x {lz} mm")),
+        // A sweep's title leaves out its axes.
+        (lx, ly, lz) => {
+            for (symbol, value) in [("Lx", lx), ("Ly", ly), ("Lz", lz)] {
+                if let Some(value) = value {
+                    parts.push(format!("{symbol} = {value} mm"));
+                }
+            }
+        }
+    }
+    if let Some(f) = num("normal_load") {
+        parts.push(format!("F_N = {}", newtons(f)));
+    }
+    let lateral = || match get("drive.lateral.kind") {
+        Some("rod") => format!(
+            "rod at h = {} mm",
+            mm("drive.lateral.height").unwrap_or_default()
+        ),
+        _ => "side".to_string(),
+    };
+    match get("drive.kind") {
+        Some("rod") => parts.push(format!(
+            "rod at h = {} mm",
+            mm("drive.height").unwrap_or_default()
+        )),
+        Some("top") => parts.push("top shear".into()),
+        Some("side") => parts.push("side shear".into()),
+        Some("mixed") => parts.push(format!(
+            "top and {} shear, n = {}",
+            lateral(),
+            num("drive.ratio").map(short).unwrap_or_default()
+        )),
+        Some("spring") => parts.push(format!(
+            "spring K_S = {:.3e} N/m on the {}",
+            num("drive.stiffness").unwrap_or(f64::NAN),
+            lateral()
+        )),
+        _ => {}
+    }
+    if let Some(xi) = mm("heights.correlation_length") {
+        parts.push(format!("ξ = {xi} mm"));
+    }
+    if let Some(seed) = get("heights.seed") {
+        parts.push(format!("seed {seed}"));
+    }
+    parts.join(", ")
+}
+
+/// A sweep axis's value in the user's words and units: `Ly = 7 mm` for `block.ly =
+/// 0.007`, `F_N = 3.5 kN` for `normal_load = 3500`; other keys as written.
+fn axis_value(key: &str, value: &str) -> String {
+    let Ok(v) = value.parse::<f64>() else {
+        return format!("{key} = {value}");
+    };
+    let length = |symbol: &str| format!("{symbol} = {} mm", short(v * 1e3));
+    match key {
+        "block.lx" => length("Lx"),
+        "block.ly" => length("Ly"),
+        "block.lz" => length("Lz"),
+        "cells.dx" => length("Δx"),
+        "cells.dy" => length("Δy"),
+        "normal_load" => format!("F_N = {}", newtons(v)),
+        "drive.height" | "drive.lateral.height" => length("h"),
+        "drive.half_width" | "drive.lateral.half_width" => length("Δh"),
+        "drive.ratio" => format!("n = {}", short(v)),
+        "drive.stiffness" => format!("K_S = {v:.3e} N/m"),
+        "heights.correlation_length" => length("ξ"),
+        "heights.mean" => format!("mean u0 = {} µm", short(v * 1e6)),
+        "heights.std_dev" => format!("sd u0 = {} µm", short(v * 1e6)),
+        "material.friction_coefficient" => format!("μ = {}", short(v)),
+        "material.young_modulus" => format!("E = {} GPa", short(v / 1e9)),
+        "material.poisson_ratio" => format!("ν = {}", short(v)),
+        "springs.c_x" => format!("c_x = {v:.3e} N/m³"),
+        "springs.c_z" => format!("c_z = {v:.3e} N/m²"),
+        _ => format!("{key} = {value}"),
+    }
+}
+
+/// The load of the run's global slip, `F/(μF_N)`, from the last row of `events.csv`
+/// and the ratio `force_over_mu_FN / force_N` of a loaded row of `curve.csv`; `None` for
+/// a table without it.
+fn global_slip(dir: &Path, curve: &[Vec<f64>]) -> Result<Option<f64>> {
+    let path = dir.join("events.csv");
+    let text = read(&path)?;
+    let Some(last) = text.lines().last() else {
+        return Ok(None);
+    };
+    let cells: Vec<&str> = last.split(',').collect();
+    if cells.get(1) != Some(&"global_slip") {
+        return Ok(None);
+    }
+    let line = text.lines().count();
+    let force = table_number(&path, line, "force_N", cells.get(4).copied().unwrap_or(""))?;
+    Ok(curve
+        .iter()
+        .rev()
+        .find(|r| r[3] > 0.0)
+        .map(|r| force * r[0] / r[3]))
 }
 
 fn read(path: &Path) -> Result<String> {
@@ -203,8 +410,8 @@ fn numbers(path: &Path, header: &str, wanted: &[&str]) -> Result<Vec<Vec<f64>>> 
 }
 
 /// The figures of one run directory.
-fn draw_run(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
-    let title = name(dir);
+fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, PlotError> {
+    let title = run_title(dir);
     let curve_path = dir.join("curve.csv");
     let rows = numbers(
         &curve_path,
@@ -213,8 +420,12 @@ fn draw_run(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
             "force_over_mu_FN",
             "precursor_over_Lx",
             "real_contact_area_m2",
+            "force_N",
         ],
     )?;
+    // The staircase ends at the last stable state; the run ends at global slip, where the
+    // whole interface slides (ℓ = Lx): a marker there.
+    let slip = global_slip(dir, &rows)?;
     let force: Vec<f64> = rows.iter().map(|r| r[0]).collect();
     let ell: Vec<(f64, f64)> = rows.iter().map(|r| (r[0], r[1])).collect();
     let a0 = rows.first().map_or(f64::NAN, |r| r[2]);
@@ -235,6 +446,7 @@ fn draw_run(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
     let top = force
         .iter()
         .copied()
+        .chain(slip)
         .filter(|f| f.is_finite())
         .fold(1.0, f64::max);
     let mut drawn = Drawn {
@@ -244,19 +456,27 @@ fn draw_run(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
     };
     for &format in formats {
         let path = dir.join(format!("precursor_length.{}", format.extension()));
-        Chart::new(&format!("Precursor length, {title}"), "F/(μF_N)", "ℓ/Lx")
+        let mut chart = Chart::new(&format!("Precursor length: {title}"), "F/(μF_N)", "ℓ/Lx")
+            .size(size.0, size.1)
             .x_range(0.0, top)
             .y_range(0.0, 1.0)
             .steps("ℓ/Lx at the stable states", &ell)
-            .legend(Corner::UpperLeft)
-            .save(&path)?;
+            .legend(Corner::UpperLeft);
+        if let Some(slip) = slip {
+            chart = chart.markers(
+                &format!("global slip at F/(μF_N) = {slip:.3}"),
+                &[(slip, 1.0)],
+            );
+        }
+        chart.save(&path)?;
         drawn.files.push(path);
         let path = dir.join(format!("contact_area.{}", format.extension()));
         Chart::new(
-            &format!("Real contact area, {title}"),
+            &format!("Real contact area: {title}"),
             "F/(μF_N)",
             "A_R/A_R(0)",
         )
+        .size(size.0, size.1)
         .x_range(0.0, top)
         .y_range(0.0, (1.04 * area_top).min(2.0))
         .steps(&area_label, &area)
@@ -297,6 +517,18 @@ fn draw_run(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
     }
     let (low, high) = (map[0][1], map[map.len() - 1][1]);
     let half = CONTACT_MAP_STEP / 2.0;
+    // Rows at their loads, the axis up to 1 (a tick there: global slip under force
+    // control) even when the last stable state lies below.
+    let edges: Vec<f64> = (0..=map.len())
+        .map(|r| {
+            if r < map.len() {
+                map[r][1] - half
+            } else {
+                high + half
+            }
+        })
+        .collect();
+    let y_top = (high + half).max(1.0 + half);
     let reference_label = if low == 0.0 {
         "A_R(x, F)/A_R(x, 0)".to_string()
     } else {
@@ -304,32 +536,34 @@ fn draw_run(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
     };
     for &format in formats {
         let path = dir.join(format!("contact_map.{}", format.extension()));
-        Map::new(nx, map.len(), values.clone())?
+        let mut figure = Map::new(nx, map.len(), values.clone())?
             .labels(
-                &format!("Real contact area per column, {title}"),
+                &format!("Real contact area per column: {title}"),
                 "x/Lx (trailing edge at 0)",
                 "F/(μF_N)",
                 &reference_label,
             )
+            .size(size.0, size.1)
             .x_range(0.0, 1.0)
-            .y_range(low - half, high + half)
-            .colour_scale(Palette::Diverging, Some((0.0, 2.0)))
-            .save(&path)?;
+            .y_range(low - half, y_top)
+            .colour_scale(Palette::Diverging, Some((0.0, 2.0)));
+        figure.row_edges = Some(edges.clone());
+        figure.save(&path)?;
         drawn.files.push(path);
     }
     Ok(drawn)
 }
 
 /// The figures of a sweep directory, after merging it.
-fn draw_sweep(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
+fn draw_sweep(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, PlotError> {
     let summary = merge(dir)?;
     let grid: Vec<f64> = (0..=200).map(|k| k as f64 * 0.005).collect();
     let points = crate::sweep::ensemble_curves(dir, &grid)?;
-    let title = name(dir);
+    let title = sweep_title(dir);
     let label = |values: &[(String, String)], runs: usize| {
         let mut text = values
             .iter()
-            .map(|(k, v)| format!("{k} = {v}"))
+            .map(|(k, v)| axis_value(k, v))
             .collect::<Vec<_>>()
             .join(", ");
         if text.is_empty() {
@@ -355,29 +589,43 @@ fn draw_sweep(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
     };
     for &format in formats {
         let mut chart = Chart::new(
-            &format!("Precursor length, {title}: mean and 95 % band"),
+            &format!("Precursor length: {title}, mean and 95 % band"),
             "F/(μF_N)",
             "ℓ/Lx",
         )
+        .size(size.0, size.1)
         .x_range(0.0, 1.0)
         .y_range(0.0, 1.0)
         .legend(Corner::UpperLeft);
         for p in &points {
-            chart = chart.band(&label(&p.values, p.runs), &p.precursor);
+            // ℓ/Lx lies in [0, 1]: so does its band (the t-band of few runs can reach out).
+            let clipped: Vec<(f64, f64, f64, f64)> = p
+                .precursor
+                .iter()
+                .map(|&(f, mean, low, high)| (f, mean, clip(low, 0.0, 1.0), clip(high, 0.0, 1.0)))
+                .collect();
+            chart = chart.band(&label(&p.values, p.runs), &clipped);
         }
         let path = dir.join(format!("precursor_length.{}", format.extension()));
         chart.save(&path)?;
         drawn.files.push(path);
         let mut chart = Chart::new(
-            &format!("Real contact area, {title}: mean and 95 % band{area_note}"),
+            &format!("Real contact area: {title}, mean and 95 % band{area_note}"),
             "F/(μF_N)",
             "A_R/A_R(0)",
         )
+        .size(size.0, size.1)
         .x_range(0.0, 1.0)
         .y_range(0.0, (1.04 * area_top).min(2.0))
         .legend(Corner::LowerLeft);
         for p in &points {
-            chart = chart.band(&label(&p.values, p.runs), &p.area);
+            // A_R/A_R(0) is not negative: neither is its band.
+            let clipped: Vec<(f64, f64, f64, f64)> = p
+                .area
+                .iter()
+                .map(|&(f, mean, low, high)| (f, mean, clip(low, 0.0, f64::INFINITY), high))
+                .collect();
+            chart = chart.band(&label(&p.values, p.runs), &clipped);
         }
         let path = dir.join(format!("contact_area.{}", format.extension()));
         chart.save(&path)?;
@@ -391,4 +639,70 @@ fn draw_sweep(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
     }
     drawn.merge = Some(summary);
     Ok(drawn)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sweep_axes_are_named_in_the_users_units() {
+        assert_eq!(axis_value("block.ly", "0.007"), "Ly = 7 mm");
+        assert_eq!(axis_value("block.lz", "0.0194"), "Lz = 19.4 mm");
+        assert_eq!(axis_value("normal_load", "3500.0"), "F_N = 3.5 kN");
+        assert_eq!(axis_value("normal_load", "750"), "F_N = 750 N");
+        assert_eq!(
+            axis_value("heights.correlation_length", "0.003"),
+            "ξ = 3 mm"
+        );
+        assert_eq!(axis_value("drive.ratio", "0.25"), "n = 0.25");
+        // Keys without a symbol, and values that are not numbers, as written.
+        assert_eq!(
+            axis_value("solver.backend", "\"dense\""),
+            "solver.backend = \"dense\""
+        );
+        assert_eq!(axis_value("heights.seed", "x"), "heights.seed = x");
+    }
+
+    #[test]
+    fn a_scene_is_described_by_its_keys() {
+        let keys = |pairs: &[(&str, &str)]| {
+            pairs
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect::<Vec<_>>()
+        };
+        let calibration = keys(&[
+            ("block.lx", "0.14"),
+            ("block.ly", "0.007"),
+            ("block.lz", "0.075"),
+            ("normal_load", "3500.0"),
+            ("drive.kind", "rod"),
+            ("drive.height", "0.006"),
+            ("heights.seed", "1"),
+        ]);
+        assert_eq!(
+            describe(&calibration),
+            "140 x 7 x 75 mm, F_N = 3.5 kN, rod at h = 6 mm, seed 1"
+        );
+        let spring = keys(&[
+            ("block.lx", "0.03"),
+            ("normal_load", "750"),
+            ("drive.kind", "spring"),
+            ("drive.stiffness", "4000000"),
+            ("drive.lateral.kind", "side"),
+        ]);
+        assert_eq!(
+            describe(&spring),
+            "Lx = 30 mm, F_N = 750 N, spring K_S = 4.000e6 N/m on the side"
+        );
+    }
+
+    #[test]
+    fn bands_are_clipped_and_a_missing_band_stays_missing() {
+        assert_eq!(clip(-0.2, 0.0, 1.0), 0.0);
+        assert_eq!(clip(1.3, 0.0, 1.0), 1.0);
+        assert_eq!(clip(0.4, 0.0, 1.0), 0.4);
+        assert!(clip(f64::NAN, 0.0, 1.0).is_nan());
+    }
 }
