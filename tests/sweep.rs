@@ -605,11 +605,11 @@ mod cli {
         ] {
             assert!(out.join(name).is_file(), "{name}");
         }
-        // One curve per point, named by the axes' values and its runs.
+        // One curve per point, named by the axes' values in the user's units and its runs.
         let svg = std::fs::read_to_string(out.join("precursor_length.svg")).unwrap();
         for label in [
-            "normal_load = 400.0, drive.height = 0.004 (2 runs)",
-            "normal_load = 600.0, drive.height = 0.008 (2 runs)",
+            "F_N = 400 N, h = 4 mm (2 runs)",
+            "F_N = 600 N, h = 8 mm (2 runs)",
         ] {
             assert!(svg.contains(label), "{label}");
         }
@@ -623,7 +623,7 @@ mod cli {
         let o = precursors(&["plot", path(&out), "--format", "svg"]);
         assert_eq!(o.status.code(), Some(5));
         let svg = std::fs::read_to_string(out.join("precursor_length.svg")).unwrap();
-        assert!(svg.contains("drive.height = 0.008 (1 runs)"));
+        assert!(svg.contains("h = 8 mm (1 runs)"));
         // Neither a run nor a sweep: invalid input.
         let o = precursors(&["plot", path(&dir)]);
         assert_eq!(o.status.code(), Some(3));
