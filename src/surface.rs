@@ -652,6 +652,20 @@ impl Truncated {
     }
 }
 
+/// `work` (complex multiply-adds of the synthesis) within [`MAX_WORK`].
+fn check_work(work: f64, what: &'static str) -> Result<()> {
+    if work.is_nan() || work > MAX_WORK as f64 {
+        return Err(Error::SurfaceTooLarge {
+            what,
+            needed: work,
+            limit: MAX_WORK as f64,
+            hint: "the grid has too many cells or the surface too many modes: use fewer \
+                   cells or a smoother surface",
+        });
+    }
+    Ok(())
+}
+
 /// The surface's plan on a grid: modes, Gauss-Legendre orders, points and work; checked
 /// against the limits without drawing anything.
 pub(crate) struct Plan {
@@ -670,16 +684,7 @@ impl Plan {
         let modes = Modes::new(block.lx(), block.ly(), spectrum)?;
         let orders = modes.orders(grid.dx(), grid.dy())?;
         let (nx, ny) = (grid.nx() * orders.0, grid.ny() * orders.1);
-        let work = modes.work(nx, ny);
-        if work.is_nan() || work > MAX_WORK as f64 {
-            return Err(Error::SurfaceTooLarge {
-                what: "complex multiply-adds",
-                needed: work,
-                limit: MAX_WORK as f64,
-                hint: "the grid has too many cells or the surface too many modes: use \
-                       fewer cells or a smoother surface",
-            });
-        }
+        check_work(modes.work(nx, ny), "complex multiply-adds")?;
         let (np, nq) = ((2 * modes.pm + 1) as f64, (modes.qm + 1) as f64);
         let (fx, fy) = (nx as f64, ny as f64);
         check_memory(
@@ -728,16 +733,10 @@ impl Plan {
                 (ox + ox / 2 + 2).min(MAX_ORDER),
                 (oy + oy / 2 + 2).min(MAX_ORDER),
             );
-            let work = self.modes.work(grid.nx() * ox, grid.ny() * oy);
-            if work.is_nan() || work > MAX_WORK as f64 {
-                return Err(Error::SurfaceTooLarge {
-                    what: "complex multiply-adds (the cell averages' rule)",
-                    needed: work,
-                    limit: MAX_WORK as f64,
-                    hint: "the grid has too many cells or the surface too many modes: use \
-                           fewer cells or a smoother surface",
-                });
-            }
+            check_work(
+                self.modes.work(grid.nx() * ox, grid.ny() * oy),
+                "complex multiply-adds (the cell averages' rule)",
+            )?;
             let next = self.cell_averages_with(grid, marginal, seed, (ox, oy));
             let change = previous
                 .iter()
