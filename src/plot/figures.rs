@@ -5,8 +5,11 @@
 //! (`A_R/A_R(0)` against `F/(μF_N)`) and, from `contact_map.csv`, `contact_map` (the real
 //! contact area of each column relative to zero shear over `x/Lx` and `F/(μF_N)`, the
 //! paper's Fig. 2b inset). A sweep: the tables of [`crate::sweep::merge`] written first,
-//! then `precursor_length` and `contact_area` with one curve per parameter point, the
-//! mean over its realizations and the 95 % band, on a load grid of step 0.005.
+//! then `precursor_length` and `contact_area` with one curve per parameter point, on a
+//! load grid of step 0.005: ℓ/Lx's mean over its realizations and its 95 % t-band;
+//! `A_R/A_R(0)`'s median and the median's distribution-free 95 % interval (none below 6
+//! runs), which a few realizations near slip, many times the others under the paper's
+//! area law, do not stretch over the chart as they do the mean's t-band.
 
 use super::PlotError;
 use super::{Chart, Corner, Map, Palette};
