@@ -1208,6 +1208,7 @@ fn embed_font(svg: &str) -> String {
         &format!("font-family=\"{FAMILY}\""),
         "font-family=\"DejaVu Sans, sans-serif\"",
     );
+    let svg = rescale_font_sizes(&svg);
     // After the opening <svg ...> tag.
     match svg
         .find("<svg")
@@ -1216,6 +1217,56 @@ fn embed_font(svg: &str) -> String {
         Some(at) => format!("{}\n{style}{}", &svg[..at], &svg[at..]),
         None => svg,
     }
+}
+
+/// `svg` with every `font-size` set as the PNG draws it. plotters writes `size / 1.24` em,
+/// but draws a PNG's text with the font's height (ascender − descender, 1.164 em for
+/// DejaVu Sans) scaled to `size` pixels: unscaled, the SVG's text is 6 % smaller than the
+/// PNG's and the typeset pieces, placed by the PNG's widths, drift apart.
+fn rescale_font_sizes(svg: &str) -> String {
+    const ATTRIBUTE: &str = "font-size=\"";
+    let factor = 1.24 / font_height_em();
+    let mut out = String::with_capacity(svg.len());
+    let mut rest = svg;
+    while let Some(at) = rest.find(ATTRIBUTE) {
+        let (head, tail) = rest.split_at(at + ATTRIBUTE.len());
+        out.push_str(head);
+        let end = tail.find('"').unwrap_or(tail.len());
+        match tail[..end].parse::<f64>() {
+            Ok(size) => out.push_str(&format!("{}", size * factor)),
+            Err(_) => out.push_str(&tail[..end]),
+        }
+        rest = &tail[end..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// The embedded font's height (hhea ascender − descender) in em, as its renderer (ab_glyph)
+/// scales it; 1.24 (plotters' own assumption) if the tables cannot be read.
+fn font_height_em() -> f64 {
+    let u16_at = |at: usize| {
+        FONT.get(at..at + 2)
+            .map(|b| u16::from_be_bytes([b[0], b[1]]))
+    };
+    let table = |tag: &[u8; 4]| -> Option<usize> {
+        let tables = usize::from(u16_at(4)?);
+        (0..tables).find_map(|k| {
+            let entry = 12 + 16 * k;
+            (FONT.get(entry..entry + 4)? == tag).then(|| {
+                let b = &FONT[entry + 8..entry + 12];
+                u32::from_be_bytes([b[0], b[1], b[2], b[3]]) as usize
+            })
+        })
+    };
+    let height = || -> Option<f64> {
+        let (hhea, head) = (table(b"hhea")?, table(b"head")?);
+        let ascender = u16_at(hhea + 4)? as i16;
+        let descender = u16_at(hhea + 6)? as i16;
+        let units = u16_at(head + 18)?;
+        Some((f64::from(ascender) - f64::from(descender)) / f64::from(units))
+    };
+    height().filter(|h| *h > 0.0).unwrap_or(1.24)
 }
 
 /// `bytes` in base64 (RFC 4648, with padding).
@@ -1375,6 +1426,20 @@ mod tests {
             assert_eq!(base64(text.as_bytes()), code);
         }
         assert_eq!(base64(&[0xfb, 0xff, 0xbf]), "+/+/");
+    }
+
+    /// DejaVu Sans' metrics (hhea ascender 1901, descender −483, 2048 units per em: the
+    /// font's source, DejaVuSans.sfd); an SVG font size scaled by 1.24 / 1.1640625.
+    #[test]
+    fn svg_font_sizes_are_the_pngs() {
+        assert_eq!(font_height_em(), 2384.0 / 2048.0);
+        // plotters writes 10 for a size of 12.4 (pixels of font height in the PNG): 12.4
+        // pixels of height are 12.4 · 2048/2384 pixels per em.
+        let svg = r#"<text font-size="10" x="1">a</text><text font-size="x">"#;
+        let scaled = rescale_font_sizes(svg);
+        let size: f64 = scaled.split('"').nth(1).unwrap().parse().unwrap();
+        assert!((size - 12.4 * 2048.0 / 2384.0).abs() < 1e-9, "{scaled}");
+        assert!(scaled.ends_with(r#"<text font-size="x">"#));
     }
 
     #[test]
