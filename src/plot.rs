@@ -509,10 +509,9 @@ impl Draw for ChartDrawing<'_> {
         root: &DrawingArea<DB, Shift>,
     ) -> std::result::Result<(), String> {
         let (me, x, y) = (self.chart, self.x, self.y);
-        let font = |size: f64| (FAMILY, size).into_font();
         let mut chart = axes(root, &me.title, x, y)?;
-        draw_axes(&mut chart, (&me.x_label, x), (&me.y_label, y), true)?;
-        let mut labelled = false;
+        draw_axes(root, &mut chart, (&me.x_label, x), (&me.y_label, y), true)?;
+        let mut legend = Vec::new();
         for (k, s) in me.series.iter().enumerate() {
             let colour = me.colour(k);
             for run in finite_runs(&s.band, |b| [b.0, b.1, b.2]) {
@@ -528,75 +527,45 @@ impl Draw for ChartDrawing<'_> {
             let style = colour.stroke_width(2);
             let markers = s.kind == Kind::Markers;
             let dashed = s.style.dashed;
-            let legend = |annotation: &mut plotters::chart::SeriesAnno<'_, DB>| {
-                let entry = annotation.label(s.label.as_str());
-                if markers {
-                    entry.legend(move |(px, py)| Circle::new((px + 11, py), 4, colour.filled()));
+            if !s.label.is_empty() {
+                let glyph = if markers {
+                    Glyph::Marker
                 } else if dashed {
-                    entry.legend(move |(px, py)| {
-                        DashedPathElement::new(
-                            vec![(px, py), (px + 22, py)],
-                            DASH,
-                            GAP,
-                            colour.stroke_width(3),
-                        )
-                    });
+                    Glyph::Dashed
                 } else {
-                    entry.legend(move |(px, py)| {
-                        PathElement::new(vec![(px, py), (px + 22, py)], colour.stroke_width(3))
-                    });
-                }
-            };
+                    Glyph::Line
+                };
+                legend.push((s.label.clone(), glyph, colour));
+            }
             if markers {
                 let points = s
                     .points
                     .iter()
                     .filter(|p| p.0.is_finite() && p.1.is_finite());
-                let annotation = chart
+                chart
                     .draw_series(points.map(|p| Circle::new(*p, 3, colour.filled())))
                     .map_err(|e| e.to_string())?;
-                if !s.label.is_empty() {
-                    legend(annotation);
-                    labelled = true;
-                }
                 continue;
             }
-            for (r, run) in finite_runs(&s.points, |p| [p.0, p.1])
-                .into_iter()
-                .enumerate()
-            {
+            for run in finite_runs(&s.points, |p| [p.0, p.1]) {
                 let line = if s.kind == Kind::Steps {
                     staircase(run)
                 } else {
                     run.to_vec()
                 };
-                let annotation = if dashed {
+                if dashed {
                     chart.draw_series(DashedLineSeries::new(line, DASH, GAP, style))
                 } else {
                     chart.draw_series(LineSeries::new(line, style))
                 }
                 .map_err(|e| e.to_string())?;
-                if r == 0 && !s.label.is_empty() {
-                    legend(annotation);
-                    labelled = true;
-                }
             }
         }
-        if labelled {
-            chart
-                .configure_series_labels()
-                .position(match me.legend {
-                    Corner::UpperLeft => SeriesLabelPosition::UpperLeft,
-                    Corner::UpperRight => SeriesLabelPosition::UpperRight,
-                    Corner::LowerLeft => SeriesLabelPosition::LowerLeft,
-                    Corner::LowerRight => SeriesLabelPosition::LowerRight,
-                })
-                .label_font(font(15.0))
-                .background_style(WHITE.mix(0.85))
-                .border_style(RGBColor(160, 160, 160))
-                .draw()
-                .map_err(|e| e.to_string())?;
-        }
+        draw_legend(
+            &chart.plotting_area().strip_coord_spec(),
+            &legend,
+            me.legend,
+        )?;
         Ok(())
     }
 }
@@ -799,7 +768,7 @@ impl Draw for MapDrawing<'_> {
                 )))
                 .map_err(|e| e.to_string())?;
         }
-        draw_axes(&mut chart, (&me.x_label, x), (&me.y_label, y), false)?;
+        draw_axes(&main, &mut chart, (&me.x_label, x), (&me.y_label, y), false)?;
         // The colour bar: a one-column chart of the colour scale, its values on the right.
         let mut scale = ChartBuilder::on(&bar)
             .margin_top(16 + 30)
@@ -822,13 +791,29 @@ impl Draw for MapDrawing<'_> {
             .configure_mesh()
             .disable_mesh()
             .disable_x_axis()
-            .y_desc(me.colour_label.as_str())
-            .axis_desc_style(font(16.0))
             .label_style(font(14.0))
             .y_labels(8)
             .y_label_formatter(&|v| tick(*v, c))
             .draw()
             .map_err(|e| e.to_string())?;
+        // The colour bar's label right of its values, reading up along the bar (where
+        // plotters puts a right axis' label).
+        if !me.colour_label.is_empty() {
+            let (_, base_y) = bar.get_base_pixel();
+            let (_, rows) = scale.plotting_area().get_pixel_range();
+            let (y0, y1) = (rows.start - base_y, rows.end - base_y);
+            let size = fitting(&bar, &me.colour_label, 16.0, y1 - y0)?;
+            let width = typeset_width(&bar, &me.colour_label, size)?;
+            let (bar_width, _) = bar.dim_in_pixel();
+            let left = bar_width as i32 - 8 - (1.15 * size) as i32;
+            typeset(
+                &bar,
+                &me.colour_label,
+                (left, (y0 + y1 + width) / 2),
+                size,
+                Reading::Up,
+            )?;
+        }
         Ok(())
     }
 }
@@ -847,17 +832,28 @@ fn axes<'a, DB: DrawingBackend>(
     builder.margin(16).margin_top(16 + 34);
     if !title.is_empty() {
         let (width, _) = area.dim_in_pixel();
-        typeset(area, title, width as i32 / 2, 12, 22.0)?;
+        let size = fitting(area, title, 22.0, width as i32 - 16)?;
+        let left = (width as i32 - typeset_width(area, title, size)?) / 2;
+        typeset(area, title, (left, 12), size, Reading::Across)?;
     }
     builder
-        .x_label_area_size(52)
-        .y_label_area_size(72)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(x.0..x.1, y.0..y.1)
         .map_err(|e| e.to_string())
 }
 
+/// The room below the plotting area for the x tick values and label (pixels).
+const X_LABEL_AREA: i32 = 52;
+/// The room left of the plotting area for the y tick values and label (pixels).
+const Y_LABEL_AREA: i32 = 72;
+/// The size of the axis labels' font (pixels).
+const AXIS_LABEL_SIZE: f64 = 18.0;
+
 /// The axes' tick values and labels, with a light grid when `grid` (charts; not on maps).
+/// The labels are typeset on `area`, the area the chart was built on.
 fn draw_axes<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
     chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     (x_label, x): (&str, (f64, f64)),
     (y_label, y): (&str, (f64, f64)),
@@ -873,70 +869,216 @@ fn draw_axes<DB: DrawingBackend>(
     } else {
         mesh.disable_mesh();
     }
-    mesh.x_desc(x_label)
-        .y_desc(y_label)
-        .axis_desc_style(font(18.0))
-        .label_style(font(15.0))
+    mesh.label_style(font(15.0))
         .x_labels(8)
         .y_labels(8)
         .x_label_formatter(&x_ticks)
         .y_label_formatter(&y_ticks)
         .draw()
-        .map_err(|e| e.to_string())
+        .map_err(|e| e.to_string())?;
+    // The labels where plotters puts its own: the x label at the bottom of its room,
+    // centred under the plotting area; the y label at the left edge of its room, reading
+    // up, centred along the plotting area.
+    let (base_x, base_y) = area.get_base_pixel();
+    let (columns, rows) = chart.plotting_area().get_pixel_range();
+    let (x0, x1) = (columns.start - base_x, columns.end - base_x);
+    let (y0, y1) = (rows.start - base_y, rows.end - base_y);
+    if !x_label.is_empty() {
+        let size = fitting(area, x_label, AXIS_LABEL_SIZE, x1 - x0)?;
+        let width = typeset_width(area, x_label, size)?;
+        let top = y1 + X_LABEL_AREA - (1.25 * size) as i32;
+        typeset(
+            area,
+            x_label,
+            ((x0 + x1 - width) / 2, top),
+            size,
+            Reading::Across,
+        )?;
+    }
+    if !y_label.is_empty() {
+        let size = fitting(area, y_label, AXIS_LABEL_SIZE, y1 - y0)?;
+        let width = typeset_width(area, y_label, size)?;
+        let left = (x0 - Y_LABEL_AREA).max(0);
+        typeset(
+            area,
+            y_label,
+            (left, (y0 + y1 + width) / 2),
+            size,
+            Reading::Up,
+        )?;
+    }
+    Ok(())
+}
+
+/// How a legend entry shows its series.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Glyph {
+    Line,
+    Dashed,
+    Marker,
+}
+
+/// Draws a legend of `entries` (label, glyph, colour) in `corner` of `area` (a chart's
+/// plotting area): a framed, almost opaque box as plotters draws its own, with the labels
+/// typeset (plotters' legend draws them as plain text).
+fn draw_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[(String, Glyph, RGBColor)],
+    corner: Corner,
+) -> std::result::Result<(), String> {
+    const SIZE: f64 = 15.0;
+    const MARGIN: i32 = 10;
+    const GLYPH_ROOM: i32 = 30;
+    // A row holds a letter and its lowered subscript.
+    let row = (1.5 * SIZE) as i32;
+    if entries.is_empty() {
+        return Ok(());
+    }
+    let mut widest = 0;
+    for (label, _, _) in entries {
+        widest = widest.max(typeset_width(area, label, SIZE)?);
+    }
+    let width = widest + GLYPH_ROOM + 2 * MARGIN;
+    let height = entries.len() as i32 * row + 2 * MARGIN;
+    let (area_width, area_height) = area.dim_in_pixel();
+    let left = match corner {
+        Corner::UpperLeft | Corner::LowerLeft => 5,
+        Corner::UpperRight | Corner::LowerRight => area_width as i32 - width - 5,
+    };
+    let top = match corner {
+        Corner::UpperLeft | Corner::UpperRight => 5,
+        Corner::LowerLeft | Corner::LowerRight => area_height as i32 - height - 5,
+    };
+    let frame = [(left, top), (left + width, top + height)];
+    area.draw(&Rectangle::new(frame, WHITE.mix(0.85).filled()))
+        .map_err(|e| e.to_string())?;
+    area.draw(&Rectangle::new(frame, RGBColor(160, 160, 160)))
+        .map_err(|e| e.to_string())?;
+    let (_, letter) = area
+        .estimate_text_size("0", &piece_font(SIZE, false, Reading::Across))
+        .map_err(|e| e.to_string())?;
+    for (k, (label, glyph, colour)) in entries.iter().enumerate() {
+        let (x, y) = (left + MARGIN, top + MARGIN + k as i32 * row + row / 2);
+        let drawn = match glyph {
+            Glyph::Marker => area.draw(&Circle::new((x + 11, y), 4, colour.filled())),
+            Glyph::Dashed => area.draw(&DashedPathElement::new(
+                vec![(x, y), (x + 22, y)],
+                DASH,
+                GAP,
+                colour.stroke_width(3),
+            )),
+            Glyph::Line => area.draw(&PathElement::new(
+                vec![(x, y), (x + 22, y)],
+                colour.stroke_width(3),
+            )),
+        };
+        drawn.map_err(|e| e.to_string())?;
+        let start = (x + GLYPH_ROOM, y - letter as i32 / 2);
+        typeset(area, label, start, SIZE, Reading::Across)?;
+    }
+    Ok(())
 }
 
 /// The largest picture side (pixels): a PNG is drawn in memory first, 3 bytes a pixel.
 pub(crate) const LARGEST_SIDE: u32 = 16384;
 
-/// Draws in memory through the backend that `path`'s extension names, then writes the
-/// file atomically (temporary file and rename, as checkpoints): a full disk or a kill
-/// never leaves a half or empty figure under its name.
-/// Draws `text` centred on `centre` (pixels), its top at `top`, with `X_Y` (one
-/// character) and `X_{...}` typeset as subscripts (`F_N`, `A_R`, `τ_C`): smaller, lowered.
+/// Which way a typeset text reads: across (left to right) or up (bottom to top, turned a
+/// quarter turn anticlockwise: a y axis or a colour bar label).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Reading {
+    Across,
+    Up,
+}
+
+/// The font of a typeset piece: a subscript is 0.7 times the size.
+fn piece_font(size: f64, sub: bool, reading: Reading) -> TextStyle<'static> {
+    let font = (FAMILY, if sub { 0.7 * size } else { size }).into_font();
+    let font = match reading {
+        Reading::Across => font,
+        Reading::Up => font.transform(FontTransform::Rotate270),
+    };
+    font.color(&BLACK)
+}
+
+/// The pieces of `text` (see [`subscripts`]) with their widths (pixels) at `size`.
+fn measure<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    text: &str,
+    size: f64,
+) -> std::result::Result<Vec<(String, bool, i32)>, String> {
+    subscripts(text)
+        .into_iter()
+        .map(|(piece, sub)| {
+            let (width, _) = area
+                .estimate_text_size(&piece, &piece_font(size, sub, Reading::Across))
+                .map_err(|e| e.to_string())?;
+            Ok((piece, sub, width as i32))
+        })
+        .collect()
+}
+
+/// The size at which `text` fits in `room` pixels: `size`, or smaller for a text wider than
+/// its room (a text running off the picture's edge would be shifted by the backend and
+/// overlap its subscripts).
+fn fitting<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    text: &str,
+    size: f64,
+    room: i32,
+) -> std::result::Result<f64, String> {
+    let natural: i32 = measure(area, text, size)?.iter().map(|p| p.2).sum();
+    let room = room.max(1) as f64;
+    Ok(if natural as f64 > room {
+        size * room / natural as f64
+    } else {
+        size
+    })
+}
+
+/// The width (pixels) of `text` typeset at `size`.
+fn typeset_width<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    text: &str,
+    size: f64,
+) -> std::result::Result<i32, String> {
+    Ok(measure(area, text, size)?.iter().map(|p| p.2).sum())
+}
+
+/// Draws `text` at `size` with `X_Y` (one character) and `X_{...}` typeset as subscripts
+/// (`F_N`, `A_R`, `τ_C`): smaller, lowered. `start` (pixels in `area`) is the top left
+/// corner of the first letter as the text is read (for [`Reading::Up`] the text's top
+/// points left: `start` is its left bottom corner on the picture). Every text of a figure
+/// goes through here (titles, axis and colour-bar labels, legends) except tick values.
 fn typeset<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     text: &str,
-    centre: i32,
-    top: i32,
+    start: (i32, i32),
     size: f64,
+    reading: Reading,
 ) -> std::result::Result<(), String> {
-    let pieces = subscripts(text);
-    let font = |size: f64, sub: bool| {
-        (FAMILY, if sub { 0.7 * size } else { size })
-            .into_font()
-            .color(&BLACK)
-    };
-    let widths = |size: f64| {
-        pieces
-            .iter()
-            .map(|(piece, sub)| {
-                area.estimate_text_size(piece, &font(size, *sub))
-                    .map(|(w, _)| w as i32)
-                    .map_err(|e| e.to_string())
-            })
-            .collect::<std::result::Result<Vec<i32>, String>>()
-    };
-    // A title wider than its area is set smaller (a text running off the left edge would
-    // be shifted by the backend and overlap its subscripts).
-    let room = (2 * centre - 16).max(1) as f64;
-    let natural = widths(size)?.iter().sum::<i32>() as f64;
-    let size = if natural > room {
-        size * room / natural
-    } else {
-        size
-    };
-    let font = |sub: bool| font(size, sub);
-    let widths = widths(size)?;
-    let mut x = centre - widths.iter().sum::<i32>() / 2;
-    for ((piece, sub), width) in pieces.iter().zip(widths) {
-        let y = if *sub {
-            top + (0.45 * size) as i32
+    let mut along = 0;
+    for (piece, sub, width) in measure(area, text, size)? {
+        // A piece's leading spaces as an advance: an SVG viewer drops them from a text.
+        let body = piece.trim_start();
+        let font = piece_font(size, sub, reading);
+        let body_width = if body.is_empty() {
+            0
         } else {
-            top
+            area.estimate_text_size(body, &piece_font(size, sub, Reading::Across))
+                .map_err(|e| e.to_string())?
+                .0 as i32
         };
-        area.draw(&Text::new(piece.clone(), (x, y), font(*sub)))
-            .map_err(|e| e.to_string())?;
-        x += width;
+        let lead = (width - body_width).max(0);
+        let lowered = if sub { (0.45 * size) as i32 } else { 0 };
+        let at = match reading {
+            Reading::Across => (start.0 + along + lead, start.1 + lowered),
+            Reading::Up => (start.0 + lowered, start.1 - along - lead),
+        };
+        if !body.is_empty() {
+            area.draw(&Text::new(body.to_string(), at, font))
+                .map_err(|e| e.to_string())?;
+        }
+        along += width;
     }
     Ok(())
 }
@@ -997,6 +1139,9 @@ fn check_size(path: &Path, size: (u32, u32)) -> Result<()> {
     Ok(())
 }
 
+/// Draws in memory through the backend that `path`'s extension names, then writes the
+/// file atomically (temporary file and rename, as checkpoints): a full disk or a kill
+/// never leaves a half or empty figure under its name.
 fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
     register_font()?;
     let fail = |reason: String| PlotError::Figure {
@@ -1025,7 +1170,7 @@ fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
                 figure,
             )
             .map_err(fail)?;
-            text.into_bytes()
+            embed_font(&text).into_bytes()
         }
         _ => {
             return Err(fail(
@@ -1038,6 +1183,112 @@ fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
         &bytes,
         "writing figure",
     )?)
+}
+
+/// The family name of the font an SVG carries: a name no system font has, so that a viewer
+/// uses the embedded one (system DejaVu Sans, then any sans-serif, where a viewer reads no
+/// CSS fonts).
+const SVG_FAMILY: &str = "precursors-DejaVuSans";
+
+/// `svg` (as plotters writes it) carrying the embedded font: an `@font-face` with the TTF
+/// as base64 in a `<style>` (about 68 kB), its family set on every text (a CSS rule, which
+/// overrides plotters' `font-family` attribute), so that the text looks as in the PNG in
+/// any browser. The positions of the typeset pieces are computed with this font's widths.
+fn embed_font(svg: &str) -> String {
+    static STYLE: OnceLock<String> = OnceLock::new();
+    let style = STYLE.get_or_init(|| {
+        format!(
+            "<style>@font-face{{font-family:\"{SVG_FAMILY}\";\
+             src:url(data:font/ttf;base64,{})format(\"truetype\");}}\
+             text{{font-family:\"{SVG_FAMILY}\",\"DejaVu Sans\",sans-serif;}}</style>\n",
+            base64(FONT)
+        )
+    });
+    let svg = svg.replace(
+        &format!("font-family=\"{FAMILY}\""),
+        "font-family=\"DejaVu Sans, sans-serif\"",
+    );
+    let svg = rescale_font_sizes(&svg);
+    // After the opening <svg ...> tag.
+    match svg
+        .find("<svg")
+        .and_then(|start| svg[start..].find('>').map(|end| start + end + 1))
+    {
+        Some(at) => format!("{}\n{style}{}", &svg[..at], &svg[at..]),
+        None => svg,
+    }
+}
+
+/// `svg` with every `font-size` set as the PNG draws it. plotters writes `size / 1.24` em,
+/// but draws a PNG's text with the font's height (ascender − descender, 1.164 em for
+/// DejaVu Sans) scaled to `size` pixels: unscaled, the SVG's text is 6 % smaller than the
+/// PNG's and the typeset pieces, placed by the PNG's widths, drift apart.
+fn rescale_font_sizes(svg: &str) -> String {
+    const ATTRIBUTE: &str = "font-size=\"";
+    let factor = 1.24 / font_height_em();
+    let mut out = String::with_capacity(svg.len());
+    let mut rest = svg;
+    while let Some(at) = rest.find(ATTRIBUTE) {
+        let (head, tail) = rest.split_at(at + ATTRIBUTE.len());
+        out.push_str(head);
+        let end = tail.find('"').unwrap_or(tail.len());
+        match tail[..end].parse::<f64>() {
+            Ok(size) => out.push_str(&format!("{}", size * factor)),
+            Err(_) => out.push_str(&tail[..end]),
+        }
+        rest = &tail[end..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// The embedded font's height (hhea ascender − descender) in em, as its renderer (ab_glyph)
+/// scales it; 1.24 (plotters' own assumption) if the tables cannot be read.
+fn font_height_em() -> f64 {
+    let u16_at = |at: usize| {
+        FONT.get(at..at + 2)
+            .map(|b| u16::from_be_bytes([b[0], b[1]]))
+    };
+    let table = |tag: &[u8; 4]| -> Option<usize> {
+        let tables = usize::from(u16_at(4)?);
+        (0..tables).find_map(|k| {
+            let entry = 12 + 16 * k;
+            (FONT.get(entry..entry + 4)? == tag).then(|| {
+                let b = &FONT[entry + 8..entry + 12];
+                u32::from_be_bytes([b[0], b[1], b[2], b[3]]) as usize
+            })
+        })
+    };
+    let height = || -> Option<f64> {
+        let (hhea, head) = (table(b"hhea")?, table(b"head")?);
+        let ascender = u16_at(hhea + 4)? as i16;
+        let descender = u16_at(hhea + 6)? as i16;
+        let units = u16_at(head + 18)?;
+        Some((f64::from(ascender) - f64::from(descender)) / f64::from(units))
+    };
+    height().filter(|h| *h > 0.0).unwrap_or(1.24)
+}
+
+/// `bytes` in base64 (RFC 4648, with padding).
+fn base64(bytes: &[u8]) -> String {
+    const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for chunk in bytes.chunks(3) {
+        let b = [
+            chunk[0],
+            *chunk.get(1).unwrap_or(&0),
+            *chunk.get(2).unwrap_or(&0),
+        ];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for k in 0..4 {
+            if k <= chunk.len() {
+                out.push(ALPHABET[((n >> (18 - 6 * k)) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
 }
 
 /// 8-bit RGB `pixels` (rows from the top) as a PNG file's bytes.
@@ -1159,6 +1410,37 @@ fn staircase(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// RFC 4648's test vectors (section 10).
+    #[test]
+    fn base64_is_rfc_4648() {
+        for (text, code) in [
+            ("", ""),
+            ("f", "Zg=="),
+            ("fo", "Zm8="),
+            ("foo", "Zm9v"),
+            ("foob", "Zm9vYg=="),
+            ("fooba", "Zm9vYmE="),
+            ("foobar", "Zm9vYmFy"),
+        ] {
+            assert_eq!(base64(text.as_bytes()), code);
+        }
+        assert_eq!(base64(&[0xfb, 0xff, 0xbf]), "+/+/");
+    }
+
+    /// DejaVu Sans' metrics (hhea ascender 1901, descender −483, 2048 units per em: the
+    /// font's source, DejaVuSans.sfd); an SVG font size scaled by 1.24 / 1.1640625.
+    #[test]
+    fn svg_font_sizes_are_the_pngs() {
+        assert_eq!(font_height_em(), 2384.0 / 2048.0);
+        // plotters writes 10 for a size of 12.4 (pixels of font height in the PNG): 12.4
+        // pixels of height are 12.4 · 2048/2384 pixels per em.
+        let svg = r#"<text font-size="10" x="1">a</text><text font-size="x">"#;
+        let scaled = rescale_font_sizes(svg);
+        let size: f64 = scaled.split('"').nth(1).unwrap().parse().unwrap();
+        assert!((size - 12.4 * 2048.0 / 2384.0).abs() < 1e-9, "{scaled}");
+        assert!(scaled.ends_with(r#"<text font-size="x">"#));
+    }
 
     #[test]
     fn subscripts_are_cut_where_the_underscores_say() {

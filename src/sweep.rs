@@ -29,7 +29,7 @@ mod merge;
 
 pub use error::SweepError;
 #[cfg(feature = "plot")]
-pub(crate) use merge::ensemble_curves;
+pub(crate) use merge::{ensemble_curves, MEDIAN_BAND_RUNS};
 pub use merge::{merge, MergeSummary, LOAD_GRID};
 
 /// The results of this module: its errors are [`SweepError`]s.

@@ -329,7 +329,10 @@ fn a_coulomb_movie_is_red_where_tau_c_is_positive_and_frames_are_titled() {
     // The title typeset: `F_N` as F with the subscript N.
     let title = ["F/(μF", "N", ") = 0.700, ℓ/Lx = 0.300  (event 15)"];
     assert!(texts.windows(3).any(|w| w == title), "{texts:?}");
-    assert!(texts.contains(&"τ_C = |τ| − μ|σ| (MPa)"), "{texts:?}");
+    // The colour bar's label typeset too, and no `_` left in any text.
+    let colour = ["τ", "C", "= |τ| − μ|σ| (MPa)"];
+    assert!(texts.windows(3).any(|w| w == colour), "{texts:?}");
+    assert!(texts.iter().all(|t| !t.contains('_')), "{texts:?}");
     let e = Movie::new(&dir, MovieKind::CoulombStress)
         .save_frame(5, &svg)
         .unwrap_err();

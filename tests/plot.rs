@@ -215,12 +215,17 @@ fn a_chart_draws_its_series_and_its_text() {
         .skip(1)
         .filter_map(|t| Some(t.split_once('>')?.1.split_once("</text>")?.0.trim()))
         .collect();
-    for label in ["A title", "F/(μF_N)", "ℓ/Lx", "first", "second", "0.4"] {
+    for label in ["A title", "ℓ/Lx", "first", "second", "0.4"] {
         assert!(
             texts.contains(&label),
             "{label} not in the SVG's text: {texts:?}"
         );
     }
+    // The x label typeset: `F_N` as F with the subscript N.
+    assert!(
+        texts.windows(3).any(|w| w == ["F/(μF", "N", ")"]),
+        "{texts:?}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -415,6 +420,135 @@ fn svg_texts(path: &Path) -> Vec<(String, String)> {
         .collect()
 }
 
+/// Whether `pieces` (text, is a subscript) follow each other among `texts`, each
+/// subscript in a smaller font than the piece before it, all turned to read up
+/// (`rotate(270`) when `up`, none turned otherwise. A piece ending in `…` matches a text
+/// that starts with the rest.
+fn typeset_in(texts: &[(String, String)], pieces: &[(&str, bool)], up: bool) -> bool {
+    let size = |attributes: &str| -> f64 {
+        let tail = attributes.split_once("font-size=\"").unwrap().1;
+        tail.split_once('"').unwrap().0.parse().unwrap()
+    };
+    texts.windows(pieces.len()).any(|w| {
+        w.iter()
+            .zip(pieces)
+            .all(|((_, t), (p, _))| match p.strip_suffix('…') {
+                Some(start) => t.starts_with(start),
+                None => t == p,
+            })
+            && w.iter().all(|(a, _)| a.contains("rotate(270") == up)
+            && (1..w.len()).all(|k| !pieces[k].1 || size(&w[k].0) < size(&w[k - 1].0))
+    })
+}
+
+/// Every text of a run's three figures and of a movie frame is typeset: no `_` of the
+/// subscript notation is left in any text, and the labels with subscripts are there as
+/// pieces, the subscripts smaller: the x axis (`F/(μF_N)`), the y axis of the area chart
+/// and the colour bar of the contact map (reading up), the legends.
+#[test]
+fn labels_colour_bars_and_legends_are_typeset() {
+    let dir = scratch("typeset");
+    let mut driver = scene().driver().unwrap();
+    RunTables::create(&dir, &driver)
+        .unwrap()
+        .run_to_slip(&mut driver, None, |_, _| {})
+        .unwrap();
+    let drawn = draw(&dir, &[Format::Svg]).unwrap();
+    assert_eq!(drawn.files.len(), 3);
+    for file in &drawn.files {
+        for (_, text) in svg_texts(file) {
+            assert!(!text.contains('_'), "{}: {text:?}", file.display());
+        }
+    }
+    let texts = |name: &str| svg_texts(&dir.join(name));
+    let force = [("F/(μF", false), ("N", true), (")", false)];
+    for name in ["precursor_length.svg", "contact_area.svg"] {
+        assert!(typeset_in(&texts(name), &force, false), "{name}");
+    }
+    // The contact map's load axis reads up.
+    assert!(typeset_in(&texts("contact_map.svg"), &force, true));
+    let ratio = [("A", false), ("R", true), ("/A", false), ("R", true)];
+    let area = texts("contact_area.svg");
+    assert!(typeset_in(
+        &area,
+        &[ratio.as_slice(), &[("(0)", false)]].concat(),
+        true
+    ));
+    let legend = [ratio.as_slice(), &[("(0) at the stable states…", false)]].concat();
+    assert!(typeset_in(&area, &legend, false), "{area:?}");
+    let colour_bar = [
+        ("A", false),
+        ("R", true),
+        ("(x, F)/A", false),
+        ("R", true),
+        ("(x, 0)", false),
+    ];
+    assert!(typeset_in(&texts("contact_map.svg"), &colour_bar, true));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// An SVG figure carries the embedded font (docs/cli.md, "Figures"): an `@font-face` whose
+/// data, decoded here, is the font file in assets/fonts, and a rule setting its family on
+/// every text.
+#[test]
+fn an_svg_carries_the_embedded_font() {
+    let dir = scratch("svg-font");
+    let line = [(0.0, 0.0), (1.0, 1.0)];
+    let path = dir.join("chart.svg");
+    Chart::new("T", "x", "y")
+        .line("a", &line)
+        .save(&path)
+        .unwrap();
+    let svg = std::fs::read_to_string(&path).unwrap();
+    let face = svg.split_once("@font-face{").unwrap().1;
+    assert!(
+        face.starts_with("font-family:\"precursors-DejaVuSans\""),
+        "{face:.80}"
+    );
+    let data = face
+        .split_once("base64,")
+        .unwrap()
+        .1
+        .split_once(')')
+        .unwrap()
+        .0;
+    let alphabet = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let (mut bytes, mut bits, mut held) = (Vec::new(), 0u32, 0u32);
+    for c in data.bytes().filter(|&c| c != b'=') {
+        let v = alphabet.iter().position(|&a| a == c).unwrap() as u32;
+        held = (held << 6) | v;
+        bits += 6;
+        if bits >= 8 {
+            bits -= 8;
+            bytes.push((held >> bits) as u8);
+            held &= (1 << bits) - 1;
+        }
+    }
+    let font = std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/assets/fonts/DejaVuSans-subset.ttf"
+    ))
+    .unwrap();
+    assert!(
+        bytes == font,
+        "{} bytes decoded, {} in the font",
+        bytes.len(),
+        font.len()
+    );
+    assert!(svg.contains("text{font-family:\"precursors-DejaVuSans\",\"DejaVu Sans\",sans-serif;}"));
+    assert!(svg.contains("font-family=\"DejaVu Sans, sans-serif\""));
+    // The size docs/cli.md gives: 68.6 kB added.
+    let style = svg
+        .split_once("<style>")
+        .unwrap()
+        .1
+        .split_once("</style>")
+        .unwrap()
+        .0;
+    assert_eq!((style.len() + 15) / 100, 686, "{}", style.len());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn run_figures_say_the_scene_mark_global_slip_and_reach_one_on_the_load_axis() {
     let dir = scratch("scene-title");
@@ -436,25 +570,31 @@ fn run_figures_say_the_scene_mark_global_slip_and_reach_one_on_the_load_axis() {
     };
     // The title names the scene of `scene()` (40 x 5 x 20 mm, 700 N, rod at 4 mm, seed 3),
     // not the directory; `F_N` typeset: `N` a text of its own, smaller.
-    let title: String = texts("precursor_length.svg")
+    let title: Vec<String> = texts("precursor_length.svg")
         .iter()
         .take(3)
-        .map(|(_, t)| t.as_str())
+        .map(|(_, t)| t.clone())
         .collect();
     assert_eq!(
         title,
-        "Precursor length: 40 x 5 x 20 mm, FN = 700 N, rod at h = 4 mm, seed 3"
+        [
+            "Precursor length: 40 x 5 x 20 mm, F",
+            "N",
+            "= 700 N, rod at h = 4 mm, seed 3"
+        ]
     );
     // Global slip: the load of events.csv's last row over μF_N (μ = 0.5, F_N = 700 N).
     let events = std::fs::read_to_string(dir.join("events.csv")).unwrap();
     let last: Vec<&str> = events.lines().last().unwrap().split(',').collect();
     assert_eq!(last[1], "global_slip");
     let slip = last[4].parse::<f64>().unwrap() / (0.5 * 700.0);
-    let legend = format!("global slip at F/(μF_N) = {slip:.3}");
+    let legend = [
+        ("global slip at F/(μF", false),
+        ("N", true),
+        (&format!(") = {slip:.3}"), false),
+    ];
     assert!(
-        texts("precursor_length.svg")
-            .iter()
-            .any(|(_, t)| *t == legend),
+        typeset_in(&texts("precursor_length.svg"), &legend, false),
         "no legend {legend:?}"
     );
     // The contact map's load axis has a tick at 1.0 although its last row lies below.

@@ -605,14 +605,20 @@ mod cli {
         ] {
             assert!(out.join(name).is_file(), "{name}");
         }
-        // One curve per point, named by the axes' values in the user's units and its runs.
+        // One curve per point, named by the axes' values in the user's units and its runs
+        // (`F_N` typeset: F, then N as a text of its own).
         let svg = std::fs::read_to_string(out.join("precursor_length.svg")).unwrap();
         for label in [
-            "F_N = 400 N, h = 4 mm (2 runs)",
-            "F_N = 600 N, h = 8 mm (2 runs)",
+            ">\n= 400 N, h = 4 mm (2 runs)",
+            ">\n= 600 N, h = 8 mm (2 runs)",
         ] {
+            assert!(svg.contains(">\nN\n</text>"), "{label}");
             assert!(svg.contains(label), "{label}");
         }
+        assert!(!svg.contains("F_N"));
+        // The area figure: the median without an interval (2 runs are too few), said.
+        let svg = std::fs::read_to_string(out.join("contact_area.svg")).unwrap();
+        assert!(svg.contains("(2 runs), no interval below 6 runs"));
         // A run of the sweep is a run directory: its three figures.
         let run = out.join("p0000-r0000");
         let o = precursors(&["plot", path(&run)]);

@@ -1030,10 +1030,17 @@ fn merge_files(py: Python<'_>, dir: PathBuf) -> PyResult<Vec<PathBuf>> {
 }
 
 /// Draws the figures of a run or sweep directory into it (`precursors plot`); `formats`
-/// of `"png"`, `"svg"`. Returns the paths of the figures.
+/// of `"png"`, `"svg"`; `width` x `height` pixels (200 to 16384 each, as `--width` and
+/// `--height`). Returns the paths of the figures.
 #[pyfunction]
-#[pyo3(signature = (dir, *, formats=vec!["png".to_string()]))]
-fn plot(py: Python<'_>, dir: PathBuf, formats: Vec<String>) -> PyResult<Vec<PathBuf>> {
+#[pyo3(signature = (dir, *, formats=vec!["png".to_string()], width=800, height=560))]
+fn plot(
+    py: Python<'_>,
+    dir: PathBuf,
+    formats: Vec<String>,
+    width: u32,
+    height: u32,
+) -> PyResult<Vec<PathBuf>> {
     let formats = formats
         .iter()
         .map(|f| match f.as_str() {
@@ -1045,9 +1052,72 @@ fn plot(py: Python<'_>, dir: PathBuf, formats: Vec<String>) -> PyResult<Vec<Path
         })
         .collect::<PyResult<Vec<_>>>()?;
     let drawn = py
-        .detach(|| precursors::plot::draw(&dir, &formats))
+        .detach(|| precursors::plot::draw_with_size(&dir, &formats, (width, height)))
         .or_raise()?;
     Ok(drawn.files)
+}
+
+/// The paper's movies of a run directory with recorded fields (`precursors movie`):
+/// `field` `"contact-area"` (Movie S1, `DIR/contact_area.gif`), `"coulomb-stress"`
+/// (Movie S2, `DIR/coulomb_stress.gif`) or `"all"` (both; S2 left out, without an error,
+/// when no planes were recorded); every `every`-th recorded state and the last, at most
+/// `max_frames` frames, `width` x `height` pixels, `frame_duration` seconds per frame;
+/// `out` names the file of a single movie. Returns the paths of the movies written.
+#[pyfunction]
+#[pyo3(signature = (dir, *, field="all", every=1, max_frames=200, width=900, height=560,
+                    frame_duration=0.1, out=None))]
+#[allow(clippy::too_many_arguments)]
+fn movie(
+    py: Python<'_>,
+    dir: PathBuf,
+    field: &str,
+    every: usize,
+    max_frames: usize,
+    width: u32,
+    height: u32,
+    frame_duration: f64,
+    out: Option<PathBuf>,
+) -> PyResult<Vec<PathBuf>> {
+    use precursors::plot::{Movie, MovieKind, PlotError};
+    let all = [
+        (MovieKind::ContactArea, "contact_area.gif"),
+        (MovieKind::CoulombStress, "coulomb_stress.gif"),
+    ];
+    let kinds = match field {
+        "contact-area" => &all[..1],
+        "coulomb-stress" => &all[1..],
+        "all" => &all[..],
+        other => {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "field {other:?} is not one of \"contact-area\", \"coulomb-stress\", \"all\""
+            )))
+        }
+    };
+    if out.is_some() && kinds.len() > 1 {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "out names one movie: give field=\"contact-area\" or field=\"coulomb-stress\"",
+        ));
+    }
+    let mut written = Vec::new();
+    for &(kind, name) in kinds {
+        let path = out.clone().unwrap_or_else(|| dir.join(name));
+        let outcome = py.detach(|| {
+            Movie::new(&dir, kind)
+                .every(every)?
+                .max_frames(max_frames)?
+                .size(width, height)
+                .frame_duration(frame_duration)?
+                .save(&path)
+        });
+        match outcome {
+            Ok(_) => written.push(path),
+            // As the program: "all" skips Movie S2 of a run that recorded no planes.
+            Err(PlotError::NoFields { .. })
+                if field == "all" && kind == MovieKind::CoulombStress => {}
+            Err(e) => return Err::<Vec<PathBuf>, _>(e).or_raise(),
+        }
+    }
+    Ok(written)
 }
 
 /// The native module; `precursors/__init__.py` re-exports it.
@@ -1063,6 +1133,7 @@ fn _precursors(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(merge_files, m)?)?;
     m.add_function(wrap_pyfunction!(plot, m)?)?;
+    m.add_function(wrap_pyfunction!(movie, m)?)?;
     m.add("ATTACHED", 0u8)?;
     m.add("DETACHED", 1u8)?;
     m.add("BROKEN", 2u8)?;

@@ -212,10 +212,10 @@ fn read_run(dir: &Path, run: &SweepRun) -> Result<RunData> {
     })
 }
 
-/// The mean and 95 % band `(mean, lo, hi)` of ℓ/Lx and of `A_R/A_R(0)` over the runs of
-/// `data` at the load `f = F/(μF_N)`, each run at its last stable state at or below `f`
-/// (a run with none yet is left out), and the number of runs counted.
-fn bands_at(data: &[RunData], f: f64) -> (usize, (f64, f64, f64), (f64, f64, f64)) {
+/// The values of ℓ/Lx and of `A_R/A_R(0)` of the runs of `data` at the load
+/// `f = F/(μF_N)`, each run at its last stable state at or below `f` (a run with none yet
+/// is left out).
+fn values_at(data: &[RunData], f: f64) -> (Vec<f64>, Vec<f64>) {
     let mut ell = Vec::new();
     let mut area = Vec::new();
     for d in data {
@@ -225,7 +225,58 @@ fn bands_at(data: &[RunData], f: f64) -> (usize, (f64, f64, f64), (f64, f64, f64
             area.push(c.2 / a0);
         }
     }
+    (ell, area)
+}
+
+/// The mean and 95 % band `(mean, lo, hi)` of ℓ/Lx and of `A_R/A_R(0)` over the runs of
+/// `data` at the load `f = F/(μF_N)` ([`values_at`]), and the number of runs counted.
+fn bands_at(data: &[RunData], f: f64) -> (usize, (f64, f64, f64), (f64, f64, f64)) {
+    let (ell, area) = values_at(data, f);
     (ell.len(), band(&ell), band(&area))
+}
+
+/// The fewest values whose median has a distribution-free 95 % interval (below six, even
+/// the smallest and largest value cover the median with less than 95 %).
+#[cfg(feature = "plot")]
+pub(crate) const MEDIAN_BAND_RUNS: usize = 6;
+
+/// The median of `x` and its distribution-free 95 % confidence interval `(median, lo,
+/// hi)`: the order statistics `x_(j)` and `x_(n+1-j)` (1-based, sorted), `j` the largest
+/// with `2·P(B ≤ j−1) ≤ 0.05` for `B` binomial(n, ½), so that the interval covers the
+/// median of the distribution with at least 95 % whatever its shape (no normality
+/// assumed: a few realizations many times the others move neither end). The interval is
+/// `NaN` below [`MEDIAN_BAND_RUNS`] values, everything `NaN` for none or for a value that
+/// is not finite.
+#[cfg(feature = "plot")]
+fn median_band(x: &[f64]) -> (f64, f64, f64) {
+    let n = x.len();
+    if n == 0 || x.iter().any(|v| !v.is_finite()) {
+        return (f64::NAN, f64::NAN, f64::NAN);
+    }
+    let mut sorted = x.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let median = if n % 2 == 1 {
+        sorted[n / 2]
+    } else {
+        0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+    };
+    // The binomial(n, ½) tail P(B ≤ k), its terms in logarithms (2^-n underflows for
+    // large n).
+    let mut log_term = -(n as f64) * std::f64::consts::LN_2;
+    let mut tail = log_term.exp();
+    let mut j = 0;
+    for k in 1..=n / 2 {
+        if 2.0 * tail > 0.05 {
+            break;
+        }
+        j = k;
+        log_term += ((n - k + 1) as f64 / k as f64).ln();
+        tail += log_term.exp();
+    }
+    if j == 0 {
+        return (median, f64::NAN, f64::NAN);
+    }
+    (median, sorted[j - 1], sorted[n - j])
 }
 
 /// The ensemble curves of one parameter point (what `plot::figures` draws).
@@ -237,7 +288,10 @@ pub(crate) struct EnsembleCurves {
     pub runs: usize,
     /// `(F/(μF_N), mean, lo, hi)` of ℓ/Lx on the load grid.
     pub precursor: Vec<(f64, f64, f64, f64)>,
-    /// The same for `A_R/A_R(0)`.
+    /// `(F/(μF_N), median, lo, hi)` of `A_R/A_R(0)`: its median and the median's
+    /// distribution-free 95 % interval ([`median_band`]; the area law spreads the
+    /// realizations over orders of magnitude near slip, where a t-band of the mean spans
+    /// the whole chart).
     pub area: Vec<(f64, f64, f64, f64)>,
 }
 
@@ -262,7 +316,8 @@ pub(crate) fn ensemble_curves(dir: &Path, grid: &[f64]) -> Result<Vec<EnsembleCu
         }
         let (mut precursor, mut area) = (Vec::new(), Vec::new());
         for &f in grid {
-            let (_, e, a) = bands_at(&data, f);
+            let (ell, area_ratio) = values_at(&data, f);
+            let (e, a) = (band(&ell), median_band(&area_ratio));
             precursor.push((f, e.0, e.1, e.2));
             area.push((f, a.0, a.1, a.2));
         }
@@ -487,6 +542,48 @@ impl Tables {
 #[cfg(test)]
 mod tests {
     use super::t_quantile_975;
+
+    /// The interval's ends against the binomial(n, ½) table (e.g. Conover, Practical
+    /// Nonparametric Statistics, table A3): n = 20: P(B ≤ 5) = 0.0207, P(B ≤ 6) = 0.0577,
+    /// so j = 6, the 6th and 15th values; n = 6: 2·(1/64) = 0.031: the smallest and the
+    /// largest; n = 5: 2·(1/32) = 0.0625 > 0.05: none. Two realizations a thousand times
+    /// the others (the area law near slip) move neither end: the mean's t-band of these
+    /// values spans 0 to above 200.
+    #[cfg(feature = "plot")]
+    #[test]
+    fn the_medians_interval_is_set_by_order_statistics() {
+        use super::median_band;
+        let value = |k: usize| 1.0 + 0.01 * k as f64;
+        let mut x: Vec<f64> = (1..=18).map(value).collect();
+        x.extend([1000.0, 2000.0]);
+        x.reverse();
+        let (median, lo, hi) = median_band(&x);
+        assert_eq!(
+            (median, lo, hi),
+            (0.5 * (value(10) + value(11)), value(6), value(15))
+        );
+        let (mean, t_lo, t_hi) = super::band(&x);
+        assert!(
+            mean > 100.0 && t_lo < 0.0 && t_hi > 200.0,
+            "{mean} {t_lo} {t_hi}"
+        );
+        assert_eq!(
+            median_band(&[6.0, 1.0, 5.0, 2.0, 4.0, 3.0]),
+            (3.5, 1.0, 6.0)
+        );
+        let (median, lo, hi) = median_band(&[5.0, 1.0, 4.0, 2.0, 3.0]);
+        assert_eq!(median, 3.0);
+        assert!(lo.is_nan() && hi.is_nan());
+        assert!(median_band(&[]).0.is_nan());
+        assert!(median_band(&[1.0, f64::NAN]).0.is_nan());
+        // Large n: no underflow; the ends near n/2 ∓ 1.96·√n/2 (normal approximation).
+        let x: Vec<f64> = (0..4000).map(|k| k as f64).collect();
+        let (_, lo, hi) = median_band(&x);
+        assert!(
+            (lo - (2000.0 - 62.0)).abs() <= 2.0 && (hi - (2000.0 + 61.0)).abs() <= 2.0,
+            "{lo} {hi}"
+        );
+    }
 
     /// Against the table of Student's t (two-sided 95 %; e.g. NIST/SEMATECH e-Handbook,
     /// table 1.3.6.7.2) and the normal quantile 1.95996 for large samples.
