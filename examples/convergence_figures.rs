@@ -213,6 +213,9 @@ fn overlapping_loads(a: &[(f64, f64, f64)], b: &[(f64, f64, f64)]) -> (usize, us
     (overlap, shared)
 }
 
+/// `(mean, lo, hi)`: an ensemble mean and its 95 % band.
+type Band = (f64, f64, f64);
+
 /// One merged sweep directory: one cell size of one heights kind.
 struct Study {
     /// The heights' description, e.g. `Gaussian surface, ξ = 3 mm`.
@@ -333,7 +336,7 @@ fn read_study(dir: &Path) -> Result<Study, Box<dyn std::error::Error>> {
     }
     let curves = Table::read(&merged)?;
     let loads = curves.numbers("force_over_mu_FN")?;
-    let triple = |name: &str| -> Result<Vec<(f64, f64, f64)>, Box<dyn std::error::Error>> {
+    let triple = |name: &str| -> Result<Vec<Band>, Box<dyn std::error::Error>> {
         let m = curves.numbers(&format!("{name}_mean"))?;
         let lo = curves.numbers(&format!("{name}_lo"))?;
         let hi = curves.numbers(&format!("{name}_hi"))?;
@@ -521,7 +524,7 @@ fn at_least(rows: &[(f64, f64)]) -> Vec<(f64, f64)> {
 
 fn fmt(x: Option<f64>) -> String {
     match x {
-        Some(v) if v == 0.0 => "0".into(),
+        Some(0.0) => "0".into(),
         Some(v) if v.is_finite() => format!("{v:.3e}"),
         _ => "—".into(),
     }
@@ -561,9 +564,9 @@ fn table(studies: &[Study], up_to: f64) {
             s.runs.to_string(),
             format!("{:.1}", s.core_seconds),
         ];
-        for q in 0..3 {
-            cells.push(fmt(distances[k][q]));
-            let order = match (k.checked_sub(1), distances[k][q]) {
+        for (q, &distance) in distances[k].iter().enumerate() {
+            cells.push(fmt(distance));
+            let order = match (k.checked_sub(1), distance) {
                 (Some(c), Some(d)) => distances[c][q]
                     .and_then(|dc| observed_order(dc, d, studies[c].dx, s.dx))
                     .map(|p| format!("{p:.2}"))

@@ -33,6 +33,7 @@ from ._precursors import (
     run,
     sweep,
 )
+from ._scene import SurfaceSpectrum
 from ._tables import read_table
 
 __all__ = [
@@ -49,6 +50,7 @@ __all__ = [
     "PrecursorsOSError",
     "PrecursorsValueError",
     "Scene",
+    "SurfaceSpectrum",
     "__version__",
     "merge",
     "plot",
