@@ -34,6 +34,7 @@ from ._precursors import (
     run,
     sweep,
 )
+from ._scene import SurfaceSpectrum
 from ._tables import read_table
 
 __all__ = [
@@ -50,6 +51,7 @@ __all__ = [
     "PrecursorsOSError",
     "PrecursorsValueError",
     "Scene",
+    "SurfaceSpectrum",
     "__version__",
     "merge",
     "movie",

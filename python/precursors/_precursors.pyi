@@ -7,6 +7,8 @@ from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple
 import numpy as np
 import numpy.typing as npt
 
+from ._scene import SurfaceSpectrum
+
 _Path = Union[str, "os.PathLike[str]"]
 _Field = npt.NDArray[np.float64]
 
@@ -27,6 +29,8 @@ class Scene:
         normal_load: Optional[float] = ...,
         seed: Optional[int] = ...,
         heights: Optional[npt.ArrayLike] = ...,
+        surface: Optional[SurfaceSpectrum] = ...,
+        height_distribution: Optional[Tuple[float, float]] = ...,
         young_modulus: Optional[float] = ...,
         poisson_ratio: Optional[float] = ...,
         friction_coefficient: Optional[float] = ...,

@@ -55,8 +55,18 @@ pub struct MergeSummary {
 /// The 97.5 % quantile of Student's t distribution with `df` degrees of freedom (the
 /// half-width of a two-sided 95 % band is `t · s/√n`, `df = n - 1`): tabulated for
 /// `df <= 30`, above by the Cornish-Fisher expansion `z + (z³ + z)/(4 df)` (error below
-/// 3e-3); `NaN` for `df = 0`.
-pub(crate) fn t_quantile_975(df: usize) -> f64 {
+/// 3e-3); `NaN` for `df = 0`. The bands of [`merge`]'s tables use it; a study's own
+/// statistics (e.g. over a quantity that `merge` does not report) can take the same.
+///
+/// ```
+/// use precursors::sweep::t_quantile_975;
+/// assert_eq!(t_quantile_975(19), 2.093);                  // 20 realizations
+/// // The 95 % band of the mean of 1, 2, 3: 2 ± t(2) · 1/√3.
+/// let half = t_quantile_975(2) / 3f64.sqrt();
+/// assert!((half - 2.484).abs() < 1e-3);
+/// assert!(t_quantile_975(0).is_nan());                     // one value: no band
+/// ```
+pub fn t_quantile_975(df: usize) -> f64 {
     const TABLE: [f64; 30] = [
         12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
         2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
