@@ -43,7 +43,7 @@
 mod report;
 
 use precursors::plot::{Chart, Corner};
-use precursors::sweep::t_quantile_975;
+use precursors::sweep::mean_band;
 use report::AtPath;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -130,20 +130,10 @@ impl Table {
     }
 }
 
-/// Mean and 95 % Student-t band of the mean `(mean, lo, hi)`, as `merge` computes its
-/// bands (NaN band below two values, NaN mean for none).
-fn mean_band(x: &[f64]) -> (f64, f64, f64) {
-    let n = x.len();
-    if n == 0 {
-        return (f64::NAN, f64::NAN, f64::NAN);
-    }
-    let mean = x.iter().sum::<f64>() / n as f64;
-    if n < 2 {
-        return (mean, f64::NAN, f64::NAN);
-    }
-    let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
-    let half = t_quantile_975(n - 1) * (var / n as f64).sqrt();
-    (mean, mean - half, mean + half)
+/// [`mean_band`] as `(mean, lo, hi)`.
+fn band(x: &[f64]) -> (f64, f64, f64) {
+    let b = mean_band(x);
+    (b.mean, b.lo, b.hi)
 }
 
 /// Two loads of `curves.csv` are the same grid load (written with 2 decimals).
@@ -265,7 +255,7 @@ impl Study {
     }
 
     fn first_mean(&self) -> f64 {
-        mean_band(&self.first).0
+        band(&self.first).0
     }
 }
 
@@ -575,7 +565,7 @@ fn table(studies: &[Study], up_to: f64) {
             };
             cells.push(order);
         }
-        let (m, lo, hi) = mean_band(&s.first);
+        let (m, lo, hi) = band(&s.first);
         cells.push(format!(
             "{m:.4} [{lo:.4}, {hi:.4}] ({} runs)",
             s.first.len()
@@ -641,7 +631,7 @@ fn figures(studies: &[Study], dir: &Path) -> report::Outcome {
     let band: Vec<_> = studies
         .iter()
         .map(|s| {
-            let (m, lo, hi) = mean_band(&s.first);
+            let (m, lo, hi) = band(&s.first);
             (s.dx * 1e3, m, lo, hi)
         })
         .collect();
@@ -705,19 +695,6 @@ mod tests {
         assert_eq!(observed_order(0.0, 0.01, 2.0, 1.0), None);
         assert_eq!(observed_order(0.1, 0.0, 2.0, 1.0), None);
         assert_eq!(observed_order(0.1, 0.05, 1.0, 2.0), None);
-    }
-
-    #[test]
-    fn mean_band_is_students_t_band_of_the_mean() {
-        // 1, 2, 3, 4: mean 2.5, s² = 5/3, t(3) = 3.182 (table): half-width
-        // 3.182 · sqrt(5/3 / 4) = 2.05394...
-        let (m, lo, hi) = mean_band(&[1.0, 2.0, 3.0, 4.0]);
-        assert_eq!(m, 2.5);
-        let half = 3.182 * (5.0f64 / 12.0).sqrt();
-        assert!((hi - m - half).abs() < 1e-12 && (m - lo - half).abs() < 1e-12);
-        let (m, lo, _) = mean_band(&[0.7]);
-        assert!(m == 0.7 && lo.is_nan());
-        assert!(mean_band(&[]).0.is_nan());
     }
 
     #[test]

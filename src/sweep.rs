@@ -30,7 +30,7 @@ mod merge;
 pub use error::SweepError;
 #[cfg(feature = "plot")]
 pub(crate) use merge::{ensemble_curves, MEDIAN_BAND_RUNS};
-pub use merge::{merge, t_quantile_975, MergeSummary, LOAD_GRID};
+pub use merge::{mean_band, merge, Band, MergeSummary, LOAD_GRID};
 
 /// The results of this module: its errors are [`SweepError`]s.
 type Result<T, E = SweepError> = std::result::Result<T, E>;

@@ -55,18 +55,8 @@ pub struct MergeSummary {
 /// The 97.5 % quantile of Student's t distribution with `df` degrees of freedom (the
 /// half-width of a two-sided 95 % band is `t · s/√n`, `df = n - 1`): tabulated for
 /// `df <= 30`, above by the Cornish-Fisher expansion `z + (z³ + z)/(4 df)` (error below
-/// 3e-3); `NaN` for `df = 0`. The bands of [`merge`]'s tables use it; a study's own
-/// statistics (e.g. over a quantity that `merge` does not report) can take the same.
-///
-/// ```
-/// use precursors::sweep::t_quantile_975;
-/// assert_eq!(t_quantile_975(19), 2.093);                  // 20 realizations
-/// // The 95 % band of the mean of 1, 2, 3: 2 ± t(2) · 1/√3.
-/// let half = t_quantile_975(2) / 3f64.sqrt();
-/// assert!((half - 2.484).abs() < 1e-3);
-/// assert!(t_quantile_975(0).is_nan());                     // one value: no band
-/// ```
-pub fn t_quantile_975(df: usize) -> f64 {
+/// 3e-3); `NaN` for `df = 0`.
+fn t_quantile_975(df: usize) -> f64 {
     const TABLE: [f64; 30] = [
         12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
         2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
@@ -82,19 +72,66 @@ pub fn t_quantile_975(df: usize) -> f64 {
     }
 }
 
-/// Mean and 95 % t-band `(mean, lo, hi)` of `x`; the band is `NaN` below two values.
-fn band(x: &[f64]) -> (f64, f64, f64) {
+/// The mean of a sample and the two-sided 95 % Student-t band of the mean
+/// ([`mean_band`]), in the units of the sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct Band {
+    /// The sample mean (`NaN` for an empty sample).
+    pub mean: f64,
+    /// `mean - t(n-1) s/√n` (`NaN` below two values).
+    pub lo: f64,
+    /// `mean + t(n-1) s/√n` (`NaN` below two values).
+    pub hi: f64,
+}
+
+/// The mean of `x` and its 95 % Student-t band, `mean ± t(n-1) · s/√n` (`s` the sample
+/// standard deviation, `t` the 97.5 % quantile: tabulated to 30 degrees of freedom,
+/// Cornish-Fisher above, error below 3e-3): the bands of [`merge`]'s tables, for a
+/// study's own statistics over a quantity `merge` does not report (e.g.
+/// `examples/convergence_figures.rs`).
+///
+/// ```
+/// use precursors::sweep::mean_band;
+/// // 1, 2, 3, 4: mean 2.5, s² = 5/3, t(3) = 3.182.
+/// let band = mean_band(&[1.0, 2.0, 3.0, 4.0]);
+/// let half = 3.182 * (5.0f64 / 3.0 / 4.0).sqrt();
+/// assert_eq!(band.mean, 2.5);
+/// assert!((band.hi - 2.5 - half).abs() < 1e-12 && (2.5 - band.lo - half).abs() < 1e-12);
+/// assert!(mean_band(&[0.7]).lo.is_nan());                 // one value: no band
+/// assert!(mean_band(&[]).mean.is_nan());
+/// ```
+pub fn mean_band(x: &[f64]) -> Band {
     let n = x.len();
+    let nan = f64::NAN;
     if n == 0 {
-        return (f64::NAN, f64::NAN, f64::NAN);
+        return Band {
+            mean: nan,
+            lo: nan,
+            hi: nan,
+        };
     }
     let mean = x.iter().sum::<f64>() / n as f64;
     if n < 2 {
-        return (mean, f64::NAN, f64::NAN);
+        return Band {
+            mean,
+            lo: nan,
+            hi: nan,
+        };
     }
     let var = x.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1) as f64;
     let half = t_quantile_975(n - 1) * (var / n as f64).sqrt();
-    (mean, mean - half, mean + half)
+    Band {
+        mean,
+        lo: mean - half,
+        hi: mean + half,
+    }
+}
+
+/// [`mean_band`] as `(mean, lo, hi)`.
+fn band(x: &[f64]) -> (f64, f64, f64) {
+    let b = mean_band(x);
+    (b.mean, b.lo, b.hi)
 }
 
 /// `mean,lo,hi,min,max` of `x` as CSV cells.
