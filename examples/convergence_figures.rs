@@ -35,8 +35,8 @@
 //!
 //! Run: `cargo run --release --features plot --example convergence_figures -- OUTDIR
 //! [FIGDIR] [--up-to LOAD]` (`--up-to` takes the distances over the loads up to LOAD
-//! only, e.g. 0.9 to leave out the last load, where the area law makes `A_R` jump by
-//! orders of magnitude just before global slip). Its arithmetic is unit-tested:
+//! only, and draws the area figure up to it, e.g. 0.9 to leave out the last load, where
+//! the area law makes `A_R` jump by orders of magnitude just before global slip). Its arithmetic is unit-tested:
 //! `cargo test --features plot --example convergence_figures`.
 
 #[path = "support/report.rs"]
@@ -455,7 +455,7 @@ fn run() -> report::Outcome {
     }
     for studies in kinds.values_mut() {
         studies.sort_by(|a, b| b.dx.total_cmp(&a.dx));
-        figures(studies, &args.figures)?;
+        figures(studies, &args.figures, args.up_to)?;
         table(studies, args.up_to);
     }
     if let Some(surface) = kinds.get("surface") {
@@ -575,7 +575,7 @@ fn table(studies: &[Study], up_to: f64) {
     println!();
 }
 
-fn figures(studies: &[Study], dir: &Path) -> report::Outcome {
+fn figures(studies: &[Study], dir: &Path, up_to: f64) -> report::Outcome {
     let heights = &studies[0].heights;
     let slug = &studies[0].slug;
     let path = |name: &str| dir.join(format!("convergence_{slug}_{name}.png"));
@@ -600,20 +600,22 @@ fn figures(studies: &[Study], dir: &Path) -> report::Outcome {
     ell.save(&p)?;
     eprintln!("wrote {}", p.display());
 
-    // The relative growth of the real contact area, on a log axis.
+    // The relative growth of the real contact area, on a log axis, up to `--up-to` (the
+    // area law's jump just before slip would set the axis otherwise).
     let log_growth = |x: f64| if x > 1.0 { (x - 1.0).log10() } else { f64::NAN };
     let mut area = Chart::new(
         &format!("Real contact area, {heights}: mean and 95 % band per cell size"),
         "F/(μF_N)",
         "log₁₀(A_R/A_R(0) − 1)",
     )
-    .x_range(0.0, 1.0)
+    .x_range(0.0, up_to.min(1.0))
     .legend(Corner::UpperLeft);
     for s in studies {
         let rows: Vec<_> = s
             .loads
             .iter()
             .zip(&s.area)
+            .filter(|(&f, _)| f <= up_to + 1e-9)
             .map(|(&f, &(m, lo, hi))| (f, log_growth(m), log_growth(lo), log_growth(hi)))
             .collect();
         area = area.band(&s.label(), &rows);
