@@ -14,7 +14,9 @@
 //! (100 kN). Not the 3.5 MPa of the smaller scene: the last site attached before global
 //! slip carries the whole normal load, and the scene refuses a load above `650 ΔA c_z`
 //! (107 kN on 1 mm cells) whose area law would overflow (docs/scene-format.md).
-//! `LARGE_RUN_MAX_RUPTURES=k` stops after `k` ruptures.
+//! `LARGE_RUN_MAX_RUPTURES=k` stops after `k` ruptures. The last line is a digest of the
+//! event sequence (kind and site of every rupture, detachment and attachment, FNV-1a):
+//! two programs ran the same events when their digests agree (docs/performance.md).
 
 #[path = "support/report.rs"]
 mod report;
@@ -79,6 +81,7 @@ fn run() -> report::Outcome {
     let mut driver = scene.driver()?;
     let (mut events, mut ruptures, mut stable, mut detach, mut attach) = (0, 0, 0, 0, 0);
     let mut slip = None;
+    let mut digest = Digest::default();
     // Optional early stop (for quick comparisons): LARGE_RUN_MAX_RUPTURES.
     let max_ruptures: usize = std::env::var("LARGE_RUN_MAX_RUPTURES")
         .ok()
@@ -87,6 +90,7 @@ fn run() -> report::Outcome {
     while let Some(event) = driver.step()? {
         let (event, d) = (&event, &driver);
         events += 1;
+        digest.event(event);
         match event {
             Event::Rupture { load, .. } => {
                 ruptures += 1;
@@ -152,5 +156,29 @@ fn run() -> report::Outcome {
         s.tangential_iterations,
         avg(s.tangential_iterations, s.tangential_solves)
     );
+    println!("event digest {:016x} (kind and site of every event)", digest.0);
     Ok(())
+}
+
+/// FNV-1a over the kind and site of the events that change the set.
+struct Digest(u64);
+
+impl Default for Digest {
+    fn default() -> Self {
+        Self(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Digest {
+    fn event(&mut self, event: &Event) {
+        let (kind, site) = match event {
+            Event::Rupture { site, .. } => (1u8, site.index),
+            Event::Detach { site, .. } => (2, site.index),
+            Event::Attach { site, .. } => (3, site.index),
+            _ => return,
+        };
+        for byte in std::iter::once(kind).chain(site.to_le_bytes()) {
+            self.0 = (self.0 ^ u64::from(byte)).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
 }
