@@ -156,7 +156,10 @@ fn run() -> report::Outcome {
         s.tangential_iterations,
         avg(s.tangential_iterations, s.tangential_solves)
     );
-    println!("event digest {:016x} (kind and site of every event)", digest.0);
+    println!(
+        "event digest {:016x} (kind and site of every event)",
+        digest.0
+    );
     Ok(())
 }
 
