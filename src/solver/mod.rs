@@ -29,6 +29,7 @@
 //! backends), `fsai.rs` (the sparse approximate inverse), `parallel.rs` (threads).
 
 mod active_set;
+mod coarse;
 mod dense;
 mod fsai;
 mod options;
@@ -424,16 +425,18 @@ impl EquilibriumSolver {
                     .solve(problem, Precond::Spectral, warm, effort)?
             }
             // The tangential system goes the spectral way on both backends (dense.rs).
-            Core::Dense(core) if tangential => {
-                core.spectral
-                    .solve(problem, spectral::warm_precond(true), warm, effort)?
-            }
+            Core::Dense(core) if tangential => core.spectral.solve(
+                problem,
+                spectral::warm_precond(true, self.grid.len()),
+                warm,
+                effort,
+            )?,
             Core::Dense(core) => core.solve(problem, warm, effort)?,
             Core::Spectral(core) => {
                 let precond = if cold {
                     Precond::Spectral
                 } else {
-                    spectral::warm_precond(tangential)
+                    spectral::warm_precond(tangential, self.grid.len())
                 };
                 core.solve(problem, precond, warm, effort)?
             }
