@@ -26,7 +26,8 @@
 //! Where things live: `options.rs` (what a solve takes and returns), `active_set.rs` and
 //! `tangential.rs` (the two equilibria), `pcg.rs` (the one projected CG), `system.rs` (the
 //! set system: staged product and preconditioners), `spectral.rs` and `dense.rs` (the
-//! backends), `fsai.rs` (the sparse approximate inverse), `parallel.rs` (threads).
+//! backends), `fsai.rs` (the sparse approximate inverse), `coarse.rs` (the coarse space of
+//! the two-level preconditioner on large grids), `parallel.rs` (threads).
 
 mod active_set;
 mod coarse;
