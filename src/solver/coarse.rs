@@ -14,13 +14,16 @@
 //!
 //! Everything here is a pure function of the set and its compliances (no history):
 //! `Zᵀ C_SS Z` is summed from the exact entries of `C` in a fixed order per pair of
-//! aggregates, and the factor is recomputed row by row from the first unknown whose row
-//! changed (rows before it are the same bits as a factorisation from scratch). So a
-//! restored solver preconditions bit for bit as the original (checkpoints).
+//! aggregates, and `E` is factorised anew whenever it changes (`k³/3` flops, `k` at most
+//! [`MAX_AGGREGATES`]). So a restored solver preconditions bit for bit as the original
+//! (checkpoints).
 
 use super::fsai::Entries;
 use super::pcg::dot;
 use crate::lock::{lock, read, write};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt;
+use faer::{Mat, Par};
 use std::sync::{Mutex, RwLock};
 
 /// The most coarse unknowns: the block size doubles from [`MIN_BLOCK`] until the blocks
@@ -50,9 +53,7 @@ pub(crate) struct Coarse {
     /// `E⁻¹ c` and `cᵀ E⁻¹ c`.
     w: Vec<f64>,
     cw: f64,
-    /// The first row of the factor whose pivot was not positive (`k` if none); the
-    /// correction is skipped unless `E` is positive definite.
-    bad: usize,
+    /// Whether `E` was positive definite (the correction is skipped otherwise).
     valid: bool,
     /// Scratch of [`Coarse::update`].
     fresh: Vec<Vec<usize>>,
@@ -86,7 +87,6 @@ impl Coarse {
             lower: Vec::new(),
             w: Vec::new(),
             cw: 0.0,
-            bad: 0,
             valid: false,
             fresh: vec![Vec::new(); count],
             dfresh: vec![Vec::new(); count],
@@ -167,21 +167,12 @@ impl Coarse {
         self.unknowns.truncate(from);
         self.unknowns
             .extend((first..count).filter(|&a| !self.members[a].is_empty()));
-        self.factor(from);
+        self.factor();
     }
 
-    /// `1_{S_a}ᵀ C 1_{S_b}` summed in a fixed order (`a ≤ b`): a pure function of the
-    /// two blocks' sites.
+    /// `1_{S_a}ᵀ C 1_{S_b}` (`a ≤ b`): a pure function of the two blocks' sites.
     fn pair(&self, entries: &Entries, a: usize, b: usize) -> f64 {
-        let mut total = 0.0;
-        for &s in &self.members[a] {
-            let mut row = 0.0;
-            for &t in &self.members[b] {
-                row += entries.get(s, t);
-            }
-            total += row;
-        }
-        total
+        entries.block_sum(&self.members[a], &self.members[b])
     }
 
     /// `E`'s diagonal compliance term of block `a` (sites in order).
@@ -189,55 +180,56 @@ impl Coarse {
         self.dmembers[a].iter().sum()
     }
 
-    /// Cholesky rows `from..k` of `E` (up-looking: row `p` from `E`'s row `p` and the rows
-    /// before it, so rows before `from` are unchanged), then `w = E⁻¹ c`.
-    fn factor(&mut self, from: usize) {
+    /// The Cholesky factor of `E` (faer's, one thread: a pure function of `E`), then
+    /// `w = E⁻¹ c`.
+    fn factor(&mut self) {
         let k = self.unknowns.len();
         let count = self.members.len();
-        let mut lower = std::mem::take(&mut self.lower);
-        if lower.len() != k * k {
-            // The stride changed: keep the rows before `from` at the new stride.
-            let old = (lower.len() as f64).sqrt() as usize;
-            let mut next = vec![0.0; k * k];
-            for p in 0..from.min(k) {
-                next[p * k..p * k + p + 1].copy_from_slice(&lower[p * old..p * old + p + 1]);
+        let mut e = Mat::<f64>::zeros(k, k);
+        for (q, &uq) in self.unknowns.iter().enumerate() {
+            let col = e.col_as_slice_mut(q);
+            for (p, &up) in self.unknowns.iter().enumerate().skip(q) {
+                col[p] = self.g[up * count + uq];
             }
-            lower = next;
+            col[q] += self.dsum(uq);
         }
-        let mut bad = if self.bad < from { self.bad } else { k };
-        for p in from..k {
-            let up = self.unknowns[p];
-            for q in 0..=p {
-                let uq = self.unknowns[q];
-                let mut e = self.g[up * count + uq];
-                if p == q {
-                    e += self.dsum(up);
-                }
-                let s = e - dot(&lower[p * k..p * k + q], &lower[q * k..q * k + q]);
-                if p == q {
-                    if s > 0.0 && s.is_finite() {
-                        lower[p * k + p] = s.sqrt();
-                    } else {
-                        bad = bad.min(p);
-                        lower[p * k + p] = 1.0;
-                    }
-                } else {
-                    lower[p * k + q] = s / lower[q * k + q];
-                }
+        let mut mem = MemBuffer::new(llt::factor::cholesky_in_place_scratch::<f64>(
+            k,
+            Par::Seq,
+            Default::default(),
+        ));
+        let result = llt::factor::cholesky_in_place(
+            e.as_mut(),
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut mem),
+            Default::default(),
+        );
+        // Row-major `L` for the substitutions (rows are contiguous in the forward one).
+        self.lower.clear();
+        self.lower.resize(k * k, 0.0);
+        for q in 0..k {
+            for (p, v) in e.col_as_slice(q).iter().enumerate().skip(q) {
+                self.lower[p * k + q] = *v;
             }
         }
-        self.lower = lower;
+        let pivots_ok = (0..k).all(|p| {
+            let v = self.lower[p * k + p];
+            v > 0.0 && v.is_finite()
+        });
         let c: Vec<f64> = self
             .unknowns
             .iter()
             .map(|&a| self.members[a].len() as f64)
             .collect();
         let mut w = c.clone();
-        self.solve_in_place(&mut w);
+        self.valid = result.is_ok() && pivots_ok;
+        if self.valid {
+            self.solve_in_place(&mut w);
+        }
         self.cw = dot(&c, &w);
         self.w = w;
-        self.bad = bad;
-        self.valid = bad == k && self.cw > 0.0 && self.cw.is_finite();
+        self.valid = self.valid && self.cw > 0.0 && self.cw.is_finite();
     }
 
     /// `x = E⁻¹ x` by the factor.
