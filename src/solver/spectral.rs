@@ -17,9 +17,10 @@ const FSAI_RADIUS: usize = 1;
 
 /// Fewest cells for the two-level preconditioner of the normal equilibrium. Measured on
 /// the rod-driven runs of `examples/large_run` (docs/performance.md, "A two-level
-/// preconditioner"): at N = 1e4 it cuts the CG iterations per warm normal solve from 32
-/// to 13 but each costs two operator products, so the solve is no faster (10 % slower);
-/// at N = 1e5 the iterations fall from 51 to 13 and the solve is 1.5x faster.
+/// preconditioner"): at N = 1e4 it cuts the CG iterations per normal solve from 32 to 13,
+/// but each costs two operator products and the coarse matrix is rebuilt as the set
+/// changes, so the solve is about 10 % slower; at N = 1e5 the iterations fall from 57 to
+/// 14 and the solve is 1.18x faster.
 const TWO_LEVEL_MIN_CELLS: usize = 32_768;
 
 /// The preconditioner of a warm solve on a grid of `cells` cells: for the normal
