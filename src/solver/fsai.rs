@@ -72,6 +72,25 @@ impl Entries {
         }
     }
 
+    /// `Σ_{i ∈ a} Σ_{j ∈ b} C_s[i, j]`, summed in a fixed order (row by row of `a`): a
+    /// pure function of the two site lists (the coarse space's `Zᵀ C Z`).
+    pub(crate) fn block_sum(&self, a: &[usize], b: &[usize]) -> f64 {
+        let w = 2 * self.nx;
+        let mut total = 0.0;
+        for &i in a {
+            let (x, y) = (i % self.nx, i / self.nx);
+            let mut row = 0.0;
+            for &j in b {
+                let (u, v) = (j % self.nx, j / self.nx);
+                let (s0, s1) = (x.abs_diff(u), x + u + 1);
+                let (t0, t1) = (y.abs_diff(v) * w, (y + v + 1) * w);
+                row += (self.k[t0 + s0] + self.k[t0 + s1]) + (self.k[t1 + s0] + self.k[t1 + s1]);
+            }
+            total += row;
+        }
+        self.scale * (total - self.shift * (a.len() * b.len()) as f64)
+    }
+
     /// `C_s[i, j]` for sites `i`, `j`.
     pub(crate) fn get(&self, i: usize, j: usize) -> f64 {
         let (a, y) = (i % self.nx, i / self.nx);

@@ -26,9 +26,11 @@
 //! Where things live: `options.rs` (what a solve takes and returns), `active_set.rs` and
 //! `tangential.rs` (the two equilibria), `pcg.rs` (the one projected CG), `system.rs` (the
 //! set system: staged product and preconditioners), `spectral.rs` and `dense.rs` (the
-//! backends), `fsai.rs` (the sparse approximate inverse), `parallel.rs` (threads).
+//! backends), `fsai.rs` (the sparse approximate inverse), `coarse.rs` (the coarse space of
+//! the two-level preconditioner on large grids), `parallel.rs` (threads).
 
 mod active_set;
+mod coarse;
 mod dense;
 mod fsai;
 mod options;
@@ -424,16 +426,18 @@ impl EquilibriumSolver {
                     .solve(problem, Precond::Spectral, warm, effort)?
             }
             // The tangential system goes the spectral way on both backends (dense.rs).
-            Core::Dense(core) if tangential => {
-                core.spectral
-                    .solve(problem, spectral::warm_precond(true), warm, effort)?
-            }
+            Core::Dense(core) if tangential => core.spectral.solve(
+                problem,
+                spectral::warm_precond(true, self.grid.len()),
+                warm,
+                effort,
+            )?,
             Core::Dense(core) => core.solve(problem, warm, effort)?,
             Core::Spectral(core) => {
                 let precond = if cold {
                     Precond::Spectral
                 } else {
-                    spectral::warm_precond(tangential)
+                    spectral::warm_precond(tangential, self.grid.len())
                 };
                 core.solve(problem, precond, warm, effort)?
             }

@@ -35,6 +35,29 @@ pub(crate) trait SetSystem: Sync {
     fn precondition(&self, stage: usize, k: usize, r: &[f64], z: &mut [f64], carry: f64) -> f64;
     /// An upper bound of `‖A‖₂` (m/Pa), the scale of the backward error.
     fn norm_bound(&self) -> f64;
+    /// Whether a coarse space corrects the preconditioner (two-level, A-DEF2: the
+    /// methods below).
+    fn has_coarse(&self) -> bool {
+        false
+    }
+    /// Stage `stage` of `y = A x` on part `k` with buffers of its own (the product of
+    /// [`SetSystem::product`] is kept: it is the solution's), as [`SetSystem::product`].
+    fn coarse_product(
+        &self,
+        _stage: usize,
+        _k: usize,
+        _x: &[f64],
+        _y: &mut [f64],
+        _carry: f64,
+    ) -> f64 {
+        0.0
+    }
+    /// Part `k`'s share of the coarse restriction `Zᵀ (r - a)` (`a` given) or `Zᵀ r`.
+    fn restrict(&self, _k: usize, _r: &[f64], _a: Option<&[f64]>) {}
+    /// The coarse solve of the restriction, the parts' shares added in part order.
+    fn coarse_solve(&self) {}
+    /// `x += sign Z y` on part `k`, `y` the last coarse solution.
+    fn prolong(&self, _k: usize, _x: &mut [f64], _sign: f64) {}
 }
 
 /// What [`projected_pcg`] returns.
@@ -99,6 +122,7 @@ pub(crate) fn projected_pcg<S: SetSystem>(
             &mut v.q,
             &mut v.w,
             &mut v.best,
+            &mut v.t,
         ] {
             x.resize(m, 0.0);
         }
@@ -140,6 +164,8 @@ struct Vectors {
     q: Vec<f64>,
     w: Vec<f64>,
     best: Vec<f64>,
+    /// `A z` of the coarse correction.
+    t: Vec<f64>,
 }
 
 /// Local updates a phase applies on its part before its main work, in this order.
@@ -161,6 +187,10 @@ struct Pre {
     direction: Option<Option<f64>>,
     /// `r = 1` (to form `w = M⁻¹ 1`).
     fill_r_one: bool,
+    /// `f -= Z y` (the coarse start), after the updates above.
+    coarse_f: bool,
+    /// `z += Z y` (the coarse correction), after the updates above.
+    coarse_z: bool,
 }
 
 impl Pre {
@@ -173,6 +203,7 @@ impl Pre {
             q,
             w,
             best,
+            t: _,
         } = v;
         if self.keep_best {
             best.copy_from_slice(f);
@@ -235,6 +266,10 @@ enum Main {
     Precondition { stage: usize, carry: f64 },
     /// `max |r|`, `max |f|`, `rᵀ z`.
     Measure,
+    /// A stage of `t = A z` (the coarse buffers); the last restricts `r - t`.
+    CoarseProduct { stage: usize, carry: f64 },
+    /// Restricts `r`.
+    Restrict,
 }
 
 #[derive(Clone, Copy)]
@@ -261,6 +296,12 @@ impl<S: SetSystem> Tasks for Work<'_, S> {
         let v = &mut *guard;
         phase.pre.apply(v);
         let sys = self.sys;
+        if phase.pre.coarse_f {
+            sys.prolong(k, &mut v.f, -1.0);
+        }
+        if phase.pre.coarse_z {
+            sys.prolong(k, &mut v.z, 1.0);
+        }
         match phase.main {
             Main::Nothing => [0.0; SLOTS],
             Main::SumF => [0.0, sum(&v.f), 0.0, 0.0],
@@ -289,6 +330,17 @@ impl<S: SetSystem> Tasks for Work<'_, S> {
                 [out, if last { sum(&v.z) } else { 0.0 }, 0.0, 0.0]
             }
             Main::Measure => [0.0, max_abs(&v.r), max_abs(&v.f), dot(&v.r, &v.z)],
+            Main::CoarseProduct { stage, carry } => {
+                let out = sys.coarse_product(stage, k, &v.z, &mut v.t, carry);
+                if stage + 1 == sys.product_stages() {
+                    sys.restrict(k, &v.r, Some(&v.t));
+                }
+                [out, 0.0, 0.0, 0.0]
+            }
+            Main::Restrict => {
+                sys.restrict(k, &v.r, None);
+                [0.0; SLOTS]
+            }
         }
     }
 }
@@ -354,11 +406,32 @@ impl<S: SetSystem> Leader<'_, '_, S> {
     /// `z = P M⁻¹ r`, the multiplier folded into `U` and `r` (applied with the next
     /// phase). Why fold: the constant part of `r` would otherwise swamp `rᵀz` in rounding
     /// (the residual-update strategy of Gould, Hribar and Nocedal).
+    ///
+    /// With a coarse space, then A-DEF2 (Tang, Nabben, Vuik and Erlangga, 2009):
+    /// `z ← z + Z E⁻¹ Zᵀ (r - A z)`, one more operator product. Why not the additive
+    /// `z + Q r`: the smooth modes of an order −1 operator are its *large* eigenvalues,
+    /// which an additive term enlarges instead of removing (docs/performance.md).
     fn project(&mut self) {
         let sz = self.precondition();
         let u = -sz / self.s1;
         self.pending.project = Some(u);
         self.offset += u;
+        if self.sys.has_coarse() {
+            self.staged(self.sys.product_stages(), |stage, carry| {
+                Main::CoarseProduct { stage, carry }
+            });
+            self.sys.coarse_solve();
+            self.pending.coarse_z = true;
+        }
+    }
+
+    /// The coarse start `f ← f - Z E⁻¹ Zᵀ r` (A-DEF2 needs a residual with `Zᵀ r = 0`).
+    fn coarse_start(&mut self) {
+        self.residual();
+        self.phase(Main::Restrict);
+        self.sys.coarse_solve();
+        self.pending.coarse_f = true;
+        self.fix_sum();
     }
 
     /// `z = M⁻¹ r`; returns `Σ z`.
@@ -387,6 +460,9 @@ impl<S: SetSystem> Leader<'_, '_, S> {
     fn solve(mut self) -> PcgOutcome {
         let tol = self.effort.tolerance;
         self.fix_sum();
+        if self.sys.has_coarse() {
+            self.coarse_start();
+        }
         // w = M⁻¹ 1.
         self.pending.fill_r_one = true;
         self.s1 = self.precondition();

@@ -2,6 +2,7 @@
 //! CG preconditioned by Jacobi, FSAI or the restricted full-grid inverse. Memory `O(N)`:
 //! no `N x N` matrix is ever formed. The dense backend uses the same product.
 
+use super::coarse::Coarse;
 use super::fsai::{Entries, Fsai};
 use super::pcg::{projected_pcg, Effort, PcgVectors};
 use super::set::{SetProblem, SetSolve};
@@ -14,14 +15,26 @@ use crate::green::{InfluencePlan, Partition, SpectralTable, Staging};
 /// radius 1: 37.6, 9.6 ms; radius 2: 27.4, 9.9 ms (its `Gᵀ G` costs 2.2x radius 1's).
 const FSAI_RADIUS: usize = 1;
 
-/// The preconditioner of a warm solve: FSAI for the normal equilibrium (the compliances
-/// `1/k_z` and most of the set are unchanged between solves, so few rows are rebuilt);
-/// Jacobi for the tangential one (every `k_x` follows `u_z`, so every row would be rebuilt
-/// per solve, and the larger `1/k_x` leaves Jacobi at about 20 iterations: FSAI radius 2
-/// gave 16.8 iterations but 9.1 ms against 4.2 ms per solve).
-pub(crate) fn warm_precond(tangential: bool) -> Precond {
+/// Fewest cells for the two-level preconditioner of the normal equilibrium. Measured on
+/// the rod-driven runs of `examples/large_run` (docs/performance.md, "A two-level
+/// preconditioner"): at N = 1e4 it cuts the CG iterations per normal solve from 32 to 13,
+/// but each costs two operator products and the coarse matrix is rebuilt as the set
+/// changes, so the solve is about 10 % slower; at N = 1e5 the iterations fall from 57 to
+/// 14 and the solve is 1.18x faster.
+const TWO_LEVEL_MIN_CELLS: usize = 32_768;
+
+/// The preconditioner of a warm solve on a grid of `cells` cells: for the normal
+/// equilibrium FSAI (the compliances `1/k_z` and most of the set are unchanged between
+/// solves, so few rows are rebuilt), with a coarse space of aggregates on large grids
+/// where FSAI's iteration count grows with `N`; Jacobi for the tangential one (every
+/// `k_x` follows `u_z`, so every row would be rebuilt per solve, and the larger `1/k_x`
+/// leaves Jacobi at about 20 iterations: FSAI radius 2 gave 16.8 iterations but 9.1 ms
+/// against 4.2 ms per solve).
+pub(crate) fn warm_precond(tangential: bool, cells: usize) -> Precond {
     if tangential {
         Precond::Jacobi
+    } else if cells >= TWO_LEVEL_MIN_CELLS {
+        Precond::TwoLevel
     } else {
         Precond::Fsai
     }
@@ -36,6 +49,8 @@ pub(crate) enum Precond {
     Spectral,
     /// The factorised sparse approximate inverse ([`Fsai`], cached between solves).
     Fsai,
+    /// FSAI and a coarse space of aggregates ([`Coarse`]).
+    TwoLevel,
 }
 
 /// Buffers and preconditioners of the spectral product, kept between solves.
@@ -51,6 +66,8 @@ pub(crate) struct SpectralCore {
     /// Exact local entries of `C_s` (built on first use), the FSAI factor and buffers.
     entries: Option<Entries>,
     fsai: Option<(Fsai, FsaiBuffers)>,
+    /// The coarse space and the buffers of its products.
+    coarse: Option<(Coarse, Staging)>,
     /// The CG's vectors (a lock: the dense backend solves through `&self`).
     vectors: std::sync::Mutex<PcgVectors>,
 }
@@ -82,6 +99,7 @@ impl SpectralCore {
             inverse: None,
             entries: None,
             fsai: None,
+            coarse: None,
             vectors: Default::default(),
         }
     }
@@ -148,7 +166,7 @@ impl SpectralCore {
     /// cold, far-from-solution solves of large grids (docs/performance.md).
     fn prepare(&mut self, set: &[usize], d: &[f64], precond: Precond) {
         match precond {
-            Precond::Fsai => {
+            Precond::Fsai | Precond::TwoLevel => {
                 let Compliance { scale, shift, .. } = self.compliance;
                 let entries = self
                     .entries
@@ -161,6 +179,13 @@ impl SpectralCore {
                     (fsai, buffers)
                 });
                 fsai.update(entries, set, d);
+                if precond == Precond::TwoLevel {
+                    let (coarse, _) = self.coarse.get_or_insert_with(|| {
+                        let coarse = Coarse::new(grid.nx(), grid.ny(), partition.parts());
+                        (coarse, Staging::new(&self.plan, partition.clone()))
+                    });
+                    coarse.update(entries, set, d);
+                }
             }
             Precond::Spectral => {
                 let mean_d = d.iter().sum::<f64>() / d.len().max(1) as f64;
@@ -188,6 +213,15 @@ impl SpectralCore {
     ) -> Result<SetSolve> {
         self.prepare(problem.set, problem.d, precond);
         let precond = match (precond, &self.fsai, &self.inverse) {
+            (Precond::TwoLevel, Some((fsai, buffers)), _) => match &self.coarse {
+                Some((coarse, staging)) => Preconditioner::TwoLevel {
+                    fsai,
+                    buffers,
+                    coarse,
+                    staging,
+                },
+                None => Preconditioner::Fsai { fsai, buffers },
+            },
             (Precond::Fsai, Some((fsai, buffers)), _) => Preconditioner::Fsai { fsai, buffers },
             (Precond::Spectral, _, Some((staging, _, table))) => {
                 Preconditioner::Spectral { staging, table }

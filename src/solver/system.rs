@@ -2,6 +2,7 @@
 //! `C_s = scale (Ĝ - shift 11ᵀ)` applied through the plan's staged product (part by
 //! part, [`crate::green::Staging`]) and one of the preconditioners.
 
+use super::coarse::Coarse;
 use super::fsai::Fsai;
 use super::pcg::{sum, SetSystem};
 use crate::green::{Partition, SpectralTable, Staging};
@@ -25,6 +26,14 @@ pub(crate) enum Preconditioner<'a> {
     },
     /// The dense backend's LDLᵀ factor (a system of one part).
     Factor(&'a (dyn ExactInverse + Sync)),
+    /// FSAI corrected by a coarse space of aggregates ([`Coarse`], A-DEF2 in the CG);
+    /// the coarse products run on buffers of their own.
+    TwoLevel {
+        fsai: &'a Fsai,
+        buffers: &'a FsaiBuffers,
+        coarse: &'a Coarse,
+        staging: &'a Staging,
+    },
 }
 
 /// `z = A_SS⁻¹ r` by a factor of the set's matrix (the dense backend's): a preconditioner
@@ -158,25 +167,15 @@ impl SetSystem for StagedSystem<'_> {
     }
 
     fn product(&self, stage: usize, k: usize, x: &[f64], y: &mut [f64], carry: f64) -> f64 {
-        if stage < 2 {
-            return self.staged_head(self.staging, self.table, stage, k, x, carry);
-        }
-        let base = self.partition().cells(k).start;
-        let range = self.ranges[k].clone();
-        let (sites, d) = (&self.set[range.clone()], &self.d[range]);
-        let (s, c) = (self.scale, self.shift * carry);
-        self.staging.inverse_rows(k, |rows| {
-            for (((ya, &i), da), xa) in y.iter_mut().zip(sites).zip(d).zip(x) {
-                *ya = s * (rows[i - base] - c) + da * xa;
-            }
-        });
-        carry
+        self.staged_product(self.staging, stage, k, x, y, carry)
     }
 
     fn precondition_stages(&self) -> usize {
         match self.precond {
             Preconditioner::Jacobi { .. } | Preconditioner::Factor(_) => 1,
-            Preconditioner::Fsai { .. } | Preconditioner::Spectral { .. } => 3,
+            Preconditioner::Fsai { .. }
+            | Preconditioner::Spectral { .. }
+            | Preconditioner::TwoLevel { .. } => 3,
         }
     }
 
@@ -202,7 +201,8 @@ impl SetSystem for StagedSystem<'_> {
                     });
                 }
             }
-            Preconditioner::Fsai { fsai, buffers } => {
+            Preconditioner::Fsai { fsai, buffers }
+            | Preconditioner::TwoLevel { fsai, buffers, .. } => {
                 let cells = self.partition().cells(k);
                 let sites = &self.set[range];
                 buffers.stage(fsai, self.partition(), stage, k, cells, sites, r, z);
@@ -213,6 +213,64 @@ impl SetSystem for StagedSystem<'_> {
 
     fn norm_bound(&self) -> f64 {
         self.norm
+    }
+
+    fn has_coarse(&self) -> bool {
+        matches!(self.precond, Preconditioner::TwoLevel { coarse, .. } if coarse.valid())
+    }
+
+    fn coarse_product(&self, stage: usize, k: usize, x: &[f64], y: &mut [f64], carry: f64) -> f64 {
+        match self.precond {
+            Preconditioner::TwoLevel { staging, .. } => {
+                self.staged_product(staging, stage, k, x, y, carry)
+            }
+            _ => 0.0,
+        }
+    }
+
+    fn restrict(&self, k: usize, r: &[f64], a: Option<&[f64]>) {
+        if let Preconditioner::TwoLevel { coarse, .. } = self.precond {
+            coarse.restrict(k, &self.set[self.ranges[k].clone()], r, a);
+        }
+    }
+
+    fn coarse_solve(&self) {
+        if let Preconditioner::TwoLevel { coarse, .. } = self.precond {
+            coarse.solve();
+        }
+    }
+
+    fn prolong(&self, k: usize, x: &mut [f64], sign: f64) {
+        if let Preconditioner::TwoLevel { coarse, .. } = self.precond {
+            coarse.prolong(&self.set[self.ranges[k].clone()], x, sign);
+        }
+    }
+}
+
+impl StagedSystem<'_> {
+    /// Stage `stage` of `y = A x` on part `k` through `staging`'s buffers.
+    fn staged_product(
+        &self,
+        staging: &Staging,
+        stage: usize,
+        k: usize,
+        x: &[f64],
+        y: &mut [f64],
+        carry: f64,
+    ) -> f64 {
+        if stage < 2 {
+            return self.staged_head(staging, self.table, stage, k, x, carry);
+        }
+        let base = self.partition().cells(k).start;
+        let range = self.ranges[k].clone();
+        let (sites, d) = (&self.set[range.clone()], &self.d[range]);
+        let (s, c) = (self.scale, self.shift * carry);
+        staging.inverse_rows(k, |rows| {
+            for (((ya, &i), da), xa) in y.iter_mut().zip(sites).zip(d).zip(x) {
+                *ya = s * (rows[i - base] - c) + da * xa;
+            }
+        });
+        carry
     }
 }
 
