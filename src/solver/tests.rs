@@ -38,6 +38,38 @@ fn largest_eigenvalue(plan: &InfluencePlan) -> f64 {
     top
 }
 
+/// The compliance constants of the tests' grids (`C_s = scale Ĝ`, no shift).
+fn compliance(plan: &InfluencePlan) -> Compliance {
+    let scale = 3.6e-16;
+    Compliance {
+        scale,
+        shift: 0.0,
+        norm: scale * largest_eigenvalue(plan),
+    }
+}
+
+/// A cold solve of `(C_SS + diag(d)) f + U 1 = b`, `Σ f = total` with `precond`.
+#[allow(clippy::too_many_arguments)]
+fn solve_cold(
+    core: &mut SpectralCore,
+    set: &[usize],
+    d: &[f64],
+    b: &[f64],
+    total: f64,
+    precond: Precond,
+    tolerance: f64,
+    parallelism: Parallelism,
+) -> super::set::SetSolve {
+    let problem = SetProblem { set, d, b, total };
+    let effort = Effort {
+        tolerance,
+        max_iterations: 5000,
+        parallelism,
+    };
+    core.solve(problem, precond, vec![0.0; set.len()], effort)
+        .unwrap()
+}
+
 /// The projected CG's solution of `(C_SS + D) f + U 1 = b`, `Σ f = total` equals the
 /// solution of the bordered (KKT) system assembled from `InfluencePlan::dense` (explicit
 /// cosine sums, not the DCT) and solved by faer's LU: an independent path.
@@ -74,18 +106,16 @@ fn pcg_solution_equals_direct_kkt_solve() {
         Precond::Spectral,
         Precond::TwoLevel,
     ] {
-        let problem = SetProblem {
-            set: &set,
-            d: &d,
-            b: &b,
+        let solved = solve_cold(
+            &mut core,
+            &set,
+            &d,
+            &b,
             total,
-        };
-        let effort = Effort {
-            tolerance: 1e-14,
-            max_iterations: 2000,
-            parallelism: Parallelism::Sequential,
-        };
-        let solved = core.solve(problem, precond, vec![0.0; m], effort).unwrap();
+            precond,
+            1e-14,
+            Parallelism::Sequential,
+        );
         assert!(solved.outcome.converged, "{precond:?}");
         let fmax = (0..m).fold(0.0f64, |a, r| a.max(direct[(r, 0)].abs()));
         for r in 0..m {
@@ -139,20 +169,7 @@ fn solves_are_thread_count_independent_and_solve() {
                     .iter()
                     .map(|i| 0.05 * compliance.norm * (1.0 + (i % 3) as f64))
                     .collect();
-                let problem = SetProblem {
-                    set: &set,
-                    d: &d,
-                    b: &b,
-                    total: 1e-3,
-                };
-                let effort = Effort {
-                    tolerance: 1e-13,
-                    max_iterations: 5000,
-                    parallelism: par,
-                };
-                let solved = core
-                    .solve(problem, precond, vec![0.0; set.len()], effort)
-                    .unwrap();
+                let solved = solve_cold(&mut core, &set, &d, &b, 1e-3, precond, 1e-13, par);
                 let out = solved.outcome;
                 assert!(out.converged, "{nx}x{ny} {precond:?}: {out:?}");
                 let f = solved.f;
@@ -199,33 +216,24 @@ fn solves_are_thread_count_independent_and_solve() {
 fn two_level_needs_far_fewer_iterations_than_fsai() {
     let plan = plan(256, 64);
     let n = 256 * 64;
-    let scale = 3.6e-16;
-    let compliance = Compliance {
-        scale,
-        shift: 0.0,
-        norm: scale * largest_eigenvalue(&plan),
-    };
+    let compliance = compliance(&plan);
     let set: Vec<usize> = (0..n).filter(|i| (i * 7919 + 3) % 10 < 4).collect();
     let b: Vec<f64> = set.iter().map(|i| 1e-6 * (1.0 + (i % 7) as f64)).collect();
     // Compliances as the springs' here: about 1/16 of C's diagonal.
-    let d = vec![0.06 * scale * largest_eigenvalue(&plan); set.len()];
+    let d = vec![0.06 * compliance.norm; set.len()];
     let mut iterations = Vec::new();
     for precond in [Precond::Fsai, Precond::TwoLevel] {
         let mut core = SpectralCore::new(&plan, compliance, Partition::of(&plan));
-        let problem = SetProblem {
-            set: &set,
-            d: &d,
-            b: &b,
-            total: 1e-3,
-        };
-        let effort = Effort {
-            tolerance: 1e-13,
-            max_iterations: 5000,
-            parallelism: Parallelism::Sequential,
-        };
-        let solved = core
-            .solve(problem, precond, vec![0.0; set.len()], effort)
-            .unwrap();
+        let solved = solve_cold(
+            &mut core,
+            &set,
+            &d,
+            &b,
+            1e-3,
+            precond,
+            1e-13,
+            Parallelism::Sequential,
+        );
         assert!(solved.outcome.converged, "{precond:?}");
         iterations.push(solved.outcome.iterations);
     }
