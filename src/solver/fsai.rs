@@ -76,12 +76,14 @@ impl Entries {
     /// pure function of the two site lists (the coarse space's `Zᵀ C Z`).
     pub(crate) fn block_sum(&self, a: &[usize], b: &[usize]) -> f64 {
         let w = 2 * self.nx;
+        // `b`'s cells once, not once per pair: the integer divisions cost about a third of
+        // the sum's time.
+        let cells: Vec<(usize, usize)> = b.iter().map(|&j| (j % self.nx, j / self.nx)).collect();
         let mut total = 0.0;
         for &i in a {
             let (x, y) = (i % self.nx, i / self.nx);
             let mut row = 0.0;
-            for &j in b {
-                let (u, v) = (j % self.nx, j / self.nx);
+            for &(u, v) in &cells {
                 let (s0, s1) = (x.abs_diff(u), x + u + 1);
                 let (t0, t1) = (y.abs_diff(v) * w, (y + v + 1) * w);
                 row += (self.k[t0 + s0] + self.k[t0 + s1]) + (self.k[t1 + s0] + self.k[t1 + s1]);
