@@ -17,14 +17,24 @@
 //! `LARGE_RUN_MAX_RUPTURES=k` stops after `k` ruptures. The last line is a digest of the
 //! event sequence (kind and site of every rupture, detachment and attachment, FNV-1a):
 //! two programs ran the same events when their digests agree (docs/performance.md).
+//!
+//! A run longer than a sitting (the N = 1e5 scene takes hours): `LARGE_RUN_CHECKPOINT=FILE`
+//! writes the driver's checkpoint to FILE at the first stable state after every
+//! `LARGE_RUN_CHECKPOINT_SECONDS` (default 600) and this program's totals (event counts,
+//! digest, solver work, wall time) to FILE.progress; started again with the same
+//! arguments and FILE, it resumes from there and ends with the totals and digest of an
+//! uninterrupted run. The wall time it prints is the sum over the sittings up to their
+//! last checkpoints (work redone after a stop is not counted, each resume's set-up is).
 
 #[path = "support/report.rs"]
 mod report;
 
 use precursors::solver::{Parallelism, SolverOptions};
-use precursors::{Event, Scene};
+use precursors::{Checkpoint, Driver, Event, Scene, SolveStats};
+use report::AtPath;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 fn main() -> ExitCode {
     report::report(run())
@@ -78,48 +88,64 @@ fn run() -> report::Outcome {
         .build()?;
     let built = start.elapsed();
     let scale = scene.material().friction_coefficient() * scene.normal_load();
-    let mut driver = scene.driver()?;
-    let (mut events, mut ruptures, mut stable, mut detach, mut attach) = (0, 0, 0, 0, 0);
+    // Optional early stop (for quick comparisons) and checkpoints (for long runs).
+    let max_ruptures: usize = env("LARGE_RUN_MAX_RUPTURES", usize::MAX)?;
+    let checkpoint = std::env::var_os("LARGE_RUN_CHECKPOINT").map(PathBuf::from);
+    let every = Duration::from_secs_f64(env("LARGE_RUN_CHECKPOINT_SECONDS", 600.0_f64)?);
+    let (mut driver, before) = match &checkpoint {
+        Some(path) if path.exists() => {
+            let saved = Checkpoint::read_from(path)?;
+            let totals = Totals::read(&progress_path(path), saved.event_count())?;
+            let driver = scene.resume(&saved)?;
+            eprintln!(
+                "resuming from {} ({} ruptures, {:.2} s so far)",
+                path.display(),
+                totals.ruptures,
+                totals.seconds
+            );
+            (driver, totals)
+        }
+        _ => (scene.driver()?, Totals::default()),
+    };
+    let mut now = before;
+    let mut last_checkpoint = Instant::now();
     let mut slip = None;
-    let mut digest = Digest::default();
-    // Optional early stop (for quick comparisons): LARGE_RUN_MAX_RUPTURES.
-    let max_ruptures: usize = std::env::var("LARGE_RUN_MAX_RUPTURES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(usize::MAX);
     while let Some(event) = driver.step()? {
-        let (event, d) = (&event, &driver);
-        events += 1;
-        digest.event(event);
+        now.event(&event);
         match event {
-            Event::Rupture { load, .. } => {
-                ruptures += 1;
-                if ruptures % 500 == 0 {
-                    let s = d.solve_stats();
-                    eprintln!(
-                        "{:8.2} s  {ruptures:6} ruptures  {stable:5} stable  F/(μF_N) = {:.6}  \
-                         normal {:.2} s / {} it, tangential {:.2} s / {} it",
-                        start.elapsed().as_secs_f64(),
-                        load.force / scale,
-                        s.normal_seconds,
-                        s.normal_iterations,
-                        s.tangential_seconds,
-                        s.tangential_iterations,
-                    );
+            Event::Rupture { load, .. } if now.ruptures % 500 == 0 => {
+                now.solver(&before, &driver, start);
+                eprintln!(
+                    "{:8.2} s  {:6} ruptures  {:5} stable  F/(μF_N) = {:.6}  \
+                     normal {:.2} s / {} it, tangential {:.2} s / {} it",
+                    now.seconds,
+                    now.ruptures,
+                    now.stable,
+                    load.force / scale,
+                    now.stats.normal_seconds,
+                    now.stats.normal_iterations,
+                    now.stats.tangential_seconds,
+                    now.stats.tangential_iterations,
+                );
+            }
+            Event::Stable { .. } => {
+                if let Some(path) = checkpoint.as_deref() {
+                    if last_checkpoint.elapsed() >= every {
+                        now.solver(&before, &driver, start);
+                        save(path, &driver, &now)?;
+                        last_checkpoint = Instant::now();
+                    }
                 }
             }
-            Event::Stable { .. } => stable += 1,
-            Event::Detach { .. } => detach += 1,
-            Event::Attach { .. } => attach += 1,
             Event::GlobalSlip { load } => slip = Some(load.force / scale),
             _ => {}
         }
-        if ruptures >= max_ruptures {
+        if now.ruptures >= max_ruptures {
             break;
         }
     }
-    let elapsed = start.elapsed().as_secs_f64();
-    let s = driver.solve_stats();
+    now.solver(&before, &driver, start);
+    let s = now.stats;
     println!(
         "N = {} ({} x {}), seed {seed}, backend {:?}",
         driver.grid().len(),
@@ -128,9 +154,19 @@ fn run() -> report::Outcome {
         precursors::solver::SolverOptions::default().backend()
     );
     println!(
-        "wall {elapsed:.2} s (scene build {:.3} s); {events} events: {ruptures} ruptures, \
-         {stable} stable states, {detach} detachments, {attach} attachments; {}",
+        "wall {:.2} s (scene build {:.3} s{}); {} events: {} ruptures, {} stable states, \
+         {} detachments, {} attachments; {}",
+        now.seconds,
         built.as_secs_f64(),
+        match now.sittings {
+            0 => String::new(),
+            k => format!(", {} sittings", k + 1),
+        },
+        now.events,
+        now.ruptures,
+        now.stable,
+        now.detach,
+        now.attach,
         match slip {
             Some(load) => format!("global slip at F/(μF_N) = {load:.12}"),
             None => "stopped before global slip".to_string(),
@@ -158,12 +194,165 @@ fn run() -> report::Outcome {
     );
     println!(
         "event digest {:016x} (kind and site of every event)",
-        digest.0
+        now.digest.0
     );
     Ok(())
 }
 
+/// The value of the environment variable `name`, `default` when it is unset; a value
+/// that does not parse is refused rather than replaced by the default.
+fn env<T: std::str::FromStr>(name: &str, default: T) -> Result<T, String> {
+    match std::env::var(name) {
+        Err(std::env::VarError::NotPresent) => Ok(default),
+        Ok(text) => text.parse().map_err(|_| format!("invalid {name} '{text}'")),
+        Err(e) => Err(format!("invalid {name}: {e}")),
+    }
+}
+
+/// Where the totals of a checkpointed run are kept, next to its checkpoint.
+fn progress_path(checkpoint: &Path) -> PathBuf {
+    let mut name = checkpoint.as_os_str().to_owned();
+    name.push(".progress");
+    PathBuf::from(name)
+}
+
+/// Writes the checkpoint, then the totals at it (each atomically). A stop between the two
+/// leaves totals that do not match the checkpoint, refused on resume.
+fn save(path: &Path, driver: &Driver, totals: &Totals) -> report::Outcome {
+    driver.checkpoint().write_to(path)?;
+    let progress = progress_path(path);
+    let temporary = progress.with_extension("progress.tmp");
+    std::fs::write(&temporary, totals.to_text(driver.event_count())).at("write", &temporary)?;
+    std::fs::rename(&temporary, &progress).at("rename into place", &progress)?;
+    Ok(())
+}
+
+/// What this program counts, summed over the sittings of a checkpointed run.
+#[derive(Clone, Copy, Default)]
+struct Totals {
+    events: usize,
+    ruptures: usize,
+    stable: usize,
+    detach: usize,
+    attach: usize,
+    digest: Digest,
+    /// Wall time (s), this sitting's included once `solver` is called.
+    seconds: f64,
+    /// Earlier sittings.
+    sittings: usize,
+    stats: SolveStats,
+}
+
+impl Totals {
+    fn event(&mut self, event: &Event) {
+        self.events += 1;
+        self.digest.event(event);
+        match event {
+            Event::Rupture { .. } => self.ruptures += 1,
+            Event::Stable { .. } => self.stable += 1,
+            Event::Detach { .. } => self.detach += 1,
+            Event::Attach { .. } => self.attach += 1,
+            _ => {}
+        }
+    }
+
+    /// The wall time and solver work of the earlier sittings `before` plus this one's.
+    fn solver(&mut self, before: &Totals, driver: &Driver, start: Instant) {
+        let (a, b) = (before.stats, driver.solve_stats());
+        self.seconds = before.seconds + start.elapsed().as_secs_f64();
+        self.stats.normal_solves = a.normal_solves + b.normal_solves;
+        self.stats.normal_active_set_iterations =
+            a.normal_active_set_iterations + b.normal_active_set_iterations;
+        self.stats.normal_iterations = a.normal_iterations + b.normal_iterations;
+        self.stats.normal_seconds = a.normal_seconds + b.normal_seconds;
+        self.stats.tangential_solves = a.tangential_solves + b.tangential_solves;
+        self.stats.tangential_iterations = a.tangential_iterations + b.tangential_iterations;
+        self.stats.tangential_seconds = a.tangential_seconds + b.tangential_seconds;
+    }
+
+    /// One `key value` line per total; the times as the bits of their f64, so a resumed
+    /// run adds exactly what was measured.
+    fn to_text(self, checkpoint_events: usize) -> String {
+        let s = self.stats;
+        [
+            ("checkpoint_events", checkpoint_events as u64),
+            ("events", self.events as u64),
+            ("ruptures", self.ruptures as u64),
+            ("stable", self.stable as u64),
+            ("detach", self.detach as u64),
+            ("attach", self.attach as u64),
+            ("digest", self.digest.0),
+            ("seconds_bits", self.seconds.to_bits()),
+            ("sittings", self.sittings as u64 + 1),
+            ("normal_solves", s.normal_solves as u64),
+            (
+                "normal_active_set_iterations",
+                s.normal_active_set_iterations as u64,
+            ),
+            ("normal_iterations", s.normal_iterations as u64),
+            ("normal_seconds_bits", s.normal_seconds.to_bits()),
+            ("tangential_solves", s.tangential_solves as u64),
+            ("tangential_iterations", s.tangential_iterations as u64),
+            ("tangential_seconds_bits", s.tangential_seconds.to_bits()),
+        ]
+        .iter()
+        .map(|(key, value)| format!("{key} {value}\n"))
+        .collect()
+    }
+
+    /// The totals written by `to_text` at the checkpoint of `checkpoint_events` events.
+    fn read(path: &Path, checkpoint_events: usize) -> Result<Totals, Box<dyn std::error::Error>> {
+        let text = std::fs::read_to_string(path).at("read", path)?;
+        let mut values = std::collections::HashMap::new();
+        for line in text.lines() {
+            let parsed = line
+                .split_once(' ')
+                .and_then(|(key, value)| Some((key, value.parse::<u64>().ok()?)));
+            let (key, value) = parsed
+                .ok_or_else(|| format!("{}: not a `key value` line: '{line}'", path.display()))?;
+            values.insert(key.to_string(), value);
+        }
+        let get = |key: &str| {
+            values
+                .get(key)
+                .copied()
+                .ok_or_else(|| format!("{}: no value for '{key}'", path.display()))
+        };
+        let count = |key: &str| get(key).map(|v| v as usize);
+        let seconds = |key: &str| get(key).map(f64::from_bits);
+        if count("checkpoint_events")? != checkpoint_events || count("events")? != checkpoint_events
+        {
+            return Err(format!(
+                "{} does not belong to the checkpoint next to it (of {checkpoint_events} events): \
+                 the run stopped between writing the two; remove both to start again",
+                path.display()
+            )
+            .into());
+        }
+        let mut stats = SolveStats::default();
+        stats.normal_solves = count("normal_solves")?;
+        stats.normal_active_set_iterations = count("normal_active_set_iterations")?;
+        stats.normal_iterations = count("normal_iterations")?;
+        stats.normal_seconds = seconds("normal_seconds_bits")?;
+        stats.tangential_solves = count("tangential_solves")?;
+        stats.tangential_iterations = count("tangential_iterations")?;
+        stats.tangential_seconds = seconds("tangential_seconds_bits")?;
+        Ok(Totals {
+            events: count("events")?,
+            ruptures: count("ruptures")?,
+            stable: count("stable")?,
+            detach: count("detach")?,
+            attach: count("attach")?,
+            digest: Digest(get("digest")?),
+            seconds: seconds("seconds_bits")?,
+            sittings: count("sittings")?,
+            stats,
+        })
+    }
+}
+
 /// FNV-1a over the kind and site of the events that change the set.
+#[derive(Clone, Copy)]
 struct Digest(u64);
 
 impl Default for Digest {
