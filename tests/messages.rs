@@ -585,3 +585,48 @@ fn a_scene_file_that_is_not_text_is_invalid_input() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The seconds of `info`'s "run ~X to global slip" line.
+fn info_run_seconds(scene: &str) -> f64 {
+    let dir = scratch("estimate");
+    let file = dir.join("scene.json");
+    std::fs::write(&file, scene).unwrap();
+    let out = precursors(&["info", path(&file)]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let text = String::from_utf8(out.stdout).unwrap();
+    let line = text.lines().find(|l| l.starts_with("run ")).unwrap();
+    let mut words = line.split('~').nth(1).unwrap().split_whitespace();
+    let value: f64 = words.next().unwrap().parse().unwrap();
+    let scale = match words.next().unwrap() {
+        "s" => 1.0,
+        "min" => 60.0,
+        "h" => 3600.0,
+        "days" => 86400.0,
+        unit => panic!("unit {unit} in {line}"),
+    };
+    value * scale
+}
+
+#[test]
+fn info_estimates_the_measured_large_runs_within_a_factor_two() {
+    // The whole runs of docs/performance.md, one thread, release build, 1 mm cells, rod
+    // drive, paper heights: N = 1e4 (200 x 50, 3.5 MPa) 115-119 s; N = 1e5 (1000 x 100,
+    // 1 MPa) 9 200 s on two threads, 1.66-1.69x faster than one thread on its first 500
+    // ruptures: about 15 400 s. (On the older machine of those pages, N = 1e4 took 70-76 s.)
+    let scene = |lx: f64, ly: f64, pressure: f64| {
+        format!(
+            r#"{{ "block": {{ "lx": {lx}, "ly": {ly}, "lz": 0.075 }},
+            "cells": {{ "kind": "size", "dx": 0.001, "dy": 0.001 }},
+            "normal_load": {} }}"#,
+            pressure * lx * ly
+        )
+    };
+    for (lx, ly, pressure, measured) in [(0.2, 0.05, 3.5e6, 117.0), (1.0, 0.1, 1e6, 15_400.0)] {
+        let estimate = info_run_seconds(&scene(lx, ly, pressure));
+        let ratio = estimate / measured;
+        assert!(
+            (0.5..=2.0).contains(&ratio),
+            "{lx} x {ly} m: info estimates {estimate} s, measured about {measured} s"
+        );
+    }
+}
