@@ -593,6 +593,7 @@ fn info_run_seconds(scene: &str) -> f64 {
     std::fs::write(&file, scene).unwrap();
     let out = precursors(&["info", path(&file)]);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    std::fs::remove_dir_all(&dir).unwrap();
     let text = String::from_utf8(out.stdout).unwrap();
     let line = text.lines().find(|l| l.starts_with("run ")).unwrap();
     let mut words = line.split('~').nth(1).unwrap().split_whitespace();
