@@ -19,7 +19,9 @@
 //! (checkpoints).
 
 use super::fsai::Entries;
+use super::parallel::{map_parts, Parallelism};
 use super::pcg::dot;
+use crate::error::Result;
 use crate::lock::{lock, read, write};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt;
@@ -32,6 +34,9 @@ use std::sync::{Mutex, RwLock};
 const MAX_AGGREGATES: usize = 512;
 /// The smallest block (cells per side).
 const MIN_BLOCK: usize = 8;
+/// Tasks the entries of `E`'s changed rows are cut into: more than threads, so that
+/// pairs of uneven cost (`|S_a| |S_b|` terms each) even out.
+const PAIR_TASKS: usize = 16;
 
 /// Aggregates, `E`'s factor and the scratch of the coarse solves.
 #[derive(Debug)]
@@ -121,8 +126,19 @@ impl Coarse {
 
     /// Brings `E` and its factor up to date for `set` (ascending sites) with compliances
     /// `d`: the rows of `Zᵀ C_SS Z` of blocks whose sites changed, then the factor from
-    /// the first unknown whose row of `E` changed.
-    pub(crate) fn update(&mut self, entries: &Entries, set: &[usize], d: &[f64]) {
+    /// the first unknown whose row of `E` changed. The rows' entries are shared among
+    /// `parallelism`'s threads (each entry is summed by one task: the same bits for any
+    /// thread count).
+    ///
+    /// # Errors
+    /// [`Error::ThreadPool`](crate::Error::ThreadPool) when the threads cannot be started.
+    pub(crate) fn update(
+        &mut self,
+        entries: &Entries,
+        set: &[usize],
+        d: &[f64],
+        parallelism: Parallelism,
+    ) -> Result<()> {
         let count = self.members.len();
         let mut fresh = std::mem::take(&mut self.fresh);
         let mut dfresh = std::mem::take(&mut self.dfresh);
@@ -151,23 +167,36 @@ impl Coarse {
         self.fresh = fresh;
         self.dfresh = dfresh;
         let Some(first) = first else {
-            return;
+            return Ok(());
         };
-        for a in 0..count {
-            if self.changed[a] {
-                // A pair of changed blocks once (the first build: every pair once).
-                for b in (0..count).filter(|&b| !(self.changed[b] && b < a)) {
-                    let v = self.pair(entries, a.min(b), a.max(b));
-                    self.g[a * count + b] = v;
-                    self.g[b * count + a] = v;
-                }
-            }
+        // A pair of changed blocks once (the first build: every pair once).
+        let changed = &self.changed;
+        let pairs: Vec<(usize, usize)> = (0..count)
+            .filter(|&a| changed[a])
+            .flat_map(|a| {
+                (0..count)
+                    .filter(move |&b| !(changed[b] && b < a))
+                    .map(move |b| (a.min(b), a.max(b)))
+            })
+            .collect();
+        let tasks = PAIR_TASKS.min(pairs.len());
+        let chunk = |t: usize| &pairs[t * pairs.len() / tasks..(t + 1) * pairs.len() / tasks];
+        let sums = map_parts(parallelism, tasks, |t| {
+            chunk(t)
+                .iter()
+                .map(|&(a, b)| self.pair(entries, a, b))
+                .collect::<Vec<f64>>()
+        })?;
+        for (&(a, b), v) in pairs.iter().zip(sums.into_iter().flatten()) {
+            self.g[a * count + b] = v;
+            self.g[b * count + a] = v;
         }
         let from = self.unknowns.partition_point(|&u| u < first);
         self.unknowns.truncate(from);
         self.unknowns
             .extend((first..count).filter(|&a| !self.members[a].is_empty()));
         self.factor();
+        Ok(())
     }
 
     /// `1_{S_a}ᵀ C 1_{S_b}` (`a ≤ b`): a pure function of the two blocks' sites.
@@ -332,7 +361,10 @@ mod tests {
         let d: Vec<f64> = set.iter().map(|i| 1e-13 * (1.0 + (i % 3) as f64)).collect();
         let mut coarse = Coarse::new(nx, ny, 1);
         assert_eq!(coarse.block(), MIN_BLOCK);
-        coarse.update(&entries, &set, &d);
+        // Two threads: the entries are summed in tasks shared between them.
+        coarse
+            .update(&entries, &set, &d, Parallelism::Threads(2))
+            .unwrap();
         let count = coarse.members.len();
         let mut e = vec![0.0; count * count];
         for (p, &i) in set.iter().enumerate() {
@@ -355,7 +387,8 @@ mod tests {
         }
     }
 
-    /// After any history of sets the factor is the same bits as a fresh one's.
+    /// After any history of sets the factor is the same bits as a fresh one's, whatever
+    /// the threads (the walked one's rows are summed on two, the fresh one's on one).
     #[test]
     fn factor_is_history_free() {
         let (nx, ny) = (48, 24);
@@ -366,7 +399,8 @@ mod tests {
         };
         let mut walked = Coarse::new(nx, ny, 2);
         let mut set = set_of(nx * ny, 1);
-        walked.update(&entries, &set, &dof(&set));
+        let two = Parallelism::Threads(2);
+        walked.update(&entries, &set, &dof(&set), two).unwrap();
         // Sites leave and join, a block empties and fills again.
         for step in 0..6 {
             let drop = set[(step * 37) % set.len()];
@@ -376,9 +410,11 @@ mod tests {
                 set.sort_unstable();
                 set.dedup();
             }
-            walked.update(&entries, &set, &dof(&set));
+            walked.update(&entries, &set, &dof(&set), two).unwrap();
             let mut fresh = Coarse::new(nx, ny, 2);
-            fresh.update(&entries, &set, &dof(&set));
+            fresh
+                .update(&entries, &set, &dof(&set), Parallelism::Sequential)
+                .unwrap();
             assert_eq!(walked.unknowns, fresh.unknowns);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&walked.lower), bits(&fresh.lower), "step {step}");
@@ -397,7 +433,9 @@ mod tests {
         let set = set_of(nx * ny, 7);
         let d = vec![2e-13; set.len()];
         let mut coarse = Coarse::new(nx, ny, 1);
-        coarse.update(&entries, &set, &d);
+        coarse
+            .update(&entries, &set, &d, Parallelism::Sequential)
+            .unwrap();
         let r: Vec<f64> = set.iter().map(|i| ((i * 31) % 17) as f64 - 8.0).collect();
         coarse.restrict(0, &set, &r, None);
         coarse.solve();

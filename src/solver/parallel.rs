@@ -323,6 +323,45 @@ pub(crate) fn with_crew<T: Tasks, R>(
     })
 }
 
+/// Runs `task(k)` for every `k < parts` as one phase on `parallelism`'s threads and
+/// returns the results in part order: for work between solves (a preconditioner's upkeep)
+/// that would otherwise run on the calling thread alone while the helpers wait. Each
+/// result is computed by one task, so it does not depend on the threads.
+pub(crate) fn map_parts<R: Send>(
+    parallelism: Parallelism,
+    parts: usize,
+    task: impl Fn(usize) -> R + Sync,
+) -> Result<Vec<R>> {
+    struct Map<F, R> {
+        task: F,
+        out: Vec<Mutex<Option<R>>>,
+    }
+    impl<F: Fn(usize) -> R + Sync, R: Send> Tasks for Map<F, R> {
+        type Phase = ();
+        fn run(&self, _: (), part: usize) -> [f64; SLOTS] {
+            let value = (self.task)(part);
+            *crate::lock::lock(&self.out[part]) = Some(value);
+            [0.0; SLOTS]
+        }
+    }
+    let map = Map {
+        task,
+        out: (0..parts).map(|_| Mutex::new(None)).collect(),
+    };
+    with_crew(parallelism, parts, &map, |crew| {
+        crew.run(());
+    })?;
+    Ok(map
+        .out
+        .into_iter()
+        .map(|slot| {
+            slot.into_inner()
+                .unwrap_or_else(|e| e.into_inner())
+                .expect("every part ran")
+        })
+        .collect())
+}
+
 /// Spawns `helpers` helpers in `scope`, runs the leader, then releases the helpers.
 fn lead<'s, T: Tasks, R>(
     scope: Option<&rayon::Scope<'s>>,
@@ -423,6 +462,29 @@ mod tests {
             match &reference {
                 None => reference = Some(sums),
                 Some(r) => assert_eq!(r, &sums, "{par:?}"),
+            }
+        }
+    }
+
+    /// `map_parts` runs every part once and returns the results in part order, on any
+    /// crew (more parts than threads, fewer, none).
+    #[test]
+    fn map_parts_returns_every_part_in_order() {
+        for par in [
+            Parallelism::Sequential,
+            Parallelism::Threads(2),
+            Parallelism::Threads(3),
+        ] {
+            for parts in [0, 1, 2, 16] {
+                let ran: Vec<AtomicUsize> = (0..parts).map(|_| AtomicUsize::new(0)).collect();
+                let out = map_parts(par, parts, |k| {
+                    ran[k].fetch_add(1, Ordering::Relaxed);
+                    vec![k; k % 3]
+                })
+                .unwrap();
+                let want: Vec<Vec<usize>> = (0..parts).map(|k| vec![k; k % 3]).collect();
+                assert_eq!(out, want, "{par:?}, {parts} parts");
+                assert!(ran.iter().all(|r| r.load(Ordering::Relaxed) == 1));
             }
         }
     }

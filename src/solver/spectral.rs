@@ -4,6 +4,7 @@
 
 use super::coarse::Coarse;
 use super::fsai::{Entries, Fsai};
+use super::parallel::Parallelism;
 use super::pcg::{projected_pcg, Effort, PcgVectors};
 use super::set::{SetProblem, SetSolve};
 use super::system::{Compliance, FsaiBuffers, Preconditioner, StagedSystem};
@@ -163,8 +164,15 @@ impl SpectralCore {
     /// FSAI rows around changed sites; the spectral table when the mean compliance moved
     /// by more than 5 %. `C` is diagonal in the DCT basis, so the spectral preconditioner
     /// costs a second staged product per iteration and halves the iterations: it pays on
-    /// cold, far-from-solution solves of large grids (docs/performance.md).
-    fn prepare(&mut self, set: &[usize], d: &[f64], precond: Precond) {
+    /// cold, far-from-solution solves of large grids (docs/performance.md). The coarse
+    /// space's upkeep runs on `parallelism`'s threads.
+    fn prepare(
+        &mut self,
+        set: &[usize],
+        d: &[f64],
+        precond: Precond,
+        parallelism: Parallelism,
+    ) -> Result<()> {
         match precond {
             Precond::Fsai | Precond::TwoLevel => {
                 let Compliance { scale, shift, .. } = self.compliance;
@@ -184,7 +192,7 @@ impl SpectralCore {
                         let coarse = Coarse::new(grid.nx(), grid.ny(), partition.parts());
                         (coarse, Staging::new(&self.plan, partition.clone()))
                     });
-                    coarse.update(entries, set, d);
+                    coarse.update(entries, set, d, parallelism)?;
                 }
             }
             Precond::Spectral => {
@@ -201,6 +209,7 @@ impl SpectralCore {
             }
             Precond::Jacobi => {}
         }
+        Ok(())
     }
 
     /// Solves `problem` with `precond`; `f` holds the warm start.
@@ -211,7 +220,7 @@ impl SpectralCore {
         f: Vec<f64>,
         effort: Effort,
     ) -> Result<SetSolve> {
-        self.prepare(problem.set, problem.d, precond);
+        self.prepare(problem.set, problem.d, precond, effort.parallelism)?;
         let precond = match (precond, &self.fsai, &self.inverse) {
             (Precond::TwoLevel, Some((fsai, buffers)), _) => match &self.coarse {
                 Some((coarse, staging)) => Preconditioner::TwoLevel {
