@@ -380,10 +380,19 @@ fn lead<'s, T: Tasks, R>(
         board,
         generation: std::cell::Cell::new(0),
     };
-    let result = leader(&crew);
-    board.finished.store(true, Ordering::SeqCst);
-    board.notify();
-    result
+    let _release = ReleaseHelpers(board);
+    leader(&crew)
+}
+
+/// Ends the helpers' loop when the leader returns or unwinds: a panic in the leader's own
+/// logic must not leave them spinning while the scope waits for them.
+struct ReleaseHelpers<'a, P: Copy>(&'a Board<P>);
+
+impl<P: Copy> Drop for ReleaseHelpers<'_, P> {
+    fn drop(&mut self) {
+        self.0.finished.store(true, Ordering::SeqCst);
+        self.0.notify();
+    }
 }
 
 /// The shared pools, by size.
@@ -463,6 +472,34 @@ mod tests {
                 None => reference = Some(sums),
                 Some(r) => assert_eq!(r, &sums, "{par:?}"),
             }
+        }
+    }
+
+    /// A leader that panics between phases releases its helpers: the panic reaches the
+    /// caller instead of a hang (checked on a thread of its own, so that a hang fails the
+    /// test instead of stalling it).
+    #[test]
+    fn a_panicking_leader_releases_its_helpers() {
+        for par in [Parallelism::Threads(2), Parallelism::Threads(3)] {
+            let (sender, receiver) = std::sync::mpsc::channel();
+            std::thread::spawn(move || {
+                let tasks = Sums {
+                    ran: (0..4).map(|_| AtomicUsize::new(0)).collect(),
+                };
+                let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    with_crew(par, 4, &tasks, |crew| {
+                        crew.run(1);
+                        panic!("the leader's logic failed");
+                    })
+                }));
+                sender.send(outcome.is_err()).unwrap();
+            });
+            let panicked = receiver.recv_timeout(Duration::from_secs(60));
+            assert_eq!(
+                panicked,
+                Ok(true),
+                "{par:?}: the crew hung or did not panic"
+            );
         }
     }
 
