@@ -15,6 +15,7 @@ LAYERS = [
     ["format"],
     ["error"],
     ["cost", "lock"],
+    ["files"],
     ["geometry"],
     ["green", "surface"],
     ["interface"],

@@ -132,22 +132,6 @@ pub(crate) fn check_memory(
     }
 }
 
-/// Refuses to read a file whose text (a few times its size once parsed) would not fit in
-/// the memory available ([`check_memory`]): a file of any size gets an answer, never an
-/// aborted allocation. A file whose size cannot be read is left to the read that follows,
-/// which reports it.
-pub(crate) fn check_file_size(path: &std::path::Path) -> Result<()> {
-    let Ok(meta) = std::fs::metadata(path) else {
-        return Ok(());
-    };
-    let size = meta.len();
-    check_memory(
-        || format!("reading {} ({size} bytes)", path.display()),
-        5.0 * size as f64,
-        "the file is too large for this machine",
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -51,7 +51,6 @@ mod observables;
 #[cfg(feature = "serde")]
 pub(crate) use checkpoint::scene_mismatch;
 pub use checkpoint::Checkpoint;
-pub(crate) use checkpoint::{sync_dir, write_atomically};
 
 /// A site of the interface grid.
 ///

@@ -493,6 +493,32 @@ pub enum Error {
         /// What the parser reported.
         reason: String,
     },
+    /// A path named as an input or an output is not a regular file: a FIFO, a device, a
+    /// socket or a directory (an input), or also a symbolic link (an output, which would
+    /// be replaced, not written through). Refused before anything is read or written: a
+    /// FIFO would block, a device would be read without end or replaced by a file.
+    #[error("{operation} {}: it is {kind}, not a regular file", path.display())]
+    NotARegularFile {
+        /// What was being done (`"reading scene file"`, `"writing checkpoint"`, ...).
+        operation: &'static str,
+        /// The path.
+        path: PathBuf,
+        /// What it is (`"a FIFO (named pipe)"`, `"a character device"`, `"a directory"`, ...).
+        kind: &'static str,
+    },
+    /// An output the caller names (a checkpoint) would take the name of a file its run
+    /// directory holds: a table, `NAME.partial`, the scene record, the lock, a sweep's
+    /// markers, a figure or a movie (`RunTables::run_to_slip`), or the file a command
+    /// reads (the program's `run`: the scene file). Refused before anything is written.
+    #[error("{what} {}: {}", path.display(), Bounded(reason))]
+    OutputCollision {
+        /// The output (`"checkpoint"`).
+        what: &'static str,
+        /// Its path.
+        path: PathBuf,
+        /// Which file it would replace, and what to do.
+        reason: String,
+    },
     /// A run's CSV table (`events.csv`, `curve.csv`, `contact_map.csv`) cannot be
     /// continued: a damaged row before the last one, another header, an index that is not
     /// a whole number, or rows that do not reach the

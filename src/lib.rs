@@ -103,6 +103,7 @@ pub mod calibration;
 mod cost;
 mod driver;
 mod error;
+mod files;
 mod format;
 mod geometry;
 pub mod green;

@@ -53,8 +53,11 @@
 //! recorded, `fields.csv` must hold exactly the recorded states up to the checkpoint's
 //! event (the same `every` and planes), and is cut back the same way.
 
-use crate::driver::{sync_dir, write_atomically, Driver, Event};
+pub(crate) mod layout;
+
+use crate::driver::{Driver, Event};
 use crate::error::{Error, Result};
+use crate::files::{check_replaceable, read_text_if_exists, sync_dir, write_atomically};
 use crate::interface::SiteState;
 use crate::lock::DirLock;
 use crate::probe::{ProbeSpec, StressProbe};
@@ -108,6 +111,30 @@ pub(crate) fn contact_map_header(nx: usize) -> String {
         header.push_str(&format!(",area_m2_ix{ix}"));
     }
     header
+}
+
+/// Refuses an output `path` a caller names beside a run writing into `dir` (a
+/// checkpoint) that would replace a file of the run directory: a table, `NAME.partial`,
+/// the scene record, the lock, a sweep's `done` or `meta.json`, a merged table, a figure
+/// or a movie; and one that exists but is not a regular file (a FIFO, a device, a
+/// directory, a symbolic link), which a checkpoint written atomically would replace.
+/// [`RunTables::run_to_slip`] checks its checkpoint so; call it before
+/// [`RunTables::create`] to refuse before anything is written.
+///
+/// ```
+/// use precursors::output::check_output_path;
+/// let dir = std::path::Path::new(".");
+/// assert!(check_output_path(dir, &dir.join("curve.csv.partial")).is_err());
+/// assert!(check_output_path(dir, &dir.join(".precursors.lock")).is_err());
+/// assert!(check_output_path(dir, &dir.join("checkpoint.json")).is_ok());
+/// ```
+///
+/// # Errors
+/// [`Error::OutputCollision`]; [`Error::NotARegularFile`]; [`Error::Io`] when `path`
+/// cannot be examined.
+pub fn check_output_path(dir: &Path, path: &Path) -> Result<()> {
+    layout::check_output(path, dir, "checkpoint")?;
+    check_replaceable(path, "writing checkpoint")
 }
 
 /// The complete rows of a table's text (line number, row), its header checked: a last
@@ -664,6 +691,7 @@ impl RunTables {
     /// [`Error::Io`] when a file cannot be written or removed.
     pub fn create(dir: &Path, driver: &Driver) -> Result<Self> {
         let lock = DirLock::lock(dir)?;
+        layout::check_not_a_sweeps(dir)?;
         Self::start(dir, driver, Some(lock))
     }
 
@@ -672,6 +700,7 @@ impl RunTables {
     pub(crate) fn start(dir: &Path, driver: &Driver, lock: Option<DirLock>) -> Result<Self> {
         let (paths, partials) = table_paths(dir);
         remove_stale_temporaries(dir)?;
+        remove_derived(dir)?;
         for path in &paths {
             match fs::remove_file(path) {
                 Err(e) if e.kind() != io::ErrorKind::NotFound => {
@@ -693,6 +722,8 @@ impl RunTables {
         ];
         let mut files = Vec::with_capacity(3);
         for (path, header) in partials.iter().zip(&headers) {
+            // A FIFO there would block the open, a link would be written through.
+            check_replaceable(path, "creating table")?;
             let file = File::create(path).map_err(|e| Error::io("creating table", path, e))?;
             let mut file = BufWriter::new(file);
             writeln!(file, "{header}").map_err(|e| Error::io("writing table", path, e))?;
@@ -706,6 +737,7 @@ impl RunTables {
             driver,
             dir,
             |path| {
+                check_replaceable(path, "creating table")?;
                 let mut file =
                     File::create(path).map_err(|e| Error::io("creating table", path, e))?;
                 writeln!(file, "{}", fields_header(nx))
@@ -755,6 +787,7 @@ impl RunTables {
             });
         }
         let lock = DirLock::lock(dir)?;
+        layout::check_not_a_sweeps(dir)?;
         #[cfg(feature = "serde")]
         check_scene_record(dir, driver)?;
         let k = driver.event_count();
@@ -764,15 +797,10 @@ impl RunTables {
         let mut read = partials.clone();
         for t in 0..3 {
             for path in [&partials[t], &paths[t]] {
-                crate::cost::check_file_size(path)?;
-                match fs::read_to_string(path) {
-                    Ok(text) => {
-                        old[t] = Some(text);
-                        read[t] = path.clone();
-                        break;
-                    }
-                    Err(e) if e.kind() == io::ErrorKind::NotFound => {}
-                    Err(e) => return Err(Error::io("reading table", path, e)),
+                if let Some(text) = read_text_if_exists(path, "reading table")? {
+                    old[t] = Some(text);
+                    read[t] = path.clone();
+                    break;
                 }
             }
         }
@@ -796,15 +824,10 @@ impl RunTables {
             let mut old = None;
             let mut read = partial.clone();
             for p in [&partial, &path] {
-                crate::cost::check_file_size(p)?;
-                match fs::read_to_string(p) {
-                    Ok(text) => {
-                        old = Some(text);
-                        read = p.clone();
-                        break;
-                    }
-                    Err(e) if e.kind() == io::ErrorKind::NotFound => {}
-                    Err(e) => return Err(Error::io("reading table", p, e)),
+                if let Some(text) = read_text_if_exists(p, "reading table")? {
+                    old = Some(text);
+                    read = p.clone();
+                    break;
                 }
             }
             Some(fields_continuation(
@@ -1030,6 +1053,9 @@ impl RunTables {
         checkpoint: Option<(&Path, std::num::NonZeroU64)>,
         mut observe: impl FnMut(&Event, &Driver),
     ) -> Result<[PathBuf; 3]> {
+        if let Some((path, _)) = checkpoint {
+            check_output_path(&self.dir, path)?;
+        }
         while let Some(event) = driver.step()? {
             self.record(driver, &event)?;
             if let (Event::Stable { .. }, Some((path, every))) = (&event, checkpoint) {
@@ -1105,6 +1131,29 @@ fn remove_stale_temporaries(dir: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Removes the figures and movies of an earlier run from `dir` ([`layout::derived`]): they
+/// would stand beside tables they were not drawn from.
+fn remove_derived(dir: &Path) -> Result<()> {
+    let entries = fs::read_dir(dir).map_err(|e| Error::io("reading directory", dir, e))?;
+    for entry in entries {
+        let entry = entry.map_err(|e| Error::io("reading directory", dir, e))?;
+        let is_file = entry.file_type().is_ok_and(|t| !t.is_dir());
+        if is_file && entry.file_name().to_str().is_some_and(layout::derived) {
+            match fs::remove_file(entry.path()) {
+                Err(e) if e.kind() != io::ErrorKind::NotFound => {
+                    return Err(Error::io(
+                        "removing the earlier run's figure",
+                        entry.path(),
+                        e,
+                    ))
+                }
+                _ => {}
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Removes `fields.csv` and `fields.csv.partial` from `dir` (where they exist).
 fn remove_fields(dir: &Path) -> Result<()> {
     let (path, partial) = FieldsTable::paths(dir);
@@ -1123,10 +1172,9 @@ fn remove_fields(dir: &Path) -> Result<()> {
 #[cfg(feature = "serde")]
 fn check_scene_record(dir: &Path, driver: &Driver) -> Result<()> {
     let path = dir.join(SCENE_RECORD);
-    crate::cost::check_file_size(&path)?;
-    let text = match fs::read_to_string(&path) {
-        Ok(text) => text,
-        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+    let text = match read_text_if_exists(&path, "reading the scene record")? {
+        Some(text) => text,
+        None => {
             return Err(Error::RunDirectory {
                 path: dir.to_path_buf(),
                 reason: format!(
@@ -1137,7 +1185,6 @@ fn check_scene_record(dir: &Path, driver: &Driver) -> Result<()> {
                 ),
             })
         }
-        Err(e) => return Err(Error::io("reading the scene record", &path, e)),
     };
     let recorded = crate::SceneBuilder::from_json_str(&text).map_err(|e| Error::RunDirectory {
         path: path.clone(),

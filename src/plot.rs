@@ -1178,7 +1178,7 @@ fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
             ))
         }
     };
-    Ok(crate::driver::write_atomically(
+    Ok(crate::files::write_atomically(
         path,
         &bytes,
         "writing figure",

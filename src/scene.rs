@@ -287,29 +287,31 @@ impl HeightSource {
     /// must fit in the memory available.
     pub(crate) fn read_file(path: &std::path::Path, cells: Option<usize>) -> Result<HeightSource> {
         let name = path.display().to_string();
+        // 1 MiB of comments and 256 bytes a height. Checked on the length reported (a
+        // long file is refused unread) and on the bytes read (a device reports 0).
+        let limit = cells.map(|c| (1u64 << 20).saturating_add((c as u64).saturating_mul(256)));
+        let too_long = |size: &str| Error::HeightsFile {
+            path: name.clone(),
+            line: 0,
+            reason: format!(
+                "the file has {size} bytes, more than the {} bytes that {} heights (one per \
+                 cell) and their comments may take",
+                limit.unwrap_or_default(),
+                cells.unwrap_or_default()
+            ),
+        };
         let size = std::fs::metadata(path)
             .map_err(|e| Error::io("reading heights file", path, e))?
             .len();
-        if let Some(cells) = cells {
-            let limit = (1u64 << 20).saturating_add((cells as u64).saturating_mul(256));
-            if size > limit {
-                return Err(Error::HeightsFile {
-                    path: name,
-                    line: 0,
-                    reason: format!(
-                        "the file has {size} bytes, more than the {limit} bytes that {cells} \
-                         heights (one per cell) and their comments may take"
-                    ),
-                });
-            }
+        if limit.is_some_and(|l| size > l) {
+            return Err(too_long(&size.to_string()));
         }
-        // The text and the values (8 bytes each, from at least 2 bytes of text).
-        crate::green::check_memory(
-            || format!("reading heights file {name} ({size} bytes)"),
-            5.0 * size as f64,
-            "the file is too large for this machine",
-        )?;
-        let bytes = std::fs::read(path).map_err(|e| Error::io("reading heights file", path, e))?;
+        // The text and the values (8 bytes each, from at least 2 bytes of text) within the
+        // memory available.
+        let bytes = crate::files::read_bytes(path, "reading heights file")?;
+        if limit.is_some_and(|l| bytes.len() as u64 > l) {
+            return Err(too_long(&format!("at least {}", bytes.len())));
+        }
         let text = match std::str::from_utf8(&bytes) {
             Ok(text) => text,
             Err(e) => {

@@ -35,8 +35,8 @@ pub use merge::{mean_band, merge, Band, MergeSummary, LOAD_GRID};
 /// The results of this module: its errors are [`SweepError`]s.
 type Result<T, E = SweepError> = std::result::Result<T, E>;
 
-use crate::driver::write_atomically;
 use crate::error::Error;
+use crate::files::write_atomically;
 use crate::lock::{Attempt, DirLock, LOCK_FILE};
 use crate::output::RunTables;
 use crate::scene::file::{check_shape, read_json_text, scene_shape, SceneFile, Shape};
@@ -50,9 +50,9 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 /// The name of a sweep's own copy of its file in the output directory.
-pub const SWEEP_FILE: &str = "sweep.json";
+pub const SWEEP_FILE: &str = crate::output::layout::SWEEP;
 /// The completion marker of a run, written last (atomically) into its directory.
-pub const DONE_FILE: &str = "done";
+pub const DONE_FILE: &str = crate::output::layout::DONE;
 /// The most runs a sweep may have (points times realizations): `1e5` runs are a day of
 /// the calibration scene on 64 cores, a run directory of four files each, and a merge
 /// that reads them all; a larger study is several sweeps (each its own directory).
@@ -730,7 +730,11 @@ impl Sweep {
             column: 0,
             source: Box::new(e),
         })?;
-        write_atomically(&dir.join("meta.json"), text.as_bytes(), "writing")?;
+        write_atomically(
+            &dir.join(crate::output::layout::META),
+            text.as_bytes(),
+            "writing",
+        )?;
         write_atomically(&dir.join(DONE_FILE), b"complete\n", "writing")?;
         Ok(RunReport {
             index: run.index,
@@ -822,19 +826,28 @@ impl Sweep {
         let _lock = DirLock::lock_waiting(out, std::time::Duration::from_secs(30))?;
         let path = out.join(SWEEP_FILE);
         let text = self.to_json()?;
-        crate::cost::check_file_size(&path)?;
-        match std::fs::read_to_string(&path) {
-            Ok(old) if old == text => Ok(()),
-            Ok(_) => Err(SweepError::Directory {
+        let existing = crate::files::read_text_if_exists(&path, "reading")?;
+        if existing.is_none() {
+            if let Some(name) = crate::output::layout::holds_a_run(out)? {
+                return Err(SweepError::Directory {
+                    path: out.to_path_buf(),
+                    reason: format!(
+                        "the directory holds a run's files ({name}), not a sweep's: a \
+                         sweep's figures and merged tables would mix with the run's; choose \
+                         another output directory"
+                    ),
+                });
+            }
+        }
+        match existing {
+            Some(old) if old == text => Ok(()),
+            Some(_) => Err(SweepError::Directory {
                 path,
                 reason: "the directory holds another sweep (its sweep.json differs): \
                          choose another output directory"
                     .into(),
             }),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                Ok(write_atomically(&path, text.as_bytes(), "writing")?)
-            }
-            Err(e) => Err(Error::io("reading", &path, e).into()),
+            None => Ok(write_atomically(&path, text.as_bytes(), "writing")?),
         }
     }
 }

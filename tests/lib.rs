@@ -23,6 +23,8 @@ mod messages;
 #[cfg(feature = "plot")]
 mod movie;
 mod operator;
+#[cfg(feature = "cli")]
+mod outputs;
 #[cfg(feature = "serde")]
 mod paper_sweeps;
 #[cfg(feature = "plot")]

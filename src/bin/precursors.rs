@@ -287,13 +287,15 @@ struct Failure {
 fn core_code(e: &Error) -> u8 {
     match e {
         Error::Io { source, .. } if source.kind() == std::io::ErrorKind::InvalidData => 3,
-        Error::Io { .. } | Error::DirectoryLocked { .. } => 4,
+        Error::Io { .. } | Error::NotARegularFile { .. } | Error::DirectoryLocked { .. } => 4,
         Error::SolverNotConverged { .. }
         | Error::Factorization { .. }
         | Error::EmptyContact { .. }
         | Error::ThreadPool { .. }
         | Error::NotSolved { .. }
         | Error::LoadBeyondFriction { .. } => 1,
+        // An output option naming a file the command writes or reads: a bad command line.
+        Error::OutputCollision { .. } => 2,
         _ => 3,
     }
 }
@@ -514,6 +516,28 @@ fn writable_dir(dir: &Path) -> Result<(), Failure> {
     Ok(())
 }
 
+/// Refuses, before anything is written, a checkpoint that would replace a file of the run
+/// directory or the scene file the run reads.
+fn refuse_colliding_checkpoint(
+    start: &Start<'_>,
+    out: &Path,
+    checkpoint: &Path,
+) -> Result<(), Failure> {
+    precursors::output::check_output_path(out, checkpoint)?;
+    if let Start::Scene(scene) = start {
+        if let (Ok(a), Ok(b)) = (scene.canonicalize(), checkpoint.canonicalize()) {
+            if a == b {
+                return Err(usage(format!(
+                    "--checkpoint {} names the scene file the run reads: the checkpoint \
+                     would replace it; name another file",
+                    checkpoint.display()
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
 fn run(
     start: Start<'_>,
     out: &Path,
@@ -524,12 +548,17 @@ fn run(
     let (scene, mut driver, tables) = match start {
         Start::Scene(path) => {
             writable_dir(out)?;
+            // Once the directory exists, so that any spelling of it is resolved.
+            if let Some(checkpoint) = checkpoint {
+                refuse_colliding_checkpoint(&start, out, checkpoint)?;
+            }
             let scene = SceneBuilder::from_json_file(path)?.build()?;
             let driver = scene.driver()?;
             let tables = RunTables::create(out, &driver)?;
             (scene, driver, tables)
         }
         Start::Checkpoint(path) => {
+            refuse_colliding_checkpoint(&start, out, path)?;
             let checkpoint = Checkpoint::read_from(path)?;
             let scene = checkpoint.scene().clone().build()?;
             let driver = scene.resume(&checkpoint)?;

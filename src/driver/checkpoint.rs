@@ -180,7 +180,7 @@ impl Checkpoint {
     /// checkpoint cannot be written as JSON.
     #[cfg(feature = "serde")]
     pub fn write_to(&self, path: impl AsRef<std::path::Path>) -> Result<()> {
-        write_atomically(
+        crate::files::write_atomically(
             path.as_ref(),
             self.to_json()?.as_bytes(),
             "writing checkpoint",
@@ -198,9 +198,7 @@ impl Checkpoint {
     #[cfg(feature = "serde")]
     pub fn read_from(path: impl AsRef<std::path::Path>) -> Result<Checkpoint> {
         let path = path.as_ref();
-        crate::cost::check_file_size(path)?;
-        let text =
-            std::fs::read_to_string(path).map_err(|e| Error::io("reading checkpoint", path, e))?;
+        let text = crate::files::read_text(path, "reading checkpoint")?;
         verified(&text).map_err(|refusal| match refusal {
             Refusal::Scene(e) => e,
             Refusal::Reason(reason) => Error::CheckpointFile {
@@ -394,74 +392,4 @@ impl Scene {
         driver.refresh_shear();
         Ok(driver)
     }
-}
-
-/// Writes `bytes` to `path` atomically: to a new temporary file in the same directory,
-/// synced to disk, then renamed over `path` (and the directory synced on Unix). A crash
-/// leaves the old file or the new one, never half of one. The temporary file is created
-/// exclusively (`create_new`), with another name on a clash, so writers in other
-/// processes or on other hosts sharing the directory (a SLURM array on a network file
-/// system) never write into the same temporary file.
-///
-/// # Errors
-/// [`Error::Io`] with `operation` and the path of the file that could not be written,
-/// synced or renamed (the temporary file is removed).
-pub(crate) fn write_atomically(
-    path: &std::path::Path,
-    bytes: &[u8],
-    operation: &'static str,
-) -> Result<()> {
-    use std::io::Write;
-    use std::sync::atomic::{AtomicU64, Ordering};
-    let io = |p: &std::path::Path, e: std::io::Error| Error::io(operation, p, e);
-    let name = path.file_name().ok_or_else(|| {
-        io(
-            path,
-            std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file name"),
-        )
-    })?;
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => std::path::Path::new("."),
-    };
-    static CALLS: AtomicU64 = AtomicU64::new(0);
-    let (tmp, mut file) = loop {
-        let call = CALLS.fetch_add(1, Ordering::Relaxed);
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map_or(0, |d| d.subsec_nanos());
-        let mut tmp_name = std::ffi::OsString::from(".");
-        tmp_name.push(name);
-        tmp_name.push(format!(".tmp{}-{call}-{nanos}", std::process::id()));
-        let tmp = dir.join(tmp_name);
-        match std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&tmp)
-        {
-            Ok(file) => break (tmp, file),
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(io(path, e)),
-        }
-    };
-    if let Err(e) = file.write_all(bytes).and_then(|()| file.sync_all()) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(io(path, e));
-    }
-    drop(file);
-    if let Err(e) = std::fs::rename(&tmp, path) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(io(path, e));
-    }
-    sync_dir(dir).map_err(|e| io(dir, e))
-}
-
-/// Syncs a directory's entries (a rename into it) to disk; a no-op where directories
-/// cannot be opened (Windows).
-pub(crate) fn sync_dir(dir: &std::path::Path) -> std::io::Result<()> {
-    #[cfg(unix)]
-    std::fs::File::open(dir)?.sync_all()?;
-    #[cfg(not(unix))]
-    let _ = dir;
-    Ok(())
 }

@@ -14,6 +14,7 @@
 use super::PlotError;
 use super::{Chart, Corner, Map, Palette};
 use crate::error::{table_number, Error, Result};
+use crate::output::layout::{AREA_FIGURE, MAP_FIGURE, PRECURSOR_FIGURE};
 use crate::output::{CONTACT_MAP_STEP, CURVE_HEADER};
 use crate::sweep::{merge, MergeSummary, MEDIAN_BAND_RUNS, SWEEP_FILE};
 use std::path::{Path, PathBuf};
@@ -356,8 +357,7 @@ fn global_slip(dir: &Path, curve: &[Vec<f64>]) -> Result<Option<f64>> {
 }
 
 fn read(path: &Path) -> Result<String> {
-    crate::cost::check_file_size(path)?;
-    std::fs::read_to_string(path).map_err(|e| Error::io("reading table", path, e))
+    crate::files::read_text(path, "reading table")
 }
 
 fn corrupt(path: &Path, reason: String) -> Error {
@@ -458,7 +458,7 @@ fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, P
         notes: Vec::new(),
     };
     for &format in formats {
-        let path = dir.join(format!("precursor_length.{}", format.extension()));
+        let path = dir.join(format!("{PRECURSOR_FIGURE}.{}", format.extension()));
         let mut chart = Chart::new(&format!("Precursor length: {title}"), "F/(μF_N)", "ℓ/Lx")
             .size(size.0, size.1)
             .x_range(0.0, top)
@@ -473,7 +473,7 @@ fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, P
         }
         chart.save(&path)?;
         drawn.files.push(path);
-        let path = dir.join(format!("contact_area.{}", format.extension()));
+        let path = dir.join(format!("{AREA_FIGURE}.{}", format.extension()));
         Chart::new(
             &format!("Real contact area: {title}"),
             "F/(μF_N)",
@@ -538,7 +538,7 @@ fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, P
         format!("A_R(x, F)/A_R(x) at F/(μF_N) = {low:.3}")
     };
     for &format in formats {
-        let path = dir.join(format!("contact_map.{}", format.extension()));
+        let path = dir.join(format!("{MAP_FIGURE}.{}", format.extension()));
         let mut figure = Map::new(nx, map.len(), values.clone())?
             .labels(
                 &format!("Real contact area per column: {title}"),
@@ -609,7 +609,7 @@ fn draw_sweep(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn,
                 .collect();
             chart = chart.band(&label(&p.values, p.runs), &clipped);
         }
-        let path = dir.join(format!("precursor_length.{}", format.extension()));
+        let path = dir.join(format!("{PRECURSOR_FIGURE}.{}", format.extension()));
         chart.save(&path)?;
         drawn.files.push(path);
         // The median and its distribution-free interval, not the mean's t-band: near slip
@@ -631,7 +631,7 @@ fn draw_sweep(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn,
             }
             chart = chart.band(&text, &p.area);
         }
-        let path = dir.join(format!("contact_area.{}", format.extension()));
+        let path = dir.join(format!("{AREA_FIGURE}.{}", format.extension()));
         chart.save(&path)?;
         drawn.files.push(path);
     }

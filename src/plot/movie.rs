@@ -273,7 +273,7 @@ impl Movie {
                 progress(k + 1, states);
             }
         }
-        crate::driver::write_atomically(path, &bytes, "writing movie")?;
+        crate::files::write_atomically(path, &bytes, "writing movie")?;
         Ok(report)
     }
 
@@ -523,9 +523,7 @@ fn read_recording(dir: &Path) -> Result<Recording> {
     let grid = builder.grid()?;
     let (nx, ny) = (grid.nx(), grid.ny());
     let planes = builder.current_fields().planes.clone();
-    crate::cost::check_file_size(&table)?;
-    let text =
-        std::fs::read_to_string(&table).map_err(|e| Error::io("reading table", &table, e))?;
+    let text = crate::files::read_text(&table, "reading table")?;
     let corrupt = |reason: String| Error::CorruptTable {
         path: Some(table.clone()),
         reason,

@@ -708,8 +708,7 @@ pub(crate) fn read_json_text<E: From<Error>>(
     operation: &'static str,
     content_error: impl FnOnce(usize, usize, String) -> E,
 ) -> Result<String, E> {
-    crate::cost::check_file_size(path)?;
-    let bytes = std::fs::read(path).map_err(|e| Error::io(operation, path, e))?;
+    let bytes = crate::files::read_bytes(path, operation)?;
     String::from_utf8(bytes).map_err(|e| {
         let (line, column, reason) = not_utf8(e.as_bytes(), e.utf8_error());
         content_error(line, column, reason)

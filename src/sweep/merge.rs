@@ -1,8 +1,9 @@
 //! Ensemble statistics of a sweep's runs (`precursors merge DIR`; docs/sweep-format.md).
 
 use super::{Sweep, SweepError, SweepRun, DONE_FILE, SWEEP_FILE};
-use crate::driver::write_atomically;
 use crate::error::{table_number, Error, Result};
+use crate::files::write_atomically;
+use crate::output::layout::MERGED;
 use crate::output::{CURVE_HEADER, EVENTS_HEADER};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -181,8 +182,7 @@ fn columns<'a>(path: &Path, text: &'a str, header: &str) -> Result<Vec<Vec<&'a s
 }
 
 fn read(path: &Path) -> Result<String> {
-    crate::cost::check_file_size(path)?;
-    std::fs::read_to_string(path).map_err(|e| Error::io("reading", path, e))
+    crate::files::read_text(path, "reading")
 }
 
 /// The index of the column `name` in `header`.
@@ -571,10 +571,10 @@ impl Tables {
     fn write(self, dir: &Path) -> Result<Vec<PathBuf>> {
         let mut files = Vec::new();
         for (name, text) in [
-            ("curves.csv", self.curves),
-            ("slip.csv", self.slips),
-            ("avalanches.csv", self.avalanches),
-            ("runs.csv", self.runs),
+            (MERGED[0], self.curves),
+            (MERGED[1], self.slips),
+            (MERGED[2], self.avalanches),
+            (MERGED[3], self.runs),
         ] {
             // Atomically: a full disk or a kill leaves the old table or the new one, never
             // an empty or half one that looks complete.

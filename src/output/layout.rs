@@ -1,0 +1,211 @@
+//! The names of the files in run and sweep directories, one list for every writer and
+//! every check: an output the user names (a checkpoint) may not take one of them, a new
+//! run removes the derived ones (figures, movies) of the old, and a run and a sweep never
+//! share a directory.
+
+use crate::error::{Error, Result};
+use crate::lock::LOCK_FILE;
+use std::path::Path;
+
+use super::{FIELDS_TABLE, PARTIAL_SUFFIX, SCENE_RECORD, TABLE_NAMES};
+
+/// The completion marker of a sweep's run (`crate::sweep::DONE_FILE`).
+pub(crate) const DONE: &str = "done";
+/// A sweep's run's record of its coordinates, counts and timings.
+pub(crate) const META: &str = "meta.json";
+/// A sweep's copy of its file (`crate::sweep::SWEEP_FILE`).
+pub(crate) const SWEEP: &str = "sweep.json";
+/// The tables `merge` writes into a sweep's directory.
+pub(crate) const MERGED: [&str; 4] = ["curves.csv", "slip.csv", "avalanches.csv", "runs.csv"];
+/// The figure of ℓ/Lx against the load (each figure as `.png` and `.svg`).
+pub(crate) const PRECURSOR_FIGURE: &str = "precursor_length";
+/// The figure of the real contact area against the load.
+pub(crate) const AREA_FIGURE: &str = "contact_area";
+/// The figure of a run's `contact_map.csv`.
+pub(crate) const MAP_FIGURE: &str = "contact_map";
+/// The figures `plot` draws.
+pub(crate) const FIGURES: [&str; 3] = [PRECURSOR_FIGURE, AREA_FIGURE, MAP_FIGURE];
+/// The extensions of the figures.
+pub(crate) const FIGURE_EXTENSIONS: [&str; 2] = ["png", "svg"];
+/// The movie of the real contact area (Movie S1), `movie`'s default name.
+pub(crate) const AREA_MOVIE: &str = "contact_area.gif";
+/// The movie of the Coulomb stress (Movie S2), `movie`'s default name.
+pub(crate) const STRESS_MOVIE: &str = "coulomb_stress.gif";
+/// The movies `movie` draws by default.
+pub(crate) const MOVIES: [&str; 2] = [AREA_MOVIE, STRESS_MOVIE];
+
+/// Whether `name` is a figure or a movie: drawn from a run's tables, so stale once the
+/// tables are another run's.
+pub(crate) fn derived(name: &str) -> bool {
+    MOVIES.contains(&name)
+        || name
+            .rsplit_once('.')
+            .is_some_and(|(stem, ext)| FIGURES.contains(&stem) && FIGURE_EXTENSIONS.contains(&ext))
+}
+
+/// Whether `name` is a name the program writes, holds or reads in a run or sweep
+/// directory (a table, `NAME.partial`, the scene record, the lock, the sweep's markers
+/// and merged tables, a figure, a movie, or a temporary file of one of them).
+pub(crate) fn reserved(name: &str) -> bool {
+    let base = name.strip_suffix(PARTIAL_SUFFIX).unwrap_or(name);
+    TABLE_NAMES.contains(&base)
+        || base == FIELDS_TABLE
+        || [SCENE_RECORD, LOCK_FILE, DONE, META, SWEEP].contains(&name)
+        || MERGED.contains(&name)
+        || derived(name)
+        // `write_atomically`'s temporaries: `.NAME.tmp<pid>-...`.
+        || name
+            .strip_prefix('.')
+            .and_then(|n| n.split_once(".tmp"))
+            .is_some_and(|(n, _)| reserved(n))
+}
+
+/// Whether `path` lies in the directory `dir` (the same directory once both are resolved:
+/// `d/./x`, a symbolic link to `d`, a relative and an absolute spelling).
+fn in_directory(path: &Path, dir: &Path) -> bool {
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    // Resolved where both exist; else (a directory not made yet) compared as absolute
+    // paths without `.` components.
+    let resolve = |p: &Path| {
+        p.canonicalize().or_else(|_| {
+            std::path::absolute(p).map(|a| a.components().collect::<std::path::PathBuf>())
+        })
+    };
+    match (resolve(parent), resolve(dir)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// Refuses an output `path` the user names (`what`: "the checkpoint") that would take a
+/// name of a file the run directory `dir` holds ([`reserved`]), so that no output of a
+/// command overwrites another or the lock.
+///
+/// # Errors
+/// [`Error::OutputCollision`].
+pub(crate) fn check_output(path: &Path, dir: &Path, what: &'static str) -> Result<()> {
+    let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
+        return Ok(());
+    };
+    if reserved(name) && in_directory(path, dir) {
+        return Err(Error::OutputCollision {
+            what,
+            path: path.to_path_buf(),
+            reason: format!(
+                "{name} is a file of the run directory {} (its tables, NAME.partial, \
+                 {SCENE_RECORD}, the lock {LOCK_FILE}, a sweep's {DONE} and {META}, figures \
+                 and movies): name the {what} otherwise or put it elsewhere",
+                dir.display()
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Refuses to write a run into a sweep's directory or into one of a sweep's run
+/// directories: the sweep's markers (`done`, `meta.json`) would describe another run's
+/// tables, and `merge` would count them.
+///
+/// # Errors
+/// [`Error::RunDirectory`]; [`Error::Io`] when `dir` cannot be examined.
+pub(crate) fn check_not_a_sweeps(dir: &Path) -> Result<()> {
+    let take_over =
+        format!("choose another directory, or remove {DONE} and {META} to take it over");
+    for (name, whose, hint) in [
+        (
+            SWEEP,
+            "a sweep's directory (its sweep.json is there)",
+            "choose another directory",
+        ),
+        (
+            DONE,
+            "a run directory of a sweep (its marker `done` is there)",
+            take_over.as_str(),
+        ),
+        (
+            META,
+            "a run directory of a sweep (its meta.json is there)",
+            take_over.as_str(),
+        ),
+    ] {
+        let path = dir.join(name);
+        match std::fs::symlink_metadata(&path) {
+            Ok(_) => {
+                return Err(Error::RunDirectory {
+                    path: dir.to_path_buf(),
+                    reason: format!(
+                        "it is {whose}: a run of its own there would mix with the sweep's \
+                         (`merge` counts what the markers name): {hint}"
+                    ),
+                })
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(Error::io("examining the run directory", &path, e)),
+        }
+    }
+    Ok(())
+}
+
+/// Whether `dir` holds a run's files (its scene record, a table, `NAME.partial`): a
+/// sweep is not written there.
+///
+/// # Errors
+/// [`Error::Io`] when `dir` cannot be read.
+#[cfg(feature = "serde")]
+pub(crate) fn holds_a_run(dir: &Path) -> Result<Option<String>> {
+    let entries = match std::fs::read_dir(dir) {
+        Ok(entries) => entries,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(Error::io("reading directory", dir, e)),
+    };
+    for entry in entries {
+        let entry = entry.map_err(|e| Error::io("reading directory", dir, e))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let base = name.strip_suffix(PARTIAL_SUFFIX).unwrap_or(&name);
+        if name == SCENE_RECORD || TABLE_NAMES.contains(&base) || base == FIELDS_TABLE {
+            return Ok(Some(name));
+        }
+    }
+    Ok(None)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_file_of_a_directory_is_reserved_and_only_those() {
+        for name in [
+            "events.csv",
+            "curve.csv.partial",
+            "contact_map.csv",
+            "fields.csv.partial",
+            "scene.json",
+            ".precursors.lock",
+            "done",
+            "meta.json",
+            "sweep.json",
+            "runs.csv",
+            "contact_map.svg",
+            "precursor_length.png",
+            "coulomb_stress.gif",
+            ".curve.csv.partial.tmp12-0-5",
+        ] {
+            assert!(reserved(name), "{name}");
+        }
+        for name in [
+            "checkpoint.json",
+            "events.csv.bak",
+            "curve.png",
+            ".x.tmp1",
+            "notes",
+        ] {
+            assert!(!reserved(name), "{name}");
+        }
+        assert!(derived("contact_area.gif") && derived("contact_map.png"));
+        assert!(!derived("contact_map.csv") && !derived("scene.json"));
+    }
+}
