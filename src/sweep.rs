@@ -943,6 +943,17 @@ fn check_size(axes: &[Axis], realizations: usize, base: &SceneBuilder) -> Result
     Ok(())
 }
 
+/// Whether two dotted keys set a common value: equal, or one an object holding the other
+/// (`block` and `block.lx`; not `drive.height` and `drive.height_m`).
+fn overlap(a: &str, b: &str) -> bool {
+    let holds = |outer: &str, inner: &str| {
+        inner
+            .strip_prefix(outer)
+            .is_some_and(|rest| rest.is_empty() || rest.starts_with('.'))
+    };
+    holds(a, b) || holds(b, a)
+}
+
 /// Each axis on its own: its keys are scene keys, on no other axis and not the heights'
 /// seed; it has values; each step gives a valid scene when set on the base scene.
 ///
@@ -953,8 +964,18 @@ fn check_axes(axes: &[Axis], base: &SceneFile) -> Result<()> {
         let name = axis.name();
         for (k, key) in axis.keys.iter().enumerate() {
             let earlier = axes[..a].iter().flat_map(|b| &b.keys);
-            if earlier.chain(&axis.keys[..k]).any(|b| b == key) {
-                return Err(key_error(key, "the key is on two axes, or twice on one"));
+            if let Some(other) = earlier.chain(&axis.keys[..k]).find(|b| overlap(b, key)) {
+                let reason = if other == key {
+                    "the key is on two axes, or twice on one".to_string()
+                } else {
+                    // `block` sets `block.lx` too: the later key would silently win, and
+                    // the tables would label points with values that never ran.
+                    format!(
+                        "the key overlaps `{other}` of an axis (one holds the other): each \
+                         scene value may be set by one axis only"
+                    )
+                };
+                return Err(key_error(key, reason));
             }
             if key == "heights" || key.starts_with("heights.seed") {
                 return Err(key_error(

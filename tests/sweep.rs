@@ -89,6 +89,25 @@ fn format_errors_name_the_key() {
         )),
         "normal_load"
     );
+    // Keys that overlap (an object and a key inside it): the later one would win and
+    // the tables would label points with values that never ran (issue 41).
+    let block = r#"{ "lx": 0.03, "ly": 0.005, "lz": 0.02 }"#;
+    let e = err(&format!(
+        r#"{{ "key": "block.lx", "values": [0.03, 0.04] }}, {{ "key": "block", "values": [{block}] }}"#
+    ));
+    assert!(e.to_string().contains("overlaps `block.lx`"), "{e}");
+    assert_eq!(key_of(e), "block");
+    let drive = r#"{ "kind": "rod", "height": 0.004, "half_width": 0.001 }"#;
+    let e = err(&format!(
+        r#"{{ "keys": ["drive.height", "drive"], "values": [[0.004, {drive}]] }}"#
+    ));
+    assert_eq!(key_of(e), "drive");
+    // Keys that only share a prefix of their names do not overlap.
+    Sweep::from_json_str(&sweep_text(
+        r#"{ "key": "drive.height", "values": [0.004] }, { "key": "drive.half_width", "values": [0.001] }"#,
+        1,
+    ))
+    .unwrap();
     assert_eq!(
         key_of(err(r#"{ "key": "heights.seed", "values": [1, 2] }"#)),
         "heights.seed"
