@@ -713,37 +713,6 @@ pub(crate) fn check_slice(name: &'static str, values: &[f64], expected: usize) -
     Ok(())
 }
 
-/// The number in the cell `text` of column `column` (named as in the header), line `line`
-/// (1-based) of the table `path`: a finite `f64`. What `merge` and `plot` read from a
-/// run's tables, so that a damaged or edited cell is refused with its place, not carried
-/// into every statistic and figure as NaN.
-///
-/// # Errors
-/// [`Error::NonFiniteCell`] for `NaN`, an infinity or an empty cell;
-/// [`Error::CorruptTable`] for text that is not a number.
-#[cfg(feature = "serde")]
-pub(crate) fn table_number(
-    path: &std::path::Path,
-    line: usize,
-    column: &str,
-    text: &str,
-) -> Result<f64> {
-    let value: Result<f64> = text.parse().map_err(|e| Error::CorruptTable {
-        path: Some(path.to_path_buf()),
-        reason: format!("line {line}, column {column}: {text:?} is not a number ({e})"),
-    });
-    match value {
-        Ok(v) if v.is_finite() => Ok(v),
-        Err(_) if !text.is_empty() => value,
-        _ => Err(Error::NonFiniteCell {
-            path: path.to_path_buf(),
-            line,
-            column: column.to_string(),
-            value: text.to_string(),
-        }),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::bounded;

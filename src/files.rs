@@ -74,7 +74,18 @@ fn open_regular(path: &Path, operation: &'static str) -> Result<std::fs::File> {
 /// [`Error::NotARegularFile`]; [`Error::OutOfMemory`].
 pub(crate) fn read_bytes(path: &Path, operation: &'static str) -> Result<Vec<u8>> {
     let file = open_regular(path, operation)?;
-    // A parsed text takes about five times its bytes (the check the reads made before).
+    // A parsed text takes about five times its bytes: a file that reports its length is
+    // refused unread when that is too much; the bytes read are bounded too (a device or
+    // a file of `/proc` reports 0).
+    let size = file
+        .metadata()
+        .map_err(|e| Error::io(operation, path, e))?
+        .len();
+    crate::cost::check_memory(
+        || format!("reading {} ({size} bytes)", path.display()),
+        5.0 * size as f64,
+        "the file is too large for this machine",
+    )?;
     let limit = crate::cost::available_memory().map_or(u64::MAX, |m| (m / 5.0) as u64);
     let mut bytes = Vec::new();
     file.take(limit.saturating_add(1))

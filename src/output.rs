@@ -53,6 +53,7 @@
 //! recorded, `fields.csv` must hold exactly the recorded states up to the checkpoint's
 //! event (the same `every` and planes), and is cut back the same way.
 
+pub(crate) mod check;
 pub(crate) mod layout;
 
 use crate::driver::{Driver, Event};
@@ -201,13 +202,13 @@ fn continuation(
     old: [Option<&str>; 3],
     paths: &[PathBuf; 3],
     k: usize,
-    nx: usize,
+    bounds: &check::Bounds,
 ) -> Result<Continuation> {
     let corrupt = |t: usize, reason: String| Error::CorruptTable {
         path: Some(paths[t].clone()),
         reason,
     };
-    let map_header = contact_map_header(nx);
+    let map_header = contact_map_header(bounds.nx);
     let headers = [EVENTS_HEADER, CURVE_HEADER, map_header.as_str()];
     // Every table's header and rows first, so a damaged third table refuses the resume
     // before anything is cut.
@@ -220,6 +221,7 @@ fn continuation(
     // events.csv: rows 1, 2, 3, ... (one run's), up to at least k.
     let mut last = 0;
     let mut stable = Vec::new();
+    let mut stable_forces = Vec::new();
     let mut kind_at_k = "";
     for &(line, row) in &events {
         let index = index_of(line, row).map_err(|r| corrupt(0, r))?;
@@ -233,12 +235,26 @@ fn continuation(
             ));
         }
         last = index;
-        let kind = row.split(',').nth(1).unwrap_or("");
-        if index <= k && kind == "stable" {
+        if index > k {
+            continue; // cut away below
+        }
+        // Every row kept is checked whole: a damaged cell must not pass into the
+        // finished table.
+        let e = check::event_row(line, row, bounds).map_err(|b| b.at(&paths[0]))?;
+        if e.kind == "global_slip" {
+            return Err(corrupt(
+                0,
+                format!(
+                    "line {line}: global slip at event {index}, before the checkpoint's event {k}"
+                ),
+            ));
+        }
+        if e.kind == "stable" {
             stable.push(index);
+            stable_forces.push(e.force_text);
         }
         if index == k {
-            kind_at_k = kind;
+            kind_at_k = e.kind;
         }
     }
     if last < k {
@@ -298,14 +314,18 @@ fn continuation(
                 ))
             }
         }
-        let x = row.split(',').nth(2).and_then(|f| f.parse::<f64>().ok());
-        let Some(x) = x.filter(|x| x.is_finite()) else {
+        let c = check::curve_row(line, row, bounds).map_err(|b| b.at(&paths[1]))?;
+        let force = &stable_forces[loads.len()];
+        if &c.force_text != force {
             return Err(corrupt(
                 1,
-                format!("line {line}: force_over_mu_FN is not a finite number"),
+                format!(
+                    "line {line}: event {event} at force_N {}, events.csv has {force}",
+                    c.force_text
+                ),
             ));
-        };
-        loads.push(x);
+        }
+        loads.push(c.load);
     }
     if loads.len() < stable.len() {
         return Err(corrupt(
@@ -324,6 +344,7 @@ fn continuation(
     // state, reaching the levels below the highest load of the states up to k.
     let mut kept_levels: Vec<u64> = Vec::new();
     let mut previous: Option<(u64, usize)> = None;
+    let map_cells: Vec<&str> = map_header.split(',').collect();
     for &(line, row) in &map {
         let event = index_of(line, row).map_err(|r| corrupt(2, r))?;
         let level = row.split(',').nth(1).and_then(|f| f.parse::<f64>().ok());
@@ -361,6 +382,7 @@ fn continuation(
         if event > k {
             break;
         }
+        check::map_row(line, &map_cells, row).map_err(|b| b.at(&paths[2]))?;
         if stable.binary_search(&event).is_err() {
             return Err(corrupt(
                 2,
@@ -454,6 +476,8 @@ fn fields_continuation(
     let rows = complete_rows(old.unwrap_or(""), &header).map_err(corrupt)?;
     let per_state = ny + planes.len();
     let last = stable.last().copied().unwrap_or(0);
+    let header_cells: Vec<&str> = header.split(',').collect();
+    let mut state_texts: Option<(&str, &str)> = None;
     let mut kept = 0;
     for (n, &(line, row)) in rows.iter().enumerate() {
         let event = index_of(line, row).map_err(corrupt)?;
@@ -465,7 +489,7 @@ fn fields_continuation(
             Some(&e) if e == event => {}
             Some(&e) => {
                 return Err(corrupt(format!(
-                    "line {line} holds event {event}, but the scene records the stable state                      of event {e} there (every {every}-th stable state from the first): the                      table was recorded with another `fields.every`"
+                    "line {line} holds event {event}, but the scene records the stable state of event {e} there (every {every}-th stable state from the first): the table was recorded with another `fields.every`"
                 )))
             }
             None => {
@@ -474,29 +498,25 @@ fn fields_continuation(
                 )))
             }
         }
-        let mut cells = row.split(',').skip(3);
-        let (field, index, z) = (cells.next(), cells.next(), cells.next());
-        let (want_field, want_index) = if within < ny {
-            (FIELD_AREA, within)
-        } else {
-            (FIELD_COULOMB, within - ny)
-        };
-        if field != Some(want_field) || index != Some(want_index.to_string().as_str()) {
-            return Err(corrupt(format!(
-                "line {line}: a state's rows are {ny} of {FIELD_AREA} (rows 0 to {}), then                  one of {FIELD_COULOMB} per recorded plane ({}): row {want_index} of                  {want_field} belongs here (another grid or other planes?)",
-                ny.saturating_sub(1),
-                planes.len()
-            )));
-        }
-        if field == Some(FIELD_COULOMB) {
-            let recorded = format!("{:.12e}", planes[want_index]);
-            if z != Some(recorded.as_str()) {
+        let r = check::fields_row(line, &header_cells, row, within, ny, planes).map_err(
+            |b| match b {
+                check::Bad::Reason(r) => corrupt(format!(
+                    "{r} (recorded with another grid or other `fields.planes`?)"
+                )),
+                b => b.at(path),
+            },
+        )?;
+        // One state, one load: every row of it as its first.
+        match state_texts {
+            Some((load, ell)) if within > 0 && (r.load_text != load || r.precursor_text != ell) => {
                 return Err(corrupt(format!(
-                    "line {line}: plane {want_index} is at z = {} m, the scene records it at                      {} m: the table was recorded with other `fields.planes`",
-                    z.unwrap_or(""),
-                    planes[want_index]
-                )));
+                    "line {line}: event {event} at F/(μF_N) = {}, ℓ/Lx = {}, but its first row \
+                     has {load}, {ell}",
+                    r.load_text, r.precursor_text
+                )))
             }
+            _ if within == 0 => state_texts = Some((r.load_text, r.precursor_text)),
+            _ => {}
         }
         kept += 1;
     }
@@ -504,7 +524,7 @@ fn fields_continuation(
     if kept % per_state != 0 || states < expected.len() {
         let missing = expected.get(states).copied().unwrap_or(last);
         return Err(corrupt(format!(
-            "it holds {states} whole recorded states up to the checkpoint's event {last},              the scene records {}: the fields from event {missing} on are missing (recorded              with another `fields.every`, or without fields: run the scene again to record              them)",
+            "it holds {states} whole recorded states up to the checkpoint's event {last},              the scene records {}: the fields from event {missing} on are missing (recorded with another `fields.every`, or without fields: run the scene again to record them)",
             expected.len()
         )));
     }
@@ -808,7 +828,7 @@ impl RunTables {
             [old[0].as_deref(), old[1].as_deref(), old[2].as_deref()],
             &read,
             k,
-            driver.grid().nx(),
+            &check::Bounds::of(driver),
         )?;
         let in_effect = if plan.in_effect {
             Some(MapState {

@@ -199,15 +199,22 @@ mod plot {
     #[test]
     fn a_nan_in_a_run_table_is_a_nested_core_error() {
         let dir = scratch("plot-nan");
+        // A run to global slip (its tables and scene record), then one cell made NaN.
+        let scene = precursors::Scene::builder()
+            .block(0.010, 0.004, 0.010)
+            .normal_load(100.0)
+            .build()
+            .unwrap();
+        let mut driver = scene.driver().unwrap();
+        let tables = precursors::output::RunTables::create(&dir, &driver).unwrap();
+        tables.run_to_slip(&mut driver, None, |_, _| {}).unwrap();
         let curve = dir.join("curve.csv");
-        std::fs::write(
-            &curve,
-            "event,force_N,force_over_mu_FN,drive_displacement_m,real_contact_area_m2,\
-             precursor_length_m,precursor_over_Lx,broken,attached,area_exceeds_nominal\n\
-             1,0,0,,1e-6,0,0,0,98,0\n\
-             4,2.9,NaN,,1e-6,0,0,1,97,0\n",
-        )
-        .unwrap();
+        let text = std::fs::read_to_string(&curve).unwrap();
+        let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+        let mut cells: Vec<&str> = lines[2].split(',').collect();
+        cells[2] = "NaN";
+        lines[2] = cells.join(",");
+        std::fs::write(&curve, lines.join("\n") + "\n").unwrap();
         let e = draw(&dir, &[Format::Png]).unwrap_err();
         assert!(
             matches!(

@@ -5,6 +5,8 @@ mod api;
 mod calibration;
 mod checkpoint;
 mod common;
+#[cfg(feature = "cli")]
+mod damage;
 mod driver;
 #[cfg(feature = "serde")]
 mod error_types;

@@ -185,7 +185,9 @@ const HIGH: [u8; 3] = [8, 29, 88];
 /// A run directory of a 10 x 4-cell scene holding a hand-written `fields.csv`: five
 /// states; in state `s` the columns `ix <= s` hold `v_s` in every row (0 elsewhere), `v_0
 /// = 1 mm²`, `v_s = 2 mm²` after; one plane with `τ_C = +1 MPa` on columns `ix <= s`, −1 MPa
-/// elsewhere. Returns the directory and the events of the states.
+/// elsewhere. The run's `events.csv` and `curve.csv` are written to match (the movie checks
+/// the recording against them): a load raised and six ruptures between states, global
+/// slip after the last. Returns the directory and the events of the states.
 fn handwritten(name: &str) -> (PathBuf, Vec<usize>) {
     let dir = scratch(name);
     let builder = Scene::builder()
@@ -220,6 +222,37 @@ fn handwritten(name: &str) -> (PathBuf, Vec<usize>) {
         text.push('\n');
     }
     std::fs::write(dir.join(FIELDS_TABLE), text).unwrap();
+    let scene = builder.build().unwrap();
+    let mu_fn = scene.material().friction_coefficient() * scene.normal_load();
+    let mut events_csv = String::from(precursors::output::EVENTS_HEADER);
+    let mut curve_csv = String::from(precursors::output::CURVE_HEADER);
+    events_csv.push('\n');
+    curve_csv.push('\n');
+    for (s, &event) in events.iter().enumerate() {
+        let x = 0.1 * s as f64 + 0.5;
+        let force = format!("{:.12e}", x * mu_fn);
+        if s > 0 {
+            events_csv.push_str(&format!("{},load_raised,,,{force},,,,0\n", event - 6));
+            for k in 1..6 {
+                events_csv.push_str(&format!(
+                    "{},rupture,{k},1,{force},,1e-9,,0\n",
+                    event - 6 + k
+                ));
+            }
+        }
+        events_csv.push_str(&format!(
+            "{event},stable,,,{force},,,{},0\n",
+            if s > 0 { 5 } else { 0 }
+        ));
+        let ell = 0.1 * (s + 1) as f64;
+        curve_csv.push_str(&format!(
+            "{event},{force},{x:.12e},,1e-6,{:.12e},{ell:.12e},{s},30,0\n",
+            ell * 0.010
+        ));
+    }
+    events_csv.push_str(&format!("30,global_slip,,,{:.12e},,,,0\n", mu_fn));
+    std::fs::write(dir.join("events.csv"), events_csv).unwrap();
+    std::fs::write(dir.join("curve.csv"), curve_csv).unwrap();
     (dir, events)
 }
 

@@ -607,7 +607,12 @@ fn files_too_large_for_memory_are_refused_before_reading() {
     {
         let run = dir.join("run");
         std::fs::create_dir_all(&run).unwrap();
-        std::fs::rename(huge("curve.csv"), run.join("curve.csv")).unwrap();
+        // A run directory (plot checks the tables against the recorded scene) whose first
+        // table read is huge.
+        let scene = Scene::builder().block(0.010, 0.004, 0.010);
+        std::fs::write(run.join("scene.json"), scene.to_json().unwrap()).unwrap();
+        std::fs::write(run.join("curve.csv"), "").unwrap();
+        std::fs::rename(huge("events.csv"), run.join("events.csv")).unwrap();
         let e = precursors::plot::draw(&run, &[precursors::plot::Format::Png]).unwrap_err();
         assert!(
             matches!(

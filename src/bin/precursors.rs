@@ -38,11 +38,14 @@ Exit codes:
   1  run, resume, sweep: the computation failed (a solver did not converge, the contact
      emptied, ...)
   2  bad command line (unknown option, missing argument, --every without --checkpoint,
-     bad --shard or SLURM variables)
+     bad --shard or SLURM variables, a checkpoint named as a file of the run directory)
   3  invalid input: a scene, sweep or checkpoint file that is not UTF-8 text or not valid
      JSON, names an unknown key, holds an invalid value, or does not fit; a damaged table
-     or one with NaN, inf or an empty cell where a number belongs
-  4  a file or directory could not be read or written (none is left half written), or
+     or one with NaN, inf or an empty cell where a number belongs, or a value out of its
+     bounds or inconsistent with the scene or the other tables; a run and a sweep in one
+     directory
+  4  a file or directory could not be read or written (none is left half written), a
+     path that is not a regular file (a FIFO, a device, a directory) named as a file, or
      another process is writing the directory (run, resume: the holder is named)
   5  merge, plot: some runs of the sweep are not complete (the tables and figures of the
      others written)";

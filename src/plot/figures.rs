@@ -13,9 +13,10 @@
 
 use super::PlotError;
 use super::{Chart, Corner, Map, Palette};
-use crate::error::{table_number, Error, Result};
+use crate::error::{Error, Result};
+use crate::output::check::RunRecord;
 use crate::output::layout::{AREA_FIGURE, MAP_FIGURE, PRECURSOR_FIGURE};
-use crate::output::{CONTACT_MAP_STEP, CURVE_HEADER};
+use crate::output::CONTACT_MAP_STEP;
 use crate::sweep::{merge, MergeSummary, MEDIAN_BAND_RUNS, SWEEP_FILE};
 use std::path::{Path, PathBuf};
 
@@ -334,32 +335,6 @@ fn axis_value(key: &str, value: &str) -> String {
     }
 }
 
-/// The load of the run's global slip, `F/(μF_N)`, from the last row of `events.csv`
-/// and the ratio `force_over_mu_FN / force_N` of a loaded row of `curve.csv`; `None` for
-/// a table without it.
-fn global_slip(dir: &Path, curve: &[Vec<f64>]) -> Result<Option<f64>> {
-    let path = dir.join("events.csv");
-    let text = read(&path)?;
-    let Some(last) = text.lines().last() else {
-        return Ok(None);
-    };
-    let cells: Vec<&str> = last.split(',').collect();
-    if cells.get(1) != Some(&"global_slip") {
-        return Ok(None);
-    }
-    let line = text.lines().count();
-    let force = table_number(&path, line, "force_N", cells.get(4).copied().unwrap_or(""))?;
-    Ok(curve
-        .iter()
-        .rev()
-        .find(|r| r[3] > 0.0)
-        .map(|r| force * r[0] / r[3]))
-}
-
-fn read(path: &Path) -> Result<String> {
-    crate::files::read_text(path, "reading table")
-}
-
 fn corrupt(path: &Path, reason: String) -> Error {
     Error::CorruptTable {
         path: Some(path.to_path_buf()),
@@ -367,72 +342,22 @@ fn corrupt(path: &Path, reason: String) -> Error {
     }
 }
 
-/// The columns `wanted` (named as in `header`) of the rows of a CSV table with that
-/// header, as finite numbers: a `NaN`, an infinity or an empty cell in them is refused
-/// with its line ([`crate::error::table_number`]), not drawn as a gap.
-fn numbers(path: &Path, header: &str, wanted: &[&str]) -> Result<Vec<Vec<f64>>> {
-    let text = read(path)?;
-    let mut lines = text.lines();
-    if lines.next() != Some(header) {
-        return Err(corrupt(
-            path,
-            format!("line 1 is not the header {header:?}"),
-        ));
-    }
-    let names: Vec<&str> = header.split(',').collect();
-    let columns = wanted
-        .iter()
-        .map(|w| {
-            names
-                .iter()
-                .position(|n| n == w)
-                .ok_or_else(|| corrupt(path, format!("the header has no column {w}")))
-        })
-        .collect::<Result<Vec<usize>>>()?;
-    let mut rows = Vec::new();
-    for (i, line) in lines.enumerate() {
-        let cells: Vec<&str> = line.split(',').collect();
-        if cells.len() != names.len() {
-            return Err(corrupt(
-                path,
-                format!(
-                    "line {} has {} fields, the header {}",
-                    i + 2,
-                    cells.len(),
-                    names.len()
-                ),
-            ));
-        }
-        let row = columns
-            .iter()
-            .map(|&k| table_number(path, i + 2, names[k], cells[k]))
-            .collect::<Result<Vec<f64>>>()?;
-        rows.push(row);
-    }
-    Ok(rows)
-}
-
 /// The figures of one run directory.
 fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, PlotError> {
     let title = run_title(dir);
-    let curve_path = dir.join("curve.csv");
-    let rows = numbers(
-        &curve_path,
-        CURVE_HEADER,
-        &[
-            "force_over_mu_FN",
-            "precursor_over_Lx",
-            "real_contact_area_m2",
-            "force_N",
-        ],
-    )?;
+    // The tables checked against the scene, each other and their bounds.
+    let record = RunRecord::read(dir)?;
     // The staircase ends at the last stable state; the run ends at global slip, where the
     // whole interface slides (ℓ = Lx): a marker there.
-    let slip = global_slip(dir, &rows)?;
-    let force: Vec<f64> = rows.iter().map(|r| r[0]).collect();
-    let ell: Vec<(f64, f64)> = rows.iter().map(|r| (r[0], r[1])).collect();
-    let a0 = rows.first().map_or(f64::NAN, |r| r[2]);
-    let area: Vec<(f64, f64)> = rows.iter().map(|r| (r[0], r[2] / a0)).collect();
+    let slip = Some(record.slip);
+    let force: Vec<f64> = record.curve.iter().map(|c| c.load).collect();
+    let ell: Vec<(f64, f64)> = record
+        .curve
+        .iter()
+        .map(|c| (c.load, c.precursor_over_lx))
+        .collect();
+    let a0 = record.curve.first().map_or(f64::NAN, |c| c.area);
+    let area: Vec<(f64, f64)> = record.curve.iter().map(|c| (c.load, c.area / a0)).collect();
     // Near slip the paper's unbounded area law can reach many times A_R(0) (flagged in
     // area_exceeds_nominal): the chart shows up to 2 and its legend says how many
     // states lie above.
@@ -488,18 +413,24 @@ fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, P
         drawn.files.push(path);
     }
     let map_path = dir.join("contact_map.csv");
-    if !map_path.is_file() {
+    let Some(rows) = &record.map else {
         drawn.notes.push(format!(
             "no contact map: {} is missing (written by this version's `run`)",
             map_path.display()
         ));
         return Ok(drawn);
-    }
-    let text = read(&map_path)?;
-    let header = text.lines().next().unwrap_or("");
-    let columns: Vec<&str> = header.split(',').collect();
-    let map = numbers(&map_path, header, &columns)?;
-    let nx = columns.len().saturating_sub(2);
+    };
+    // As the rows were: event, load, the columns' areas.
+    let map: Vec<Vec<f64>> = rows
+        .iter()
+        .map(|r| {
+            [r.event as f64, r.level as f64 * CONTACT_MAP_STEP]
+                .into_iter()
+                .chain(r.columns.iter().copied())
+                .collect()
+        })
+        .collect();
+    let nx = record.bounds.nx;
     let Some(first) = map.first() else {
         drawn.notes.push(format!(
             "no contact map: {} has no rows",

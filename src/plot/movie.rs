@@ -14,9 +14,10 @@
 //! atomically: no half movie is left on a full disk.
 
 use super::{axis_range, paint, register_font, Map, MapDrawing, Palette, PlotError, Result};
-use crate::error::{table_number, Error};
+use crate::error::Error;
+use crate::output::check::{fields_row, RunRecord};
 use crate::output::SCENE_RECORD;
-use crate::output::{fields_header, FIELDS_TABLE, FIELD_AREA, FIELD_COULOMB, PARTIAL_SUFFIX};
+use crate::output::{fields_header, FIELDS_TABLE, PARTIAL_SUFFIX};
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -537,62 +538,71 @@ fn read_recording(dir: &Path) -> Result<Recording> {
         ))
         .into());
     }
+    // The run's tables, checked, for the states the recording must hold.
+    let run = RunRecord::read(dir)?;
+    let every = builder.current_fields().every.max(1);
+    let expected: Vec<&crate::output::check::CurveRow> = run.curve.iter().step_by(every).collect();
+    let header_cells: Vec<&str> = header.split(',').collect();
     let per_state = ny + planes.len();
     let mut states: Vec<State> = Vec::new();
+    let mut texts: (&str, &str) = ("", "");
     for (n, row) in lines.enumerate() {
         let line = n + 2;
-        let cells: Vec<&str> = row.split(',').collect();
-        if cells.len() != 6 + nx {
-            return Err(corrupt(format!(
-                "line {line} has {} fields, the header {}",
-                cells.len(),
-                6 + nx
-            ))
-            .into());
-        }
-        let event: usize = cells[0].parse().map_err(|e| {
-            corrupt(format!(
-                "line {line}: the event index is not a whole number ({e})"
-            ))
-        })?;
         let within = n % per_state;
-        let (field, index) = if within < ny {
-            (FIELD_AREA, within)
-        } else {
-            (FIELD_COULOMB, within - ny)
-        };
-        if cells[3] != field || cells[4] != index.to_string() {
-            return Err(corrupt(format!(
-                "line {line}: row {index} of {field} belongs here ({ny} rows of {FIELD_AREA}, \
-                 then one of {FIELD_COULOMB} per plane of {SCENE_RECORD}, for each state)"
-            ))
-            .into());
-        }
-        let mut values = Vec::with_capacity(nx);
-        for (ix, text) in cells[6..].iter().enumerate() {
-            values.push(table_number(&table, line, &format!("value_ix{ix}"), text)?);
-        }
+        let r =
+            fields_row(line, &header_cells, row, within, ny, &planes).map_err(|b| b.at(&table))?;
         if within == 0 {
+            // The next state the scene records: the `every`-th stable state of curve.csv
+            // from the first, at its load and ℓ.
+            let Some(want) = expected.get(states.len()) else {
+                return Err(corrupt(format!(
+                    "line {line}: event {} is a state more than the {} the scene records \
+                     (every {every}-th of the {} stable states of curve.csv)",
+                    r.event,
+                    expected.len(),
+                    run.curve.len()
+                ))
+                .into());
+            };
+            if r.event != want.event
+                || r.load_text != want.load_text
+                || r.precursor_text != want.precursor_text
+            {
+                return Err(corrupt(format!(
+                    "line {line}: event {} at F/(μF_N) = {}, ℓ/Lx = {}, but the state recorded \
+                     there is event {} at {}, {} (curve.csv): states out of order, repeated, \
+                     edited, or from another run",
+                    r.event,
+                    r.load_text,
+                    r.precursor_text,
+                    want.event,
+                    want.load_text,
+                    want.precursor_text
+                ))
+                .into());
+            }
+            texts = (r.load_text, r.precursor_text);
             states.push(State {
-                event,
-                load: table_number(&table, line, "force_over_mu_FN", cells[1])?,
-                ell: table_number(&table, line, "precursor_over_Lx", cells[2])?,
+                event: r.event,
+                load: r.load,
+                ell: r.precursor_over_lx,
                 area: Vec::with_capacity(nx * ny),
                 coulomb: Vec::with_capacity(nx * planes.len()),
             });
         }
         let state = states.last_mut().expect("a state was started");
-        if state.event != event {
+        if r.event != state.event || (r.load_text, r.precursor_text) != texts {
             return Err(corrupt(format!(
-                "line {line}: event {event} inside the rows of event {}",
-                state.event
+                "line {line}: event {} at F/(μF_N) = {}, ℓ/Lx = {} inside the rows of event {} \
+                 at {}, {}",
+                r.event, r.load_text, r.precursor_text, state.event, texts.0, texts.1
             ))
             .into());
         }
-        if field == FIELD_AREA {
-            state.area.extend(values);
+        if within < ny {
+            state.area.extend(r.values);
         } else {
-            state.coulomb.extend(values);
+            state.coulomb.extend(r.values);
         }
     }
     if states.is_empty() {
@@ -603,6 +613,17 @@ fn read_recording(dir: &Path) -> Result<Recording> {
         return Err(corrupt(format!(
             "the last state (event {}) is cut: its rows are not all there",
             last.event
+        ))
+        .into());
+    }
+    if states.len() < expected.len() {
+        return Err(corrupt(format!(
+            "it holds {} states, the scene records {} (every {every}-th of the {} stable states \
+             of curve.csv): the states from event {} on are missing",
+            states.len(),
+            expected.len(),
+            run.curve.len(),
+            expected[states.len()].event
         ))
         .into());
     }

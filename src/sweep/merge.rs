@@ -1,10 +1,11 @@
 //! Ensemble statistics of a sweep's runs (`precursors merge DIR`; docs/sweep-format.md).
 
 use super::{Sweep, SweepError, SweepRun, DONE_FILE, SWEEP_FILE};
-use crate::error::{table_number, Error, Result};
+use crate::error::{Error, Result};
 use crate::files::write_atomically;
+use crate::output::check::RunRecord;
 use crate::output::layout::MERGED;
-use crate::output::{CURVE_HEADER, EVENTS_HEADER};
+use crate::output::SCENE_RECORD;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -170,92 +171,40 @@ struct RunData {
     slip: Option<f64>,
 }
 
-fn columns<'a>(path: &Path, text: &'a str, header: &str) -> Result<Vec<Vec<&'a str>>> {
-    let mut lines = text.lines();
-    if lines.next() != Some(header) {
-        return Err(Error::CorruptTable {
-            path: Some(path.to_path_buf()),
-            reason: format!("line 1 is not the header {header:?}"),
-        });
-    }
-    Ok(lines.map(|l| l.split(',').collect()).collect())
-}
-
-fn read(path: &Path) -> Result<String> {
-    crate::files::read_text(path, "reading")
-}
-
-/// The index of the column `name` in `header`.
-fn column(header: &str, name: &str) -> usize {
-    header.split(',').position(|h| h == name).unwrap_or(0)
-}
-
+/// The complete run in `dir`, read and checked ([`RunRecord::read`]): its tables whole,
+/// within their bounds and consistent with each other, and its recorded scene the one
+/// the sweep gives `run` (a directory swapped with another point's, a `scene.json` from
+/// elsewhere, or a `sweep.json` edited since the run are refused).
 fn read_run(dir: &Path, run: &SweepRun) -> Result<RunData> {
-    let curve_path = dir.join("curve.csv");
-    let text = read(&curve_path)?;
-    let mut curve = Vec::new();
-    let wanted = [
-        "force_over_mu_FN",
-        "precursor_over_Lx",
-        "real_contact_area_m2",
-    ]
-    .map(|name| (name, column(CURVE_HEADER, name)));
-    let fields = CURVE_HEADER.split(',').count();
-    for (i, row) in columns(&curve_path, &text, CURVE_HEADER)?
-        .iter()
-        .enumerate()
-    {
-        if row.len() != fields {
-            return Err(Error::CorruptTable {
-                path: Some(curve_path.clone()),
+    // The scene first: tables checked against another point's scene would be refused
+    // for their numbers, not for what is wrong.
+    let record_path = dir.join(SCENE_RECORD);
+    if record_path.is_file() {
+        let recorded = crate::SceneBuilder::from_json_file(&record_path)?;
+        if let Some(e) = crate::driver::scene_mismatch(
+            &run.scene,
+            &format!("the sweep's run {} ({})", run.index, run.dir_name),
+            &recorded,
+            &format!("the scene recorded in {}", dir.join(SCENE_RECORD).display()),
+        ) {
+            return Err(Error::RunDirectory {
+                path: dir.to_path_buf(),
                 reason: format!(
-                    "line {} has {} fields, the header {fields}",
-                    i + 2,
-                    row.len()
+                    "its tables are not the sweep's run: {e} (a run directory moved, or {SWEEP_FILE} \
+                     edited since the run: run the sweep again into a new directory)"
                 ),
             });
         }
-        let [f, ell, area] = wanted.map(|(name, k)| table_number(&curve_path, i + 2, name, row[k]));
-        curve.push((f?, ell?, area?));
     }
-    let events_path = dir.join("events.csv");
-    let text = read(&events_path)?;
-    let mu_fn =
-        run.scene.current_material().friction_coefficient() * run.scene.current_normal_load();
-    let mut avalanches = Vec::new();
-    let mut slip = None;
-    let (kind, force, ruptures) = (
-        column(EVENTS_HEADER, "kind"),
-        column(EVENTS_HEADER, "force_N"),
-        column(EVENTS_HEADER, "ruptures"),
-    );
-    for (i, row) in columns(&events_path, &text, EVENTS_HEADER)?
-        .iter()
-        .enumerate()
-    {
-        let at = |k: usize| row.get(k).copied().unwrap_or("");
-        match at(kind) {
-            "stable" => {
-                let r = at(ruptures);
-                let count = r.parse::<usize>().map_err(|e| Error::CorruptTable {
-                    path: Some(events_path.clone()),
-                    reason: format!(
-                        "line {}, column ruptures: {r:?} is not a count ({e})",
-                        i + 2
-                    ),
-                })?;
-                avalanches.push(count);
-            }
-            "global_slip" => {
-                slip = Some(table_number(&events_path, i + 2, "force_N", at(force))? / mu_fn);
-            }
-            _ => {}
-        }
-    }
+    let record = RunRecord::read(dir)?;
     Ok(RunData {
-        curve,
-        avalanches,
-        slip,
+        curve: record
+            .curve
+            .iter()
+            .map(|c| (c.load, c.precursor_over_lx, c.area))
+            .collect(),
+        avalanches: record.ruptures,
+        slip: Some(record.slip),
     })
 }
 
