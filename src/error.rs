@@ -24,8 +24,7 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 /// `output`). A sweep's own failures are `sweep::SweepError` (feature `serde`), a
 /// figure's `plot::PlotError` (feature `plot`); each nests this type for the
 /// failures of the runs, scenes and tables under it. A variant that only a feature's code
-/// can return exists only with that feature (`ShapeMismatch`: `nalgebra`;
-/// `NonFiniteCell`: `serde`).
+/// can return exists only with that feature (`ShapeMismatch`: `nalgebra`).
 ///
 /// Every variant carries the offending values so a caller can report them or recover.
 /// Variants that wrap another error (I/O, JSON, factorisation, thread pool) return it from
@@ -561,9 +560,8 @@ pub enum Error {
         /// What is wrong.
         reason: String,
     },
-    #[cfg(feature = "serde")]
-    /// (Feature `serde`.) A run's table that [`crate::sweep::merge`] or the figures of a
-    /// directory (feature `plot`) read holds, where a number belongs, a value that is not a
+    /// A run's table that `RunTables::resume`, `sweep::merge` (feature `serde`), the
+    /// figures or the movies of a directory (feature `plot`) read holds, where a number belongs, a value that is not a
     /// finite number (`NaN`, `inf`, an empty cell): a damaged or edited table, which
     /// would turn every statistic and figure made from it into NaN.
     #[error(

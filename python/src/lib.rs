@@ -47,7 +47,10 @@ impl Class {
 fn core_class(e: &precursors::Error) -> Class {
     use precursors::Error as E;
     match e {
-        E::Io { .. } | E::RunDirectory { .. } | E::DirectoryLocked { .. } => Class::Os,
+        E::Io { .. }
+        | E::NotARegularFile { .. }
+        | E::RunDirectory { .. }
+        | E::DirectoryLocked { .. } => Class::Os,
         E::SolverNotConverged { .. } | E::SeriesNotConverged { .. } | E::FitNotConverged { .. } => {
             Class::NotConverged
         }
@@ -80,6 +83,7 @@ fn core_class(e: &precursors::Error) -> Class {
         | E::InvalidCheckpoint { .. }
         | E::CorruptTable { .. }
         | E::NonFiniteCell { .. }
+        | E::OutputCollision { .. }
         | E::LoadBeyondFriction { .. } => Class::Value,
         _ => Class::Base,
     }

@@ -7,11 +7,12 @@
 //! Why: a table cut short, edited, shuffled, or from another run was read as if whole
 //! and turned into statistics and figures with exit 0.
 
-use super::{
-    contact_map_header, first_level_at_or_above, level, CONTACT_MAP_STEP, CURVE_HEADER,
-    EVENTS_HEADER, TABLE_NAMES,
-};
-use crate::error::{Error, Result};
+#[cfg(feature = "serde")]
+use super::{contact_map_header, first_level_at_or_above, level, TABLE_NAMES};
+use super::{CONTACT_MAP_STEP, CURVE_HEADER, EVENTS_HEADER};
+use crate::error::Error;
+#[cfg(feature = "serde")]
+use crate::error::Result;
 use std::path::Path;
 
 /// What is wrong with a row: a cell that is not a finite number (typed, as
@@ -396,6 +397,7 @@ pub(crate) fn map_row(line: usize, header: &[&str], row: &str) -> Row<MapRow> {
 
 /// The rows of a table's text (line number, row) under `header`, every one whole: a
 /// finished table has no row cut by a crash.
+#[cfg(feature = "serde")]
 fn rows<'a>(text: &'a str, header: &str) -> Row<Vec<(usize, &'a str)>> {
     let mut lines = text.split_inclusive('\n');
     match lines.next() {
