@@ -722,13 +722,8 @@ impl SceneBuilder {
         if let Some(Lateral::Rod { height, half_width }) = self.lateral() {
             RodLoad::new(&block, height, half_width)?;
         }
-        for &z in &self.fields.planes {
-            block.check_height(z)?;
-        }
+        // The planes' heights: `bounds::physics`, naming their key.
         if !self.probes.is_empty() {
-            for &z in self.probes.planes() {
-                block.check_height(z)?;
-            }
             for &p in self.probes.points() {
                 block.check_point(p, ["x", "y", "z"])?;
             }

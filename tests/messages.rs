@@ -631,3 +631,56 @@ fn info_estimates_the_measured_large_runs_within_a_factor_two() {
         );
     }
 }
+
+/// `info` and `run` agree on planes near the interface (issue 41): a plane at 1e-6 m or
+/// at the smallest positive double is refused by both, naming `fields.planes` (or
+/// `probes.planes`) and its valid range, before `run` writes anything; a plane at the
+/// range's printed lower end runs.
+#[test]
+fn info_and_run_agree_on_planes_near_the_interface() {
+    let dir = scratch("planes");
+    let scene = |planes: &str, key: &str| {
+        let text = BASE.trim_end().trim_end_matches('}').to_string()
+            + &match key {
+                "fields" => format!(r#", "fields": {{ "every": 5, "planes": [{planes}] }} }}"#),
+                _ => format!(r#", "probes": {{ "planes": [{planes}] }} }}"#),
+            };
+        let path = dir.join(format!("{key}-{planes}.json"));
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    for key in ["fields", "probes"] {
+        for z in ["1e-6", "5e-324"] {
+            let path = scene(z, key);
+            let out = dir.join(format!("out-{key}-{z}"));
+            let info = precursors(&["info", path_str(&path)]);
+            let run = precursors(&["run", path_str(&path), "--out", path_str(&out), "-q"]);
+            for o in [&info, &run] {
+                let text = stderr(o);
+                assert_eq!(o.status.code(), Some(3), "{text}");
+                assert!(text.contains(&format!("{key}.planes = {z}")), "{text}");
+                assert!(text.contains("the valid range is 0 or ["), "{text}");
+            }
+            assert!(!out.exists() || std::fs::read_dir(&out).unwrap().next().is_none());
+        }
+    }
+    // The printed lower end runs (the range holds only what runs).
+    let text = stderr(&precursors(&["info", path_str(&scene("1e-6", "fields"))]));
+    let low = text
+        .split("0 or [")
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .to_string();
+    let path = scene(&low, "fields");
+    let out = dir.join("out-low");
+    let o = precursors(&["run", path_str(&path), "--out", path_str(&out), "-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn path_str(p: &Path) -> &str {
+    p.to_str().unwrap()
+}

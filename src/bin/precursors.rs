@@ -128,10 +128,12 @@ enum Command {
         #[arg(long, value_enum, default_value_t = FormatArg::Png)]
         format: FormatArg,
         /// Figure width in pixels (200 to 16384; 2400 x 1680 prints 8 x 5.6 in at 300 dpi).
-        #[arg(long, default_value_t = 800)]
+        #[arg(long, default_value_t = 800,
+              value_parser = clap::value_parser!(u32).range(200..=16384))]
         width: u32,
         /// Figure height in pixels (200 to 16384).
-        #[arg(long, default_value_t = 560)]
+        #[arg(long, default_value_t = 560,
+              value_parser = clap::value_parser!(u32).range(200..=16384))]
         height: u32,
     },
     /// Draws a run's recorded fields (the scene key "fields") as an animated GIF:
@@ -151,14 +153,16 @@ enum Command {
         #[arg(long, value_name = "N", default_value_t = 200,
               value_parser = clap::value_parser!(u64).range(2..100_000))]
         max_frames: u64,
-        /// Frame width in pixels.
-        #[arg(long, default_value_t = 900)]
+        /// Frame width in pixels (200 to 16384).
+        #[arg(long, default_value_t = 900,
+              value_parser = clap::value_parser!(u32).range(200..=16384))]
         width: u32,
-        /// Frame height in pixels.
-        #[arg(long, default_value_t = 560)]
+        /// Frame height in pixels (150 to 16384).
+        #[arg(long, default_value_t = 560,
+              value_parser = clap::value_parser!(u32).range(150..=16384))]
         height: u32,
-        /// Seconds per frame.
-        #[arg(long, value_name = "SECONDS", default_value_t = 0.1)]
+        /// Seconds per frame (0.01 to 655; GIF counts hundredths).
+        #[arg(long, value_name = "SECONDS", default_value_t = 0.1, value_parser = parse_frame_duration)]
         frame_duration: f64,
         /// The output file (one movie only) [default: DIR/contact_area.gif,
         /// DIR/coulomb_stress.gif].
@@ -182,6 +186,22 @@ enum FormatArg {
     Png,
     Svg,
     Both,
+}
+
+/// A frame duration a GIF can hold: 0.01 to 655.35 s, in hundredths (bad values are a bad
+/// command line, code 2, as every other option's).
+fn parse_frame_duration(text: &str) -> Result<f64, String> {
+    let seconds: f64 = text
+        .trim()
+        .parse()
+        .map_err(|e| format!("{text:?} is not a number of seconds ({e})"))?;
+    let hundredths = (seconds * 100.0).round();
+    if !(1.0..=65535.0).contains(&hundredths) {
+        return Err(format!(
+            "{text:?}: a frame is shown 0.01 to 655 s (GIF counts hundredths of a second)"
+        ));
+    }
+    Ok(seconds)
 }
 
 fn parse_shard(text: &str) -> Result<(usize, usize), String> {

@@ -29,6 +29,7 @@ pub use plan::{InfluencePlan, InfluencePlanBuilder, DENSE_LIMIT};
 pub use planner::Planner;
 pub use point::{Estimate, GreenFunction, SeriesOptions, SummationAxis};
 pub(crate) use staged::{Partition, Staging};
+pub(crate) use transfer::lowest_plane;
 pub use transfer::PlaneTransfer;
 
 /// What the green module built on this thread, counted for the tests of "What a scene

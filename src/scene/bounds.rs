@@ -105,12 +105,12 @@ fn out_of_range(
     Error::OutOfRange {
         key,
         value,
-        range: format!("[{}, {}]{unit}", Short(min), Short(max)),
+        range: format!("[{}, {}]{unit}", End(min, true), End(max, false)),
         reason,
     }
 }
 
-/// A bound in a message: four significant digits (bounds derived from other keys are not
+/// A value in a message: four significant digits (bounds derived from other keys are not
 /// round numbers).
 struct Short(f64);
 
@@ -118,6 +118,29 @@ impl std::fmt::Display for Short {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let rounded: f64 = format!("{:.3e}", self.0).parse().unwrap_or(self.0);
         write!(f, "{}", Num(rounded))
+    }
+}
+
+/// A range's end in a message: exact where eight significant digits write it (`-0.999999`,
+/// not the `-1` that four give and that holds a refused `-0.9999991`), else four rounded
+/// inward (up for the lower end `lower`, down for the upper), so that every value of the
+/// printed range is valid.
+struct End(f64, bool);
+
+impl std::fmt::Display for End {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let End(v, lower) = *self;
+        let exact = (0..8).any(|d| format!("{v:.d$e}").parse::<f64>() == Ok(v));
+        if exact || v == 0.0 || !v.is_finite() {
+            return write!(f, "{}", Num(v));
+        }
+        let scale = 10f64.powi(3 - v.abs().log10().floor() as i32);
+        let inward = if lower {
+            (v * scale).ceil()
+        } else {
+            (v * scale).floor()
+        };
+        write!(f, "{}", Num(inward / scale))
     }
 }
 
@@ -296,6 +319,30 @@ pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
         "",
         "below 1e-15 the alias sums cannot reach it, above 1e-2 the stresses are noise",
     )?;
+    // A plane is the interface (z = 0) or high enough for its alias sums to converge
+    // within their budget at the probes' tolerance: refused here, by `info` as by `run`,
+    // not when the run has begun.
+    let lowest = crate::green::lowest_plane(grid, probes.tolerance());
+    let lz = grid.block().lz();
+    for (key, planes) in [
+        ("fields.planes", builder.fields.planes.as_slice()),
+        ("probes.planes", probes.planes()),
+    ] {
+        for &z in planes {
+            if z == 0.0 || (z.is_finite() && (lowest..=lz).contains(&z)) {
+                continue;
+            }
+            return Err(Error::OutOfRange {
+                key,
+                value: z,
+                range: format!("0 or [{}, {}] m", End(lowest, true), End(lz, false)),
+                reason: "a plane lies in the block (z = 0 is the interface); the stresses on a \
+                         plane closer to the interface than about 0.007 cells (at \
+                         probes.tolerance 1e-10) need more alias terms than their budget: \
+                         use z = 0, or raise the plane or probes.tolerance",
+            });
+        }
+    }
     for (key, count) in [
         ("probes.planes", probes.planes().len()),
         ("probes.points", probes.points().len()),
@@ -513,8 +560,8 @@ fn drive(builder: &SceneBuilder) -> Result<()> {
                         range: format!(
                             "[{}, {}] N/m (1e-12 to 1e12 times the block's shear stiffness \
                              M·Ly·Lz/Lx = {} N/m)",
-                            Short(low),
-                            Short(high),
+                            End(low, true),
+                            End(high, false),
                             Short(block)
                         ),
                         reason: "a softer spring is force control to twelve digits and its \
