@@ -489,7 +489,9 @@ fn fields_continuation(
             Some(&e) if e == event => {}
             Some(&e) => {
                 return Err(corrupt(format!(
-                    "line {line} holds event {event}, but the scene records the stable state of event {e} there (every {every}-th stable state from the first): the table was recorded with another `fields.every`"
+                    "line {line} holds event {event}, but the scene records the stable state \
+                     of event {e} there (every {every}-th stable state from the first): the \
+                     table was recorded with another `fields.every`"
                 )))
             }
             None => {
@@ -524,7 +526,10 @@ fn fields_continuation(
     if kept % per_state != 0 || states < expected.len() {
         let missing = expected.get(states).copied().unwrap_or(last);
         return Err(corrupt(format!(
-            "it holds {states} whole recorded states up to the checkpoint's event {last},              the scene records {}: the fields from event {missing} on are missing (recorded with another `fields.every`, or without fields: run the scene again to record them)",
+            "it holds {states} whole recorded states up to the checkpoint's event {last}, \
+             the scene records {}: the fields from event {missing} on are missing (recorded \
+             with another `fields.every`, or without fields: run the scene again to record \
+             them)",
             expected.len()
         )));
     }

@@ -290,8 +290,9 @@ impl Modes {
                 what: "Fourier modes",
                 needed: count,
                 limit: MAX_MODES as f64,
-                hint: "the surface's shortest wavelength (correlation length or short \
-                       cut-off) is too small against the block",
+                hint: "the surface's shortest wavelength is too small against the block: \
+                       raise heights.correlation_length (gaussian_surface) or \
+                       heights.short_cutoff (self_affine_surface), or use a smaller block",
             });
         }
         let (pm, qm) = (pm as usize, qm as usize);
@@ -324,7 +325,8 @@ impl Modes {
                        narrower than the modes' spacing 2π/P)",
                 needed: 1.0,
                 limit: 0.0,
-                hint: "widen the band between the long and the short cut-off",
+                hint: "widen the band between heights.long_cutoff and heights.short_cutoff \
+                       (self_affine_surface)",
             });
         }
         variance.iter_mut().for_each(|v| *v /= total);
@@ -716,6 +718,12 @@ impl Plan {
         marginal: &Truncated,
         seed: u64,
     ) -> Result<Vec<f64>> {
+        // Heights without spread (`std_dev` 0, documented as valid) are the mean in every
+        // cell: no rule to converge (the rules' sums differ in their last bits, which a
+        // tolerance of 0 never accepts).
+        if marginal.std_dev == 0.0 {
+            return Ok(vec![marginal.mean; grid.len()]);
+        }
         let (mut ox, mut oy) = self.orders;
         let mut previous = self.cell_averages_with(grid, marginal, seed, (ox, oy));
         loop {
@@ -726,7 +734,9 @@ impl Plan {
                     needed: MAX_ORDER as f64 + 1.0,
                     limit: MAX_ORDER as f64,
                     hint: "the cells are too large against the surface's shortest \
-                           wavelength: use smaller cells or a smoother surface",
+                           wavelength: use smaller cells (cells.dx, cells.dy) or a smoother \
+                           surface (a longer heights.correlation_length or \
+                           heights.short_cutoff)",
                 });
             }
             (ox, oy) = (

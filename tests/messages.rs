@@ -684,3 +684,36 @@ fn info_and_run_agree_on_planes_near_the_interface() {
 fn path_str(p: &Path) -> &str {
     p.to_str().unwrap()
 }
+
+/// Messages that named a Rust type, a thread count not asked for, or a range holding the
+/// refused value (issue 41 item 10).
+#[test]
+fn scene_messages_say_what_is_valid() {
+    let with = |extra: &str| {
+        let text = BASE.trim_end().trim_end_matches('}').to_string() + extra + " }";
+        let builder = SceneBuilder::from_json_str(&text);
+        match builder {
+            Err(e) => e.to_string(),
+            Ok(b) => b.build().unwrap_err().to_string(),
+        }
+    };
+    let text = with(r#", "solver": { "threads": "2" }"#);
+    assert!(
+        !text.contains("untagged") && !text.contains("ThreadsSpec"),
+        "{text}"
+    );
+    assert!(
+        text.contains("solver.threads") && text.contains("\"all\""),
+        "{text}"
+    );
+    // threads 0 asks for one per core: refused with the dense backend where there are
+    // several.
+    if std::thread::available_parallelism().is_ok_and(|n| n.get() > 1) {
+        let text = with(r#", "solver": { "threads": 0, "backend": "dense" }"#);
+        assert!(text.contains("solver.threads 0 or \"all\""), "{text}");
+    }
+    let text = with(r#", "material": { "poisson_ratio": -0.9999991 }"#);
+    assert!(text.contains("[-0.999999, 0.5]"), "{text}");
+    let text = with(r#", "fields": { "every": 1, "planes": [1e-7] }"#);
+    assert!(text.starts_with("fields.planes = 1e-7"), "{text}");
+}

@@ -395,3 +395,23 @@ fn the_convergence_sweeps_share_their_surfaces_across_cell_sizes() {
         }
     }
 }
+
+/// Heights without spread (`std_dev` 0, documented as valid) are the mean in every cell,
+/// for a surface as for white noise (issue 41: the cell averages' rule never converged).
+#[test]
+fn a_surface_without_spread_is_its_mean_everywhere() {
+    let grid = Grid::new(block(), 8, 4).unwrap();
+    for spectrum in [
+        SurfaceSpectrum::gaussian(2e-3).unwrap(),
+        SurfaceSpectrum::self_affine(0.7, 3e-3, 6e-4, 5e-3).unwrap(),
+    ] {
+        let heights = Heights::random_surface(
+            &grid,
+            spectrum,
+            HeightDistribution::new(1.5e-6, 0.0).unwrap(),
+            7,
+        )
+        .unwrap();
+        assert!(heights.values().iter().all(|&h| h == 1.5e-6), "{heights:?}");
+    }
+}

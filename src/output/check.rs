@@ -477,7 +477,12 @@ impl RunRecord {
         for (line, row) in rows(&text, EVENTS_HEADER).map_err(|r| corrupt(0, r))? {
             let e = event_row(line, row, &bounds).map_err(|r| corrupt(0, r))?;
             if e.index != last + 1 {
-                return Err(corrupt(0, format!("line {line}: event {} follows event {last}: the rows are not those of one run (1, 2, 3, ...)", e.index).into()));
+                let reason = format!(
+                    "line {line}: event {} follows event {last}: the rows are not those of \
+                     one run (1, 2, 3, ...)",
+                    e.index
+                );
+                return Err(corrupt(0, reason.into()));
             }
             last = e.index;
             if slip.is_some() {
@@ -523,10 +528,15 @@ impl RunRecord {
                 ));
             };
             if c.event != s.index || c.force_text != s.force_text {
-                return Err(corrupt(1, format!(
-                    "line {line} holds event {} at force_N {}, but the stable state there in events.csv is event {} at {}",
-                    c.event, c.force_text, s.index, s.force_text
-                ).into()));
+                return Err(corrupt(
+                    1,
+                    format!(
+                        "line {line} holds event {} at force_N {}, but the stable state there in \
+                     events.csv is event {} at {}",
+                        c.event, c.force_text, s.index, s.force_text
+                    )
+                    .into(),
+                ));
             }
             curve.push(c);
         }
@@ -583,11 +593,22 @@ impl RunRecord {
                 states.next();
             }
             if states.peek() != Some(&r.event) {
-                return Err(format!("line {line}: event {} is not a stable state of curve.csv (or the rows are out of order)", r.event).into());
+                return Err(format!(
+                    "line {line}: event {} is not a stable state of curve.csv (or the rows \
+                     are out of order)",
+                    r.event
+                )
+                .into());
             }
             if let Some(p) = out.last() {
                 if r.level != p.level + 1 {
-                    return Err(format!("line {line}: level {:.3} follows level {:.3}: the levels are not consecutive", level(r.level), level(p.level)).into());
+                    return Err(format!(
+                        "line {line}: level {:.3} follows level {:.3}: the levels are not \
+                         consecutive",
+                        level(r.level),
+                        level(p.level)
+                    )
+                    .into());
                 }
             }
             out.push(r);
@@ -609,10 +630,13 @@ impl RunRecord {
         let rows = out.len() as u64;
         if out.first().is_some_and(|r| r.level != start) || rows < lo || rows > hi {
             return Err(format!(
-                "it holds {rows} levels from {}, but the run's loads give {lo} levels from {:.3} (up to F/(μF_N) = {reached})",
-                out.first().map_or("none".to_string(), |r| format!("{:.3}", level(r.level))),
+                "it holds {rows} levels from {}, but the run's loads give {lo} levels from \
+                 {:.3} (up to F/(μF_N) = {reached})",
+                out.first()
+                    .map_or("none".to_string(), |r| format!("{:.3}", level(r.level))),
                 level(start)
-            ).into());
+            )
+            .into());
         }
         Ok(out)
     }

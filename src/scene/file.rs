@@ -233,11 +233,46 @@ schema_struct! {
 /// `solver.threads`: a count (`1`: the calling thread only; `0`: every core), `"all"`
 /// (every core) or `"current"` (the caller's rayon pool).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", derive(Serialize))]
 #[cfg_attr(feature = "serde", serde(untagged))]
 enum ThreadsSpec {
     Count(usize),
     Name(ThreadsName),
+}
+
+// By hand, not `untagged`: serde's untagged enums fail with "data did not match any
+// variant of untagged enum ThreadsSpec", which names a Rust type and not what is valid.
+#[cfg(feature = "serde")]
+impl<'de> Deserialize<'de> for ThreadsSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        use serde::de::Unexpected;
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = ThreadsSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(
+                    "solver.threads as a whole number (0: one thread per core, 1: the calling \
+                     thread only), \"all\" or \"current\"",
+                )
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> std::result::Result<ThreadsSpec, E> {
+                usize::try_from(v)
+                    .map(ThreadsSpec::Count)
+                    .map_err(|_| E::invalid_value(Unexpected::Unsigned(v), &self))
+            }
+            fn visit_str<E: serde::de::Error>(
+                self,
+                v: &str,
+            ) -> std::result::Result<ThreadsSpec, E> {
+                match v {
+                    "all" => Ok(ThreadsSpec::Name(ThreadsName::All)),
+                    "current" => Ok(ThreadsSpec::Name(ThreadsName::Current)),
+                    _ => Err(E::invalid_value(Unexpected::Str(v), &self)),
+                }
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
 }
 
 schema_leaf!(ThreadsSpec, |v| match v {
