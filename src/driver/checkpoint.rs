@@ -353,11 +353,31 @@ impl Scene {
                 ));
             }
         }
+        // What a driver holds once it has returned an event (the first is the stable state
+        // at zero shear: both equilibria solved, the columns' areas recorded, the solver's
+        // warm starts set) and holds none of before: a checkpoint whose digest was
+        // recomputed after an edit must still be one a driver could have written.
+        let started = checkpoint.events > 0;
         let columns = checkpoint.initial_columns.len();
-        if !(columns == 0 || columns == self.grid().nx()) {
+        let nx = self.grid().nx();
+        if columns != if started { nx } else { 0 }
+            || !checkpoint
+                .initial_columns
+                .iter()
+                .all(|a| a.is_finite() && *a >= 0.0)
+        {
             return bad(format!(
-                "{columns} initial column areas for {} columns",
-                self.grid().nx()
+                "{columns} initial column areas after {} events (a driver records the {nx} \
+                 columns' finite areas >= 0 at its first event, none before)",
+                checkpoint.events
+            ));
+        }
+        if checkpoint.normal.is_some() != started || checkpoint.response.is_some() != started {
+            return bad(format!(
+                "after {} events it {} the equilibria (a driver solves them for its first \
+                 event)",
+                checkpoint.events,
+                if started { "lacks" } else { "holds" }
             ));
         }
         if !checkpoint.control.is_finite() {
@@ -371,7 +391,7 @@ impl Scene {
         for (i, state) in checkpoint.states.iter().enumerate() {
             driver.interface.set_state(i, *state);
         }
-        driver.solver.restore(checkpoint.solver.clone())?;
+        driver.solver.restore(checkpoint.solver.clone(), started)?;
         // λ is a function of the two equilibria: recomputed rather than stored (it holds
         // infinities, which JSON cannot).
         if let (Some(normal), Some(response)) = (&checkpoint.normal, &checkpoint.response) {

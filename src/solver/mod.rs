@@ -328,7 +328,7 @@ impl EquilibriumSolver {
     }
 
     /// Restores a state taken by [`EquilibriumSolver::state`] on the same geometry.
-    pub(crate) fn restore(&mut self, state: SolverState) -> Result<()> {
+    pub(crate) fn restore(&mut self, state: SolverState, solved: bool) -> Result<()> {
         let n = self.grid.len();
         let bad = |reason: String| Err(Error::InvalidCheckpoint { reason });
         if state.backend != self.backend {
@@ -341,10 +341,19 @@ impl EquilibriumSolver {
             ("normal", &state.warm_normal),
             ("tangential", &state.warm_tangential),
         ] {
-            if !(warm.is_empty() || warm.len() == n) || !warm.iter().all(|x| x.is_finite()) {
+            // Empty until the first solve, then one value per site ever after: an empty one
+            // later would start the next solve cold, on another path to other digits.
+            let expected = if solved { n } else { 0 };
+            if warm.len() != expected || !warm.iter().all(|x| x.is_finite()) {
                 return bad(format!(
-                    "the {name} warm start has {} values (expected 0 or {n}, all finite)",
-                    warm.len()
+                    "the {name} warm start has {} values (expected {expected}, all finite: \
+                     {})",
+                    warm.len(),
+                    if solved {
+                        "a solver that has solved keeps one per site"
+                    } else {
+                        "none before the first solve"
+                    }
                 ));
             }
         }
