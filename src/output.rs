@@ -119,7 +119,7 @@ pub(crate) fn contact_map_header(nx: usize) -> String {
 /// the scene record, the lock, a sweep's `done` or `meta.json`, a merged table, a figure
 /// or a movie; and one that exists but is not a regular file (a FIFO, a device, a
 /// directory, a symbolic link), which a checkpoint written atomically would replace.
-/// [`RunTables::run_to_slip`] checks its checkpoint so; call it before
+/// `RunTables::run_to_slip` (feature `serde`) checks its checkpoint so; call it before
 /// [`RunTables::create`] to refuse before anything is written.
 ///
 /// ```
