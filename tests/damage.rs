@@ -6,7 +6,7 @@
 //! global slip dropped, values out of their physical bounds or not finite, another
 //! point's `scene.json`, run directories swapped, `sweep.json` edited.
 
-use crate::common::program::{path, precursors, stderr};
+use crate::common::program::{contents, path, precursors, stderr};
 use std::path::{Path, PathBuf};
 
 fn scratch(name: &str) -> PathBuf {
@@ -39,21 +39,6 @@ fn copy(from: &Path, to: &Path) {
             std::fs::copy(entry.path(), target).unwrap();
         }
     }
-}
-
-/// Every file under `dir` with its bytes, sorted.
-fn contents(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
-    let mut out = Vec::new();
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let entry = entry.unwrap();
-        if entry.file_type().unwrap().is_dir() {
-            out.extend(contents(&entry.path()));
-        } else {
-            out.push((entry.path(), std::fs::read(entry.path()).unwrap()));
-        }
-    }
-    out.sort();
-    out
 }
 
 /// The lines of a table (header first).

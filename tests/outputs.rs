@@ -7,7 +7,7 @@
 //! Each case runs the program under a time bound (a hang fails the test) and compares the
 //! directory's bytes before and after a refusal.
 
-use crate::common::program::{command, path, precursors, stderr};
+use crate::common::program::{command, contents, path, precursors, stderr};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 use std::time::{Duration, Instant};
@@ -58,29 +58,6 @@ fn bounded(args: &[&str]) -> Option<Output> {
     let _ = child.kill();
     let _ = child.wait();
     None
-}
-
-/// Every file under `dir` (relative path, bytes; a special file by its kind), sorted.
-fn contents(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).unwrap() {
-            let entry = entry.unwrap();
-            let p = entry.path();
-            let name = p.strip_prefix(dir).unwrap().display().to_string();
-            let kind = entry.file_type().unwrap();
-            if kind.is_dir() {
-                stack.push(p);
-            } else if kind.is_file() {
-                out.push((name, std::fs::read(&p).unwrap()));
-            } else {
-                out.push((name, format!("{kind:?}").into_bytes()));
-            }
-        }
-    }
-    out.sort();
-    out
 }
 
 /// A finished run of [`SCENE`] in `dir/run` with its figures and movies drawn, and a

@@ -37,3 +37,26 @@ pub fn path(p: &Path) -> &str {
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
+
+/// Every file under `dir` (relative path, bytes; a special file by its kind), sorted.
+pub fn contents(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let entry = entry.unwrap();
+            let p = entry.path();
+            let name = p.strip_prefix(dir).unwrap().display().to_string();
+            let kind = entry.file_type().unwrap();
+            if kind.is_dir() {
+                stack.push(p);
+            } else if kind.is_file() {
+                out.push((name, std::fs::read(&p).unwrap()));
+            } else {
+                out.push((name, format!("{kind:?}").into_bytes()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
