@@ -263,8 +263,8 @@ pub enum Error {
     // Spelled as the scene file spells them (`solver.backend`, `solver.threads`): most
     // users meet this message from a scene file.
     #[error(
-        "backend \"dense\" runs on one thread, but {threads} threads were asked for \
-         (solver.threads 0 or \"all\" ask for one per core): use \
+        "backend \"dense\" runs on one thread, but threads {threads} was asked for \
+         (solver.threads 0 and \"all\" ask for one per core): use \
          backend \"spectral\" (or \"auto\" above {auto_limit} cells) to solve on several \
          threads, or threads 1 with backend \"dense\" (scene file: solver.backend, \
          solver.threads)"

@@ -722,12 +722,7 @@ impl SceneBuilder {
         if let Some(Lateral::Rod { height, half_width }) = self.lateral() {
             RodLoad::new(&block, height, half_width)?;
         }
-        // The planes' heights: `bounds::physics`, naming their key.
-        if !self.probes.is_empty() {
-            for &p in self.probes.points() {
-                block.check_point(p, ["x", "y", "z"])?;
-            }
-        }
+        // The planes' heights and the points: `bounds::physics`, naming their key.
         bounds::physics(self, &grid)?;
         Ok(grid)
     }

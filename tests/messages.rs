@@ -710,7 +710,7 @@ fn scene_messages_say_what_is_valid() {
     // several.
     if std::thread::available_parallelism().is_ok_and(|n| n.get() > 1) {
         let text = with(r#", "solver": { "threads": 0, "backend": "dense" }"#);
-        assert!(text.contains("solver.threads 0 or \"all\""), "{text}");
+        assert!(text.contains("solver.threads 0 and \"all\""), "{text}");
     }
     let text = with(r#", "material": { "poisson_ratio": -0.9999991 }"#);
     assert!(text.contains("[-0.999999, 0.5]"), "{text}");

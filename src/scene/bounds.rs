@@ -343,6 +343,23 @@ pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
             });
         }
     }
+    let block = grid.block();
+    for p in probes.points() {
+        for (axis, value, max) in [
+            ("x", p.x, block.lx()),
+            ("y", p.y, block.ly()),
+            ("z", p.z, lz),
+        ] {
+            if !(value.is_finite() && (0.0..=max).contains(&value)) {
+                return Err(Error::OutOfRange {
+                    key: "probes.points",
+                    value,
+                    range: format!("[0, {}] m for {axis}", End(max, false)),
+                    reason: "a probe point lies in the block",
+                });
+            }
+        }
+    }
     for (key, count) in [
         ("probes.planes", probes.planes().len()),
         ("probes.points", probes.points().len()),
