@@ -554,8 +554,46 @@ pub(crate) mod json {
                     other => panic!("{case} ({backend:?}): not refused: {:?}", other.map(|_| ())),
                 }
             }
+            // With events queued (a rupture followed by a state change): a queued site
+            // outside the grid.
+            let queued = rupture_with_queue(&scene);
+            let mut d = scene.driver().unwrap();
+            for _ in 0..queued {
+                d.step().unwrap();
+            }
+            let with_queue = d.checkpoint().to_json().unwrap();
+            let pending = with_queue.find("\"pending\":").unwrap();
+            let ix = pending + with_queue[pending..].find("\"ix\":").unwrap();
+            let forged_site = format!(
+                "{}{}",
+                &with_queue[..ix],
+                replace_value(&with_queue[ix..], "ix", "999")
+            );
+            assert_ne!(forged_site, with_queue);
+            for (case, forged) in [
+                ("a queued site outside the grid", forged_site),
+                (
+                    "the start phase after events",
+                    replace_value(&text, "phase", "\"Start\""),
+                ),
+                (
+                    "more ruptures than broken sites",
+                    replace_value(&text, "avalanche_ruptures", "100000"),
+                ),
+            ] {
+                assert_ne!(forged, text, "{case}: nothing forged");
+                let checkpoint = Checkpoint::from_json_str(&resigned(&forged))
+                    .unwrap_or_else(|e| panic!("{case}: the forged text does not parse: {e}"));
+                assert!(
+                    matches!(
+                        scene.resume(&checkpoint),
+                        Err(Error::InvalidCheckpoint { .. })
+                    ),
+                    "{case} ({backend:?}): not refused"
+                );
+            }
             // The checkpoints as written resume.
-            for t in [&fresh, &text] {
+            for t in [&fresh, &text, &with_queue] {
                 scene
                     .resume(&Checkpoint::from_json_str(t).unwrap())
                     .unwrap();

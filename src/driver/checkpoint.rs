@@ -380,6 +380,48 @@ impl Scene {
                 if started { "lacks" } else { "holds" }
             ));
         }
+        // The protocol's own state: it starts before the first event only, its queued
+        // events name sites of the grid (index and column, row agreeing), and the ruptures
+        // of an avalanche each broke a site that stays broken.
+        if (checkpoint.phase == Phase::Start) == started
+            || (checkpoint.phase == Phase::Start && !checkpoint.pending.is_empty())
+        {
+            return bad(format!(
+                "phase {:?} after {} events with {} queued (a driver starts before its first \
+                 event only, with none queued)",
+                checkpoint.phase,
+                checkpoint.events,
+                checkpoint.pending.len()
+            ));
+        }
+        for event in &checkpoint.pending {
+            let site = match event {
+                Event::Rupture { site, .. } | Event::Detach { site } | Event::Attach { site } => {
+                    *site
+                }
+                _ => continue,
+            };
+            if site.index >= n || site.ix != site.index % nx || site.iy != site.index / nx {
+                return bad(format!(
+                    "a queued event names site {} at ({}, {}), not a site of the {nx} x {} grid",
+                    site.index,
+                    site.ix,
+                    site.iy,
+                    n / nx
+                ));
+            }
+        }
+        let broken = checkpoint
+            .states
+            .iter()
+            .filter(|s| **s == SiteState::Broken)
+            .count();
+        if checkpoint.avalanche_ruptures > broken {
+            return bad(format!(
+                "{} ruptures in the avalanche under way, but {broken} broken sites",
+                checkpoint.avalanche_ruptures
+            ));
+        }
         if !checkpoint.control.is_finite() {
             return bad(format!("the load {} is not finite", checkpoint.control));
         }
