@@ -716,4 +716,15 @@ fn scene_messages_say_what_is_valid() {
     assert!(text.contains("[-0.999999, 0.5]"), "{text}");
     let text = with(r#", "fields": { "every": 1, "planes": [1e-7] }"#);
     assert!(text.starts_with("fields.planes = 1e-7"), "{text}");
+    // A probe point outside the block, and one nearer the interface than its sums reach.
+    let text = with(r#", "probes": { "points": [[0.05, 0.002, 0.01]] }"#);
+    assert!(
+        text.starts_with("probes.points = 0.05") && text.contains("for x"),
+        "{text}"
+    );
+    let text = with(r#", "probes": { "points": [[0.01, 0.002, 1e-300]] }"#);
+    assert!(
+        text.starts_with("probes.points = 1e-300") && text.contains("0 or ["),
+        "{text}"
+    );
 }

@@ -344,6 +344,7 @@ pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
         }
     }
     let block = grid.block();
+    let lowest_point = crate::probe::lowest_point(grid, probes.tolerance());
     for p in probes.points() {
         for (axis, value, max) in [
             ("x", p.x, block.lx()),
@@ -358,6 +359,19 @@ pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
                     reason: "a probe point lies in the block",
                 });
             }
+        }
+        if p.z != 0.0 && p.z < lowest_point {
+            return Err(Error::OutOfRange {
+                key: "probes.points",
+                value: p.z,
+                range: format!(
+                    "0 or [{}, {}] m for z",
+                    End(lowest_point, true),
+                    End(lz, false)
+                ),
+                reason: "a point closer to the interface than this needs more alias terms than \
+                         their budget: use z = 0, or raise the point or probes.tolerance",
+            });
         }
     }
     for (key, count) in [
