@@ -203,6 +203,7 @@ fn continuation(
     paths: &[PathBuf; 3],
     k: usize,
     bounds: &check::Bounds,
+    force_at_k: f64,
 ) -> Result<Continuation> {
     let corrupt = |t: usize, reason: String| Error::CorruptTable {
         path: Some(paths[t].clone()),
@@ -279,6 +280,21 @@ fn continuation(
                  --checkpoint` takes them)"
             ),
         });
+    }
+
+    // The checkpoint's load is the one the tables give its stable state (as written:
+    // the same 13 digits), so neither was edited since.
+    if let (true, Some(force)) = (k > 0, stable_forces.last()) {
+        let checkpoint = format!("{force_at_k:.12e}");
+        if *force != checkpoint {
+            return Err(corrupt(
+                0,
+                format!(
+                    "event {k} is at force_N {force}, the checkpoint's load is {checkpoint} N: \
+                     the table or the checkpoint was edited"
+                ),
+            ));
+        }
     }
 
     // curve.csv: one row per stable state of events.csv up to k, in order.
@@ -834,6 +850,7 @@ impl RunTables {
             &read,
             k,
             &check::Bounds::of(driver),
+            driver.force(),
         )?;
         let in_effect = if plan.in_effect {
             Some(MapState {

@@ -601,6 +601,63 @@ pub(crate) mod json {
         }
     }
 
+    /// A checkpoint whose load was edited (its digest recomputed) is consistent in itself,
+    /// but not with the tables of its run: `RunTables::resume` refuses it before writing.
+    #[test]
+    fn a_checkpoint_whose_load_was_edited_does_not_resume_its_tables() {
+        let dir =
+            std::env::temp_dir().join(format!("precursors-{}-checkpoint-load", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let scene = Scene::builder()
+            .block(0.020, 0.004, 0.020)
+            .normal_load(200.0)
+            .seed(1)
+            .build()
+            .unwrap();
+        let mut driver = scene.driver().unwrap();
+        let mut tables = output::RunTables::create(&dir, &driver).unwrap();
+        let mut stable = 0;
+        let mut text = String::new();
+        while let Some(event) = driver.step().unwrap() {
+            tables.record(&driver, &event).unwrap();
+            if matches!(event, Event::Stable { .. }) {
+                stable += 1;
+                if stable == 6 {
+                    tables.flush().unwrap();
+                    text = driver.checkpoint().to_json().unwrap();
+                    break;
+                }
+            }
+        }
+        drop(tables);
+        let control: f64 = {
+            let at = text.find("\"control\":").unwrap() + "\"control\":".len();
+            let end = at + text[at..].find(',').unwrap();
+            text[at..end].parse().unwrap()
+        };
+        let forged = replace_value(&text, "control", &format!("{:?}", control * 1.001));
+        let checkpoint = Checkpoint::from_json_str(&resigned(&forged)).unwrap();
+        let resumed = scene.resume(&checkpoint).unwrap();
+        let before = std::fs::read(dir.join("events.csv.partial")).unwrap();
+        match output::RunTables::resume(&dir, &resumed) {
+            Err(Error::CorruptTable { reason, .. }) => {
+                assert!(reason.contains("the checkpoint's load"), "{reason}")
+            }
+            other => panic!("not refused: {:?}", other.map(|_| ())),
+        }
+        assert_eq!(
+            std::fs::read(dir.join("events.csv.partial")).unwrap(),
+            before
+        );
+        // The checkpoint as written resumes its tables.
+        let good = scene
+            .resume(&Checkpoint::from_json_str(&text).unwrap())
+            .unwrap();
+        output::RunTables::resume(&dir, &good).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     #[test]
     fn damaged_checkpoints_are_refused_with_typed_errors() {
         let scene = Scene::builder()
