@@ -212,6 +212,31 @@ pub(crate) fn write_atomically(path: &Path, bytes: &[u8], operation: &'static st
     sync_dir(dir).map_err(|e| io(dir, e))
 }
 
+/// Removes from `dir` the temporary files [`write_atomically`] names for `names`
+/// (`.NAME.tmp...`), left by a writer killed while writing one: call it only while
+/// holding the directory (its lock), so that no live writer's file is removed.
+///
+/// # Errors
+/// [`Error::Io`] when `dir` cannot be read or a temporary file removed.
+pub(crate) fn remove_temporaries(dir: &Path, names: &[String]) -> Result<()> {
+    let prefixes: Vec<String> = names.iter().map(|n| format!(".{n}.tmp")).collect();
+    let entries = std::fs::read_dir(dir).map_err(|e| Error::io("reading directory", dir, e))?;
+    for entry in entries {
+        let entry = entry.map_err(|e| Error::io("reading directory", dir, e))?;
+        let name = entry.file_name();
+        let name = name.to_string_lossy();
+        if prefixes.iter().any(|p| name.starts_with(p.as_str())) {
+            match std::fs::remove_file(entry.path()) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(Error::io("removing a temporary file", entry.path(), e))
+                }
+                _ => {}
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Syncs a directory's entries (a rename into it) to disk; a no-op where directories
 /// cannot be opened (Windows).
 pub(crate) fn sync_dir(dir: &Path) -> std::io::Result<()> {

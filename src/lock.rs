@@ -210,8 +210,27 @@ pub(crate) fn write<T>(lock: &std::sync::RwLock<T>) -> std::sync::RwLockWriteGua
         .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
+/// The value of a mutex through `&mut`, poisoned or not ([`lock`]).
+pub(crate) fn get_mut<T>(mutex: &mut std::sync::Mutex<T>) -> &mut T {
+    mutex
+        .get_mut()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// [`std::sync::Condvar::wait_timeout`] on `guard`, poisoned or not ([`lock`]); whether
+/// it timed out is not needed by its callers.
+pub(crate) fn wait_timeout<'a, T>(
+    condvar: &std::sync::Condvar,
+    guard: std::sync::MutexGuard<'a, T>,
+    timeout: std::time::Duration,
+) -> std::sync::MutexGuard<'a, T> {
+    match condvar.wait_timeout(guard, timeout) {
+        Ok((guard, _)) => guard,
+        Err(poisoned) => poisoned.into_inner().0,
+    }
+}
+
 /// The value of a mutex, poisoned or not ([`lock`]).
-#[cfg_attr(not(feature = "serde"), allow(dead_code))]
 pub(crate) fn into_inner<T>(mutex: std::sync::Mutex<T>) -> T {
     mutex
         .into_inner()

@@ -1145,32 +1145,17 @@ impl RunTables {
 }
 
 /// Removes the temporary files of the tables and the scene record that a writer killed
-/// while writing one left in `dir` (`write_atomically` names them `.NAME.tmp...`); only
-/// the lock holder writes them.
+/// while writing one left in `dir`; only the lock holder writes them.
 fn remove_stale_temporaries(dir: &Path) -> Result<()> {
-    let prefixes: Vec<String> = TABLE_NAMES
+    let names: Vec<String> = TABLE_NAMES
         .iter()
-        .map(|n| format!(".{n}{PARTIAL_SUFFIX}.tmp"))
+        .map(|n| format!("{n}{PARTIAL_SUFFIX}"))
         .chain([
-            format!(".{SCENE_RECORD}.tmp"),
-            format!(".{FIELDS_TABLE}{PARTIAL_SUFFIX}.tmp"),
+            SCENE_RECORD.to_string(),
+            format!("{FIELDS_TABLE}{PARTIAL_SUFFIX}"),
         ])
         .collect();
-    let entries = fs::read_dir(dir).map_err(|e| Error::io("reading directory", dir, e))?;
-    for entry in entries {
-        let entry = entry.map_err(|e| Error::io("reading directory", dir, e))?;
-        let name = entry.file_name();
-        let name = name.to_string_lossy();
-        if prefixes.iter().any(|p| name.starts_with(p.as_str())) {
-            match fs::remove_file(entry.path()) {
-                Err(e) if e.kind() != io::ErrorKind::NotFound => {
-                    return Err(Error::io("removing a temporary file", entry.path(), e))
-                }
-                _ => {}
-            }
-        }
-    }
-    Ok(())
+    crate::files::remove_temporaries(dir, &names)
 }
 
 /// Removes the figures and movies of an earlier run from `dir` ([`layout::derived`]): they

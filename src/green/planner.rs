@@ -90,6 +90,6 @@ impl Planner {
     }
 
     fn lock(&self) -> std::sync::MutexGuard<'_, Vec<InfluencePlan>> {
-        self.plans.lock().unwrap_or_else(|e| e.into_inner())
+        crate::lock::lock(&self.plans)
     }
 }

@@ -383,7 +383,7 @@ struct FactorSolve<'a> {
 
 impl ExactInverse for FactorSolve<'_> {
     fn solve(&self, r: &[f64], z: &mut [f64]) {
-        let mut work = self.work.lock().unwrap_or_else(|e| e.into_inner());
+        let mut work = crate::lock::lock(&self.work);
         for (a, &p) in self.perm.iter().enumerate() {
             work[(a, 0)] = r[p];
         }

@@ -216,7 +216,7 @@ impl<P: Copy> Board<P> {
             if generation != seen {
                 // The phase read here belongs to `generation` if a claim of it succeeds
                 // (the leader publishes the next phase only once every task is done).
-                let phase = *self.phase.lock().unwrap_or_else(|e| e.into_inner());
+                let phase = *crate::lock::lock(&self.phase);
                 if let Some(phase) = phase {
                     self.work(tasks, worker, generation, phase);
                 }
@@ -227,16 +227,17 @@ impl<P: Copy> Board<P> {
             }
             spins += 1;
             if spins.is_multiple_of(64) && idle.elapsed() > SPIN {
-                let guard = self.lock.lock().unwrap_or_else(|e| e.into_inner());
+                let guard = crate::lock::lock(&self.lock);
                 self.sleepers.fetch_add(1, Ordering::SeqCst);
                 let stale = self.generation.load(Ordering::SeqCst) == seen
                     && !self.finished.load(Ordering::SeqCst);
                 if stale {
                     // The timeout only bounds a missed wake-up's cost.
-                    let _ = self
-                        .wake
-                        .wait_timeout(guard, Duration::from_millis(50))
-                        .unwrap_or_else(|e| e.into_inner());
+                    drop(crate::lock::wait_timeout(
+                        &self.wake,
+                        guard,
+                        Duration::from_millis(50),
+                    ));
                 }
                 self.sleepers.fetch_sub(1, Ordering::SeqCst);
                 idle = Instant::now();
@@ -248,7 +249,7 @@ impl<P: Copy> Board<P> {
 
     fn notify(&self) {
         if self.sleepers.load(Ordering::SeqCst) > 0 {
-            let _guard = self.lock.lock().unwrap_or_else(|e| e.into_inner());
+            let _guard = crate::lock::lock(&self.lock);
             self.wake.notify_all();
         }
     }
@@ -278,7 +279,7 @@ impl<T: Tasks> Crew<'_, T> {
         let board = self.board;
         let generation = self.generation.get() + 1;
         self.generation.set(generation);
-        *board.phase.lock().unwrap_or_else(|e| e.into_inner()) = Some(phase);
+        *crate::lock::lock(&board.phase) = Some(phase);
         board.done.store(0, Ordering::Relaxed);
         board.generation.store(generation, Ordering::SeqCst);
         board.notify();
@@ -354,11 +355,7 @@ pub(crate) fn map_parts<R: Send>(
     Ok(map
         .out
         .into_iter()
-        .map(|slot| {
-            slot.into_inner()
-                .unwrap_or_else(|e| e.into_inner())
-                .expect("every part ran")
-        })
+        .map(|slot| crate::lock::into_inner(slot).expect("every part ran"))
         .collect())
 }
 
@@ -402,7 +399,7 @@ type Pools = Vec<(usize, Arc<rayon::ThreadPool>)>;
 fn shared_pool(size: usize) -> Result<Arc<rayon::ThreadPool>> {
     static POOLS: OnceLock<Mutex<Pools>> = OnceLock::new();
     let pools = POOLS.get_or_init(Default::default);
-    let mut pools = pools.lock().unwrap_or_else(|e| e.into_inner());
+    let mut pools = crate::lock::lock(pools);
     if let Some((_, pool)) = pools.iter().find(|(n, _)| *n == size) {
         return Ok(pool.clone());
     }

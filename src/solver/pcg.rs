@@ -110,7 +110,7 @@ pub(crate) fn projected_pcg<S: SetSystem>(
     let parts = sys.parts();
     vectors.0.resize_with(parts, Default::default);
     for (k, v) in vectors.0.iter_mut().enumerate() {
-        let v = v.get_mut().unwrap_or_else(|e| e.into_inner());
+        let v = crate::lock::get_mut(v);
         let range = sys.range(k);
         let m = range.len();
         v.f.clear();
