@@ -284,6 +284,30 @@ pub struct Driver {
     avalanche_ruptures: usize,
     events: usize,
     stats: SolveStats,
+    /// The message of the error that failed the driver (repeated by later steps).
+    failure: Option<String>,
+}
+
+/// Where a [`Driver`]'s run stands ([`Driver::state`]).
+///
+/// ```
+/// use precursors::{RunState, Scene};
+/// let scene = Scene::builder().block(0.010, 0.004, 0.010).normal_load(100.0).build()?;
+/// let mut driver = scene.driver()?;
+/// assert_eq!(driver.state(), RunState::Running);
+/// while driver.step()?.is_some() {}
+/// assert_eq!(driver.state(), RunState::GlobalSlip);
+/// # Ok::<(), precursors::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum RunState {
+    /// Events are still to come ([`Driver::step`] returns the next).
+    Running,
+    /// Global slip was returned: the run is over (`step` returns `Ok(None)`).
+    GlobalSlip,
+    /// A step failed: the run cannot go on (`step` returns [`Error::DriverFailed`]).
+    Failed,
 }
 
 /// Cumulative solver work of a driver since it was created or resumed
@@ -364,34 +388,58 @@ impl Scene {
             avalanche_ruptures: 0,
             events: 0,
             stats: SolveStats::default(),
+            failure: None,
         })
     }
 }
 
 impl Driver {
     /// The next event, `Ok(None)` after [`Event::GlobalSlip`]. After an error the driver
-    /// stays failed (every later call returns `Ok(None)`).
+    /// stays failed ([`Driver::state`]): every later call returns
+    /// [`Error::DriverFailed`] with the first error's message, never `Ok(None)`, so a
+    /// failed run cannot pass for a finished one. (As an iterator, the driver yields the
+    /// first error and then ends.)
     ///
     /// # Errors
     /// The first failure of a solve ([`Error::SolverNotConverged`],
     /// [`Error::Factorization`], [`Error::EmptyContact`], [`Error::NonFinite`],
-    /// [`Error::ThreadPool`], ...); the driver then stays failed.
+    /// [`Error::ThreadPool`], ...); the driver then stays failed, and later calls return
+    /// [`Error::DriverFailed`].
     pub fn step(&mut self) -> Result<Option<Event>> {
         loop {
             if let Some(event) = self.pending.pop_front() {
                 self.events += 1;
                 return Ok(Some(event));
             }
-            if matches!(self.phase, Phase::Done | Phase::Failed) {
-                return Ok(None);
+            match self.phase {
+                Phase::Done => return Ok(None),
+                Phase::Failed => {
+                    return Err(Error::DriverFailed {
+                        reason: self.failure.clone().unwrap_or_else(|| {
+                            "it was resumed from the checkpoint of a failed driver".into()
+                        }),
+                    })
+                }
+                _ => {}
             }
             let advanced = self.advance();
             self.refresh_shear();
             if let Err(e) = advanced {
                 self.phase = Phase::Failed;
+                self.failure = Some(e.to_string());
                 self.pending.clear();
                 return Err(e);
             }
+        }
+    }
+
+    /// Where the run stands: running, at global slip (returned by [`Driver::step`]), or
+    /// failed (a step returned an error; `step` repeats it as [`Error::DriverFailed`]).
+    pub fn state(&self) -> RunState {
+        match self.phase {
+            Phase::Failed => RunState::Failed,
+            Phase::Done if self.pending.is_empty() => RunState::GlobalSlip,
+            _ => RunState::Running,
         }
     }
 
@@ -709,6 +757,11 @@ impl Iterator for Driver {
     type Item = Result<Event>;
 
     fn next(&mut self) -> Option<Self::Item> {
+        // The first error is yielded (by the step that failed), then the iterator ends:
+        // a loop over the events that goes on after an error must not spin.
+        if self.phase == Phase::Failed {
+            return None;
+        }
         self.step().transpose()
     }
 }

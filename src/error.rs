@@ -304,6 +304,14 @@ pub enum Error {
         /// Cell index (paper order `iy * Nx + ix`).
         index: usize,
     },
+    /// A driver whose step failed was stepped again (`Driver::step` after an error): the
+    /// run cannot go on; `reason` is the first error's message. Before 1.1 such a step
+    /// returned `Ok(None)`, as after global slip.
+    #[error("the driver failed earlier and cannot go on: {}", Bounded(reason))]
+    DriverFailed {
+        /// The message of the error that failed the driver.
+        reason: String,
+    },
     /// A driver was asked for a field of its equilibrium before it solved one
     /// (`Driver::normal_traction`, `shear_traction`, ... before the first `step`).
     #[error("the driver has not solved {what} yet: call step() first")]

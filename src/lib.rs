@@ -122,7 +122,7 @@ mod surface;
 pub mod sweep;
 
 pub use cost::GridCost;
-pub use driver::{Checkpoint, Driver, Event, Load, Site, SolveStats};
+pub use driver::{Checkpoint, Driver, Event, Load, RunState, Site, SolveStats};
 pub use error::{Error, Result};
 pub use geometry::{Block, Grid, Point};
 pub use interface::{

@@ -599,3 +599,54 @@ fn precursor_drop_threshold_is_refused_outside_zero_to_one() {
         "zero shear: no front"
     );
 }
+
+/// A failed driver does not look finished (issue 45 item 1): its state says so, later
+/// steps repeat the failure as `Error::DriverFailed` instead of `Ok(None)`, and as an
+/// iterator it yields the first error and ends. A run to global slip says so too.
+#[test]
+fn a_failed_driver_is_told_apart_from_a_finished_one() {
+    // One CG iteration cannot reach the tolerance: the first equilibrium fails.
+    let options = SolverOptions::default()
+        .with_backend(Backend::Spectral)
+        .unwrap()
+        .with_max_linear_iterations(1)
+        .unwrap();
+    let scene = Scene::builder()
+        .block(0.020, 0.004, 0.010)
+        .normal_load(100.0)
+        .solver_options(options)
+        .build()
+        .unwrap();
+    let mut driver = scene.driver().unwrap();
+    assert_eq!(driver.state(), RunState::Running);
+    let first = driver.step().unwrap_err();
+    assert!(matches!(first, Error::SolverNotConverged { .. }), "{first}");
+    assert_eq!(driver.state(), RunState::Failed);
+    for _ in 0..3 {
+        match driver.step() {
+            Err(Error::DriverFailed { reason }) => assert_eq!(reason, first.to_string()),
+            other => panic!("a failed driver answered {other:?}"),
+        }
+    }
+    // The iterator: the first error, then the end (a loop over it never spins).
+    let mut fresh = scene.driver().unwrap();
+    assert!(matches!(
+        fresh.next(),
+        Some(Err(Error::SolverNotConverged { .. }))
+    ));
+    assert!(fresh.next().is_none() && fresh.next().is_none());
+    // A run to global slip.
+    let mut whole = Scene::builder()
+        .block(0.010, 0.004, 0.010)
+        .normal_load(100.0)
+        .build()
+        .unwrap()
+        .driver()
+        .unwrap();
+    while let Some(event) = whole.step().unwrap() {
+        let last = matches!(event, Event::GlobalSlip { .. });
+        assert_eq!(whole.state() == RunState::GlobalSlip, last);
+    }
+    assert_eq!(whole.state(), RunState::GlobalSlip);
+    assert!(whole.step().unwrap().is_none());
+}

@@ -316,6 +316,7 @@ fn core_code(e: &Error) -> u8 {
         | Error::EmptyContact { .. }
         | Error::ThreadPool { .. }
         | Error::NotSolved { .. }
+        | Error::DriverFailed { .. }
         | Error::LoadBeyondFriction { .. } => 1,
         // An output option naming a file the command writes or reads: a bad command line.
         Error::OutputCollision { .. } => 2,

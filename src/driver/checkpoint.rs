@@ -383,8 +383,10 @@ impl Scene {
         // The protocol's own state: it starts before the first event only, its queued
         // events name sites of the grid (index and column, row agreeing), and the ruptures
         // of an avalanche each broke a site that stays broken.
-        if (checkpoint.phase == Phase::Start) == started
-            || (checkpoint.phase == Phase::Start && !checkpoint.pending.is_empty())
+        let start = checkpoint.phase == Phase::Start;
+        if (start && (started || !checkpoint.pending.is_empty()))
+            // Before the first event: starting, or failed at the first step.
+            || (!started && !start && checkpoint.phase != Phase::Failed)
         {
             return bad(format!(
                 "phase {:?} after {} events with {} queued (a driver starts before its first \
