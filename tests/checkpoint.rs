@@ -380,10 +380,7 @@ pub(crate) mod json {
 
     /// A fresh directory under the system's temporary directory.
     fn scratch(name: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("precursors-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+        crate::common::scratch("checkpoint", name)
     }
 
     #[test]

@@ -10,10 +10,7 @@ use crate::common::program::{contents, path, precursors, stderr};
 use std::path::{Path, PathBuf};
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("precursors-{}-damage-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::common::scratch("damage", name)
 }
 
 /// Two loads, two realizations of a tiny scene (30 x 5 cells) recording its fields.

@@ -13,13 +13,7 @@ use std::path::PathBuf;
 
 /// A fresh, empty directory under the system's temporary one.
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "precursors-{}-error-types-{name}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::common::scratch("error-types", name)
 }
 
 /// The tiny base scene of tests/sweep.rs (30 x 5 cells).

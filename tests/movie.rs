@@ -13,10 +13,7 @@ use precursors::{Error, Event, ProbeSpec, Scene, SceneBuilder};
 use std::path::{Path, PathBuf};
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("precursors-{}-movie-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::common::scratch("movie", name)
 }
 
 /// A 20 x 4-cell scene driven by the rod (the default drive) to global slip.

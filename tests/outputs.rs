@@ -13,11 +13,7 @@ use std::process::Output;
 use std::time::{Duration, Instant};
 
 fn scratch(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("precursors-{}-outputs-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::common::scratch("outputs", name)
 }
 
 /// A tiny scene (30 x 5 cells, about 10 ms to global slip) recording its fields (one

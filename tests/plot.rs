@@ -13,10 +13,7 @@ use precursors::{Drive, Error, Event, Lateral, Scene};
 use std::path::{Path, PathBuf};
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("precursors-{}-plot-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::common::scratch("plot", name)
 }
 
 /// A 40 x 5-cell rod-driven scene: about 200 events to global slip.

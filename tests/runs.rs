@@ -13,10 +13,7 @@ use std::path::{Path, PathBuf};
 
 /// A fresh, empty directory under the system's temporary one.
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("precursors-{}-runs-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::common::scratch("runs", name)
 }
 
 /// A tiny scene: 30 x 5 = 150 cells, about 330 events to global slip.

@@ -9,9 +9,7 @@ use std::path::{Path, PathBuf};
 
 /// A fresh directory under the system's temporary one.
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("precursors-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::common::scratch("scene-file", name)
 }
 
 /// A builder with every option away from its default.

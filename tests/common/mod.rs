@@ -4,6 +4,18 @@
 #[cfg(feature = "cli")]
 pub mod program;
 
+/// A new, empty directory for one test: `precursors-<pid>-<module>-<name>` under the
+/// temporary directory (the pid keeps two test processes apart, `module` and `name` the
+/// tests of one process), emptied if a run before left it.
+#[allow(dead_code)] // not every feature set has a test that writes files
+pub fn scratch(module: &str, name: &str) -> std::path::PathBuf {
+    let dir =
+        std::env::temp_dir().join(format!("precursors-{}-{module}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 /// Gauss–Legendre nodes and weights on [-1, 1] by Newton iteration on P_n.
 pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
     let mut out = Vec::with_capacity(n);
