@@ -78,23 +78,109 @@ def files():
                 yield path, rel
 
 
-def main():
-    os.chdir(os.path.join(os.path.dirname(__file__), ".."))
+def crate_paths(text):
+    """The first segment of every path into the crate in `text`: `crate::x::...`, each
+    item of `crate::{x::..., Y, ...}` (nested groups included), and `super::...` (what the
+    caller counts as the crate root only in a module's top file)."""
+    out = set(re.findall(r"\bcrate::([A-Za-z_][A-Za-z0-9_]*)", text))
+    for group in re.finditer(r"\bcrate::\{", text):
+        depth, i, item, items = 1, group.end(), "", []
+        while i < len(text) and depth:
+            c = text[i]
+            if c == "{":
+                depth += 1
+            elif c == "}":
+                depth -= 1
+            if depth == 1 and c == ",":
+                items.append(item)
+                item = ""
+            elif depth >= 1 and not (depth == 1 and c == "}"):
+                item += c if depth == 1 else ""
+            i += 1
+        items.append(item)
+        for it in items:
+            first = re.match(r"\s*([A-Za-z_][A-Za-z0-9_]*)", it)
+            if first and first.group(1) not in ("self",):
+                out.add(first.group(1))
+    return out
+
+
+def root_reexports():
+    """Names the crate root re-exports (`pub use module::{A, B}` / `pub use module::A`),
+    with the module each comes from."""
+    text = code(os.path.join("src", "lib.rs"))
+    names = {}
+    for m in re.finditer(r"pub\s+use\s+([a-z_]+)::(\{[^}]*\}|[A-Za-z_][A-Za-z0-9_]*)\s*;", text):
+        module, what = m.group(1), m.group(2)
+        for name in re.findall(r"[A-Za-z_][A-Za-z0-9_]*", what):
+            names[name] = module
+    return names
+
+
+def arrows(path, rel, text, reexported):
+    """The problems of one file's imports (its path `rel` below src/, its code `text`)."""
     problems = []
-    # 1. Module layers.
-    for path, rel in files():
-        mod = module_of(rel)
-        if mod not in RANK:
-            problems.append(f"{path}: module `{mod}` is not in the layer table of .ci/layers.py")
-            continue
-        for used in sorted(set(re.findall(r"\bcrate::([a-z_]+)", code(path)))):
-            if used == mod or used not in RANK:
-                continue
-            if RANK[used] >= RANK[mod]:
+    mod = module_of(rel)
+    if mod not in RANK:
+        return [f"{path}: module `{mod}` is not in the layer table of .ci/layers.py"]
+    used_names = crate_paths(text)
+    # `super::` climbs from the file's module (depth: its folders) to the crate root
+    # after depth + 1 steps; one more allows for an inline `mod tests` inside it.
+    depth = rel.count(os.sep)
+    if re.search(r"\b(super::){%d,}" % (depth + 2), text):
+        problems.append(
+            f"{path}: a `super::` path reaches the crate root: name the module "
+            f"(`crate::module::Item`)"
+        )
+    for used in sorted(used_names):
+        if used in RANK:
+            if used != mod and RANK[used] >= RANK[mod]:
                 problems.append(
                     f"{path}: `{mod}` (layer {RANK[mod]}) imports `crate::{used}` "
                     f"(layer {RANK[used]}): only lower layers may be imported"
                 )
+        elif used in reexported:
+            problems.append(
+                f"{path}: `crate::{used}` goes through the crate root's re-export (the "
+                f"root sits above every layer): write `crate::{reexported[used]}::{used}`"
+            )
+        elif used[0].isupper():
+            problems.append(
+                f"{path}: `crate::{used}` is no module of the layer table nor a name the "
+                f"crate root re-exports: the check cannot place it"
+            )
+    return problems
+
+
+def self_test(reexported):
+    """Planted imports of every path form are caught, and lawful ones pass: the check
+    can fail."""
+    planted = [
+        ("geometry.rs", "use crate::driver::Event;", True),
+        ("geometry.rs", "fn f() -> crate::Event { todo!() }", True),
+        ("geometry.rs", "use crate::{error::Error, driver::{Driver, Event}};", True),
+        ("geometry.rs", "use crate::{Grid};", True),
+        ("solver/fsai.rs", "use super::super::super::Event;", True),
+        ("geometry.rs", "use crate::error::{Error, Result};", False),
+        ("solver/fsai.rs", "use super::parallel::Parallelism;", False),
+        ("solver/fsai.rs", "mod tests { use super::super::Entries; }", False),
+    ]
+    for rel, text, bad in planted:
+        found = arrows(rel, rel, text, reexported)
+        if bool(found) != bad:
+            sys.exit(f".ci/layers.py self-test: {text!r} in {rel} gave {found}")
+
+
+def main():
+    os.chdir(os.path.join(os.path.dirname(__file__), ".."))
+    problems = []
+    reexported = root_reexports()
+    self_test(reexported)
+    # 1. Module layers. Every path form counts: `crate::module::...`, `crate::{...}`, a
+    #    name the crate root re-exports (`crate::Event`: an arrow through the root, which
+    #    sits above every layer), and `super::` paths that climb to the root.
+    for path, rel in files():
+        problems += arrows(path, rel, code(path), reexported)
     # 2. No circle among the sibling files of one module (`super::x::`). A parent file
     #    (`mod.rs`, `scene.rs`) and its children may use each other: the parent holds the
     #    type, the children its methods.

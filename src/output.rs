@@ -791,10 +791,11 @@ fn check_scene_record(dir: &Path, driver: &Driver) -> Result<()> {
             })
         }
     };
-    let recorded = crate::SceneBuilder::from_json_str(&text).map_err(|e| Error::RunDirectory {
-        path: path.clone(),
-        reason: format!("not a scene file ({e})"),
-    })?;
+    let recorded =
+        crate::scene::SceneBuilder::from_json_str(&text).map_err(|e| Error::RunDirectory {
+            path: path.clone(),
+            reason: format!("not a scene file ({e})"),
+        })?;
     match crate::driver::scene_mismatch(
         &driver.scene().to_builder(),
         "the checkpoint's scene",

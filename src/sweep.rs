@@ -361,7 +361,7 @@ impl SweepOptions {
     ///
     /// # Errors
     /// [`Error::InvalidCount`] for 0.
-    pub fn with_jobs(self, jobs: usize) -> crate::Result<Self> {
+    pub fn with_jobs(self, jobs: usize) -> crate::error::Result<Self> {
         if jobs == 0 {
             return Err(Error::InvalidCount {
                 name: "jobs",
@@ -376,7 +376,7 @@ impl SweepOptions {
     ///
     /// # Errors
     /// [`Error::InvalidCount`] for `n = 0` or `k >= n`.
-    pub fn with_shard(self, k: usize, n: usize) -> crate::Result<Self> {
+    pub fn with_shard(self, k: usize, n: usize) -> crate::error::Result<Self> {
         check_shard(k, n)?;
         Ok(Self {
             shard: (k, n),
@@ -386,7 +386,7 @@ impl SweepOptions {
 }
 
 /// A share `k` of `n`: `n ≥ 1`, `k < n`.
-fn check_shard(k: usize, n: usize) -> crate::Result<()> {
+fn check_shard(k: usize, n: usize) -> crate::error::Result<()> {
     if n == 0 {
         return Err(Error::InvalidCount {
             name: "shard count",
@@ -697,9 +697,9 @@ impl Sweep {
         let tables = RunTables::start(&dir, &driver, None)?;
         let (mut slip, mut ruptures, mut stable_states) = (None, 0usize, 0usize);
         tables.run_to_slip(&mut driver, None, |event, _| match event {
-            crate::Event::GlobalSlip { load } => slip = Some(load.force),
-            crate::Event::Rupture { .. } => ruptures += 1,
-            crate::Event::Stable { .. } => stable_states += 1,
+            crate::driver::Event::GlobalSlip { load } => slip = Some(load.force),
+            crate::driver::Event::Rupture { .. } => ruptures += 1,
+            crate::driver::Event::Stable { .. } => stable_states += 1,
             _ => {}
         })?;
         let seconds = started.elapsed().as_secs_f64();

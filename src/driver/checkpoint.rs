@@ -9,11 +9,11 @@
 //! build, same CPU features: the FFT kernels are chosen at run time).
 
 use super::{Driver, Phase};
+use crate::driver::Event;
 use crate::error::{Error, Result};
 use crate::interface::SiteState;
 use crate::scene::{file, Scene, SceneBuilder};
 use crate::solver::{NormalEquilibrium, SolverState, TangentialResponse};
-use crate::Event;
 
 /// Version of the checkpoint layout; a checkpoint of another version is refused.
 /// Version 2: the scene digest; the dense backend's one factor. Version 3: the JSON form

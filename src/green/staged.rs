@@ -223,7 +223,7 @@ pub(crate) use crate::lock::{lock, read, write};
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Block, Grid};
+    use crate::geometry::{Block, Grid};
 
     /// Staged products, stage by stage over the parts, equal the whole-grid filter on every
     /// transform path (paired FFT rows, matrix-product, direct and FFT columns, rustdct).

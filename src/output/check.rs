@@ -93,7 +93,7 @@ pub(crate) struct Bounds {
 
 impl Bounds {
     /// The bounds of `driver`'s run.
-    pub(crate) fn of(driver: &crate::Driver) -> Bounds {
+    pub(crate) fn of(driver: &crate::driver::Driver) -> Bounds {
         let grid = driver.grid();
         Bounds {
             nx: grid.nx(),
@@ -457,7 +457,7 @@ impl RunRecord {
                 ),
             });
         }
-        let scene = crate::SceneBuilder::from_json_file(&record)?;
+        let scene = crate::scene::SceneBuilder::from_json_file(&record)?;
         let grid = scene.grid()?;
         let bounds = Bounds {
             nx: grid.nx(),

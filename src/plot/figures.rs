@@ -193,7 +193,7 @@ fn name(dir: &Path) -> String {
 /// The scene of a run directory in a few words (block, `F_N`, drive, heights' seed), from
 /// its `scene.json`; the directory's name when it has none.
 fn run_title(dir: &Path) -> String {
-    match crate::SceneBuilder::from_json_file(dir.join("scene.json")) {
+    match crate::scene::SceneBuilder::from_json_file(dir.join("scene.json")) {
         Ok(scene) => describe(&crate::scene::file::all_keys(&scene)),
         Err(_) => name(dir),
     }

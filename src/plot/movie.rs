@@ -520,7 +520,7 @@ fn read_recording(dir: &Path) -> Result<Recording> {
             "it holds {FIELDS_TABLE} but no {SCENE_RECORD}, the record of the run's scene"
         )));
     }
-    let builder = crate::SceneBuilder::from_json_file(&record)?;
+    let builder = crate::scene::SceneBuilder::from_json_file(&record)?;
     let grid = builder.grid()?;
     let (nx, ny) = (grid.nx(), grid.ny());
     let planes = builder.current_fields().planes.clone();

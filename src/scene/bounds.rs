@@ -610,7 +610,7 @@ fn drive(builder: &SceneBuilder) -> Result<()> {
 /// ([`crate::GridCost`] plus what it leaves out).
 pub(super) fn memory_bytes(builder: &SceneBuilder, grid: &Grid) -> f64 {
     let n = grid.len() as f64;
-    let cost = crate::GridCost::of(grid.nx(), grid.ny()).memory_bytes;
+    let cost = crate::cost::GridCost::of(grid.nx(), grid.ny()).memory_bytes;
     // Each probe keeps a kernel of N values and returns a field of N values.
     let probes = (builder.probes.planes().len() + builder.probes.points().len()) as f64 * 16.0 * n;
     // Given heights are copied into the interface.

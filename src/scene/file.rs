@@ -982,13 +982,13 @@ mod tests {
                 .heights(HeightSource::Values(vec![1e-6; 80])),
             base.clone().heights(HeightSource::Surface {
                 spectrum: SurfaceSpectrum::gaussian(2e-3).unwrap(),
-                distribution: crate::HeightDistribution::new(2e-6, 1e-6).unwrap(),
+                distribution: crate::interface::HeightDistribution::new(2e-6, 1e-6).unwrap(),
                 seed: 5,
             }),
             // Half of each value stays valid: λ_s < λ_r/2, λ_l/2 ≥ λ_r.
             base.clone().heights(HeightSource::Surface {
                 spectrum: SurfaceSpectrum::self_affine(0.7, 3e-3, 0.6e-3, 8e-3).unwrap(),
-                distribution: crate::HeightDistribution::default(),
+                distribution: crate::interface::HeightDistribution::default(),
                 seed: 6,
             }),
             base.solver_options(

@@ -333,8 +333,8 @@ impl Coarse {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::{Block, Grid};
     use crate::green::InfluencePlan;
-    use crate::{Block, Grid};
 
     fn plan(nx: usize, ny: usize) -> InfluencePlan {
         let block = Block::new(nx as f64 * 1e-3, ny as f64 * 1e-3, 0.075).unwrap();

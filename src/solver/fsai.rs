@@ -429,7 +429,7 @@ fn build_row(entries: &Entries, pattern: &[usize], d: &[f64], small: &mut [f64],
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Block, Grid};
+    use crate::geometry::{Block, Grid};
 
     #[test]
     fn entries_match_operator_columns() {

@@ -6,8 +6,8 @@ use super::pcg::Effort;
 use super::set::SetProblem;
 use super::spectral::{Precond, SpectralCore};
 use super::system::Compliance;
+use crate::geometry::{Block, Grid};
 use crate::green::{InfluencePlan, Partition};
-use crate::{Block, Grid};
 use faer::prelude::*;
 
 /// Every crew tested: the results must be the same bits for each.

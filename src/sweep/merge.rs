@@ -180,7 +180,7 @@ fn read_run(dir: &Path, run: &SweepRun) -> Result<RunData> {
     // for their numbers, not for what is wrong.
     let record_path = dir.join(SCENE_RECORD);
     if record_path.is_file() {
-        let recorded = crate::SceneBuilder::from_json_file(&record_path)?;
+        let recorded = crate::scene::SceneBuilder::from_json_file(&record_path)?;
         if let Some(e) = crate::driver::scene_mismatch(
             &run.scene,
             &format!("the sweep's run {} ({})", run.index, run.dir_name),
