@@ -304,6 +304,37 @@ impl Scene {
     /// scene was edited since (the digest differs); [`Error::InvalidCheckpoint`] when it
     /// is of another layout version or inconsistent; those of [`Scene::driver`].
     pub fn resume(&self, checkpoint: &Checkpoint) -> Result<Driver> {
+        self.check_checkpoint_scene(checkpoint)?;
+        let started = self.check_checkpoint_state(checkpoint)?;
+        let mut driver = self.driver()?;
+        for (i, state) in checkpoint.states.iter().enumerate() {
+            driver.interface.set_state(i, *state);
+        }
+        driver.solver.restore(checkpoint.solver.clone(), started)?;
+        // λ is a function of the two equilibria: recomputed rather than stored (it holds
+        // infinities, which JSON cannot).
+        if let (Some(normal), Some(response)) = (&checkpoint.normal, &checkpoint.response) {
+            driver.breaking = driver.interface.breaking_loads(
+                &normal.traction,
+                &response.traction,
+                driver.friction_coefficient(),
+            )?;
+        }
+        driver.normal = checkpoint.normal.clone();
+        driver.response = checkpoint.response.clone();
+        driver.initial_columns = checkpoint.initial_columns.clone();
+        driver.control = checkpoint.control;
+        driver.pending = checkpoint.pending.iter().copied().collect();
+        driver.phase = checkpoint.phase;
+        driver.avalanche_ruptures = checkpoint.avalanche_ruptures;
+        driver.events = checkpoint.events;
+        driver.refresh_shear();
+        Ok(driver)
+    }
+
+    /// Refuses a checkpoint of another layout, or whose scene was edited or is not this
+    /// one ([`Scene::resume`]'s first checks).
+    fn check_checkpoint_scene(&self, checkpoint: &Checkpoint) -> Result<()> {
         let bad = |reason: String| Err(Error::InvalidCheckpoint { reason });
         if checkpoint.format != FORMAT {
             return bad(format!(
@@ -330,7 +361,14 @@ impl Scene {
         ) {
             return Err(e);
         }
-        let mut driver = self.driver()?;
+        Ok(())
+    }
+
+    /// Refuses a checkpoint whose state no driver of this scene writes (its digest may
+    /// have been recomputed after an edit): lengths, values and the protocol's invariants.
+    /// Returns whether the driver had returned events.
+    fn check_checkpoint_state(&self, checkpoint: &Checkpoint) -> Result<bool> {
+        let bad = |reason: String| Err(Error::InvalidCheckpoint { reason });
         let n = self.grid().len();
         if checkpoint.states.len() != n {
             return bad(format!(
@@ -380,6 +418,23 @@ impl Scene {
                 if started { "lacks" } else { "holds" }
             ));
         }
+        self.check_checkpoint_protocol(checkpoint, started)?;
+        if !checkpoint.control.is_finite() {
+            return bad(format!("the load {} is not finite", checkpoint.control));
+        }
+        if let Phase::Avalanche { forced: Some(i) } = checkpoint.phase {
+            if i >= n {
+                return bad(format!("the threshold site {i} is beyond the grid's {n}"));
+            }
+        }
+        Ok(started)
+    }
+
+    /// The protocol's own state in a checkpoint ([`Scene::check_checkpoint_state`]).
+    fn check_checkpoint_protocol(&self, checkpoint: &Checkpoint, started: bool) -> Result<()> {
+        let bad = |reason: String| Err(Error::InvalidCheckpoint { reason });
+        let n = self.grid().len();
+        let nx = self.grid().nx();
         // The protocol's own state: it starts before the first event only, its queued
         // events name sites of the grid (index and column, row agreeing), and the ruptures
         // of an avalanche each broke a site that stays broken.
@@ -424,36 +479,6 @@ impl Scene {
                 checkpoint.avalanche_ruptures
             ));
         }
-        if !checkpoint.control.is_finite() {
-            return bad(format!("the load {} is not finite", checkpoint.control));
-        }
-        if let Phase::Avalanche { forced: Some(i) } = checkpoint.phase {
-            if i >= n {
-                return bad(format!("the threshold site {i} is beyond the grid's {n}"));
-            }
-        }
-        for (i, state) in checkpoint.states.iter().enumerate() {
-            driver.interface.set_state(i, *state);
-        }
-        driver.solver.restore(checkpoint.solver.clone(), started)?;
-        // λ is a function of the two equilibria: recomputed rather than stored (it holds
-        // infinities, which JSON cannot).
-        if let (Some(normal), Some(response)) = (&checkpoint.normal, &checkpoint.response) {
-            driver.breaking = driver.interface.breaking_loads(
-                &normal.traction,
-                &response.traction,
-                driver.friction_coefficient(),
-            )?;
-        }
-        driver.normal = checkpoint.normal.clone();
-        driver.response = checkpoint.response.clone();
-        driver.initial_columns = checkpoint.initial_columns.clone();
-        driver.control = checkpoint.control;
-        driver.pending = checkpoint.pending.iter().copied().collect();
-        driver.phase = checkpoint.phase;
-        driver.avalanche_ruptures = checkpoint.avalanche_ruptures;
-        driver.events = checkpoint.events;
-        driver.refresh_shear();
-        Ok(driver)
+        Ok(())
     }
 }

@@ -469,90 +469,8 @@ impl RunRecord {
         let corrupt = |t: usize, bad: Bad| bad.at(&path(t));
         let read = |t: usize| crate::files::read_text(&path(t), "reading table");
 
-        // events.csv
-        let text = read(0)?;
-        let mut stable = Vec::new();
-        let mut slip = None;
-        let mut last = 0;
-        for (line, row) in rows(&text, EVENTS_HEADER).map_err(|r| corrupt(0, r))? {
-            let e = event_row(line, row, &bounds).map_err(|r| corrupt(0, r))?;
-            if e.index != last + 1 {
-                let reason = format!(
-                    "line {line}: event {} follows event {last}: the rows are not those of \
-                     one run (1, 2, 3, ...)",
-                    e.index
-                );
-                return Err(corrupt(0, reason.into()));
-            }
-            last = e.index;
-            if slip.is_some() {
-                return Err(corrupt(
-                    0,
-                    format!(
-                        "line {line}: event {} follows global slip, the run's last",
-                        e.index
-                    )
-                    .into(),
-                ));
-            }
-            match e.kind {
-                "stable" => stable.push(e),
-                "global_slip" => slip = e.force,
-                _ => {}
-            }
-        }
-        let Some(slip_force) = slip else {
-            return Err(corrupt(
-                0,
-                format!(
-                    "it ends at event {last} without global slip: the table is not a whole run"
-                )
-                .into(),
-            ));
-        };
-
-        // curve.csv: the stable states of events.csv.
-        let text = read(1)?;
-        let mut curve = Vec::with_capacity(stable.len());
-        for (line, row) in rows(&text, CURVE_HEADER).map_err(|r| corrupt(1, r))? {
-            let c = curve_row(line, row, &bounds).map_err(|r| corrupt(1, r))?;
-            let Some(s) = stable.get(curve.len()) else {
-                return Err(corrupt(
-                    1,
-                    format!(
-                        "line {line}: event {}: events.csv has {} stable states, this table more",
-                        c.event,
-                        stable.len()
-                    )
-                    .into(),
-                ));
-            };
-            if c.event != s.index || c.force_text != s.force_text {
-                return Err(corrupt(
-                    1,
-                    format!(
-                        "line {line} holds event {} at force_N {}, but the stable state there in \
-                     events.csv is event {} at {}",
-                        c.event, c.force_text, s.index, s.force_text
-                    )
-                    .into(),
-                ));
-            }
-            curve.push(c);
-        }
-        if curve.len() < stable.len() {
-            return Err(corrupt(
-                1,
-                format!(
-                "it holds {} stable states, events.csv {}: the rows from event {} on are missing",
-                curve.len(),
-                stable.len(),
-                stable[curve.len()].index
-            )
-                .into(),
-            ));
-        }
-
+        let (stable, slip_force) = Self::events(&read(0)?, &bounds).map_err(|r| corrupt(0, r))?;
+        let curve = Self::curve(&read(1)?, &stable, &bounds).map_err(|r| corrupt(1, r))?;
         let map = if path(2).is_file() {
             Some(
                 Self::map(&read(2)?, &curve, slip_force / bounds.mu_fn, &bounds)
@@ -568,6 +486,78 @@ impl RunRecord {
             slip: slip_force / bounds.mu_fn,
             map,
         })
+    }
+
+    /// Checks `events.csv`: events 1, 2, 3, ..., one global slip, last. Returns the
+    /// stable states and the force of global slip (N).
+    fn events(text: &str, bounds: &Bounds) -> Row<(Vec<EventRow>, f64)> {
+        let mut stable = Vec::new();
+        let mut slip = None;
+        let mut last = 0;
+        for (line, row) in rows(text, EVENTS_HEADER)? {
+            let e = event_row(line, row, bounds)?;
+            if e.index != last + 1 {
+                let reason = format!(
+                    "line {line}: event {} follows event {last}: the rows are not those of \
+                     one run (1, 2, 3, ...)",
+                    e.index
+                );
+                return Err(Bad::Reason(reason));
+            }
+            last = e.index;
+            if slip.is_some() {
+                return Err(Bad::Reason(format!(
+                    "line {line}: event {} follows global slip, the run's last",
+                    e.index
+                )));
+            }
+            match e.kind {
+                "stable" => stable.push(e),
+                "global_slip" => slip = e.force,
+                _ => {}
+            }
+        }
+        let Some(slip_force) = slip else {
+            return Err(Bad::Reason(format!(
+                "it ends at event {last} without global slip: the table is not a whole run"
+            )));
+        };
+
+        Ok((stable, slip_force))
+    }
+
+    /// Checks `curve.csv`: exactly the stable states of `events.csv`, in order, at the
+    /// same `force_N`.
+    fn curve(text: &str, stable: &[EventRow], bounds: &Bounds) -> Row<Vec<CurveRow>> {
+        let mut curve = Vec::with_capacity(stable.len());
+        for (line, row) in rows(text, CURVE_HEADER)? {
+            let c = curve_row(line, row, bounds)?;
+            let Some(s) = stable.get(curve.len()) else {
+                return Err(Bad::Reason(format!(
+                    "line {line}: event {}: events.csv has {} stable states, this table more",
+                    c.event,
+                    stable.len()
+                )));
+            };
+            if c.event != s.index || c.force_text != s.force_text {
+                return Err(Bad::Reason(format!(
+                    "line {line} holds event {} at force_N {}, but the stable state there in \
+                     events.csv is event {} at {}",
+                    c.event, c.force_text, s.index, s.force_text
+                )));
+            }
+            curve.push(c);
+        }
+        if curve.len() < stable.len() {
+            return Err(Bad::Reason(format!(
+                "it holds {} stable states, events.csv {}: the rows from event {} on are missing",
+                curve.len(),
+                stable.len(),
+                stable[curve.len()].index
+            )));
+        }
+
+        Ok(curve)
     }
 
     /// Checks `contact_map.csv` against the stable states and the slip load.

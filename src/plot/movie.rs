@@ -541,6 +541,38 @@ fn read_recording(dir: &Path) -> Result<Recording> {
     // The run's tables, checked, for the states the recording must hold.
     let run = RunRecord::read(dir)?;
     let every = builder.current_fields().every.max(1);
+    let states = read_states(lines, &table, &run, every, (nx, ny), &planes, &header)?;
+    if states.is_empty() {
+        return Err(no_fields(format!("its {FIELDS_TABLE} holds no state")));
+    }
+    let block = grid.block();
+    Ok(Recording {
+        nx,
+        ny,
+        lx: block.lx(),
+        ly: block.ly(),
+        planes,
+        states,
+    })
+}
+
+/// The states of `fields.csv` (`lines`: its rows after the header; `table` for the
+/// messages), each row checked ([`fields_row`]) and the states against the run's
+/// `curve.csv` (`run`): every `every`-th stable state from the first, in order, at its
+/// load and ℓ, each whole. An empty table gives no state (the caller says so).
+fn read_states<'a>(
+    lines: impl Iterator<Item = &'a str>,
+    table: &Path,
+    run: &RunRecord,
+    every: usize,
+    (nx, ny): (usize, usize),
+    planes: &[f64],
+    header: &str,
+) -> Result<Vec<State>> {
+    let corrupt = |reason: String| Error::CorruptTable {
+        path: Some(table.to_path_buf()),
+        reason,
+    };
     let expected: Vec<&crate::output::check::CurveRow> = run.curve.iter().step_by(every).collect();
     let header_cells: Vec<&str> = header.split(',').collect();
     let per_state = ny + planes.len();
@@ -550,7 +582,7 @@ fn read_recording(dir: &Path) -> Result<Recording> {
         let line = n + 2;
         let within = n % per_state;
         let r =
-            fields_row(line, &header_cells, row, within, ny, &planes).map_err(|b| b.at(&table))?;
+            fields_row(line, &header_cells, row, within, ny, planes).map_err(|b| b.at(table))?;
         if within == 0 {
             // The next state the scene records: the `every`-th stable state of curve.csv
             // from the first, at its load and ℓ.
@@ -605,10 +637,9 @@ fn read_recording(dir: &Path) -> Result<Recording> {
             state.coulomb.extend(r.values);
         }
     }
-    if states.is_empty() {
-        return Err(no_fields(format!("its {FIELDS_TABLE} holds no state")));
-    }
-    let last = states.last().expect("not empty");
+    let Some(last) = states.last() else {
+        return Ok(states);
+    };
     if last.area.len() + last.coulomb.len() != nx * per_state {
         return Err(corrupt(format!(
             "the last state (event {}) is cut: its rows are not all there",
@@ -627,13 +658,5 @@ fn read_recording(dir: &Path) -> Result<Recording> {
         ))
         .into());
     }
-    let block = grid.block();
-    Ok(Recording {
-        nx,
-        ny,
-        lx: block.lx(),
-        ly: block.ly(),
-        planes,
-        states,
-    })
+    Ok(states)
 }

@@ -259,6 +259,67 @@ pub(super) fn solver_iterations(active_set: usize, linear: usize) -> Result<()> 
     )
 }
 
+/// The heights of the recorded and probed planes and the probe points: inside the block,
+/// and at the interface or high enough for their alias sums to converge within their
+/// budget at the probes' tolerance (refused here, by `info` as by `run`, not when the run
+/// has begun).
+fn probe_positions(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
+    let probes = &builder.probes;
+    let lowest = crate::green::lowest_plane(grid, probes.tolerance());
+    let lz = grid.block().lz();
+    for (key, planes) in [
+        ("fields.planes", builder.fields.planes.as_slice()),
+        ("probes.planes", probes.planes()),
+    ] {
+        for &z in planes {
+            if z == 0.0 || (z.is_finite() && (lowest..=lz).contains(&z)) {
+                continue;
+            }
+            return Err(Error::OutOfRange {
+                key,
+                value: z,
+                range: format!("0 or [{}, {}] m", End(lowest, true), End(lz, false)),
+                reason: "a plane lies in the block (z = 0 is the interface); the stresses on a \
+                         plane closer to the interface than about 0.007 cells (at \
+                         probes.tolerance 1e-10) need more alias terms than their budget: \
+                         use z = 0, or raise the plane or probes.tolerance",
+            });
+        }
+    }
+    let block = grid.block();
+    let lowest_point = crate::probe::lowest_point(grid, probes.tolerance());
+    for p in probes.points() {
+        for (axis, value, max) in [
+            ("x", p.x, block.lx()),
+            ("y", p.y, block.ly()),
+            ("z", p.z, lz),
+        ] {
+            if !(value.is_finite() && (0.0..=max).contains(&value)) {
+                return Err(Error::OutOfRange {
+                    key: "probes.points",
+                    value,
+                    range: format!("[0, {}] m for {axis}", End(max, false)),
+                    reason: "a probe point lies in the block",
+                });
+            }
+        }
+        if p.z != 0.0 && p.z < lowest_point {
+            return Err(Error::OutOfRange {
+                key: "probes.points",
+                value: p.z,
+                range: format!(
+                    "0 or [{}, {}] m for z",
+                    End(lowest_point, true),
+                    End(lz, false)
+                ),
+                reason: "a point closer to the interface than this needs more alias terms than \
+                         their budget: use z = 0, or raise the point or probes.tolerance",
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Everything but the geometry (after the builder's own checks of signs and finiteness).
 pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
     const HUGE: &str = "beyond it the model's products overflow or underflow f64";
@@ -319,61 +380,7 @@ pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
         "",
         "below 1e-15 the alias sums cannot reach it, above 1e-2 the stresses are noise",
     )?;
-    // A plane is the interface (z = 0) or high enough for its alias sums to converge
-    // within their budget at the probes' tolerance: refused here, by `info` as by `run`,
-    // not when the run has begun.
-    let lowest = crate::green::lowest_plane(grid, probes.tolerance());
-    let lz = grid.block().lz();
-    for (key, planes) in [
-        ("fields.planes", builder.fields.planes.as_slice()),
-        ("probes.planes", probes.planes()),
-    ] {
-        for &z in planes {
-            if z == 0.0 || (z.is_finite() && (lowest..=lz).contains(&z)) {
-                continue;
-            }
-            return Err(Error::OutOfRange {
-                key,
-                value: z,
-                range: format!("0 or [{}, {}] m", End(lowest, true), End(lz, false)),
-                reason: "a plane lies in the block (z = 0 is the interface); the stresses on a \
-                         plane closer to the interface than about 0.007 cells (at \
-                         probes.tolerance 1e-10) need more alias terms than their budget: \
-                         use z = 0, or raise the plane or probes.tolerance",
-            });
-        }
-    }
-    let block = grid.block();
-    let lowest_point = crate::probe::lowest_point(grid, probes.tolerance());
-    for p in probes.points() {
-        for (axis, value, max) in [
-            ("x", p.x, block.lx()),
-            ("y", p.y, block.ly()),
-            ("z", p.z, lz),
-        ] {
-            if !(value.is_finite() && (0.0..=max).contains(&value)) {
-                return Err(Error::OutOfRange {
-                    key: "probes.points",
-                    value,
-                    range: format!("[0, {}] m for {axis}", End(max, false)),
-                    reason: "a probe point lies in the block",
-                });
-            }
-        }
-        if p.z != 0.0 && p.z < lowest_point {
-            return Err(Error::OutOfRange {
-                key: "probes.points",
-                value: p.z,
-                range: format!(
-                    "0 or [{}, {}] m for z",
-                    End(lowest_point, true),
-                    End(lz, false)
-                ),
-                reason: "a point closer to the interface than this needs more alias terms than \
-                         their budget: use z = 0, or raise the point or probes.tolerance",
-            });
-        }
-    }
+    probe_positions(builder, grid)?;
     for (key, count) in [
         ("probes.planes", probes.planes().len()),
         ("probes.points", probes.points().len()),
