@@ -212,6 +212,38 @@ pub enum Event {
     },
 }
 
+impl Event {
+    /// The kinds of events, as [`Event::kind`] names them (the `kind` column of a run's
+    /// `events.csv`), in the order of the variants.
+    pub const KINDS: [&'static str; 6] = [
+        "load_raised",
+        "rupture",
+        "detach",
+        "attach",
+        "stable",
+        "global_slip",
+    ];
+
+    /// The event's kind as a run's `events.csv` writes it (one of [`Event::KINDS`]).
+    ///
+    /// ```
+    /// use precursors::{Event, Load};
+    /// let e = Event::LoadRaised { load: Load { force: 1.0, drive_displacement: None } };
+    /// assert_eq!(e.kind(), "load_raised");
+    /// assert!(Event::KINDS.contains(&e.kind()));
+    /// ```
+    pub fn kind(&self) -> &'static str {
+        Self::KINDS[match self {
+            Event::LoadRaised { .. } => 0,
+            Event::Rupture { .. } => 1,
+            Event::Detach { .. } => 2,
+            Event::Attach { .. } => 3,
+            Event::Stable { .. } => 4,
+            Event::GlobalSlip { .. } => 5,
+        }]
+    }
+}
+
 /// Where the protocol stands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]

@@ -830,15 +830,12 @@ fn optional(x: Option<f64>) -> String {
 }
 
 fn write_event(out: &mut impl Write, index: usize, event: &Event, exceeds: bool) -> io::Result<()> {
-    let (kind, site, load, energy, ruptures) = match *event {
-        Event::LoadRaised { load } => ("load_raised", None, Some(load), None, None),
-        Event::Rupture { site, load, energy } => {
-            ("rupture", Some(site), Some(load), Some(energy), None)
-        }
-        Event::Detach { site } => ("detach", Some(site), None, None, None),
-        Event::Attach { site } => ("attach", Some(site), None, None, None),
-        Event::Stable { load, ruptures } => ("stable", None, Some(load), None, Some(ruptures)),
-        Event::GlobalSlip { load } => ("global_slip", None, Some(load), None, None),
+    let kind = event.kind();
+    let (site, load, energy, ruptures) = match *event {
+        Event::LoadRaised { load } | Event::GlobalSlip { load } => (None, Some(load), None, None),
+        Event::Rupture { site, load, energy } => (Some(site), Some(load), Some(energy), None),
+        Event::Detach { site } | Event::Attach { site } => (Some(site), None, None, None),
+        Event::Stable { load, ruptures } => (None, Some(load), None, Some(ruptures)),
     };
     let (ix, iy) = site.map_or((String::new(), String::new()), |s| {
         (s.ix.to_string(), s.iy.to_string())

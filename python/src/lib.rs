@@ -430,16 +430,13 @@ struct Event {
 impl Event {
     fn new(event: &precursors::Event, index: usize) -> Self {
         use precursors::Event as E;
-        let (kind, site, load, energy, ruptures) = match *event {
-            E::LoadRaised { load } => ("load_raised", None, Some(load), None, None),
-            E::Rupture { site, load, energy } => {
-                ("rupture", Some(site), Some(load), Some(energy), None)
-            }
-            E::Detach { site } => ("detach", Some(site), None, None, None),
-            E::Attach { site } => ("attach", Some(site), None, None, None),
-            E::Stable { load, ruptures } => ("stable", None, Some(load), None, Some(ruptures)),
-            E::GlobalSlip { load } => ("global_slip", None, Some(load), None, None),
-            _ => ("unknown", None, None, None, None),
+        let kind = event.kind();
+        let (site, load, energy, ruptures) = match *event {
+            E::LoadRaised { load } | E::GlobalSlip { load } => (None, Some(load), None, None),
+            E::Rupture { site, load, energy } => (Some(site), Some(load), Some(energy), None),
+            E::Detach { site } | E::Attach { site } => (Some(site), None, None, None),
+            E::Stable { load, ruptures } => (None, Some(load), None, Some(ruptures)),
+            _ => (None, None, None, None),
         };
         Event {
             kind,
@@ -548,17 +545,10 @@ impl Driver {
             }
         };
         if let Until::Kind(kind) = &until {
-            const KINDS: [&str; 6] = [
-                "load_raised",
-                "rupture",
-                "detach",
-                "attach",
-                "stable",
-                "global_slip",
-            ];
-            if !KINDS.contains(&kind.as_str()) {
+            if !precursors::Event::KINDS.contains(&kind.as_str()) {
                 return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                    "until = {kind:?} is not an event kind: one of {KINDS:?}"
+                    "until = {kind:?} is not an event kind: one of {:?}",
+                    precursors::Event::KINDS
                 )));
             }
         }

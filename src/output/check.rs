@@ -104,15 +104,8 @@ impl Bounds {
     }
 }
 
-/// The kinds of `events.csv`, as `write_event` names them.
-const KINDS: [&str; 6] = [
-    "load_raised",
-    "rupture",
-    "detach",
-    "attach",
-    "stable",
-    "global_slip",
-];
+/// The kinds of `events.csv`.
+const KINDS: [&str; 6] = crate::driver::Event::KINDS;
 
 /// A row of `events.csv`, checked.
 #[derive(Debug, Clone, PartialEq)]
