@@ -227,10 +227,14 @@ impl Event {
     /// The event's kind as a run's `events.csv` writes it (one of [`Event::KINDS`]).
     ///
     /// ```
-    /// use precursors::{Event, Load};
-    /// let e = Event::LoadRaised { load: Load { force: 1.0, drive_displacement: None } };
-    /// assert_eq!(e.kind(), "load_raised");
-    /// assert!(Event::KINDS.contains(&e.kind()));
+    /// use precursors::{Event, Scene};
+    /// let scene = Scene::builder().block(0.010, 0.004, 0.010).normal_load(100.0).build()?;
+    /// let mut driver = scene.driver()?;
+    /// let first = driver.step()?.expect("a first event");
+    /// assert_eq!(first.kind(), "stable"); // the state at zero shear
+    /// assert_eq!(driver.step()?.map(|e| e.kind()), Some("load_raised"));
+    /// assert!(Event::KINDS.contains(&first.kind()));
+    /// # Ok::<(), precursors::Error>(())
     /// ```
     pub fn kind(&self) -> &'static str {
         Self::KINDS[match self {
