@@ -23,6 +23,7 @@ LAYERS = [
     ["probe"],
     ["scene"],
     ["driver"],
+    ["avalanche"],
     ["calibration", "output", "matrix"],
     ["sweep"],
     ["plot"],

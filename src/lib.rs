@@ -99,6 +99,7 @@
 #![warn(clippy::missing_errors_doc)]
 #![forbid(unsafe_code)]
 
+mod avalanche;
 pub mod calibration;
 mod cost;
 mod driver;
@@ -121,6 +122,7 @@ mod surface;
 #[cfg(feature = "serde")]
 pub mod sweep;
 
+pub use avalanche::{Avalanche, Avalanches, DamageFront};
 pub use cost::GridCost;
 pub use driver::{Checkpoint, Driver, Event, Load, RunState, Site, SolveStats};
 pub use error::{Error, Result};

@@ -54,6 +54,7 @@
 //! event (the same `every` and planes), and is cut back the same way.
 
 pub(crate) mod check;
+pub(crate) mod derived;
 pub(crate) mod layout;
 mod resume;
 
@@ -184,6 +185,9 @@ pub struct RunTables {
     slipped: bool,
     /// `fields.csv`, when the scene records fields.
     fields: Option<FieldsTable>,
+    /// The run's grid and the bounds of its rows, for the tables derived at its end.
+    grid: crate::geometry::Grid,
+    bounds: check::Bounds,
     /// The directory's lock, `None` when the caller holds it (a sweep's run).
     _lock: Option<DirLock>,
 }
@@ -377,6 +381,8 @@ impl RunTables {
             in_effect: None,
             slipped: false,
             fields,
+            grid: *driver.grid(),
+            bounds: check::Bounds::of(driver),
             _lock: lock,
         })
     }
@@ -504,6 +510,8 @@ impl RunTables {
             in_effect,
             slipped: false,
             fields,
+            grid: *driver.grid(),
+            bounds: check::Bounds::of(driver),
             _lock: Some(lock),
         })
     }
@@ -707,6 +715,16 @@ impl RunTables {
             });
         }
         self.flush()?;
+        // The derived tables before the renames: a run whose events.csv has its name has
+        // them too.
+        let read = |t: usize| crate::files::read_text(&self.partials[t], "reading table");
+        derived::write(
+            &self.dir,
+            &self.grid,
+            &self.bounds,
+            [&read(0)?, &read(1)?],
+            [&self.partials[0], &self.partials[1]],
+        )?;
         // events.csv last: a crash between the renames leaves it .partial, so a resume
         // or a rerun still sees the run as not finished.
         if let Some(fields) = &self.fields {
@@ -732,6 +750,7 @@ fn remove_stale_temporaries(dir: &Path) -> Result<()> {
             SCENE_RECORD.to_string(),
             format!("{FIELDS_TABLE}{PARTIAL_SUFFIX}"),
         ])
+        .chain(layout::DERIVED_TABLES.map(String::from))
         .collect();
     crate::files::remove_temporaries(dir, &names)
 }

@@ -41,6 +41,8 @@ mod runs;
 mod scene_file;
 mod solver;
 mod stability;
+#[cfg(feature = "serde")]
+mod statistics;
 mod surfaces;
 #[cfg(feature = "serde")]
 mod sweep;

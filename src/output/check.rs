@@ -10,6 +10,7 @@
 #[cfg(feature = "serde")]
 use super::{contact_map_header, first_level_at_or_above, level, TABLE_NAMES};
 use super::{CONTACT_MAP_STEP, CURVE_HEADER, EVENTS_HEADER};
+use crate::driver::{Event, Load, Site};
 use crate::error::Error;
 #[cfg(feature = "serde")]
 use crate::error::Result;
@@ -105,7 +106,7 @@ impl Bounds {
 }
 
 /// The kinds of `events.csv`.
-const KINDS: [&str; 6] = crate::driver::Event::KINDS;
+const KINDS: [&str; 6] = Event::KINDS;
 
 /// A row of `events.csv`, checked.
 #[derive(Debug, Clone, PartialEq)]
@@ -117,6 +118,8 @@ pub(crate) struct EventRow {
     pub force: Option<f64>,
     /// Ruptures of the avalanche that a stable state ends.
     pub ruptures: Option<usize>,
+    /// The event the row records.
+    pub event: Event,
 }
 
 /// A row of `curve.csv`, checked.
@@ -226,6 +229,7 @@ pub(crate) fn event_row(line: usize, row: &str, b: &Bounds) -> Row<EventRow> {
         )
     })?;
     let site = matches!(kind, "rupture" | "detach" | "attach");
+    let mut at_site = [0; 2];
     for (k, n) in [(2, b.nx), (3, b.ny)] {
         if site {
             let v = count(line, &header, &c, k)?;
@@ -236,6 +240,7 @@ pub(crate) fn event_row(line: usize, row: &str, b: &Bounds) -> Row<EventRow> {
                     format!("{v} is outside the grid's 0 to {}", n - 1),
                 ));
             }
+            at_site[k - 2] = v;
         } else if !c[k].is_empty() {
             return Err(at(
                 line,
@@ -262,7 +267,7 @@ pub(crate) fn event_row(line: usize, row: &str, b: &Bounds) -> Row<EventRow> {
             ));
         }
     }
-    optional(line, &header, &c, 5)?;
+    let drive_displacement = optional(line, &header, &c, 5)?;
     let energy = optional(line, &header, &c, 6)?;
     if energy.is_some() != (kind == "rupture") {
         return Err(at(
@@ -286,12 +291,38 @@ pub(crate) fn event_row(line: usize, row: &str, b: &Bounds) -> Row<EventRow> {
         return Err(at(line, "ruptures", format!("a {kind} counts no ruptures")));
     };
     flag(line, &header, &c, 8)?;
+    let [ix, iy] = at_site;
+    let site = Site {
+        index: iy * b.nx + ix,
+        ix,
+        iy,
+    };
+    let load = Load {
+        force: force.unwrap_or(0.0),
+        drive_displacement,
+    };
+    let event = match kind {
+        "load_raised" => Event::LoadRaised { load },
+        "rupture" => Event::Rupture {
+            site,
+            load,
+            energy: energy.unwrap_or(0.0),
+        },
+        "detach" => Event::Detach { site },
+        "attach" => Event::Attach { site },
+        "stable" => Event::Stable {
+            load,
+            ruptures: ruptures.unwrap_or(0),
+        },
+        _ => Event::GlobalSlip { load },
+    };
     Ok(EventRow {
         index,
         kind,
         force_text: c[4].to_string(),
         force,
         ruptures,
+        event,
     })
 }
 
@@ -390,7 +421,6 @@ pub(crate) fn map_row(line: usize, header: &[&str], row: &str) -> Row<MapRow> {
 
 /// The rows of a table's text (line number, row) under `header`, every one whole: a
 /// finished table has no row cut by a crash.
-#[cfg(feature = "serde")]
 fn rows<'a>(text: &'a str, header: &str) -> Row<Vec<(usize, &'a str)>> {
     let mut lines = text.split_inclusive('\n');
     match lines.next() {
@@ -412,11 +442,104 @@ fn rows<'a>(text: &'a str, header: &str) -> Row<Vec<(usize, &'a str)>> {
     Ok(out)
 }
 
+/// A whole run's `events.csv`, checked ([`whole_events`]).
+#[derive(Debug, Clone)]
+pub(crate) struct WholeEvents {
+    /// The rows of the stable states, in order.
+    pub stable: Vec<EventRow>,
+    /// The force of global slip (N).
+    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
+    pub slip_force: f64,
+    /// Every event, in order.
+    pub events: Vec<Event>,
+}
+
+/// Checks the text of a whole `events.csv`: events 1, 2, 3, ..., one global slip, last.
+pub(crate) fn whole_events(text: &str, bounds: &Bounds) -> Row<WholeEvents> {
+    let mut stable = Vec::new();
+    let mut events = Vec::new();
+    let mut slip = None;
+    let mut last = 0;
+    for (line, row) in rows(text, EVENTS_HEADER)? {
+        let e = event_row(line, row, bounds)?;
+        if e.index != last + 1 {
+            let reason = format!(
+                "line {line}: event {} follows event {last}: the rows are not those of \
+                 one run (1, 2, 3, ...)",
+                e.index
+            );
+            return Err(Bad::Reason(reason));
+        }
+        last = e.index;
+        events.push(e.event);
+        if slip.is_some() {
+            return Err(Bad::Reason(format!(
+                "line {line}: event {} follows global slip, the run's last",
+                e.index
+            )));
+        }
+        match e.kind {
+            "stable" => stable.push(e),
+            "global_slip" => slip = e.force,
+            _ => {}
+        }
+    }
+    let Some(slip_force) = slip else {
+        return Err(Bad::Reason(format!(
+            "it ends at event {last} without global slip: the table is not a whole run"
+        )));
+    };
+
+    Ok(WholeEvents {
+        stable,
+        slip_force,
+        events,
+    })
+}
+
+/// Checks the text of a whole `curve.csv`: exactly the stable states of `events.csv`, in order, at the
+/// same `force_N`.
+pub(crate) fn whole_curve(text: &str, stable: &[EventRow], bounds: &Bounds) -> Row<Vec<CurveRow>> {
+    let mut curve = Vec::with_capacity(stable.len());
+    for (line, row) in rows(text, CURVE_HEADER)? {
+        let c = curve_row(line, row, bounds)?;
+        let Some(s) = stable.get(curve.len()) else {
+            return Err(Bad::Reason(format!(
+                "line {line}: event {}: events.csv has {} stable states, this table more",
+                c.event,
+                stable.len()
+            )));
+        };
+        if c.event != s.index || c.force_text != s.force_text {
+            return Err(Bad::Reason(format!(
+                "line {line} holds event {} at force_N {}, but the stable state there in \
+                 events.csv is event {} at {}",
+                c.event, c.force_text, s.index, s.force_text
+            )));
+        }
+        curve.push(c);
+    }
+    if curve.len() < stable.len() {
+        return Err(Bad::Reason(format!(
+            "it holds {} stable states, events.csv {}: the rows from event {} on are missing",
+            curve.len(),
+            stable.len(),
+            stable[curve.len()].index
+        )));
+    }
+
+    Ok(curve)
+}
+
 /// A finished run read from its directory and checked ([`RunRecord::read`]).
 #[cfg(feature = "serde")]
 #[derive(Debug, Clone)]
 pub(crate) struct RunRecord {
     pub bounds: Bounds,
+    /// The run's grid (from its scene record).
+    pub grid: crate::geometry::Grid,
+    /// Every event of `events.csv`, in order.
+    pub events: Vec<Event>,
     /// The stable states (`curve.csv`), in order.
     pub curve: Vec<CurveRow>,
     /// The ruptures of each stable state's avalanche (`events.csv`), as `curve`.
@@ -462,8 +585,12 @@ impl RunRecord {
         let corrupt = |t: usize, bad: Bad| bad.at(&path(t));
         let read = |t: usize| crate::files::read_text(&path(t), "reading table");
 
-        let (stable, slip_force) = Self::events(&read(0)?, &bounds).map_err(|r| corrupt(0, r))?;
-        let curve = Self::curve(&read(1)?, &stable, &bounds).map_err(|r| corrupt(1, r))?;
+        let WholeEvents {
+            stable,
+            slip_force,
+            events,
+        } = whole_events(&read(0)?, &bounds).map_err(|r| corrupt(0, r))?;
+        let curve = whole_curve(&read(1)?, &stable, &bounds).map_err(|r| corrupt(1, r))?;
         let map = if path(2).is_file() {
             Some(
                 Self::map(&read(2)?, &curve, slip_force / bounds.mu_fn, &bounds)
@@ -474,83 +601,13 @@ impl RunRecord {
         };
         Ok(RunRecord {
             bounds,
+            grid,
+            events,
             ruptures: stable.iter().map(|s| s.ruptures.unwrap_or(0)).collect(),
             curve,
             slip: slip_force / bounds.mu_fn,
             map,
         })
-    }
-
-    /// Checks `events.csv`: events 1, 2, 3, ..., one global slip, last. Returns the
-    /// stable states and the force of global slip (N).
-    fn events(text: &str, bounds: &Bounds) -> Row<(Vec<EventRow>, f64)> {
-        let mut stable = Vec::new();
-        let mut slip = None;
-        let mut last = 0;
-        for (line, row) in rows(text, EVENTS_HEADER)? {
-            let e = event_row(line, row, bounds)?;
-            if e.index != last + 1 {
-                let reason = format!(
-                    "line {line}: event {} follows event {last}: the rows are not those of \
-                     one run (1, 2, 3, ...)",
-                    e.index
-                );
-                return Err(Bad::Reason(reason));
-            }
-            last = e.index;
-            if slip.is_some() {
-                return Err(Bad::Reason(format!(
-                    "line {line}: event {} follows global slip, the run's last",
-                    e.index
-                )));
-            }
-            match e.kind {
-                "stable" => stable.push(e),
-                "global_slip" => slip = e.force,
-                _ => {}
-            }
-        }
-        let Some(slip_force) = slip else {
-            return Err(Bad::Reason(format!(
-                "it ends at event {last} without global slip: the table is not a whole run"
-            )));
-        };
-
-        Ok((stable, slip_force))
-    }
-
-    /// Checks `curve.csv`: exactly the stable states of `events.csv`, in order, at the
-    /// same `force_N`.
-    fn curve(text: &str, stable: &[EventRow], bounds: &Bounds) -> Row<Vec<CurveRow>> {
-        let mut curve = Vec::with_capacity(stable.len());
-        for (line, row) in rows(text, CURVE_HEADER)? {
-            let c = curve_row(line, row, bounds)?;
-            let Some(s) = stable.get(curve.len()) else {
-                return Err(Bad::Reason(format!(
-                    "line {line}: event {}: events.csv has {} stable states, this table more",
-                    c.event,
-                    stable.len()
-                )));
-            };
-            if c.event != s.index || c.force_text != s.force_text {
-                return Err(Bad::Reason(format!(
-                    "line {line} holds event {} at force_N {}, but the stable state there in \
-                     events.csv is event {} at {}",
-                    c.event, c.force_text, s.index, s.force_text
-                )));
-            }
-            curve.push(c);
-        }
-        if curve.len() < stable.len() {
-            return Err(Bad::Reason(format!(
-                "it holds {} stable states, events.csv {}: the rows from event {} on are missing",
-                curve.len(),
-                stable.len(),
-                stable[curve.len()].index
-            )));
-        }
-
-        Ok(curve)
     }
 
     /// Checks `contact_map.csv` against the stable states and the slip load.

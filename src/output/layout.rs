@@ -7,6 +7,7 @@ use crate::error::{Error, Result};
 use crate::lock::LOCK_FILE;
 use std::path::Path;
 
+use super::derived::{AVALANCHE_TABLE, FRONTS_TABLE};
 use super::{FIELDS_TABLE, PARTIAL_SUFFIX, SCENE_RECORD, TABLE_NAMES};
 
 /// The completion marker of a sweep's run (`crate::sweep::DONE_FILE`).
@@ -34,10 +35,14 @@ pub(crate) const STRESS_MOVIE: &str = "coulomb_stress.gif";
 /// The movies `movie` draws by default.
 pub(crate) const MOVIES: [&str; 2] = [AREA_MOVIE, STRESS_MOVIE];
 
-/// Whether `name` is a figure or a movie: drawn from a run's tables, so stale once the
-/// tables are another run's.
+/// The tables a run's end derives from its events (`output/derived.rs`).
+pub(crate) const DERIVED_TABLES: [&str; 2] = [AVALANCHE_TABLE, FRONTS_TABLE];
+
+/// Whether `name` is a derived table, a figure or a movie: derived or drawn from a run's
+/// tables, so stale once the tables are another run's.
 pub(crate) fn derived(name: &str) -> bool {
     MOVIES.contains(&name)
+        || DERIVED_TABLES.contains(&name)
         || name
             .rsplit_once('.')
             .is_some_and(|(stem, ext)| FIGURES.contains(&stem) && FIGURE_EXTENSIONS.contains(&ext))
@@ -192,6 +197,9 @@ mod tests {
             "contact_map.svg",
             "precursor_length.png",
             "coulomb_stress.gif",
+            "per_avalanche.csv",
+            "fronts.csv",
+            ".fronts.csv.tmp12-0-5",
             ".curve.csv.partial.tmp12-0-5",
         ] {
             assert!(reserved(name), "{name}");
@@ -206,6 +214,7 @@ mod tests {
             assert!(!reserved(name), "{name}");
         }
         assert!(derived("contact_area.gif") && derived("contact_map.png"));
+        assert!(derived("per_avalanche.csv") && derived("fronts.csv"));
         assert!(!derived("contact_map.csv") && !derived("scene.json"));
     }
 }

@@ -1,0 +1,137 @@
+//! The tables a run's end derives from its whole `events.csv` and `curve.csv`
+//! (`RunTables::finish`): `per_avalanche.csv`, one row per avalanche, and `fronts.csv`,
+//! the damage front beside `ℓ` at every stable state (docs/statistics.md defines both).
+//! Derived, not recorded as the run goes: a resumed run's come out the same, and
+//! `precursors stats` derives them again from the checked `events.csv` rather than trust
+//! these files.
+
+use super::check::{whole_curve, whole_events, Bounds, CurveRow};
+use crate::avalanche::{Avalanche, Avalanches, DamageFront};
+use crate::driver::Event;
+use crate::error::{Error, Result};
+use crate::files::write_atomically;
+use crate::geometry::Grid;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// One row per avalanche.
+pub(crate) const AVALANCHE_TABLE: &str = "per_avalanche.csv";
+/// The damage front and `ℓ` at every stable state.
+pub(crate) const FRONTS_TABLE: &str = "fronts.csv";
+/// The header of `per_avalanche.csv`.
+pub(crate) const AVALANCHE_HEADER: &str = "avalanche,start_event,end_event,ruptures,\
+     broken_area_m2,force_before_N,force_after_N,force_drop_N,drive_displacement_before_m,\
+     drive_displacement_after_m,energy_J,attaches,detaches,flash_ruptures,global_slip";
+/// The header of `fronts.csv`.
+pub(crate) const FRONTS_HEADER: &str =
+    "event,force_N,force_over_mu_FN,precursor_over_Lx,damage_front_m,damage_front_over_Lx";
+
+/// What a whole run's events give: its avalanches, and the damage front (m) at each
+/// stable state (in order, the zero-shear state first).
+#[derive(Debug, Clone)]
+pub(crate) struct RunDerived {
+    pub avalanches: Vec<Avalanche>,
+    pub fronts: Vec<f64>,
+}
+
+/// The avalanches and damage fronts of the whole run `events` on `grid`.
+///
+/// # Errors
+/// [`Error::LengthMismatch`] when `events` are not a whole run on `grid`.
+pub(crate) fn derive(grid: &Grid, events: &[Event]) -> Result<RunDerived> {
+    let zero_shear = DamageFront::zero_shear_states(grid, events)?;
+    let mut front = DamageFront::new(grid, &zero_shear)?;
+    let mut avalanches = Avalanches::new(grid);
+    let mut out = RunDerived {
+        avalanches: Vec::new(),
+        fronts: Vec::new(),
+    };
+    for event in events {
+        front.observe(event);
+        out.avalanches.extend(avalanches.observe(event));
+        if let Event::Stable { .. } = event {
+            out.fronts.push(front.position());
+        }
+    }
+    Ok(out)
+}
+
+/// Writes `per_avalanche.csv` and `fronts.csv` into `dir` (atomically) from the texts of
+/// the run's whole `events.csv` and `curve.csv` (read from `paths`, named in errors).
+///
+/// # Errors
+/// [`Error::CorruptTable`] (or [`Error::NonFiniteCell`]) when a table is not a whole run;
+/// [`Error::Io`].
+pub(crate) fn write(
+    dir: &Path,
+    grid: &Grid,
+    bounds: &Bounds,
+    texts: [&str; 2],
+    paths: [&Path; 2],
+) -> Result<()> {
+    let whole = whole_events(texts[0], bounds).map_err(|bad| bad.at(paths[0]))?;
+    let curve = whole_curve(texts[1], &whole.stable, bounds).map_err(|bad| bad.at(paths[1]))?;
+    let derived = derive(grid, &whole.events).map_err(|e| Error::CorruptTable {
+        path: Some(paths[0].to_path_buf()),
+        reason: format!("not the whole run of its scene: {e}"),
+    })?;
+    write_atomically(
+        &dir.join(AVALANCHE_TABLE),
+        avalanche_text(&derived.avalanches).as_bytes(),
+        "writing table",
+    )?;
+    write_atomically(
+        &dir.join(FRONTS_TABLE),
+        fronts_text(&curve, &derived.fronts, bounds.lx).as_bytes(),
+        "writing table",
+    )
+}
+
+fn optional(x: Option<f64>) -> String {
+    x.map(|v| format!("{v:.12e}")).unwrap_or_default()
+}
+
+/// The text of `per_avalanche.csv`.
+fn avalanche_text(avalanches: &[Avalanche]) -> String {
+    let mut text = format!("{AVALANCHE_HEADER}\n");
+    for (k, a) in avalanches.iter().enumerate() {
+        let _ = writeln!(
+            text,
+            "{},{},{},{},{:.12e},{:.12e},{:.12e},{:.12e},{},{},{:.12e},{},{},{},{}",
+            k + 1,
+            a.start_event,
+            a.end_event,
+            a.ruptures,
+            a.broken_area,
+            a.load_before.force,
+            a.load_after.force,
+            a.force_drop(),
+            optional(a.load_before.drive_displacement),
+            optional(a.load_after.drive_displacement),
+            a.energy,
+            a.attaches,
+            a.detaches,
+            a.flash_ruptures,
+            u8::from(a.global_slip),
+        );
+    }
+    text
+}
+
+/// The text of `fronts.csv`: `curve`'s stable states (their loads and `ℓ/Lx` as written
+/// there) with the damage front of each.
+fn fronts_text(curve: &[CurveRow], fronts: &[f64], lx: f64) -> String {
+    let mut text = format!("{FRONTS_HEADER}\n");
+    for (c, front) in curve.iter().zip(fronts) {
+        let _ = writeln!(
+            text,
+            "{},{},{},{},{front:.12e},{:.12e}",
+            c.event,
+            c.force_text,
+            c.load_text,
+            c.precursor_text,
+            front / lx,
+        );
+    }
+    text
+}
