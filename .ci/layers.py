@@ -14,7 +14,7 @@ import sys
 LAYERS = [
     ["format"],
     ["error"],
-    ["cost", "lock"],
+    ["cost", "lock", "statistics"],
     ["files"],
     ["geometry"],
     ["green", "surface"],

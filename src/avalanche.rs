@@ -249,9 +249,7 @@ impl DamageFront {
         let mut seen = 0;
         for event in events {
             let (site, state) = match *event {
-                Event::Rupture { site, .. } | Event::Detach { site } => {
-                    (site, SiteState::Attached)
-                }
+                Event::Rupture { site, .. } | Event::Detach { site } => (site, SiteState::Attached),
                 Event::Attach { site } => (site, SiteState::Detached),
                 _ => continue,
             };

@@ -51,6 +51,7 @@ mod observables;
 #[cfg(feature = "serde")]
 pub(crate) use checkpoint::scene_mismatch;
 pub use checkpoint::Checkpoint;
+pub use observables::SlipProfile;
 
 /// A site of the interface grid.
 ///

@@ -639,6 +639,18 @@ pub enum Error {
         /// What to change.
         hint: &'static str,
     },
+    /// A statistic asked of fewer samples than it needs: a power-law fit
+    /// ([`crate::statistics::fit_power_law`]) of fewer than its options' `min_tail` samples
+    /// (after the non-positive ones, which a power law cannot hold, are counted out).
+    #[error("{what}: {count} samples, at least {needed} are needed")]
+    TooFewSamples {
+        /// Which statistic, of what.
+        what: &'static str,
+        /// The samples available.
+        count: usize,
+        /// The samples it needs.
+        needed: usize,
+    },
     /// A load `F/(μF_N)` beyond the friction limit at a stable state or at global slip:
     /// no stable state carries more than `μF_N` (every site holds `|φ_x| ≤ μ φ_z`), so
     /// the computation went wrong; refused rather than written to a table

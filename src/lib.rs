@@ -118,13 +118,14 @@ pub mod plot;
 mod probe;
 mod scene;
 pub mod solver;
+pub mod statistics;
 mod surface;
 #[cfg(feature = "serde")]
 pub mod sweep;
 
 pub use avalanche::{Avalanche, Avalanches, DamageFront};
 pub use cost::GridCost;
-pub use driver::{Checkpoint, Driver, Event, Load, RunState, Site, SolveStats};
+pub use driver::{Checkpoint, Driver, Event, Load, RunState, Site, SlipProfile, SolveStats};
 pub use error::{Error, Result};
 pub use geometry::{Block, Grid, Point};
 pub use interface::{

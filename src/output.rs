@@ -28,6 +28,15 @@
 //!   [`crate::Profile::coulomb_of_means`]). About `(Ny + planes)·Nx·20` bytes per recorded
 //!   state: `every` bounds the size.
 //!
+//! * `per_avalanche.csv` and `fronts.csv`, derived from the whole `events.csv` and
+//!   `curve.csv` when the run reaches global slip ([`RunTables::finish`], before the
+//!   tables take their names): one row per avalanche ([`crate::Avalanche`]: `avalanche,
+//!   start_event,end_event,ruptures,broken_area_m2,force_before_N,force_after_N,
+//!   force_drop_N,drive_displacement_before_m,drive_displacement_after_m,energy_J,
+//!   attaches,detaches,flash_ruptures,global_slip`), and the damage front beside `ℓ` at
+//!   every stable state ([`crate::DamageFront`]: `event,force_N,force_over_mu_FN,
+//!   precursor_over_Lx,damage_front_m,damage_front_over_Lx`); docs/statistics.md.
+//!
 //! `area_exceeds_nominal` is 1 when the total real contact area of the state after the
 //! event exceeds the nominal area `Lx·Ly` (the paper's unbounded area law), 0 otherwise.
 //! Numbers are written with 13 significant digits (`{:.12e}`), so the tables of two runs
@@ -697,13 +706,17 @@ impl RunTables {
         self.finish()
     }
 
-    /// Ends a run that reached global slip: the tables are flushed, synced and renamed
-    /// from `NAME.partial` to `NAME` (replacing those of an earlier run), and the
-    /// directory's lock (if this writer took it) is released. Returns the tables' paths.
+    /// Ends a run that reached global slip: the tables are flushed and synced,
+    /// `per_avalanche.csv` and `fronts.csv` derived from them and written, then the
+    /// tables renamed from `NAME.partial` to `NAME` (replacing those of an earlier run),
+    /// and the directory's lock (if this writer took it) is released. Returns the tables'
+    /// paths.
     ///
     /// # Errors
     /// [`Error::RunDirectory`] when global slip was not recorded (the tables stay
-    /// `.partial`); [`Error::Io`] when a table cannot be written, synced or renamed.
+    /// `.partial`); [`Error::Io`] when a table cannot be written, synced or renamed;
+    /// [`Error::CorruptTable`] when the tables written are not the whole run (another
+    /// process changed them).
     pub fn finish(mut self) -> Result<[PathBuf; 3]> {
         if !self.slipped {
             return Err(Error::RunDirectory {

@@ -335,6 +335,8 @@ pub struct Chart {
     series: Vec<Series>,
     /// [`Chart::style`] was called with no series to apply to (refused by `save`).
     orphan_style: bool,
+    /// Logarithmic x and y axes ([`Chart::log_x`], [`Chart::log_y`]).
+    log: (bool, bool),
 }
 
 impl Chart {
@@ -351,7 +353,22 @@ impl Chart {
             colours: Colours::Distinct,
             series: Vec::new(),
             orphan_style: false,
+            log: (false, false),
         }
+    }
+
+    /// A logarithmic x axis (base 10, for values spanning decades: a distribution's
+    /// sizes): ticks labelled with the values; points with `x ≤ 0` are not drawn; a range
+    /// given by [`Chart::x_range`] is in the data's units and must be positive.
+    pub fn log_x(mut self) -> Self {
+        self.log.0 = true;
+        self
+    }
+
+    /// A logarithmic y axis (as [`Chart::log_x`]).
+    pub fn log_y(mut self) -> Self {
+        self.log.1 = true;
+        self
     }
 
     /// The x axis spans `[low, high]` (in the data's units) instead of the data's extent.
@@ -480,6 +497,61 @@ impl Chart {
                 s.label
             )));
         }
+        if self.log.0 || self.log.1 {
+            // Drawn in log10 of the data: a value <= 0 becomes NaN and is left out.
+            let (lx, ly) = (axis_map(self.log.0), axis_map(self.log.1));
+            let ranges = [
+                (self.x_range, lx, "x", self.log.0),
+                (self.y_range, ly, "y", self.log.1),
+            ];
+            for (range, _, axis, log) in ranges {
+                if let (Some((low, high)), true) = (range, log) {
+                    if !(low > 0.0 && high > low && high.is_finite()) {
+                        return Err(refuse(format!(
+                            "the {axis} range [{low}, {high}] is invalid on a logarithmic \
+                             axis: both ends must be finite and positive, the first below \
+                             the second"
+                        )));
+                    }
+                }
+            }
+            let mut drawn = self.clone();
+            drawn.log = (false, false);
+            drawn.x_range = self.x_range.map(|(a, b)| (lx(a), lx(b)));
+            drawn.y_range = self.y_range.map(|(a, b)| (ly(a), ly(b)));
+            for s in &mut drawn.series {
+                s.points.iter_mut().for_each(|p| *p = (lx(p.0), ly(p.1)));
+                s.band
+                    .iter_mut()
+                    .for_each(|b| *b = (lx(b.0), ly(b.1), ly(b.2)));
+            }
+            let (x, y) = drawn.ranges(path)?;
+            return render(
+                path,
+                self.size,
+                &ChartDrawing {
+                    chart: &drawn,
+                    x,
+                    y,
+                    log: self.log,
+                },
+            );
+        }
+        let (x, y) = self.ranges(path)?;
+        render(
+            path,
+            self.size,
+            &ChartDrawing {
+                chart: self,
+                x,
+                y,
+                log: (false, false),
+            },
+        )
+    }
+
+    /// The axis ranges: given, or fitted to the data.
+    fn ranges(&self, path: &Path) -> Result<((f64, f64), (f64, f64))> {
         let xs = self
             .series
             .iter()
@@ -492,7 +564,17 @@ impl Chart {
                 .chain(s.band.iter().flat_map(|b| [b.1, b.2]))
         });
         let y = axis_range(path, "y", self.y_range, ys)?;
-        render(path, self.size, &ChartDrawing { chart: self, x, y })
+        Ok((x, y))
+    }
+}
+
+/// The map of a value onto a drawn axis: `log10` (NaN for `v <= 0`) on a logarithmic
+/// axis, the value itself otherwise.
+fn axis_map(log: bool) -> fn(f64) -> f64 {
+    if log {
+        |v| if v > 0.0 { v.log10() } else { f64::NAN }
+    } else {
+        |v| v
     }
 }
 
@@ -501,6 +583,8 @@ struct ChartDrawing<'a> {
     chart: &'a Chart,
     x: (f64, f64),
     y: (f64, f64),
+    /// Whether the axes show `log10` of the data (their ticks then print `10^v`).
+    log: (bool, bool),
 }
 
 impl Draw for ChartDrawing<'_> {
@@ -510,7 +594,13 @@ impl Draw for ChartDrawing<'_> {
     ) -> std::result::Result<(), String> {
         let (me, x, y) = (self.chart, self.x, self.y);
         let mut chart = axes(root, &me.title, x, y)?;
-        draw_axes(root, &mut chart, (&me.x_label, x), (&me.y_label, y), true)?;
+        draw_axes(
+            root,
+            &mut chart,
+            (&me.x_label, x),
+            (&me.y_label, y),
+            (true, self.log),
+        )?;
         let mut legend = Vec::new();
         for (k, s) in me.series.iter().enumerate() {
             let colour = me.colour(k);
@@ -768,7 +858,13 @@ impl Draw for MapDrawing<'_> {
                 )))
                 .map_err(|e| e.to_string())?;
         }
-        draw_axes(&main, &mut chart, (&me.x_label, x), (&me.y_label, y), false)?;
+        draw_axes(
+            &main,
+            &mut chart,
+            (&me.x_label, x),
+            (&me.y_label, y),
+            (false, (false, false)),
+        )?;
         // The colour bar: a one-column chart of the colour scale, its values on the right.
         let mut scale = ChartBuilder::on(&bar)
             .margin_top(16 + 30)
@@ -857,11 +953,11 @@ fn draw_axes<DB: DrawingBackend>(
     chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     (x_label, x): (&str, (f64, f64)),
     (y_label, y): (&str, (f64, f64)),
-    grid: bool,
+    (grid, log): (bool, (bool, bool)),
 ) -> std::result::Result<(), String> {
     let font = |size: f64| (FAMILY, size).into_font();
-    let x_ticks = |v: &f64| tick(*v, x);
-    let y_ticks = |v: &f64| tick(*v, y);
+    let x_ticks = |v: &f64| if log.0 { log_tick(*v) } else { tick(*v, x) };
+    let y_ticks = |v: &f64| if log.1 { log_tick(*v) } else { tick(*v, y) };
     let mut mesh = chart.configure_mesh();
     if grid {
         mesh.light_line_style(RGBColor(235, 235, 235))
@@ -1387,6 +1483,25 @@ fn tick(v: f64, range: (f64, f64)) -> String {
     text.replace('-', "−")
 }
 
+/// The tick at `v = log10(x)` of a logarithmic axis: the value `x`, with two significant
+/// digits (`1e−3`, `0.02`, `300`, `2.5e4`); `−` as the minus.
+fn log_tick(v: f64) -> String {
+    let x = 10f64.powf(v);
+    let text = if (1e-2..1e4).contains(&x) {
+        let digits = (1.0 - x.log10().floor()).max(0.0) as usize;
+        let t = format!("{x:.digits$}");
+        if t.contains('.') {
+            t.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            t
+        }
+    } else {
+        let t = format!("{x:.1e}");
+        t.replace(".0e", "e")
+    };
+    text.replace('-', "−")
+}
+
 /// The maximal runs of consecutive items whose coordinates are all finite.
 fn finite_runs<T: Copy, const K: usize>(items: &[T], coords: impl Fn(&T) -> [f64; K]) -> Vec<&[T]> {
     items
@@ -1465,6 +1580,17 @@ mod tests {
         // Left as written: no character after it, or a space.
         assert_eq!(subscripts("a_ b_"), [piece("a_ b_", false)]);
         assert!(subscripts("").is_empty());
+    }
+
+    #[test]
+    fn log_ticks_print_the_values() {
+        assert_eq!(log_tick(0.0), "1");
+        assert_eq!(log_tick(2.0), "100");
+        assert_eq!(log_tick(-1.0), "0.1");
+        assert_eq!(log_tick(-3.0), "1e−3");
+        assert_eq!(log_tick(5.0), "1e5");
+        assert_eq!(log_tick(0.5), "3.2");
+        assert_eq!(log_tick(4.5_f64.log10() + 4.0), "4.5e4");
     }
 
     #[test]

@@ -26,11 +26,13 @@
 
 mod error;
 mod merge;
+mod stats;
 
 pub use error::SweepError;
 #[cfg(feature = "plot")]
 pub(crate) use merge::{ensemble_curves, MEDIAN_BAND_RUNS};
 pub use merge::{mean_band, merge, Band, MergeSummary, LOAD_GRID};
+pub use stats::{statistics, StatsOptions, StatsSummary};
 
 /// The results of this module: its errors are [`SweepError`]s.
 type Result<T, E = SweepError> = std::result::Result<T, E>;

@@ -76,6 +76,7 @@ fn finished_run(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
             "-q",
         ],
         vec!["plot", path(&run), "--format", "both"],
+        vec!["stats", path(&run), "--bootstrap", "5", "--goodness", "5"],
         vec![
             "movie",
             path(&run),
@@ -135,6 +136,10 @@ fn every_name(dir: &Path, run: &Path) -> Vec<String> {
         "contact_map.svg",
         "coulomb_stress.gif",
         "scene.json",
+        "per_avalanche.csv",
+        "fronts.csv",
+        "power_laws.csv",
+        "distributions.csv",
     ] {
         assert!(
             names.iter().any(|n| n == expected),
@@ -279,6 +284,8 @@ fn a_run_and_a_sweep_never_share_a_directory() {
 
 #[test]
 fn a_new_run_removes_the_figures_and_movies_of_the_old() {
+    // And the statistics of the old (`power_laws.csv`, `distributions.csv`); the new run
+    // derives its own `per_avalanche.csv` and `fronts.csv`.
     let dir = scratch("stale");
     let (_, run, _) = finished_run(&dir);
     let drawn: Vec<String> = contents(&run)
@@ -301,7 +308,9 @@ fn a_new_run_removes_the_figures_and_movies_of_the_old() {
             "contact_map.csv",
             "curve.csv",
             "events.csv",
+            "fronts.csv",
             "notes.png",
+            "per_avalanche.csv",
             "scene.json"
         ],
     );

@@ -264,7 +264,7 @@ mod cli {
         let o = precursors(&["merge", path(&shared)]);
         assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
         let reference = tables(&one);
-        assert_eq!(reference.len(), 28); // 8 runs x 3 tables + 4 merged files
+        assert_eq!(reference.len(), 44); // 8 runs x (3 tables + 2 derived) + 4 merged files
         assert!(tables(&shared) == reference, "the merged tables differ");
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -27,14 +27,15 @@ fn run(scene: &Scene, dir: &Path) {
 fn table(path: &Path) -> Vec<HashMap<String, String>> {
     let text = std::fs::read_to_string(path).unwrap();
     let mut lines = text.lines();
-    let header: Vec<String> = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(String::from)
-        .collect();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
     lines
-        .map(|l| header.iter().cloned().zip(l.split(',').map(String::from)).collect())
+        .map(|l| {
+            header
+                .iter()
+                .cloned()
+                .zip(l.split(',').map(String::from))
+                .collect()
+        })
         .collect()
 }
 
@@ -154,8 +155,14 @@ fn the_calibration_runs_avalanches_and_damage_front() {
             .iter()
             .rfind(|f| num(f, "force_over_mu_FN") <= load)
             .unwrap();
-        assert!((num(row, "precursor_over_Lx") - ell).abs() < 0.0015, "{row:?}");
-        assert!((num(row, "damage_front_over_Lx") - front).abs() < 0.005, "{row:?}");
+        assert!(
+            (num(row, "precursor_over_Lx") - ell).abs() < 0.0015,
+            "{row:?}"
+        );
+        assert!(
+            (num(row, "damage_front_over_Lx") - front).abs() < 0.005,
+            "{row:?}"
+        );
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -240,7 +247,10 @@ fn the_observers_agree_with_the_tables_and_a_resumed_run_derives_the_same() {
     let rows = table(&dir.join("fronts.csv"));
     assert_eq!(rows.len(), fronts.len());
     for (row, x) in rows.iter().zip(&fronts) {
-        assert!((num(row, "damage_front_m") - x).abs() <= 1e-15, "{row:?} against {x}");
+        assert!(
+            (num(row, "damage_front_m") - x).abs() <= 1e-15,
+            "{row:?} against {x}"
+        );
     }
     let rows = table(&dir.join("per_avalanche.csv"));
     assert_eq!(rows.len(), all.len());
@@ -250,4 +260,207 @@ fn the_observers_agree_with_the_tables_and_a_resumed_run_derives_the_same() {
         assert!((num(row, "energy_J") - a.energy).abs() <= 1e-12 * a.energy);
     }
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A small sweep: two normal loads, three realizations each, a driving spring.
+const SWEEP: &str = r#"{
+    "base": { "block": { "lx": 0.02, "ly": 0.004, "lz": 0.01 },
+              "cells": { "kind": "count", "nx": 20, "ny": 4 },
+              "normal_load": 100.0,
+              "drive": { "kind": "spring", "stiffness": 4e6, "lateral": { "kind": "side" } } },
+    "axes": [ { "key": "normal_load", "values": [100.0, 150.0] } ],
+    "realizations": 3,
+    "seed": 5
+}"#;
+
+#[test]
+fn stats_pool_each_points_realizations() {
+    use precursors::sweep::{statistics, StatsOptions, Sweep, SweepOptions};
+    let dir = scratch("statistics", "sweep");
+    let sweep = Sweep::from_json_str(SWEEP).unwrap();
+    sweep.execute(&dir, &SweepOptions::new(), |_| {}).unwrap();
+    let options = StatsOptions::default().fit(
+        precursors::statistics::PowerLawOptions::default()
+            .bootstrap(10)
+            .goodness_samples(10)
+            .min_tail(5),
+    );
+    let summary = statistics(&dir, &options).unwrap();
+    assert_eq!(
+        (summary.points, summary.runs, summary.runs_missing),
+        (2, 6, 0)
+    );
+    // The avalanches of each point's runs as this test reads their events.csv.
+    let mut sizes: [Vec<usize>; 2] = Default::default();
+    let mut drops: [usize; 2] = [0; 2];
+    for run in sweep.runs() {
+        let events = table(&dir.join(run.dir_name()).join("events.csv"));
+        let all = read_avalanches(&events);
+        for a in &all[..all.len() - 1] {
+            sizes[run.point()].push(a.ruptures);
+            let drop = a.before.parse::<f64>().unwrap() - a.after.parse::<f64>().unwrap();
+            drops[run.point()] += usize::from(drop > 0.0);
+        }
+    }
+    let fits = table(&dir.join("power_laws.csv"));
+    let bins = table(&dir.join("distributions.csv"));
+    for point in 0..2 {
+        let of = |observable: &str| {
+            fits.iter()
+                .find(|r| r["point"] == point.to_string() && r["observable"] == observable)
+                .unwrap()
+                .clone()
+        };
+        let row = of("avalanche_ruptures");
+        assert_eq!(row["normal_load"], ["100.0", "150.0"][point]);
+        assert_eq!(num(&row, "samples") as usize, sizes[point].len());
+        assert_eq!(num(&of("force_drop_N"), "samples") as usize, drops[point]);
+        // The binned counts are the pooled sizes.
+        let binned: Vec<_> = bins
+            .iter()
+            .filter(|r| r["point"] == point.to_string() && r["observable"] == "avalanche_ruptures")
+            .collect();
+        let total: usize = binned.iter().map(|r| num(r, "count") as usize).sum();
+        assert_eq!(total, sizes[point].len());
+        for b in &binned {
+            let (lo, hi) = (num(b, "bin_low"), num(b, "bin_high"));
+            let inside = sizes[point]
+                .iter()
+                .filter(|&&s| (s as f64) >= lo && (s as f64) < hi)
+                .count();
+            assert_eq!(num(b, "count") as usize, inside, "{b:?}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[cfg(feature = "cli")]
+mod cli {
+    use super::*;
+    use crate::common::program::{path, precursors, stderr};
+
+    #[test]
+    fn stats_of_a_run_and_its_refusals() {
+        let dir = scratch("statistics", "cli");
+        let run_dir = dir.join("run");
+        std::fs::create_dir_all(&run_dir).unwrap();
+        run(&calibration(), &run_dir);
+        let o = precursors(&[
+            "stats",
+            path(&run_dir),
+            "--bootstrap",
+            "10",
+            "--goodness",
+            "10",
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let fits = table(&run_dir.join("power_laws.csv"));
+        assert_eq!(fits.len(), 7);
+        assert_eq!(fits[0]["observable"], "avalanche_ruptures");
+        // The rod drive does not drop its force: no samples, no fit.
+        assert_eq!(fits[1]["samples"], "0");
+        assert_eq!(fits[1]["alpha"], "");
+        // Bad options are a bad command line.
+        for bad in [
+            ["--confidence", "1"],
+            ["--confidence", "nan"],
+            ["--bootstrap", "10001"],
+            ["--min-tail", "1"],
+            ["--bins-per-decade", "0"],
+        ] {
+            let o = precursors(&["stats", path(&run_dir), bad[0], bad[1]]);
+            assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", stderr(&o));
+        }
+        // Neither a run nor a sweep; a damaged events.csv.
+        let o = precursors(&["stats", path(&dir)]);
+        assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains("neither a run directory"),
+            "{}",
+            stderr(&o)
+        );
+        let events = run_dir.join("events.csv");
+        let text = std::fs::read_to_string(&events).unwrap();
+        let cut: Vec<&str> = text.lines().filter(|l| !l.contains(",rupture,")).collect();
+        std::fs::write(&events, cut.join("\n") + "\n").unwrap();
+        let o = precursors(&["stats", path(&run_dir)]);
+        assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+        assert!(stderr(&o).contains("events.csv"), "{}", stderr(&o));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
+#[test]
+fn slip_profiles_balance_the_loads() {
+    // docs/model.md section 1: ∫ φ_z = F_N and ∫ φ_x = -F over the interface; the column
+    // averages times Δx Ly must give them back, at every stable state under shear.
+    let scene = calibration();
+    let mut driver = scene.driver().unwrap();
+    let (dx, ly) = (scene.grid().dx(), scene.grid().block().ly());
+    let mut checked = 0;
+    while let Some(event) = driver.step().unwrap() {
+        if let Event::Stable { load, .. } = event {
+            let p = driver.slip_profile().unwrap();
+            let normal: f64 = p.normal_traction.iter().sum::<f64>() * dx * ly;
+            let shear: f64 = p.shear_traction.iter().sum::<f64>() * dx * ly;
+            assert!((normal - 3500.0).abs() < 1e-6 * 3500.0, "{normal}");
+            assert!(
+                (shear + load.force).abs() < 1e-6 * 3500.0,
+                "{shear} {}",
+                load.force
+            );
+            // The rod pushes +x: every column has moved forward.
+            if load.force > 0.0 {
+                assert!(p.slip.iter().all(|u| *u > 0.0));
+            }
+            checked += 1;
+            if checked == 40 {
+                break;
+            }
+        }
+    }
+    assert_eq!(checked, 40);
+}
+
+/// The study's files (docs/statistics.md): each expands to 50 runs on the calibration
+/// block with the drive, heights and grid its name says; the two cell sizes of the
+/// correlated surface share their seeds, so realization `r` is one surface at both.
+#[test]
+fn the_study_files_are_the_documented_study() {
+    use precursors::sweep::Sweep;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/sweeps/statistics");
+    let mut seeds = Vec::new();
+    for (name, drive, heights, nx) in [
+        ("rod", "rod", "gaussian", 140),
+        ("spring", "spring", "gaussian", 140),
+        ("surface_1mm", "rod", "gaussian_surface", 140),
+        ("surface_0.5mm", "rod", "gaussian_surface", 280),
+    ] {
+        let path = dir.join(format!("{name}.json"));
+        let sweep = Sweep::from_json_file(&path).unwrap_or_else(|e| panic!("{path:?}: {e}"));
+        assert_eq!(sweep.runs().len(), 50, "{path:?}");
+        let scene = sweep.runs()[0].scene();
+        let grid = scene.grid().unwrap();
+        assert_eq!(grid.nx(), nx, "{path:?}");
+        let b = grid.block();
+        assert_eq!((b.lx(), b.ly(), b.lz()), (0.14, 0.007, 0.075));
+        let json: serde_json::Value = serde_json::from_str(&scene.to_json().unwrap()).unwrap();
+        assert_eq!(json["drive"]["kind"], drive, "{path:?}");
+        assert_eq!(json["heights"]["kind"], heights, "{path:?}");
+        assert_eq!(json["normal_load"], 3500.0, "{path:?}");
+        seeds.push(sweep.runs().iter().map(|r| r.seed()).collect::<Vec<u64>>());
+    }
+    assert_eq!(seeds[2], seeds[3]);
+    let docs = std::fs::read_to_string("docs/statistics.md").unwrap();
+    for name in [
+        "rod.json",
+        "spring.json",
+        "surface_1mm.json",
+        "surface_0.5mm.json",
+    ] {
+        assert!(
+            docs.contains(name),
+            "docs/statistics.md does not name {name}"
+        );
+    }
 }

@@ -419,7 +419,7 @@ fn tables_do_not_depend_on_jobs_or_shards() {
     }
     let reference = tables(&one);
     // 8 runs x 3 tables (events, curve, contact_map) + 4 merged files.
-    assert_eq!(reference.len(), 28);
+    assert_eq!(reference.len(), 44); // 8 runs x (3 tables + 2 derived) + 4 merged files
     assert_eq!(tables(&two), reference);
     assert_eq!(tables(&sharded), reference);
     // The merge has the axes as columns and every grid load per point.
@@ -557,7 +557,7 @@ mod cli {
             );
         }
         let reference = tables(&one);
-        assert_eq!(reference.len(), 28); // 8 runs x 3 tables + 4 merged files
+        assert_eq!(reference.len(), 44); // 8 runs x (3 tables + 2 derived) + 4 merged files
         assert_eq!(tables(&two), reference);
         assert_eq!(tables(&shards), reference);
         assert_eq!(tables(&step), reference);

@@ -7,7 +7,7 @@ events, the state between events as ``(Ny, Nx)`` float64 arrays (row ``iy``, col
 """
 
 from pathlib import Path
-from typing import Dict, Union
+from typing import Any, Dict, Union
 
 import numpy as np
 
@@ -28,7 +28,9 @@ from ._precursors import (
     PointStress,
     Scene,
     __version__,
+    fit_power_law,
     merge_files as _merge_files,
+    stats_files as _stats_files,
     movie,
     plot,
     run,
@@ -53,25 +55,38 @@ __all__ = [
     "Scene",
     "SurfaceSpectrum",
     "__version__",
+    "fit_power_law",
     "merge",
     "movie",
     "plot",
     "read_table",
     "read_tables",
     "run",
+    "stats",
     "sweep",
 ]
 
 
 def read_tables(directory: Union[str, Path]) -> Dict[str, Dict[str, np.ndarray]]:
-    """The tables of a run directory (``events``, ``curve``, ``contact_map``; those that
-    are complete) as dicts of columns (see ``read_table``)."""
+    """The tables of a run directory (``events``, ``curve``, ``contact_map``, and those a
+    finished run derives from them, ``per_avalanche`` and ``fronts``; those that are
+    complete) as dicts of columns (see ``read_table``)."""
     directory = Path(directory)
     return {
         name: read_table(directory / f"{name}.csv")
-        for name in ("events", "curve", "contact_map")
+        for name in ("events", "curve", "contact_map", "per_avalanche", "fronts")
         if (directory / f"{name}.csv").is_file()
     }
+
+
+def stats(directory: Union[str, Path], **options: Any) -> Dict[str, Dict[str, np.ndarray]]:
+    """The statistics of a run or sweep directory (as ``precursors stats``: avalanche
+    sizes, force drops, energies and front leaps pooled per point, their power-law fits
+    and log-binned distributions, written as ``power_laws.csv`` and ``distributions.csv``
+    in it), returned by file name without ``.csv`` as dicts of columns. ``options``:
+    ``bootstrap``, ``goodness``, ``confidence``, ``min_tail``, ``bins_per_decade``,
+    ``seed`` (docs/statistics.md)."""
+    return {Path(p).stem: read_table(p) for p in _stats_files(directory, **options)}
 
 
 def merge(directory: Union[str, Path]) -> Dict[str, Dict[str, np.ndarray]]:

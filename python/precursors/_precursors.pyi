@@ -180,6 +180,26 @@ class Checkpoint:
 def run(scene: Scene, out: _Path, *, threads: Optional[int] = ...) -> List[Path]: ...
 def sweep(file: _Path, out: _Path, *, jobs: int = ...) -> Dict[str, Any]: ...
 def merge_files(dir: _Path) -> List[Path]: ...
+def stats_files(
+    dir: _Path,
+    *,
+    bootstrap: int = ...,
+    goodness: int = ...,
+    confidence: float = ...,
+    min_tail: int = ...,
+    bins_per_decade: int = ...,
+    seed: int = ...,
+) -> List[Path]: ...
+def fit_power_law(
+    samples: Sequence[float],
+    *,
+    discrete: bool,
+    bootstrap: int = ...,
+    goodness: int = ...,
+    confidence: float = ...,
+    min_tail: int = ...,
+    seed: int = ...,
+) -> Dict[str, Any]: ...
 def plot(
     dir: _Path, *, formats: Sequence[str] = ..., width: int = ..., height: int = ...
 ) -> List[Path]: ...

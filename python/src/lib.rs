@@ -84,7 +84,8 @@ fn core_class(e: &precursors::Error) -> Class {
         | E::CorruptTable { .. }
         | E::NonFiniteCell { .. }
         | E::OutputCollision { .. }
-        | E::LoadBeyondFriction { .. } => Class::Value,
+        | E::LoadBeyondFriction { .. }
+        | E::TooFewSamples { .. } => Class::Value,
         _ => Class::Base,
     }
 }
@@ -1023,6 +1024,95 @@ fn merge_files(py: Python<'_>, dir: PathBuf) -> PyResult<Vec<PathBuf>> {
     Ok(summary.files)
 }
 
+/// The options of the power-law fits, checked as the program checks its options.
+fn power_law_options(
+    bootstrap: usize,
+    goodness: usize,
+    confidence: f64,
+    min_tail: usize,
+    seed: u64,
+) -> precursors::statistics::PowerLawOptions {
+    precursors::statistics::PowerLawOptions::default()
+        .bootstrap(bootstrap)
+        .goodness_samples(goodness)
+        .confidence(confidence)
+        .min_tail(min_tail)
+        .seed(seed)
+}
+
+/// The statistics of a run or sweep directory (`precursors stats`): pooled per point,
+/// fitted and log-binned into `power_laws.csv` and `distributions.csv` there; returns
+/// their paths (`precursors.stats` reads them into arrays).
+#[pyfunction]
+#[pyo3(signature = (dir, *, bootstrap=200, goodness=200, confidence=0.95, min_tail=10,
+                    bins_per_decade=5, seed=0))]
+#[allow(clippy::too_many_arguments)]
+fn stats_files(
+    py: Python<'_>,
+    dir: PathBuf,
+    bootstrap: usize,
+    goodness: usize,
+    confidence: f64,
+    min_tail: usize,
+    bins_per_decade: usize,
+    seed: u64,
+) -> PyResult<Vec<PathBuf>> {
+    let options = precursors::sweep::StatsOptions::default()
+        .fit(power_law_options(
+            bootstrap, goodness, confidence, min_tail, seed,
+        ))
+        .bins_per_decade(bins_per_decade);
+    let summary = py
+        .detach(|| precursors::sweep::statistics(&dir, &options))
+        .or_raise()?;
+    Ok(summary.files)
+}
+
+/// The maximum-likelihood power-law fit of `samples` (Clauset, Shalizi and Newman 2009):
+/// `discrete` for counts; returns a dict of the fit's values (`x_min`, `alpha`, its
+/// bootstrap interval `alpha_low`/`alpha_high` at `confidence`, `ks_distance`, `p_value`
+/// (None when `goodness` is 0), `samples`, `tail`, ...).
+#[pyfunction]
+#[pyo3(signature = (samples, *, discrete, bootstrap=200, goodness=200, confidence=0.95,
+                    min_tail=10, seed=0))]
+#[allow(clippy::too_many_arguments)]
+fn fit_power_law<'py>(
+    py: Python<'py>,
+    samples: Vec<f64>,
+    discrete: bool,
+    bootstrap: usize,
+    goodness: usize,
+    confidence: f64,
+    min_tail: usize,
+    seed: u64,
+) -> PyResult<Bound<'py, PyDict>> {
+    use precursors::statistics::Support;
+    let support = if discrete {
+        Support::Discrete
+    } else {
+        Support::Continuous
+    };
+    let options = power_law_options(bootstrap, goodness, confidence, min_tail, seed);
+    let fit = py
+        .detach(|| precursors::statistics::fit_power_law(&samples, support, &options))
+        .or_raise()?;
+    let d = PyDict::new(py);
+    d.set_item("discrete", discrete)?;
+    d.set_item("samples", fit.samples)?;
+    d.set_item("tail", fit.tail)?;
+    d.set_item("x_min", fit.x_min)?;
+    d.set_item("alpha", fit.alpha)?;
+    d.set_item("alpha_std_error", fit.alpha_std_error)?;
+    d.set_item("alpha_low", fit.alpha_low)?;
+    d.set_item("alpha_high", fit.alpha_high)?;
+    d.set_item("x_min_low", fit.x_min_low)?;
+    d.set_item("x_min_high", fit.x_min_high)?;
+    d.set_item("ks_distance", fit.ks_distance)?;
+    d.set_item("p_value", fit.p_value)?;
+    d.set_item("confidence", confidence)?;
+    Ok(d)
+}
+
 /// Draws the figures of a run or sweep directory into it (`precursors plot`); `formats`
 /// of `"png"`, `"svg"`; `width` x `height` pixels (200 to 16384 each, as `--width` and
 /// `--height`). Returns the paths of the figures.
@@ -1126,6 +1216,8 @@ fn _precursors(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(merge_files, m)?)?;
+    m.add_function(wrap_pyfunction!(stats_files, m)?)?;
+    m.add_function(wrap_pyfunction!(fit_power_law, m)?)?;
     m.add_function(wrap_pyfunction!(plot, m)?)?;
     m.add_function(wrap_pyfunction!(movie, m)?)?;
     m.add("ATTACHED", 0u8)?;

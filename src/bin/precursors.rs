@@ -15,7 +15,8 @@ mod format;
 use format::{format_bytes, format_seconds};
 use precursors::output::RunTables;
 use precursors::plot::PlotError;
-use precursors::sweep::{Sweep, SweepError, SweepOptions};
+use precursors::statistics::PowerLawOptions;
+use precursors::sweep::{StatsOptions, Sweep, SweepError, SweepOptions};
 use precursors::{Checkpoint, Driver, Error, GridCost, SceneBuilder};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -47,8 +48,8 @@ Exit codes:
   4  a file or directory could not be read or written (none is left half written), a
      path that is not a regular file (a FIFO, a device, a directory) named as a file, or
      another process is writing the directory (run, resume: the holder is named)
-  5  merge, plot: some runs of the sweep are not complete (the tables and figures of the
-     others written)";
+  5  merge, stats, plot: some runs of the sweep are not complete (the tables and figures
+     of the others written)";
 
 /// Quasi-static friction precursors: runs scene files and sweeps (docs/cli.md).
 #[derive(Debug, Parser)]
@@ -118,6 +119,35 @@ enum Command {
     Merge {
         /// The sweep's output directory.
         dir: PathBuf,
+    },
+    /// Fits the statistics of a run's or a sweep's avalanches, stress drops and front
+    /// leaps (pooled per point; docs/statistics.md) into DIR/power_laws.csv and
+    /// distributions.csv.
+    Stats {
+        /// A run's or a sweep's output directory.
+        dir: PathBuf,
+        /// Bootstrap resamples of each fit's confidence interval (0 to 10000).
+        #[arg(long, default_value_t = 200,
+              value_parser = clap::value_parser!(u64).range(0..=10_000))]
+        bootstrap: u64,
+        /// Synthetic data sets of each goodness-of-fit test (0 to 10000; 0: no p-value).
+        #[arg(long, default_value_t = 200,
+              value_parser = clap::value_parser!(u64).range(0..=10_000))]
+        goodness: u64,
+        /// Confidence level of the intervals (between 0 and 1).
+        #[arg(long, default_value_t = 0.95, value_parser = parse_confidence)]
+        confidence: f64,
+        /// Fewest samples a fitted tail may hold (2 to 1000000).
+        #[arg(long, default_value_t = 10,
+              value_parser = clap::value_parser!(u64).range(2..=1_000_000))]
+        min_tail: u64,
+        /// Bins per decade of the distributions (1 to 100).
+        #[arg(long, default_value_t = 5,
+              value_parser = clap::value_parser!(u64).range(1..=100))]
+        bins_per_decade: u64,
+        /// Seed of the bootstrap and of the synthetic data sets.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
     },
     /// Draws the figures of a run (precursor_length, contact_area, contact_map) or of a
     /// sweep (merged first; ensemble curves with 95 % bands) into DIR.
@@ -408,6 +438,27 @@ fn main() -> ExitCode {
             shard,
         } => run_sweep(&sweep, &out, jobs, shard, progress),
         Command::Merge { dir } => merge(&dir),
+        Command::Stats {
+            dir,
+            bootstrap,
+            goodness,
+            confidence,
+            min_tail,
+            bins_per_decade,
+            seed,
+        } => stats(
+            &dir,
+            &StatsOptions::default()
+                .fit(
+                    PowerLawOptions::default()
+                        .bootstrap(bootstrap as usize)
+                        .goodness_samples(goodness as usize)
+                        .confidence(confidence)
+                        .min_tail(min_tail as usize)
+                        .seed(seed),
+                )
+                .bins_per_decade(bins_per_decade as usize),
+        ),
         Command::Plot {
             dir,
             format,
@@ -907,6 +958,40 @@ fn incomplete(summary: &precursors::sweep::MergeSummary, dir: &Path) -> Failure 
         )
         .into(),
         code: 5,
+    }
+}
+
+fn stats(dir: &Path, options: &StatsOptions) -> Result<(), Failure> {
+    let summary = precursors::sweep::statistics(dir, options)?;
+    for file in &summary.files {
+        say!("wrote {}", file.display());
+    }
+    say!(
+        "{} points, {} runs pooled, {} missing",
+        summary.points,
+        summary.runs,
+        summary.runs_missing
+    );
+    if summary.runs_missing > 0 {
+        return Err(Failure {
+            error: format!(
+                "{} runs of the sweep in {} are not complete: run the sweep (or its missing \
+                 shards) again, then stats",
+                summary.runs_missing,
+                dir.display()
+            )
+            .into(),
+            code: 5,
+        });
+    }
+    Ok(())
+}
+
+/// A confidence level: a number strictly between 0 and 1.
+fn parse_confidence(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(c) if c > 0.0 && c < 1.0 => Ok(c),
+        _ => Err(format!("{text:?} is not a number strictly between 0 and 1")),
     }
 }
 

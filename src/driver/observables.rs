@@ -14,6 +14,19 @@ use crate::scene::Drive;
 /// areas, so a capped area of `ΔA` on every cell is not flagged.
 const NOMINAL_AREA_SLACK: f64 = 1e-9;
 
+/// The interface along `x`, averaged over `y` ([`Driver::slip_profile`]): one value per
+/// column `ix`, from the trailing edge.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct SlipProfile {
+    /// `⟨u_x⟩_y`, the shear displacement of the bottom face (m).
+    pub slip: Vec<f64>,
+    /// `⟨φ_x⟩_y`, the shear traction (Pa; negative where the springs resist `+x`).
+    pub shear_traction: Vec<f64>,
+    /// `⟨φ_z⟩_y`, the normal traction (Pa; compressive positive).
+    pub normal_traction: Vec<f64>,
+}
+
 impl Driver {
     /// The spring force `K_S (U_S - ⟨u_x⟩)` (N) under displacement control, `None` under
     /// force control.
@@ -72,6 +85,55 @@ impl Driver {
     /// [`Error::NotSolved`] before the first [`Driver::step`].
     pub fn mean_shear_displacement(&self) -> Result<f64> {
         Ok(self.force() * self.response()?.offset_per_newton)
+    }
+
+    /// The interface's profiles along `x`, averaged over `y` (one value per column `ix`,
+    /// from the trailing edge): the slip `⟨u_x⟩_y` (m) and the tractions `⟨φ_x⟩_y`,
+    /// `⟨φ_z⟩_y` (Pa; a detached or broken cell counts with zero traction). The paper's
+    /// interface `τ(x, 0)` and `σ(x, 0)` up to their signs (docs/model.md section 1).
+    ///
+    /// ```
+    /// use precursors::{Event, Scene};
+    /// let scene = Scene::builder()
+    ///     .block(0.020, 0.004, 0.010)
+    ///     .cells(20, 4)
+    ///     .normal_load(80.0)
+    ///     .seed(0)
+    ///     .build()?;
+    /// let mut driver = scene.driver()?;
+    /// while let Some(event) = driver.step()? {
+    ///     if let Event::Stable { load, .. } = event {
+    ///         if load.force > 0.0 {
+    ///             break; // the first stable state under shear
+    ///         }
+    ///     }
+    /// }
+    /// let profile = driver.slip_profile()?;
+    /// assert_eq!(profile.slip.len(), 20);
+    /// // The column averages carry the load: Σ ⟨φ_z⟩_y Δx Ly = F_N (N).
+    /// let carried: f64 = profile.normal_traction.iter().sum::<f64>() * 0.001 * 0.004;
+    /// assert!((carried - 80.0).abs() < 1e-6 * 80.0);
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first [`Driver::step`].
+    pub fn slip_profile(&self) -> Result<SlipProfile> {
+        let nx = self.grid().nx();
+        let ny = self.grid().ny() as f64;
+        let average = |field: &[f64]| {
+            let mut columns = vec![0.0; nx];
+            for row in field.chunks_exact(nx) {
+                columns.iter_mut().zip(row).for_each(|(c, v)| *c += v);
+            }
+            columns.iter_mut().for_each(|c| *c /= ny);
+            columns
+        };
+        Ok(SlipProfile {
+            slip: average(self.shear_displacement()?),
+            shear_traction: average(self.shear_traction()?),
+            normal_traction: average(self.normal_traction()?),
+        })
     }
 
     /// Breaking load `λ_i` (N) of each site in the current state (`+∞` off contact).

@@ -37,12 +37,17 @@ pub(crate) const MOVIES: [&str; 2] = [AREA_MOVIE, STRESS_MOVIE];
 
 /// The tables a run's end derives from its events (`output/derived.rs`).
 pub(crate) const DERIVED_TABLES: [&str; 2] = [AVALANCHE_TABLE, FRONTS_TABLE];
+/// The power-law fits `stats` writes into a run or sweep directory.
+pub(crate) const POWER_LAWS: &str = "power_laws.csv";
+/// The log-binned distributions `stats` writes.
+pub(crate) const DISTRIBUTIONS: &str = "distributions.csv";
 
 /// Whether `name` is a derived table, a figure or a movie: derived or drawn from a run's
 /// tables, so stale once the tables are another run's.
 pub(crate) fn derived(name: &str) -> bool {
     MOVIES.contains(&name)
         || DERIVED_TABLES.contains(&name)
+        || [POWER_LAWS, DISTRIBUTIONS].contains(&name)
         || name
             .rsplit_once('.')
             .is_some_and(|(stem, ext)| FIGURES.contains(&stem) && FIGURE_EXTENSIONS.contains(&ext))
@@ -199,6 +204,8 @@ mod tests {
             "coulomb_stress.gif",
             "per_avalanche.csv",
             "fronts.csv",
+            "power_laws.csv",
+            "distributions.csv",
             ".fronts.csv.tmp12-0-5",
             ".curve.csv.partial.tmp12-0-5",
         ] {

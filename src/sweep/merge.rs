@@ -144,7 +144,7 @@ fn stats(x: &[f64]) -> String {
     [m, lo, hi, min, max].map(num).join(",")
 }
 
-fn num(x: f64) -> String {
+pub(super) fn num(x: f64) -> String {
     if x.is_finite() {
         format!("{x:.12e}")
     } else {
@@ -153,7 +153,7 @@ fn num(x: f64) -> String {
 }
 
 /// A CSV cell: quoted when it holds a comma or a quote.
-fn cell(text: &str) -> String {
+pub(super) fn cell(text: &str) -> String {
     if text.contains([',', '"', '\n']) {
         format!("\"{}\"", text.replace('"', "\"\""))
     } else {
@@ -176,6 +176,20 @@ struct RunData {
 /// the sweep gives `run` (a directory swapped with another point's, a `scene.json` from
 /// elsewhere, or a `sweep.json` edited since the run are refused).
 fn read_run(dir: &Path, run: &SweepRun) -> Result<RunData> {
+    let record = checked_record(dir, run)?;
+    Ok(RunData {
+        curve: record
+            .curve
+            .iter()
+            .map(|c| (c.load, c.precursor_over_lx, c.area))
+            .collect(),
+        avalanches: record.ruptures,
+        slip: Some(record.slip),
+    })
+}
+
+/// The complete run in `dir` as [`read_run`] checks it, whole.
+pub(super) fn checked_record(dir: &Path, run: &SweepRun) -> Result<RunRecord> {
     // The scene first: tables checked against another point's scene would be refused
     // for their numbers, not for what is wrong.
     let record_path = dir.join(SCENE_RECORD);
@@ -196,16 +210,7 @@ fn read_run(dir: &Path, run: &SweepRun) -> Result<RunData> {
             });
         }
     }
-    let record = RunRecord::read(dir)?;
-    Ok(RunData {
-        curve: record
-            .curve
-            .iter()
-            .map(|c| (c.load, c.precursor_over_lx, c.area))
-            .collect(),
-        avalanches: record.ruptures,
-        slip: Some(record.slip),
-    })
+    RunRecord::read(dir)
 }
 
 /// The values of ℓ/Lx and of `A_R/A_R(0)` of the runs of `data` at the load
@@ -397,7 +402,7 @@ pub fn merge(dir: &Path) -> Result<MergeSummary, SweepError> {
 ///
 /// # Errors
 /// [`SweepError::Directory`] when `dir` holds no `sweep.json`; its errors as a sweep file.
-fn read_sweep(dir: &Path) -> Result<Sweep, SweepError> {
+pub(super) fn read_sweep(dir: &Path) -> Result<Sweep, SweepError> {
     let sweep_path = dir.join(SWEEP_FILE);
     if !sweep_path.is_file() {
         return Err(SweepError::Directory {

@@ -1,0 +1,1728 @@
+//! Statistics of avalanches: maximum-likelihood power-law fits in the manner of A. Clauset,
+//! C. R. Shalizi and M. E. J. Newman, "Power-law distributions in empirical data", SIAM
+//! Review 51, 661 (2009), and log-binned histograms.
+//!
+//! * [`fit_power_law`]: the exponent `α` of `p(x) ∝ x^(-α)` for `x ≥ x_min` by maximum
+//!   likelihood, `x_min` by the smallest Kolmogorov–Smirnov distance, a bootstrap interval
+//!   of both, and the goodness-of-fit p-value of Clauset et al. section 4.1. Samples are
+//!   [`Support::Discrete`] (integer counts: the ruptures of an avalanche) or
+//!   [`Support::Continuous`] (reals: a force drop in N, a stress drop in Pa).
+//! * [`log_binned`]: a histogram with logarithmically spaced bins, as density estimates
+//!   `P(x)` for log-log plots.
+//!
+//! Both drop the samples that are zero or negative before anything else (a power law
+//! holds no such value: an avalanche of no rupture, a zero stress drop), and refuse NaN
+//! and infinite ones. Results depend only on the multiset of samples, never on their
+//! order, and are reproducible bit for bit from [`PowerLawOptions::seed`].
+//!
+//! ```
+//! use precursors::statistics::{fit_power_law, PowerLawOptions, Support};
+//! // Force drops (N) of a run, in any order; the zero drop is left out of the fit.
+//! let drops = [0.0, 1.3e-3, 2.0e-3, 4.1e-3, 1.1e-3, 9.0e-3, 1.6e-3, 3.0e-2, 1.2e-3, 2.6e-3,
+//!              1.0e-3, 5.5e-3, 1.4e-3];
+//! let options = PowerLawOptions::default().bootstrap(20).goodness_samples(20).min_tail(5);
+//! let fit = fit_power_law(&drops, Support::Continuous, &options)?;
+//! assert_eq!(fit.samples, 12);
+//! assert!(fit.alpha > 1.0 && fit.x_min >= 1.0e-3);
+//! # Ok::<(), precursors::Error>(())
+//! ```
+
+use crate::error::{Error, Result};
+use rand::rngs::Xoshiro256PlusPlus;
+use rand::{RngExt, SeedableRng};
+
+/// Whether samples are integers (counts: the ruptures of an avalanche) or reals (a force
+/// drop in N, a stress drop in Pa).
+///
+/// The two are fitted by different laws: a discrete power law `P(X = k) = k^(-α) /
+/// ζ(α, x_min)` over the integers `k ≥ x_min` (`ζ` the Hurwitz zeta function), or a
+/// continuous density `p(x) = (α - 1) / x_min · (x / x_min)^(-α)` over `x ≥ x_min`.
+#[non_exhaustive]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Support {
+    /// Integer samples (`x.fract() == 0`), e.g. the number of ruptures of an avalanche.
+    Discrete,
+    /// Real samples, e.g. force drops (N) or stress drops (Pa).
+    Continuous,
+}
+
+/// Options of [`fit_power_law`].
+///
+/// The setters never fail: [`fit_power_law`] checks the values. The costs add up as
+/// `(1 + bootstrap + goodness_samples)` complete fits (the `x_min` search included).
+///
+/// ```
+/// use precursors::statistics::PowerLawOptions;
+/// let options = PowerLawOptions::default().confidence(0.9).bootstrap(100).seed(7);
+/// assert_eq!((options.confidence, options.bootstrap, options.seed), (0.9, 100, 7));
+/// assert_eq!((options.goodness_samples, options.min_tail), (200, 10));
+/// ```
+#[non_exhaustive]
+#[derive(Debug, Clone, PartialEq)]
+pub struct PowerLawOptions {
+    /// Level of the bootstrap intervals of `α` and `x_min` (dimensionless, strictly
+    /// between 0 and 1; default 0.95).
+    pub confidence: f64,
+    /// Bootstrap resamples (default 200). 0: no interval, the bounds equal the estimates.
+    pub bootstrap: usize,
+    /// Synthetic data sets of the goodness-of-fit test (default 200). 0: no test,
+    /// [`PowerLawFit::p_value`] is `None`. The p-value is resolved to
+    /// `1 / goodness_samples`; Clauset et al. suggest 2500 for a precision of 0.01.
+    pub goodness_samples: usize,
+    /// The fewest samples at or above `x_min` a candidate `x_min` may leave (at least 2;
+    /// default 10).
+    pub min_tail: usize,
+    /// Seed of the bootstrap and of the synthetic data sets (default 0).
+    pub seed: u64,
+}
+
+impl Default for PowerLawOptions {
+    fn default() -> Self {
+        Self {
+            confidence: 0.95,
+            bootstrap: 200,
+            goodness_samples: 200,
+            min_tail: 10,
+            seed: 0,
+        }
+    }
+}
+
+impl PowerLawOptions {
+    /// Sets [`PowerLawOptions::confidence`], the level of the bootstrap intervals (checked
+    /// by [`fit_power_law`]: strictly between 0 and 1).
+    #[must_use]
+    pub fn confidence(mut self, v: f64) -> Self {
+        self.confidence = v;
+        self
+    }
+
+    /// Sets [`PowerLawOptions::bootstrap`], the number of bootstrap resamples.
+    #[must_use]
+    pub fn bootstrap(mut self, n: usize) -> Self {
+        self.bootstrap = n;
+        self
+    }
+
+    /// Sets [`PowerLawOptions::goodness_samples`], the number of synthetic data sets of the
+    /// goodness-of-fit test.
+    #[must_use]
+    pub fn goodness_samples(mut self, n: usize) -> Self {
+        self.goodness_samples = n;
+        self
+    }
+
+    /// Sets [`PowerLawOptions::min_tail`] (checked by [`fit_power_law`]: at least 2).
+    #[must_use]
+    pub fn min_tail(mut self, n: usize) -> Self {
+        self.min_tail = n;
+        self
+    }
+
+    /// Sets [`PowerLawOptions::seed`].
+    #[must_use]
+    pub fn seed(mut self, s: u64) -> Self {
+        self.seed = s;
+        self
+    }
+}
+
+/// The fit of `p(x) ∝ x^(-α)` for `x ≥ x_min` ([`fit_power_law`]). Values of `x` are in
+/// the samples' unit (N for force drops, a count for avalanche sizes).
+#[non_exhaustive]
+#[derive(Debug, Clone, PartialEq)]
+pub struct PowerLawFit {
+    /// Whether the samples were fitted as integers or reals.
+    pub support: Support,
+    /// Samples fitted: the positive ones (zero and negative samples are dropped).
+    pub samples: usize,
+    /// Samples at or above `x_min`, the tail the exponent is fitted to.
+    pub tail: usize,
+    /// Lower bound of the power-law behaviour (samples' unit): the candidate of smallest
+    /// Kolmogorov–Smirnov distance.
+    pub x_min: f64,
+    /// Maximum-likelihood exponent `α` (dimensionless, > 1). The discrete exponent is
+    /// searched in `(1, 20]`, so 20 means "20 or steeper".
+    pub alpha: f64,
+    /// Asymptotic standard error of `α` at the chosen `x_min`: `(α - 1) / √tail` for
+    /// continuous samples (Clauset et al. eq. 3.2), `1 / √(tail · Var(ln X))` for discrete
+    /// ones (the discrete analogue, from the Fisher information: `Var(ln X) = ζ''/ζ -
+    /// (ζ'/ζ)²` under the fitted law, derivatives in `α`).
+    /// It does not include the uncertainty of `x_min`; the bootstrap interval does.
+    pub alpha_std_error: f64,
+    /// Lower end of the percentile bootstrap interval of `α` at the options' `confidence`;
+    /// each resample refits `x_min` and `α` (the whole procedure, Clauset et al. sec. 3.4).
+    /// Equal to `alpha` when `bootstrap` is 0. A percentile interval need not be centred
+    /// on the estimate.
+    pub alpha_low: f64,
+    /// Upper end of the bootstrap interval of `α` (see [`PowerLawFit::alpha_low`]).
+    pub alpha_high: f64,
+    /// Lower end of the bootstrap interval of `x_min` (samples' unit), from the same
+    /// resamples as that of `α`.
+    pub x_min_low: f64,
+    /// Upper end of the bootstrap interval of `x_min` (samples' unit).
+    pub x_min_high: f64,
+    /// Kolmogorov–Smirnov distance (dimensionless, in `[0, 1]`) between the tail's
+    /// empirical distribution function and the fitted law at `x_min`.
+    pub ks_distance: f64,
+    /// Goodness of fit (Clauset et al. sec. 4.1): the fraction of synthetic data sets,
+    /// drawn from the fitted law above `x_min` and from the data below it, whose own fit
+    /// (`x_min` search included) has a Kolmogorov–Smirnov distance `≥ ks_distance`. Small
+    /// values (Clauset et al.: `≤ 0.1`) rule the power law out. `None` when
+    /// `goodness_samples` is 0.
+    pub p_value: Option<f64>,
+}
+
+impl PowerLawFit {
+    /// The fitted law as a density of all the samples (per unit of `x`, the unit of
+    /// [`LogBin::density`], so the two plot on one chart): `(tail/samples) · p(x)` with
+    /// `p(x) = (α-1)/x_min · (x/x_min)^(-α)` for reals and `p(x) = x^(-α) / ζ(α, x_min)`
+    /// for counts (Hurwitz ζ); 0 below `x_min`.
+    ///
+    /// ```
+    /// use precursors::statistics::{fit_power_law, PowerLawOptions, Support};
+    /// let samples: Vec<f64> = (1..=200).map(|k| 200.0 / k as f64).collect();
+    /// let fit = fit_power_law(&samples, Support::Continuous, &PowerLawOptions::default())?;
+    /// assert_eq!(fit.density(0.5 * fit.x_min), 0.0);
+    /// let at = fit.density(fit.x_min);
+    /// let share = fit.tail as f64 / fit.samples as f64;
+    /// assert!((at - share * (fit.alpha - 1.0) / fit.x_min).abs() <= 1e-12 * at);
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    pub fn density(&self, x: f64) -> f64 {
+        if !(x >= self.x_min) || self.samples == 0 {
+            return 0.0;
+        }
+        let share = self.tail as f64 / self.samples as f64;
+        match self.support {
+            Support::Discrete => share * x.powf(-self.alpha) / hurwitz_zeta(self.alpha, self.x_min),
+            _ => share * (self.alpha - 1.0) / self.x_min * (x / self.x_min).powf(-self.alpha),
+        }
+    }
+}
+
+/// One bin of a log-binned histogram ([`log_binned`]). Values are in the samples' unit.
+#[non_exhaustive]
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogBin {
+    /// Lower edge (included).
+    pub low: f64,
+    /// Upper edge (excluded; the last bin holds the largest sample).
+    pub high: f64,
+    /// Geometric mean of `low` and `high`: where the density is plotted on log axes.
+    pub center: f64,
+    /// Samples in the bin.
+    pub count: usize,
+    /// Density estimate `P(x) = count / (n · width)` (inverse unit of the samples), `n`
+    /// the number of positive samples. `width` is `high - low` for continuous samples and
+    /// the number of integers in `[low, high)` for discrete ones, so that `P` is a
+    /// probability per integer and compares with `P(X = k)` directly. Capped at
+    /// `f64::MAX` (reached only in bins of subnormal width).
+    pub density: f64,
+}
+
+/// Fits a power law `p(x) ∝ x^(-α)`, `x ≥ x_min`, to samples by maximum likelihood, with
+/// `x_min` chosen by the Kolmogorov–Smirnov criterion of Clauset, Shalizi and Newman (SIAM
+/// Review 51, 661, 2009), a bootstrap interval of `α` and `x_min` and the goodness-of-fit
+/// p-value.
+///
+/// The procedure:
+///
+/// * Zero and negative samples are dropped (no power law holds them); the positive ones
+///   are sorted, so the result does not depend on the samples' order.
+/// * For each candidate `x_min`, `α` is the maximum-likelihood estimate of the tail
+///   `x ≥ x_min`: `α = 1 + n / Σ ln(x_i / x_min)` for continuous samples; for discrete
+///   ones the root of the score `d/dα [-n ln ζ(α, x_min) - α Σ ln x_i] = 0` in the
+///   bracket `(1, 20]` (the log-likelihood is concave in `α`: safeguarded Newton steps,
+///   bisection as fallback, to about 1e-13 relative; 20 when the likelihood still rises
+///   there). `ζ` is the Hurwitz zeta function (direct summation plus an Euler–Maclaurin
+///   tail, about 1e-15 relative).
+/// * `x_min` is the candidate of smallest Kolmogorov–Smirnov distance `D = max |S - P|`
+///   between the tail's empirical distribution function `S` and the fitted law's `P`
+///   (the smallest `x_min` on ties). Continuous: `D` is taken at both sides of every jump
+///   of `S`. Discrete: at every integer (where the two step functions can differ most:
+///   at each sample value and just before the next one), with
+///   `P(X ≤ x) = 1 - ζ(α, x + 1) / ζ(α, x_min)`.
+/// * Candidates are the distinct sample values that leave at least
+///   [`PowerLawOptions::min_tail`] samples at or above them, except the largest value
+///   (a tail of one value has an infinite exponent). So that large data sets stay
+///   affordable, a candidate is skipped when its tail is within 1 % of the tail of the
+///   last candidate tried: tails of up to 100 samples are all tried, larger ones on a
+///   grid of 1 % steps (a 1e4-sample set has about 560 candidates instead of 1e4).
+/// * The bootstrap redraws the positive samples with replacement and refits both `x_min`
+///   and `α` (Clauset et al. sec. 3.4); the intervals are the percentiles
+///   `(1 ∓ confidence) / 2` of the resampled values (the order statistics at or outside
+///   those ranks, so an end is a resampled value). A resample of
+///   one value only (no fit possible) is left out.
+/// * The goodness-of-fit test draws `goodness_samples` synthetic sets of as many samples,
+///   each sample from the fitted law above `x_min` with probability `tail / samples`, else
+///   uniformly from the samples below `x_min` (sec. 4.1). Discrete draws invert the exact
+///   distribution function (Clauset's approximation `⌊(x_min - ½)(1 - r)^(-1/(α-1)) + ½⌋`
+///   refined to the exact integer), capped at 2^53; continuous draws are
+///   `x_min (1 - r)^(-1/(α-1))`, capped at `f64::MAX`. A synthetic set of a single value
+///   counts as a perfect fit (`D = 0`).
+/// * Randomness comes from two `Xoshiro256PlusPlus` streams seeded from
+///   [`PowerLawOptions::seed`], one for the bootstrap and one for the synthetic sets, drawn
+///   in a fixed order: the same samples (in any order), support and options give the same
+///   fit bit for bit.
+///
+/// Cost: `1 + bootstrap + goodness_samples` fits of `n` samples; with the default options
+/// 1e4 samples take 0.2 to 3 s in a release build (less for data that follow the law).
+///
+/// ```
+/// use precursors::statistics::{fit_power_law, PowerLawOptions, Support};
+/// // Avalanche sizes (ruptures per avalanche), counted as `(size, times)`: about k^-2.
+/// let counts = [(1.0, 58), (2.0, 15), (3.0, 7), (4.0, 4), (5.0, 2), (6.0, 2), (8.0, 2),
+///               (11.0, 1), (14.0, 1), (23.0, 1), (37.0, 1), (90.0, 1)];
+/// let sizes: Vec<f64> = counts.iter().flat_map(|&(k, t)| std::iter::repeat_n(k, t)).collect();
+/// let options = PowerLawOptions::default().bootstrap(50).goodness_samples(50);
+/// let fit = fit_power_law(&sizes, Support::Discrete, &options)?;
+/// assert_eq!((fit.samples, fit.x_min, fit.tail), (95, 1.0, 95));
+/// assert!((fit.alpha - 2.0).abs() < 2.0 * fit.alpha_std_error, "alpha = {}", fit.alpha);
+/// assert!(fit.alpha_low < 2.0 && 2.0 < fit.alpha_high);
+/// assert!(fit.p_value.is_some_and(|p| p > 0.1));   // a power law is not ruled out
+/// # Ok::<(), precursors::Error>(())
+/// ```
+///
+/// # Errors
+///
+/// * [`Error::InvalidParameter`] (`name` `"confidence"`) when the confidence level is not
+///   strictly between 0 and 1 (or NaN);
+/// * [`Error::InvalidCount`] (`"min_tail"`) when `min_tail < 2`;
+/// * [`Error::InvalidParameter`] (`"samples"`) for a NaN or infinite sample, a sample of
+///   [`Support::Discrete`] that is not an integer or exceeds 2^53 in magnitude, or
+///   positive samples that are all equal (no exponent can be fitted);
+/// * [`Error::TooFewSamples`] (`what` `"power-law fit"`) when fewer than `min_tail`
+///   samples are positive.
+pub fn fit_power_law(
+    samples: &[f64],
+    support: Support,
+    options: &PowerLawOptions,
+) -> Result<PowerLawFit> {
+    let confidence = options.confidence;
+    if !(confidence > 0.0 && confidence < 1.0) {
+        return Err(Error::InvalidParameter {
+            name: "confidence",
+            value: confidence,
+            reason: "the confidence level must lie strictly between 0 and 1",
+        });
+    }
+    let min_tail = options.min_tail;
+    if min_tail < 2 {
+        return Err(Error::InvalidCount {
+            name: "min_tail",
+            value: min_tail as u64,
+            reason: "a tail needs at least 2 samples to fit an exponent",
+        });
+    }
+    let xs = positive_sorted(samples, support)?;
+    let n = xs.len();
+    if n < min_tail {
+        return Err(Error::TooFewSamples {
+            what: "power-law fit",
+            count: n,
+            needed: min_tail,
+        });
+    }
+    let mut scratch = Scratch::default();
+    let best = fit_sorted(&xs, support, min_tail, &mut scratch).ok_or(Error::InvalidParameter {
+        name: "samples",
+        value: xs[0],
+        reason: "all positive samples are equal (or their logarithms are): a power law \
+                 needs two distinct values",
+    })?;
+    let alpha_std_error = match support {
+        Support::Continuous => (best.alpha - 1.0) / (best.tail as f64).sqrt(),
+        Support::Discrete => {
+            let (_, variance) = discrete_score(best.alpha, best.x_min, 0.0);
+            let fisher = best.tail as f64 * variance;
+            // Var(ln X) > 0 for any law over two integers or more; the guard only keeps a
+            // rounding accident from giving an infinite or NaN error.
+            if fisher > 0.0 && fisher.is_finite() {
+                1.0 / fisher.sqrt()
+            } else {
+                (best.alpha - 1.0) / (best.tail as f64).sqrt()
+            }
+        }
+    };
+
+    // The bootstrap: whole refits of resamples (counts per sorted index keep them sorted
+    // without a sort).
+    let (mut alpha_low, mut alpha_high) = (best.alpha, best.alpha);
+    let (mut x_min_low, mut x_min_high) = (best.x_min, best.x_min);
+    if options.bootstrap > 0 {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(options.seed);
+        let mut counts = vec![0usize; n];
+        let mut resample = Vec::with_capacity(n);
+        let mut alphas = Vec::with_capacity(options.bootstrap);
+        let mut x_mins = Vec::with_capacity(options.bootstrap);
+        for _ in 0..options.bootstrap {
+            counts.iter_mut().for_each(|c| *c = 0);
+            for _ in 0..n {
+                counts[rng.random_range(0..n)] += 1;
+            }
+            resample.clear();
+            for (&x, &c) in xs.iter().zip(&counts) {
+                resample.extend(std::iter::repeat_n(x, c));
+            }
+            if let Some(fit) = fit_sorted(&resample, support, min_tail, &mut scratch) {
+                alphas.push(fit.alpha);
+                x_mins.push(fit.x_min);
+            }
+        }
+        if let (Some(a), Some(x)) = (
+            percentile_interval(&mut alphas, confidence),
+            percentile_interval(&mut x_mins, confidence),
+        ) {
+            (alpha_low, alpha_high) = a;
+            (x_min_low, x_min_high) = x;
+        }
+    }
+
+    let p_value = (options.goodness_samples > 0).then(|| {
+        goodness_of_fit(
+            &xs,
+            support,
+            min_tail,
+            &best,
+            options.goodness_samples,
+            // A second stream, distinct from the bootstrap's for every seed.
+            options.seed ^ 0x9E37_79B9_7F4A_7C15,
+            &mut scratch,
+        )
+    });
+
+    Ok(PowerLawFit {
+        support,
+        samples: n,
+        tail: best.tail,
+        x_min: best.x_min,
+        alpha: best.alpha,
+        alpha_std_error,
+        alpha_low,
+        alpha_high,
+        x_min_low,
+        x_min_high,
+        ks_distance: best.ks,
+        p_value,
+    })
+}
+
+/// The most bins (edges) [`log_binned`] makes.
+const MAX_BINS: usize = 1_000_000;
+
+/// A histogram of the positive samples in logarithmically spaced bins, as density
+/// estimates `P(x)` for log-log plots.
+///
+/// Edges are `e_k = x0 · 10^(k / bins_per_decade)`, `x0` the smallest positive sample,
+/// up to the first edge above the largest sample (so the last bin holds it). For
+/// [`Support::Discrete`] the edges are rounded up to integers, bin `k` being
+/// `[⌈e_k⌉, ⌈e_(k+1)⌉)` (an edge within 1e-9 relative of an integer counts as that
+/// integer, so rounding noise in `10^(k/b)` does not shift a bin), so that every bin holds
+/// whole integers; bins that would hold no integer are left out. Empty bins (no sample)
+/// are listed with count and density 0, so that plots show the gaps.
+///
+/// `density = count / (n · width)`, `n` the number of positive samples, `width`
+/// `high - low` (continuous) or the number of integers in the bin (discrete): the
+/// densities times widths sum to 1. Zero and negative samples are dropped (as in
+/// [`fit_power_law`]); with no positive sample the histogram is empty.
+///
+/// ```
+/// use precursors::statistics::{log_binned, Support};
+/// // Avalanche sizes (ruptures): a zero is left out, 7 positive sizes remain.
+/// let sizes = [1.0, 1.0, 2.0, 3.0, 0.0, 5.0, 12.0, 40.0];
+/// let bins = log_binned(&sizes, Support::Discrete, 2)?;
+/// // Edges 1, 10^0.5 = 3.16, 10, 31.6, 100 rounded up: [1, 4), [4, 10), [10, 32), [32, 100).
+/// let edges: Vec<_> = bins.iter().map(|b| (b.low, b.high, b.count)).collect();
+/// assert_eq!(edges, [(1.0, 4.0, 4), (4.0, 10.0, 1), (10.0, 32.0, 1), (32.0, 100.0, 1)]);
+/// assert_eq!(bins[0].density, 4.0 / (7.0 * 3.0));   // probability per integer
+/// # Ok::<(), precursors::Error>(())
+/// ```
+///
+/// # Errors
+///
+/// * [`Error::InvalidCount`] (`name` `"bins_per_decade"`) when `bins_per_decade` is 0,
+///   above a million, or so large for the samples' range that the histogram would exceed
+///   a million edges;
+/// * [`Error::InvalidParameter`] (`"samples"`) for a NaN or infinite sample, or a sample
+///   of [`Support::Discrete`] that is not an integer or exceeds 2^53 in magnitude.
+pub fn log_binned(
+    samples: &[f64],
+    support: Support,
+    bins_per_decade: usize,
+) -> Result<Vec<LogBin>> {
+    if bins_per_decade == 0 {
+        return Err(Error::InvalidCount {
+            name: "bins_per_decade",
+            value: 0,
+            reason: "a histogram needs at least one bin per decade",
+        });
+    }
+    let xs = positive_sorted(samples, support)?;
+    let (Some(&x0), Some(&x_max)) = (xs.first(), xs.last()) else {
+        return Ok(Vec::new());
+    };
+    let per_decade = bins_per_decade as f64;
+    // Edges needed: the decades spanned times the bins per decade, plus the last one.
+    // At most MAX_BINS per decade also keeps 10^(1/b) distinguishable from 1.
+    let edges = (x_max.log10() - x0.log10()) * per_decade + 2.0;
+    if edges > MAX_BINS as f64 || bins_per_decade > MAX_BINS {
+        return Err(Error::InvalidCount {
+            name: "bins_per_decade",
+            value: bins_per_decade as u64,
+            reason: "the histogram would have more than a million edges (or bins per decade)",
+        });
+    }
+    let edge = |k: usize| -> f64 {
+        let e = x0 * 10f64.powf(k as f64 / per_decade);
+        match support {
+            Support::Continuous => e,
+            Support::Discrete => {
+                let r = e.round();
+                if (e - r).abs() <= 1e-9 * e {
+                    r
+                } else {
+                    e.ceil()
+                }
+            }
+        }
+    };
+    let n = xs.len() as f64;
+    let mut bins = Vec::new();
+    let (mut next, mut low) = (0usize, edge(0));
+    for k in 1.. {
+        let mut high = edge(k);
+        if high <= low {
+            continue; // a discrete bin of no integer: its edges coincide
+        }
+        // Edges pass the largest sample by k ≈ `edges` (checked above); the bound only
+        // makes the end certain, with every sample counted.
+        let last = high > x_max || !high.is_finite() || k > MAX_BINS;
+        if !high.is_finite() {
+            high = f64::MAX; // beyond the largest float: the last bin ends there, closed
+        }
+        let start = next;
+        while next < xs.len() && (last || xs[next] < high) {
+            next += 1;
+        }
+        let count = next - start;
+        let width = high - low;
+        bins.push(LogBin {
+            low,
+            high,
+            center: low.sqrt() * high.sqrt(),
+            count,
+            // Divided in turn: n · width could overflow for huge samples. Capped: bins of
+            // subnormal width (samples near 1e-320) would give infinity. A zero width only
+            // if the largest sample is f64::MAX and sits on an edge.
+            density: if width > 0.0 {
+                (count as f64 / n / width).min(f64::MAX)
+            } else {
+                0.0
+            },
+        });
+        if last {
+            break;
+        }
+        low = high;
+    }
+    Ok(bins)
+}
+
+/// The positive samples, sorted; refuses NaN, infinities, and discrete samples that are
+/// not integers or exceed 2^53 in magnitude.
+fn positive_sorted(samples: &[f64], support: Support) -> Result<Vec<f64>> {
+    for &x in samples {
+        if !x.is_finite() {
+            return Err(Error::InvalidParameter {
+                name: "samples",
+                value: x,
+                reason: "samples must be finite",
+            });
+        }
+        if support == Support::Discrete && x.fract() != 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "samples",
+                value: x,
+                reason: "discrete samples must be integers",
+            });
+        }
+        if support == Support::Discrete && x.abs() > MAX_DRAW {
+            return Err(Error::InvalidParameter {
+                name: "samples",
+                value: x,
+                reason: "discrete samples must not exceed 2^53 in magnitude, where f64 \
+                         stops holding every integer",
+            });
+        }
+    }
+    let mut xs: Vec<f64> = samples.iter().copied().filter(|&x| x > 0.0).collect();
+    xs.sort_unstable_by(f64::total_cmp);
+    Ok(xs)
+}
+
+/// The fit at one `x_min`: what the search, the bootstrap and the synthetic sets need.
+#[derive(Debug, Clone, Copy)]
+struct TailFit {
+    x_min: f64,
+    alpha: f64,
+    tail: usize,
+    ks: f64,
+    /// Index of the first sample `≥ x_min` in the sorted samples.
+    start: usize,
+}
+
+/// Buffers reused across the many fits of one call.
+#[derive(Debug, Default)]
+struct Scratch {
+    /// `ln x` of each sorted sample.
+    logs: Vec<f64>,
+    /// Start index of each run of equal sorted samples, then the number of samples.
+    groups: Vec<usize>,
+    /// `ζ(α, q)` for consecutive integers `q` (see [`zeta_ladder`]).
+    ladder: Vec<f64>,
+    /// A synthetic data set.
+    synthetic: Vec<f64>,
+}
+
+/// Tail sizes are tried on a grid of this relative step (tails within 1 % of the last
+/// candidate tried are skipped): the fit's cost falls from `O(n²)` to about
+/// `O(100 n)` operations for large `n`, at an `x_min` resolution far below its bootstrap
+/// spread.
+const TAIL_STEP_PERCENT: u128 = 1;
+
+/// The whole fit of sorted positive samples (`xs.len() ≥ min_tail ≥ 2`): the `x_min`
+/// search and the exponent there. `None` when every sample is equal.
+fn fit_sorted(xs: &[f64], support: Support, min_tail: usize, s: &mut Scratch) -> Option<TailFit> {
+    let n = xs.len();
+    s.logs.clear();
+    s.logs.extend(xs.iter().map(|x| x.ln()));
+    s.groups.clear();
+    for (i, x) in xs.iter().enumerate() {
+        if i == 0 || xs[i - 1] != *x {
+            s.groups.push(i);
+        }
+    }
+    s.groups.push(n);
+    let Scratch {
+        logs,
+        groups,
+        ladder,
+        ..
+    } = s;
+    let mut best: Option<TailFit> = None;
+    let mut last_tail: Option<usize> = None;
+    // The last group is never a candidate: a tail of one value has an infinite exponent.
+    for g in 0..groups.len().saturating_sub(2) {
+        let start = groups[g];
+        let tail = n - start;
+        if tail < min_tail {
+            break; // tails only shrink from here
+        }
+        if let Some(last) = last_tail {
+            if (tail as u128) * 100 > (last as u128) * (100 - TAIL_STEP_PERCENT) {
+                continue;
+            }
+        }
+        last_tail = Some(tail);
+        let bound = best.map_or(f64::INFINITY, |b| b.ks);
+        let candidate = match support {
+            Support::Continuous => continuous_candidate(logs, groups, g, bound),
+            Support::Discrete => discrete_candidate(xs, logs, groups, g, bound, ladder),
+        };
+        // Strictly smaller only: on ties the smaller x_min, tried first, stays.
+        if let Some((alpha, ks)) = candidate {
+            best = Some(TailFit {
+                x_min: xs[start],
+                alpha,
+                tail,
+                ks,
+                start,
+            });
+        }
+    }
+    best
+}
+
+/// The continuous fit at the `g`-th distinct value: `(α, D)`, or `None` once `D` reaches
+/// `bound` (the candidate cannot win; the rest of its distance is not computed).
+fn continuous_candidate(
+    logs: &[f64],
+    groups: &[usize],
+    g: usize,
+    bound: f64,
+) -> Option<(f64, f64)> {
+    let start = groups[g];
+    let n = logs.len();
+    let tail = (n - start) as f64;
+    let ln_min = logs[start];
+    // Σ ln(x / x_min) term by term rather than from prefix sums, which would cancel for
+    // a narrow tail far from the smallest sample.
+    let sum: f64 = logs[start..].iter().map(|l| l - ln_min).sum();
+    let alpha = 1.0 + tail / sum;
+    if !alpha.is_finite() {
+        return None; // distinct values of equal logarithms (adjacent floats near 1e300)
+    }
+    let mut ks = 0.0f64;
+    for w in groups[g..].windows(2) {
+        let (lo, hi) = (w[0], w[1]);
+        // P(x) = 1 - (x / x_min)^(1 - α), with expm1 for small distances.
+        let p = -((1.0 - alpha) * (logs[lo] - ln_min)).exp_m1();
+        let below = (lo - start) as f64 / tail;
+        let at = (hi - start) as f64 / tail;
+        ks = ks.max((below - p).abs()).max((at - p).abs());
+        if ks >= bound {
+            return None;
+        }
+    }
+    Some((alpha, ks))
+}
+
+/// The discrete fit at the `g`-th distinct value: `(α, D)`, or `None` once `D` reaches
+/// `bound`.
+fn discrete_candidate(
+    xs: &[f64],
+    logs: &[f64],
+    groups: &[usize],
+    g: usize,
+    bound: f64,
+    ladder: &mut Vec<f64>,
+) -> Option<(f64, f64)> {
+    let start = groups[g];
+    let n = xs.len();
+    let tail = (n - start) as f64;
+    let x_min = xs[start];
+    let sum: f64 = groups[g..]
+        .windows(2)
+        .map(|w| (w[1] - w[0]) as f64 * logs[w[0]])
+        .sum();
+    let alpha = discrete_mle(x_min, sum / tail);
+    zeta_ladder(alpha, x_min, ladder);
+    let top = x_min + (ladder.len() - 1) as f64;
+    let zeta = |q: f64| {
+        if q <= top {
+            ladder[(q - x_min) as usize]
+        } else {
+            hurwitz_tail(alpha, q)
+        }
+    };
+    let norm = ladder[0];
+    let mut ks = 0.0f64;
+    for w in groups[g..].windows(2) {
+        let (lo, hi) = (w[0], w[1]);
+        let x = xs[lo];
+        let at = (hi - start) as f64 / tail;
+        // At the sample value, and just before the next one, where P is largest while S
+        // stays at `at` (beyond the largest sample |1 - P| only falls).
+        let p = 1.0 - zeta(x + 1.0) / norm;
+        ks = ks.max((at - p).abs());
+        if hi < n {
+            let x_next = xs[hi];
+            if x_next > x + 1.0 {
+                let p_before = 1.0 - zeta(x_next) / norm;
+                ks = ks.max((at - p_before).abs());
+            }
+        }
+        if ks >= bound {
+            return None;
+        }
+    }
+    Some((alpha, ks))
+}
+
+/// The largest discrete exponent searched.
+const ALPHA_MAX: f64 = 20.0;
+
+/// Minus the derivative in `α` of the discrete log-likelihood per tail sample,
+/// `-ln ζ(α, q) - α m`: `ζ'/ζ + m` (zero at the estimate, rising with `α`), and its own
+/// derivative `Var(ln X) = ζ''/ζ - (ζ'/ζ)²` under the law (`m = ⟨ln x⟩` of the tail).
+fn discrete_score(alpha: f64, q: f64, m: f64) -> (f64, f64) {
+    let (z, z1, z2) = hurwitz_zeta_derivatives(alpha, q);
+    let r = z1 / z;
+    (r + m, z2 / z - r * r)
+}
+
+/// The maximum-likelihood exponent of a discrete power law above `q` whose tail has mean
+/// `m = ⟨ln x⟩`: the root of the score in `(1, ALPHA_MAX]`, by Newton steps kept inside
+/// a shrinking bracket (the score rises with `α`: the log-likelihood is concave).
+fn discrete_mle(q: f64, m: f64) -> f64 {
+    let (at_max, _) = discrete_score(ALPHA_MAX, q, m);
+    if at_max.is_nan() || at_max <= 0.0 {
+        return ALPHA_MAX; // the likelihood still rises at the cap
+    }
+    let (mut lo, mut hi) = (1.0, ALPHA_MAX);
+    // Clauset et al.'s approximation 1 + n / Σ ln(x / (q - 1/2)) as the start: within a
+    // few per cent of the root.
+    let guess = 1.0 + 1.0 / (m - (q - 0.5).ln());
+    let mut alpha = if guess > lo && guess < hi {
+        guess
+    } else {
+        0.5 * (lo + hi)
+    };
+    for _ in 0..200 {
+        let (score, slope) = discrete_score(alpha, q, m);
+        if score > 0.0 {
+            hi = alpha;
+        } else if score < 0.0 {
+            lo = alpha;
+        } else {
+            return alpha;
+        }
+        let mut next = alpha - score / slope;
+        if !(next > lo && next < hi) {
+            next = 0.5 * (lo + hi);
+        }
+        let done = (next - alpha).abs() <= 1e-13 * alpha;
+        alpha = next;
+        if done || hi - lo <= 1e-14 * alpha {
+            break;
+        }
+    }
+    alpha
+}
+
+/// The Euler–Maclaurin tail starts at `q + N ≥ EM_START`; with `BERNOULLI.len()`
+/// correction terms it is accurate to about 1e-16 relative for `s ∈ (1, 20]` (checked
+/// against 90-digit values).
+const EM_START: f64 = 20.0;
+
+/// `B_2j / (2j)!`, `j = 1..=12`.
+const BERNOULLI: [f64; 12] = [
+    0.083_333_333_333_333_33,
+    -0.001_388_888_888_888_889,
+    3.306_878_306_878_307e-5,
+    -8.267_195_767_195_768e-7,
+    2.087_675_698_786_81e-8,
+    -5.284_190_138_687_493e-10,
+    1.338_253_653_068_467_9e-11,
+    -3.389_680_296_322_582_7e-13,
+    8.586_062_056_277_845e-15,
+    -2.174_868_698_558_062e-16,
+    5.509_002_828_360_229_5e-18,
+    -1.395_446_468_581_252_2e-19,
+];
+
+/// `Σ_{k≥0} (k + a)^(-s)` by Euler–Maclaurin alone (accurate for `a ≥ EM_START`).
+fn hurwitz_tail(s: f64, a: f64) -> f64 {
+    // a^(1-s) rather than a · a^(-s): the latter is subnormal sooner (a = 2^53, s = 20).
+    let a1s = a.powf(1.0 - s);
+    let mut terms = [0.0; BERNOULLI.len()];
+    // B_2j/(2j)! · s(s+1)…(s+2j-2) · a^(-s-2j+1)
+    let mut t = s * a1s / (a * a);
+    for (j, (term, b)) in terms.iter_mut().zip(BERNOULLI).enumerate() {
+        *term = b * t;
+        let j = j as f64 + 1.0;
+        t *= (s + 2.0 * j - 1.0) * (s + 2.0 * j) / (a * a);
+    }
+    // Smallest first.
+    let corrections: f64 = terms.iter().rev().sum();
+    corrections + 0.5 * a1s / a + a1s / (s - 1.0)
+}
+
+/// The Hurwitz zeta function `ζ(s, q) = Σ_{k≥0} (k + q)^(-s)` for `s > 1`, `q > 0`: the
+/// first terms summed up to `q + N ≥ EM_START`, then the Euler–Maclaurin tail. About
+/// 1e-15 relative for `s ∈ (1, 20]`.
+fn hurwitz_zeta(s: f64, q: f64) -> f64 {
+    let terms = if q < EM_START {
+        (EM_START - q).ceil() as usize
+    } else {
+        0
+    };
+    let mut sum = hurwitz_tail(s, q + terms as f64);
+    // Smallest terms first.
+    for k in (0..terms).rev() {
+        sum += (q + k as f64).powf(-s);
+    }
+    sum
+}
+
+/// `ζ(s, q)` and its first two derivatives in `s`, `ζ' = -Σ ln(k+q) (k+q)^(-s)` and
+/// `ζ'' = Σ ln²(k+q) (k+q)^(-s)`: the derivatives of the same summation and
+/// Euler–Maclaurin formula, term by term.
+fn hurwitz_zeta_derivatives(s: f64, q: f64) -> (f64, f64, f64) {
+    let n = if q < EM_START {
+        (EM_START - q).ceil() as usize
+    } else {
+        0
+    };
+    let a = q + n as f64;
+    let la = a.ln();
+    let a1s = ((1.0 - s) * la).exp();
+    // a^(1-s)/(s-1): d/ds ln = -(ln a + 1/(s-1)), d²/ds² ln = 1/(s-1)².
+    let g = a1s / (s - 1.0);
+    let dg = la + 1.0 / (s - 1.0);
+    let (mut z, mut z1, mut z2) = (0.0, 0.0, 0.0);
+    // Corrections c_j = B_2j/(2j)! · P_j(s) · a^(-s-2j+1), P_j = s(s+1)…(s+2j-2):
+    // d/ds ln c_j = Σ 1/(s+i) - ln a, d²/ds² ln c_j = -Σ 1/(s+i)².
+    let mut terms = [(0.0, 0.0, 0.0); BERNOULLI.len()];
+    let (mut c, mut s1, mut s2) = (s * a1s / (a * a), 1.0 / s, 1.0 / (s * s));
+    for (j, (term, b)) in terms.iter_mut().zip(BERNOULLI).enumerate() {
+        let l1 = s1 - la;
+        let cj = b * c;
+        *term = (cj, cj * l1, cj * (l1 * l1 - s2));
+        let j = j as f64 + 1.0;
+        let (u, v) = (s + 2.0 * j - 1.0, s + 2.0 * j);
+        c *= u * v / (a * a);
+        s1 += 1.0 / u + 1.0 / v;
+        s2 += 1.0 / (u * u) + 1.0 / (v * v);
+    }
+    for (t0, t1, t2) in terms.iter().rev() {
+        z += t0;
+        z1 += t1;
+        z2 += t2;
+    }
+    let h = 0.5 * a1s / a;
+    z += h + g;
+    z1 += -la * h - g * dg;
+    z2 += la * la * h + g * (dg * dg + 1.0 / ((s - 1.0) * (s - 1.0)));
+    for k in (0..n).rev() {
+        let x = q + k as f64;
+        let l = x.ln();
+        let p = (-s * l).exp();
+        z += p;
+        z1 -= l * p;
+        z2 += l * l * p;
+    }
+    (z, z1, z2)
+}
+
+/// Fills `out` with `ζ(s, q)` for the consecutive integers `q = q0, q0 + 1, …,
+/// max(q0, EM_START)`, summed downwards from the Euler–Maclaurin tail at the top (adding
+/// positive terms: no cancellation, unlike `ζ(s, q+1) = ζ(s, q) - q^(-s)` upwards).
+fn zeta_ladder(s: f64, q0: f64, out: &mut Vec<f64>) {
+    let top = q0.max(EM_START);
+    let len = (top - q0) as usize + 1;
+    out.clear();
+    out.resize(len, 0.0);
+    out[len - 1] = hurwitz_tail(s, top);
+    for i in (0..len - 1).rev() {
+        out[i] = out[i + 1] + (q0 + i as f64).powf(-s);
+    }
+}
+
+/// The largest discrete sample accepted, and where draws of the discrete sampler stop:
+/// f64 holds every integer up to 2^53.
+const MAX_DRAW: f64 = 9_007_199_254_740_992.0; // 2^53
+
+/// A discrete power law above `x_min` to draw from: its survival function
+/// `S(x) = P(X ≥ x) = ζ(α, x) / ζ(α, x_min)`, tabulated near `x_min`.
+struct DiscreteLaw {
+    alpha: f64,
+    x_min: f64,
+    /// `ζ(α, x_min + k)`, `k = 0..TABLE`.
+    table: Vec<f64>,
+}
+
+impl DiscreteLaw {
+    const TABLE: usize = 1024;
+
+    fn new(alpha: f64, x_min: f64) -> Self {
+        let mut table = vec![0.0; Self::TABLE];
+        let top = x_min + (Self::TABLE - 1) as f64;
+        table[Self::TABLE - 1] = hurwitz_zeta(alpha, top);
+        for i in (0..Self::TABLE - 1).rev() {
+            table[i] = table[i + 1] + (x_min + i as f64).powf(-alpha);
+        }
+        Self {
+            alpha,
+            x_min,
+            table,
+        }
+    }
+
+    /// `P(X ≥ x)` for an integer `x ≥ x_min`.
+    fn survival(&self, x: f64) -> f64 {
+        let k = x - self.x_min;
+        let z = if k < Self::TABLE as f64 {
+            self.table[k as usize]
+        } else {
+            hurwitz_zeta(self.alpha, x)
+        };
+        z / self.table[0]
+    }
+
+    /// The smallest integer `x ≥ x_min` with `P(X > x) ≤ u`, `u ∈ (0, 1]`: the inverse
+    /// distribution function at `1 - u`. Clauset et al.'s approximation (their appendix
+    /// D) is the start; galloping steps bracket the exact integer, bisection finds it.
+    fn draw(&self, u: f64) -> f64 {
+        let x_min = self.x_min;
+        let fits = |x: f64| self.survival(x + 1.0) <= u;
+        let guess = ((x_min - 0.5) * u.powf(-1.0 / (self.alpha - 1.0)) + 0.5).floor();
+        let guess = if guess.is_nan() {
+            x_min
+        } else {
+            guess.clamp(x_min, MAX_DRAW.max(x_min))
+        };
+        // Invariant: `fits(hi)`, and `lo < x_min` or `!fits(lo)`.
+        let (mut lo, mut hi);
+        let mut step = 1.0;
+        if fits(guess) {
+            hi = guess;
+            loop {
+                let c = hi - step;
+                if c < x_min {
+                    lo = x_min - 1.0;
+                    break;
+                }
+                if fits(c) {
+                    hi = c;
+                    step *= 2.0;
+                } else {
+                    lo = c;
+                    break;
+                }
+            }
+        } else {
+            lo = guess;
+            loop {
+                let c = lo + step;
+                if c >= MAX_DRAW {
+                    if !fits(MAX_DRAW) {
+                        return MAX_DRAW;
+                    }
+                    hi = MAX_DRAW;
+                    break;
+                }
+                if fits(c) {
+                    hi = c;
+                    break;
+                }
+                lo = c;
+                step *= 2.0;
+            }
+        }
+        while hi - lo > 1.0 {
+            let mid = lo + ((hi - lo) * 0.5).floor();
+            if mid <= lo || mid >= hi {
+                break; // no integer between them in f64 (not below 2^53)
+            }
+            if fits(mid) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        hi
+    }
+}
+
+/// Clauset et al. sec. 4.1: the fraction of `sets` synthetic data sets, each refitted
+/// from scratch, whose Kolmogorov–Smirnov distance is at least the data's.
+fn goodness_of_fit(
+    xs: &[f64],
+    support: Support,
+    min_tail: usize,
+    fit: &TailFit,
+    sets: usize,
+    seed: u64,
+    scratch: &mut Scratch,
+) -> f64 {
+    let n = xs.len();
+    let below = &xs[..fit.start];
+    let p_tail = fit.tail as f64 / n as f64;
+    let law = match support {
+        Support::Discrete => Some(DiscreteLaw::new(fit.alpha, fit.x_min)),
+        Support::Continuous => None,
+    };
+    let exponent = -1.0 / (fit.alpha - 1.0);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let mut synthetic = std::mem::take(&mut scratch.synthetic);
+    let mut exceed = 0usize;
+    for _ in 0..sets {
+        synthetic.clear();
+        for _ in 0..n {
+            let r: f64 = rng.random();
+            // `below` is empty only when p_tail is 1, and r < 1.
+            let x = if r < p_tail || below.is_empty() {
+                let u = 1.0 - rng.random::<f64>(); // in (0, 1]
+                match &law {
+                    Some(law) => law.draw(u),
+                    None => {
+                        let x = fit.x_min * (exponent * u.ln()).exp();
+                        if x.is_finite() {
+                            x
+                        } else {
+                            f64::MAX
+                        }
+                    }
+                }
+            } else {
+                below[rng.random_range(0..below.len())]
+            };
+            synthetic.push(x);
+        }
+        synthetic.sort_unstable_by(f64::total_cmp);
+        // One value only: a point mass, fitted perfectly in the limit α → ∞ (D = 0).
+        let ks = fit_sorted(&synthetic, support, min_tail, scratch).map_or(0.0, |f| f.ks);
+        if ks >= fit.ks {
+            exceed += 1;
+        }
+    }
+    scratch.synthetic = synthetic;
+    exceed as f64 / sets as f64
+}
+
+/// The percentile interval `(1 ∓ confidence) / 2` of `values` (sorted in place): the
+/// order statistics at or outside those ranks, so each end is a resampled value (an
+/// integer `x_min` for counts) and the interval is never narrower than the percentiles;
+/// `None` for no values.
+fn percentile_interval(values: &mut [f64], confidence: f64) -> Option<(f64, f64)> {
+    if values.is_empty() {
+        return None;
+    }
+    values.sort_unstable_by(f64::total_cmp);
+    let last = values.len() - 1;
+    let rank = |p: f64| last as f64 * p;
+    let low = rank(0.5 * (1.0 - confidence)).floor() as usize;
+    let high = (rank(0.5 * (1.0 + confidence)).ceil() as usize).min(last);
+    Some((values[low], values[high]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand_distr::{Distribution, Exp, Pareto, Zeta};
+    use std::f64::consts::PI;
+
+    fn rng(seed: u64) -> Xoshiro256PlusPlus {
+        Xoshiro256PlusPlus::seed_from_u64(seed)
+    }
+
+    fn pareto(alpha: f64, x_min: f64, n: usize, seed: u64) -> Vec<f64> {
+        let law = Pareto::new(x_min, alpha - 1.0).unwrap();
+        let mut r = rng(seed);
+        (0..n).map(|_| law.sample(&mut r)).collect()
+    }
+
+    fn zeta_samples(alpha: f64, n: usize, seed: u64) -> Vec<f64> {
+        let law = Zeta::new(alpha).unwrap();
+        let mut r = rng(seed);
+        (0..n).map(|_| law.sample(&mut r)).collect()
+    }
+
+    fn close(a: f64, b: f64, rel: f64) -> bool {
+        (a - b).abs() <= rel * b.abs()
+    }
+
+    #[test]
+    fn hurwitz_zeta_matches_independent_values() {
+        let pi2 = PI * PI / 6.0;
+        for (s, q, expected) in [
+            (2.0, 1.0, pi2),
+            (3.0, 1.0, 1.202_056_903_159_594_2),
+            (2.0, 2.0, pi2 - 1.0),
+            (1.5, 1.0, 2.612_375_348_685_488),
+            (4.0, 1.0, PI.powi(4) / 90.0),
+            // mpmath.zeta(2.5, 7.3) at 50 digits.
+            (2.5, 7.3, 0.037_470_518_158_700_956),
+        ] {
+            let z = hurwitz_zeta(s, q);
+            assert!(
+                close(z, expected, 2e-15),
+                "zeta({s}, {q}) = {z}, expected {expected}"
+            );
+        }
+        // A brute-force sum for a non-integer s and q = 7, with the rest as the midpoint
+        // integral ∫_{K+q-1/2}^∞ x^(-s) dx (error ~ s(s+1)/24 · K^(-s-1)).
+        let (s, q) = (1.7, 7.0);
+        let k_max = 2_000_000;
+        let direct: f64 = (0..k_max).rev().map(|k| (k as f64 + q).powf(-s)).sum();
+        let rest = (k_max as f64 + q - 0.5).powf(1.0 - s) / (s - 1.0);
+        let brute = direct + rest;
+        let z = hurwitz_zeta(s, q);
+        assert!(
+            close(z, brute, 1e-11),
+            "zeta({s}, {q}) = {z}, brute force {brute}"
+        );
+        assert!(close(z, 0.384_907_255_874_874_57, 2e-15)); // mpmath
+                                                            // Large q, where only the Euler–Maclaurin tail is used; and q just above and
+                                                            // below EM_START (same function, two paths).
+        assert!(close(
+            hurwitz_zeta(2.0, 1e6),
+            1.000_000_500_000_166_6e-6,
+            1e-14
+        ));
+        let (below, above) = (hurwitz_zeta(3.3, 19.5), hurwitz_zeta(3.3, 20.5));
+        assert!(close(below - above, 19.5f64.powf(-3.3), 1e-12));
+    }
+
+    #[test]
+    fn zeta_derivatives_match_independent_values() {
+        // mpmath.zeta(s, q, 1) and mpmath.zeta(s, q, 2) at 50 digits.
+        for (s, q, z1, z2) in [
+            (2.0, 1.0, -0.937_548_254_315_843_8, 1.989_280_234_298_901),
+            (
+                2.5,
+                7.3,
+                -0.096_942_000_493_160_39,
+                0.267_391_345_710_090_93,
+            ),
+            (1.5, 1.0, -3.932_239_737_431_101_6, 15.989_556_371_225_687),
+            (3.0, 2.0, -0.198_126_242_885_636_85, 0.239_746_917_305_387_2),
+            (
+                19.5,
+                1.0,
+                -9.353_953_082_461_458e-7,
+                6.485_896_800_551_832e-7,
+            ),
+            (1.05, 3.0, -399.592_903_170_232_94, 15_999.758_166_324_926),
+        ] {
+            let (z, d1, d2) = hurwitz_zeta_derivatives(s, q);
+            assert!(close(z, hurwitz_zeta(s, q), 1e-14), "zeta({s}, {q})");
+            assert!(
+                close(d1, z1, 1e-13),
+                "zeta'({s}, {q}) = {d1}, expected {z1}"
+            );
+            assert!(
+                close(d2, z2, 1e-13),
+                "zeta''({s}, {q}) = {d2}, expected {z2}"
+            );
+        }
+    }
+
+    #[test]
+    fn discrete_mle_maximises_the_likelihood() {
+        // The likelihood on a fine grid, written out directly, peaks where the fit says.
+        let xs = {
+            let mut v = zeta_samples(2.3, 3000, 5);
+            v.sort_unstable_by(f64::total_cmp);
+            v
+        };
+        for x_min in [1.0, 2.0, 4.0] {
+            let tail: Vec<f64> = xs.iter().copied().filter(|&x| x >= x_min).collect();
+            let n = tail.len() as f64;
+            let sum_ln: f64 = tail.iter().map(|x| x.ln()).sum();
+            let log_l = |a: f64| -n * hurwitz_zeta(a, x_min).ln() - a * sum_ln;
+            let alpha = discrete_mle(x_min, sum_ln / n);
+            let (mut best, mut best_l) = (1.0, f64::NEG_INFINITY);
+            for i in 1..=19_000 {
+                let a = 1.0 + i as f64 * 1e-3;
+                let l = log_l(a);
+                if l > best_l {
+                    (best, best_l) = (a, l);
+                }
+            }
+            assert!(
+                (alpha - best).abs() <= 1e-3,
+                "x_min {x_min}: {alpha} vs grid {best}"
+            );
+            assert!(log_l(alpha) >= best_l - 1e-9);
+            assert!(log_l(alpha) >= log_l(alpha + 1e-5) && log_l(alpha) >= log_l(alpha - 1e-5));
+        }
+        // Every tail sample at x_min: the likelihood rises up to the cap.
+        assert_eq!(discrete_mle(3.0, 3f64.ln()), ALPHA_MAX);
+    }
+
+    #[test]
+    fn discrete_sampler_matches_rand_distr_zeta() {
+        // The goodness-of-fit sampler at x_min = 1 against rand_distr's Zeta (an
+        // independent rejection sampler): the frequencies of 1..=5, 6..=20 and > 20 agree
+        // within 5 standard deviations.
+        let n = 200_000;
+        for alpha in [1.7, 2.5] {
+            let law = DiscreteLaw::new(alpha, 1.0);
+            let mut r = rng(11);
+            let ours: Vec<f64> = (0..n).map(|_| law.draw(1.0 - r.random::<f64>())).collect();
+            let theirs = zeta_samples(alpha, n, 12);
+            let classes = |v: &[f64]| {
+                let mut c = [0usize; 7];
+                for &x in v {
+                    assert!(x >= 1.0 && x.fract() == 0.0);
+                    let i = if x <= 5.0 {
+                        x as usize - 1
+                    } else if x <= 20.0 {
+                        5
+                    } else {
+                        6
+                    };
+                    c[i] += 1;
+                }
+                c
+            };
+            let (a, b) = (classes(&ours), classes(&theirs));
+            for i in 0..7 {
+                let (pa, pb) = (a[i] as f64 / n as f64, b[i] as f64 / n as f64);
+                let sigma = ((pa * (1.0 - pa) + pb * (1.0 - pb)) / n as f64).sqrt();
+                assert!(
+                    (pa - pb).abs() < 5.0 * sigma,
+                    "alpha {alpha}, class {i}: {pa} vs {pb}"
+                );
+            }
+        }
+        // Far in the tail (beyond the table) the draw inverts the survival function.
+        let law = DiscreteLaw::new(2.0, 3.0);
+        for u in [0.5, 1e-3, 1e-6, 1e-9] {
+            let x = law.draw(u);
+            assert!(
+                law.survival(x + 1.0) <= u && (x == 3.0 || law.survival(x) > u),
+                "{u}"
+            );
+        }
+        assert_eq!(law.draw(1.0), 3.0);
+    }
+
+    #[test]
+    fn continuous_fits_cover_the_true_exponent() {
+        let options = PowerLawOptions::default()
+            .confidence(0.9)
+            .bootstrap(50)
+            .goodness_samples(0);
+        let (sets, mut covered) = (40usize, 0);
+        for seed in 0..sets {
+            let xs = pareto(2.5, 1.0, 2000, 100 + seed as u64);
+            let fit = fit_power_law(&xs, Support::Continuous, &options).unwrap();
+            assert!(
+                (fit.alpha - 2.5).abs() < 4.0 * fit.alpha_std_error,
+                "seed {seed}: {fit:?}"
+            );
+            assert!(fit.p_value.is_none() && fit.samples == 2000);
+            assert!(fit.alpha_low <= fit.alpha_high && fit.x_min_low <= fit.x_min_high);
+            covered += usize::from(fit.alpha_low <= 2.5 && 2.5 <= fit.alpha_high);
+        }
+        assert!(
+            covered >= 30,
+            "{covered} of {sets} intervals hold alpha = 2.5"
+        );
+    }
+
+    #[test]
+    fn discrete_fits_cover_the_true_exponent() {
+        let options = PowerLawOptions::default()
+            .confidence(0.9)
+            .bootstrap(50)
+            .goodness_samples(0);
+        for alpha in [2.0, 2.7] {
+            let (sets, mut covered, mut small_x_min) = (40usize, 0, 0);
+            for seed in 0..sets {
+                let xs = zeta_samples(alpha, 2000, 200 + seed as u64);
+                let fit = fit_power_law(&xs, Support::Discrete, &options).unwrap();
+                assert!(
+                    (fit.alpha - alpha).abs() < 4.0 * fit.alpha_std_error,
+                    "alpha {alpha}, seed {seed}: {fit:?}"
+                );
+                covered += usize::from(fit.alpha_low <= alpha && alpha <= fit.alpha_high);
+                small_x_min += usize::from(fit.x_min <= 3.0);
+            }
+            assert!(
+                covered * 4 >= sets * 3,
+                "alpha {alpha}: {covered} of {sets} cover"
+            );
+            assert!(
+                small_x_min * 10 >= sets * 8,
+                "alpha {alpha}: x_min <= 3 in {small_x_min}"
+            );
+        }
+    }
+
+    /// Clauset's test has little power when the tail may shrink to a few dozen samples
+    /// (the far tail of an exponential is locally a steep power law), so both kinds of
+    /// data are tested for a power law over at least a quarter of the samples.
+    #[test]
+    fn goodness_of_fit_accepts_power_laws_and_rejects_exponentials() {
+        let options = PowerLawOptions::default()
+            .bootstrap(0)
+            .goodness_samples(50)
+            .min_tail(500);
+        let exp = Exp::new(1.0f64).unwrap();
+        let sets = 20;
+        let (mut accepted, mut rejected) = ([0usize; 2], [0usize; 2]);
+        for seed in 0..sets {
+            let mut r = rng(300 + seed);
+            let power = [
+                (pareto(2.5, 1.0, 2000, 400 + seed), Support::Continuous),
+                (zeta_samples(2.0, 2000, 500 + seed), Support::Discrete),
+            ];
+            let exponential = [
+                // Force drops of 1 mN on average; sizes of 10 ruptures on average.
+                (
+                    (0..2000)
+                        .map(|_| 1e-3 * exp.sample(&mut r))
+                        .collect::<Vec<_>>(),
+                    Support::Continuous,
+                ),
+                (
+                    (0..2000)
+                        .map(|_| (10.0 * exp.sample(&mut r)).ceil())
+                        .collect(),
+                    Support::Discrete,
+                ),
+            ];
+            for (i, (xs, support)) in power.iter().enumerate() {
+                let p = fit_power_law(xs, *support, &options)
+                    .unwrap()
+                    .p_value
+                    .unwrap();
+                assert!((0.0..=1.0).contains(&p));
+                accepted[i] += usize::from(p > 0.05);
+            }
+            for (i, (xs, support)) in exponential.iter().enumerate() {
+                let p = fit_power_law(xs, *support, &options)
+                    .unwrap()
+                    .p_value
+                    .unwrap();
+                rejected[i] += usize::from(p < 0.1);
+            }
+        }
+        for i in 0..2 {
+            assert!(
+                accepted[i] >= 16,
+                "power laws accepted: {accepted:?} of {sets}"
+            );
+            assert!(
+                rejected[i] >= 16,
+                "exponentials rejected: {rejected:?} of {sets}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_start_of_a_power_law_tail_is_found_in_a_mixture() {
+        // A quarter of the samples uniform on [1, 10), the rest a power law (alpha 2.5)
+        // above 10.
+        let options = PowerLawOptions::default().bootstrap(0).goodness_samples(0);
+        let (sets, mut found) = (30, 0);
+        for seed in 0..sets {
+            let mut r = rng(600 + seed);
+            let mut xs = pareto(2.5, 10.0, 1500, 700 + seed);
+            xs.extend((0..500).map(|_| 1.0 + 9.0 * r.random::<f64>()));
+            let fit = fit_power_law(&xs, Support::Continuous, &options).unwrap();
+            found += usize::from((7.0..=14.0).contains(&fit.x_min));
+            assert!(fit.tail < 2000);
+        }
+        assert!(found >= 22, "x_min in [7, 14] in {found} of {sets} sets");
+    }
+
+    #[test]
+    fn the_search_minimises_an_independently_computed_ks_distance() {
+        // 100 samples: every candidate is tried (tails up to 100 are never thinned), so
+        // the search is exhaustive and can be redone by brute force.
+        let options = PowerLawOptions::default()
+            .bootstrap(0)
+            .goodness_samples(0)
+            .min_tail(5);
+        for seed in 0..4 {
+            // Continuous: D over both sides of each sample of the tail.
+            let mut xs = pareto(2.2, 1.0, 100, 800 + seed);
+            let fit = fit_power_law(&xs, Support::Continuous, &options).unwrap();
+            xs.sort_unstable_by(f64::total_cmp);
+            let brute = |x_min: f64| {
+                let tail: Vec<f64> = xs.iter().copied().filter(|&x| x >= x_min).collect();
+                let t = tail.len() as f64;
+                let alpha = 1.0 + t / tail.iter().map(|x| (x / x_min).ln()).sum::<f64>();
+                let d = tail
+                    .iter()
+                    .enumerate()
+                    .map(|(i, x)| {
+                        let p = 1.0 - (x / x_min).powf(1.0 - alpha);
+                        (i as f64 / t - p).abs().max(((i + 1) as f64 / t - p).abs())
+                    })
+                    .fold(0.0, f64::max);
+                (alpha, d)
+            };
+            let (alpha, d) = brute(fit.x_min);
+            assert!(close(fit.alpha, alpha, 1e-12) && (fit.ks_distance - d).abs() < 1e-12);
+            for &x in &xs[..xs.len() - 5] {
+                assert!(brute(x).1 >= d - 1e-12, "x_min {x} beats {}", fit.x_min);
+            }
+
+            // Discrete: D over every integer from x_min to the largest sample.
+            let mut ks = zeta_samples(2.2, 100, 900 + seed);
+            let fit = fit_power_law(&ks, Support::Discrete, &options).unwrap();
+            ks.sort_unstable_by(f64::total_cmp);
+            let brute = |x_min: f64, alpha: f64| {
+                let tail: Vec<f64> = ks.iter().copied().filter(|&x| x >= x_min).collect();
+                let t = tail.len() as f64;
+                let norm = hurwitz_zeta(alpha, x_min);
+                let (mut d, mut x, mut below) = (0.0f64, x_min, 0usize);
+                while x <= tail[tail.len() - 1] {
+                    below += tail.iter().filter(|&&y| y == x).count();
+                    let p = 1.0 - hurwitz_zeta(alpha, x + 1.0) / norm;
+                    d = d.max((below as f64 / t - p).abs());
+                    x += 1.0;
+                }
+                d
+            };
+            let d = brute(fit.x_min, fit.alpha);
+            assert!(
+                (fit.ks_distance - d).abs() < 1e-12,
+                "{} vs {d}",
+                fit.ks_distance
+            );
+            let mut values = ks.clone();
+            values.dedup();
+            for &x in &values {
+                let tail: Vec<f64> = ks.iter().copied().filter(|&y| y >= x).collect();
+                if tail.len() < 5 || tail[0] == tail[tail.len() - 1] {
+                    continue;
+                }
+                let m = tail.iter().map(|y| y.ln()).sum::<f64>() / tail.len() as f64;
+                assert!(brute(x, discrete_mle(x, m)) >= d - 1e-12, "x_min {x}");
+            }
+        }
+    }
+
+    #[test]
+    fn bad_inputs_give_typed_errors() {
+        let good = pareto(2.5, 1.0, 50, 1);
+        let options = PowerLawOptions::default().bootstrap(0).goodness_samples(0);
+        let fit = |xs: &[f64], support, o: &PowerLawOptions| fit_power_law(xs, support, o);
+        let mut bad = good.clone();
+        bad[7] = f64::NAN;
+        let e = fit(&bad, Support::Continuous, &options).unwrap_err();
+        assert!(
+            matches!(e, Error::InvalidParameter { name: "samples", value, .. } if value.is_nan())
+        );
+        bad[7] = f64::NEG_INFINITY;
+        let e = log_binned(&bad, Support::Continuous, 5).unwrap_err();
+        assert!(
+            matches!(e, Error::InvalidParameter { name: "samples", value, .. } if value == f64::NEG_INFINITY)
+        );
+        let e = fit(
+            &[1.0, 2.0, 2.5, 3.0],
+            Support::Discrete,
+            &options.clone().min_tail(2),
+        );
+        assert!(matches!(
+            e,
+            Err(Error::InvalidParameter {
+                name: "samples",
+                value: 2.5,
+                ..
+            })
+        ));
+        let e = log_binned(&[1.0, 2.5], Support::Discrete, 5).unwrap_err();
+        assert!(matches!(
+            e,
+            Error::InvalidParameter {
+                name: "samples",
+                value: 2.5,
+                ..
+            }
+        ));
+        // 9 positive samples (the zero and the negative one do not count) for min_tail 10.
+        let few = [0.0, -1.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0];
+        let e = fit(&few, Support::Discrete, &options).unwrap_err();
+        assert!(matches!(
+            e,
+            Error::TooFewSamples {
+                what: "power-law fit",
+                count: 9,
+                needed: 10
+            }
+        ));
+        assert!(fit(&few, Support::Discrete, &options.clone().min_tail(9)).is_ok());
+        for c in [0.0, 1.0, f64::NAN, -0.5, 1.5] {
+            let e = fit(&good, Support::Continuous, &options.clone().confidence(c)).unwrap_err();
+            assert!(
+                matches!(
+                    e,
+                    Error::InvalidParameter {
+                        name: "confidence",
+                        ..
+                    }
+                ),
+                "{c}"
+            );
+        }
+        for m in [0, 1] {
+            let e = fit(&good, Support::Continuous, &options.clone().min_tail(m)).unwrap_err();
+            assert!(
+                matches!(e, Error::InvalidCount { name: "min_tail", value, .. } if value == m as u64)
+            );
+        }
+        let e = fit(&[3.0; 20], Support::Discrete, &options).unwrap_err();
+        assert!(matches!(
+            e,
+            Error::InvalidParameter {
+                name: "samples",
+                value: 3.0,
+                ..
+            }
+        ));
+        let e = log_binned(&good, Support::Continuous, 0).unwrap_err();
+        assert!(matches!(
+            e,
+            Error::InvalidCount {
+                name: "bins_per_decade",
+                value: 0,
+                ..
+            }
+        ));
+        let e = log_binned(&[1e-300, 1e300], Support::Continuous, 10_000).unwrap_err();
+        assert!(matches!(
+            e,
+            Error::InvalidCount {
+                name: "bins_per_decade",
+                value: 10_000,
+                ..
+            }
+        ));
+        assert_eq!(log_binned(&[0.0, -2.0], Support::Discrete, 3).unwrap(), []);
+        let e = log_binned(&[1.0, 2.0], Support::Continuous, 2_000_000).unwrap_err();
+        assert!(matches!(
+            e,
+            Error::InvalidCount {
+                name: "bins_per_decade",
+                ..
+            }
+        ));
+        let huge = [1.0, 2.0, 3.0, 1e16];
+        let e = fit(&huge, Support::Discrete, &options.clone().min_tail(2)).unwrap_err();
+        assert!(
+            matches!(e, Error::InvalidParameter { name: "samples", value, .. } if value == 1e16)
+        );
+    }
+
+    #[test]
+    fn extreme_samples_give_finite_results_or_errors() {
+        let options = PowerLawOptions::default()
+            .bootstrap(10)
+            .goodness_samples(10)
+            .min_tail(2);
+        let finite = |f: &PowerLawFit| {
+            [
+                f.x_min,
+                f.alpha,
+                f.alpha_std_error,
+                f.alpha_low,
+                f.alpha_high,
+            ]
+            .iter()
+            .chain(&[f.x_min_low, f.x_min_high, f.ks_distance, f.p_value.unwrap()])
+            .all(|v| v.is_finite())
+        };
+        // Integers near 2^53, a steep law on them, and a heavy one (draws capped at 2^53).
+        let big = 9_007_199_254_740_000.0;
+        for xs in [
+            vec![big, big, big + 1.0, big + 2.0, big + 900.0],
+            vec![1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 2.0],
+            vec![1.0, 1e3, 1e6, 1e9, 1e12, 1e15],
+        ] {
+            let fit = fit_power_law(&xs, Support::Discrete, &options).unwrap();
+            assert!(finite(&fit), "{fit:?}");
+            let fit = fit_power_law(&xs, Support::Continuous, &options).unwrap();
+            assert!(finite(&fit), "{fit:?}");
+        }
+        // Continuous samples over the whole float range, and adjacent floats whose
+        // logarithms are equal (no exponent: an error, not a NaN).
+        let wide = [5e-324, 1e-300, 1e-100, 1.0, 1e100, 1e300, f64::MAX];
+        let fit = fit_power_law(&wide, Support::Continuous, &options).unwrap();
+        assert!(finite(&fit), "{fit:?}");
+        let x = 1e300f64;
+        let close_pair = [x, x, x.next_up(), x.next_up()];
+        let e = fit_power_law(&close_pair, Support::Continuous, &options).unwrap_err();
+        assert!(matches!(
+            e,
+            Error::InvalidParameter {
+                name: "samples",
+                ..
+            }
+        ));
+        for support in [Support::Continuous, Support::Discrete] {
+            for per_decade in [1, 7, 1000] {
+                let xs: &[f64] = match support {
+                    Support::Continuous => &wide,
+                    Support::Discrete => &[1.0, 2.0, 9e15],
+                };
+                let bins = log_binned(xs, support, per_decade).unwrap();
+                assert_eq!(bins.iter().map(|b| b.count).sum::<usize>(), xs.len());
+                assert!(bins.iter().all(|b| [b.low, b.high, b.center, b.density]
+                    .iter()
+                    .all(|v| v.is_finite())));
+            }
+        }
+    }
+
+    #[test]
+    fn results_depend_on_the_samples_not_their_order() {
+        let options = PowerLawOptions::default()
+            .bootstrap(30)
+            .goodness_samples(30)
+            .seed(3);
+        let mut r = rng(17);
+        for support in [Support::Continuous, Support::Discrete] {
+            let mut xs = match support {
+                Support::Continuous => pareto(2.2, 0.5, 800, 18),
+                Support::Discrete => zeta_samples(2.2, 800, 19),
+            };
+            xs.extend([0.0, -1.0, 0.0]); // dropped
+            let fit = fit_power_law(&xs, support, &options).unwrap();
+            assert_eq!(fit.samples, 800);
+            for _ in 0..3 {
+                for i in (1..xs.len()).rev() {
+                    xs.swap(i, r.random_range(0..=i));
+                }
+                let again = fit_power_law(&xs, support, &options).unwrap();
+                // Debug prints the shortest round-tripping decimal: equal text, equal bits.
+                assert_eq!(format!("{again:?}"), format!("{fit:?}"));
+                assert_eq!(again.alpha_low.to_bits(), fit.alpha_low.to_bits());
+            }
+            // Another seed, another bootstrap: the seed is used.
+            let other = fit_power_law(&xs, support, &options.clone().seed(4)).unwrap();
+            assert_eq!(other.alpha.to_bits(), fit.alpha.to_bits());
+            assert_ne!(
+                (other.alpha_low, other.alpha_high),
+                (fit.alpha_low, fit.alpha_high)
+            );
+        }
+    }
+
+    #[test]
+    fn log_bins_count_every_sample_and_follow_the_slope() {
+        // Zeta(2) sizes: P(k) ∝ k^-2, the binned densities fall with slope -2.
+        let mut xs = zeta_samples(2.0, 100_000, 21);
+        xs.extend([0.0, 0.0]); // dropped
+        let n = 100_000.0;
+        let bins = log_binned(&xs, Support::Discrete, 5).unwrap();
+        assert_eq!(bins.iter().map(|b| b.count).sum::<usize>(), 100_000);
+        let mass: f64 = bins.iter().map(|b| b.density * (b.high - b.low) * n).sum();
+        assert!(close(mass, n, 1e-12), "{mass}");
+        for pair in bins.windows(2) {
+            let (a, b) = (&pair[0], &pair[1]);
+            assert!(a.low.fract() == 0.0 && a.high.fract() == 0.0 && a.low < a.high);
+            assert!(a.high <= b.low, "overlap: {a:?} {b:?}");
+        }
+        assert_eq!(bins[0].low, 1.0);
+        let largest = xs.iter().copied().fold(0.0, f64::max);
+        let last = &bins[bins.len() - 1];
+        assert!(last.low <= largest && largest < last.high && last.count >= 1);
+        // Least-squares slope of ln P against ln center over well-filled bins (100 samples
+        // or more) from 10 up: in narrower bins the centre misplaces the density (the mass
+        // of [1, 2) sits at 1, not at √2), which steepens the expected slope to -2.11 with
+        // them, -2.03 without.
+        let points: Vec<(f64, f64)> = bins
+            .iter()
+            .filter(|b| b.count >= 100 && b.low >= 10.0)
+            .map(|b| (b.center.ln(), b.density.ln()))
+            .collect();
+        assert!(points.len() >= 6, "{} well-filled bins", points.len());
+        let m = points.len() as f64;
+        let (mx, my) = points
+            .iter()
+            .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / m, b + y / m));
+        let sxy: f64 = points.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
+        let sxx: f64 = points.iter().map(|(x, _)| (x - mx) * (x - mx)).sum();
+        let slope = sxy / sxx;
+        assert!((slope + 2.0).abs() < 0.1, "slope {slope}");
+
+        // Continuous: edges x0 · 10^(k/b) from the smallest sample, empty bins listed.
+        let drops = [2e-3, 3e-3, 2.5, 0.0];
+        let bins = log_binned(&drops, Support::Continuous, 1).unwrap();
+        let counts: Vec<usize> = bins.iter().map(|b| b.count).collect();
+        assert_eq!(counts, [2, 0, 0, 1]);
+        assert!(close(bins[1].low, 2e-2, 1e-15) && close(bins[3].high, 20.0, 1e-15));
+        assert_eq!((bins[1].density, bins[2].density), (0.0, 0.0));
+        assert!(close(bins[0].center, 2e-3 * 10f64.sqrt(), 1e-15));
+        let mass: f64 = bins
+            .iter()
+            .map(|b| b.density * (b.high - b.low) * 3.0)
+            .sum();
+        assert!(close(mass, 3.0, 1e-12));
+        // Discrete bins of no integer are left out: 1, 1.26, 1.58, 2.00, 2.51, 3.16, 3.98,
+        // 5.01, 6.31, 7.94, 10 round up to 1, 2, 2, 2, 3, 4, 4, 6, 7, 8, 10.
+        let bins = log_binned(&[1.0, 2.0, 3.0, 9.0], Support::Discrete, 10).unwrap();
+        let lows: Vec<f64> = bins.iter().map(|b| b.low).collect();
+        assert_eq!(lows, [1.0, 2.0, 3.0, 4.0, 6.0, 7.0, 8.0]);
+        assert_eq!(bins[bins.len() - 1].high, 10.0);
+    }
+}

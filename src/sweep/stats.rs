@@ -1,0 +1,319 @@
+//! The statistics of avalanches, stress drops and front leaps over the realizations of a
+//! run or a sweep (`precursors stats DIR`; docs/statistics.md): log-binned distributions
+//! and maximum-likelihood power-law fits (`crate::statistics`), pooled per parameter
+//! point. Every sample is derived from the checked `events.csv` and `curve.csv` of each
+//! complete run (`RunRecord`), never from the derived tables a run leaves beside them.
+
+use super::merge::{cell, checked_record, num, read_sweep};
+use super::{SweepError, DONE_FILE, SWEEP_FILE};
+use crate::error::{Error, Result};
+use crate::files::write_atomically;
+use crate::output::check::RunRecord;
+use crate::output::derived::derive;
+use crate::output::layout::{DISTRIBUTIONS, POWER_LAWS};
+use crate::statistics::{fit_power_law, log_binned, PowerLawFit, PowerLawOptions, Support};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Options of [`statistics`]: the power-law fits' and the bins of the distributions.
+/// Setters never fail; [`statistics`] checks the values.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct StatsOptions {
+    /// The options of every power-law fit.
+    pub fit: PowerLawOptions,
+    /// Bins per decade of the log-binned distributions (default 5).
+    pub bins_per_decade: usize,
+}
+
+impl Default for StatsOptions {
+    fn default() -> Self {
+        Self {
+            fit: PowerLawOptions::default(),
+            bins_per_decade: 5,
+        }
+    }
+}
+
+impl StatsOptions {
+    /// The options of the power-law fits.
+    pub fn fit(mut self, fit: PowerLawOptions) -> Self {
+        self.fit = fit;
+        self
+    }
+
+    /// Bins per decade of the distributions.
+    pub fn bins_per_decade(mut self, bins: usize) -> Self {
+        self.bins_per_decade = bins;
+        self
+    }
+}
+
+/// What [`statistics`] wrote.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct StatsSummary {
+    /// Parameter points (1 for a run directory).
+    pub points: usize,
+    /// Complete runs whose samples were pooled.
+    pub runs: usize,
+    /// Runs left out: not complete (no completion marker).
+    pub runs_missing: usize,
+    /// The files written: `power_laws.csv`, `distributions.csv`.
+    pub files: Vec<PathBuf>,
+}
+
+/// The observables [`statistics`] pools and fits, in the order of its tables: the name
+/// (the `observable` column), whether the samples are counts, and what they are
+/// (docs/statistics.md has the list).
+pub(crate) const OBSERVABLES: [(&str, Support, &str); 7] = [
+    (
+        "avalanche_ruptures",
+        Support::Discrete,
+        "ruptures of each avalanche before global slip",
+    ),
+    (
+        "force_drop_N",
+        Support::Continuous,
+        "drop of the shear force over each avalanche before global slip (N): a driving \
+         spring's stress drops; none under force control",
+    ),
+    (
+        "energy_J",
+        Support::Continuous,
+        "elastic energy ½ k_x u_x² ΔA of the springs broken in each avalanche before global \
+         slip, summed (J)",
+    ),
+    (
+        "precursor_leap_cells",
+        Support::Discrete,
+        "each advance of ℓ from one stable state to the next, in cells Δx",
+    ),
+    (
+        "damage_front_leap_cells",
+        Support::Discrete,
+        "each advance of the damage front from one stable state to the next, in cells Δx",
+    ),
+    (
+        "load_between_precursor_leaps",
+        Support::Continuous,
+        "the increase of F/(μF_N) between two advances of ℓ",
+    ),
+    (
+        "load_between_front_leaps",
+        Support::Continuous,
+        "the increase of F/(μF_N) between two advances of the damage front",
+    ),
+];
+
+/// The samples of each of [`OBSERVABLES`] in one complete run.
+///
+/// # Errors
+/// [`Error::CorruptTable`] when its events are not the whole run of its grid.
+fn samples(record: &RunRecord, dir: &Path) -> Result<[Vec<f64>; 7]> {
+    let derived = derive(&record.grid, &record.events).map_err(|e| Error::CorruptTable {
+        path: Some(dir.join(crate::output::TABLE_NAMES[0])),
+        reason: format!("not the whole run of its scene: {e}"),
+    })?;
+    let mut out: [Vec<f64>; 7] = Default::default();
+    for a in derived.avalanches.iter().filter(|a| !a.global_slip) {
+        out[0].push(a.ruptures as f64);
+        out[1].push(a.force_drop());
+        out[2].push(a.energy);
+    }
+    let nx = record.bounds.nx as f64;
+    let loads: Vec<f64> = record.curve.iter().map(|c| c.load).collect();
+    let ell: Vec<f64> = record
+        .curve
+        .iter()
+        .map(|c| (c.precursor_over_lx * nx).round())
+        .collect();
+    let front: Vec<f64> = derived
+        .fronts
+        .iter()
+        .map(|x| (x / record.grid.dx()).round())
+        .collect();
+    for (k, cells) in [(3, &ell), (4, &front)] {
+        let mut last_leap: Option<f64> = None;
+        for s in 1..cells.len().min(loads.len()) {
+            let step = cells[s] - cells[s - 1];
+            if step > 0.0 {
+                out[k].push(step);
+                if let Some(at) = last_leap {
+                    out[k + 2].push(loads[s] - at);
+                }
+                last_leap = Some(loads[s]);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The run directories of `dir` grouped by parameter point, with the point's axis values
+/// (`None` for a run directory: one point, its own run), and the runs not complete.
+type Points = Vec<(Vec<(String, String)>, Vec<(PathBuf, RunRecord)>)>;
+
+/// The complete runs of `dir` per point: a sweep's (those with their completion marker,
+/// checked against the sweep's scenes), or the run in a run directory.
+fn points(dir: &Path) -> Result<(Vec<String>, Points, usize), SweepError> {
+    if !dir.join(SWEEP_FILE).is_file() {
+        if !dir.join(crate::output::SCENE_RECORD).is_file() {
+            return Err(SweepError::Directory {
+                path: dir.to_path_buf(),
+                reason: format!(
+                    "neither a run directory (no {}) nor a sweep's (no {SWEEP_FILE})",
+                    crate::output::SCENE_RECORD
+                ),
+            });
+        }
+        let record = RunRecord::read(dir)?;
+        return Ok((
+            Vec::new(),
+            vec![(Vec::new(), vec![(dir.to_path_buf(), record)])],
+            0,
+        ));
+    }
+    let sweep = read_sweep(dir)?;
+    let keys = sweep.keys().iter().map(|k| k.to_string()).collect();
+    let mut out = Vec::new();
+    let mut missing = 0;
+    for point in 0..sweep.points() {
+        let runs: Vec<_> = sweep.runs().iter().filter(|r| r.point == point).collect();
+        let Some(first) = runs.first() else { continue };
+        let mut records = Vec::new();
+        for run in &runs {
+            let run_dir = dir.join(&run.dir_name);
+            if run_dir.join(DONE_FILE).is_file() {
+                let record = checked_record(&run_dir, run)?;
+                records.push((run_dir, record));
+            } else {
+                missing += 1;
+            }
+        }
+        out.push((first.values.clone(), records));
+    }
+    Ok((keys, out, missing))
+}
+
+/// Pools, over the complete runs of each parameter point of the run or sweep directory
+/// `dir`, the samples of seven observables (each derived from the run's checked
+/// `events.csv` and `curve.csv`; docs/statistics.md defines them):
+/// `avalanche_ruptures` (counts), `force_drop_N`, `energy_J` (of each avalanche before
+/// global slip), `precursor_leap_cells`, `damage_front_leap_cells` (counts: the advances
+/// of ℓ and of the damage front from one stable state to the next, in cells),
+/// `load_between_precursor_leaps` and `load_between_front_leaps` (the increase of
+/// `F/(μF_N)` between two advances); and writes into `dir`:
+///
+/// * `power_laws.csv`: per point and observable, the maximum-likelihood power-law fit
+///   ([`fit_power_law`]: `x_min` by the Kolmogorov-Smirnov distance, the exponent with
+///   its bootstrap interval, the goodness-of-fit p-value), header `point,<axis
+///   keys>,observable,support,samples,tail,x_min,alpha,alpha_std_error,alpha_low,
+///   alpha_high,x_min_low,x_min_high,ks_distance,p_value,confidence`; the fit's cells are
+///   empty where the samples are too few (fewer than `min_tail` positive ones);
+/// * `distributions.csv`: per point and observable, the log-binned density
+///   ([`log_binned`]), header `point,<axis keys>,observable,bin_low,bin_high,
+///   bin_center,count,density`.
+///
+/// Both are written atomically. Runs of a sweep without their completion marker are left
+/// out and counted.
+///
+/// # Errors
+/// [`SweepError::Directory`] for a directory that is neither a run's nor a sweep's;
+/// as [`super::merge`] for the runs' tables; in [`SweepError::Core`]:
+/// [`Error::InvalidParameter`]/[`Error::InvalidCount`] for bad options.
+pub fn statistics(dir: &Path, options: &StatsOptions) -> Result<StatsSummary, SweepError> {
+    if options.bins_per_decade == 0 {
+        return Err(Error::InvalidCount {
+            name: "bins_per_decade",
+            value: 0,
+            reason: "the distributions need at least one bin per decade",
+        }
+        .into());
+    }
+    let (keys, points, missing) = points(dir)?;
+    let key_header: String = keys.iter().map(|k| format!("{},", cell(k))).collect();
+    let mut fits = format!(
+        "point,{key_header}observable,support,samples,tail,x_min,alpha,alpha_std_error,\
+         alpha_low,alpha_high,x_min_low,x_min_high,ks_distance,p_value,confidence\n"
+    );
+    let mut bins =
+        format!("point,{key_header}observable,bin_low,bin_high,bin_center,count,density\n");
+    let mut runs = 0;
+    for (point, (values, records)) in points.iter().enumerate() {
+        let values: String = values
+            .iter()
+            .map(|(_, v)| format!("{},", cell(v)))
+            .collect();
+        let mut pooled: [Vec<f64>; 7] = Default::default();
+        for (run_dir, record) in records {
+            for (all, s) in pooled.iter_mut().zip(samples(record, run_dir)?) {
+                all.extend(s);
+            }
+        }
+        runs += records.len();
+        for ((name, support, _), x) in OBSERVABLES.iter().zip(&pooled) {
+            let positive = x.iter().filter(|v| **v > 0.0).count();
+            let fit = if positive >= options.fit.min_tail {
+                Some(fit_power_law(x, *support, &options.fit)?)
+            } else {
+                // Checked all the same: bad options are an error whatever the samples.
+                match fit_power_law(x, *support, &options.fit) {
+                    Err(Error::TooFewSamples { .. }) | Ok(_) => None,
+                    Err(e) => return Err(e.into()),
+                }
+            };
+            let support_name = match support {
+                Support::Discrete => "discrete",
+                _ => "continuous",
+            };
+            let _ = writeln!(
+                fits,
+                "{point},{values}{name},{support_name},{positive},{}",
+                fit_cells(fit.as_ref(), options.fit.confidence)
+            );
+            if positive > 0 {
+                for b in log_binned(x, *support, options.bins_per_decade)? {
+                    let _ = writeln!(
+                        bins,
+                        "{point},{values}{name},{},{},{},{},{}",
+                        num(b.low),
+                        num(b.high),
+                        num(b.center),
+                        b.count,
+                        num(b.density)
+                    );
+                }
+            }
+        }
+    }
+    let files = vec![dir.join(POWER_LAWS), dir.join(DISTRIBUTIONS)];
+    write_atomically(&files[0], fits.as_bytes(), "writing table")?;
+    write_atomically(&files[1], bins.as_bytes(), "writing table")?;
+    Ok(StatsSummary {
+        points: points.len(),
+        runs,
+        runs_missing: missing,
+        files,
+    })
+}
+
+/// The cells of a fit from `tail` on (empty without one).
+fn fit_cells(fit: Option<&PowerLawFit>, confidence: f64) -> String {
+    let Some(f) = fit else {
+        return ",,,,,,,,,,".to_string();
+    };
+    format!(
+        "{},{},{},{},{},{},{},{},{},{},{}",
+        f.tail,
+        num(f.x_min),
+        num(f.alpha),
+        num(f.alpha_std_error),
+        num(f.alpha_low),
+        num(f.alpha_high),
+        num(f.x_min_low),
+        num(f.x_min_high),
+        num(f.ks_distance),
+        f.p_value.map(num).unwrap_or_default(),
+        num(confidence),
+    )
+}
