@@ -24,6 +24,7 @@
 //! # Ok::<(), precursors::plot::PlotError>(())
 //! ```
 
+mod distributions;
 mod error;
 mod figures;
 mod movie;

@@ -190,7 +190,7 @@ impl PowerLawFit {
     /// # Ok::<(), precursors::Error>(())
     /// ```
     pub fn density(&self, x: f64) -> f64 {
-        if !(x >= self.x_min) || self.samples == 0 {
+        if x.is_nan() || x < self.x_min || self.samples == 0 {
             return 0.0;
         }
         let share = self.tail as f64 / self.samples as f64;

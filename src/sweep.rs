@@ -26,7 +26,7 @@
 
 mod error;
 mod merge;
-mod stats;
+pub(crate) mod stats;
 
 pub use error::SweepError;
 #[cfg(feature = "plot")]

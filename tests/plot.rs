@@ -9,7 +9,7 @@
 use precursors::output::{RunTables, CONTACT_MAP_STEP};
 use precursors::plot::{draw, Format};
 use precursors::plot::{Chart, Corner, Map, Palette, PlotError, Style};
-use precursors::{Drive, Error, Event, Lateral, Scene};
+use precursors::{Drive, Error, Event, Lateral, Scene, SceneBuilder};
 use std::path::{Path, PathBuf};
 
 fn scratch(name: &str) -> PathBuf {
@@ -368,7 +368,7 @@ fn bad_figures_are_refused_with_typed_errors() {
 }
 
 #[test]
-fn a_run_directory_gets_its_three_figures() {
+fn a_run_directory_gets_its_five_figures() {
     let scene = scene();
     let dir = scratch("run");
     let mut driver = scene.driver().unwrap();
@@ -387,19 +387,26 @@ fn a_run_directory_gets_its_three_figures() {
     assert_eq!(
         names,
         [
+            "avalanche_sizes.png",
+            "avalanche_sizes.svg",
             "contact_area.png",
             "contact_area.svg",
             "contact_map.png",
             "contact_map.svg",
+            "fronts.png",
+            "fronts.svg",
             "precursor_length.png",
             "precursor_length.svg"
         ]
     );
-    assert!(drawn.notes.is_empty() && drawn.merge.is_none());
-    // Without the map table: two figures and a note saying why.
+    // A force-controlled run has no force drops: no figure, and a note saying why.
+    assert_eq!(drawn.notes.len(), 1, "{:?}", drawn.notes);
+    assert!(drawn.notes[0].contains("no force_drops figure"));
+    assert!(drawn.merge.is_none());
+    // Without the map table: the four other figures and a note saying why.
     std::fs::remove_file(dir.join("contact_map.csv")).unwrap();
     let drawn = draw(&dir, &[Format::Png]).unwrap();
-    assert_eq!(drawn.files.len(), 2);
+    assert_eq!(drawn.files.len(), 4);
     assert!(drawn.notes[0].contains("contact_map.csv is missing"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -451,7 +458,7 @@ fn labels_colour_bars_and_legends_are_typeset() {
         .run_to_slip(&mut driver, None, |_, _| {})
         .unwrap();
     let drawn = draw(&dir, &[Format::Svg]).unwrap();
-    assert_eq!(drawn.files.len(), 3);
+    assert_eq!(drawn.files.len(), 5);
     for file in &drawn.files {
         for (_, text) in svg_texts(file) {
             assert!(!text.contains('_'), "{}: {text:?}", file.display());
@@ -633,5 +640,67 @@ fn figures_take_the_size_asked_for_within_limits() {
         assert!(matches!(error, PlotError::Figure { .. }));
         assert!(error.to_string().contains("[200, 16384]"), "{error}");
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The statistics figures show what the run's tables give: `avalanche_sizes` the power
+/// law fitted to the sizes of `per_avalanche.csv` (read here, the last avalanche, global
+/// slip, left out) with its exponent and interval in the legend, on logarithmic axes whose
+/// ticks print values; `fronts` both fronts.
+#[test]
+fn statistics_figures_show_the_runs_fit_and_fronts() {
+    use precursors::statistics::{fit_power_law, PowerLawOptions, Support};
+    let dir = scratch("statistics");
+    let scene = SceneBuilder::from_json_file(Path::new("examples/scenes/calibration.json"))
+        .unwrap()
+        .build()
+        .unwrap();
+    let mut driver = scene.driver().unwrap();
+    RunTables::create(&dir, &driver)
+        .unwrap()
+        .run_to_slip(&mut driver, None, |_, _| {})
+        .unwrap();
+    draw(&dir, &[Format::Svg]).unwrap();
+    let text = std::fs::read_to_string(dir.join("per_avalanche.csv")).unwrap();
+    let sizes: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .filter(|l| l.ends_with(",0"))
+        .map(|l| l.split(',').nth(3).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(sizes.len(), text.lines().count() - 2);
+    let options = PowerLawOptions::default().goodness_samples(0);
+    let fit = fit_power_law(&sizes, Support::Discrete, &options).unwrap();
+    let texts: Vec<String> = svg_texts(&dir.join("avalanche_sizes.svg"))
+        .into_iter()
+        .map(|(_, t)| t)
+        .collect();
+    let legend = format!(
+        "power law above {}: α = {:.2} [{:.2}, {:.2}] (95 %)",
+        fit.x_min, fit.alpha, fit.alpha_low, fit.alpha_high
+    );
+    assert!(
+        texts.iter().any(|t| t == &legend),
+        "{legend} not in {texts:?}"
+    );
+    assert!(texts
+        .iter()
+        .any(|t| t == &format!("{} avalanche sizes", sizes.len())));
+    assert!(texts
+        .iter()
+        .any(|t| t.starts_with("Distribution of avalanche sizes")));
+    // Log axes: ticks at values spanning decades, printed as values (no "log").
+    assert!(texts.iter().any(|t| t == "10") && texts.iter().any(|t| t == "0.01"));
+    assert!(texts.iter().all(|t| !t.contains("log")));
+    let fronts: Vec<String> = svg_texts(&dir.join("fronts.svg"))
+        .into_iter()
+        .map(|(_, t)| t)
+        .collect();
+    assert!(fronts
+        .iter()
+        .any(|t| t.contains("columns with half their contacts lost")));
+    assert!(fronts
+        .iter()
+        .any(|t| t.contains("columns below their zero-shear area")));
     std::fs::remove_dir_all(&dir).unwrap();
 }

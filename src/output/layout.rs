@@ -24,8 +24,21 @@ pub(crate) const PRECURSOR_FIGURE: &str = "precursor_length";
 pub(crate) const AREA_FIGURE: &str = "contact_area";
 /// The figure of a run's `contact_map.csv`.
 pub(crate) const MAP_FIGURE: &str = "contact_map";
+/// The figure of `ℓ` and the damage front against the load.
+pub(crate) const FRONTS_FIGURE: &str = "fronts";
+/// The figure of the avalanche sizes' distribution.
+pub(crate) const SIZES_FIGURE: &str = "avalanche_sizes";
+/// The figure of the force drops' distribution.
+pub(crate) const DROPS_FIGURE: &str = "force_drops";
 /// The figures `plot` draws.
-pub(crate) const FIGURES: [&str; 3] = [PRECURSOR_FIGURE, AREA_FIGURE, MAP_FIGURE];
+pub(crate) const FIGURES: [&str; 6] = [
+    PRECURSOR_FIGURE,
+    AREA_FIGURE,
+    MAP_FIGURE,
+    FRONTS_FIGURE,
+    SIZES_FIGURE,
+    DROPS_FIGURE,
+];
 /// The extensions of the figures.
 pub(crate) const FIGURE_EXTENSIONS: [&str; 2] = ["png", "svg"];
 /// The movie of the real contact area (Movie S1), `movie`'s default name.

@@ -4,13 +4,16 @@
 //! A run: `precursor_length` (ℓ/Lx against `F/(μF_N)`, paper Fig. 2b), `contact_area`
 //! (`A_R/A_R(0)` against `F/(μF_N)`) and, from `contact_map.csv`, `contact_map` (the real
 //! contact area of each column relative to zero shear over `x/Lx` and `F/(μF_N)`, the
-//! paper's Fig. 2b inset). A sweep: the tables of [`crate::sweep::merge`] written first,
+//! paper's Fig. 2b inset). A run and a sweep: the statistics figures of
+//! `plot/distributions.rs` (`avalanche_sizes`, `force_drops` when the force drops,
+//! `fronts` for a run). A sweep: the tables of [`crate::sweep::merge`] written first,
 //! then `precursor_length` and `contact_area` with one curve per parameter point, on a
 //! load grid of step 0.005: ℓ/Lx's mean over its realizations and its 95 % t-band;
 //! `A_R/A_R(0)`'s median and the median's distribution-free 95 % interval (none below 6
 //! runs), which a few realizations near slip, many times the others under the paper's
 //! area law, do not stretch over the chart as they do the mean's t-band.
 
+use super::distributions::draw_statistics;
 use super::PlotError;
 use super::{Chart, Corner, Map, Palette};
 use crate::error::{Error, Result};
@@ -33,8 +36,8 @@ use std::path::{Path, PathBuf};
 /// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
 /// let drawn = draw(&dir, &[Format::Png, Format::Svg])?;
 /// let extension = |k: usize| drawn.files[k].extension().unwrap().to_owned();
-/// assert_eq!(drawn.files.len(), 6);                 // three figures in each format
-/// assert_eq!((extension(0), extension(5)), ("png".into(), "svg".into()));
+/// assert_eq!(drawn.files.len(), 10);                // five figures in each format
+/// assert_eq!((extension(0), extension(9)), ("png".into(), "svg".into()));
 /// std::fs::remove_dir_all(&dir)?;
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
@@ -69,8 +72,13 @@ impl Format {
 /// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
 /// let drawn = draw(&dir, &[Format::Svg])?;
 /// let names: Vec<_> = drawn.files.iter().map(|f| f.file_name().unwrap().to_owned()).collect();
-/// assert_eq!(names, ["precursor_length.svg", "contact_area.svg", "contact_map.svg"]);
-/// assert!(drawn.merge.is_none() && drawn.notes.is_empty());  // a run: no merge, nothing left out
+/// assert_eq!(
+///     names,
+///     ["precursor_length.svg", "contact_area.svg", "contact_map.svg", "avalanche_sizes.svg",
+///      "fronts.svg"]
+/// );
+/// // A run: no merge; under force control no force drops, so no figure of them.
+/// assert!(drawn.merge.is_none() && drawn.notes[0].contains("no force_drops figure"));
 /// // A directory that is neither a run's nor a sweep's.
 /// let empty = dir.join("empty");
 /// std::fs::create_dir(&empty)?;
@@ -155,15 +163,16 @@ pub fn draw_with_size(
             ),
         });
     }
-    if dir.join(SWEEP_FILE).is_file() {
-        draw_sweep(dir, formats, size)
+    let extensions: Vec<&str> = formats.iter().map(|f| f.extension()).collect();
+    let (mut drawn, title) = if dir.join(SWEEP_FILE).is_file() {
+        (draw_sweep(dir, formats, size)?, sweep_title(dir))
     } else if dir.join("curve.csv").is_file() {
-        draw_run(dir, formats, size)
+        (draw_run(dir, formats, size)?, run_title(dir))
     } else if dir
         .join(format!("curve.csv{}", crate::output::PARTIAL_SUFFIX))
         .is_file()
     {
-        Err(PlotError::Figure {
+        return Err(PlotError::Figure {
             path: Some(dir.to_path_buf()),
             reason: format!(
                 "a run that has not reached global slip: it is under way, or was cut (its \
@@ -171,15 +180,32 @@ pub fn draw_with_size(
                  it again, then plot",
                 crate::output::PARTIAL_SUFFIX
             ),
-        })
+        });
     } else {
-        Err(PlotError::Figure {
+        return Err(PlotError::Figure {
             path: Some(dir.to_path_buf()),
             reason: format!(
                 "neither a sweep directory ({SWEEP_FILE}) nor a run directory (curve.csv)"
             ),
-        })
+        });
+    };
+    let statistics = draw_statistics(dir, &extensions, size, (&title, point_label))?;
+    drawn.files.extend(statistics.files);
+    drawn.notes.extend(statistics.notes);
+    Ok(drawn)
+}
+
+/// A sweep's point in a legend: its axes' values in the user's units, and its runs.
+fn point_label(values: &[(String, String)], runs: usize) -> String {
+    let mut text = values
+        .iter()
+        .map(|(k, v)| axis_value(k, v))
+        .collect::<Vec<_>>()
+        .join(", ");
+    if text.is_empty() {
+        text = "all runs".into();
     }
+    format!("{text} ({runs} runs)")
 }
 
 /// The name figures give a directory: its last component.
@@ -494,17 +520,7 @@ fn draw_sweep(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn,
     let grid: Vec<f64> = (0..=200).map(|k| k as f64 * 0.005).collect();
     let points = crate::sweep::ensemble_curves(dir, &grid)?;
     let title = sweep_title(dir);
-    let label = |values: &[(String, String)], runs: usize| {
-        let mut text = values
-            .iter()
-            .map(|(k, v)| axis_value(k, v))
-            .collect::<Vec<_>>()
-            .join(", ");
-        if text.is_empty() {
-            text = "all runs".into();
-        }
-        format!("{text} ({runs} runs)")
-    };
+    let label = point_label;
     // As for a run: near slip the unbounded area law can reach many times A_R(0).
     let area_top = points
         .iter()

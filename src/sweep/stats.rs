@@ -110,7 +110,7 @@ pub(crate) const OBSERVABLES: [(&str, Support, &str); 7] = [
 ///
 /// # Errors
 /// [`Error::CorruptTable`] when its events are not the whole run of its grid.
-fn samples(record: &RunRecord, dir: &Path) -> Result<[Vec<f64>; 7]> {
+pub(crate) fn samples(record: &RunRecord, dir: &Path) -> Result<[Vec<f64>; 7]> {
     let derived = derive(&record.grid, &record.events).map_err(|e| Error::CorruptTable {
         path: Some(dir.join(crate::output::TABLE_NAMES[0])),
         reason: format!("not the whole run of its scene: {e}"),
@@ -151,11 +151,11 @@ fn samples(record: &RunRecord, dir: &Path) -> Result<[Vec<f64>; 7]> {
 
 /// The run directories of `dir` grouped by parameter point, with the point's axis values
 /// (`None` for a run directory: one point, its own run), and the runs not complete.
-type Points = Vec<(Vec<(String, String)>, Vec<(PathBuf, RunRecord)>)>;
+pub(crate) type Points = Vec<(Vec<(String, String)>, Vec<(PathBuf, RunRecord)>)>;
 
 /// The complete runs of `dir` per point: a sweep's (those with their completion marker,
 /// checked against the sweep's scenes), or the run in a run directory.
-fn points(dir: &Path) -> Result<(Vec<String>, Points, usize), SweepError> {
+pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Points, usize), SweepError> {
     if !dir.join(SWEEP_FILE).is_file() {
         if !dir.join(crate::output::SCENE_RECORD).is_file() {
             return Err(SweepError::Directory {

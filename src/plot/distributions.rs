@@ -1,0 +1,231 @@
+//! The figures of a run's or a sweep's statistics (docs/statistics.md), drawn by
+//! [`super::draw`] beside the curves: `avalanche_sizes` (the log-binned `P(S)` of the
+//! avalanche sizes on log-log axes, with each point's maximum-likelihood power law and
+//! its exponent), `force_drops` (the same for a driving spring's force drops, when there
+//! are any) and, for a run, `fronts` (`ℓ/Lx` and the damage front `x_D/Lx` against the
+//! load). The samples are derived from the checked tables, as `precursors stats` derives
+//! them; the goodness of fit is `stats`' (it is not drawn).
+
+use super::{Chart, Corner, PlotError, Style, DISTINCT};
+use crate::output::derived::derive;
+use crate::output::layout::{DROPS_FIGURE, FRONTS_FIGURE, SIZES_FIGURE};
+use crate::statistics::{fit_power_law, log_binned, PowerLawOptions, Support};
+use crate::sweep::stats::{points, samples};
+use std::path::{Path, PathBuf};
+
+/// What [`draw_statistics`] drew, and what it left out and why.
+#[derive(Debug, Default)]
+pub(super) struct Statistics {
+    pub files: Vec<PathBuf>,
+    pub notes: Vec<String>,
+}
+
+/// A sweep point's name in a legend, from its axes' values and its runs.
+pub(super) type PointLabel = fn(&[(String, String)], usize) -> String;
+
+/// One point's series of a distribution: its label, samples and support.
+struct Pooled {
+    label: String,
+    samples: Vec<f64>,
+}
+
+/// Draws `avalanche_sizes`, `force_drops` and (for a run) `fronts` of `dir` (a run's or a
+/// sweep's directory) into it, as files of each of `extensions` (`png`, `svg`); `label`
+/// names each point of a sweep.
+pub(super) fn draw_statistics(
+    dir: &Path,
+    extensions: &[&str],
+    size: (u32, u32),
+    (title, label): (&str, PointLabel),
+) -> Result<Statistics, PlotError> {
+    let mut drawn = Statistics::default();
+    let (_, points, _) = points(dir)?;
+    let mut sizes = Vec::new();
+    let mut drops = Vec::new();
+    for (values, records) in &points {
+        let (mut s, mut d) = (Vec::new(), Vec::new());
+        for (run_dir, record) in records {
+            let [ruptures, drop, ..] = samples(record, run_dir)?;
+            s.extend(ruptures);
+            d.extend(drop.into_iter().filter(|x| *x > 0.0));
+        }
+        let name = if points.len() == 1 && values.is_empty() {
+            String::new()
+        } else {
+            label(values, records.len())
+        };
+        sizes.push(Pooled {
+            label: name.clone(),
+            samples: s,
+        });
+        drops.push(Pooled {
+            label: name,
+            samples: d,
+        });
+    }
+    let sizes_axes = ("S (ruptures of an avalanche)", "P(S)", "avalanche sizes");
+    distribution(
+        dir,
+        extensions,
+        size,
+        (SIZES_FIGURE, title, sizes_axes),
+        (&sizes, Support::Discrete),
+        &mut drawn,
+    )?;
+    if drops.iter().all(|p| p.samples.is_empty()) {
+        drawn.notes.push(
+            "no force_drops figure: the force never drops (force control; a driving spring \
+             drops it)"
+                .into(),
+        );
+    } else {
+        let drops_axes = ("ΔF (N)", "P(ΔF) (1/N)", "force drops");
+        distribution(
+            dir,
+            extensions,
+            size,
+            (DROPS_FIGURE, title, drops_axes),
+            (&drops, Support::Continuous),
+            &mut drawn,
+        )?;
+    }
+    if let [(_, records)] = points.as_slice() {
+        if let [(_, record)] = records.as_slice() {
+            fronts(dir, extensions, size, title, record, &mut drawn)?;
+        }
+    }
+    Ok(drawn)
+}
+
+/// A log-log figure of the log-binned density of each point's samples, with its fit.
+fn distribution(
+    dir: &Path,
+    extensions: &[&str],
+    size: (u32, u32),
+    (name, title, (x_label, y_label, what)): (&str, &str, (&str, &str, &str)),
+    (pooled, support): (&[Pooled], Support),
+    drawn: &mut Statistics,
+) -> Result<(), PlotError> {
+    // The interval from the bootstrap; the goodness of fit is `stats`' to compute.
+    let options = PowerLawOptions::default().goodness_samples(0);
+    let mut chart = Chart::new(
+        &format!("Distribution of {what}: {title}"),
+        x_label,
+        y_label,
+    )
+    .size(size.0, size.1)
+    .log_x()
+    .log_y()
+    .legend(Corner::LowerLeft);
+    for (k, p) in pooled.iter().enumerate() {
+        let colour = DISTINCT[k % DISTINCT.len()];
+        let style = Style::new().colour(colour.0, colour.1, colour.2);
+        let positive = p.samples.iter().filter(|x| **x > 0.0).count();
+        if positive == 0 {
+            continue;
+        }
+        let bins: Vec<(f64, f64)> = log_binned(&p.samples, support, 5)?
+            .iter()
+            .filter(|b| b.count > 0)
+            .map(|b| (b.center, b.density))
+            .collect();
+        let prefix = if p.label.is_empty() {
+            String::new()
+        } else {
+            format!("{}: ", p.label)
+        };
+        chart = chart
+            .markers(&format!("{prefix}{positive} {what}"), &bins)
+            .style(style);
+        match fit_power_law(&p.samples, support, &options) {
+            Ok(fit) => {
+                let top = p.samples.iter().copied().fold(fit.x_min, f64::max);
+                let line: Vec<(f64, f64)> = (0..=40)
+                    .map(|i| fit.x_min * (top / fit.x_min).powf(f64::from(i) / 40.0))
+                    .map(|x| (x, fit.density(x)))
+                    .collect();
+                chart = chart
+                    .line(
+                        &format!(
+                            "power law above {}: α = {:.2} [{:.2}, {:.2}] (95 %)",
+                            short(fit.x_min),
+                            fit.alpha,
+                            fit.alpha_low,
+                            fit.alpha_high
+                        ),
+                        &line,
+                    )
+                    .style(style.dashed());
+            }
+            Err(crate::error::Error::TooFewSamples { count, needed, .. }) => {
+                drawn.notes.push(format!(
+                    "{name}: {prefix}no power law fitted ({count} samples, {needed} needed)"
+                ));
+            }
+            Err(e) => return Err(e.into()),
+        }
+    }
+    for extension in extensions {
+        let path = dir.join(format!("{name}.{extension}"));
+        chart.save(&path)?;
+        drawn.files.push(path);
+    }
+    Ok(())
+}
+
+/// `ℓ/Lx` and the damage front `x_D/Lx` of a run against the load, as staircases.
+fn fronts(
+    dir: &Path,
+    extensions: &[&str],
+    size: (u32, u32),
+    title: &str,
+    record: &crate::output::check::RunRecord,
+    drawn: &mut Statistics,
+) -> Result<(), PlotError> {
+    let derived = derive(&record.grid, &record.events)?;
+    let lx = record.bounds.lx;
+    let ell: Vec<(f64, f64)> = record
+        .curve
+        .iter()
+        .map(|c| (c.load, c.precursor_over_lx))
+        .collect();
+    let front: Vec<(f64, f64)> = record
+        .curve
+        .iter()
+        .zip(&derived.fronts)
+        .map(|(c, x)| (c.load, x / lx))
+        .collect();
+    let top = record.slip.max(1.0);
+    for extension in extensions {
+        let path = dir.join(format!("{FRONTS_FIGURE}.{extension}"));
+        Chart::new(
+            &format!("Precursor and damage fronts: {title}"),
+            "F/(μF_N)",
+            "x/Lx",
+        )
+        .size(size.0, size.1)
+        .x_range(0.0, top)
+        .y_range(0.0, 1.0)
+        .steps("ℓ/Lx: columns below their zero-shear area", &ell)
+        .steps("x_D/Lx: columns with half their contacts lost", &front)
+        .legend(Corner::UpperLeft)
+        .save(&path)?;
+        drawn.files.push(path);
+    }
+    Ok(())
+}
+
+/// `v` with three significant digits, trailing zeros dropped (`12`, `0.351`, `7.3e-5`).
+fn short(v: f64) -> String {
+    if (1e-3..1e5).contains(&v.abs()) {
+        let digits = (2.0 - v.abs().log10().floor()).max(0.0) as usize;
+        let text = format!("{v:.digits$}");
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            text
+        }
+    } else {
+        format!("{v:.2e}")
+    }
+}
