@@ -704,6 +704,8 @@ pub struct Map {
     row_edges: Option<Vec<f64>>,
     /// Lines drawn over the cells in black (a movie's precursor front), in axis units.
     overlay: Vec<Vec<(f64, f64)>>,
+    /// Lines drawn over the cells in black dashes (the damage front over a contact map).
+    dashed_overlay: Vec<Vec<(f64, f64)>>,
 }
 
 impl Map {
@@ -749,6 +751,7 @@ impl Map {
             size: (900, 560),
             row_edges: None,
             overlay: Vec::new(),
+            dashed_overlay: Vec::new(),
         })
     }
 
@@ -857,6 +860,16 @@ impl Draw for MapDrawing<'_> {
                     line.clone(),
                     BLACK.stroke_width(3),
                 )))
+                .map_err(|e| e.to_string())?;
+        }
+        for line in &me.dashed_overlay {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    line.clone(),
+                    DASH,
+                    GAP,
+                    BLACK.stroke_width(3),
+                ))
                 .map_err(|e| e.to_string())?;
         }
         draw_axes(

@@ -704,3 +704,38 @@ fn statistics_figures_show_the_runs_fit_and_fronts() {
         .any(|t| t.contains("columns below their zero-shear area")));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The contact map carries ℓ (a solid black line) and the damage front (black dashes)
+/// over its cells, and its title says which is which. (Where the lines run is the
+/// derivation's, tested in tests/statistics.rs; here: that they are drawn.)
+#[test]
+fn the_contact_map_carries_both_fronts() {
+    let dir = scratch("map-fronts");
+    let mut driver = scene().driver().unwrap();
+    RunTables::create(&dir, &driver)
+        .unwrap()
+        .run_to_slip(&mut driver, None, |_, _| {})
+        .unwrap();
+    draw(&dir, &[Format::Svg]).unwrap();
+    let svg = std::fs::read_to_string(dir.join("contact_map.svg")).unwrap();
+    let title: Vec<String> = svg_texts(&dir.join("contact_map.svg"))
+        .into_iter()
+        .map(|(_, t)| t)
+        .collect();
+    assert!(title
+        .iter()
+        .any(|t| t.starts_with("Contact area per column; ℓ solid, x")));
+    // Two black polylines of 3 px: the solid one (one path) and the dashes (many).
+    let black = svg.matches("stroke=\"#000000\" stroke-width=\"3\"").count();
+    assert!(black >= 3, "{black} black lines");
+    let fronts = std::fs::read_to_string(dir.join("fronts.csv")).unwrap();
+    let moved = fronts
+        .lines()
+        .skip(1)
+        .any(|l| l.split(',').nth(5).unwrap().parse::<f64>().unwrap() > 0.0);
+    assert!(
+        moved,
+        "the damage front never left the trailing edge: {fronts}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

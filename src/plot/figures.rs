@@ -18,6 +18,7 @@ use super::PlotError;
 use super::{Chart, Corner, Map, Palette};
 use crate::error::{Error, Result};
 use crate::output::check::RunRecord;
+use crate::output::derived::derive;
 use crate::output::layout::{AREA_FIGURE, MAP_FIGURE, PRECURSOR_FIGURE};
 use crate::output::CONTACT_MAP_STEP;
 use crate::sweep::{merge, MergeSummary, MEDIAN_BAND_RUNS, SWEEP_FILE};
@@ -489,6 +490,20 @@ fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, P
         })
         .collect();
     let y_top = (high + half).max(1.0 + half);
+    // ℓ (solid) and the damage front (dashed) over the map: each held from its stable
+    // state's load to the next one's.
+    let fronts = derive(&record.grid, &record.events)?.fronts;
+    let vertical_steps = |x: &dyn Fn(usize) -> f64| {
+        let mut line = Vec::with_capacity(2 * record.curve.len());
+        for (k, c) in record.curve.iter().enumerate() {
+            let next = record.curve.get(k + 1).map_or(record.slip, |n| n.load);
+            line.push((x(k), c.load));
+            line.push((x(k), next.min(y_top)));
+        }
+        line
+    };
+    let ell_line = vertical_steps(&|k| record.curve[k].precursor_over_lx);
+    let front_line = vertical_steps(&|k| fronts[k] / record.bounds.lx);
     let reference_label = if low == 0.0 {
         "A_R(x, F)/A_R(x, 0)".to_string()
     } else {
@@ -498,7 +513,7 @@ fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, P
         let path = dir.join(format!("{MAP_FIGURE}.{}", format.extension()));
         let mut figure = Map::new(nx, map.len(), values.clone())?
             .labels(
-                &format!("Real contact area per column: {title}"),
+                &format!("Contact area per column; ℓ solid, x_D dashed: {title}"),
                 "x/Lx (trailing edge at 0)",
                 "F/(μF_N)",
                 &reference_label,
@@ -508,6 +523,8 @@ fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, P
             .y_range(low - half, y_top)
             .colour_scale(Palette::Diverging, Some((0.0, 2.0)));
         figure.row_edges = Some(edges.clone());
+        figure.overlay = vec![ell_line.clone()];
+        figure.dashed_overlay = vec![front_line.clone()];
         figure.save(&path)?;
         drawn.files.push(path);
     }
