@@ -439,13 +439,27 @@ fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, P
         .save(&path)?;
         drawn.files.push(path);
     }
+    draw_contact_map(dir, formats, size, (&title, &record), &mut drawn)?;
+    Ok(drawn)
+}
+
+/// The contact map of a run (`contact_map.csv`: each column's real contact area relative
+/// to zero shear over `x/Lx` and the load), `ℓ` and the damage front over it; a note in
+/// `drawn` when the run has no map.
+fn draw_contact_map(
+    dir: &Path,
+    formats: &[Format],
+    size: (u32, u32),
+    (title, record): (&str, &RunRecord),
+    drawn: &mut Drawn,
+) -> Result<(), PlotError> {
     let map_path = dir.join("contact_map.csv");
     let Some(rows) = &record.map else {
         drawn.notes.push(format!(
             "no contact map: {} is missing (written by this version's `run`)",
             map_path.display()
         ));
-        return Ok(drawn);
+        return Ok(());
     };
     // As the rows were: event, load, the columns' areas.
     let map: Vec<Vec<f64>> = rows
@@ -463,7 +477,7 @@ fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, P
             "no contact map: {} has no rows",
             map_path.display()
         ));
-        return Ok(drawn);
+        return Ok(());
     };
     if nx == 0 {
         return Err(corrupt(&map_path, "no area columns in the header".into()).into());
@@ -490,20 +504,7 @@ fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, P
         })
         .collect();
     let y_top = (high + half).max(1.0 + half);
-    // ℓ (solid) and the damage front (dashed) over the map: each held from its stable
-    // state's load to the next one's.
-    let fronts = derive(&record.grid, &record.events)?.fronts;
-    let vertical_steps = |x: &dyn Fn(usize) -> f64| {
-        let mut line = Vec::with_capacity(2 * record.curve.len());
-        for (k, c) in record.curve.iter().enumerate() {
-            let next = record.curve.get(k + 1).map_or(record.slip, |n| n.load);
-            line.push((x(k), c.load));
-            line.push((x(k), next.min(y_top)));
-        }
-        line
-    };
-    let ell_line = vertical_steps(&|k| record.curve[k].precursor_over_lx);
-    let front_line = vertical_steps(&|k| fronts[k] / record.bounds.lx);
+    let (ell_line, front_line) = front_lines(record, y_top)?;
     let reference_label = if low == 0.0 {
         "A_R(x, F)/A_R(x, 0)".to_string()
     } else {
@@ -528,7 +529,30 @@ fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, P
         figure.save(&path)?;
         drawn.files.push(path);
     }
-    Ok(drawn)
+    Ok(())
+}
+
+/// A polyline in a figure's axis units.
+type Line = Vec<(f64, f64)>;
+
+/// `ℓ/Lx` and the damage front `x_D/Lx` as lines over a contact map (x along the block,
+/// y the load): each held from its stable state's load up to the next one's (global
+/// slip's for the last), cut at `y_top`.
+fn front_lines(record: &RunRecord, y_top: f64) -> Result<(Line, Line)> {
+    let fronts = derive(&record.grid, &record.events)?.fronts;
+    let vertical_steps = |x: &dyn Fn(usize) -> f64| {
+        let mut line = Vec::with_capacity(2 * record.curve.len());
+        for (k, c) in record.curve.iter().enumerate() {
+            let next = record.curve.get(k + 1).map_or(record.slip, |n| n.load);
+            line.push((x(k), c.load));
+            line.push((x(k), next.min(y_top)));
+        }
+        line
+    };
+    Ok((
+        vertical_steps(&|k| record.curve[k].precursor_over_lx),
+        vertical_steps(&|k| fronts[k] / record.bounds.lx),
+    ))
 }
 
 /// The figures of a sweep directory, after merging it.
