@@ -6,6 +6,7 @@
 //! these files.
 
 use super::check::{whole_curve, whole_events, Bounds, CurveRow};
+use super::optional;
 use crate::avalanche::{Avalanche, Avalanches, DamageFront};
 use crate::driver::Event;
 use crate::error::{Error, Result};
@@ -85,10 +86,6 @@ pub(crate) fn write(
         fronts_text(&curve, &derived.fronts, bounds.lx).as_bytes(),
         "writing table",
     )
-}
-
-fn optional(x: Option<f64>) -> String {
-    x.map(|v| format!("{v:.12e}")).unwrap_or_default()
 }
 
 /// The text of `per_avalanche.csv`.
