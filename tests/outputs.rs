@@ -293,7 +293,7 @@ fn a_new_run_removes_the_figures_and_movies_of_the_old() {
         .map(|(n, _)| n)
         .filter(|n| n.ends_with(".png") || n.ends_with(".svg") || n.ends_with(".gif"))
         .collect();
-    assert_eq!(drawn.len(), 8, "{drawn:?}"); // 3 figures x 2 formats, 2 movies
+    assert_eq!(drawn.len(), 12, "{drawn:?}"); // 5 figures x 2 formats, 2 movies
     let mine = run.join("notes.png");
     std::fs::write(&mine, "the user's own file").unwrap();
     let other = dir.join("other.json");
