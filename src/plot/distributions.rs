@@ -11,6 +11,7 @@ use crate::output::derived::derive;
 use crate::output::layout::{DROPS_FIGURE, FRONTS_FIGURE, SIZES_FIGURE};
 use crate::statistics::{fit_power_law, log_binned, PowerLawOptions, Support};
 use crate::sweep::stats::{points, samples};
+use crate::sweep::SWEEP_FILE;
 use std::path::{Path, PathBuf};
 
 /// What [`draw_statistics`] drew, and what it left out and why.
@@ -42,17 +43,18 @@ pub(super) fn draw_statistics(
     let (_, points, _) = points(dir)?;
     let mut sizes = Vec::new();
     let mut drops = Vec::new();
-    for (values, records) in &points {
+    for point in &points {
         let (mut s, mut d) = (Vec::new(), Vec::new());
-        for (run_dir, record) in records {
+        point.for_each_record(|run_dir, record| {
             let [ruptures, drop, ..] = samples(record, run_dir)?;
             s.extend(ruptures);
             d.extend(drop.into_iter().filter(|x| *x > 0.0));
-        }
-        let name = if points.len() == 1 && values.is_empty() {
+            Ok(())
+        })?;
+        let name = if points.len() == 1 && point.values.is_empty() {
             String::new()
         } else {
-            label(values, records.len())
+            label(&point.values, point.runs())
         };
         sizes.push(Pooled {
             label: name.clone(),
@@ -89,10 +91,16 @@ pub(super) fn draw_statistics(
             &mut drawn,
         )?;
     }
-    if let [(_, records)] = points.as_slice() {
-        if let [(_, record)] = records.as_slice() {
-            fronts(dir, extensions, size, title, record, &mut drawn)?;
+    // A run directory: its fronts.
+    if !dir.join(SWEEP_FILE).is_file() {
+        let mut figure = Ok(());
+        for point in &points {
+            point.for_each_record(|_, record| {
+                figure = fronts(dir, extensions, size, title, record, &mut drawn);
+                Ok(())
+            })?;
         }
+        figure?;
     }
     Ok(drawn)
 }

@@ -5,7 +5,7 @@
 //! complete run (`RunRecord`), never from the derived tables a run leaves beside them.
 
 use super::merge::{cell, checked_record, num, read_sweep};
-use super::{SweepError, DONE_FILE, SWEEP_FILE};
+use super::{SweepError, SweepRun, DONE_FILE, SWEEP_FILE};
 use crate::error::{Error, Result};
 use crate::files::write_atomically;
 use crate::output::check::RunRecord;
@@ -149,13 +149,46 @@ pub(crate) fn samples(record: &RunRecord, dir: &Path) -> Result<[Vec<f64>; 7]> {
     Ok(out)
 }
 
-/// The run directories of `dir` grouped by parameter point, with the point's axis values
-/// (`None` for a run directory: one point, its own run), and the runs not complete.
-pub(crate) type Points = Vec<(Vec<(String, String)>, Vec<(PathBuf, RunRecord)>)>;
+/// A parameter point of a run or sweep directory: its axes' values (none for a run
+/// directory) and its complete runs, read one at a time ([`Point::for_each_record`]) so
+/// that a sweep of many runs never holds more than one run's events.
+pub(crate) struct Point {
+    pub values: Vec<(String, String)>,
+    /// Each complete run's directory, and the sweep's run it must be (`None`: a run
+    /// directory of its own).
+    runs: Vec<(PathBuf, Option<SweepRun>)>,
+}
 
-/// The complete runs of `dir` per point: a sweep's (those with their completion marker,
-/// checked against the sweep's scenes), or the run in a run directory.
-pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Points, usize), SweepError> {
+impl Point {
+    /// The complete runs.
+    pub(crate) fn runs(&self) -> usize {
+        self.runs.len()
+    }
+
+    /// Calls `f` with each complete run's directory and its record, read and checked
+    /// ([`RunRecord::read`]; a sweep's run against the sweep's scene), in run order.
+    pub(crate) fn for_each_record(
+        &self,
+        mut f: impl FnMut(&Path, &RunRecord) -> Result<()>,
+    ) -> Result<()> {
+        for (dir, run) in &self.runs {
+            let record = match run {
+                Some(run) => checked_record(dir, run)?,
+                None => RunRecord::read(dir)?,
+            };
+            f(dir, &record)?;
+        }
+        Ok(())
+    }
+}
+
+/// The points of `dir` with their complete runs, the axes' keys (none for a run
+/// directory), and the runs of a sweep that are not complete (no completion marker).
+///
+/// # Errors
+/// [`SweepError::Directory`] for a directory that is neither a run's nor a sweep's; a
+/// sweep file's errors.
+pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Vec<Point>, usize), SweepError> {
     if !dir.join(SWEEP_FILE).is_file() {
         if !dir.join(crate::output::SCENE_RECORD).is_file() {
             return Err(SweepError::Directory {
@@ -166,31 +199,32 @@ pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Points, usize), SweepEr
                 ),
             });
         }
-        let record = RunRecord::read(dir)?;
-        return Ok((
-            Vec::new(),
-            vec![(Vec::new(), vec![(dir.to_path_buf(), record)])],
-            0,
-        ));
+        let point = Point {
+            values: Vec::new(),
+            runs: vec![(dir.to_path_buf(), None)],
+        };
+        return Ok((Vec::new(), vec![point], 0));
     }
     let sweep = read_sweep(dir)?;
     let keys = sweep.keys().iter().map(|k| k.to_string()).collect();
     let mut out = Vec::new();
     let mut missing = 0;
     for point in 0..sweep.points() {
-        let runs: Vec<_> = sweep.runs().iter().filter(|r| r.point == point).collect();
+        let runs: Vec<&SweepRun> = sweep.runs().iter().filter(|r| r.point == point).collect();
         let Some(first) = runs.first() else { continue };
-        let mut records = Vec::new();
+        let mut complete = Vec::new();
         for run in &runs {
             let run_dir = dir.join(&run.dir_name);
             if run_dir.join(DONE_FILE).is_file() {
-                let record = checked_record(&run_dir, run)?;
-                records.push((run_dir, record));
+                complete.push((run_dir, Some((*run).clone())));
             } else {
                 missing += 1;
             }
         }
-        out.push((first.values.clone(), records));
+        out.push(Point {
+            values: first.values.clone(),
+            runs: complete,
+        });
     }
     Ok((keys, out, missing))
 }
@@ -239,18 +273,20 @@ pub fn statistics(dir: &Path, options: &StatsOptions) -> Result<StatsSummary, Sw
     let mut bins =
         format!("point,{key_header}observable,bin_low,bin_high,bin_center,count,density\n");
     let mut runs = 0;
-    for (point, (values, records)) in points.iter().enumerate() {
-        let values: String = values
+    for (index, point) in points.iter().enumerate() {
+        let values: String = point
+            .values
             .iter()
             .map(|(_, v)| format!("{},", cell(v)))
             .collect();
         let mut pooled: [Vec<f64>; 7] = Default::default();
-        for (run_dir, record) in records {
+        point.for_each_record(|run_dir, record| {
             for (all, s) in pooled.iter_mut().zip(samples(record, run_dir)?) {
                 all.extend(s);
             }
-        }
-        runs += records.len();
+            Ok(())
+        })?;
+        runs += point.runs();
         for ((name, support, _), x) in OBSERVABLES.iter().zip(&pooled) {
             let positive = x.iter().filter(|v| **v > 0.0).count();
             let fit = if positive >= options.fit.min_tail {
@@ -268,14 +304,14 @@ pub fn statistics(dir: &Path, options: &StatsOptions) -> Result<StatsSummary, Sw
             };
             let _ = writeln!(
                 fits,
-                "{point},{values}{name},{support_name},{positive},{}",
+                "{index},{values}{name},{support_name},{positive},{}",
                 fit_cells(fit.as_ref(), options.fit.confidence)
             );
             if positive > 0 {
                 for b in log_binned(x, *support, options.bins_per_decade)? {
                     let _ = writeln!(
                         bins,
-                        "{point},{values}{name},{},{},{},{},{}",
+                        "{index},{values}{name},{},{},{},{},{}",
                         num(b.low),
                         num(b.high),
                         num(b.center),
