@@ -42,7 +42,7 @@ def test_run_directory_tables_and_figures(tmp_path):
     scene = precursors.Scene.from_dict(SMALL)
     precursors.run(scene, tmp_path)
     tables = precursors.read_tables(tmp_path)
-    assert set(tables) == {"events", "curve", "contact_map"}
+    assert set(tables) == {"events", "curve", "contact_map", "per_avalanche", "fronts"}
     assert tables["events"]["kind"][-1] == "global_slip"
     assert tables["curve"]["force_over_mu_FN"].dtype == np.float64
     figures = precursors.plot(tmp_path)
