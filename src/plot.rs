@@ -361,6 +361,28 @@ impl Chart {
     /// A logarithmic x axis (base 10, for values spanning decades: a distribution's
     /// sizes): ticks labelled with the values; points with `x ≤ 0` are not drawn; a range
     /// given by [`Chart::x_range`] is in the data's units and must be positive.
+    ///
+    /// ```
+    /// use precursors::plot::Chart;
+    /// let dir = std::env::temp_dir().join(format!("precursors-doc-log-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// // P(S) ∝ S^-2 over three decades, on log-log axes.
+    /// let p: Vec<(f64, f64)> = (0..=30).map(|k| 10f64.powf(k as f64 / 10.0))
+    ///     .map(|s| (s, s.powi(-2))).collect();
+    /// Chart::new("P(S)", "S", "P(S)").log_x().log_y().line("S^-2", &p)
+    ///     .save(dir.join("p.svg"))?;
+    /// let svg = std::fs::read_to_string(dir.join("p.svg"))?;
+    /// let texts: Vec<&str> = svg.split("<text").skip(1)
+    ///     .filter_map(|t| t.split_once('>')?.1.split_once("</text>").map(|x| x.0.trim()))
+    ///     .collect();
+    /// // The ticks print values: 10 on the x axis, powers of ten like 1e−4 on the y axis.
+    /// assert!(texts.contains(&"10") && texts.iter().any(|t| t.starts_with("1e−")), "{texts:?}");
+    /// // A range on a log axis must be positive.
+    /// assert!(Chart::new("t", "x", "y").log_x().x_range(0.0, 1.0).line("", &p)
+    ///     .save(dir.join("bad.svg")).is_err());
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn log_x(mut self) -> Self {
         self.log.0 = true;
         self

@@ -377,6 +377,11 @@ fn field_damages() -> Vec<(&'static str, Damage)> {
 }
 
 /// Runs `args`; the code must be 3, the message must name `names`, and `dir` unchanged.
+/// `stats` of `dir` with few resamples (the checks are what is tested, not the fits).
+fn stats(dir: &Path) -> Vec<&str> {
+    vec!["stats", path(dir), "--bootstrap", "5", "--goodness", "5"]
+}
+
 fn refused(case: &str, args: &[&str], names: &str, dir: &Path, failures: &mut Vec<String>) {
     let before = contents(dir);
     let o = precursors(args);
@@ -411,19 +416,24 @@ fn pristine() -> PathBuf {
 }
 
 #[test]
-fn merge_plot_and_movie_refuse_every_damaged_table_with_its_name() {
+fn merge_stats_plot_and_movie_refuse_every_damaged_table_with_its_name() {
     let sweep = pristine();
     let root = sweep.parent().unwrap().to_path_buf();
     // The undamaged copy is read (the checks refuse nothing a run writes).
     let whole = root.join("whole");
     copy(&sweep, &whole);
-    for args in [vec!["merge", path(&whole)], vec!["plot", path(&whole)]] {
+    for args in [
+        vec!["merge", path(&whole)],
+        vec!["plot", path(&whole)],
+        stats(&whole),
+    ] {
         let o = precursors(&args);
         assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
     }
     let whole_run = whole.join(RUN);
     for args in [
         vec!["plot", path(&whole_run)],
+        stats(&whole_run),
         vec![
             "movie",
             path(&whole_run),
@@ -447,11 +457,13 @@ fn merge_plot_and_movie_refuse_every_damaged_table_with_its_name() {
         let run = d.join(RUN);
         refused(case, &["merge", path(&d)], names, &d, &mut failures);
         refused(case, &["plot", path(&d)], names, &d, &mut failures);
+        refused(case, &stats(&d), names, &d, &mut failures);
         if !case.contains("sweep.json")
             && !case.contains("swapped")
             && !case.contains("another point")
         {
             refused(case, &["plot", path(&run)], names, &d, &mut failures);
+            refused(case, &stats(&run), names, &d, &mut failures);
             refused(
                 case,
                 &[

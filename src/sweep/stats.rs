@@ -251,6 +251,26 @@ pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Vec<Point>, usize), Swe
 /// Both are written atomically. Runs of a sweep without their completion marker are left
 /// out and counted.
 ///
+/// ```
+/// use precursors::statistics::PowerLawOptions;
+/// use precursors::sweep::{statistics, StatsOptions, Sweep, SweepOptions};
+/// let sweep = Sweep::from_json_str(r#"{
+///     "base": { "block": { "lx": 0.02, "ly": 0.004, "lz": 0.01 },
+///               "cells": { "kind": "count", "nx": 20, "ny": 4 },
+///               "normal_load": 100.0 },
+///     "axes": [], "realizations": 3, "seed": 2
+/// }"#)?;
+/// let out = std::env::temp_dir().join(format!("precursors-doc-stats-{}", std::process::id()));
+/// sweep.execute(&out, &SweepOptions::new(), |_| {})?;
+/// let options = StatsOptions::default().fit(PowerLawOptions::default().bootstrap(20));
+/// let summary = statistics(&out, &options)?;
+/// assert_eq!((summary.points, summary.runs, summary.runs_missing), (1, 3, 0));
+/// let fits = std::fs::read_to_string(&summary.files[0])?;
+/// assert!(fits.lines().nth(1).unwrap().starts_with("0,avalanche_ruptures,discrete,"));
+/// std::fs::remove_dir_all(&out).ok();
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+///
 /// # Errors
 /// [`SweepError::Directory`] for a directory that is neither a run's nor a sweep's;
 /// as [`super::merge`] for the runs' tables; in [`SweepError::Core`]:
