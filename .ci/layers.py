@@ -20,7 +20,7 @@ LAYERS = [
     ["green", "surface"],
     ["interface"],
     ["solver"],
-    ["probe"],
+    ["probe", "recording"],
     ["scene"],
     ["driver"],
     ["avalanche"],

@@ -3,7 +3,7 @@
 //! block, 1 mm cells, F_N = 2.7 kN, seed 1): a rod (h = 6 mm, Δh = 2 mm), a uniform side
 //! load and a uniform top load.
 //!
-//! Each run records its fields (`SceneBuilder::record_fields`: the cells' contact area of
+//! Each run records its fields (`RunOptions::record_fields`: the cells' contact area of
 //! every stable state) into `movie_s1_<drive>/` (the run tables, `scene.json` and
 //! `fields.csv`, as `precursors run` writes them), then `plot::Movie` draws
 //! `movie_s1_<drive>.gif`: at most 150 frames, one colour scale per movie (mm² per cell),
@@ -19,7 +19,7 @@ mod figures;
 
 use precursors::output::RunTables;
 use precursors::plot::{Movie, MovieKind};
-use precursors::{Drive, ForceLoad, Lateral, Scene};
+use precursors::{Drive, ForceLoad, Lateral, RunOptions, Scene};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -45,7 +45,7 @@ fn run() -> report::Outcome {
             .normal_load(2.7e3)
             .drive(drive)
             .seed(1)
-            .record_fields(1, &[])
+            .run_options(RunOptions::new().record_fields(1, &[]))
             .build()?;
         let run_dir = format!("{dir}/movie_s1_{name}");
         std::fs::create_dir_all(&run_dir)?;

@@ -3,7 +3,7 @@
 //! F_top = F_lat, seed 1) as the shear grows: where `τ_C > 0` opens inside the bulk, and
 //! the interface's precursor `ℓ`.
 //!
-//! The run records its fields (`SceneBuilder::record_fields`) every 2nd stable state on
+//! The run records its fields (`RunOptions::record_fields`) every 2nd stable state on
 //! 50 planes, z = 1, 3, ..., 99 mm, into `movie_s2/` (the run tables, `scene.json`,
 //! `fields.csv`), then `plot::Movie` draws `movie_s2.gif` (at most 150 frames): τ_C in MPa
 //! on one diverging scale for the whole movie (symmetric, to the 98th percentile of |τ_C|,
@@ -20,6 +20,7 @@ mod figures;
 
 use precursors::output::RunTables;
 use precursors::plot::{Movie, MovieKind};
+use precursors::RunOptions;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -31,7 +32,7 @@ fn run() -> report::Outcome {
     let planes: Vec<f64> = (0..50).map(|k| (2 * k + 1) as f64 * 1e-3).collect();
     let scene = figures::stress_block()
         .seed(1)
-        .record_fields(2, &planes)
+        .run_options(RunOptions::new().record_fields(2, &planes))
         .build()?;
     let run_dir = format!("{dir}/movie_s2");
     std::fs::create_dir_all(&run_dir)?;

@@ -116,6 +116,7 @@ pub mod output;
 #[cfg(feature = "plot")]
 pub mod plot;
 mod probe;
+mod recording;
 mod scene;
 pub mod solver;
 pub mod statistics;
@@ -134,6 +135,7 @@ pub use interface::{
 pub use probe::{
     CellStress, PlaneStress, PointStress, ProbeInput, ProbeSpec, Profile, StressProbe, Stresses,
 };
+pub use recording::RunOptions;
 pub use scene::{Drive, ForceLoad, HeightSource, Lateral, Scene, SceneBuilder};
 pub use surface::SurfaceSpectrum;
 

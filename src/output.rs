@@ -17,8 +17,8 @@
 //!   driving spring's slip), a level's row is the state in effect when the load first
 //!   passed it.
 //!
-//! * `fields.csv` ([`FIELDS_TABLE`]), only when the scene records fields
-//!   ([`crate::SceneBuilder::record_fields`], scene-file key `fields`): the fields of the
+//! * `fields.csv` ([`FIELDS_TABLE`]), only when the run records fields
+//!   ([`crate::RunOptions::record_fields`], scene-file key `fields`): the fields of the
 //!   1st, `(1 + every)`-th, `(1 + 2·every)`-th, ... stable state, for the movies (`precursors
 //!   movie`), header `event,force_over_mu_FN,precursor_over_Lx,field,row,z_m,value_ix0,
 //!   ...,value_ix{Nx-1}`. Each recorded state has `Ny` rows of field `area_m2` (row `iy`,
@@ -27,6 +27,19 @@
 //!   stress `τ_C(x, z) = |⟨τ⟩_y| - μ|⟨σ⟩_y|` of each column, Pa, as
 //!   [`crate::Profile::coulomb_of_means`]). About `(Ny + planes)·Nx·20` bytes per recorded
 //!   state: `every` bounds the size.
+//!
+//! * `profiles.csv`, only when the run records profiles
+//!   ([`crate::RunOptions::record_profiles`], scene-file key `profiles`): profiles along
+//!   `x`, averaged over `y`, in the stable state in effect at each requested load (the
+//!   last one reached at or below it, as in `contact_map.csv`; a load below the first
+//!   state's or one the run never passes has no rows), header `level,event,
+//!   force_over_mu_FN,field,z_m,value_ix0,...,value_ix{Nx-1}`. Per load, in increasing
+//!   order: three rows at the interface (`z_m` 0) of field `slip_m` (`⟨u_x⟩_y`, m),
+//!   `shear_traction_Pa` (`⟨φ_x⟩_y`) and `normal_traction_Pa` (`⟨φ_z⟩_y`,
+//!   compressive positive), then four per recorded plane (`z_m` its height) of field
+//!   `shear_Pa` (`⟨τ⟩_y`), `normal_Pa` (`⟨σ⟩_y`), `coulomb_of_means_Pa` (`|⟨τ⟩_y| -
+//!   μ|⟨σ⟩_y|`) and `mean_coulomb_Pa` (`⟨|τ| - μ|σ|⟩_y`), as [`crate::Profile`]'s.
+//!   `level` is the requested load, `event` and `force_over_mu_FN` the state's.
 //!
 //! * `per_avalanche.csv` and `fronts.csv`, derived from the whole `events.csv` and
 //!   `curve.csv` when the run reaches global slip ([`RunTables::finish`], before the
@@ -60,11 +73,13 @@
 //! `contact_map.csv` hold the stable states and load levels reached by then; then it
 //! rewrites the `.partial` tables with the rows up to the checkpoint's event. With fields
 //! recorded, `fields.csv` must hold exactly the recorded states up to the checkpoint's
-//! event (the same `every` and planes), and is cut back the same way.
+//! event (the same `every` and planes), and is cut back the same way; with profiles
+//! recorded, `profiles.csv` the loads passed by then (the same loads and planes).
 
 pub(crate) mod check;
 pub(crate) mod derived;
 pub(crate) mod layout;
+pub(crate) mod profiles;
 mod resume;
 
 use crate::driver::{Driver, Event};
@@ -73,6 +88,8 @@ use crate::files::{check_replaceable, read_text_if_exists, sync_dir, write_atomi
 use crate::interface::SiteState;
 use crate::lock::DirLock;
 use crate::probe::{ProbeSpec, StressProbe};
+use crate::recording::RunOptions;
+use profiles::ProfilesTable;
 use resume::{continuation, fields_continuation};
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufWriter, Write};
@@ -99,8 +116,8 @@ pub const PARTIAL_SUFFIX: &str = ".partial";
 /// `SceneBuilder::to_json`), written when the run starts, checked on resume.
 pub const SCENE_RECORD: &str = "scene.json";
 
-/// The table of the fields a run records for the movies (written only when the scene
-/// records fields: [`crate::SceneBuilder::record_fields`]; layout in the module's docs).
+/// The table of the fields a run records for the movies (written only when the run
+/// records fields: [`crate::RunOptions::record_fields`]; layout in the module's docs).
 pub const FIELDS_TABLE: &str = "fields.csv";
 
 /// The `field` of the rows of `fields.csv` that hold the real contact area of a row `iy`
@@ -192,8 +209,10 @@ pub struct RunTables {
     in_effect: Option<MapState>,
     /// Global slip was recorded.
     slipped: bool,
-    /// `fields.csv`, when the scene records fields.
+    /// `fields.csv`, when the run records fields.
     fields: Option<FieldsTable>,
+    /// `profiles.csv`, when the run records profiles.
+    profiles: Option<ProfilesTable>,
     /// The run's grid and the bounds of its rows, for the tables derived at its end.
     grid: crate::geometry::Grid,
     bounds: check::Bounds,
@@ -201,7 +220,7 @@ pub struct RunTables {
     _lock: Option<DirLock>,
 }
 
-/// `fields.csv` of a run that records fields ([`crate::SceneBuilder::record_fields`]).
+/// `fields.csv` of a run that records fields ([`crate::RunOptions::record_fields`]).
 #[derive(Debug)]
 struct FieldsTable {
     file: BufWriter<File>,
@@ -229,19 +248,20 @@ impl FieldsTable {
     }
 
     /// The writer of `driver`'s fields into `file` (`stable`: the stable states before
-    /// its first row); `None` when its scene records none.
+    /// its first row); `None` when `options` record none.
     fn new(
         driver: &Driver,
+        options: &RunOptions,
         dir: &Path,
         file: impl FnOnce(&Path) -> Result<File>,
         stable: usize,
     ) -> Result<Option<Self>> {
         let scene = driver.scene();
-        let every = scene.fields_every();
+        let every = options.fields_every();
         if every == 0 {
             return Ok(None);
         }
-        let planes = scene.field_planes().to_vec();
+        let planes = options.field_planes().to_vec();
         let probe = if planes.is_empty() {
             None
         } else {
@@ -314,69 +334,99 @@ fn table_paths(dir: &Path) -> ([PathBuf; 3], [PathBuf; 3]) {
 }
 
 impl RunTables {
-    /// New tables in `dir` (which must exist), header only, for `driver`'s run: the
-    /// directory is locked, the tables of an earlier run there removed, the scene
-    /// recorded ([`SCENE_RECORD`], feature `serde`).
+    /// New tables in `dir` (which must exist), header only, for `driver`'s run, recording
+    /// what its scene's run options ask ([`crate::Scene::run_options`]): as
+    /// [`RunTables::create_with`].
     ///
     /// # Errors
-    /// [`Error::DirectoryLocked`] when another process writes the directory;
-    /// [`Error::Io`] when a file cannot be written or removed.
+    /// As [`RunTables::create_with`].
     pub fn create(dir: &Path, driver: &Driver) -> Result<Self> {
-        let lock = DirLock::lock(dir)?;
-        layout::check_not_a_sweeps(dir)?;
-        Self::start(dir, driver, Some(lock))
+        Self::create_with(dir, driver, driver.scene().run_options())
     }
 
-    /// [`RunTables::create`] in a directory whose lock the caller holds (`lock: None`)
-    /// or passes on.
-    pub(crate) fn start(dir: &Path, driver: &Driver, lock: Option<DirLock>) -> Result<Self> {
+    /// New tables in `dir` (which must exist), header only, for `driver`'s run, recording
+    /// what `options` ask beside the three tables (`fields.csv`, `profiles.csv`): the
+    /// options are checked against the scene, the directory is locked, the tables of an
+    /// earlier run there removed, the scene recorded with these options ([`SCENE_RECORD`],
+    /// feature `serde`; a resume and `precursors movie` read them there).
+    ///
+    /// ```
+    /// use precursors::{output::RunTables, RunOptions, Scene};
+    /// let dir = std::env::temp_dir().join(format!("precursors-doc-with-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// let scene = Scene::builder().block(0.010, 0.004, 0.010).normal_load(100.0).build()?;
+    /// let mut driver = scene.driver()?;
+    /// // The interface profiles, and the stresses 2 mm above it, at half the friction limit.
+    /// let options = RunOptions::new().record_profiles(&[0.5], &[0.002]);
+    /// RunTables::create_with(&dir, &driver, &options)?.run_to_slip(&mut driver, None, |_, _| {})?;
+    /// let profiles = std::fs::read_to_string(dir.join("profiles.csv"))?;
+    /// // 3 rows at the interface and 4 on the plane, for the one load.
+    /// assert_eq!(profiles.lines().count(), 1 + 3 + 4);
+    /// assert!(profiles.lines().nth(1).unwrap().starts_with("5.000000000000e-1,"));
+    /// // A plane outside the block is refused before anything is written.
+    /// let outside = RunOptions::new().record_profiles(&[0.5], &[0.02]);
+    /// assert!(RunTables::create_with(&dir, &driver, &outside).is_err());
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::OutOfRange`] for options the scene cannot record, naming the key;
+    /// [`Error::DirectoryLocked`] when another process writes the directory;
+    /// [`Error::Io`] when a file cannot be written or removed.
+    pub fn create_with(dir: &Path, driver: &Driver, options: &RunOptions) -> Result<Self> {
+        check_options(driver, options)?;
+        let lock = DirLock::lock(dir)?;
+        layout::check_not_a_sweeps(dir)?;
+        Self::start(dir, driver, options, Some(lock))
+    }
+
+    /// [`RunTables::create_with`] in a directory whose lock the caller holds (`lock:
+    /// None`) or passes on.
+    pub(crate) fn start(
+        dir: &Path,
+        driver: &Driver,
+        options: &RunOptions,
+        lock: Option<DirLock>,
+    ) -> Result<Self> {
+        check_options(driver, options)?;
         let (paths, partials) = table_paths(dir);
         remove_stale_temporaries(dir)?;
         remove_derived(dir)?;
         for path in &paths {
-            match fs::remove_file(path) {
-                Err(e) if e.kind() != io::ErrorKind::NotFound => {
-                    return Err(Error::io("removing the earlier run's table", path, e))
-                }
-                _ => {}
-            }
+            remove_if_exists(path)?;
         }
         #[cfg(feature = "serde")]
         write_atomically(
             &dir.join(SCENE_RECORD),
-            driver.scene().to_builder().to_json()?.as_bytes(),
+            driver
+                .scene()
+                .to_builder()
+                .run_options(options.clone())
+                .to_json()?
+                .as_bytes(),
             "recording the scene",
         )?;
-        let headers = [
-            EVENTS_HEADER.to_string(),
-            CURVE_HEADER.to_string(),
-            contact_map_header(driver.grid().nx()),
-        ];
-        let mut files = Vec::with_capacity(3);
-        for (path, header) in partials.iter().zip(&headers) {
-            // A FIFO there would block the open, a link would be written through.
-            check_replaceable(path, "creating table")?;
-            let file = File::create(path).map_err(|e| Error::io("creating table", path, e))?;
-            let mut file = BufWriter::new(file);
-            writeln!(file, "{header}").map_err(|e| Error::io("writing table", path, e))?;
-            files.push(file);
-        }
-        let [events, curve, map]: [BufWriter<File>; 3] = files.try_into().expect("three tables");
-        // An earlier run's fields never pass for this run's.
-        remove_fields(dir)?;
         let nx = driver.grid().nx();
+        let open = |t: usize, header: &str| new_table(&partials[t], header).map(BufWriter::new);
+        let events = open(0, EVENTS_HEADER)?;
+        let curve = open(1, CURVE_HEADER)?;
+        let map = open(2, &contact_map_header(nx))?;
+        // An earlier run's recordings never pass for this run's.
+        remove_recordings(dir)?;
         let fields = FieldsTable::new(
             driver,
+            options,
             dir,
-            |path| {
-                check_replaceable(path, "creating table")?;
-                let mut file =
-                    File::create(path).map_err(|e| Error::io("creating table", path, e))?;
-                writeln!(file, "{}", fields_header(nx))
-                    .map_err(|e| Error::io("writing table", path, e))?;
-                Ok(file)
-            },
+            |path| new_table(path, &fields_header(nx)),
             0,
+        )?;
+        let profiles = ProfilesTable::new(
+            driver,
+            options,
+            dir,
+            |path| new_table(path, &profiles::header(nx)),
+            profiles::Levels::new(options.profile_loads()),
         )?;
         Ok(Self {
             events,
@@ -390,30 +440,45 @@ impl RunTables {
             in_effect: None,
             slipped: false,
             fields,
+            profiles,
             grid: *driver.grid(),
             bounds: check::Bounds::of(driver),
             _lock: lock,
         })
     }
 
-    /// The tables in `dir` continued after `driver` was resumed ([`crate::Scene::resume`])
-    /// from a checkpoint taken at a stable state. The directory is locked; then, before
-    /// anything is written, its recorded scene ([`SCENE_RECORD`], feature `serde`) must be
-    /// the driver's, and the tables (each `NAME.partial` if present, else `NAME`) must
-    /// hold whole rows under their headers, `events.csv` the events 1, 2, ... up to the
-    /// checkpoint's (a last row cut by a crash is dropped), `curve.csv` and
-    /// `contact_map.csv` the stable states and load levels reached by then. The `.partial`
-    /// tables are then rewritten (atomically) with the rows up to the checkpoint's event;
-    /// complete tables of a finished run stay until [`RunTables::finish`] replaces them.
+    /// The tables in `dir` continued after `driver` was resumed from a checkpoint,
+    /// recording what its scene's run options ask ([`crate::Scene::run_options`]): as
+    /// [`RunTables::resume_with`].
     ///
     /// # Errors
+    /// As [`RunTables::resume_with`].
+    pub fn resume(dir: &Path, driver: &Driver) -> Result<Self> {
+        Self::resume_with(dir, driver, driver.scene().run_options())
+    }
+
+    /// The tables in `dir` continued after `driver` was resumed ([`crate::Scene::resume`])
+    /// from a checkpoint taken at a stable state, recording what `options` ask. The
+    /// directory is locked; then, before anything is written, its recorded scene
+    /// ([`SCENE_RECORD`], feature `serde`) must be the driver's, and the tables (each
+    /// `NAME.partial` if present, else `NAME`) must hold whole rows under their headers,
+    /// `events.csv` the events 1, 2, ... up to the checkpoint's (a last row cut by a crash
+    /// is dropped), `curve.csv` and `contact_map.csv` the stable states and load levels
+    /// reached by then, and with `options` recording them, `fields.csv` and
+    /// `profiles.csv` what they record up to then. The `.partial` tables are then
+    /// rewritten (atomically) with the rows up to the checkpoint's event; complete tables
+    /// of a finished run stay until [`RunTables::finish`] replaces them.
+    ///
+    /// # Errors
+    /// [`Error::OutOfRange`] for options the scene cannot record;
     /// [`Error::RunDirectory`] for a missing directory or (feature `serde`) one without
     /// its scene record; [`Error::CheckpointSceneMismatch`], naming the first differing
     /// key, when the recorded scene is another; [`Error::CorruptTable`], naming the file
     /// and line, for a table that is damaged, too short or inconsistent with the others;
     /// [`Error::InvalidCheckpoint`] for a checkpoint inside an avalanche;
     /// [`Error::DirectoryLocked`]; [`Error::Io`].
-    pub fn resume(dir: &Path, driver: &Driver) -> Result<Self> {
+    pub fn resume_with(dir: &Path, driver: &Driver, options: &RunOptions) -> Result<Self> {
+        check_options(driver, options)?;
         if !dir.is_dir() {
             return Err(Error::RunDirectory {
                 path: dir.to_path_buf(),
@@ -430,13 +495,7 @@ impl RunTables {
         let mut old: [Option<String>; 3] = Default::default();
         let mut read = partials.clone();
         for t in 0..3 {
-            for path in [&partials[t], &paths[t]] {
-                if let Some(text) = read_text_if_exists(path, "reading table")? {
-                    old[t] = Some(text);
-                    read[t] = path.clone();
-                    break;
-                }
-            }
+            (old[t], read[t]) = read_old(&partials[t], &paths[t])?;
         }
         let plan = continuation(
             [old[0].as_deref(), old[1].as_deref(), old[2].as_deref()],
@@ -453,58 +512,70 @@ impl RunTables {
         } else {
             None
         };
-        let scene = driver.scene();
-        let fields_text = if scene.fields_every() > 0 {
+        let nx = driver.grid().nx();
+        let fields_text = if options.fields_every() > 0 {
             let (path, partial) = FieldsTable::paths(dir);
-            let mut old = None;
-            let mut read = partial.clone();
-            for p in [&partial, &path] {
-                if let Some(text) = read_text_if_exists(p, "reading table")? {
-                    old = Some(text);
-                    read = p.clone();
-                    break;
-                }
-            }
+            let (old, read) = read_old(&partial, &path)?;
             Some(fields_continuation(
                 old.as_deref(),
                 &read,
                 &plan.stable,
-                (scene.fields_every(), scene.field_planes()),
-                (driver.grid().nx(), driver.grid().ny()),
+                (options.fields_every(), options.field_planes()),
+                (nx, driver.grid().ny()),
             )?)
         } else {
             None
         };
+        let profiles_kept = if options.profile_loads().is_empty() {
+            None
+        } else {
+            let (path, partial) = ProfilesTable::paths(dir);
+            let (old, read) = read_old(&partial, &path)?;
+            let states: Vec<(usize, f64)> = plan
+                .stable
+                .iter()
+                .copied()
+                .zip(plan.loads.iter().copied())
+                .collect();
+            Some(profiles::continuation(
+                old.as_deref(),
+                &read,
+                options,
+                nx,
+                &states,
+                |event| {
+                    states
+                        .iter()
+                        .find(|s| s.0 == event)
+                        .map(|s| format!("{:.12e}", s.1))
+                },
+            )?)
+        };
         // Checked: now the directory is written.
         remove_stale_temporaries(dir)?;
-        let mut files = Vec::with_capacity(3);
-        for (path, text) in partials.iter().zip(&plan.texts) {
-            write_atomically(path, text.as_bytes(), "writing table")?;
-            let file = OpenOptions::new()
-                .append(true)
-                .open(path)
-                .map_err(|e| Error::io("opening table", path, e))?;
-            files.push(BufWriter::new(file));
-        }
-        let [events, curve, map]: [BufWriter<File>; 3] = files.try_into().expect("three tables");
-        // Without fields recorded now, those of the run before the checkpoint would not
-        // cover the run: removed.
+        let continued = |t: usize| append_to(&partials[t], &plan.texts[t]).map(BufWriter::new);
+        let (events, curve, map) = (continued(0)?, continued(1)?, continued(2)?);
+        // Recordings not asked for now would not cover the run: removed.
         if fields_text.is_none() {
             remove_fields(dir)?;
+        }
+        if profiles_kept.is_none() {
+            remove_profiles(dir)?;
         }
         let fields = match fields_text {
             Some(text) => FieldsTable::new(
                 driver,
+                options,
                 dir,
-                |path| {
-                    write_atomically(path, text.as_bytes(), "writing table")?;
-                    OpenOptions::new()
-                        .append(true)
-                        .open(path)
-                        .map_err(|e| Error::io("opening table", path, e))
-                },
+                |path| append_to(path, &text),
                 plan.stable.len(),
             )?,
+            None => None,
+        };
+        let profiles = match profiles_kept {
+            Some((text, rule)) => {
+                ProfilesTable::new(driver, options, dir, |path| append_to(path, &text), rule)?
+            }
             None => None,
         };
         Ok(Self {
@@ -519,6 +590,7 @@ impl RunTables {
             in_effect,
             slipped: false,
             fields,
+            profiles,
             grid: *driver.grid(),
             bounds: check::Bounds::of(driver),
             _lock: Some(lock),
@@ -576,6 +648,9 @@ impl RunTables {
             if let Some(fields) = &mut self.fields {
                 fields.record(driver, index, x, ell / driver.grid().block().lx())?;
             }
+            if let Some(profiles) = &mut self.profiles {
+                profiles.reach(driver, index, load.force, true)?;
+            }
             self.map_rows_below(x, true)?;
             self.in_effect = Some(MapState {
                 event: index,
@@ -583,6 +658,9 @@ impl RunTables {
             });
         }
         if let Event::GlobalSlip { load } = *event {
+            if let Some(profiles) = &mut self.profiles {
+                profiles.reach(driver, index, load.force, false)?;
+            }
             let mu_fn = driver.friction_coefficient() * driver.normal_load();
             self.map_rows_below(load.force / mu_fn, false)?;
             self.slipped = true;
@@ -647,6 +725,9 @@ impl RunTables {
                 .flush()
                 .and_then(|()| fields.file.get_ref().sync_data())
                 .map_err(|e| Error::io("writing table", &fields.partial, e))?;
+        }
+        if let Some(profiles) = &mut self.profiles {
+            profiles.flush()?;
         }
         Ok(())
     }
@@ -744,6 +825,9 @@ impl RunTables {
             fs::rename(&fields.partial, &fields.path)
                 .map_err(|e| Error::io("renaming table", &fields.path, e))?;
         }
+        if let Some(profiles) = &self.profiles {
+            profiles.rename()?;
+        }
         for t in [2, 1, 0] {
             fs::rename(&self.partials[t], &self.paths[t])
                 .map_err(|e| Error::io("renaming table", &self.paths[t], e))?;
@@ -762,6 +846,7 @@ fn remove_stale_temporaries(dir: &Path) -> Result<()> {
         .chain([
             SCENE_RECORD.to_string(),
             format!("{FIELDS_TABLE}{PARTIAL_SUFFIX}"),
+            format!("{}{PARTIAL_SUFFIX}", layout::PROFILES_TABLE),
         ])
         .chain(layout::DERIVED_TABLES.map(String::from))
         .collect();
@@ -791,18 +876,68 @@ fn remove_derived(dir: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Removes `path` where it exists.
+fn remove_if_exists(path: &Path) -> Result<()> {
+    match fs::remove_file(path) {
+        Err(e) if e.kind() != io::ErrorKind::NotFound => {
+            Err(Error::io("removing the earlier run's table", path, e))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Removes `fields.csv` and `fields.csv.partial` from `dir` (where they exist).
 fn remove_fields(dir: &Path) -> Result<()> {
     let (path, partial) = FieldsTable::paths(dir);
-    for path in [path, partial] {
-        match fs::remove_file(&path) {
-            Err(e) if e.kind() != io::ErrorKind::NotFound => {
-                return Err(Error::io("removing the earlier run's table", &path, e))
-            }
-            _ => {}
+    remove_if_exists(&path)?;
+    remove_if_exists(&partial)
+}
+
+/// Removes `profiles.csv` and `profiles.csv.partial` from `dir` (where they exist).
+fn remove_profiles(dir: &Path) -> Result<()> {
+    let (path, partial) = ProfilesTable::paths(dir);
+    remove_if_exists(&path)?;
+    remove_if_exists(&partial)
+}
+
+/// Removes what an earlier run recorded beside its tables.
+fn remove_recordings(dir: &Path) -> Result<()> {
+    remove_fields(dir)?;
+    remove_profiles(dir)
+}
+
+/// A new table at `path` holding its header.
+fn new_table(path: &Path, header: &str) -> Result<File> {
+    // A FIFO there would block the open, a link would be written through.
+    check_replaceable(path, "creating table")?;
+    let mut file = File::create(path).map_err(|e| Error::io("creating table", path, e))?;
+    writeln!(file, "{header}").map_err(|e| Error::io("writing table", path, e))?;
+    Ok(file)
+}
+
+/// The table at `path` rewritten (atomically) as `text`, opened to append.
+fn append_to(path: &Path, text: &str) -> Result<File> {
+    write_atomically(path, text.as_bytes(), "writing table")?;
+    OpenOptions::new()
+        .append(true)
+        .open(path)
+        .map_err(|e| Error::io("opening table", path, e))
+}
+
+/// The text of a table of a run under way (`partial`), else of a finished run (`path`),
+/// and the path read (`partial` when neither exists).
+fn read_old(partial: &Path, path: &Path) -> Result<(Option<String>, PathBuf)> {
+    for p in [partial, path] {
+        if let Some(text) = read_text_if_exists(p, "reading table")? {
+            return Ok((Some(text), p.to_path_buf()));
         }
     }
-    Ok(())
+    Ok((None, partial.to_path_buf()))
+}
+
+/// Refuses run options that `driver`'s scene cannot record, naming the key.
+fn check_options(driver: &Driver, options: &RunOptions) -> Result<()> {
+    crate::scene::check_run_options(options, driver.grid(), driver.scene().probes().tolerance())
 }
 
 /// Refuses a directory whose recorded scene is not `driver`'s, or that records none.

@@ -28,6 +28,7 @@ mod distributions;
 mod error;
 mod figures;
 mod movie;
+mod profiles;
 
 pub use error::PlotError;
 pub use figures::{draw, draw_with_size, Drawn, Format};

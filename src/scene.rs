@@ -26,10 +26,12 @@ use crate::geometry::{Block, Grid};
 use crate::green::{InfluencePlan, Planner, RodLoad};
 use crate::interface::{AreaLaw, HeightDistribution, Heights, Interface, Material, SpringLaw};
 use crate::probe::{ProbeSpec, StressProbe};
+use crate::recording::RunOptions;
 use crate::solver::SolverOptions;
 use crate::surface::SurfaceSpectrum;
 
 mod bounds;
+pub(crate) use bounds::run_options as check_run_options;
 pub(crate) mod file;
 pub(crate) mod schema;
 
@@ -444,15 +446,7 @@ pub struct SceneBuilder {
     plan_tolerance: f64,
     probes: ProbeSpec,
     max_cells: usize,
-    fields: FieldRecording,
-}
-
-/// What a run records of its fields ([`SceneBuilder::record_fields`]): every `every`-th
-/// stable state (0: none), the planes of the Coulomb stress profiles.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub(crate) struct FieldRecording {
-    pub(crate) every: usize,
-    pub(crate) planes: Vec<f64>,
+    run: RunOptions,
 }
 
 impl Default for SceneBuilder {
@@ -469,7 +463,7 @@ impl Default for SceneBuilder {
             plan_tolerance: 1e-8,
             probes: ProbeSpec::default(),
             max_cells: crate::green::DEFAULT_MAX_CELLS,
-            fields: FieldRecording::default(),
+            run: RunOptions::default(),
         }
     }
 }
@@ -578,33 +572,40 @@ impl SceneBuilder {
         self
     }
 
-    /// Records the fields of the run's stable states for the movies (`precursors movie`,
-    /// `crate::plot::Movie`, feature `plot`): the run tables ([`crate::output::RunTables`])
-    /// then write `fields.csv` ([`crate::output::FIELDS_TABLE`]) with, at the 1st, the
-    /// `(1 + every)`-th, the `(1 + 2·every)`-th, ... stable state, the real contact area
-    /// `A_R` of each cell (m²) and the y-averaged Coulomb stress `τ_C(x, z)` (Pa) on each
-    /// of `planes` (heights `z` in m above the interface, within `[0, Lz]`). `every = 0`
-    /// (the default) records nothing; `planes` may be empty (the contact area only).
-    /// Recording observes: it changes neither the events nor the scene's identity (a
-    /// checkpoint resumes across it; the resumed tables are checked against it).
+    /// What a run of the scene records beside its three tables (default: nothing; the
+    /// scene file's keys `fields` and `profiles`): the options
+    /// [`crate::output::RunTables::create`] takes for its run (`create_with` takes
+    /// others). Recording observes: it changes neither the events nor the scene's
+    /// identity (a checkpoint resumes across it; the resumed tables are checked against
+    /// it). Checked when the scene is built, each refusal naming its key.
     ///
     /// ```
-    /// use precursors::Scene;
+    /// use precursors::{RunOptions, Scene};
     /// let scene = Scene::builder()
     ///     .block(0.010, 0.004, 0.010)
-    ///     .record_fields(5, &[0.0, 0.005])
+    ///     .run_options(RunOptions::new().record_fields(5, &[0.0, 0.005]))
     ///     .build()?;
-    /// assert_eq!(scene.fields_every(), 5);
-    /// assert_eq!(scene.field_planes(), [0.0, 0.005]);
+    /// assert_eq!(scene.run_options().fields_every(), 5);
+    /// assert_eq!(scene.run_options().field_planes(), [0.0, 0.005]);
     /// // Outside the block: refused when the scene is built.
-    /// assert!(Scene::builder().block(0.010, 0.004, 0.010).record_fields(1, &[0.02]).build().is_err());
+    /// let outside = RunOptions::new().record_profiles(&[0.5], &[0.02]);
+    /// assert!(Scene::builder().block(0.010, 0.004, 0.010).run_options(outside).build().is_err());
     /// # Ok::<(), precursors::Error>(())
     /// ```
+    pub fn run_options(mut self, options: RunOptions) -> Self {
+        self.run = options;
+        self
+    }
+
+    /// Records the fields of the run's stable states for the movies: as
+    /// [`RunOptions::record_fields`] in [`SceneBuilder::run_options`].
+    #[deprecated(
+        since = "1.1.0",
+        note = "what a run records is a `RunOptions`: \
+                `.run_options(RunOptions::new().record_fields(every, planes))`"
+    )]
     pub fn record_fields(mut self, every: usize, planes: &[f64]) -> Self {
-        self.fields = FieldRecording {
-            every,
-            planes: planes.to_vec(),
-        };
+        self.run = self.run.record_fields(every, planes);
         self
     }
 
@@ -627,10 +628,10 @@ impl SceneBuilder {
         self.normal_load
     }
 
-    /// The fields recording set so far (see [`SceneBuilder::current_springs`]).
-    #[cfg_attr(not(feature = "plot"), allow(dead_code))]
-    pub(crate) fn current_fields(&self) -> &FieldRecording {
-        &self.fields
+    /// The run options set so far (see [`SceneBuilder::current_springs`]).
+    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
+    pub(crate) fn current_run(&self) -> &RunOptions {
+        &self.run
     }
 
     /// The heights source set so far (see [`SceneBuilder::current_springs`]).
@@ -925,16 +926,22 @@ impl Scene {
         &self.inner.builder.probes
     }
 
-    /// Every how many stable states a run records its fields
-    /// ([`SceneBuilder::record_fields`]; 0: none, the default).
-    pub fn fields_every(&self) -> usize {
-        self.inner.builder.fields.every
+    /// What a run of the scene records beside its tables
+    /// ([`SceneBuilder::run_options`]; nothing by default).
+    pub fn run_options(&self) -> &RunOptions {
+        &self.inner.builder.run
     }
 
-    /// The heights `z` (m) of the planes whose y-averaged Coulomb stress a run records
-    /// ([`SceneBuilder::record_fields`]; empty by default).
+    /// Every how many stable states a run records its fields (0: none, the default).
+    #[deprecated(since = "1.1.0", note = "use `scene.run_options().fields_every()`")]
+    pub fn fields_every(&self) -> usize {
+        self.inner.builder.run.fields_every()
+    }
+
+    /// The heights `z` (m) of the planes whose y-averaged Coulomb stress a run records.
+    #[deprecated(since = "1.1.0", note = "use `scene.run_options().field_planes()`")]
     pub fn field_planes(&self) -> &[f64] {
-        &self.inner.builder.fields.planes
+        self.inner.builder.run.field_planes()
     }
 
     /// The default probes as planned at build (`None` when there are none).

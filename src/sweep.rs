@@ -696,7 +696,7 @@ impl Sweep {
         let scene = run.scene.clone().build_with_planner(&self.planner)?;
         let built = started.elapsed().as_secs_f64();
         let mut driver = scene.driver()?;
-        let tables = RunTables::start(&dir, &driver, None)?;
+        let tables = RunTables::start(&dir, &driver, driver.scene().run_options(), None)?;
         let (mut slip, mut ruptures, mut stable_states) = (None, 0usize, 0usize);
         tables.run_to_slip(&mut driver, None, |event, _| match event {
             crate::driver::Event::GlobalSlip { load } => slip = Some(load.force),

@@ -32,6 +32,8 @@ mod paper_sweeps;
 #[cfg(feature = "plot")]
 mod plot;
 mod probe;
+#[cfg(feature = "serde")]
+mod profiles;
 mod properties;
 mod refinement;
 mod robustness;

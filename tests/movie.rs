@@ -9,7 +9,7 @@
 
 use precursors::output::{RunTables, FIELDS_TABLE};
 use precursors::plot::{Movie, MovieKind, PlotError};
-use precursors::{Error, Event, ProbeSpec, Scene, SceneBuilder};
+use precursors::{Error, Event, ProbeSpec, RunOptions, Scene, SceneBuilder};
 use std::path::{Path, PathBuf};
 
 fn scratch(name: &str) -> PathBuf {
@@ -41,7 +41,10 @@ fn recording_fields_changes_no_table_and_records_the_drivers_fields() {
     let recorded = scratch("recorded");
     run(&builder().build().unwrap(), &plain);
     let every = 3;
-    let scene = builder().record_fields(every, &PLANES).build().unwrap();
+    let scene = builder()
+        .run_options(RunOptions::new().record_fields(every, &PLANES))
+        .build()
+        .unwrap();
     run(&scene, &recorded);
     for name in ["events.csv", "curve.csv", "contact_map.csv"] {
         let a = std::fs::read(plain.join(name)).unwrap();
@@ -121,7 +124,10 @@ fn recording_fields_changes_no_table_and_records_the_drivers_fields() {
 
 #[test]
 fn resumed_fields_end_as_the_uninterrupted_ones_and_another_recording_is_refused() {
-    let scene = builder().record_fields(2, &PLANES).build().unwrap();
+    let scene = builder()
+        .run_options(RunOptions::new().record_fields(2, &PLANES))
+        .build()
+        .unwrap();
     let whole = scratch("whole");
     run(&scene, &whole);
     // The same run killed 30 events after a checkpoint at its 12th stable state.
@@ -150,7 +156,10 @@ fn resumed_fields_end_as_the_uninterrupted_ones_and_another_recording_is_refused
     drop(tables);
     let checkpoint = checkpoint.unwrap();
     // Recorded every 3rd state instead: the table does not match, refused.
-    let other = builder().record_fields(3, &PLANES).build().unwrap();
+    let other = builder()
+        .run_options(RunOptions::new().record_fields(3, &PLANES))
+        .build()
+        .unwrap();
     let driver = other.resume(&checkpoint).unwrap();
     match RunTables::resume(&cut, &driver) {
         Err(Error::CorruptTable { path, reason }) => {
@@ -190,7 +199,7 @@ fn handwritten(name: &str) -> (PathBuf, Vec<usize>) {
     let builder = Scene::builder()
         .block(0.010, 0.004, 0.010)
         .cell_size(1e-3, 1e-3)
-        .record_fields(1, &[0.001]);
+        .run_options(RunOptions::new().record_fields(1, &[0.001]));
     std::fs::write(dir.join("scene.json"), builder.to_json().unwrap()).unwrap();
     let mut text = String::from("event,force_over_mu_FN,precursor_over_Lx,field,row,z_m");
     for ix in 0..10 {
@@ -383,7 +392,10 @@ fn a_directory_without_recorded_fields_is_refused_saying_how_to_record_them() {
     assert!(text.contains("\"fields\": {\"every\": 1"), "{text}");
     assert!(text.contains("precursors run"), "{text}");
     // The contact area only: the Coulomb stress movie is refused, naming the key.
-    let scene = builder().record_fields(4, &[]).build().unwrap();
+    let scene = builder()
+        .run_options(RunOptions::new().record_fields(4, &[]))
+        .build()
+        .unwrap();
     run(&scene, &dir);
     Movie::new(&dir, MovieKind::ContactArea)
         .save(dir.join("s1.gif"))

@@ -75,7 +75,7 @@ impl std::fmt::Display for Bad {
 }
 
 /// A row's check.
-type Row<T> = std::result::Result<T, Bad>;
+pub(super) type Row<T> = std::result::Result<T, Bad>;
 
 /// The largest `|F|/(μF_N)` of a stable state (the writer's limit, `map_rows_below`):
 /// no stable state carries more than the friction limit.
@@ -147,12 +147,12 @@ pub(crate) struct MapRow {
 }
 
 /// A cell's problem as `line L, column NAME: ...`.
-fn at(line: usize, column: &str, what: impl std::fmt::Display) -> Bad {
+pub(super) fn at(line: usize, column: &str, what: impl std::fmt::Display) -> Bad {
     Bad::Reason(format!("line {line}, column {column}: {what}"))
 }
 
 /// The cell `k` (named by `header`'s `k`-th column) as a finite number.
-fn number(line: usize, header: &[&str], cells: &[&str], k: usize) -> Row<f64> {
+pub(super) fn number(line: usize, header: &[&str], cells: &[&str], k: usize) -> Row<f64> {
     let text = cells[k];
     match text.parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
@@ -175,7 +175,7 @@ fn number(line: usize, header: &[&str], cells: &[&str], k: usize) -> Row<f64> {
 }
 
 /// The cell `k` as a whole number.
-fn count(line: usize, header: &[&str], cells: &[&str], k: usize) -> Row<usize> {
+pub(super) fn count(line: usize, header: &[&str], cells: &[&str], k: usize) -> Row<usize> {
     cells[k].parse().map_err(|e| {
         at(
             line,
@@ -195,7 +195,7 @@ fn optional(line: usize, header: &[&str], cells: &[&str], k: usize) -> Row<Optio
 }
 
 /// The cells of `row` under `header`, as many as it has columns.
-fn cells<'a>(line: usize, header: &[&str], row: &'a str) -> Row<Vec<&'a str>> {
+pub(super) fn cells<'a>(line: usize, header: &[&str], row: &'a str) -> Row<Vec<&'a str>> {
     let cells: Vec<&str> = row.split(',').collect();
     if cells.len() != header.len() {
         return Err(format!(
@@ -421,7 +421,7 @@ pub(crate) fn map_row(line: usize, header: &[&str], row: &str) -> Row<MapRow> {
 
 /// The rows of a table's text (line number, row) under `header`, every one whole: a
 /// finished table has no row cut by a crash.
-fn rows<'a>(text: &'a str, header: &str) -> Row<Vec<(usize, &'a str)>> {
+pub(super) fn rows<'a>(text: &'a str, header: &str) -> Row<Vec<(usize, &'a str)>> {
     let mut lines = text.split_inclusive('\n');
     match lines.next() {
         Some(first) if first.trim_end_matches(['\n', '\r']) == header => {}
@@ -548,6 +548,8 @@ pub(crate) struct RunRecord {
     pub slip: f64,
     /// `contact_map.csv` (`None` for a directory without it).
     pub map: Option<Vec<MapRow>>,
+    /// What the run recorded beside its tables (from its scene record).
+    pub options: crate::recording::RunOptions,
 }
 
 #[cfg(feature = "serde")]
@@ -599,6 +601,7 @@ impl RunRecord {
         } else {
             None
         };
+        let options = scene.current_run().clone();
         Ok(RunRecord {
             bounds,
             grid,
@@ -607,6 +610,7 @@ impl RunRecord {
             curve,
             slip: slip_force / bounds.mu_fn,
             map,
+            options,
         })
     }
 

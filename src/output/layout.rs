@@ -10,6 +10,8 @@ use std::path::Path;
 use super::derived::{AVALANCHE_TABLE, FRONTS_TABLE};
 use super::{FIELDS_TABLE, PARTIAL_SUFFIX, SCENE_RECORD, TABLE_NAMES};
 
+/// The profiles a run records at given loads (`output/profiles.rs`).
+pub(crate) const PROFILES_TABLE: &str = "profiles.csv";
 /// The completion marker of a sweep's run (`crate::sweep::DONE_FILE`).
 pub(crate) const DONE: &str = "done";
 /// A sweep's run's record of its coordinates, counts and timings.
@@ -30,14 +32,26 @@ pub(crate) const FRONTS_FIGURE: &str = "fronts";
 pub(crate) const SIZES_FIGURE: &str = "avalanche_sizes";
 /// The figure of the force drops' distribution.
 pub(crate) const DROPS_FIGURE: &str = "force_drops";
+/// The slip profiles at the recorded loads (`profiles.csv`).
+pub(crate) const SLIP_PROFILES_FIGURE: &str = "slip_profiles";
+/// `|τ(x, z_P)|` at the recorded loads (paper Fig. S10).
+pub(crate) const SHEAR_PROFILES_FIGURE: &str = "shear_profiles";
+/// `|σ(x, z_P)|` at the recorded loads (paper Fig. S10).
+pub(crate) const NORMAL_PROFILES_FIGURE: &str = "normal_profiles";
+/// The stresses and Coulomb stresses at the first recorded load (paper Fig. 7).
+pub(crate) const COULOMB_PROFILES_FIGURE: &str = "coulomb_profiles";
 /// The figures `plot` draws.
-pub(crate) const FIGURES: [&str; 6] = [
+pub(crate) const FIGURES: [&str; 10] = [
     PRECURSOR_FIGURE,
     AREA_FIGURE,
     MAP_FIGURE,
     FRONTS_FIGURE,
     SIZES_FIGURE,
     DROPS_FIGURE,
+    SLIP_PROFILES_FIGURE,
+    SHEAR_PROFILES_FIGURE,
+    NORMAL_PROFILES_FIGURE,
+    COULOMB_PROFILES_FIGURE,
 ];
 /// The extensions of the figures.
 pub(crate) const FIGURE_EXTENSIONS: [&str; 2] = ["png", "svg"];
@@ -73,6 +87,7 @@ pub(crate) fn reserved(name: &str) -> bool {
     let base = name.strip_suffix(PARTIAL_SUFFIX).unwrap_or(name);
     TABLE_NAMES.contains(&base)
         || base == FIELDS_TABLE
+        || base == PROFILES_TABLE
         || [SCENE_RECORD, LOCK_FILE, DONE, META, SWEEP].contains(&name)
         || MERGED.contains(&name)
         || derived(name)

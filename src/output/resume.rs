@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 /// The complete rows of a table's text (line number, row), its header checked: a last
 /// row cut by a crash (no trailing newline, or not as many fields as the header) is left
 /// out; the same damage on an earlier row is refused.
-fn complete_rows<'a>(
+pub(super) fn complete_rows<'a>(
     old: &'a str,
     header: &str,
 ) -> std::result::Result<Vec<(usize, &'a str)>, String> {
@@ -65,6 +65,8 @@ pub(super) struct Continuation {
     pub(super) in_effect: bool,
     /// The events of the stable states up to the checkpoint's.
     pub(super) stable: Vec<usize>,
+    /// Their loads `F/(μF_N)` as `curve.csv` writes them.
+    pub(super) loads: Vec<f64>,
 }
 
 /// Checks the three tables (`old[t]`: the text of table `t` in [`super::TABLE_NAMES`]
@@ -109,6 +111,7 @@ pub(super) fn continuation(
         next_level,
         in_effect: k > 0,
         stable,
+        loads,
     })
 }
 

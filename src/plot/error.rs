@@ -61,7 +61,7 @@ pub enum PlotError {
         "{}: no recorded fields to draw a movie from: {}. Record them with the scene-file \
          key \"fields\" (e.g. \"fields\": {{\"every\": 1, \"planes\": [0.0, 0.005]}}: \
          every stable state, τ_C on planes at z = 0 and 5 mm; docs/scene-format.md) or \
-         SceneBuilder::record_fields, then run the scene again into the directory \
+         RunOptions::record_fields, then run the scene again into the directory \
          (`precursors run SCENE --out DIR`)",
         dir.display(),
         Bounded(reason)

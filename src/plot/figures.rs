@@ -14,6 +14,7 @@
 //! area law, do not stretch over the chart as they do the mean's t-band.
 
 use super::distributions::draw_statistics;
+use super::profiles::draw_profiles;
 use super::PlotError;
 use super::{Chart, Corner, Map, Palette};
 use crate::error::{Error, Result};
@@ -440,6 +441,10 @@ fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, P
         drawn.files.push(path);
     }
     draw_contact_map(dir, formats, size, (&title, &record), &mut drawn)?;
+    let extensions: Vec<&str> = formats.iter().map(|f| f.extension()).collect();
+    let profiles = draw_profiles(dir, &extensions, size, &title, &record)?;
+    drawn.files.extend(profiles.files);
+    drawn.notes.extend(profiles.notes);
     Ok(drawn)
 }
 

@@ -1,6 +1,6 @@
 //! The paper's Supplementary Movies drawn from a run directory (`precursors movie DIR`):
 //! the fields a run recorded (`fields.csv`, [`crate::output::FIELDS_TABLE`]; the scene
-//! key `fields`, [`crate::SceneBuilder::record_fields`]) as an animated GIF, one frame per
+//! key `fields`, [`crate::RunOptions::record_fields`]) as an animated GIF, one frame per
 //! recorded stable state (or every k-th), on one colour scale for the whole movie.
 //!
 //! * [`MovieKind::ContactArea`] (Movie S1): the real contact area `A_R` of each cell over
@@ -97,14 +97,14 @@ struct Recording {
 /// ```
 /// use precursors::output::RunTables;
 /// use precursors::plot::{Movie, MovieKind, PlotError};
-/// use precursors::Scene;
+/// use precursors::{RunOptions, Scene};
 /// let dir = std::env::temp_dir().join(format!("precursors-doc-movie-{}", std::process::id()));
 /// std::fs::create_dir_all(&dir)?;
 /// // Record the fields of every 2nd stable state, with two planes for τ_C.
 /// let scene = Scene::builder()
 ///     .block(0.010, 0.004, 0.010)
 ///     .normal_load(100.0)
-///     .record_fields(2, &[0.0, 0.005])
+///     .run_options(RunOptions::new().record_fields(2, &[0.0, 0.005]))
 ///     .build()?;
 /// let mut driver = scene.driver()?;
 /// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
@@ -523,7 +523,7 @@ fn read_recording(dir: &Path) -> Result<Recording> {
     let builder = crate::scene::SceneBuilder::from_json_file(&record)?;
     let grid = builder.grid()?;
     let (nx, ny) = (grid.nx(), grid.ny());
-    let planes = builder.current_fields().planes.clone();
+    let planes = builder.current_run().field_planes().to_vec();
     let text = crate::files::read_text(&table, "reading table")?;
     let corrupt = |reason: String| Error::CorruptTable {
         path: Some(table.clone()),
@@ -540,7 +540,7 @@ fn read_recording(dir: &Path) -> Result<Recording> {
     }
     // The run's tables, checked, for the states the recording must hold.
     let run = RunRecord::read(dir)?;
-    let every = builder.current_fields().every.max(1);
+    let every = builder.current_run().fields_every().max(1);
     let states = read_states(lines, &table, &run, every, (nx, ny), &planes, &header)?;
     if states.is_empty() {
         return Err(no_fields(format!("its {FIELDS_TABLE} holds no state")));

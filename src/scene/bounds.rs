@@ -265,27 +265,8 @@ pub(super) fn solver_iterations(active_set: usize, linear: usize) -> Result<()> 
 /// has begun).
 fn probe_positions(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
     let probes = &builder.probes;
-    let lowest = crate::green::lowest_plane(grid, probes.tolerance());
+    planes_within("probes.planes", probes.planes(), grid, probes.tolerance())?;
     let lz = grid.block().lz();
-    for (key, planes) in [
-        ("fields.planes", builder.fields.planes.as_slice()),
-        ("probes.planes", probes.planes()),
-    ] {
-        for &z in planes {
-            if z == 0.0 || (z.is_finite() && (lowest..=lz).contains(&z)) {
-                continue;
-            }
-            return Err(Error::OutOfRange {
-                key,
-                value: z,
-                range: format!("0 or [{}, {}] m", End(lowest, true), End(lz, false)),
-                reason: "a plane lies in the block (z = 0 is the interface); the stresses on a \
-                         plane closer to the interface than about 0.007 cells (at \
-                         probes.tolerance 1e-10) need more alias terms than their budget: \
-                         use z = 0, or raise the plane or probes.tolerance",
-            });
-        }
-    }
     let block = grid.block();
     let lowest_point = crate::probe::lowest_point(grid, probes.tolerance());
     for p in probes.points() {
@@ -318,6 +299,61 @@ fn probe_positions(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The heights `planes` (key `key`): `0` (the interface) or within `[z_min, Lz]`, where
+/// the transfer's alias sums converge at the probes' `tolerance`.
+fn planes_within(key: &'static str, planes: &[f64], grid: &Grid, tolerance: f64) -> Result<()> {
+    let lowest = crate::green::lowest_plane(grid, tolerance);
+    let lz = grid.block().lz();
+    for &z in planes {
+        if z == 0.0 || (z.is_finite() && (lowest..=lz).contains(&z)) {
+            continue;
+        }
+        return Err(Error::OutOfRange {
+            key,
+            value: z,
+            range: format!("0 or [{}, {}] m", End(lowest, true), End(lz, false)),
+            reason: "a plane lies in the block (z = 0 is the interface); the stresses on a \
+                     plane closer to the interface than about 0.007 cells (at \
+                     probes.tolerance 1e-10) need more alias terms than their budget: \
+                     use z = 0, or raise the plane or probes.tolerance",
+        });
+    }
+    count_within(
+        key,
+        planes.len(),
+        (0, MAX_PROBES),
+        "each probe costs a kernel of Nx·Ny values",
+    )
+}
+
+/// What a run records ([`RunOptions`](crate::recording::RunOptions), scene-file keys
+/// `fields` and `profiles`) on `grid` at the probes' `tolerance`: the planes as
+/// [`planes_within`], the profiles' loads `F/(μF_N)` within `[0, 1]` and at most
+/// [`MAX_PROBES`] of them.
+pub(crate) fn run_options(
+    options: &crate::recording::RunOptions,
+    grid: &Grid,
+    tolerance: f64,
+) -> Result<()> {
+    planes_within("fields.planes", options.field_planes(), grid, tolerance)?;
+    planes_within("profiles.planes", options.profile_planes(), grid, tolerance)?;
+    for &load in options.profile_loads() {
+        within(
+            "profiles.loads",
+            load,
+            (0.0, 1.0),
+            "(F/(μF_N))",
+            "no stable state carries a load beyond the friction limit μF_N",
+        )?;
+    }
+    count_within(
+        "profiles.loads",
+        options.profile_loads().len(),
+        (0, MAX_PROBES),
+        "each load is a row group of the table",
+    )
 }
 
 /// Everything but the geometry (after the builder's own checks of signs and finiteness).
@@ -381,18 +417,13 @@ pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
         "below 1e-15 the alias sums cannot reach it, above 1e-2 the stresses are noise",
     )?;
     probe_positions(builder, grid)?;
-    for (key, count) in [
-        ("probes.planes", probes.planes().len()),
-        ("probes.points", probes.points().len()),
-        ("fields.planes", builder.fields.planes.len()),
-    ] {
-        count_within(
-            key,
-            count,
-            (0, MAX_PROBES),
-            "each probe costs a kernel of Nx·Ny values",
-        )?;
-    }
+    count_within(
+        "probes.points",
+        probes.points().len(),
+        (0, MAX_PROBES),
+        "each probe costs a kernel of Nx·Ny values",
+    )?;
+    run_options(&builder.run, grid, probes.tolerance())?;
     // The last site attached carries the whole normal load: its tangential stiffness and
     // area grow like e^{F_N/(ΔA c_z)}.
     let exponent = builder.normal_load / (grid.cell_area() * builder.law.c_z());

@@ -20,6 +20,7 @@ use {
     crate::geometry::Point,
     crate::interface::{HeightDistribution, Material, SpringLaw},
     crate::probe::ProbeSpec,
+    crate::recording::RunOptions,
     crate::solver::SolverOptions,
     serde::{Deserialize, Serialize},
     std::path::Path,
@@ -49,11 +50,14 @@ schema_struct! {
         /// were.
         #[cfg_attr(feature = "serde", serde(skip_serializing_if = "FieldsSpec::is_off"))]
         fields: FieldsSpec,
+        /// Written only when profiles are recorded.
+        #[cfg_attr(feature = "serde", serde(skip_serializing_if = "ProfilesSpec::is_off"))]
+        profiles: ProfilesSpec,
     }
 }
 
 schema_struct! {
-    /// `fields`: what a run records for the movies (`SceneBuilder::record_fields`).
+    /// `fields`: what a run records for the movies (`RunOptions::record_fields`).
     #[derive(Debug, Clone, PartialEq)]
     #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
     #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
@@ -67,6 +71,24 @@ schema_struct! {
 impl FieldsSpec {
     fn is_off(&self) -> bool {
         self.every == 0 && self.planes.is_empty()
+    }
+}
+
+schema_struct! {
+    /// `profiles`: the profiles a run records at given loads (`RunOptions::record_profiles`).
+    #[derive(Debug, Clone, PartialEq)]
+    #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+    #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+    struct ProfilesSpec {
+        loads: Vec<f64>,
+        planes: Vec<f64>,
+    }
+}
+
+#[cfg(feature = "serde")]
+impl ProfilesSpec {
+    fn is_off(&self) -> bool {
+        self.loads.is_empty() && self.planes.is_empty()
     }
 }
 
@@ -345,6 +367,7 @@ default_from_builder!(SpringsSpec, springs);
 default_from_builder!(SolverSpec, solver);
 default_from_builder!(ProbesSpec, probes);
 default_from_builder!(FieldsSpec, fields);
+default_from_builder!(ProfilesSpec, profiles);
 
 impl From<Lateral> for LateralSpec {
     fn from(l: Lateral) -> Self {
@@ -381,7 +404,7 @@ impl From<&SceneBuilder> for SceneFile {
             plan_tolerance,
             probes,
             max_cells,
-            fields,
+            run,
         } = b;
         let drive = match *drive {
             Drive::Force(ForceLoad::Top) => DriveSpec::Top {},
@@ -477,8 +500,12 @@ impl From<&SceneBuilder> for SceneFile {
             },
             max_cells: *max_cells,
             fields: FieldsSpec {
-                every: fields.every,
-                planes: fields.planes.clone(),
+                every: run.fields_every(),
+                planes: run.field_planes().to_vec(),
+            },
+            profiles: ProfilesSpec {
+                loads: run.profile_loads().to_vec(),
+                planes: run.profile_planes().to_vec(),
             },
         }
     }
@@ -594,10 +621,9 @@ impl SceneFile {
             plan_tolerance: self.plan_tolerance,
             probes,
             max_cells: self.max_cells,
-            fields: super::FieldRecording {
-                every: self.fields.every,
-                planes: self.fields.planes,
-            },
+            run: RunOptions::new()
+                .record_fields(self.fields.every, &self.fields.planes)
+                .record_profiles(&self.profiles.loads, &self.profiles.planes),
         })
     }
 }
@@ -997,7 +1023,8 @@ mod tests {
                     .unwrap(),
             )
             .max_cells(5000)
-            .probes(ProbeSpec::default().with_plane(1e-3)),
+            .probes(ProbeSpec::default().with_plane(1e-3))
+            .run_options(RunOptions::new().record_profiles(&[0.2, 0.4], &[0.0])),
         ]
     }
 
@@ -1016,7 +1043,8 @@ mod tests {
             assert!(left_out.iter().all(|k| *k == "solver.threads"
                 || *k == "max_cells"
                 || k.starts_with("probes.")
-                || k.starts_with("fields.")));
+                || k.starts_with("fields.")
+                || k.starts_with("profiles.")));
         }
     }
 
@@ -1032,7 +1060,11 @@ mod tests {
             )
             .max_cells(10)
             .probes(ProbeSpec::default().with_plane(1e-3))
-            .record_fields(3, &[1e-3]);
+            .run_options(
+                RunOptions::new()
+                    .record_fields(3, &[1e-3])
+                    .record_profiles(&[0.5], &[1e-3]),
+            );
         assert_eq!(first_difference(&a, &b), None);
         assert_eq!(
             first_difference(&a, &a.clone().normal_load(1.0)).as_deref(),

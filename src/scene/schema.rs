@@ -16,7 +16,13 @@ use crate::interface::AreaLaw;
 /// (results are bit for bit the same for every choice), the probes (observers, which a
 /// driver may add at any time) and the cell limit (a bound, not a value). They are not
 /// part of a scene's identity: a checkpoint resumes across them.
-pub(crate) const OBSERVERS: [&str; 4] = ["solver.threads", "probes", "max_cells", "fields"];
+pub(crate) const OBSERVERS: [&str; 5] = [
+    "solver.threads",
+    "probes",
+    "max_cells",
+    "fields",
+    "profiles",
+];
 
 /// A node of the scene's schema: a value of the scene file.
 pub(crate) trait Schema {

@@ -1,0 +1,193 @@
+//! The figures of the profiles a run recorded at requested loads (`profiles.csv`, scene
+//! key `profiles`), drawn by [`super::draw`] for a run that records them:
+//!
+//! * `slip_profiles`: the slip `⟨u_x⟩_y` (µm) along `x` at each recorded load;
+//! * `shear_profiles` and `normal_profiles` (the paper's Fig. S10): `|τ(x, z_P)|` and
+//!   `|σ(x, z_P)|` (MPa) on the lowest recorded plane above the interface, at each load;
+//! * `coulomb_profiles` (the paper's Fig. 7): at the first recorded load, `|τ|`, `|σ|`
+//!   and `τ_C = |τ| - μ|σ|` of the y-averages on that plane, and `τ_C` averaged over `y`
+//!   at the interface when the plane `z = 0` is recorded too.
+//!
+//! One curve per load, coloured from blue (lowest) to red (highest).
+
+use super::{Chart, Colours, Corner, PlotError, Style};
+use crate::output::check::RunRecord;
+use crate::output::layout::{
+    COULOMB_PROFILES_FIGURE, NORMAL_PROFILES_FIGURE, SHEAR_PROFILES_FIGURE, SLIP_PROFILES_FIGURE,
+};
+use crate::output::profiles::ProfileRow;
+use std::path::{Path, PathBuf};
+
+/// What [`draw_profiles`] drew, and what it left out and why.
+#[derive(Debug, Default)]
+pub(super) struct Profiles {
+    pub files: Vec<PathBuf>,
+    pub notes: Vec<String>,
+}
+
+/// One recorded load's rows.
+struct Level<'a> {
+    load: f64,
+    rows: Vec<&'a ProfileRow>,
+}
+
+impl Level<'_> {
+    /// The values of `field` at height `z`, against `x` (mm) at the columns' centres.
+    fn curve(&self, field: &str, z: f64, dx_mm: f64, f: impl Fn(f64) -> f64) -> Vec<(f64, f64)> {
+        self.rows
+            .iter()
+            .find(|r| r.field == field && r.z == z)
+            .map(|r| {
+                r.values
+                    .iter()
+                    .enumerate()
+                    .map(|(ix, &v)| ((ix as f64 + 0.5) * dx_mm, f(v)))
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+
+    fn label(&self) -> String {
+        format!("F/(μF_N) = {}", short(self.load))
+    }
+}
+
+/// Draws the profiles figures of the run `record` (read from `dir`) into `dir`, as files
+/// of each of `extensions`; nothing (and no note) when the run records no profiles.
+pub(super) fn draw_profiles(
+    dir: &Path,
+    extensions: &[&str],
+    size: (u32, u32),
+    title: &str,
+    record: &RunRecord,
+) -> Result<Profiles, PlotError> {
+    let mut drawn = Profiles::default();
+    let Some(rows) = crate::output::profiles::read(dir, record)? else {
+        return Ok(drawn);
+    };
+    let loads = record.options.profile_loads();
+    let mut levels: Vec<Level> = Vec::new();
+    for row in &rows {
+        match levels.last_mut() {
+            Some(l) if l.load == loads[row.level] => l.rows.push(row),
+            _ => levels.push(Level {
+                load: loads[row.level],
+                rows: vec![row],
+            }),
+        }
+    }
+    if levels.is_empty() {
+        drawn.notes.push(
+            "no profiles figures: the run passed none of the loads of `profiles.loads`".into(),
+        );
+        return Ok(drawn);
+    }
+    let dx_mm = record.grid.dx() * 1e3;
+    let lx_mm = record.bounds.lx * 1e3;
+    let save = |chart: Chart, name: &str, drawn: &mut Profiles| -> Result<(), PlotError> {
+        for extension in extensions {
+            let path = dir.join(format!("{name}.{extension}"));
+            chart.save(&path)?;
+            drawn.files.push(path);
+        }
+        Ok(())
+    };
+    let family = |what: &str, y: &str, field: &str, z: f64, f: &dyn Fn(f64) -> f64| {
+        levels.iter().fold(
+            Chart::new(&format!("{what}: {title}"), "x (mm)", y)
+                .size(size.0, size.1)
+                .x_range(0.0, lx_mm)
+                .colours(Colours::Ordered)
+                .legend(Corner::UpperRight),
+            |chart, level| chart.line(&level.label(), &level.curve(field, z, dx_mm, f)),
+        )
+    };
+    let micro = |v: f64| v * 1e6;
+    save(
+        family(
+            "Slip profiles ⟨u_x⟩_y",
+            "⟨u_x⟩_y (µm)",
+            "slip_m",
+            0.0,
+            &micro,
+        ),
+        SLIP_PROFILES_FIGURE,
+        &mut drawn,
+    )?;
+    let planes = record.options.profile_planes();
+    let lowest = planes.iter().copied().filter(|&z| z > 0.0).reduce(f64::min);
+    let Some(z_p) = lowest else {
+        drawn.notes.push(
+            "no shear_profiles, normal_profiles or coulomb_profiles figure: no plane above \
+             the interface is recorded (`profiles.planes`)"
+                .into(),
+        );
+        return Ok(drawn);
+    };
+    let mpa = |v: f64| v.abs() * 1e-6;
+    let at = format!("z_P = {} mm", short(z_p * 1e3));
+    save(
+        family(
+            &format!("|τ(x, z_P)|, {at}"),
+            "|τ_xz| (MPa)",
+            "shear_Pa",
+            z_p,
+            &mpa,
+        ),
+        SHEAR_PROFILES_FIGURE,
+        &mut drawn,
+    )?;
+    save(
+        family(
+            &format!("|σ(x, z_P)|, {at}"),
+            "|σ_zz| (MPa)",
+            "normal_Pa",
+            z_p,
+            &mpa,
+        ),
+        NORMAL_PROFILES_FIGURE,
+        &mut drawn,
+    )?;
+    let first = &levels[0];
+    let signed = |v: f64| v * 1e-6;
+    let mut chart = Chart::new(
+        &format!("Stresses at {}, {at}: {title}", first.label()),
+        "x (mm)",
+        "stress (MPa)",
+    )
+    .size(size.0, size.1)
+    .x_range(0.0, lx_mm)
+    .legend(Corner::UpperRight)
+    .line("|τ(x, z_P)|", &first.curve("shear_Pa", z_p, dx_mm, mpa))
+    .line("|σ(x, z_P)|", &first.curve("normal_Pa", z_p, dx_mm, mpa))
+    .line(
+        "τ_C(x, z_P) = |τ| - μ|σ|",
+        &first.curve("coulomb_of_means_Pa", z_p, dx_mm, signed),
+    );
+    if planes.contains(&0.0) {
+        chart = chart
+            .line(
+                "τ_C(x, 0), averaged over y",
+                &first.curve("mean_coulomb_Pa", 0.0, dx_mm, signed),
+            )
+            .style(Style::new().dashed());
+    } else {
+        drawn.notes.push(
+            "coulomb_profiles: no τ_C at the interface (record the plane z = 0 in \
+             `profiles.planes`)"
+                .into(),
+        );
+    }
+    save(chart, COULOMB_PROFILES_FIGURE, &mut drawn)?;
+    Ok(drawn)
+}
+
+/// `v` with up to four significant digits, trailing zeros dropped.
+fn short(v: f64) -> String {
+    let text = format!("{v:.4}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    }
+}
