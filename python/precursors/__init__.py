@@ -68,13 +68,14 @@ __all__ = [
 
 
 def read_tables(directory: Union[str, Path]) -> Dict[str, Dict[str, np.ndarray]]:
-    """The tables of a run directory (``events``, ``curve``, ``contact_map``, and those a
-    finished run derives from them, ``per_avalanche`` and ``fronts``; those that are
-    complete) as dicts of columns (see ``read_table``)."""
+    """The tables of a run directory (``events``, ``curve``, ``contact_map``, those a
+    finished run derives from them, ``per_avalanche`` and ``fronts``, and ``profiles``
+    when the run records them; those that are complete) as dicts of columns (see
+    ``read_table``)."""
     directory = Path(directory)
     return {
         name: read_table(directory / f"{name}.csv")
-        for name in ("events", "curve", "contact_map", "per_avalanche", "fronts")
+        for name in ("events", "curve", "contact_map", "per_avalanche", "fronts", "profiles")
         if (directory / f"{name}.csv").is_file()
     }
 

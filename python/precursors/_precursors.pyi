@@ -42,6 +42,8 @@ class Scene:
         threads: Union[int, str, None] = ...,
         probe_planes: Optional[Sequence[float]] = ...,
         probe_points: Optional[Sequence[Tuple[float, float, float]]] = ...,
+        profile_loads: Optional[Sequence[float]] = ...,
+        profile_planes: Optional[Sequence[float]] = ...,
     ) -> None: ...
     @staticmethod
     def from_file(path: _Path) -> Scene: ...

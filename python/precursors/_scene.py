@@ -98,6 +98,8 @@ def scene_dict(
     threads: Union[int, str, None] = None,
     probe_planes: Optional[Sequence[float]] = None,
     probe_points: Optional[Sequence[Tuple[float, float, float]]] = None,
+    profile_loads: Optional[Sequence[float]] = None,
+    profile_planes: Optional[Sequence[float]] = None,
 ) -> Dict[str, Any]:
     """The scene-file dict of the keywords of ``precursors.Scene(...)``; a keyword left
     out is a key left out (the calibration scene's value)."""
@@ -179,4 +181,11 @@ def scene_dict(
         probes["points"] = [list(p) for p in probe_points]
     if probes:
         scene["probes"] = probes
+    if profile_planes is not None and profile_loads is None:
+        raise TypeError("profile_planes= goes with profile_loads=[F/(μF_N), ...]")
+    if profile_loads is not None:
+        scene["profiles"] = {
+            "loads": [float(x) for x in profile_loads],
+            "planes": [float(z) for z in (profile_planes or [])],
+        }
     return scene

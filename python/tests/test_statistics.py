@@ -54,3 +54,37 @@ def test_the_fit_recovers_a_known_exponent():
     assert fit["p_value"] is None
     with pytest.raises(precursors.PrecursorsValueError, match="samples"):
         precursors.fit_power_law([1.0, 2.0], discrete=True)
+
+
+def test_profiles_at_requested_loads(tmp_path):
+    # Keywords map onto the scene file's key `profiles`; the run writes profiles.csv and
+    # read_tables reads it: per load passed, 3 interface rows and 4 per plane.
+    scene = precursors.Scene(
+        block=(0.02, 0.004, 0.01),
+        cell_size=(1e-3, 1e-3),
+        normal_load=300.0,
+        seed=5,
+        profile_loads=[0.8, 0.2, 0.5],
+        profile_planes=[0.002],
+    )
+    # The loads kept in increasing order.
+    assert scene.to_dict()["profiles"] == {"loads": [0.2, 0.5, 0.8], "planes": [0.002]}
+    precursors.run(scene, tmp_path)
+    profiles = precursors.read_tables(tmp_path)["profiles"]
+    levels = list(dict.fromkeys(profiles["level"]))
+    assert levels == [0.2, 0.5, 0.8]
+    assert len(profiles["field"]) == 3 * 7
+    assert list(profiles["field"][:7]) == [
+        "slip_m",
+        "shear_traction_Pa",
+        "normal_traction_Pa",
+        "shear_Pa",
+        "normal_Pa",
+        "coulomb_of_means_Pa",
+        "mean_coulomb_Pa",
+    ]
+    # The mean slip grows with the load.
+    slip = np.array([[profiles[f"value_ix{ix}"][7 * k] for ix in range(20)] for k in range(3)])
+    assert np.all(np.diff(slip.mean(axis=1)) > 0)
+    with pytest.raises(TypeError, match="profile_loads"):
+        precursors.Scene(profile_planes=[0.002])
