@@ -30,11 +30,18 @@ pub(crate) const FRONTS_FIGURE: &str = "fronts";
 pub(crate) const SIZES_FIGURE: &str = "avalanche_sizes";
 /// The figure of the force drops' distribution.
 pub(crate) const DROPS_FIGURE: &str = "force_drops";
-/// The figures `plot` draws.
-pub(crate) const FIGURES: [&str; 6] = [
+/// The figure of a driving spring's force against the drive displacement (paper Fig. 4).
+pub(crate) const STICK_SLIP_FIGURE: &str = "stick_slip";
+/// The figure of a sweep's real contact area at zero shear against the normal load
+/// (paper Fig. 2a).
+pub(crate) const ARCHARD_FIGURE: &str = "archard";
+/// The figures `plot` draws (the names `plot --figure` takes).
+pub(crate) const FIGURES: [&str; 8] = [
     PRECURSOR_FIGURE,
     AREA_FIGURE,
     MAP_FIGURE,
+    STICK_SLIP_FIGURE,
+    ARCHARD_FIGURE,
     FRONTS_FIGURE,
     SIZES_FIGURE,
     DROPS_FIGURE,
@@ -214,6 +221,8 @@ mod tests {
             "runs.csv",
             "contact_map.svg",
             "precursor_length.png",
+            "stick_slip.svg",
+            "archard.png",
             "coulomb_stress.gif",
             "per_avalanche.csv",
             "fronts.csv",
