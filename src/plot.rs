@@ -28,10 +28,12 @@ mod distributions;
 mod error;
 mod figures;
 mod movie;
+mod paper;
 mod profiles;
+mod selection;
 
 pub use error::PlotError;
-pub use figures::{draw, draw_with_size, Drawn, Format};
+pub use figures::{draw, draw_with_options, draw_with_size, DrawOptions, Drawn, Format};
 pub use movie::{Movie, MovieKind, MovieReport};
 
 use crate::error::Error;

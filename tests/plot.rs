@@ -399,9 +399,11 @@ fn a_run_directory_gets_its_five_figures() {
             "precursor_length.svg"
         ]
     );
-    // A force-controlled run has no force drops: no figure, and a note saying why.
-    assert_eq!(drawn.notes.len(), 1, "{:?}", drawn.notes);
+    // A force-controlled run has no force drops and no spring: neither figure, and
+    // notes saying why.
+    assert_eq!(drawn.notes.len(), 2, "{:?}", drawn.notes);
     assert!(drawn.notes[0].contains("no force_drops figure"));
+    assert!(drawn.notes[1].contains("no stick_slip figure"));
     assert!(drawn.merge.is_none());
     // Without the map table: the four other figures and a note saying why.
     std::fs::remove_file(dir.join("contact_map.csv")).unwrap();
@@ -738,4 +740,393 @@ fn the_contact_map_carries_both_fronts() {
         "the damage front never left the trailing edge: {fronts}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A run of a small block (30 x 5 cells of 1 mm, 500 N) driven through a spring on its
+/// side, to global slip, in `dir`.
+fn spring_run(dir: &Path) {
+    let scene = Scene::builder()
+        .block(0.03, 0.005, 0.02)
+        .cell_size(1e-3, 1e-3)
+        .normal_load(500.0)
+        .drive(Drive::Spring {
+            stiffness: 4e6,
+            lateral: Lateral::Side,
+        })
+        .seed(2)
+        .build()
+        .unwrap();
+    let mut driver = scene.driver().unwrap();
+    RunTables::create(dir, &driver)
+        .unwrap()
+        .run_to_slip(&mut driver, None, |_, _| {})
+        .unwrap();
+}
+
+/// The texts of an SVG, without their attributes.
+fn svg_words(path: &Path) -> Vec<String> {
+    svg_texts(path).into_iter().map(|(_, t)| t).collect()
+}
+
+/// `stick_slip` (paper Fig. 4) draws, from a spring-driven run's `events.csv`, one point
+/// per event with a load (read here from the table: the polyline of the first series
+/// has as many vertices), counts the avalanches that drop the force (a stable state
+/// below the raise before it, from the table's cells) and marks global slip at its drive
+/// displacement and load; the axes are `U_S (µm)` and `F/(μF_N)`.
+#[test]
+fn stick_slip_draws_the_spring_force_against_the_drive_displacement() {
+    use precursors::plot::{draw_with_options, DrawOptions};
+    let dir = scratch("stick-slip");
+    spring_run(&dir);
+    let options = DrawOptions::default()
+        .formats(&[Format::Svg])
+        .figures(["stick_slip"]);
+    let drawn = draw_with_options(&dir, &options).unwrap();
+    assert_eq!(drawn.files, [dir.join("stick_slip.svg")]);
+    // The reference from events.csv: loaded rows, the force drops, global slip.
+    let events = std::fs::read_to_string(dir.join("events.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = events
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    let loaded: Vec<&Vec<&str>> = rows
+        .iter()
+        .filter(|r| ["load_raised", "rupture", "stable", "global_slip"].contains(&r[1]))
+        .collect();
+    assert!(loaded.iter().all(|r| !r[5].is_empty()), "a row without U_S");
+    let force = |r: &[&str]| r[4].parse::<f64>().unwrap();
+    let (mut drops, mut raised) = (0, None);
+    for r in &rows {
+        match r[1] {
+            "load_raised" => raised = Some(force(r)),
+            "stable" => drops += usize::from(raised.take().is_some_and(|f| f > force(r))),
+            _ => {}
+        }
+    }
+    assert!(drops > 0, "the spring never dropped the force");
+    let last = rows.last().unwrap();
+    assert_eq!(last[1], "global_slip");
+    let mu_fn = 0.5 * 500.0;
+    let u_slip = last[5].parse::<f64>().unwrap() * 1e6;
+    let f_slip = force(last) / mu_fn;
+    let svg_path = dir.join("stick_slip.svg");
+    let texts = svg_texts(&svg_path);
+    let words = svg_words(&svg_path);
+    assert!(
+        words[0].starts_with("Stick-slip: 30 x 5 x 20 mm"),
+        "{words:?}"
+    );
+    assert!(typeset_in(
+        &texts,
+        &[("U", false), ("S", true), ("(µm)", false)],
+        false
+    ));
+    let force_axis = [("F/(μF", false), ("N", true), (")", false)];
+    assert!(typeset_in(&texts, &force_axis, true), "{words:?}");
+    let count = format!("at each load step and rupture: {drops} force drops");
+    assert!(
+        words.iter().any(|t| t.ends_with(&count)),
+        "{count} not in {words:?}"
+    );
+    let slip = [
+        ("global slip at U", false),
+        ("S", true),
+        (&*format!("= {u_slip:.4} µm, F/(μF"), false),
+        ("N", true),
+        (&*format!(") = {f_slip:.3}"), false),
+    ];
+    assert!(
+        typeset_in(&texts, &slip, false),
+        "{slip:?} not in {words:?}"
+    );
+    // The first series' polyline (Tableau blue): a vertex per loaded event.
+    let svg = std::fs::read_to_string(&svg_path).unwrap();
+    let vertices = svg
+        .split("<polyline")
+        .skip(1)
+        .filter(|p| p.contains("stroke=\"#1F77B4\""))
+        .map(|p| {
+            let points = p
+                .split_once("points=\"")
+                .unwrap()
+                .1
+                .split_once('"')
+                .unwrap()
+                .0;
+            points.split_whitespace().count()
+        })
+        .max()
+        .unwrap();
+    assert_eq!(vertices, loaded.len());
+    // By default a spring-driven run gets it with the others, in each format.
+    let drawn = draw(&dir, &[Format::Png]).unwrap();
+    assert!(drawn.files.contains(&dir.join("stick_slip.png")));
+    assert!(drawn.files.contains(&dir.join("force_drops.png")));
+    assert!(
+        drawn.notes.iter().all(|n| !n.contains("figure:")),
+        "{:?}",
+        drawn.notes
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `--figure`'s library side: only the named figures are drawn; a name that is no
+/// figure is `UnknownFigure` (its message lists the figures), a figure the directory
+/// cannot give `FigureUnavailable` before any file is written; a figure the directory
+/// does not allow and not named is left out with a note.
+#[test]
+fn named_figures_are_drawn_alone_and_unknown_or_unavailable_ones_refused() {
+    use precursors::plot::{draw_with_options, DrawOptions};
+    let dir = scratch("named");
+    let mut driver = scene().driver().unwrap();
+    RunTables::create(&dir, &driver)
+        .unwrap()
+        .run_to_slip(&mut driver, None, |_, _| {})
+        .unwrap();
+    let svg = DrawOptions::default().formats(&[Format::Svg]);
+    let drawn = draw_with_options(
+        &dir,
+        &svg.clone().figures(["fronts", "contact_map", "fronts"]),
+    )
+    .unwrap();
+    assert_eq!(
+        drawn.files,
+        [dir.join("contact_map.svg"), dir.join("fronts.svg")]
+    );
+    assert!(
+        drawn.notes.iter().all(|n| !n.contains("figure:")),
+        "{:?}",
+        drawn.notes
+    );
+    let figures = |dir: &Path| {
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".svg") || n.ends_with(".png"))
+            .collect();
+        names.sort();
+        names
+    };
+    assert_eq!(figures(&dir), ["contact_map.svg", "fronts.svg"]);
+    let e =
+        draw_with_options(&dir, &svg.clone().figures(["contact_area", "stickslip"])).unwrap_err();
+    assert!(matches!(&e, PlotError::UnknownFigure { name, .. } if name == "stickslip"));
+    let text = e.to_string();
+    for name in [
+        "precursor_length",
+        "contact_area",
+        "contact_map",
+        "stick_slip",
+        "archard",
+        "fronts",
+        "avalanche_sizes",
+        "force_drops",
+    ] {
+        assert!(text.contains(name), "{name} not in {text}");
+    }
+    // Force control: no spring, no drops; a run is no sweep. Nothing is drawn first.
+    for name in ["stick_slip", "force_drops", "archard"] {
+        let e = draw_with_options(&dir, &svg.clone().figures(["contact_area", name])).unwrap_err();
+        assert!(
+            matches!(&e, PlotError::FigureUnavailable { figure, .. } if figure == name),
+            "{e:?}"
+        );
+        assert!(e.to_string().contains(&format!("no {name} figure")), "{e}");
+    }
+    assert_eq!(figures(&dir), ["contact_map.svg", "fronts.svg"]);
+    // Not named: left out with notes.
+    let drawn = draw(&dir, &[Format::Svg]).unwrap();
+    assert_eq!(drawn.files.len(), 5);
+    assert!(
+        drawn.notes[0].contains("no force_drops figure"),
+        "{:?}",
+        drawn.notes
+    );
+    assert!(
+        drawn.notes[1].starts_with("no stick_slip figure: the run is not driven through a spring")
+    );
+    // A named contact map without its table.
+    std::fs::remove_file(dir.join("contact_map.csv")).unwrap();
+    let e = draw_with_options(&dir, &svg.figures(["contact_map"])).unwrap_err();
+    assert!(e.to_string().contains("contact_map.csv is missing"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `archard` (paper Fig. 2a) of a sweep over the normal load: the least-squares slope
+/// through the origin in its legend is the one of the zero-shear areas (each run's first
+/// row of `curve.csv`, read here) against the loads the sweep gave its runs; the mean and
+/// the standard deviation have their legends. A sweep without the axis: a note, or an
+/// error when named; a run: an error when named.
+#[test]
+fn archard_fits_the_zero_shear_areas_of_a_sweep_over_the_normal_load() {
+    use precursors::plot::{draw_with_options, DrawOptions};
+    use precursors::sweep::{Sweep, SweepOptions};
+    let dir = scratch("archard");
+    let base = r#"{ "block": { "lx": 0.02, "ly": 0.004, "lz": 0.01 },
+        "cells": { "kind": "count", "nx": 20, "ny": 4 }, "normal_load": 100.0 }"#;
+    let sweep = Sweep::from_json_str(&format!(
+        r#"{{ "base": {base}, "axes": [ {{ "key": "normal_load",
+              "values": [100.0, 200.0, 400.0] }} ], "realizations": 3, "seed": 4 }}"#
+    ))
+    .unwrap();
+    let out = dir.join("loads");
+    sweep.execute(&out, &SweepOptions::new(), |_| {}).unwrap();
+    let options = DrawOptions::default()
+        .formats(&[Format::Svg])
+        .figures(["archard"]);
+    let drawn = draw_with_options(&out, &options).unwrap();
+    assert_eq!(drawn.files, [out.join("archard.svg")]);
+    // The reference: α = Σ F_N A_R / Σ F_N² over the runs.
+    let (mut fa, mut ff) = (0.0, 0.0);
+    for run in sweep.runs() {
+        let load: f64 = run.values()[0].1.parse().unwrap();
+        let curve = std::fs::read_to_string(out.join(run.dir_name()).join("curve.csv")).unwrap();
+        let mut lines = curve.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let column = header
+            .iter()
+            .position(|h| *h == "real_contact_area_m2")
+            .unwrap();
+        let area: f64 = lines
+            .next()
+            .unwrap()
+            .split(',')
+            .nth(column)
+            .unwrap()
+            .parse()
+            .unwrap();
+        fa += load * area;
+        ff += load * load;
+    }
+    let alpha = fa / ff;
+    let path = out.join("archard.svg");
+    let texts = svg_texts(&path);
+    let words = svg_words(&path);
+    let fit = [
+        ("least squares A", false),
+        ("R", true),
+        ("= α F", false),
+        ("N", true),
+        (", α = …", false),
+    ];
+    assert!(typeset_in(&texts, &fit, false), "{words:?}");
+    let shown: f64 = words
+        .iter()
+        .find_map(|t| t.strip_prefix(", α = ")?.strip_suffix(" m²/N"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        (shown - alpha).abs() <= 1e-4 * alpha,
+        "α = {shown} in the legend, {alpha} from curve.csv"
+    );
+    assert!(
+        words.iter().any(|t| t == "mean at each load (9 runs)"),
+        "{words:?}"
+    );
+    assert!(
+        words.iter().any(|t| t == "± one standard deviation"),
+        "{words:?}"
+    );
+    assert!(
+        words[0].starts_with("Real contact area at zero shear: "),
+        "{words:?}"
+    );
+    assert!(typeset_in(
+        &texts,
+        &[("F", false), ("N", true), ("(N)", false)],
+        false
+    ));
+    // Drawn by default beside the sweep's other figures.
+    let drawn = draw(&out, &[Format::Png]).unwrap();
+    assert!(drawn.files.contains(&out.join("archard.png")));
+    // A sweep without the axis: a note, or an error when named.
+    let flat = Sweep::from_json_str(&format!(
+        r#"{{ "base": {base}, "axes": [], "realizations": 2, "seed": 4 }}"#
+    ))
+    .unwrap();
+    let flat_out = dir.join("flat");
+    flat.execute(&flat_out, &SweepOptions::new(), |_| {})
+        .unwrap();
+    let drawn = draw(&flat_out, &[Format::Svg]).unwrap();
+    assert!(!flat_out.join("archard.svg").exists());
+    assert!(
+        drawn
+            .notes
+            .iter()
+            .any(|n| n.starts_with("no archard figure: the sweep has no axis normal_load")),
+        "{:?}",
+        drawn.notes
+    );
+    let e = draw_with_options(&flat_out, &options).unwrap_err();
+    assert!(matches!(e, PlotError::FigureUnavailable { .. }), "{e:?}");
+    // A run's directory, and a run's figure of a sweep.
+    let run = out.join(sweep.runs()[0].dir_name());
+    let e = draw_with_options(&run, &options).unwrap_err();
+    assert!(e.to_string().contains("a sweep's figure"), "{e}");
+    let e = draw_with_options(&out, &options.figures(["contact_map"])).unwrap_err();
+    assert!(
+        e.to_string().contains("plot one of its run directories"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[cfg(feature = "cli")]
+mod cli {
+    use super::*;
+    use crate::common::program::{path, precursors, stderr};
+
+    /// `precursors plot --figure`: repeatable and comma separated, only those files; a
+    /// name that is no figure or one the directory cannot give is a bad command line
+    /// (code 2) whose message names the figures, or says why, and nothing is written.
+    #[test]
+    fn plot_figure_draws_only_the_named_figures() {
+        let dir = scratch("cli-figure");
+        spring_run(&dir);
+        let figures = || {
+            let mut names: Vec<String> = std::fs::read_dir(&dir)
+                .unwrap()
+                .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .filter(|n| n.ends_with(".svg") || n.ends_with(".png"))
+                .collect();
+            names.sort();
+            names
+        };
+        let o = precursors(&[
+            "plot",
+            path(&dir),
+            "--figure",
+            "stick_slip,force_drops",
+            "--figure",
+            "contact_area",
+            "--format",
+            "svg",
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        assert_eq!(
+            figures(),
+            ["contact_area.svg", "force_drops.svg", "stick_slip.svg"]
+        );
+        let o = precursors(&["plot", path(&dir), "--figure", "fig4"]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        let text = stderr(&o);
+        assert!(text.contains("no figure is named \"fig4\""), "{text}");
+        assert!(
+            text.contains(
+                "precursor_length, contact_area, contact_map, stick_slip, archard, fronts, \
+                 avalanche_sizes, force_drops"
+            ),
+            "{text}"
+        );
+        let o = precursors(&["plot", path(&dir), "--figure", "precursor_length,archard"]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).contains("no archard figure"), "{}", stderr(&o));
+        assert_eq!(
+            figures(),
+            ["contact_area.svg", "force_drops.svg", "stick_slip.svg"]
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

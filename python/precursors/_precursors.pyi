@@ -203,7 +203,12 @@ def fit_power_law(
     seed: int = ...,
 ) -> Dict[str, Any]: ...
 def plot(
-    dir: _Path, *, formats: Sequence[str] = ..., width: int = ..., height: int = ...
+    dir: _Path,
+    *,
+    formats: Sequence[str] = ...,
+    width: int = ...,
+    height: int = ...,
+    figures: Optional[Sequence[str]] = ...,
 ) -> List[Path]: ...
 def movie(
     dir: _Path,

@@ -1115,15 +1115,17 @@ fn fit_power_law<'py>(
 
 /// Draws the figures of a run or sweep directory into it (`precursors plot`); `formats`
 /// of `"png"`, `"svg"`; `width` x `height` pixels (200 to 16384 each, as `--width` and
-/// `--height`). Returns the paths of the figures.
+/// `--height`); `figures` the names of the figures to draw (as `--figure`; `None`: every
+/// figure the directory allows). Returns the paths of the figures.
 #[pyfunction]
-#[pyo3(signature = (dir, *, formats=vec!["png".to_string()], width=800, height=560))]
+#[pyo3(signature = (dir, *, formats=vec!["png".to_string()], width=800, height=560, figures=None))]
 fn plot(
     py: Python<'_>,
     dir: PathBuf,
     formats: Vec<String>,
     width: u32,
     height: u32,
+    figures: Option<Vec<String>>,
 ) -> PyResult<Vec<PathBuf>> {
     let formats = formats
         .iter()
@@ -1135,8 +1137,12 @@ fn plot(
             ))),
         })
         .collect::<PyResult<Vec<_>>>()?;
+    let options = precursors::plot::DrawOptions::default()
+        .formats(&formats)
+        .size(width, height)
+        .figures(figures.unwrap_or_default());
     let drawn = py
-        .detach(|| precursors::plot::draw_with_size(&dir, &formats, (width, height)))
+        .detach(|| precursors::plot::draw_with_options(&dir, &options))
         .or_raise()?;
     Ok(drawn.files)
 }

@@ -92,3 +92,14 @@ def test_movie_refusals(tmp_path):
     ]:
         with pytest.raises(precursors.PrecursorsError, match=words):
             precursors.movie(tmp_path, field="contact-area", **keywords)
+
+
+def test_plot_draws_the_figures_named(tmp_path):
+    precursors.run(precursors.Scene.from_dict(SMALL), tmp_path)
+    assert precursors.plot(tmp_path, formats=["svg"], figures=["contact_area"]) == [
+        tmp_path / "contact_area.svg"
+    ]
+    with pytest.raises(precursors.PrecursorsError, match="no figure is named \"fig4\""):
+        precursors.plot(tmp_path, figures=["fig4"])
+    with pytest.raises(precursors.PrecursorsError, match="no stick_slip figure"):
+        precursors.plot(tmp_path, figures=["stick_slip"])

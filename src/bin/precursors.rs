@@ -39,7 +39,8 @@ Exit codes:
   1  run, resume, sweep: the computation failed (a solver did not converge, the contact
      emptied, ...)
   2  bad command line (unknown option, missing argument, --every without --checkpoint,
-     bad --shard or SLURM variables, a checkpoint named as a file of the run directory)
+     bad --shard or SLURM variables, a checkpoint named as a file of the run directory,
+     plot --figure naming no figure or one the directory cannot give)
   3  invalid input: a scene, sweep or checkpoint file that is not UTF-8 text or not valid
      JSON, names an unknown key, holds an invalid value, or does not fit; a damaged table
      or one with NaN, inf or an empty cell where a number belongs, or a value out of its
@@ -149,11 +150,18 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         seed: u64,
     },
-    /// Draws the figures of a run (precursor_length, contact_area, contact_map) or of a
-    /// sweep (merged first; ensemble curves with 95 % bands) into DIR.
+    /// Draws the figures of a run (precursor_length, contact_area, contact_map, stick_slip
+    /// under a driving spring, the statistics) or of a sweep (merged first; ensemble
+    /// curves with 95 % bands, archard over a normal_load axis, the statistics) into DIR.
     Plot {
         /// A run's or a sweep's output directory.
         dir: PathBuf,
+        /// Draws only the figure NAME (repeatable, or comma separated: precursor_length,
+        /// contact_area, contact_map, stick_slip, archard, fronts, avalanche_sizes,
+        /// force_drops, slip_profiles, shear_profiles, normal_profiles, coulomb_profiles)
+        /// [default: every figure the directory allows].
+        #[arg(long = "figure", value_name = "NAME", value_delimiter = ',')]
+        figures: Vec<String>,
         /// File format(s).
         #[arg(long, value_enum, default_value_t = FormatArg::Png)]
         format: FormatArg,
@@ -386,6 +394,8 @@ impl From<PlotError> for Failure {
         let code = match &e {
             PlotError::Core(e) => core_code(e),
             PlotError::Sweep(e) => sweep_code(e),
+            // --figure naming no figure, or one the directory cannot give.
+            PlotError::UnknownFigure { .. } | PlotError::FigureUnavailable { .. } => 2,
             // A figure that cannot be drawn (a directory neither a run's nor a sweep's).
             _ => 3,
         };
@@ -461,10 +471,11 @@ fn main() -> ExitCode {
         ),
         Command::Plot {
             dir,
+            figures,
             format,
             width,
             height,
-        } => plot(&dir, format, (width, height)),
+        } => plot(&dir, format, (width, height), &figures),
         Command::Movie {
             dir,
             field,
@@ -847,14 +858,23 @@ fn run_sweep(
     Ok(())
 }
 
-fn plot(dir: &Path, format: FormatArg, size: (u32, u32)) -> Result<(), Failure> {
-    use precursors::plot::{draw_with_size, Format};
+fn plot(
+    dir: &Path,
+    format: FormatArg,
+    size: (u32, u32),
+    figures: &[String],
+) -> Result<(), Failure> {
+    use precursors::plot::{draw_with_options, DrawOptions, Format};
     let formats: &[Format] = match format {
         FormatArg::Png => &[Format::Png],
         FormatArg::Svg => &[Format::Svg],
         FormatArg::Both => &[Format::Png, Format::Svg],
     };
-    let drawn = draw_with_size(dir, formats, size)?;
+    let options = DrawOptions::default()
+        .formats(formats)
+        .size(size.0, size.1)
+        .figures(figures);
+    let drawn = draw_with_options(dir, &options)?;
     if let Some(summary) = &drawn.merge {
         for file in &summary.files {
             say!("wrote {}", file.display());

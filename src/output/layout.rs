@@ -40,11 +40,18 @@ pub(crate) const SHEAR_PROFILES_FIGURE: &str = "shear_profiles";
 pub(crate) const NORMAL_PROFILES_FIGURE: &str = "normal_profiles";
 /// The stresses and Coulomb stresses at the first recorded load (paper Fig. 7).
 pub(crate) const COULOMB_PROFILES_FIGURE: &str = "coulomb_profiles";
-/// The figures `plot` draws.
-pub(crate) const FIGURES: [&str; 10] = [
+/// The figure of a driving spring's force against the drive displacement (paper Fig. 4).
+pub(crate) const STICK_SLIP_FIGURE: &str = "stick_slip";
+/// The figure of a sweep's real contact area at zero shear against the normal load
+/// (paper Fig. 2a).
+pub(crate) const ARCHARD_FIGURE: &str = "archard";
+/// The figures `plot` draws (the names `plot --figure` takes).
+pub(crate) const FIGURES: [&str; 12] = [
     PRECURSOR_FIGURE,
     AREA_FIGURE,
     MAP_FIGURE,
+    STICK_SLIP_FIGURE,
+    ARCHARD_FIGURE,
     FRONTS_FIGURE,
     SIZES_FIGURE,
     DROPS_FIGURE,
@@ -229,6 +236,8 @@ mod tests {
             "runs.csv",
             "contact_map.svg",
             "precursor_length.png",
+            "stick_slip.svg",
+            "archard.png",
             "coulomb_stress.gif",
             "per_avalanche.csv",
             "fronts.csv",

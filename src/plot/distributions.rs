@@ -6,6 +6,7 @@
 //! load). The samples are derived from the checked tables, as `precursors stats` derives
 //! them; the goodness of fit is `stats`' (it is not drawn).
 
+use super::selection::Selection;
 use super::{Chart, Corner, PlotError, Style, DISTINCT};
 use crate::output::derived::derive;
 use crate::output::layout::{DROPS_FIGURE, FRONTS_FIGURE, SIZES_FIGURE};
@@ -32,18 +33,25 @@ struct Pooled {
 
 /// Draws `avalanche_sizes`, `force_drops` and (for a run) `fronts` of `dir` (a run's or a
 /// sweep's directory) into it, as files of each of `extensions` (`png`, `svg`); `label`
-/// names each point of a sweep.
+/// names each point of a sweep; only the figures `selection` wants.
 pub(super) fn draw_statistics(
     dir: &Path,
     extensions: &[&str],
     size: (u32, u32),
     (title, label): (&str, PointLabel),
+    selection: &Selection,
 ) -> Result<Statistics, PlotError> {
     let mut drawn = Statistics::default();
+    let run = !dir.join(SWEEP_FILE).is_file();
+    let pooled = selection.wants(SIZES_FIGURE) || selection.wants(DROPS_FIGURE);
+    let fronts_wanted = run && selection.wants(FRONTS_FIGURE);
+    if !pooled && !fronts_wanted {
+        return Ok(drawn);
+    }
     let (_, points, _) = points(dir)?;
     let mut sizes = Vec::new();
     let mut drops = Vec::new();
-    for point in &points {
+    for point in points.iter().filter(|_| pooled) {
         let (mut s, mut d) = (Vec::new(), Vec::new());
         point.for_each_record(|run_dir, record| {
             let [ruptures, drop, ..] = samples(record, run_dir)?;
@@ -66,21 +74,21 @@ pub(super) fn draw_statistics(
         });
     }
     let sizes_axes = ("S (ruptures of an avalanche)", "P(S)", "avalanche sizes");
-    distribution(
-        dir,
-        extensions,
-        size,
-        (SIZES_FIGURE, title, sizes_axes),
-        (&sizes, Support::Discrete),
-        &mut drawn,
-    )?;
-    if drops.iter().all(|p| p.samples.is_empty()) {
-        drawn.notes.push(
-            "no force_drops figure: the force never drops (force control; a driving spring \
-             drops it)"
-                .into(),
-        );
-    } else {
+    if selection.wants(SIZES_FIGURE) {
+        distribution(
+            dir,
+            extensions,
+            size,
+            (SIZES_FIGURE, title, sizes_axes),
+            (&sizes, Support::Discrete),
+            &mut drawn,
+        )?;
+    }
+    let no_drops = drops.iter().all(|p| p.samples.is_empty());
+    if selection.wants(DROPS_FIGURE) && no_drops {
+        let reason = "the force never drops (force control; a driving spring drops it)";
+        selection.skip(DROPS_FIGURE, dir, reason.into(), &mut drawn.notes)?;
+    } else if selection.wants(DROPS_FIGURE) {
         let drops_axes = ("ΔF (N)", "P(ΔF) (1/N)", "force drops");
         distribution(
             dir,
@@ -92,7 +100,7 @@ pub(super) fn draw_statistics(
         )?;
     }
     // A run directory: its fronts.
-    if !dir.join(SWEEP_FILE).is_file() {
+    if fronts_wanted {
         let mut figure = Ok(());
         for point in &points {
             point.for_each_record(|_, record| {

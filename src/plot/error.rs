@@ -54,6 +54,33 @@ pub enum PlotError {
         /// What is wrong.
         reason: String,
     },
+    /// A figure name ([`crate::plot::DrawOptions::figures`], `precursors plot --figure`)
+    /// that is not one of the figures `plot` draws; the message lists them.
+    #[error(
+        "no figure is named \"{}\": the figures are {}",
+        Bounded(name),
+        known.join(", ")
+    )]
+    UnknownFigure {
+        /// The name given.
+        name: String,
+        /// The figures' names.
+        known: Vec<String>,
+    },
+    /// A figure named in [`crate::plot::DrawOptions::figures`] that the directory cannot
+    /// give: a run's figure of a sweep, `archard` of a run or of a sweep without the axis
+    /// `normal_load`, `stick_slip` of a run without a driving spring, `force_drops` where
+    /// the force never drops, `contact_map` without `contact_map.csv`. Figures not named
+    /// are left out with a note instead.
+    #[error("{}: no {figure} figure: {}", dir.display(), Bounded(reason))]
+    FigureUnavailable {
+        /// The figure's name.
+        figure: String,
+        /// The run or sweep directory.
+        dir: PathBuf,
+        /// Why it cannot be drawn.
+        reason: String,
+    },
     /// A movie ([`crate::plot::Movie`], `precursors movie`) of a run directory that holds
     /// no recorded fields (no `fields.csv`, or no planes for the Coulomb stress movie):
     /// the message says how to record them.

@@ -11,16 +11,24 @@
 //! load grid of step 0.005: ℓ/Lx's mean over its realizations and its 95 % t-band;
 //! `A_R/A_R(0)`'s median and the median's distribution-free 95 % interval (none below 6
 //! runs), which a few realizations near slip, many times the others under the paper's
-//! area law, do not stretch over the chart as they do the mean's t-band.
+//! area law, do not stretch over the chart as they do the mean's t-band. The paper's
+//! figures of `plot/paper.rs`: `stick_slip` for a spring-driven run, `archard` for a sweep
+//! over the normal load. [`draw_with_options`] draws the figures named
+//! ([`DrawOptions::figures`], names from `output/layout.rs`' `FIGURES`), after checking
+//! that the directory allows them.
 
 use super::distributions::draw_statistics;
+use super::paper::{draw_archard, draw_stick_slip};
 use super::profiles::draw_profiles;
+use super::selection::{Selection, NORMAL_LOAD};
 use super::PlotError;
 use super::{Chart, Corner, Map, Palette};
 use crate::error::{Error, Result};
 use crate::output::check::RunRecord;
 use crate::output::derived::derive;
-use crate::output::layout::{AREA_FIGURE, MAP_FIGURE, PRECURSOR_FIGURE};
+use crate::output::layout::{
+    ARCHARD_FIGURE, AREA_FIGURE, FIGURES, MAP_FIGURE, PRECURSOR_FIGURE, STICK_SLIP_FIGURE,
+};
 use crate::output::CONTACT_MAP_STEP;
 use crate::sweep::{merge, MergeSummary, MEDIAN_BAND_RUNS, SWEEP_FILE};
 use std::path::{Path, PathBuf};
@@ -100,7 +108,8 @@ pub struct Drawn {
 }
 
 /// Draws the figures of `dir` in each of `formats` into `dir`: a sweep's (`dir` holds
-/// `sweep.json`) or a run's (`dir` holds `curve.csv`).
+/// `sweep.json`) or a run's (`dir` holds `curve.csv`); every figure the directory allows
+/// ([`draw_with_options`] says which, and draws some of them only).
 ///
 /// # Errors
 /// [`PlotError::Figure`] when `dir` is neither, or a figure cannot be drawn; in
@@ -153,6 +162,117 @@ pub fn draw_with_size(
     formats: &[Format],
     size: (u32, u32),
 ) -> Result<Drawn, PlotError> {
+    draw_with_options(
+        dir,
+        &DrawOptions::default().formats(formats).size(size.0, size.1),
+    )
+}
+
+/// What [`draw_with_options`] draws: the formats, the size in pixels and which figures.
+/// Setters never fail; [`draw_with_options`] checks the values.
+///
+/// ```
+/// use precursors::plot::{DrawOptions, Format};
+/// let options = DrawOptions::default()
+///     .formats(&[Format::Svg])
+///     .size(1200, 840)
+///     .figures(["precursor_length", "stick_slip"]);
+/// assert_eq!(options.size, (1200, 840));
+/// assert_eq!(options.figures, ["precursor_length", "stick_slip"]);
+/// // The default: PNG, 800 x 560 pixels, every figure the directory allows.
+/// let default = DrawOptions::default();
+/// assert_eq!((default.formats, default.size), (vec![Format::Png], (800, 560)));
+/// assert!(default.figures.is_empty());
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct DrawOptions {
+    /// The file formats, each figure written once in each (default PNG).
+    pub formats: Vec<Format>,
+    /// The figures' size in pixels `(width, height)`, each side from 200 to 16384
+    /// (default 800 x 560; a PNG of 2400 x 1680 prints 8 x 5.6 inches at 300 dpi).
+    pub size: (u32, u32),
+    /// The names of the figures to draw (`precursor_length`, `contact_area`,
+    /// `contact_map`, `stick_slip`, `archard`, `fronts`, `avalanche_sizes`,
+    /// `force_drops`, `slip_profiles`, `shear_profiles`, `normal_profiles`,
+    /// `coulomb_profiles`); empty (the default): every figure the directory allows.
+    pub figures: Vec<String>,
+}
+
+impl Default for DrawOptions {
+    fn default() -> Self {
+        Self {
+            formats: vec![Format::Png],
+            size: (800, 560),
+            figures: Vec::new(),
+        }
+    }
+}
+
+impl DrawOptions {
+    /// The file formats.
+    pub fn formats(mut self, formats: &[Format]) -> Self {
+        self.formats = formats.to_vec();
+        self
+    }
+
+    /// The size in pixels.
+    pub fn size(mut self, width: u32, height: u32) -> Self {
+        self.size = (width, height);
+        self
+    }
+
+    /// The figures to draw, by name (none: every figure the directory allows).
+    pub fn figures<S: Into<String>>(mut self, names: impl IntoIterator<Item = S>) -> Self {
+        self.figures = names.into_iter().map(Into::into).collect();
+        self
+    }
+}
+
+/// Draws the figures of `dir` into `dir` as [`draw`] does, in the formats, at the size
+/// and of the figures `options` gives. Besides [`draw`]'s figures: for a run driven
+/// through a spring, `stick_slip` (the spring force `F/(μF_N)` against the drive
+/// displacement `U_S` in µm at every load step, rupture, stable state and global slip,
+/// from `events.csv`: the paper's Fig. 4); for a sweep with the axis `normal_load`,
+/// `archard` (the real contact area of each complete run's first stable state, zero
+/// shear, in % of the nominal area `Lx Ly`, against `F_N` in N: the mean over the runs
+/// at each load with ± one standard deviation, and the least-squares line through the
+/// origin `A_R = α F_N` over every run, `α` in m²/N in the legend; the paper's Fig. 2a;
+/// points that differ in other keys than `normal_load` and the drive's are one series
+/// each). A figure the directory does not allow and not named is left out, with a note
+/// in [`Drawn::notes`] where one is useful (`stick_slip` of a run without a driving
+/// spring or of a sweep, `archard` of a sweep without the axis).
+///
+/// ```
+/// use precursors::{output::RunTables, plot::{draw_with_options, DrawOptions, Format, PlotError}, Scene};
+/// let dir = std::env::temp_dir().join(format!("precursors-doc-options-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// let scene = Scene::builder().block(0.010, 0.004, 0.010).normal_load(100.0).build()?;
+/// let mut driver = scene.driver()?;
+/// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
+/// let options = DrawOptions::default().formats(&[Format::Svg]).figures(["contact_area"]);
+/// let drawn = draw_with_options(&dir, &options)?;
+/// assert_eq!(drawn.files, [dir.join("contact_area.svg")]);
+/// // A name that is no figure, and a figure this run (force control) cannot give.
+/// let e = draw_with_options(&dir, &options.clone().figures(["area"])).unwrap_err();
+/// assert!(matches!(e, PlotError::UnknownFigure { .. }));
+/// assert!(e.to_string().contains("precursor_length, contact_area"));
+/// let e = draw_with_options(&dir, &options.figures(["stick_slip"])).unwrap_err();
+/// assert!(matches!(e, PlotError::FigureUnavailable { .. }));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+///
+/// # Errors
+/// As [`draw`]; [`PlotError::Figure`] also for a side below 200 or above 16384 pixels;
+/// [`PlotError::UnknownFigure`] for a name in [`DrawOptions::figures`] that is no figure;
+/// [`PlotError::FigureUnavailable`] for a named figure the directory cannot give (a
+/// run's figure of a sweep, `archard` of a run or of a sweep without the axis
+/// `normal_load`, `stick_slip` without a driving spring, `force_drops` where the force
+/// never drops, `contact_map` without `contact_map.csv`): found before any figure is
+/// drawn, but for a spring's force that never drops and a contact map without rows.
+pub fn draw_with_options(dir: &Path, options: &DrawOptions) -> Result<Drawn, PlotError> {
+    let size = options.size;
     let (width, height) = size;
     if !(200..=super::LARGEST_SIDE).contains(&width)
         || !(200..=super::LARGEST_SIDE).contains(&height)
@@ -165,35 +285,59 @@ pub fn draw_with_size(
             ),
         });
     }
+    let mut named = Vec::new();
+    for name in &options.figures {
+        let Some(figure) = FIGURES.iter().find(|f| **f == name.trim()) else {
+            return Err(PlotError::UnknownFigure {
+                name: name.clone(),
+                known: FIGURES.iter().map(|f| f.to_string()).collect(),
+            });
+        };
+        if !named.contains(figure) {
+            named.push(*figure);
+        }
+    }
+    let formats = &options.formats;
     let extensions: Vec<&str> = formats.iter().map(|f| f.extension()).collect();
-    let (mut drawn, title) = if dir.join(SWEEP_FILE).is_file() {
-        (draw_sweep(dir, formats, size)?, sweep_title(dir))
-    } else if dir.join("curve.csv").is_file() {
-        (draw_run(dir, formats, size)?, run_title(dir))
-    } else if dir
-        .join(format!("curve.csv{}", crate::output::PARTIAL_SUFFIX))
-        .is_file()
-    {
-        return Err(PlotError::Figure {
-            path: Some(dir.to_path_buf()),
-            reason: format!(
-                "a run that has not reached global slip: it is under way, or was cut (its \
-                 tables are still named curve.csv{}); resume it from its checkpoint or run \
-                 it again, then plot",
-                crate::output::PARTIAL_SUFFIX
-            ),
-        });
+    let sweep = dir.join(SWEEP_FILE).is_file();
+    if !sweep && !dir.join("curve.csv").is_file() {
+        return Err(
+            if dir
+                .join(format!("curve.csv{}", crate::output::PARTIAL_SUFFIX))
+                .is_file()
+            {
+                PlotError::Figure {
+                    path: Some(dir.to_path_buf()),
+                    reason: format!(
+                        "a run that has not reached global slip: it is under way, or was cut (its \
+                     tables are still named curve.csv{}); resume it from its checkpoint or \
+                     run it again, then plot",
+                        crate::output::PARTIAL_SUFFIX
+                    ),
+                }
+            } else {
+                PlotError::Figure {
+                    path: Some(dir.to_path_buf()),
+                    reason: format!(
+                        "neither a sweep directory ({SWEEP_FILE}) nor a run directory (curve.csv)"
+                    ),
+                }
+            },
+        );
+    }
+    let (selection, skipped) = Selection::of(dir, sweep, named)?;
+    let (mut drawn, title) = if sweep {
+        (
+            draw_sweep(dir, formats, size, &selection)?,
+            sweep_title(dir),
+        )
     } else {
-        return Err(PlotError::Figure {
-            path: Some(dir.to_path_buf()),
-            reason: format!(
-                "neither a sweep directory ({SWEEP_FILE}) nor a run directory (curve.csv)"
-            ),
-        });
+        (draw_run(dir, formats, size, &selection)?, run_title(dir))
     };
-    let statistics = draw_statistics(dir, &extensions, size, (&title, point_label))?;
+    let statistics = draw_statistics(dir, &extensions, size, (&title, point_label), &selection)?;
     drawn.files.extend(statistics.files);
     drawn.notes.extend(statistics.notes);
+    drawn.notes.extend(skipped);
     Ok(drawn)
 }
 
@@ -371,7 +515,12 @@ fn corrupt(path: &Path, reason: String) -> Error {
 }
 
 /// The figures of one run directory.
-fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, PlotError> {
+fn draw_run(
+    dir: &Path,
+    formats: &[Format],
+    size: (u32, u32),
+    selection: &Selection,
+) -> Result<Drawn, PlotError> {
     let title = run_title(dir);
     // The tables checked against the scene, each other and their bounds.
     let record = RunRecord::read(dir)?;
@@ -410,7 +559,7 @@ fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, P
         merge: None,
         notes: Vec::new(),
     };
-    for &format in formats {
+    for &format in formats.iter().filter(|_| selection.wants(PRECURSOR_FIGURE)) {
         let path = dir.join(format!("{PRECURSOR_FIGURE}.{}", format.extension()));
         let mut chart = Chart::new(&format!("Precursor length: {title}"), "F/(μF_N)", "ℓ/Lx")
             .size(size.0, size.1)
@@ -426,6 +575,8 @@ fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, P
         }
         chart.save(&path)?;
         drawn.files.push(path);
+    }
+    for &format in formats.iter().filter(|_| selection.wants(AREA_FIGURE)) {
         let path = dir.join(format!("{AREA_FIGURE}.{}", format.extension()));
         Chart::new(
             &format!("Real contact area: {title}"),
@@ -440,9 +591,16 @@ fn draw_run(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, P
         .save(&path)?;
         drawn.files.push(path);
     }
-    draw_contact_map(dir, formats, size, (&title, &record), &mut drawn)?;
+    if selection.wants(MAP_FIGURE) {
+        draw_contact_map(dir, formats, size, (&title, &record), selection, &mut drawn)?;
+    }
     let extensions: Vec<&str> = formats.iter().map(|f| f.extension()).collect();
-    let profiles = draw_profiles(dir, &extensions, size, &title, &record)?;
+    if selection.wants(STICK_SLIP_FIGURE) {
+        drawn
+            .files
+            .extend(draw_stick_slip(dir, &extensions, size, &title, &record)?);
+    }
+    let profiles = draw_profiles(dir, &extensions, size, (&title, &record), selection)?;
     drawn.files.extend(profiles.files);
     drawn.notes.extend(profiles.notes);
     Ok(drawn)
@@ -456,15 +614,16 @@ fn draw_contact_map(
     formats: &[Format],
     size: (u32, u32),
     (title, record): (&str, &RunRecord),
+    selection: &Selection,
     drawn: &mut Drawn,
 ) -> Result<(), PlotError> {
     let map_path = dir.join("contact_map.csv");
     let Some(rows) = &record.map else {
-        drawn.notes.push(format!(
-            "no contact map: {} is missing (written by this version's `run`)",
+        let reason = format!(
+            "{} is missing (written by this version's `run`)",
             map_path.display()
-        ));
-        return Ok(());
+        );
+        return selection.skip(MAP_FIGURE, dir, reason, &mut drawn.notes);
     };
     // As the rows were: event, load, the columns' areas.
     let map: Vec<Vec<f64>> = rows
@@ -478,11 +637,8 @@ fn draw_contact_map(
         .collect();
     let nx = record.bounds.nx;
     let Some(first) = map.first() else {
-        drawn.notes.push(format!(
-            "no contact map: {} has no rows",
-            map_path.display()
-        ));
-        return Ok(());
+        let reason = format!("{} has no rows", map_path.display());
+        return selection.skip(MAP_FIGURE, dir, reason, &mut drawn.notes);
     };
     if nx == 0 {
         return Err(corrupt(&map_path, "no area columns in the header".into()).into());
@@ -561,10 +717,19 @@ fn front_lines(record: &RunRecord, y_top: f64) -> Result<(Line, Line)> {
 }
 
 /// The figures of a sweep directory, after merging it.
-fn draw_sweep(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn, PlotError> {
+fn draw_sweep(
+    dir: &Path,
+    formats: &[Format],
+    size: (u32, u32),
+    selection: &Selection,
+) -> Result<Drawn, PlotError> {
     let summary = merge(dir)?;
     let grid: Vec<f64> = (0..=200).map(|k| k as f64 * 0.005).collect();
-    let points = crate::sweep::ensemble_curves(dir, &grid)?;
+    let points = if selection.wants(PRECURSOR_FIGURE) || selection.wants(AREA_FIGURE) {
+        crate::sweep::ensemble_curves(dir, &grid)?
+    } else {
+        Vec::new()
+    };
     let title = sweep_title(dir);
     let label = point_label;
     // As for a run: near slip the unbounded area law can reach many times A_R(0).
@@ -583,7 +748,7 @@ fn draw_sweep(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn,
         merge: None,
         notes: Vec::new(),
     };
-    for &format in formats {
+    for &format in formats.iter().filter(|_| selection.wants(PRECURSOR_FIGURE)) {
         let mut chart = Chart::new(
             &format!("Precursor length: {title}, mean and 95 % band"),
             "F/(μF_N)",
@@ -605,6 +770,8 @@ fn draw_sweep(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn,
         let path = dir.join(format!("{PRECURSOR_FIGURE}.{}", format.extension()));
         chart.save(&path)?;
         drawn.files.push(path);
+    }
+    for &format in formats.iter().filter(|_| selection.wants(AREA_FIGURE)) {
         // The median and its distribution-free interval, not the mean's t-band: near slip
         // the area law spreads the realizations over orders of magnitude, a few of them
         // carry the mean, and a t-band of it spans the whole chart.
@@ -627,6 +794,12 @@ fn draw_sweep(dir: &Path, formats: &[Format], size: (u32, u32)) -> Result<Drawn,
         let path = dir.join(format!("{AREA_FIGURE}.{}", format.extension()));
         chart.save(&path)?;
         drawn.files.push(path);
+    }
+    if selection.wants(ARCHARD_FIGURE) {
+        let extensions: Vec<&str> = formats.iter().map(|f| f.extension()).collect();
+        let archard = draw_archard(dir, &extensions, size, (&title, point_label), NORMAL_LOAD)?;
+        drawn.files.extend(archard.files);
+        drawn.notes.extend(archard.notes);
     }
     if summary.runs_missing > 0 {
         drawn.notes.push(format!(

@@ -10,6 +10,7 @@
 //!
 //! One curve per load, coloured from blue (lowest) to red (highest).
 
+use super::selection::Selection;
 use super::{Chart, Colours, Corner, PlotError, Style};
 use crate::output::check::RunRecord;
 use crate::output::layout::{
@@ -52,16 +53,25 @@ impl Level<'_> {
     }
 }
 
-/// Draws the profiles figures of the run `record` (read from `dir`) into `dir`, as files
-/// of each of `extensions`; nothing (and no note) when the run records no profiles.
+/// Draws the profiles figures `selection` wants of the run `record` (read from `dir`)
+/// into `dir`, as files of each of `extensions`.
 pub(super) fn draw_profiles(
     dir: &Path,
     extensions: &[&str],
     size: (u32, u32),
-    title: &str,
-    record: &RunRecord,
+    (title, record): (&str, &RunRecord),
+    selection: &Selection,
 ) -> Result<Profiles, PlotError> {
     let mut drawn = Profiles::default();
+    let names = [
+        SLIP_PROFILES_FIGURE,
+        SHEAR_PROFILES_FIGURE,
+        NORMAL_PROFILES_FIGURE,
+        COULOMB_PROFILES_FIGURE,
+    ];
+    if !names.iter().any(|n| selection.wants(n)) {
+        return Ok(drawn);
+    }
     let Some(rows) = crate::output::profiles::read(dir, record)? else {
         return Ok(drawn);
     };
@@ -77,14 +87,18 @@ pub(super) fn draw_profiles(
         }
     }
     if levels.is_empty() {
-        drawn.notes.push(
-            "no profiles figures: the run passed none of the loads of `profiles.loads`".into(),
-        );
+        for name in names.iter().filter(|n| selection.wants(n)) {
+            let reason = "the run passed none of the loads of `profiles.loads`".to_string();
+            selection.skip(name, dir, reason, &mut drawn.notes)?;
+        }
         return Ok(drawn);
     }
     let dx_mm = record.grid.dx() * 1e3;
     let lx_mm = record.bounds.lx * 1e3;
     let save = |chart: Chart, name: &str, drawn: &mut Profiles| -> Result<(), PlotError> {
+        if !selection.wants(name) {
+            return Ok(());
+        }
         for extension in extensions {
             let path = dir.join(format!("{name}.{extension}"));
             chart.save(&path)?;
@@ -116,12 +130,8 @@ pub(super) fn draw_profiles(
     )?;
     let planes = record.options.profile_planes();
     let lowest = planes.iter().copied().filter(|&z| z > 0.0).reduce(f64::min);
+    // Without one, the selection left the stress figures out (with a note).
     let Some(z_p) = lowest else {
-        drawn.notes.push(
-            "no shear_profiles, normal_profiles or coulomb_profiles figure: no plane above \
-             the interface is recorded (`profiles.planes`)"
-                .into(),
-        );
         return Ok(drawn);
     };
     let mpa = |v: f64| v.abs() * 1e-6;
@@ -171,7 +181,7 @@ pub(super) fn draw_profiles(
                 &first.curve("mean_coulomb_Pa", 0.0, dx_mm, signed),
             )
             .style(Style::new().dashed());
-    } else {
+    } else if selection.wants(COULOMB_PROFILES_FIGURE) {
         drawn.notes.push(
             "coulomb_profiles: no τ_C at the interface (record the plane z = 0 in \
              `profiles.planes`)"
