@@ -93,6 +93,8 @@ use profiles::ProfilesTable;
 use resume::{continuation, fields_continuation};
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufWriter, Write};
+#[cfg(feature = "serde")]
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 /// The header of `events.csv`.
@@ -732,14 +734,9 @@ impl RunTables {
         Ok(())
     }
 
-    /// Runs `driver` to global slip writing its tables (feature `serde`): each event
-    /// [recorded](RunTables::record), then `observe` called with it and the driver in the
-    /// state right after it; with `checkpoint = Some((path, every))`, at every `every`-th
-    /// stable state recorded by this writer, the tables [flushed](RunTables::flush) and a
-    /// checkpoint written over `path` ([`crate::Checkpoint::write_to`]), so a resume finds
-    /// every row up to it; at global slip, the tables [finished](RunTables::finish).
-    /// Returns the tables' paths. The one run loop of the program's `run` and `resume` and
-    /// of a sweep's runs.
+    /// Runs `driver` to global slip writing its tables (feature `serde`), as
+    /// [`RunTables::run_until`] with an observer that never stops the run, then the
+    /// tables [finished](RunTables::finish). Returns the tables' paths.
     ///
     /// ```
     /// use precursors::{output::RunTables, Event, Scene};
@@ -762,8 +759,7 @@ impl RunTables {
     /// ```
     ///
     /// # Errors
-    /// The first error of [`Driver::step`], [`RunTables::record`], [`RunTables::flush`],
-    /// [`crate::Checkpoint::write_to`] or [`RunTables::finish`].
+    /// As [`RunTables::run_until`] and [`RunTables::finish`].
     #[cfg(feature = "serde")]
     pub fn run_to_slip(
         mut self,
@@ -771,6 +767,62 @@ impl RunTables {
         checkpoint: Option<(&Path, std::num::NonZeroU64)>,
         mut observe: impl FnMut(&Event, &Driver),
     ) -> Result<[PathBuf; 3]> {
+        self.run_until(driver, checkpoint, |event, driver| {
+            observe(event, driver);
+            ControlFlow::<std::convert::Infallible>::Continue(())
+        })?;
+        self.finish()
+    }
+
+    /// The one run loop (feature `serde`) of the program's `run` and `resume`, of a
+    /// sweep's runs and of the Python package: steps `driver` writing its tables, each
+    /// event [recorded](RunTables::record), then `observe` called with it and the driver
+    /// in the state right after it; with `checkpoint = Some((path, every))`, at every
+    /// `every`-th stable state recorded by this writer, the tables
+    /// [flushed](RunTables::flush) and a checkpoint written over `path`
+    /// ([`crate::Checkpoint::write_to`]), so a resume finds every row up to it.
+    ///
+    /// Returns `Ok(None)` at global slip (then [`RunTables::finish`] the tables), or
+    /// `Ok(Some(value))` as soon as `observe` returns `ControlFlow::Break(value)`: the rows
+    /// so far are then flushed to disk, the tables stay `NAME.partial`, and a later call
+    /// continues with the next event (as [`Driver::run`]). A run stopped so is resumed in
+    /// another process from its last checkpoint (`precursors resume`).
+    ///
+    /// ```
+    /// use precursors::{output::RunTables, Event, Scene};
+    /// use std::ops::ControlFlow;
+    /// let scene = Scene::builder().block(0.012, 0.002, 0.010).normal_load(50.0).build()?;
+    /// let mut driver = scene.driver()?;
+    /// # let out = std::env::temp_dir().join(format!("precursors-doc-until-{}", std::process::id()));
+    /// # std::fs::create_dir_all(&out).unwrap();
+    /// let mut tables = RunTables::create(&out, &driver)?;
+    /// // Stop at the first rupture: the rows so far are on disk, still `.partial`.
+    /// let stop = |event: &Event, _: &_| match event {
+    ///     Event::Rupture { .. } => ControlFlow::Break(()),
+    ///     _ => ControlFlow::Continue(()),
+    /// };
+    /// assert_eq!(tables.run_until(&mut driver, None, stop)?, Some(()));
+    /// assert!(out.join("events.csv.partial").is_file());
+    /// // Continue to global slip, then finish.
+    /// let never = |_: &Event, _: &_| ControlFlow::<()>::Continue(());
+    /// assert_eq!(tables.run_until(&mut driver, None, never)?, None);
+    /// let [events, ..] = tables.finish()?;
+    /// assert!(events.is_file());
+    /// # std::fs::remove_dir_all(&out).ok();
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// The first error of [`Driver::step`], [`RunTables::record`], [`RunTables::flush`]
+    /// or [`crate::Checkpoint::write_to`]; a checkpoint `path` naming a file of the run
+    /// directory ([`check_output_path`]).
+    #[cfg(feature = "serde")]
+    pub fn run_until<B>(
+        &mut self,
+        driver: &mut Driver,
+        checkpoint: Option<(&Path, std::num::NonZeroU64)>,
+        mut observe: impl FnMut(&Event, &Driver) -> ControlFlow<B>,
+    ) -> Result<Option<B>> {
         if let Some((path, _)) = checkpoint {
             check_output_path(&self.dir, path)?;
         }
@@ -782,9 +834,12 @@ impl RunTables {
                     driver.checkpoint().write_to(path)?;
                 }
             }
-            observe(&event, driver);
+            if let ControlFlow::Break(value) = observe(&event, driver) {
+                self.flush()?;
+                return Ok(Some(value));
+            }
         }
-        self.finish()
+        Ok(None)
     }
 
     /// Ends a run that reached global slip: the tables are flushed and synced,

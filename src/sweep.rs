@@ -438,6 +438,9 @@ pub struct RunReport {
     /// Another process holds its directory (it is running it): left to that process,
     /// neither run nor marked complete here.
     pub held_elsewhere: bool,
+    /// It was stopped before global slip ([`Sweep::execute_until`]): left without its
+    /// marker, redone from the start by a later execution.
+    pub stopped: bool,
     /// Events of the run (0 when skipped or held elsewhere).
     pub events: usize,
     /// Wall time of the run (s; 0 when skipped).
@@ -477,6 +480,9 @@ pub struct SweepSummary {
     /// Runs of the share that another process was running (their directories locked):
     /// left to it, not complete as far as this call knows.
     pub held_elsewhere: usize,
+    /// Runs of the share stopped before global slip ([`Sweep::execute_until`]); the runs
+    /// not counted anywhere were not started.
+    pub stopped: usize,
     /// Wall time (s).
     pub seconds: f64,
 }
@@ -670,11 +676,19 @@ impl Sweep {
     /// that cannot be written; the scene's and the
     /// driver's errors.
     pub fn run_one(&self, run: &SweepRun, out: &Path) -> Result<RunReport> {
+        self.run_one_until(run, out, &AtomicBool::new(false))
+    }
+
+    /// [`Sweep::run_one`], stopped at the next event once `stop` is raised: the run is
+    /// then left without its marker (redone from the start by a later call), and its
+    /// report says so ([`RunReport::stopped`]).
+    fn run_one_until(&self, run: &SweepRun, out: &Path, stop: &AtomicBool) -> Result<RunReport> {
         let dir = out.join(&run.dir_name);
         let report = |skipped, held_elsewhere| RunReport {
             index: run.index,
             skipped,
             held_elsewhere,
+            stopped: false,
             events: 0,
             seconds: 0.0,
         };
@@ -696,14 +710,29 @@ impl Sweep {
         let scene = run.scene.clone().build_with_planner(&self.planner)?;
         let built = started.elapsed().as_secs_f64();
         let mut driver = scene.driver()?;
-        let tables = RunTables::start(&dir, &driver, driver.scene().run_options(), None)?;
+        let mut tables = RunTables::start(&dir, &driver, driver.scene().run_options(), None)?;
         let (mut slip, mut ruptures, mut stable_states) = (None, 0usize, 0usize);
-        tables.run_to_slip(&mut driver, None, |event, _| match event {
-            crate::driver::Event::GlobalSlip { load } => slip = Some(load.force),
-            crate::driver::Event::Rupture { .. } => ruptures += 1,
-            crate::driver::Event::Stable { .. } => stable_states += 1,
-            _ => {}
+        let stopped = tables.run_until(&mut driver, None, |event, _| {
+            match event {
+                crate::driver::Event::GlobalSlip { load } => slip = Some(load.force),
+                crate::driver::Event::Rupture { .. } => ruptures += 1,
+                crate::driver::Event::Stable { .. } => stable_states += 1,
+                _ => {}
+            }
+            match stop.load(Ordering::SeqCst) {
+                true => std::ops::ControlFlow::Break(()),
+                false => std::ops::ControlFlow::Continue(()),
+            }
         })?;
+        if stopped.is_some() {
+            return Ok(RunReport {
+                stopped: true,
+                events: driver.event_count(),
+                seconds: started.elapsed().as_secs_f64(),
+                ..report(false, false)
+            });
+        }
+        tables.finish()?;
         let seconds = started.elapsed().as_secs_f64();
         let mu_fn = driver.friction_coefficient() * driver.normal_load();
         let meta = serde_json::json!({
@@ -739,11 +768,9 @@ impl Sweep {
         )?;
         write_atomically(&dir.join(DONE_FILE), b"complete\n", "writing")?;
         Ok(RunReport {
-            index: run.index,
-            skipped: false,
-            held_elsewhere: false,
             events: driver.event_count(),
             seconds,
+            ..report(false, false)
         })
     }
 
@@ -767,6 +794,42 @@ impl Sweep {
         options: &SweepOptions,
         progress: impl Fn(&RunReport) + Sync,
     ) -> Result<SweepSummary> {
+        self.execute_until(out, options, progress, &AtomicBool::new(false))
+    }
+
+    /// [`Sweep::execute`], stopped once `stop` is raised (by another thread: a signal
+    /// handler, a user interface): no new run starts, and the runs under way stop at
+    /// their next event, left without their marker, so that only complete runs are
+    /// marked done. Executed again, the sweep redoes the stopped runs from the start and
+    /// ends with the tables of an uninterrupted execution. [`SweepSummary::stopped`]
+    /// counts the runs stopped.
+    ///
+    /// ```
+    /// use precursors::sweep::{Sweep, SweepOptions};
+    /// use std::sync::atomic::AtomicBool;
+    /// let sweep = Sweep::from_json_str(r#"{
+    ///     "base": {"block": {"lx": 0.012, "ly": 0.002, "lz": 0.01}, "normal_load": 50.0},
+    ///     "axes": [{"key": "normal_load", "values": [50.0, 60.0]}]
+    /// }"#)?;
+    /// let out = std::env::temp_dir().join(format!("precursors-doc-stop-{}", std::process::id()));
+    /// // Raised before it starts: nothing runs, nothing is marked done.
+    /// let summary = sweep.execute_until(&out, &SweepOptions::new(), |_| {}, &AtomicBool::new(true))?;
+    /// assert_eq!((summary.completed, summary.runs), (0, 2));
+    /// let summary = sweep.execute(&out, &SweepOptions::new(), |_| {})?;
+    /// assert_eq!(summary.completed, 2);
+    /// std::fs::remove_dir_all(&out).ok();
+    /// # Ok::<(), precursors::sweep::SweepError>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Sweep::execute`].
+    pub fn execute_until(
+        &self,
+        out: &Path,
+        options: &SweepOptions,
+        progress: impl Fn(&RunReport) + Sync,
+        stop: &AtomicBool,
+    ) -> Result<SweepSummary> {
         let started = Instant::now();
         let (k, n) = options.shard;
         let share = self.shard(k, n)?;
@@ -779,12 +842,12 @@ impl Sweep {
         std::thread::scope(|scope| {
             for _ in 0..jobs {
                 scope.spawn(|| loop {
-                    if failed.load(Ordering::SeqCst) {
+                    if failed.load(Ordering::SeqCst) || stop.load(Ordering::SeqCst) {
                         break;
                     }
                     let i = next.fetch_add(1, Ordering::SeqCst);
                     let Some(run) = share.get(i) else { break };
-                    match self.run_one(run, out) {
+                    match self.run_one_until(run, out, stop) {
                         Ok(report) => {
                             progress(&report);
                             if let Ok(mut r) = reports.lock() {
@@ -809,11 +872,13 @@ impl Sweep {
         let reports = crate::lock::into_inner(reports);
         let skipped = reports.iter().filter(|r| r.skipped).count();
         let held_elsewhere = reports.iter().filter(|r| r.held_elsewhere).count();
+        let stopped = reports.iter().filter(|r| r.stopped).count();
         Ok(SweepSummary {
             runs: share.len(),
-            completed: reports.len() - skipped - held_elsewhere,
+            completed: reports.len() - skipped - held_elsewhere - stopped,
             skipped,
             held_elsewhere,
+            stopped,
             seconds: started.elapsed().as_secs_f64(),
         })
     }

@@ -455,3 +455,31 @@ fn the_program_draws_the_movies_and_refuses_a_directory_without_fields() {
     assert!(stderr.contains("\"fields\""), "{stderr}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_movie_stopped_by_its_progress_writes_nothing() {
+    use std::ops::ControlFlow;
+    let (dir, _) = handwritten("stopped");
+    let path = dir.join("s1.gif");
+    let mut seen = Vec::new();
+    let outcome = Movie::new(&dir, MovieKind::ContactArea)
+        .save_until(&path, |drawn, frames| {
+            seen.push((drawn, frames));
+            match drawn {
+                2 => ControlFlow::Break(()),
+                _ => ControlFlow::Continue(()),
+            }
+        })
+        .unwrap();
+    assert!(outcome.is_none());
+    assert_eq!(seen, [(1, 5), (2, 5)]);
+    assert!(!path.exists());
+    // Not stopped: the whole movie, as `save` draws it.
+    let report = Movie::new(&dir, MovieKind::ContactArea)
+        .save_until(&path, |_, _| ControlFlow::Continue(()))
+        .unwrap()
+        .unwrap();
+    assert_eq!(report.frames, 5);
+    assert_eq!(decode_frames(&path).len(), 5);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -650,3 +650,52 @@ mod cli {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
+
+/// The one run loop stops where its observer says and continues from there: stopped at
+/// every 25th event, each time with the rows so far on disk under their `.partial`
+/// names, a run ends with the tables of a run never stopped; and a checkpoint written on
+/// the way resumes the scene at its event.
+#[test]
+fn a_run_stopped_by_its_observer_continues_to_the_tables_of_an_unstopped_one() {
+    use std::ops::ControlFlow;
+    let scene = scene();
+    let whole = scratch("unstopped");
+    let mut driver = scene.driver().unwrap();
+    RunTables::create(&whole, &driver)
+        .unwrap()
+        .run_to_slip(&mut driver, None, |_, _| {})
+        .unwrap();
+    let dir = scratch("stopped");
+    let checkpoint = scratch("stopped-checkpoint").join("cp.bin");
+    let mut driver = scene.driver().unwrap();
+    let mut run = RunTables::create(&dir, &driver).unwrap();
+    let every = std::num::NonZeroU64::new(10).unwrap();
+    let mut stops = 0;
+    loop {
+        let stopped = run
+            .run_until(&mut driver, Some((&checkpoint, every)), |_, d| {
+                match d.event_count() % 25 {
+                    0 => ControlFlow::Break(d.event_count()),
+                    _ => ControlFlow::Continue(()),
+                }
+            })
+            .unwrap();
+        let Some(at) = stopped else { break };
+        stops += 1;
+        // On disk: the events up to the stop.
+        let partial = dir.join(format!("events.csv{PARTIAL_SUFFIX}"));
+        assert_eq!(
+            std::fs::read_to_string(&partial).unwrap().lines().count(),
+            1 + at
+        );
+        assert!(!dir.join("events.csv").exists());
+    }
+    run.finish().unwrap();
+    assert!(stops > 5, "{stops}");
+    assert_eq!(tables(&dir), tables(&whole));
+    let cp = precursors::Checkpoint::read_from(&checkpoint).unwrap();
+    assert_eq!(scene.resume(&cp).unwrap().event_count(), cp.event_count());
+    for d in [&dir, &whole, &checkpoint.parent().unwrap().to_path_buf()] {
+        std::fs::remove_dir_all(d).unwrap();
+    }
+}

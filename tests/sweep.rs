@@ -721,3 +721,57 @@ mod cli {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
+
+#[test]
+fn a_stopped_sweep_marks_only_complete_runs_and_ends_as_an_uninterrupted_one() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::time::{Duration, Instant};
+    // Runs of 60 x 6 cells: hundreds of events each, long enough to stop one mid-way.
+    let sweep = Sweep::from_json_str(
+        r#"{ "base": { "block": { "lx": 0.06, "ly": 0.006, "lz": 0.03 }, "normal_load": 800.0 },
+             "axes": [ { "key": "normal_load", "values": [700.0, 800.0, 900.0] } ],
+             "seed": 3 }"#,
+    )
+    .unwrap();
+    let whole = scratch("unstopped");
+    sweep.execute(&whole, &SweepOptions::new(), |_| {}).unwrap();
+    let dir = scratch("stopped");
+    let (stop, ended) = (AtomicBool::new(false), AtomicBool::new(false));
+    // Raised once the second run has written a few events (as Ctrl-C would be).
+    let second = dir
+        .join(sweep.runs()[1].dir_name())
+        .join("events.csv.partial");
+    let summary = std::thread::scope(|scope| {
+        scope.spawn(|| {
+            let start = Instant::now();
+            while !ended.load(Ordering::SeqCst) && start.elapsed() < Duration::from_secs(60) {
+                if std::fs::read_to_string(&second).is_ok_and(|t| t.lines().count() > 5) {
+                    stop.store(true, Ordering::SeqCst);
+                    return;
+                }
+                std::thread::sleep(Duration::from_millis(1));
+            }
+        });
+        let summary = sweep.execute_until(&dir, &SweepOptions::new(), |_| {}, &stop);
+        ended.store(true, Ordering::SeqCst);
+        summary.unwrap()
+    });
+    assert_eq!(
+        (summary.runs, summary.completed, summary.stopped),
+        (3, 1, 1)
+    );
+    // Only the complete run is marked done; the stopped one is left partial, the third
+    // never started.
+    let run = |k: usize| dir.join(sweep.runs()[k].dir_name());
+    assert!(run(0).join(DONE_FILE).is_file());
+    assert!(!run(1).join(DONE_FILE).exists() && second.is_file());
+    assert!(!run(2).join(DONE_FILE).exists());
+    // Executed again: the stopped run redone, the sweep as an uninterrupted one.
+    let again = sweep.execute(&dir, &SweepOptions::new(), |_| {}).unwrap();
+    assert_eq!((again.completed, again.skipped, again.stopped), (2, 1, 0));
+    merge(&dir).unwrap();
+    merge(&whole).unwrap();
+    assert_eq!(tables(&dir), tables(&whole));
+    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(&whole).unwrap();
+}

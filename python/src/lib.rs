@@ -5,7 +5,9 @@
 //! (row `iy`, column `ix`), always fresh copies of the driver's state.
 
 use std::error::Error as StdError;
+use std::ops::ControlFlow;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyUntypedArrayMethods};
@@ -949,16 +951,25 @@ impl Checkpoint {
 
 /// Runs `scene` to global slip writing its tables into `out` (created if missing), as
 /// `precursors run` does: `events.csv`, `curve.csv`, `contact_map.csv` keep their
-/// `.partial` names until global slip. Returns their paths. Ctrl-C stops between events
-/// with `KeyboardInterrupt`, the tables left `.partial`.
+/// `.partial` names until global slip. Returns their paths. With `checkpoint=PATH`, a
+/// checkpoint is written over PATH every `every` stable states (`precursors resume PATH
+/// DIR` continues the run). Ctrl-C stops at the next event with `KeyboardInterrupt`, the
+/// rows so far on disk, the tables left `.partial`.
 #[pyfunction]
-#[pyo3(signature = (scene, out, *, threads=None))]
+#[pyo3(signature = (scene, out, *, threads=None, checkpoint=None, every=100))]
 fn run(
     py: Python<'_>,
     scene: &Scene,
     out: PathBuf,
     threads: Option<usize>,
+    checkpoint: Option<PathBuf>,
+    every: u64,
 ) -> PyResult<Vec<PathBuf>> {
+    let every = std::num::NonZeroU64::new(every).ok_or_else(|| {
+        pyo3::exceptions::PyValueError::new_err(
+            "every= is the number of stable states between checkpoints: at least 1, not 0",
+        )
+    })?;
     std::fs::create_dir_all(&out)
         .map_err(|source| precursors::Error::Io {
             operation: "creating the output directory",
@@ -969,29 +980,29 @@ fn run(
     let mut driver =
         Driver::with_threads(py.detach(|| scene.inner.driver()).or_raise()?, threads)?.inner;
     let mut tables = RunTables::create(&out, &driver).or_raise()?;
-    loop {
-        let slipped = py
-            .detach(|| -> precursors::Result<bool> {
-                match driver.step()? {
-                    Some(event) => tables.record(&driver, &event).map(|()| false),
-                    None => Ok(true),
+    let checkpoint = checkpoint.as_deref().map(|path| (path, every));
+    // The crate's one run loop; Python's signals are checked after each event.
+    let stopped = py
+        .detach(|| {
+            tables.run_until(&mut driver, checkpoint, |_, _| {
+                match Python::attach(|py| py.check_signals()) {
+                    Ok(()) => ControlFlow::Continue(()),
+                    Err(interrupt) => ControlFlow::Break(interrupt),
                 }
             })
-            .or_raise()?;
-        if slipped {
-            break;
-        }
-        if let Err(interrupt) = py.check_signals() {
-            // The rows so far on disk, under their .partial names.
-            let _ = tables.flush();
-            return Err(interrupt);
-        }
+        })
+        .or_raise()?;
+    if let Some(interrupt) = stopped {
+        return Err(interrupt);
     }
     Ok(py.detach(|| tables.finish()).or_raise()?.to_vec())
 }
 
 /// Runs the sweep file `file` into `out` on `jobs` parallel runs (`precursors sweep`);
-/// returns the summary (`runs`, `completed`, `skipped`, `held_elsewhere`, `seconds`).
+/// returns the summary (`runs`, `completed`, `skipped`, `held_elsewhere`, `stopped`,
+/// `seconds`). Ctrl-C stops it with `KeyboardInterrupt`: no new run starts and the runs
+/// under way stop at their next event, unmarked, so that only complete runs are marked
+/// done; called again, the sweep redoes the stopped runs.
 #[pyfunction]
 #[pyo3(signature = (file, out, *, jobs=1))]
 fn sweep<'py>(
@@ -1000,20 +1011,43 @@ fn sweep<'py>(
     out: PathBuf,
     jobs: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let summary = py
-        .detach(|| -> Result<_, SweepError> {
-            let sweep = Sweep::from_json_file(&file)?;
-            let options = SweepOptions::new().with_jobs(jobs)?;
-            sweep.execute(&out, &options, |_| {})
-        })
-        .or_raise()?;
+    let sweep = py.detach(|| Sweep::from_json_file(&file)).or_raise()?;
+    let options = SweepOptions::new().with_jobs(jobs).or_raise()?;
+    let stop = AtomicBool::new(false);
+    let summary = std::thread::scope(|scope| -> PyResult<_> {
+        let handle = scope.spawn(|| sweep.execute_until(&out, &options, |_| {}, &stop));
+        // The sweep on its own thread; this one, Python's, watches for signals.
+        while !py.detach(|| wait_for(&handle)) {
+            if let Err(interrupt) = py.check_signals() {
+                stop.store(true, Ordering::SeqCst);
+                let _ = py.detach(|| handle.join());
+                return Err(interrupt);
+            }
+        }
+        match handle.join() {
+            Ok(summary) => summary.or_raise(),
+            Err(_) => Err(pyo3::exceptions::PyRuntimeError::new_err(
+                "the sweep's thread panicked",
+            )),
+        }
+    })?;
     let d = PyDict::new(py);
     d.set_item("runs", summary.runs)?;
     d.set_item("completed", summary.completed)?;
     d.set_item("skipped", summary.skipped)?;
     d.set_item("held_elsewhere", summary.held_elsewhere)?;
+    d.set_item("stopped", summary.stopped)?;
     d.set_item("seconds", summary.seconds)?;
     Ok(d)
+}
+
+/// Waits up to 0.1 s for the thread of `handle` to end; whether it has.
+fn wait_for<T>(handle: &std::thread::ScopedJoinHandle<'_, T>) -> bool {
+    let start = std::time::Instant::now();
+    while !handle.is_finished() && start.elapsed() < std::time::Duration::from_millis(100) {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    handle.is_finished()
 }
 
 /// Merges the runs of the sweep directory `dir` (`precursors merge`); returns the paths
@@ -1191,14 +1225,27 @@ fn movie(
     let mut written = Vec::new();
     for &(kind, name) in kinds {
         let path = out.clone().unwrap_or_else(|| dir.join(name));
+        let mut interrupt = None;
         let outcome = py.detach(|| {
             Movie::new(&dir, kind)
                 .every(every)?
                 .max_frames(max_frames)?
                 .size(width, height)
                 .frame_duration(frame_duration)?
-                .save(&path)
+                // Ctrl-C between frames: nothing written.
+                .save_until(&path, |_, _| {
+                    match Python::attach(|py| py.check_signals()) {
+                        Ok(()) => ControlFlow::Continue(()),
+                        Err(e) => {
+                            interrupt = Some(e);
+                            ControlFlow::Break(())
+                        }
+                    }
+                })
         });
+        if let Some(interrupt) = interrupt {
+            return Err(interrupt);
+        }
         match outcome {
             Ok(_) => written.push(path),
             // As the program: "all" skips Movie S2 of a run that recorded no planes.

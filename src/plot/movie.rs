@@ -19,6 +19,7 @@ use crate::output::check::{fields_row, RunRecord};
 use crate::output::SCENE_RECORD;
 use crate::output::{fields_header, FIELDS_TABLE, PARTIAL_SUFFIX};
 use plotters::prelude::*;
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 /// Which of the paper's movies [`Movie`] draws.
@@ -239,6 +240,25 @@ impl Movie {
         path: impl AsRef<Path>,
         mut progress: impl FnMut(usize, usize),
     ) -> Result<MovieReport> {
+        let report = self.save_until(path, |drawn, frames| {
+            progress(drawn, frames);
+            ControlFlow::Continue(())
+        })?;
+        // The callback never stops the movie.
+        report.ok_or_else(|| self.refuse("the movie was stopped"))
+    }
+
+    /// [`Movie::save`], calling `progress(drawn, frames)` after each frame drawn, which
+    /// may stop it (`ControlFlow::Break`: a cancel button, Ctrl-C): then nothing is
+    /// written and `Ok(None)` is returned.
+    ///
+    /// # Errors
+    /// As [`Movie::save_with_progress`].
+    pub fn save_until(
+        &self,
+        path: impl AsRef<Path>,
+        mut progress: impl FnMut(usize, usize) -> ControlFlow<()>,
+    ) -> Result<Option<MovieReport>> {
         let path = path.as_ref();
         let is_gif = path
             .extension()
@@ -271,11 +291,13 @@ impl Movie {
                     gif::Frame::from_rgb_speed(width as u16, height as u16, &pixels, 10);
                 frame.delay = self.delay;
                 encoder.write_frame(&frame).map_err(fail)?;
-                progress(k + 1, states);
+                if progress(k + 1, states).is_break() {
+                    return Ok(None);
+                }
             }
         }
         crate::files::write_atomically(path, &bytes, "writing movie")?;
-        Ok(report)
+        Ok(Some(report))
     }
 
     /// Draws frame `frame` (0-based, of the frames [`Movie::save`] draws) as a still PNG
