@@ -9,7 +9,7 @@
 //!   precursor_over_Lx,broken,attached,area_exceeds_nominal`;
 //! * `contact_map.csv` (header `event,force_over_mu_FN`, then `area_m2_ix0`, `area_m2_ix1`, ...): the map over x and F of the paper's
 //!   Fig. 2b inset, one row per load level `F/(μF_N)` = 0, 0.005, 0.01, ...
-//!   ([`CONTACT_MAP_STEP`]) from the first stable state up to global slip: the real
+//!   (`0.005`) from the first stable state up to global slip: the real
 //!   contact area of each column `ix` (m², summed over y) in the stable state in effect
 //!   at that load (the last one reached at or below it), and that state's event index:
 //!   `event,force_over_mu_FN,area_m2_ix0,...`. At most about 200 rows whatever the
@@ -17,7 +17,7 @@
 //!   driving spring's slip), a level's row is the state in effect when the load first
 //!   passed it.
 //!
-//! * `fields.csv` ([`FIELDS_TABLE`]), only when the run records fields
+//! * `fields.csv`, only when the run records fields
 //!   ([`crate::RunOptions::record_fields`], scene-file key `fields`): the fields of the
 //!   1st, `(1 + every)`-th, `(1 + 2·every)`-th, ... stable state, for the movies (`precursors
 //!   movie`), header `event,force_over_mu_FN,precursor_over_Lx,field,row,z_m,value_ix0,
@@ -57,13 +57,13 @@
 //!
 //! **Complete or marked partial.** While a run is under way its tables are written as
 //! `events.csv.partial`, `curve.csv.partial` and `contact_map.csv.partial`
-//! ([`PARTIAL_SUFFIX`]); [`RunTables::finish`], once the run reached global slip, syncs
+//! (`.partial`); [`RunTables::finish`], once the run reached global slip, syncs
 //! them to disk and renames them to their names. A crash, a kill or a full disk leaves
 //! `.partial` files (or the tables of a complete run), never a table under its name that
 //! is not complete. The directory is locked while the tables are written (an advisory lock
 //! of the operating system, on the file `.precursors.lock`, that ends with the process): a
 //! second writer is refused ([`Error::DirectoryLocked`], naming the holder). With the
-//! `serde` feature the run's scene is recorded in the directory ([`SCENE_RECORD`]).
+//! `serde` feature the run's scene is recorded in the directory (`scene.json`).
 //!
 //! **Resume.** [`RunTables::resume`] continues the tables of a run from a checkpoint taken
 //! at a stable state: it checks, before it writes anything, that the directory's recorded
@@ -106,21 +106,55 @@ pub const CURVE_HEADER: &str = "event,force_N,force_over_mu_FN,drive_displacemen
                                 broken,attached,area_exceeds_nominal";
 
 /// The spacing in `F/(μF_N)` of the rows of `contact_map.csv`.
-pub const CONTACT_MAP_STEP: f64 = 0.005;
+pub(crate) const MAP_STEP: f64 = 0.005;
 
 /// The names of a run's tables, in the order of [`RunTables::paths`].
-pub const TABLE_NAMES: [&str; 3] = ["events.csv", "curve.csv", "contact_map.csv"];
+pub(crate) const TABLES: [&str; 3] = ["events.csv", "curve.csv", "contact_map.csv"];
 
 /// Appended to a table's name while its run is under way (`events.csv.partial`).
-pub const PARTIAL_SUFFIX: &str = ".partial";
+pub(crate) const PARTIAL: &str = ".partial";
 
 /// The record of a run's scene in its directory (feature `serde`: the scene file of
 /// `SceneBuilder::to_json`), written when the run starts, checked on resume.
-pub const SCENE_RECORD: &str = "scene.json";
+pub(crate) const RUN_SCENE: &str = "scene.json";
 
-/// The table of the fields a run records for the movies (written only when the run
-/// records fields: [`crate::RunOptions::record_fields`]; layout in the module's docs).
-pub const FIELDS_TABLE: &str = "fields.csv";
+/// The table of the fields a run records for the movies.
+pub(crate) const FIELDS_FILE: &str = "fields.csv";
+
+/// The spacing in `F/(μF_N)` of the rows of `contact_map.csv` (0.005).
+#[deprecated(
+    since = "1.1.0",
+    note = "a file-format detail (the module docs give the layout); removed in 2.0"
+)]
+pub const CONTACT_MAP_STEP: f64 = MAP_STEP;
+
+/// The names of a run's tables, in the order of [`RunTables::paths`].
+#[deprecated(
+    since = "1.1.0",
+    note = "a file-format detail: use `RunTables::paths`; removed in 2.0"
+)]
+pub const TABLE_NAMES: [&str; 3] = TABLES;
+
+/// Appended to a table's name while its run is under way (`events.csv.partial`).
+#[deprecated(
+    since = "1.1.0",
+    note = "a file-format detail (the module docs give the layout); removed in 2.0"
+)]
+pub const PARTIAL_SUFFIX: &str = PARTIAL;
+
+/// The record of a run's scene in its directory (`scene.json`).
+#[deprecated(
+    since = "1.1.0",
+    note = "a file-format detail (the module docs give the layout); removed in 2.0"
+)]
+pub const SCENE_RECORD: &str = RUN_SCENE;
+
+/// The table of the fields a run records for the movies (`fields.csv`).
+#[deprecated(
+    since = "1.1.0",
+    note = "a file-format detail: use `RunTables::fields_path`; removed in 2.0"
+)]
+pub const FIELDS_TABLE: &str = FIELDS_FILE;
 
 /// The `field` of the rows of `fields.csv` that hold the real contact area of a row `iy`
 /// of cells (m²), and of those that hold the y-averaged Coulomb stress on a plane (Pa).
@@ -205,7 +239,7 @@ pub struct RunTables {
     /// The files written until then.
     partials: [PathBuf; 3],
     stable_states: usize,
-    /// The next level of `contact_map.csv`, in steps of [`CONTACT_MAP_STEP`].
+    /// The next level of `contact_map.csv`, in steps of `0.005`.
     next_level: u64,
     /// The stable state in effect: the rows of the levels below the next state's load.
     in_effect: Option<MapState>,
@@ -244,8 +278,8 @@ impl FieldsTable {
     /// `dir/fields.csv` and `dir/fields.csv.partial`.
     fn paths(dir: &Path) -> (PathBuf, PathBuf) {
         (
-            dir.join(FIELDS_TABLE),
-            dir.join(format!("{FIELDS_TABLE}{PARTIAL_SUFFIX}")),
+            dir.join(FIELDS_FILE),
+            dir.join(format!("{FIELDS_FILE}{PARTIAL}")),
         )
     }
 
@@ -330,8 +364,8 @@ struct MapState {
 /// `dir/NAME` and `dir/NAME.partial` of each table.
 fn table_paths(dir: &Path) -> ([PathBuf; 3], [PathBuf; 3]) {
     (
-        TABLE_NAMES.map(|n| dir.join(n)),
-        TABLE_NAMES.map(|n| dir.join(format!("{n}{PARTIAL_SUFFIX}"))),
+        TABLES.map(|n| dir.join(n)),
+        TABLES.map(|n| dir.join(format!("{n}{PARTIAL}"))),
     )
 }
 
@@ -349,7 +383,7 @@ impl RunTables {
     /// New tables in `dir` (which must exist), header only, for `driver`'s run, recording
     /// what `options` ask beside the three tables (`fields.csv`, `profiles.csv`): the
     /// options are checked against the scene, the directory is locked, the tables of an
-    /// earlier run there removed, the scene recorded with these options ([`SCENE_RECORD`],
+    /// earlier run there removed, the scene recorded with these options (`scene.json`,
     /// feature `serde`; a resume and `precursors movie` read them there).
     ///
     /// ```
@@ -400,7 +434,7 @@ impl RunTables {
         }
         #[cfg(feature = "serde")]
         write_atomically(
-            &dir.join(SCENE_RECORD),
+            &dir.join(RUN_SCENE),
             driver
                 .scene()
                 .to_builder()
@@ -462,7 +496,7 @@ impl RunTables {
     /// The tables in `dir` continued after `driver` was resumed ([`crate::Scene::resume`])
     /// from a checkpoint taken at a stable state, recording what `options` ask. The
     /// directory is locked; then, before anything is written, its recorded scene
-    /// ([`SCENE_RECORD`], feature `serde`) must be the driver's, and the tables (each
+    /// (`scene.json`, feature `serde`) must be the driver's, and the tables (each
     /// `NAME.partial` if present, else `NAME`) must hold whole rows under their headers,
     /// `events.csv` the events 1, 2, ... up to the checkpoint's (a last row cut by a crash
     /// is dropped), `curve.csv` and `contact_map.csv` the stable states and load levels
@@ -600,12 +634,12 @@ impl RunTables {
     }
 
     /// The paths of `events.csv`, `curve.csv` and `contact_map.csv` (their names once
-    /// [`RunTables::finish`]ed; until then they are written with [`PARTIAL_SUFFIX`]).
+    /// [`RunTables::finish`]ed; until then they are written with `.partial`).
     pub fn paths(&self) -> [&Path; 3] {
         [&self.paths[0], &self.paths[1], &self.paths[2]]
     }
 
-    /// The path of `fields.csv` ([`FIELDS_TABLE`]; written as `fields.csv.partial` until
+    /// The path of `fields.csv` (written as `fields.csv.partial` until
     /// [`RunTables::finish`]), `None` when the scene records no fields
     /// ([`crate::SceneBuilder::record_fields`]).
     pub fn fields_path(&self) -> Option<&Path> {
@@ -859,7 +893,7 @@ impl RunTables {
                 path: self.dir.clone(),
                 reason: format!(
                     "the run has not reached global slip: its tables stay \
-                     NAME{PARTIAL_SUFFIX}"
+                     NAME{PARTIAL}"
                 ),
             });
         }
@@ -895,13 +929,13 @@ impl RunTables {
 /// Removes the temporary files of the tables and the scene record that a writer killed
 /// while writing one left in `dir`; only the lock holder writes them.
 fn remove_stale_temporaries(dir: &Path) -> Result<()> {
-    let names: Vec<String> = TABLE_NAMES
+    let names: Vec<String> = TABLES
         .iter()
-        .map(|n| format!("{n}{PARTIAL_SUFFIX}"))
+        .map(|n| format!("{n}{PARTIAL}"))
         .chain([
-            SCENE_RECORD.to_string(),
-            format!("{FIELDS_TABLE}{PARTIAL_SUFFIX}"),
-            format!("{}{PARTIAL_SUFFIX}", layout::PROFILES_TABLE),
+            RUN_SCENE.to_string(),
+            format!("{FIELDS_FILE}{PARTIAL}"),
+            format!("{}{PARTIAL}", layout::PROFILES_TABLE),
         ])
         .chain(layout::DERIVED_TABLES.map(String::from))
         .collect();
@@ -998,14 +1032,14 @@ fn check_options(driver: &Driver, options: &RunOptions) -> Result<()> {
 /// Refuses a directory whose recorded scene is not `driver`'s, or that records none.
 #[cfg(feature = "serde")]
 fn check_scene_record(dir: &Path, driver: &Driver) -> Result<()> {
-    let path = dir.join(SCENE_RECORD);
+    let path = dir.join(RUN_SCENE);
     let text = match read_text_if_exists(&path, "reading the scene record")? {
         Some(text) => text,
         None => {
             return Err(Error::RunDirectory {
                 path: dir.to_path_buf(),
                 reason: format!(
-                    "it holds no {SCENE_RECORD}, the record of the scene its tables belong to \
+                    "it holds no {RUN_SCENE}, the record of the scene its tables belong to \
                      (written when a run starts), so the checkpoint cannot be checked against \
                      them: run the scene again into this directory, or resume into a copy of \
                      the directory of the checkpoint's run"
@@ -1029,15 +1063,15 @@ fn check_scene_record(dir: &Path, driver: &Driver) -> Result<()> {
     }
 }
 
-/// Map level `k`: `F/(μF_N) = k·`[`CONTACT_MAP_STEP`].
+/// Map level `k`: `F/(μF_N) = k · 0.005`.
 fn level(k: u64) -> f64 {
-    k as f64 * CONTACT_MAP_STEP
+    k as f64 * MAP_STEP
 }
 
 /// The first map level at or above the load `x = F/(μF_N)` (0 for `x <= 0`). Rounded to
 /// 1e-9 of a step first, so that a load on a level up to rounding counts as on it.
 fn first_level_at_or_above(x: f64) -> u64 {
-    ((x / CONTACT_MAP_STEP * 1e9).round() / 1e9).max(0.0).ceil() as u64
+    ((x / MAP_STEP * 1e9).round() / 1e9).max(0.0).ceil() as u64
 }
 
 /// Broken and attached sites of `states`.

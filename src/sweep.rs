@@ -29,9 +29,10 @@ mod merge;
 pub(crate) mod stats;
 
 pub use error::SweepError;
+pub(crate) use merge::GRID_LOADS;
 #[cfg(feature = "plot")]
 pub(crate) use merge::{ensemble_curves, MEDIAN_BAND_RUNS};
-pub use merge::{mean_band, merge, Band, MergeSummary, LOAD_GRID};
+pub use merge::{mean_band, merge, Band, MergeSummary};
 pub use stats::{statistics, StatsOptions, StatsSummary};
 
 /// The results of this module: its errors are [`SweepError`]s.
@@ -54,11 +55,30 @@ use std::time::Instant;
 /// The name of a sweep's own copy of its file in the output directory.
 pub const SWEEP_FILE: &str = crate::output::layout::SWEEP;
 /// The completion marker of a run, written last (atomically) into its directory.
-pub const DONE_FILE: &str = crate::output::layout::DONE;
+pub(crate) const DONE: &str = crate::output::layout::DONE;
 /// The most runs a sweep may have (points times realizations): `1e5` runs are a day of
 /// the calibration scene on 64 cores, a run directory of four files each, and a merge
 /// that reads them all; a larger study is several sweeps (each its own directory).
-pub const MAX_RUNS: usize = 100_000;
+pub(crate) const RUN_LIMIT: usize = 100_000;
+
+/// The completion marker of a run (`done`).
+#[deprecated(
+    since = "1.1.0",
+    note = "a directory-layout detail (docs/sweep-format.md gives it); removed in 2.0"
+)]
+pub const DONE_FILE: &str = DONE;
+/// The most runs a sweep may have (1e5; docs/sweep-format.md).
+#[deprecated(
+    since = "1.1.0",
+    note = "a limit the docs give (docs/sweep-format.md); removed in 2.0"
+)]
+pub const MAX_RUNS: usize = RUN_LIMIT;
+/// The loads `F/(μF_N)` of `merge`'s `curves.csv`: 0.05, 0.10, ..., 0.95.
+#[deprecated(
+    since = "1.1.0",
+    note = "a file-format detail (docs/sweep-format.md gives the grid); removed in 2.0"
+)]
+pub const LOAD_GRID: [f64; 19] = GRID_LOADS;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -409,7 +429,7 @@ fn check_shard(k: usize, n: usize) -> crate::error::Result<()> {
 /// What one run did ([`Sweep::run_one`]).
 ///
 /// ```
-/// use precursors::sweep::{Sweep, DONE_FILE};
+/// use precursors::sweep::Sweep;
 /// let sweep = Sweep::from_json_str(r#"{
 ///     "base": { "block": { "lx": 0.01, "ly": 0.004, "lz": 0.01 },
 ///               "cells": { "kind": "count", "nx": 10, "ny": 4 },
@@ -421,7 +441,7 @@ fn check_shard(k: usize, n: usize) -> crate::error::Result<()> {
 /// let run = &sweep.runs()[1];                                    // F_N = 60 N
 /// let report = sweep.run_one(run, &out)?;
 /// assert!(!report.skipped && !report.held_elsewhere && report.events > 0);
-/// assert!(out.join(run.dir_name()).join(DONE_FILE).is_file());   // marked complete
+/// assert!(out.join(run.dir_name()).join("done").is_file());   // marked complete
 /// // A complete run is not run again.
 /// let again = sweep.run_one(run, &out)?;
 /// assert!(again.skipped && again.events == 0 && again.index == 1);
@@ -662,7 +682,7 @@ impl Sweep {
         Ok(self.runs.iter().filter(|r| r.index % n == k).collect())
     }
 
-    /// Runs `run` into `out/run.dir_name` unless it is complete (its [`DONE_FILE`]
+    /// Runs `run` into `out/run.dir_name` unless it is complete (its `done`
     /// exists) or another process holds the directory's lock (it is running it). The
     /// directory is locked (an advisory lock of the operating system, which ends with the
     /// process) and emptied, then `events.csv`, `curve.csv` and `contact_map.csv` are
@@ -692,7 +712,7 @@ impl Sweep {
             events: 0,
             seconds: 0.0,
         };
-        if dir.join(DONE_FILE).is_file() {
+        if dir.join(DONE).is_file() {
             return Ok(report(true, false));
         }
         std::fs::create_dir_all(&dir)
@@ -702,7 +722,7 @@ impl Sweep {
             Attempt::Held(_) => return Ok(report(false, true)),
         };
         // Complete by a process that held the lock since the first look.
-        if dir.join(DONE_FILE).is_file() {
+        if dir.join(DONE).is_file() {
             return Ok(report(true, false));
         }
         empty_but_lock(&dir)?;
@@ -766,7 +786,7 @@ impl Sweep {
             text.as_bytes(),
             "writing",
         )?;
-        write_atomically(&dir.join(DONE_FILE), b"complete\n", "writing")?;
+        write_atomically(&dir.join(DONE), b"complete\n", "writing")?;
         Ok(RunReport {
             events: driver.event_count(),
             seconds,
@@ -966,7 +986,7 @@ fn check_realizations(realizations: usize, base: &SceneBuilder) -> Result<bool> 
 }
 
 /// The size of the sweep, before any scene is checked or any run built: at most
-/// [`MAX_RUNS`] runs, whose list fits in the memory available.
+/// `1e5` runs, whose list fits in the memory available.
 ///
 /// # Errors
 /// [`SweepError::TooLarge`]; [`Error::OutOfMemory`].
@@ -976,7 +996,7 @@ fn check_size(axes: &[Axis], realizations: usize, base: &SceneBuilder) -> Result
         .try_fold(1u128, |p, a| p.checked_mul(a.steps.len() as u128));
     let runs = points.and_then(|p| p.checked_mul(realizations as u128));
     let runs = match (points, runs) {
-        (Some(_), Some(runs)) if runs <= MAX_RUNS as u128 => runs,
+        (Some(_), Some(runs)) if runs <= RUN_LIMIT as u128 => runs,
         _ => {
             return Err(SweepError::TooLarge {
                 points: axes
@@ -984,7 +1004,7 @@ fn check_size(axes: &[Axis], realizations: usize, base: &SceneBuilder) -> Result
                     .fold(1u128, |p, a| p.saturating_mul(a.steps.len() as u128)),
                 realizations,
                 runs: points.map_or(u128::MAX, |p| p.saturating_mul(realizations as u128)),
-                limit: MAX_RUNS,
+                limit: RUN_LIMIT,
             })
         }
     };

@@ -7,10 +7,13 @@
 //! the movies against a hand-written `fields.csv` whose colours and frame order follow
 //! from the palette's documented stops (not from the code that draws them).
 
-use precursors::output::{RunTables, FIELDS_TABLE};
+use precursors::output::RunTables;
 use precursors::plot::{Movie, MovieKind, PlotError};
 use precursors::{Error, Event, ProbeSpec, RunOptions, Scene, SceneBuilder};
 use std::path::{Path, PathBuf};
+
+// The documented file-format names and values (docs/cli.md, docs/sweep-format.md).
+const FIELDS_TABLE: &str = "fields.csv";
 
 fn scratch(name: &str) -> PathBuf {
     crate::common::scratch("movie", name)

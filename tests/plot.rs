@@ -6,11 +6,14 @@
 //! series' colours are drawn, the text of the embedded font is drawn where the title
 //! goes) and by reading the SVG's text.
 
-use precursors::output::{RunTables, CONTACT_MAP_STEP};
+use precursors::output::RunTables;
 use precursors::plot::{draw, Format};
 use precursors::plot::{Chart, Corner, Map, Palette, PlotError, Style};
 use precursors::{Drive, Error, Event, Lateral, Scene, SceneBuilder};
 use std::path::{Path, PathBuf};
+
+// The documented file-format names and values (docs/cli.md, docs/sweep-format.md).
+const CONTACT_MAP_STEP: f64 = 0.005;
 
 fn scratch(name: &str) -> PathBuf {
     crate::common::scratch("plot", name)

@@ -6,10 +6,15 @@
 //! random moments and continued ends with the tables of an undisturbed run. The reference
 //! is always an undisturbed run or sweep of the same scene.
 
-use precursors::output::{RunTables, PARTIAL_SUFFIX, TABLE_NAMES};
-use precursors::sweep::{merge, Sweep, SweepError, SweepOptions, DONE_FILE};
+use precursors::output::RunTables;
+use precursors::sweep::{merge, Sweep, SweepError, SweepOptions};
 use precursors::{Error, Scene};
 use std::path::{Path, PathBuf};
+
+// The documented file-format names and values (docs/cli.md, docs/sweep-format.md).
+const PARTIAL_SUFFIX: &str = ".partial";
+const TABLE_NAMES: [&str; 3] = ["events.csv", "curve.csv", "contact_map.csv"];
+const DONE_FILE: &str = "done";
 
 /// A fresh, empty directory under the system's temporary one.
 fn scratch(name: &str) -> PathBuf {

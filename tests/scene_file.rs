@@ -7,6 +7,9 @@ use precursors::solver::{Backend, Parallelism, SolverOptions};
 use precursors::*;
 use std::path::{Path, PathBuf};
 
+// The documented file-format names and values (docs/cli.md, docs/sweep-format.md).
+const MAX_RUNS: usize = 100_000;
+
 /// A fresh directory under the system's temporary one.
 fn scratch(name: &str) -> PathBuf {
     crate::common::scratch("scene-file", name)
@@ -528,8 +531,7 @@ fn heights_files_are_bounded_by_the_grid() {
 /// and started) are refused at once with the count and the limit of 1e5 runs.
 #[test]
 fn sweeps_beyond_the_run_limit_are_refused_at_once() {
-    use precursors::sweep::{Sweep, MAX_RUNS};
-    assert_eq!(MAX_RUNS, 100_000);
+    use precursors::sweep::Sweep;
     let base = r#""base": {"block": {"lx": 0.02, "ly": 0.004, "lz": 0.01},
                           "cells": {"kind": "count", "nx": 20, "ny": 4}}"#;
     let values: Vec<String> = (0..1_000_000)

@@ -2,9 +2,12 @@
 //! seeds are stable, complete runs are skipped and cut ones redone, and the tables do not
 //! depend on the jobs or the shards. The program's side (feature `cli`) is at the end.
 
-use precursors::sweep::{derive_seed, merge, Sweep, SweepError, SweepOptions, DONE_FILE};
+use precursors::sweep::{derive_seed, merge, Sweep, SweepError, SweepOptions};
 use precursors::Error;
 use std::path::{Path, PathBuf};
+
+// The documented file-format names and values (docs/cli.md, docs/sweep-format.md).
+const DONE_FILE: &str = "done";
 
 /// A fresh, empty directory under the system's temporary one.
 fn scratch(name: &str) -> PathBuf {

@@ -8,8 +8,8 @@
 //! and turned into statistics and figures with exit 0.
 
 #[cfg(feature = "serde")]
-use super::{contact_map_header, first_level_at_or_above, level, TABLE_NAMES};
-use super::{CONTACT_MAP_STEP, CURVE_HEADER, EVENTS_HEADER};
+use super::{contact_map_header, first_level_at_or_above, level, TABLES};
+use super::{CURVE_HEADER, EVENTS_HEADER, MAP_STEP};
 use crate::driver::{Event, Load, Site};
 use crate::error::Error;
 #[cfg(feature = "serde")]
@@ -140,7 +140,7 @@ pub(crate) struct CurveRow {
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct MapRow {
     pub event: usize,
-    /// The level's index (`F/(μF_N)` = index · [`CONTACT_MAP_STEP`]).
+    /// The level's index (`F/(μF_N)` = index · `0.005`).
     pub level: u64,
     /// The real contact area of each column (m²).
     pub columns: Vec<f64>,
@@ -394,14 +394,14 @@ pub(crate) fn map_row(line: usize, header: &[&str], row: &str) -> Row<MapRow> {
     let c = cells(line, header, row)?;
     let event = count(line, header, &c, 0)?;
     let x = number(line, header, &c, 1)?;
-    let steps = (x / CONTACT_MAP_STEP).round();
-    if !(0.0..=(LOAD_LIMIT / CONTACT_MAP_STEP).ceil()).contains(&steps)
-        || (steps * CONTACT_MAP_STEP - x).abs() > 1e-9
+    let steps = (x / MAP_STEP).round();
+    if !(0.0..=(LOAD_LIMIT / MAP_STEP).ceil()).contains(&steps)
+        || (steps * MAP_STEP - x).abs() > 1e-9
     {
         return Err(at(
             line,
             header[1],
-            format!("{x} is not a load level (a multiple of {CONTACT_MAP_STEP} from 0 to 1)"),
+            format!("{x} is not a load level (a multiple of {MAP_STEP} from 0 to 1)"),
         ));
     }
     let mut columns = Vec::with_capacity(c.len() - 2);
@@ -564,14 +564,14 @@ impl RunRecord {
     /// [`Error::RunDirectory`] for a directory without its scene record;
     /// [`Error::CorruptTable`] naming the file, line and column; [`Error::Io`].
     pub(crate) fn read(dir: &Path) -> Result<RunRecord> {
-        let record = dir.join(super::SCENE_RECORD);
+        let record = dir.join(super::RUN_SCENE);
         if !record.is_file() {
             return Err(Error::RunDirectory {
                 path: dir.to_path_buf(),
                 reason: format!(
                     "it holds no {}, the record of the scene its tables belong to (written \
                      when a run starts): the tables cannot be checked; run the scene again",
-                    super::SCENE_RECORD
+                    super::RUN_SCENE
                 ),
             });
         }
@@ -583,7 +583,7 @@ impl RunRecord {
             lx: grid.block().lx(),
             mu_fn: scene.current_material().friction_coefficient() * scene.current_normal_load(),
         };
-        let path = |t: usize| dir.join(TABLE_NAMES[t]);
+        let path = |t: usize| dir.join(TABLES[t]);
         let corrupt = |t: usize, bad: Bad| bad.at(&path(t));
         let read = |t: usize| crate::files::read_text(&path(t), "reading table");
 

@@ -8,11 +8,11 @@ use crate::lock::LOCK_FILE;
 use std::path::Path;
 
 use super::derived::{AVALANCHE_TABLE, FRONTS_TABLE};
-use super::{FIELDS_TABLE, PARTIAL_SUFFIX, SCENE_RECORD, TABLE_NAMES};
+use super::{FIELDS_FILE, PARTIAL, RUN_SCENE, TABLES};
 
 /// The profiles a run records at given loads (`output/profiles.rs`).
 pub(crate) const PROFILES_TABLE: &str = "profiles.csv";
-/// The completion marker of a sweep's run (`crate::sweep::DONE_FILE`).
+/// The completion marker of a sweep's run.
 pub(crate) const DONE: &str = "done";
 /// A sweep's run's record of its coordinates, counts and timings.
 pub(crate) const META: &str = "meta.json";
@@ -91,11 +91,11 @@ pub(crate) fn derived(name: &str) -> bool {
 /// directory (a table, `NAME.partial`, the scene record, the lock, the sweep's markers
 /// and merged tables, a figure, a movie, or a temporary file of one of them).
 pub(crate) fn reserved(name: &str) -> bool {
-    let base = name.strip_suffix(PARTIAL_SUFFIX).unwrap_or(name);
-    TABLE_NAMES.contains(&base)
-        || base == FIELDS_TABLE
+    let base = name.strip_suffix(PARTIAL).unwrap_or(name);
+    TABLES.contains(&base)
+        || base == FIELDS_FILE
         || base == PROFILES_TABLE
-        || [SCENE_RECORD, LOCK_FILE, DONE, META, SWEEP].contains(&name)
+        || [RUN_SCENE, LOCK_FILE, DONE, META, SWEEP].contains(&name)
         || MERGED.contains(&name)
         || derived(name)
         // `write_atomically`'s temporaries: `.NAME.tmp<pid>-...`.
@@ -141,7 +141,7 @@ pub(crate) fn check_output(path: &Path, dir: &Path, what: &'static str) -> Resul
             path: path.to_path_buf(),
             reason: format!(
                 "{name} is a file of the run directory {} (its tables, NAME.partial, \
-                 {SCENE_RECORD}, the lock {LOCK_FILE}, a sweep's {DONE} and {META}, figures \
+                 {RUN_SCENE}, the lock {LOCK_FILE}, a sweep's {DONE} and {META}, figures \
                  and movies): name the {what} otherwise or put it elsewhere",
                 dir.display()
             ),
@@ -209,8 +209,8 @@ pub(crate) fn holds_a_run(dir: &Path) -> Result<Option<String>> {
     for entry in entries {
         let entry = entry.map_err(|e| Error::io("reading directory", dir, e))?;
         let name = entry.file_name().to_string_lossy().into_owned();
-        let base = name.strip_suffix(PARTIAL_SUFFIX).unwrap_or(&name);
-        if name == SCENE_RECORD || TABLE_NAMES.contains(&base) || base == FIELDS_TABLE {
+        let base = name.strip_suffix(PARTIAL).unwrap_or(&name);
+        if name == RUN_SCENE || TABLES.contains(&base) || base == FIELDS_FILE {
             return Ok(Some(name));
         }
     }

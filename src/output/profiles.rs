@@ -14,7 +14,7 @@
 
 use super::check::{self, Bad, Row};
 use super::layout::PROFILES_TABLE;
-use super::PARTIAL_SUFFIX;
+use super::PARTIAL;
 use crate::driver::Driver;
 use crate::error::{Error, Result};
 use crate::probe::{ProbeSpec, StressProbe};
@@ -161,7 +161,7 @@ impl ProfilesTable {
     pub(super) fn paths(dir: &Path) -> (PathBuf, PathBuf) {
         (
             dir.join(PROFILES_TABLE),
-            dir.join(format!("{PROFILES_TABLE}{PARTIAL_SUFFIX}")),
+            dir.join(format!("{PROFILES_TABLE}{PARTIAL}")),
         )
     }
 
@@ -504,7 +504,7 @@ pub(crate) fn read(dir: &Path, record: &check::RunRecord) -> Result<Option<Vec<P
                 path: Some(path),
                 reason: format!(
                     "the run's scene ({}) records no profiles: the table is another run's",
-                    super::SCENE_RECORD
+                    super::RUN_SCENE
                 ),
             }),
         };

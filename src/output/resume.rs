@@ -4,8 +4,8 @@
 //! finished table's. Nothing here writes.
 
 use super::{
-    check, contact_map_header, fields_header, first_level_at_or_above, level, CONTACT_MAP_STEP,
-    CURVE_HEADER, EVENTS_HEADER,
+    check, contact_map_header, fields_header, first_level_at_or_above, level, CURVE_HEADER,
+    EVENTS_HEADER, MAP_STEP,
 };
 use crate::error::{Error, Result};
 use std::path::{Path, PathBuf};
@@ -69,7 +69,7 @@ pub(super) struct Continuation {
     pub(super) loads: Vec<f64>,
 }
 
-/// Checks the three tables (`old[t]`: the text of table `t` in [`super::TABLE_NAMES`]
+/// Checks the three tables (`old[t]`: the text of table `t` (`events.csv`, `curve.csv`, `contact_map.csv`)
 /// order, `None` when missing; `paths` for the messages) against each other and against
 /// the checkpoint's event `k` and load `force_at_k`, and cuts them back to it. Nothing is
 /// written.
@@ -305,10 +305,10 @@ impl Cut<'_> {
         for &(line, row) in map {
             let event = index_of(line, row).map_err(|r| self.corrupt(2, r))?;
             let level = row.split(',').nth(1).and_then(|f| f.parse::<f64>().ok());
-            let step = level.map(|l| (l / CONTACT_MAP_STEP).round());
+            let step = level.map(|l| (l / MAP_STEP).round());
             let level = match (level, step) {
                 (Some(l), Some(s))
-                    if l.is_finite() && s >= 0.0 && (s * CONTACT_MAP_STEP - l).abs() < 1e-9 =>
+                    if l.is_finite() && s >= 0.0 && (s * MAP_STEP - l).abs() < 1e-9 =>
                 {
                     s as u64
                 }
@@ -317,7 +317,7 @@ impl Cut<'_> {
                         2,
                         format!(
                             "line {line}: force_over_mu_FN is not a load level (a multiple of \
-                             {CONTACT_MAP_STEP})"
+                             {MAP_STEP})"
                         ),
                     ))
                 }

@@ -29,7 +29,7 @@ use crate::output::derived::derive;
 use crate::output::layout::{
     ARCHARD_FIGURE, AREA_FIGURE, FIGURES, MAP_FIGURE, PRECURSOR_FIGURE, STICK_SLIP_FIGURE,
 };
-use crate::output::CONTACT_MAP_STEP;
+use crate::output::MAP_STEP;
 use crate::sweep::{merge, MergeSummary, MEDIAN_BAND_RUNS, SWEEP_FILE};
 use std::path::{Path, PathBuf};
 
@@ -303,7 +303,7 @@ pub fn draw_with_options(dir: &Path, options: &DrawOptions) -> Result<Drawn, Plo
     if !sweep && !dir.join("curve.csv").is_file() {
         return Err(
             if dir
-                .join(format!("curve.csv{}", crate::output::PARTIAL_SUFFIX))
+                .join(format!("curve.csv{}", crate::output::PARTIAL))
                 .is_file()
             {
                 PlotError::Figure {
@@ -312,7 +312,7 @@ pub fn draw_with_options(dir: &Path, options: &DrawOptions) -> Result<Drawn, Plo
                         "a run that has not reached global slip: it is under way, or was cut (its \
                      tables are still named curve.csv{}); resume it from its checkpoint or \
                      run it again, then plot",
-                        crate::output::PARTIAL_SUFFIX
+                        crate::output::PARTIAL
                     ),
                 }
             } else {
@@ -629,7 +629,7 @@ fn draw_contact_map(
     let map: Vec<Vec<f64>> = rows
         .iter()
         .map(|r| {
-            [r.event as f64, r.level as f64 * CONTACT_MAP_STEP]
+            [r.event as f64, r.level as f64 * MAP_STEP]
                 .into_iter()
                 .chain(r.columns.iter().copied())
                 .collect()
@@ -652,7 +652,7 @@ fn draw_contact_map(
         }
     }
     let (low, high) = (map[0][1], map[map.len() - 1][1]);
-    let half = CONTACT_MAP_STEP / 2.0;
+    let half = MAP_STEP / 2.0;
     // Rows at their loads, the axis up to 1 (a tick there: global slip under force
     // control) even when the last stable state lies below.
     let edges: Vec<f64> = (0..=map.len())

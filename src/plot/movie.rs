@@ -1,5 +1,5 @@
 //! The paper's Supplementary Movies drawn from a run directory (`precursors movie DIR`):
-//! the fields a run recorded (`fields.csv`, [`crate::output::FIELDS_TABLE`]; the scene
+//! the fields a run recorded (`fields.csv`; the scene
 //! key `fields`, [`crate::RunOptions::record_fields`]) as an animated GIF, one frame per
 //! recorded stable state (or every k-th), on one colour scale for the whole movie.
 //!
@@ -16,8 +16,8 @@
 use super::{axis_range, paint, register_font, Map, MapDrawing, Palette, PlotError, Result};
 use crate::error::Error;
 use crate::output::check::{fields_row, RunRecord};
-use crate::output::SCENE_RECORD;
-use crate::output::{fields_header, FIELDS_TABLE, PARTIAL_SUFFIX};
+use crate::output::RUN_SCENE;
+use crate::output::{fields_header, FIELDS_FILE, PARTIAL};
 use plotters::prelude::*;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -326,7 +326,7 @@ impl Movie {
             return Err(PlotError::NoFields {
                 dir: self.dir.clone(),
                 reason: format!(
-                    "its {FIELDS_TABLE} holds the contact area only: the scene recorded no \
+                    "its {FIELDS_FILE} holds the contact area only: the scene recorded no \
                      planes of the Coulomb stress (`fields.planes`)"
                 ),
             });
@@ -520,26 +520,26 @@ fn map_pixels(map: &Map, path: &Path) -> Result<Vec<u8>> {
 /// The fields recorded in `dir`: its scene record gives the grid and the planes,
 /// `fields.csv` the states.
 fn read_recording(dir: &Path) -> Result<Recording> {
-    let table = dir.join(FIELDS_TABLE);
+    let table = dir.join(FIELDS_FILE);
     let no_fields = |reason: String| PlotError::NoFields {
         dir: dir.to_path_buf(),
         reason,
     };
     if !table.is_file() {
-        let partial = dir.join(format!("{FIELDS_TABLE}{PARTIAL_SUFFIX}"));
+        let partial = dir.join(format!("{FIELDS_FILE}{PARTIAL}"));
         return Err(no_fields(if partial.is_file() {
             format!(
-                "its run has not reached global slip ({FIELDS_TABLE}{PARTIAL_SUFFIX}): resume it \
+                "its run has not reached global slip ({FIELDS_FILE}{PARTIAL}): resume it \
                  (`precursors resume`) to finish the table"
             )
         } else {
-            format!("it holds no {FIELDS_TABLE}")
+            format!("it holds no {FIELDS_FILE}")
         }));
     }
-    let record = dir.join(SCENE_RECORD);
+    let record = dir.join(RUN_SCENE);
     if !record.is_file() {
         return Err(no_fields(format!(
-            "it holds {FIELDS_TABLE} but no {SCENE_RECORD}, the record of the run's scene"
+            "it holds {FIELDS_FILE} but no {RUN_SCENE}, the record of the run's scene"
         )));
     }
     let builder = crate::scene::SceneBuilder::from_json_file(&record)?;
@@ -555,8 +555,8 @@ fn read_recording(dir: &Path) -> Result<Recording> {
     let mut lines = text.lines();
     if lines.next() != Some(header.as_str()) {
         return Err(corrupt(format!(
-            "line 1 is not the header of {FIELDS_TABLE} for the {nx} columns of the scene in \
-             {SCENE_RECORD}"
+            "line 1 is not the header of {FIELDS_FILE} for the {nx} columns of the scene in \
+             {RUN_SCENE}"
         ))
         .into());
     }
@@ -565,7 +565,7 @@ fn read_recording(dir: &Path) -> Result<Recording> {
     let every = builder.current_run().fields_every().max(1);
     let states = read_states(lines, &table, &run, every, (nx, ny), &planes, &header)?;
     if states.is_empty() {
-        return Err(no_fields(format!("its {FIELDS_TABLE} holds no state")));
+        return Err(no_fields(format!("its {FIELDS_FILE} holds no state")));
     }
     let block = grid.block();
     Ok(Recording {

@@ -39,7 +39,7 @@ pub(super) fn draw_stick_slip(
         };
         let Some(u) = load.drive_displacement else {
             return Err(Error::CorruptTable {
-                path: Some(dir.join(crate::output::TABLE_NAMES[0])),
+                path: Some(dir.join(crate::output::TABLES[0])),
                 reason: format!(
                     "event {}: a {} of a run driven through a spring without its \
                      drive_displacement_m",
@@ -138,7 +138,7 @@ pub(super) fn draw_archard(
         let mut nominal = f64::NAN;
         point.for_each_record(|run_dir, record| {
             let first = record.curve.first().ok_or_else(|| Error::CorruptTable {
-                path: Some(run_dir.join(crate::output::TABLE_NAMES[1])),
+                path: Some(run_dir.join(crate::output::TABLES[1])),
                 reason: "no stable state: the zero-shear state is missing".into(),
             })?;
             areas.push(first.area);

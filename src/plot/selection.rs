@@ -135,7 +135,7 @@ impl Facts {
             }
         } else {
             let scene =
-                crate::scene::SceneBuilder::from_json_file(dir.join(crate::output::SCENE_RECORD));
+                crate::scene::SceneBuilder::from_json_file(dir.join(crate::output::RUN_SCENE));
             let profiles_of = |scene: &crate::scene::SceneBuilder| {
                 let run = scene.current_run();
                 (

@@ -66,7 +66,7 @@ pub enum SweepError {
     },
     /// A sweep file ([`crate::sweep::Sweep::from_json_file`],
     /// [`crate::sweep::Sweep::from_json_str`]) whose axes and realizations make more runs
-    /// than [`crate::sweep::MAX_RUNS`]; refused before any scene is built.
+    /// than `1e5`; refused before any scene is built.
     #[error(
         "the sweep has {points} points x {realizations} realizations = {runs} runs, more than \
          the limit of {limit} runs per sweep: split it into several sweeps (fewer values per \

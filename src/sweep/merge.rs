@@ -1,17 +1,17 @@
 //! Ensemble statistics of a sweep's runs (`precursors merge DIR`; docs/sweep-format.md).
 
-use super::{Sweep, SweepError, SweepRun, DONE_FILE, SWEEP_FILE};
+use super::{Sweep, SweepError, SweepRun, DONE, SWEEP_FILE};
 use crate::error::{Error, Result};
 use crate::files::write_atomically;
 use crate::output::check::RunRecord;
 use crate::output::layout::MERGED;
-use crate::output::SCENE_RECORD;
+use crate::output::RUN_SCENE;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// The loads `F/(μF_N)` at which [`merge`] reports ℓ/Lx and `A_R/A_R(0)`:
 /// 0.05, 0.10, ..., 0.95.
-pub const LOAD_GRID: [f64; 19] = [
+pub(crate) const GRID_LOADS: [f64; 19] = [
     0.05, 0.10, 0.15, 0.20, 0.25, 0.30, 0.35, 0.40, 0.45, 0.50, 0.55, 0.60, 0.65, 0.70, 0.75, 0.80,
     0.85, 0.90, 0.95,
 ];
@@ -192,14 +192,14 @@ fn read_run(dir: &Path, run: &SweepRun) -> Result<RunData> {
 pub(super) fn checked_record(dir: &Path, run: &SweepRun) -> Result<RunRecord> {
     // The scene first: tables checked against another point's scene would be refused
     // for their numbers, not for what is wrong.
-    let record_path = dir.join(SCENE_RECORD);
+    let record_path = dir.join(RUN_SCENE);
     if record_path.is_file() {
         let recorded = crate::scene::SceneBuilder::from_json_file(&record_path)?;
         if let Some(e) = crate::driver::scene_mismatch(
             &run.scene,
             &format!("the sweep's run {} ({})", run.index, run.dir_name),
             &recorded,
-            &format!("the scene recorded in {}", dir.join(SCENE_RECORD).display()),
+            &format!("the scene recorded in {}", dir.join(RUN_SCENE).display()),
         ) {
             return Err(Error::RunDirectory {
                 path: dir.to_path_buf(),
@@ -311,7 +311,7 @@ pub(crate) fn ensemble_curves(dir: &Path, grid: &[f64]) -> Result<Vec<EnsembleCu
         let mut data = Vec::new();
         for run in &runs {
             let run_dir = dir.join(&run.dir_name);
-            if run_dir.join(DONE_FILE).is_file() {
+            if run_dir.join(DONE).is_file() {
                 data.push(read_run(&run_dir, run)?);
             }
         }
@@ -336,7 +336,7 @@ pub(crate) fn ensemble_curves(dir: &Path, grid: &[f64]) -> Result<Vec<EnsembleCu
 /// one directory) into four CSV files in `dir`, one block of rows per parameter point
 /// (the axes' values as columns, named by their keys):
 ///
-/// * `curves.csv`: on [`LOAD_GRID`], the mean and 95 % band of ℓ/Lx and of `A_R/A_R(0)`
+/// * `curves.csv`: on 0.05, 0.10, ..., 0.95, the mean and 95 % band of ℓ/Lx and of `A_R/A_R(0)`
 ///   over the realizations, each taking the value of its last stable state at or below
 ///   the load (a realization with none yet is left out; `runs` counts those in). `A_R(0)`
 ///   is the real contact area of the run's first stable state (zero shear). The band is
@@ -453,7 +453,7 @@ impl Tables {
         for run in runs {
             let run_dir = dir.join(&run.dir_name);
             let (point, realization, seed) = (run.point, run.realization, run.seed);
-            if !run_dir.join(DONE_FILE).is_file() {
+            if !run_dir.join(DONE).is_file() {
                 let _ = writeln!(
                     self.runs,
                     "{},{point},{realization},{seed},{values},,",
@@ -476,7 +476,7 @@ impl Tables {
 
     /// The rows of one point in `curves.csv`, `slip.csv` and `avalanches.csv`.
     fn add_point(&mut self, point: usize, values: &str, data: &[RunData]) {
-        for &f in &LOAD_GRID {
+        for &f in &GRID_LOADS {
             let (runs, (em, el, eh), (am, al, ah)) = bands_at(data, f);
             let _ = writeln!(
                 self.curves,

@@ -5,7 +5,7 @@
 //! complete run (`RunRecord`), never from the derived tables a run leaves beside them.
 
 use super::merge::{cell, checked_record, num, read_sweep};
-use super::{SweepError, SweepRun, DONE_FILE, SWEEP_FILE};
+use super::{SweepError, SweepRun, DONE, SWEEP_FILE};
 use crate::error::{Error, Result};
 use crate::files::write_atomically;
 use crate::output::check::RunRecord;
@@ -112,7 +112,7 @@ pub(crate) const OBSERVABLES: [(&str, Support, &str); 7] = [
 /// [`Error::CorruptTable`] when its events are not the whole run of its grid.
 pub(crate) fn samples(record: &RunRecord, dir: &Path) -> Result<[Vec<f64>; 7]> {
     let derived = derive(&record.grid, &record.events).map_err(|e| Error::CorruptTable {
-        path: Some(dir.join(crate::output::TABLE_NAMES[0])),
+        path: Some(dir.join(crate::output::TABLES[0])),
         reason: format!("not the whole run of its scene: {e}"),
     })?;
     let mut out: [Vec<f64>; 7] = Default::default();
@@ -190,12 +190,12 @@ impl Point {
 /// sweep file's errors.
 pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Vec<Point>, usize), SweepError> {
     if !dir.join(SWEEP_FILE).is_file() {
-        if !dir.join(crate::output::SCENE_RECORD).is_file() {
+        if !dir.join(crate::output::RUN_SCENE).is_file() {
             return Err(SweepError::Directory {
                 path: dir.to_path_buf(),
                 reason: format!(
                     "neither a run directory (no {}) nor a sweep's (no {SWEEP_FILE})",
-                    crate::output::SCENE_RECORD
+                    crate::output::RUN_SCENE
                 ),
             });
         }
@@ -215,7 +215,7 @@ pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Vec<Point>, usize), Swe
         let mut complete = Vec::new();
         for run in &runs {
             let run_dir = dir.join(&run.dir_name);
-            if run_dir.join(DONE_FILE).is_file() {
+            if run_dir.join(DONE).is_file() {
                 complete.push((run_dir, Some((*run).clone())));
             } else {
                 missing += 1;
