@@ -139,7 +139,7 @@ pub(super) fn draw_profiles(
     save(
         family(
             &format!("|τ(x, z_P)|, {at}"),
-            "|τ_xz| (MPa)",
+            "|τ_{xz}| (MPa)",
             "shear_Pa",
             z_p,
             &mpa,
@@ -150,7 +150,7 @@ pub(super) fn draw_profiles(
     save(
         family(
             &format!("|σ(x, z_P)|, {at}"),
-            "|σ_zz| (MPa)",
+            "|σ_{zz}| (MPa)",
             "normal_Pa",
             z_p,
             &mpa,
