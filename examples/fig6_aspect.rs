@@ -123,7 +123,7 @@ fn run() -> report::Outcome {
     figures::precursor_panel(
         &dir,
         "fig6d",
-        "Fig. 6d: rod (h = 6 mm) + top, F_top = n·F_lat, 201 x 7 x 132 mm, F_N = 2.7 kN",
+        "Fig. 6d: rod (h = 6 mm) + top, F_{top} = n·F_{lat}, 201 x 7 x 132 mm, F_N = 2.7 kN",
         &d,
         &seeds,
     )?;

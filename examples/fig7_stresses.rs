@@ -119,8 +119,8 @@ fn run() -> report::Outcome {
     )
     .x_range(0.0, lx_mm)
     .y_range(low - 0.05 * (high - low), high + 0.35 * (high - low))
-    .line("|τ_xz| at z_P = 2 mm", &mpa(&sums[0]))
-    .line("|σ_zz| at z_P = 2 mm", &mpa(&sums[1]))
+    .line("|τ_{xz}| at z_P = 2 mm", &mpa(&sums[0]))
+    .line("|σ_{zz}| at z_P = 2 mm", &mpa(&sums[1]))
     .line("τ_C = |τ| − μ|σ| at z_P = 2 mm", &mpa(&sums[2]))
     .line("τ_C at the interface, z = 0", &mpa(&sums[3]))
     // Zero, where τ_C changes sign: the Coulomb stress ahead of the front.

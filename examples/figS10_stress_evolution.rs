@@ -74,8 +74,8 @@ fn run() -> report::Outcome {
         &rows,
     )?;
     let figures = [
-        ("sigma", "normal stress", "|σ_zz(x, z_P)| (MPa)", &sigma),
-        ("tau", "shear stress", "|τ_xz(x, z_P)| (MPa)", &tau),
+        ("sigma", "normal stress", "|σ_{zz}(x, z_P)| (MPa)", &sigma),
+        ("tau", "shear stress", "|τ_{xz}(x, z_P)| (MPa)", &tau),
     ];
     for (name, what, y_label, data) in figures {
         let top = data.iter().flatten().fold(0.0f64, |m, v| m.max(*v)) / 1e6;

@@ -177,7 +177,8 @@ fn realizations(builder: &SceneBuilder, options: &FitOptions) -> Vec<SceneBuilde
     options
         .seeds
         .iter()
-        .map(|&seed| builder.clone().heights(source.reseeded(seed)))
+        // `seed` too: a seed given to the builder would otherwise reseed the source.
+        .map(|&seed| builder.clone().heights(source.reseeded(seed)).seed(seed))
         .collect()
 }
 

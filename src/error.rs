@@ -229,7 +229,9 @@ pub enum Error {
     /// The grid has more cells than the limit a plan or scene is built with
     /// ([`crate::green::InfluencePlanBuilder::max_cells`], [`crate::SceneBuilder::max_cells`],
     /// default [`crate::green::DEFAULT_MAX_CELLS`]): refused before anything is allocated,
-    /// with the estimated cost ([`crate::GridCost`], docs/performance.md).
+    /// with the estimated cost ([`crate::GridCost`], docs/performance.md). A scene whose
+    /// block length of 1 m or more may be millimetres meant as metres reports it as the
+    /// source of [`Error::LengthInMillimetres`].
     #[error(
         "a grid of {nx} x {ny} = {cells} cells exceeds the limit of {limit} cells: it would \
          need about {memory} of memory, about {plan} to plan and about {solve} per cold \
@@ -255,6 +257,25 @@ pub enum Error {
         /// Estimated time of one cold normal and tangential equilibrium (s, one thread,
         /// release build).
         solve_seconds: f64,
+    },
+    /// A scene's grid above the cell limit ([`Error::GridTooLarge`], the source) whose cells
+    /// are given by size and whose block has a length of 1 m or more
+    /// ([`crate::SceneBuilder::grid`], `check`, `build`): most likely lengths typed in
+    /// millimetres (`"lx": 140` for 140 mm makes 140 000 cells of 1 mm along x).
+    #[error(
+        "{key} = {} m makes the grid too large: lengths are in metres: did you mean {} m?",
+        Num(*value),
+        Num(*value / 1e3)
+    )]
+    LengthInMillimetres {
+        /// The scene-file key of the first such length (`block.lx`, `block.ly`,
+        /// `block.lz`).
+        key: &'static str,
+        /// The length given (m).
+        value: f64,
+        /// The [`Error::GridTooLarge`] of the grid, with its size and cost.
+        #[source]
+        source: Box<Error>,
     },
     /// An explicit thread count above one with the dense backend, which runs on one
     /// thread (its factor solve needs the whole attached set): `SolverOptions`, a scene's

@@ -432,7 +432,7 @@ enum Cells {
 /// assert!(matches!(refused, Err(Error::InvalidParameter { name: "normal_load", .. })));
 /// # Ok::<(), precursors::Error>(())
 /// ```
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 #[must_use]
 pub struct SceneBuilder {
     lengths: (f64, f64, f64),
@@ -440,6 +440,9 @@ pub struct SceneBuilder {
     material: Material,
     law: SpringLaw,
     heights: HeightSource,
+    // The seed of `seed()`: kept so that a later `heights()` of a random kind takes it,
+    // and given values refuse it at `check()`, whatever the order of the calls.
+    seed: Option<u64>,
     normal_load: f64,
     drive: Drive,
     solver: SolverOptions,
@@ -447,6 +450,30 @@ pub struct SceneBuilder {
     probes: ProbeSpec,
     max_cells: usize,
     run: RunOptions,
+}
+
+impl PartialEq for SceneBuilder {
+    /// The same scene: the seed of [`SceneBuilder::seed`] counts through the heights it
+    /// seeded (and as a seed given with given heights, which `build` refuses).
+    fn eq(&self, other: &Self) -> bool {
+        let refused = |b: &Self| match b.heights {
+            HeightSource::Values(_) => b.seed,
+            _ => None,
+        };
+        self.lengths == other.lengths
+            && self.cells == other.cells
+            && self.material == other.material
+            && self.law == other.law
+            && self.heights == other.heights
+            && refused(self) == refused(other)
+            && self.normal_load == other.normal_load
+            && self.drive == other.drive
+            && self.solver == other.solver
+            && self.plan_tolerance == other.plan_tolerance
+            && self.probes == other.probes
+            && self.max_cells == other.max_cells
+            && self.run == other.run
+    }
 }
 
 impl Default for SceneBuilder {
@@ -457,6 +484,7 @@ impl Default for SceneBuilder {
             material: Material::default(),
             law: SpringLaw::default(),
             heights: HeightSource::default(),
+            seed: None,
             normal_load: 3.5e3,
             drive: Drive::default(),
             solver: SolverOptions::default(),
@@ -507,18 +535,38 @@ impl SceneBuilder {
         self
     }
 
-    /// Heights source (default: paper Gaussian, seed 1).
+    /// Heights source (default: paper Gaussian, seed 1). A seed given by
+    /// [`SceneBuilder::seed`], before or after, replaces the seed of a random source;
+    /// given values replace the random heights, a seed given before included.
     pub fn heights(mut self, heights: HeightSource) -> Self {
-        self.heights = heights;
+        self.heights = match (self.seed, &heights) {
+            (Some(seed), HeightSource::Random { .. } | HeightSource::Surface { .. }) => {
+                heights.reseeded(seed)
+            }
+            (_, HeightSource::Values(_)) => {
+                self.seed = None;
+                heights
+            }
+            _ => heights,
+        };
         self
     }
 
-    /// Paper Gaussian heights (mean 1 µm, sd 1 µm, truncated at 0) from `seed` (default 1).
+    /// The seed of random heights (default 1): the paper's Gaussian heights (mean 1 µm,
+    /// sd 1 µm, truncated at 0) unless [`SceneBuilder::heights`] gives another random
+    /// source ([`HeightSource::Random`] with another distribution, or
+    /// [`HeightSource::Surface`]), which keeps its distribution and spectrum and takes
+    /// this seed. The order of the two calls does not matter: `.heights(surface).seed(5)`
+    /// and `.seed(5).heights(surface)` are the same surface, from seed 5. Given heights
+    /// ([`HeightSource::Values`], a heights file) take no seed: set after a seed they
+    /// replace the random heights, seed included; a seed set after them is refused at
+    /// [`SceneBuilder::check`] and [`SceneBuilder::build`] ([`Error::InvalidCount`]
+    /// naming `seed`; it replaced them with the paper's Gaussian heights before 1.1).
     pub fn seed(mut self, seed: u64) -> Self {
-        self.heights = HeightSource::Random {
-            distribution: HeightDistribution::default(),
-            seed,
-        };
+        self.seed = Some(seed);
+        if !matches!(self.heights, HeightSource::Values(_)) {
+            self.heights = self.heights.reseeded(seed);
+        }
         self
     }
 
@@ -645,7 +693,8 @@ impl SceneBuilder {
     ///
     /// # Errors
     /// The first invalid length or cell size or count; [`Error::GridTooLarge`] above
-    /// [`SceneBuilder::max_cells`]; [`Error::OutOfRange`] (naming the scene-file key) for
+    /// [`SceneBuilder::max_cells`], or [`Error::LengthInMillimetres`] holding it when the
+    /// cells are given by size and a block length is 1 m or more; [`Error::OutOfRange`] (naming the scene-file key) for
     /// a length, an aspect ratio or a cell size outside the ranges of
     /// `docs/scene-format.md` ("Valid ranges").
     pub fn grid(&self) -> Result<Grid> {
@@ -656,7 +705,21 @@ impl SceneBuilder {
             Cells::Size(dx, dy) => Grid::from_cell_size(block, dx, dy)?,
             Cells::Count(nx, ny) => Grid::new(block, nx, ny)?,
         };
-        crate::cost::check_cells(grid.nx(), grid.ny(), self.max_cells)?;
+        crate::cost::check_cells(grid.nx(), grid.ny(), self.max_cells).map_err(|e| {
+            // Cells of a given size and a length of a metre or more: millimetres typed as
+            // metres, most likely.
+            let lengths = [("block.lx", lx), ("block.ly", ly), ("block.lz", lz)];
+            match lengths.into_iter().find(|&(_, v)| v >= 1.0) {
+                Some((key, value)) if matches!(self.cells, Cells::Size(..)) => {
+                    Error::LengthInMillimetres {
+                        key,
+                        value,
+                        source: Box::new(e),
+                    }
+                }
+                _ => e,
+            }
+        })?;
         Ok(grid)
     }
 
@@ -692,6 +755,14 @@ impl SceneBuilder {
                 name: "normal_load",
                 value: self.normal_load,
                 reason: "the normal load must be finite and > 0 N",
+            });
+        }
+        if let (HeightSource::Values(_), Some(seed)) = (&self.heights, self.seed) {
+            return Err(Error::InvalidCount {
+                name: "seed",
+                value: seed,
+                reason: "given heights (values or a heights file) take no seed: leave the \
+                         seed out, or give random heights",
             });
         }
         match &self.heights {
@@ -772,7 +843,7 @@ impl SceneBuilder {
     ///
     /// # Errors
     /// As [`SceneBuilder::build`].
-    pub fn build_with_planner(self, planner: &Planner) -> Result<Scene> {
+    pub fn build_with_planner(mut self, planner: &Planner) -> Result<Scene> {
         let (lx, ly, lz) = self.lengths;
         let (block, grid, heights, lateral) = self.checked()?;
         let plan = planner.plan_with_max_cells(grid, self.plan_tolerance, self.max_cells)?;
@@ -799,6 +870,8 @@ impl SceneBuilder {
             }
         };
         let interface = Interface::new(grid, heights, self.law)?;
+        // The seed is in the heights now: `to_builder` then takes given values.
+        self.seed = None;
         let probe = if self.probes.is_empty() {
             None
         } else {

@@ -190,6 +190,18 @@ mod plot {
         std::fs::remove_dir_all(&dir).ok();
     }
 
+    /// A directory that does not exist is a file error (issue 45, item 10), not a figure's.
+    #[test]
+    fn a_missing_directory_is_a_not_found_io_error() {
+        let dir = scratch("plot-missing").join("no-such-directory");
+        let e = draw(&dir, &[Format::Png]).unwrap_err();
+        let PlotError::Core(Error::Io { path, source, .. }) = &e else {
+            panic!("another error: {e:?}")
+        };
+        assert_eq!((path, source.kind()), (&dir, std::io::ErrorKind::NotFound));
+        assert!(e.to_string().contains("no-such-directory"), "{e}");
+    }
+
     #[test]
     fn a_nan_in_a_run_table_is_a_nested_core_error() {
         let dir = scratch("plot-nan");

@@ -781,3 +781,43 @@ mod ranges {
         assert_eq!(b.build().unwrap_err().to_string(), e.to_string());
     }
 }
+
+/// Lengths typed in millimetres (`lx = 140` for 140 mm) with cells of 1 mm: the grid is
+/// too large, and the error asks whether metres were meant (issue 45, item 10), holding
+/// the grid's `GridTooLarge` as its source. Cells given by count keep `GridTooLarge`.
+#[test]
+fn millimetres_typed_as_metres_are_asked_about() {
+    let e = precursors::Scene::builder()
+        .block(140.0, 7.0, 75.0)
+        .cell_size(1e-3, 1e-3)
+        .grid()
+        .unwrap_err();
+    let Error::LengthInMillimetres { key, value, source } = &e else {
+        panic!("another error: {e}")
+    };
+    assert_eq!((*key, *value), ("block.lx", 140.0));
+    assert!(matches!(
+        **source,
+        Error::GridTooLarge {
+            nx: 140_000,
+            ny: 7000,
+            ..
+        }
+    ));
+    let text = e.to_string();
+    assert!(
+        text.contains("lengths are in metres: did you mean 0.14 m?"),
+        "{text}"
+    );
+    let cause = std::error::Error::source(&e)
+        .map(|c| c.to_string())
+        .unwrap_or_default();
+    assert!(cause.contains("140000 x 7000"), "{cause}");
+    // A count of cells does not depend on the lengths' unit: no question then.
+    let e = precursors::Scene::builder()
+        .block(1.4, 0.007, 0.075)
+        .cells(10_000, 1_000)
+        .grid()
+        .unwrap_err();
+    assert!(matches!(e, Error::GridTooLarge { .. }), "{e}");
+}

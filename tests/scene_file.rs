@@ -625,3 +625,41 @@ fn files_too_large_for_memory_are_refused_before_reading() {
     assert!(started.elapsed().as_secs_f64() < 5.0);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A heights file named in a scene file is reported by the path it was read from: resolved
+/// against the scene file's directory, not as written in the file (issue 45, item 10).
+#[test]
+fn a_heights_file_is_reported_by_its_resolved_path() {
+    let dir = scratch("heights-resolved");
+    std::fs::create_dir_all(dir.join("maps")).unwrap();
+    std::fs::write(dir.join("maps/bad.txt"), "1e-6\nabc\n").unwrap();
+    let scene = |path: &str| {
+        let scene_path = dir.join(format!("{}.json", path.replace(['/', '.'], "_")));
+        std::fs::write(
+            &scene_path,
+            format!(
+                r#"{{"block": {{"lx": 0.010, "ly": 0.002, "lz": 0.010}},
+                    "cells": {{"kind": "count", "nx": 10, "ny": 2}},
+                    "heights": {{"kind": "file", "path": "{path}"}}}}"#
+            ),
+        )
+        .unwrap();
+        SceneBuilder::from_json_file(&scene_path).unwrap_err()
+    };
+    let missing = dir.join("maps/missing.txt");
+    match scene("maps/missing.txt") {
+        Error::Io { path, .. } => assert_eq!(path, missing),
+        other => panic!("{other:?}"),
+    }
+    match scene("maps/bad.txt") {
+        e @ Error::HeightsFile { .. } => {
+            let text = e.to_string();
+            let resolved = dir.join("maps/bad.txt");
+            assert!(
+                text.starts_with(&format!("{}, line 2", resolved.display())),
+                "{text}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+}

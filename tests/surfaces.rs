@@ -3,7 +3,8 @@
 //! size, the heights' statistics, and the scene-file kinds and sweep axes.
 
 use precursors::{
-    Block, Error, Grid, HeightDistribution, HeightSource, Heights, Scene, SurfaceSpectrum,
+    Block, Error, Grid, HeightDistribution, HeightSource, Heights, Scene, SceneBuilder,
+    SurfaceSpectrum,
 };
 
 fn block() -> Block {
@@ -414,4 +415,53 @@ fn a_surface_without_spread_is_its_mean_everywhere() {
         .unwrap();
         assert!(heights.values().iter().all(|&h| h == 1.5e-6), "{heights:?}");
     }
+}
+
+/// `seed` and `heights` combine in any order (issue 45, item 10): a surface keeps its
+/// spectrum and takes the seed; given values refuse a seed, in either order.
+#[test]
+fn seed_and_heights_combine_in_any_order() {
+    let surface = |seed| HeightSource::Surface {
+        spectrum: SurfaceSpectrum::gaussian(2e-3).unwrap(),
+        distribution: HeightDistribution::default(),
+        seed,
+    };
+    let base = Scene::builder()
+        .block(0.008, 0.004, 0.010)
+        .cells(8, 4)
+        .normal_load(30.0);
+    let after = base.clone().heights(surface(1)).seed(5);
+    let before = base.clone().seed(5).heights(surface(1));
+    assert_eq!(after, base.clone().heights(surface(5)));
+    assert_eq!(before, after);
+    let heights = |b: SceneBuilder| b.build().unwrap().interface().heights().to_vec();
+    let expected = heights(base.clone().heights(surface(5)));
+    assert_eq!(heights(after), expected);
+    assert_eq!(heights(before), expected);
+    // Given values take no seed: set after one they replace the random heights, seed
+    // included; a seed set after them is refused, not a silent switch to white noise.
+    let values = HeightSource::Values(vec![1e-6; 32]);
+    let replaced = base.clone().seed(5).heights(values.clone());
+    assert_eq!(replaced, base.clone().heights(values.clone()));
+    assert_eq!(heights(replaced), vec![1e-6; 32]);
+    let e = base
+        .clone()
+        .heights(values.clone())
+        .seed(5)
+        .build()
+        .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            Error::InvalidCount {
+                name: "seed",
+                value: 5,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    // A built scene's builder carries no seed of its own: new values are accepted.
+    let built = base.seed(5).build().unwrap();
+    assert!(built.to_builder().heights(values).build().is_ok());
 }

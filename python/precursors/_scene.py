@@ -2,9 +2,13 @@
 crate's, docs/scene-format.md), and the JSON text of a scene dict."""
 
 import json
-from typing import Any, Dict, Optional, Sequence, Tuple, Union
+import math
+import numbers
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
+
+from ._errors import PrecursorsValueError
 
 
 def _plain(value: Any) -> Any:
@@ -19,6 +23,86 @@ def _plain(value: Any) -> Any:
 def dumps(scene: Any) -> str:
     """A dict in the scene-file format as its JSON text."""
     return json.dumps(scene, default=_plain, allow_nan=True)
+
+
+# Keyword checks: a wrong type or a non-finite number is refused here, in the keywords'
+# terms (the scene file's JSON parser would name a line and column of text the caller never
+# wrote).
+
+
+def _value_error(kind: str, message: str) -> PrecursorsValueError:
+    error = PrecursorsValueError(message)
+    error.kind = kind
+    return error
+
+
+def _number(name: str, value: Any) -> float:
+    """A finite real number (int, float or numpy scalar)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a number (float), not {type(value).__name__}")
+    number = float(value)
+    if not math.isfinite(number):
+        raise _value_error("NonFinite", f"{name} = {number} is not a finite number")
+    return number
+
+
+def _count(name: str, value: Any) -> int:
+    """A whole number >= 0 (int or numpy integer)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an int, not {type(value).__name__}")
+    count = int(value)
+    if count < 0:
+        raise _value_error("InvalidCount", f"{name} = {count} is invalid: it must be >= 0")
+    return count
+
+
+def _items(name: str, value: Any, size: Optional[int], what: str) -> List[Any]:
+    """The items of a tuple or list (of `size` items when given)."""
+    if isinstance(value, (str, bytes, dict)) or not hasattr(value, "__iter__"):
+        raise TypeError(f"{name} must be {what}, not {type(value).__name__}")
+    items = list(value)
+    if size is not None and len(items) != size:
+        raise TypeError(f"{name} must be {what}, not {len(items)} values")
+    return items
+
+
+def _numbers(name: str, value: Any, size: Optional[int], what: str) -> List[float]:
+    items = _items(name, value, size, what)
+    return [_number(f"{name}[{i}]", v) for i, v in enumerate(items)]
+
+
+def _choice(name: str, value: Any, choices: Sequence[str]) -> str:
+    options = ", ".join(repr(c) for c in choices)
+    if not isinstance(value, str):
+        raise TypeError(
+            f"{name} must be a str (one of {options}), not {type(value).__name__}"
+        )
+    if value not in choices:
+        raise _value_error("InvalidChoice", f"{name} = {value!r} is not one of {options}")
+    return value
+
+
+def _heights(value: Any) -> np.ndarray:
+    """The heights array: numbers, each finite and > 0 (its shape is checked against the
+    grid by ``Scene``)."""
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(
+            "heights must be an array of numbers (float, m) of shape (Ny, Nx), not "
+            f"{type(value).__name__}"
+        ) from None
+    bad = np.argwhere(~(np.isfinite(array) & (array > 0.0)))
+    if len(bad):
+        at = tuple(int(i) for i in bad[0])
+        place = ", ".join(str(i) for i in at)
+        height = array[at]
+        kind = "NonFinite" if not math.isfinite(height) else "NonPositiveHeight"
+        raise _value_error(
+            kind,
+            f"heights[{place}] = {height} is invalid: heights (m) must be finite and > 0",
+        )
+    return array
 
 
 class SurfaceSpectrum:
@@ -77,6 +161,10 @@ class SurfaceSpectrum:
         return f"SurfaceSpectrum.{name}({args})"
 
 
+# The drives a string names (the others are dicts in the scene-file format).
+_DRIVES = ("rod", "top", "side")
+
+
 def scene_dict(
     *,
     block: Optional[Tuple[float, float, float]] = None,
@@ -105,18 +193,19 @@ def scene_dict(
     out is a key left out (the calibration scene's value)."""
     scene: Dict[str, Any] = {}
     if block is not None:
-        lx, ly, lz = block
+        lx, ly, lz = _numbers("block", block, 3, "(lx, ly, lz): three lengths (float, m)")
         scene["block"] = {"lx": lx, "ly": ly, "lz": lz}
     if cells is not None and cell_size is not None:
         raise TypeError("give cells=(nx, ny) or cell_size=(dx, dy), not both")
     if cells is not None:
-        nx, ny = cells
+        items = _items("cells", cells, 2, "(nx, ny): two counts (int)")
+        nx, ny = (_count(f"cells[{i}]", v) for i, v in enumerate(items))
         scene["cells"] = {"kind": "count", "nx": nx, "ny": ny}
     if cell_size is not None:
-        dx, dy = cell_size
+        dx, dy = _numbers("cell_size", cell_size, 2, "(dx, dy): two lengths (float, m)")
         scene["cells"] = {"kind": "size", "dx": dx, "dy": dy}
     if normal_load is not None:
-        scene["normal_load"] = normal_load
+        scene["normal_load"] = _number("normal_load", normal_load)
     if heights is not None and seed is not None:
         raise TypeError("give heights=array or seed=n, not both")
     if heights is not None and (surface is not None or height_distribution is not None):
@@ -129,6 +218,12 @@ def scene_dict(
             f"surface= takes a SurfaceSpectrum (SurfaceSpectrum.gaussian(ξ), "
             f"SurfaceSpectrum.self_affine(H, λ_r, λ_s, λ_l)), not {type(surface).__name__}"
         )
+    if seed is not None:
+        seed = _count("seed", seed)
+        if seed >= 2**64:
+            raise _value_error(
+                "InvalidCount", f"seed = {seed} is invalid: it must be < 2**64"
+            )
     if seed is not None or surface is not None or height_distribution is not None:
         # Random heights: the paper's white noise, or a surface; the seed and the
         # distribution default as in a scene file.
@@ -138,14 +233,27 @@ def scene_dict(
         if seed is not None:
             random["seed"] = seed
         if height_distribution is not None:
-            mean, std_dev = height_distribution
+            mean, std_dev = _numbers(
+                "height_distribution", height_distribution, 2, "(mean, std_dev) (float, m)"
+            )
             random["mean"] = mean
             random["std_dev"] = std_dev
         scene["heights"] = random
     if heights is not None:
         # (Ny, Nx), row iy and column ix: C order is the crate's cell order iy*Nx + ix.
-        values = np.asarray(heights, dtype=np.float64)
+        # Scene checks the shape against the grid.
+        values = _heights(heights)
         scene["heights"] = {"kind": "values", "values": values.ravel(order="C")}
+    young_modulus, poisson_ratio, friction_coefficient, c_x, c_z = (
+        None if v is None else _number(k, v)
+        for k, v in (
+            ("young_modulus", young_modulus),
+            ("poisson_ratio", poisson_ratio),
+            ("friction_coefficient", friction_coefficient),
+            ("c_x", c_x),
+            ("c_z", c_z),
+        )
+    )
     material = {
         k: v
         for k, v in (
@@ -160,32 +268,56 @@ def scene_dict(
     springs = {k: v for k, v in (("c_x", c_x), ("c_z", c_z)) if v is not None}
     if springs:
         scene["springs"] = springs
+    if isinstance(drive, str) and drive not in _DRIVES:
+        raise _value_error(
+            "InvalidChoice",
+            f"drive = {drive!r} is not one of 'rod', 'top', 'side'; give the other drives "
+            "as a dict in the scene-file format (drive={'kind': 'mixed', 'ratio': n})",
+        )
+    if drive is not None and not isinstance(drive, (str, dict)):
+        raise TypeError(f"drive must be a str or a dict, not {type(drive).__name__}")
     if rod is not None and drive not in (None, "rod"):
         raise TypeError("rod=(height, half_width) goes with drive='rod'")
     if isinstance(drive, dict):
         scene["drive"] = drive
     elif rod is not None:
-        height, half_width = rod
+        height, half_width = _numbers("rod", rod, 2, "(height, half_width) (float, m)")
         scene["drive"] = {"kind": "rod", "height": height, "half_width": half_width}
     elif drive == "rod":
         pass  # the default drive: the paper's rod
     elif drive is not None:
         scene["drive"] = {"kind": drive}
+    if backend is not None:
+        _choice("backend", backend, ("auto", "dense", "spectral"))
+    if isinstance(threads, str):
+        _choice("threads", threads, ("all", "current"))
+    elif threads is not None:
+        threads = _count("threads", threads)
     solver = {k: v for k, v in (("backend", backend), ("threads", threads)) if v is not None}
     if solver:
         scene["solver"] = solver
     probes: Dict[str, Any] = {}
     if probe_planes is not None:
-        probes["planes"] = list(probe_planes)
+        probes["planes"] = _numbers(
+            "probe_planes", probe_planes, None, "a list of heights z (float, m)"
+        )
     if probe_points is not None:
-        probes["points"] = [list(p) for p in probe_points]
+        points = _items("probe_points", probe_points, None, "a list of points (x, y, z)")
+        probes["points"] = [
+            _numbers(f"probe_points[{i}]", p, 3, "a point (x, y, z) (float, m)")
+            for i, p in enumerate(points)
+        ]
     if probes:
         scene["probes"] = probes
     if profile_planes is not None and profile_loads is None:
         raise TypeError("profile_planes= goes with profile_loads=[F/(μF_N), ...]")
     if profile_loads is not None:
         scene["profiles"] = {
-            "loads": [float(x) for x in profile_loads],
-            "planes": [float(z) for z in (profile_planes or [])],
+            "loads": _numbers(
+                "profile_loads", profile_loads, None, "a list of loads F/(μF_N) (float)"
+            ),
+            "planes": _numbers(
+                "profile_planes", profile_planes or [], None, "a list of heights z (float, m)"
+            ),
         }
     return scene

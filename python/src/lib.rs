@@ -67,6 +67,7 @@ fn core_class(e: &precursors::Error) -> Class {
         | E::EmptyContact { .. }
         | E::GridDoesNotDivide { .. }
         | E::GridTooLarge { .. }
+        | E::LengthInMillimetres { .. }
         | E::NonFinite { .. }
         | E::NonPositiveHeight { .. }
         | E::LengthMismatch { .. }
@@ -207,6 +208,28 @@ impl<T, E: Into<Failure>> OrRaise<T> for Result<T, E> {
     }
 }
 
+/// A scene file error of the keyword form: the JSON text is the package's, not the
+/// caller's, so its line and column are left out (`precursors._scene` checks the
+/// keywords' types; what is left is a value the format refuses, named by its key).
+fn keyword_error(e: precursors::Error) -> PyErr {
+    match &e {
+        precursors::Error::SceneFile { source, .. } => {
+            let text = source.to_string();
+            let text = match text.rfind(" at line ") {
+                Some(at) => &text[..at],
+                None => &text,
+            };
+            Failure {
+                class: Class::Value,
+                kind: "SceneFile".into(),
+                message: format!("Scene(): a keyword's value is invalid: {text}"),
+            }
+            .into()
+        }
+        _ => Failure::from(e).into(),
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // Helpers.
 
@@ -252,6 +275,16 @@ fn build(py: Python<'_>, builder: precursors::SceneBuilder) -> PyResult<Scene> {
 /// normal load and the drive (the crate's `Scene`). Build one from a scene file
 /// (`Scene.from_file`), a dict in the scene-file format (`Scene.from_dict`) or keywords
 /// (`Scene(block=(0.14, 0.007, 0.075), cell_size=(0.001, 0.001), normal_load=3500.0)`).
+///
+/// Keywords (SI units; one left out takes the calibration scene's value):
+/// block=(lx, ly, lz) lengths (m); cells=(nx, ny) counts, or cell_size=(dx, dy) (m);
+/// normal_load (N); seed (int) of random heights, heights=array of shape (Ny, Nx) (m),
+/// surface=SurfaceSpectrum, height_distribution=(mean, std_dev) (m);
+/// young_modulus (Pa), poisson_ratio, friction_coefficient; c_x, c_z (springs);
+/// drive='rod' | 'top' | 'side' or a scene-file dict, rod=(height, half_width) (m);
+/// backend='auto' | 'dense' | 'spectral', threads (int, 'all', 'current');
+/// probe_planes=[z, ...], probe_points=[(x, y, z), ...] (m);
+/// profile_loads=[F/(μF_N), ...], profile_planes=[z, ...] (m).
 #[pyclass(module = "precursors", frozen)]
 struct Scene {
     inner: precursors::Scene,
@@ -263,13 +296,52 @@ impl Scene {
     /// keywords onto the scene-file format; missing keys take the calibration scene's
     /// values).
     #[new]
-    #[pyo3(signature = (**kwargs))]
+    #[pyo3(
+        signature = (**kwargs),
+        text_signature = "(*, block=None, cells=None, cell_size=None, normal_load=None, \
+                          seed=None, heights=None, surface=None, height_distribution=None, \
+                          young_modulus=None, poisson_ratio=None, friction_coefficient=None, \
+                          c_x=None, c_z=None, drive=None, rod=None, backend=None, \
+                          threads=None, probe_planes=None, probe_points=None, \
+                          profile_loads=None, profile_planes=None)"
+    )]
     fn new(py: Python<'_>, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
         let dict = py
             .import("precursors._scene")?
             .getattr("scene_dict")?
             .call((), kwargs)?;
-        Self::from_dict(py, &dict)
+        let text = dumps(py, &dict)?;
+        let builder = precursors::SceneBuilder::from_json_str(&text).map_err(keyword_error)?;
+        let heights = match kwargs {
+            Some(k) => k.get_item("heights")?.filter(|h| !h.is_none()),
+            None => None,
+        };
+        if let Some(heights) = heights {
+            // The array's shape, which the scene file's flat values no longer carry: a
+            // transposed or flat array is refused, not read row by row.
+            let shape: Vec<usize> = py
+                .import("numpy")?
+                .call_method1("shape", (heights,))?
+                .extract()?;
+            let grid = builder.grid().or_raise()?;
+            if shape != [grid.ny(), grid.nx()] {
+                let given: Vec<String> = shape.iter().map(usize::to_string).collect();
+                let comma = if shape.len() == 1 { "," } else { "" };
+                return Err(Failure {
+                    class: Class::Value,
+                    kind: "ShapeMismatch".into(),
+                    message: format!(
+                        "heights has shape ({}{comma}), the grid needs (Ny, Nx) = ({}, {}): \
+                         row iy, column ix",
+                        given.join(", "),
+                        grid.ny(),
+                        grid.nx()
+                    ),
+                }
+                .into());
+            }
+        }
+        build(py, builder)
     }
 
     /// The scene of a JSON scene file (docs/scene-format.md).
@@ -630,10 +702,18 @@ impl Driver {
         self.inner.nominal_area()
     }
 
-    /// The real contact area `A_R` (m²).
+    /// The real contact area `A_R` (m²). Not bounded by `nominal_area`: under the
+    /// paper's area law it exceeds the face when asperities are pressed below the mean
+    /// plane, a meaningless area; check `area_exceeds_nominal()`.
     #[getter]
     fn real_contact_area(&self) -> PyResult<f64> {
         self.inner.real_contact_area().or_raise()
+    }
+
+    /// Whether `real_contact_area` exceeds `nominal_area` (beyond rounding): a state the
+    /// paper's unbounded area law reaches, whose area is not physical.
+    fn area_exceeds_nominal(&self) -> PyResult<bool> {
+        self.inner.area_exceeds_nominal().or_raise()
     }
 
     /// The precursor length `ℓ` (m).
@@ -764,7 +844,21 @@ impl Driver {
     /// (a list of `PlaneStress`) and `points` (a list of `PointStress`).
     fn stresses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let driver = &self.inner;
-        let stresses = py.detach(|| driver.stresses()).or_raise()?;
+        let stresses = match py.detach(|| driver.stresses()) {
+            // The crate's message names SceneBuilder::probes: say it in Python's terms.
+            Err(precursors::Error::NoProbes) => {
+                return Err(Failure {
+                    class: Class::Value,
+                    kind: "NoProbes".into(),
+                    message: "no stress probes: give them to the scene \
+                              (Scene(probe_planes=[z, ...], probe_points=[(x, y, z), ...])) \
+                              or to the driver (driver.add_probes(planes=..., points=...))"
+                        .into(),
+                }
+                .into())
+            }
+            other => other.or_raise()?,
+        };
         let planes = PyList::empty(py);
         for plane in stresses.planes {
             planes.append(PlaneStress::new(py, plane)?)?;

@@ -3,6 +3,7 @@
 import errno
 import json
 
+import numpy as np
 import pytest
 
 import precursors
@@ -104,3 +105,105 @@ def test_sweep_file_errors(tmp_path):
     with pytest.raises(PrecursorsOSError) as raised:
         precursors.sweep(tmp_path / "missing.json", tmp_path / "out")
     assert raised.value.errno is None or raised.value.errno == errno.ENOENT
+
+
+# Issue 45, item 10: first contact. Messages in Python's terms, arrays of the wrong shape
+# refused with the shape expected.
+
+SMALL = dict(block=(0.010, 0.004, 0.010), normal_load=10.0)
+
+
+def test_transposed_heights_are_refused_with_the_expected_shape():
+    with pytest.raises(PrecursorsValueError) as raised:
+        precursors.Scene(cells=(50, 10), heights=np.full((50, 10), 1e-6), **SMALL)
+    assert raised.value.kind == "ShapeMismatch"
+    message = str(raised.value)
+    assert "(Ny, Nx) = (10, 50)" in message and "(50, 10)" in message
+
+
+def test_flat_heights_are_refused_with_the_expected_shape():
+    # The grid from cell_size: known only to the crate.
+    with pytest.raises(PrecursorsValueError) as raised:
+        precursors.Scene(cell_size=(0.001, 0.001), heights=np.full(40, 1e-6), **SMALL)
+    assert "(Ny, Nx) = (4, 10)" in str(raised.value) and "(40,)" in str(raised.value)
+
+
+def test_heights_of_the_right_shape_are_accepted():
+    scene = precursors.Scene(cells=(10, 4), heights=np.full((4, 10), 1e-6), **SMALL)
+    assert scene.shape == (4, 10)
+
+
+def test_nan_heights_name_their_row_and_column():
+    heights = np.full((4, 10), 1e-6)
+    heights[2, 3] = np.nan
+    with pytest.raises(PrecursorsValueError) as raised:
+        precursors.Scene(cells=(10, 4), heights=heights, **SMALL)
+    message = str(raised.value)
+    assert "heights[2, 3] = nan" in message
+    assert "line" not in message and "column" not in message
+
+
+@pytest.mark.parametrize(
+    "keywords, words",
+    [
+        (dict(normal_load="3500"), "normal_load must be a number (float), not str"),
+        (dict(cells=(10.5, 2)), "cells[0] must be an int, not float"),
+        (dict(block=(0.01, 0.004)), "block must be (lx, ly, lz)"),
+        (dict(seed=1.5), "seed must be an int, not float"),
+    ],
+)
+def test_keyword_types_are_named_in_python_terms(keywords, words):
+    with pytest.raises(TypeError) as raised:
+        precursors.Scene(**keywords)
+    message = str(raised.value)
+    assert words in message
+    assert "scene file" not in message and "usize" not in message and "f64" not in message
+
+
+@pytest.mark.parametrize(
+    "keywords, words",
+    [
+        (dict(normal_load=float("nan")), "normal_load = nan is not a finite number"),
+        (dict(backend="gpu"), "backend = 'gpu' is not one of"),
+        (dict(drive="sideways"), "drive = 'sideways' is not one of"),
+        (dict(cells=(-1, 2)), "cells[0] = -1 is invalid"),
+    ],
+)
+def test_keyword_values_are_named_in_python_terms(keywords, words):
+    with pytest.raises(PrecursorsValueError) as raised:
+        precursors.Scene(**keywords)
+    message = str(raised.value)
+    assert words in message
+    assert "scene file" not in message and "line 1" not in message
+
+
+def test_millimetres_ask_whether_metres_were_meant():
+    with pytest.raises(PrecursorsValueError) as raised:
+        precursors.Scene(block=(140, 7, 75))
+    assert raised.value.kind == "LengthInMillimetres"
+    assert "did you mean 0.14 m?" in str(raised.value)
+
+
+def test_stresses_without_probes_name_the_python_keywords(calibration):
+    driver = calibration.driver()
+    driver.step()
+    with pytest.raises(PrecursorsValueError) as raised:
+        driver.stresses()
+    message = str(raised.value)
+    assert "probe_planes" in message and "add_probes" in message
+    assert "SceneBuilder" not in message
+
+
+def test_plot_of_a_missing_directory_is_an_os_error(tmp_path):
+    missing = tmp_path / "nosuchdir"
+    with pytest.raises(PrecursorsOSError) as raised:
+        precursors.plot(missing)
+    assert raised.value.kind == "Io"
+    assert "nosuchdir" in str(raised.value) and "No such file" in str(raised.value)
+
+
+def test_help_lists_the_scene_keywords():
+    signature = precursors.Scene.__text_signature__ or ""
+    for keyword in ("block", "cells", "normal_load", "heights", "seed", "probe_planes"):
+        assert keyword in signature
+    assert "heights=array of shape (Ny, Nx)" in (precursors.Scene.__doc__ or "")

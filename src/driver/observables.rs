@@ -218,6 +218,14 @@ impl Driver {
     /// [`crate::calibration::fit_normal_stiffness`]). Per cell:
     /// [`Driver::cell_contact_area`]; per column: [`Driver::column_contact_area`].
     ///
+    /// **The value is not bounded by the nominal area `Lx·Ly`.** Under the paper's area
+    /// law ([`crate::AreaLaw::Paper`], the default) asperities pressed below the
+    /// substrate's mean plane give areas above it (e.g. 0.107 m² on a 0.002 m² face in a
+    /// top-drive run), physically meaningless as areas. A loop that records this value
+    /// should check [`Driver::area_exceeds_nominal`] (or compare with
+    /// [`Driver::nominal_area`]), or bound the law with [`crate::AreaLaw::Capped`]
+    /// ([`crate::SceneBuilder::area_law`]).
+    ///
     /// # Errors
     /// [`Error::NotSolved`] before the first [`Driver::step`]; [`Error::NonFinite`] on
     /// overflow.

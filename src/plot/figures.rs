@@ -113,7 +113,8 @@ pub struct Drawn {
 ///
 /// # Errors
 /// [`PlotError::Figure`] when `dir` is neither, or a figure cannot be drawn; in
-/// [`PlotError::Core`]: [`Error::Io`] for a table that cannot be read or a figure that
+/// [`PlotError::Core`]: [`Error::Io`] for a directory that does not exist or cannot be
+/// read (`NotFound` when missing), a table that cannot be read or a figure that
 /// cannot be written (each figure is written atomically: none is left half written),
 /// [`Error::CorruptTable`] for a damaged table, [`Error::NonFiniteCell`] for a `NaN`, an
 /// infinity or an empty cell where a number belongs (with the file, line and column); in
@@ -299,6 +300,8 @@ pub fn draw_with_options(dir: &Path, options: &DrawOptions) -> Result<Drawn, Plo
     }
     let formats = &options.formats;
     let extensions: Vec<&str> = formats.iter().map(|f| f.extension()).collect();
+    // A directory that does not exist or cannot be read is a file error, not a figure's.
+    std::fs::read_dir(dir).map_err(|e| Error::io("reading the run or sweep directory", dir, e))?;
     let sweep = dir.join(SWEEP_FILE).is_file();
     if !sweep && !dir.join("curve.csv").is_file() {
         return Err(
