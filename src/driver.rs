@@ -463,7 +463,8 @@ impl Driver {
             self.refresh_shear();
             if let Err(e) = advanced {
                 self.phase = Phase::Failed;
-                self.failure = Some(e.to_string());
+                // With its causes: the reason is all a later step reports of them.
+                self.failure = Some(crate::error::Chain(&e).to_string());
                 self.pending.clear();
                 return Err(e);
             }

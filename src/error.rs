@@ -28,8 +28,9 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 ///
 /// Every variant carries the offending values so a caller can report them or recover.
 /// Variants that wrap another error (I/O, JSON, factorisation, thread pool) return it from
-/// [`std::error::Error::source`], so a report can print the whole cause chain; their
-/// `Display` already names the cause's message, with the file and the operation.
+/// [`std::error::Error::source`] and leave its message out of their own `Display` (the
+/// file and the operation), so a report of the cause chain (`anyhow`'s `{:#}`, the
+/// program's `caused by:` lines) prints each cause once.
 ///
 /// `Error` is neither `Clone` nor `PartialEq`, as the `std::io::Error` it keeps: match on
 /// the variant, e.g. `matches!(e, Error::GridDoesNotDivide { axis: "x", .. })`.
@@ -299,7 +300,7 @@ pub enum Error {
     },
     /// The operating system refused the solver's threads: the first solve with
     /// `Parallelism::Threads(n)` (`Driver::step`, `EquilibriumSolver`).
-    #[error("could not start a pool of {threads} solver threads: {}", Bounded(&source.to_string()))]
+    #[error("could not start a pool of {threads} solver threads")]
     ThreadPool {
         /// Threads requested ([`crate::solver::SolverOptions::parallelism`]).
         threads: usize,
@@ -429,8 +430,9 @@ pub enum Error {
         source: Option<Cause>,
     },
     /// A file could not be read or written: the operation, the file and the operating
-    /// system's error (its [`std::io::ErrorKind`] through `source.kind()`).
-    #[error("{operation} {}: {source}", path.display())]
+    /// system's error (its [`std::io::ErrorKind`] through `source.kind()`), which only
+    /// `source()` gives: the message is the operation and the file.
+    #[error("{operation} {}", path.display())]
     Io {
         /// What was being done (`"reading scene file"`, `"reading heights file"`, ...).
         operation: &'static str,
@@ -455,9 +457,8 @@ pub enum Error {
     /// `docs/scene-format.md` (feature `serde`: `SceneBuilder::from_json_file`,
     /// `from_json_str`).
     #[error(
-        "scene file{}: {}",
-        path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default(),
-        Bounded(&source.to_string())
+        "invalid scene file{}",
+        path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default()
     )]
     SceneFile {
         /// The file (`None` for JSON text given directly).
@@ -466,7 +467,8 @@ pub enum Error {
         line: usize,
         /// Column of the error (1-based; 0 when the parser gave none).
         column: usize,
-        /// What the parser reported (its message names the line and column).
+        /// What the parser reported (its message names the line and column); `source()`
+        /// returns it.
         #[source]
         source: Cause,
     },
@@ -688,6 +690,23 @@ pub enum Error {
         /// The largest ratio accepted.
         limit: f64,
     },
+}
+
+/// `error` and its causes ([`std::error::Error::source`]) joined by ": ", as `anyhow`
+/// prints `{:#}`: for a message that keeps another error as text (a driver's failure, a
+/// sweep's reason), since an error's own `Display` leaves its cause out.
+pub(crate) struct Chain<'a>(pub(crate) &'a (dyn std::error::Error + 'static));
+
+impl std::fmt::Display for Chain<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.0)?;
+        let mut source = self.0.source();
+        while let Some(cause) = source {
+            write!(f, ": {cause}")?;
+            source = cause.source();
+        }
+        Ok(())
+    }
 }
 
 impl Error {

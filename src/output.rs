@@ -1050,7 +1050,7 @@ fn check_scene_record(dir: &Path, driver: &Driver) -> Result<()> {
     let recorded =
         crate::scene::SceneBuilder::from_json_str(&text).map_err(|e| Error::RunDirectory {
             path: path.clone(),
-            reason: format!("not a scene file ({e})"),
+            reason: format!("not a scene file ({})", crate::error::Chain(&e)),
         })?;
     match crate::driver::scene_mismatch(
         &driver.scene().to_builder(),

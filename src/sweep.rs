@@ -38,7 +38,7 @@ pub use stats::{statistics, StatsOptions, StatsSummary};
 /// The results of this module: its errors are [`SweepError`]s.
 type Result<T, E = SweepError> = std::result::Result<T, E>;
 
-use crate::error::Error;
+use crate::error::{Chain, Error};
 use crate::files::write_atomically;
 use crate::lock::{Attempt, DirLock, LOCK_FILE};
 use crate::output::RunTables;
@@ -568,6 +568,12 @@ fn set_key(
     }
 }
 
+/// An error and its causes as one text, for a reason that keeps it (its `Display` leaves
+/// the causes out).
+fn chain(e: &(dyn std::error::Error + 'static)) -> String {
+    Chain(e).to_string()
+}
+
 /// The error of a sweep file at `path` (`None`: text given directly) without a position.
 fn file_error(path: Option<&Path>, reason: String) -> SweepError {
     SweepError::File {
@@ -621,9 +627,9 @@ impl Sweep {
     fn from_spec(mut spec: SweepSpec, path: Option<&Path>, base_dir: &Path) -> Result<Sweep> {
         let base_error = |reason: String| file_error(path, format!("base scene: {reason}"));
         let base =
-            SceneFile::from_value(&spec.base, base_dir).map_err(|e| base_error(e.to_string()))?;
-        spec.base = base.to_value().map_err(|e| base_error(e.to_string()))?;
-        let base_builder = base.to_builder().map_err(|e| base_error(e.to_string()))?;
+            SceneFile::from_value(&spec.base, base_dir).map_err(|e| base_error(chain(&e)))?;
+        spec.base = base.to_value().map_err(|e| base_error(chain(&e)))?;
+        let base_builder = base.to_builder().map_err(|e| base_error(chain(&e)))?;
         let random = check_realizations(spec.realizations, &base_builder)?;
         let axes = read_axes(&spec, |reason| file_error(path, reason))?;
         check_size(&axes, spec.realizations, &base_builder)?;
@@ -1088,11 +1094,11 @@ fn check_axes(axes: &[Axis], base: &SceneFile) -> Result<()> {
             for (key, value) in axis.keys.iter().zip(step) {
                 set_key(&mut scene, key, value, invalid)?;
             }
-            let builder = scene.to_builder().map_err(|e| invalid(e.to_string()))?;
+            let builder = scene.to_builder().map_err(|e| invalid(chain(&e)))?;
             builder.check().map_err(|e| {
                 key_error(
                     &name,
-                    format!("value {value} (#{i}) gives an invalid scene: {e}"),
+                    format!("value {value} (#{i}) gives an invalid scene: {}", Chain(&e)),
                 )
             })?;
         }
@@ -1162,14 +1168,15 @@ fn runs_of(
             if random {
                 set_key(&mut scene, "heights.seed", &Value::from(seed), invalid)?;
             }
-            let builder = scene.to_builder().map_err(|e| invalid(e.to_string()))?;
+            let builder = scene.to_builder().map_err(|e| invalid(chain(&e)))?;
             if realization == 0 {
                 builder.check().map_err(|e| {
                     key_error(
                         &keys(),
                         format!(
-                            "the point {} gives an invalid scene: {e}",
-                            describe(&values)
+                            "the point {} gives an invalid scene: {}",
+                            describe(&values),
+                            Chain(&e)
                         ),
                     )
                 })?;

@@ -1,6 +1,7 @@
 //! The error types of the sweep (`SweepError`) and of the figures (`PlotError`): a real
-//! failing call returns the type's variant, `source()` reaches the nested core `Error`,
-//! and the messages are those of the single error type before the split.
+//! failing call returns the type's variant, which holds the nested core `Error`, and the
+//! messages are those of the single error type before the split, except that from 1.1 a
+//! message leaves out the cause its `source()` returns: each cause is printed once.
 //!
 //! The expected messages were written down by running the program built from main
 //! before the split (commit 1b83f13, `precursors sweep/merge/plot` on the same inputs,
@@ -43,17 +44,16 @@ fn a_sweep_file_that_is_not_json_is_a_sweep_file_error() {
         ),
         "{e:?}"
     );
-    // main: "error: sweep file bad.json: key must be a string at line 1 column 3".
+    // main: "error: sweep file bad.json: key must be a string at line 1 column 3"; from
+    // 1.1 the message names the file and its source is the parser's error (each once).
     assert_eq!(
         e.to_string(),
-        format!(
-            "sweep file {}: key must be a string at line 1 column 3",
-            path.display()
-        )
+        format!("invalid sweep file {}", path.display())
     );
     // Its cause is the parser's error, not a core error.
     let cause = e.source().expect("the parser's error");
     assert!(cause.downcast_ref::<Error>().is_none());
+    assert_eq!(cause.to_string(), "key must be a string at line 1 column 3");
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -143,11 +143,12 @@ fn a_core_failure_under_a_sweep_is_nested_and_its_source() {
     // main: the same line after "error: ".
     let text = "realizations = 0 is invalid: a sweep needs at least one realization per point";
     assert_eq!(e.to_string(), text);
-    let core = e
-        .source()
-        .and_then(|s| s.downcast_ref::<Error>())
-        .expect("source() is the core error");
-    assert!(matches!(core, Error::InvalidCount { .. }), "{core:?}");
+    // `Core` is transparent (from 1.1): its source is the core error's, here none; the
+    // core error is the variant's.
+    assert!(e.source().is_none());
+    let SweepError::Core(core) = &e else {
+        unreachable!()
+    };
     assert_eq!(core.to_string(), text);
     // `?` turns a core error into a sweep error.
     fn lift() -> Result<(), SweepError> {
@@ -237,11 +238,11 @@ mod plot {
             curve.display()
         );
         assert_eq!(e.to_string(), text);
-        let core = e
-            .source()
-            .and_then(|s| s.downcast_ref::<Error>())
-            .expect("source() is the core error");
-        assert!(matches!(core, Error::NonFiniteCell { .. }), "{core:?}");
+        // `Core` is transparent (from 1.1): the core error is the variant's, not a source.
+        assert!(e.source().is_none());
+        let PlotError::Core(core) = &e else {
+            unreachable!()
+        };
         assert_eq!(core.to_string(), text);
         std::fs::remove_dir_all(&dir).ok();
     }
@@ -256,17 +257,16 @@ mod plot {
             "{e:?}"
         );
         // main: "error: sweep file badsweep/sweep.json: key must be a string at line 1
-        // column 3".
-        let text = format!(
-            "sweep file {}: key must be a string at line 1 column 3",
-            dir.join("sweep.json").display()
-        );
+        // column 3"; from 1.1 the message names the file, its source is the parser's error.
+        let text = format!("invalid sweep file {}", dir.join("sweep.json").display());
         assert_eq!(e.to_string(), text);
-        let sweep = e
-            .source()
-            .and_then(|s| s.downcast_ref::<SweepError>())
-            .expect("source() is the sweep error");
+        // `Sweep` is transparent (from 1.1): its source is the sweep error's.
+        let PlotError::Sweep(sweep) = &e else {
+            unreachable!()
+        };
         assert_eq!(sweep.to_string(), text);
+        let cause = e.source().expect("the parser's error");
+        assert_eq!(cause.to_string(), "key must be a string at line 1 column 3");
         // A core error under the figure: `?` nests it.
         fn lift() -> Result<(), PlotError> {
             Err(Error::EmptyGrid { axis: "y" })?
@@ -277,4 +277,122 @@ mod plot {
         ));
         std::fs::remove_dir_all(&dir).ok();
     }
+
+    #[test]
+    fn each_cause_of_a_nested_figure_error_is_printed_once() {
+        let dir = scratch("plot-chain");
+        std::fs::write(dir.join("sweep.json"), "{ not json\n").unwrap();
+        // A figure error nesting a sweep error nesting the parser's.
+        let e = draw(&dir, &[Format::Png]).unwrap_err();
+        assert!(
+            matches!(&e, PlotError::Sweep(SweepError::File { .. })),
+            "{e:?}"
+        );
+        let joined = super::assert_each_cause_once(&e);
+        assert!(
+            joined.ends_with(": key must be a string at line 1 column 3"),
+            "{joined}"
+        );
+        // A figure error nesting a core `Io`, and one nesting a sweep error nesting it.
+        let missing = dir.join("missing.json");
+        let os = std::fs::read(&missing).unwrap_err().to_string();
+        let io = || precursors::SceneBuilder::from_json_file(&missing).unwrap_err();
+        let expected = format!("reading scene file {}: {os}", missing.display());
+        let e = PlotError::from(io());
+        assert_eq!(super::assert_each_cause_once(&e), expected);
+        let e = PlotError::from(SweepError::from(io()));
+        assert_eq!(super::assert_each_cause_once(&e), expected);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
+
+/// Each level's message of `e` and its causes (`source()`), outermost first, and the
+/// chain as `anyhow` prints it with `{:#}`: the messages joined by ": ".
+fn chain(e: &(dyn std::error::Error + 'static)) -> (Vec<String>, String) {
+    let mut levels = vec![e.to_string()];
+    let mut source = e.source();
+    while let Some(cause) = source {
+        levels.push(cause.to_string());
+        source = cause.source();
+    }
+    let joined = levels.join(": ");
+    (levels, joined)
+}
+
+/// Every level's message appears exactly once in the printed chain: no wrapper repeats
+/// the error it returns from `source()`, no message embeds its own cause.
+fn assert_each_cause_once(e: &(dyn std::error::Error + 'static)) -> String {
+    let (levels, joined) = chain(e);
+    for text in &levels {
+        assert_eq!(
+            joined.matches(text.as_str()).count(),
+            1,
+            "{text:?} is not printed exactly once in {joined:?} (levels {levels:?})"
+        );
+    }
+    joined
+}
+
+#[test]
+fn each_cause_of_a_nested_error_is_printed_once() {
+    let dir = scratch("chain");
+    let missing = dir.join("missing.json");
+    let os = std::fs::read(&missing).unwrap_err().to_string();
+    // A sweep error nesting a core `Io` nesting the operating system's error.
+    let e = Sweep::from_json_file(&missing).unwrap_err();
+    assert!(matches!(e, SweepError::Core(Error::Io { .. })), "{e:?}");
+    assert_eq!(
+        assert_each_cause_once(&e),
+        format!("reading sweep file {}: {os}", missing.display())
+    );
+    let mut io = None;
+    let mut source = e.source();
+    while let Some(cause) = source {
+        io = io.or(cause.downcast_ref::<std::io::Error>());
+        source = cause.source();
+    }
+    let io = io.expect("the io::Error is in the chain");
+    assert_eq!(io.kind(), std::io::ErrorKind::NotFound);
+    // A core `Io` alone, and a scene file the parser refuses (with or without a path).
+    let e = precursors::SceneBuilder::from_json_file(&missing).unwrap_err();
+    assert_eq!(
+        assert_each_cause_once(&e),
+        format!("reading scene file {}: {os}", missing.display())
+    );
+    let e = precursors::SceneBuilder::from_json_str("{ not json").unwrap_err();
+    assert!(matches!(e, Error::SceneFile { .. }), "{e:?}");
+    assert!(assert_each_cause_once(&e).ends_with(": key must be a string at line 1 column 3"));
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, "{ not json\n").unwrap();
+    let e = precursors::SceneBuilder::from_json_file(&bad).unwrap_err();
+    assert!(assert_each_cause_once(&e).contains(&bad.display().to_string()));
+    // A sweep file the parser refuses.
+    let e = Sweep::from_json_file(&bad).unwrap_err();
+    assert!(matches!(e, SweepError::File { .. }), "{e:?}");
+    let joined = assert_each_cause_once(&e);
+    assert!(
+        joined.contains(&bad.display().to_string())
+            && joined.ends_with(": key must be a string at line 1 column 3"),
+        "{joined}"
+    );
+    // A base scene whose heights file is missing: the reason, in a sweep file's error,
+    // keeps the operating system's message (once).
+    let base = BASE.replace(
+        r#""normal_load""#,
+        &format!(
+            r#""heights": {{ "kind": "file", "path": {:?} }}, "normal_load""#,
+            dir.join("no-heights.txt").display().to_string()
+        ),
+    );
+    let text = format!(r#"{{ "base": {base}, "axes": [], "realizations": 1, "seed": 1 }}"#);
+    let e = Sweep::from_json_str(&text).unwrap_err();
+    let joined = assert_each_cause_once(&e);
+    assert_eq!(joined.matches(os.as_str()).count(), 1, "{joined}");
+    // A core error with another library's cause: the thread pool's.
+    let e = Error::ThreadPool {
+        threads: 4,
+        source: "the system refused a thread".into(),
+    };
+    assert!(assert_each_cause_once(&e).ends_with(": the system refused a thread"));
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -177,15 +177,12 @@ fn a_long_value_is_cut_in_the_message() {
     let dir = scratch("long");
     let cut = format!("... ({LONG} bytes)");
     for text in &scenes {
-        // The library's Display ...
-        let e = SceneBuilder::from_json_str(text).unwrap_err().to_string();
-        assert!(
-            e.len() < 1000 && e.contains(&cut),
-            "{} bytes: {}",
-            e.len(),
-            head(&e)
-        );
-        // ... and the program's message, every line of it.
+        // The library's Display leaves the parser's message, the source, out ...
+        let e = SceneBuilder::from_json_str(text).unwrap_err();
+        assert!(std::error::Error::source(&e).is_some());
+        let e = e.to_string();
+        assert!(e.len() < 1000, "{} bytes: {}", e.len(), head(&e));
+        // ... and the program's message, every line of it, cuts the value it echoes.
         let file = dir.join("scene.json");
         std::fs::write(&file, text).unwrap();
         let o = precursors(&["info", path(&file)]);
@@ -582,6 +579,53 @@ fn a_scene_file_that_is_not_text_is_invalid_input() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// The program prints an error and each of its causes once: a missing scene file, sweep
+/// file or figure directory's sweep file names the file and the system's message, each
+/// once, over the lines `error: ...` and `  caused by: ...`.
+#[test]
+fn each_cause_is_printed_once() {
+    let dir = scratch("causes");
+    let missing = dir.join("missing.json");
+    let os = std::fs::read(&missing).unwrap_err().to_string();
+    let (run_out, sweep_out) = (dir.join("o"), dir.join("s"));
+    let bad = dir.join("bad");
+    std::fs::create_dir_all(&bad).unwrap();
+    std::fs::write(bad.join("sweep.json"), "{ not json\n").unwrap();
+    let cases: [(Vec<&str>, &str, i32); 4] = [
+        (vec!["info", path(&missing)], os.as_str(), 4),
+        (
+            vec!["run", path(&missing), "--out", path(&run_out)],
+            os.as_str(),
+            4,
+        ),
+        (
+            vec!["sweep", path(&missing), "--out", path(&sweep_out)],
+            os.as_str(),
+            4,
+        ),
+        (
+            vec!["merge", path(&bad)],
+            "key must be a string at line 1 column 3",
+            3,
+        ),
+    ];
+    for (args, cause, code) in cases {
+        let o = precursors(&args);
+        let text = stderr(&o);
+        assert_eq!(o.status.code(), Some(code), "{args:?}: {text}");
+        assert!(text.starts_with("error: "), "{args:?}: {text}");
+        assert_eq!(text.matches(cause).count(), 1, "{args:?}: {text}");
+        let file = if args[0] == "merge" {
+            bad.join("sweep.json")
+        } else {
+            missing.clone()
+        };
+        let file = file.display().to_string();
+        assert_eq!(text.matches(file.as_str()).count(), 1, "{args:?}: {text}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// The seconds of `info`'s "run ~X to global slip" line.
 fn info_run_seconds(scene: &str) -> f64 {
     let dir = scratch("estimate");
@@ -689,7 +733,7 @@ fn scene_messages_say_what_is_valid() {
         let text = BASE.trim_end().trim_end_matches('}').to_string() + extra + " }";
         let builder = SceneBuilder::from_json_str(&text);
         match builder {
-            Err(e) => e.to_string(),
+            Err(e) => crate::common::chain(&e),
             Ok(b) => b.build().unwrap_err().to_string(),
         }
     };

@@ -226,7 +226,7 @@ fn linked_axes_move_their_keys_together() {
     ] {
         let e = err(bad);
         assert!(
-            matches!(e, SweepError::File { .. }) && e.to_string().contains("axis #0"),
+            matches!(e, SweepError::File { .. }) && crate::common::chain(&e).contains("axis #0"),
             "{bad}: {e:?}"
         );
     }

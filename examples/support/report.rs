@@ -13,9 +13,10 @@ use std::process::ExitCode;
 pub type Outcome = Result<(), Box<dyn Error>>;
 
 /// Prints `error: <message>` and one `caused by: <message>` per source to stderr and
-/// fails; succeeds quietly on `Ok`. A cause whose message already ends the message before
-/// it (the crate's `Error::Io` says "reading scene file <path>: <the io::Error>") is not
-/// printed twice.
+/// fails; succeeds quietly on `Ok`. The crate's errors leave their cause out of their
+/// message (`Error::Io` says "reading scene file <path>", its source the system's
+/// message); a cause whose message already ends the one before it (another library's
+/// error that repeats its own) is not printed twice.
 pub fn report(outcome: Outcome) -> ExitCode {
     match outcome {
         Ok(()) => ExitCode::SUCCESS,

@@ -130,8 +130,10 @@ fn kind(debug: &str) -> String {
     }
 }
 
-/// The error's Display text followed by its causes' (`source()`), a cause skipped when
-/// the text already ends with it (the crate's outer errors repeat the nested one).
+/// The error's Display text followed by its causes' (`source()`), joined by ": ": the
+/// crate's errors leave their cause out of their Display (`Error::Io` names the file, its
+/// source the system's message). A cause the text already ends with (another library's
+/// error that repeats its own) is skipped.
 fn message(e: &(dyn StdError + 'static)) -> String {
     let mut text = e.to_string();
     let mut cause = e.source();

@@ -508,10 +508,10 @@ fn main() -> ExitCode {
 }
 
 /// The messages of `error` and of its causes ([`std::error::Error::source`]), outermost
-/// first, each with its echoed values cut ([`bounded::bounded`]), leaving out a cause
-/// whose message already ends the one before it (the library's `Error::Io` says "reading
-/// scene file `<path>`: `<the io::Error>`", and a sweep's or a figure's error nesting a
-/// core error repeats its message).
+/// first, each with its echoed values cut ([`bounded::bounded`]). The library's errors
+/// leave their cause out of their message (`Error::Io` says "reading scene file `<path>`",
+/// its source the system's message); a cause whose message already ends the one before it
+/// (another library's error that repeats its own) is left out, so each is printed once.
 fn messages(error: &(dyn std::error::Error + 'static)) -> Vec<String> {
     let mut out = vec![bounded::bounded(&error.to_string()).into_owned()];
     let mut source = error.source();
@@ -525,8 +525,7 @@ fn messages(error: &(dyn std::error::Error + 'static)) -> Vec<String> {
     out
 }
 
-/// Prints `error: <message>` and one `caused by: <message>` per source; a cause whose
-/// message already ends the message before it is not printed twice.
+/// Prints `error: <message>` and one `caused by: <message>` per source ([`messages`]).
 fn report(e: &(dyn std::error::Error + 'static)) {
     for (k, text) in messages(e).iter().enumerate() {
         if k == 0 {

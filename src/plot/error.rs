@@ -12,8 +12,9 @@ use thiserror::Error;
 /// The figure's own failures are [`PlotError::Figure`]; the rest is nested: the core
 /// [`enum@Error`] in [`PlotError::Core`] (a figure or table that cannot be written or read, a
 /// damaged table, a map of the wrong size), the merge of a sweep directory in
-/// [`PlotError::Sweep`]. `?` turns either into a `PlotError`, and
-/// [`std::error::Error::source`] returns the nested error, whose `Display` it repeats.
+/// [`PlotError::Sweep`]. `?` turns either into a `PlotError`. Both are transparent: their
+/// `Display` and [`std::error::Error::source`] are the nested error's own, so a report of
+/// the cause chain prints each cause once; match on the variant to reach the nested error.
 ///
 /// ```
 /// use precursors::plot::{Chart, PlotError};
@@ -28,12 +29,12 @@ pub enum PlotError {
     /// ([`Error::CorruptTable`], [`Error::NonFiniteCell`]: file, line and column), map
     /// values that do not fit its size ([`Error::LengthMismatch`], [`Error::InvalidCount`]
     /// from [`crate::plot::Map::new`]).
-    #[error("{0}")]
+    #[error(transparent)]
     Core(#[from] Error),
     /// The merge of a sweep directory that [`crate::plot::figures::draw`] does before its
     /// figures failed ([`crate::sweep::merge`]: a damaged `sweep.json`, a run's files that
     /// do not belong to the sweep, ...).
-    #[error("{0}")]
+    #[error(transparent)]
     Sweep(#[from] SweepError),
     /// A figure cannot be drawn: [`crate::plot::Chart::save`] or [`crate::plot::Map::save`]
     /// to a file name that does not end in `.png` or `.svg`, with an axis range that is not

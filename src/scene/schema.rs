@@ -69,7 +69,7 @@ pub(crate) enum KeyError {
         segment: String,
     },
     /// The value is not one of the key's type (serde's message, with the value).
-    #[error("{0}")]
+    #[error(transparent)]
     Value(#[from] serde_json::Error),
 }
 

@@ -13,8 +13,9 @@ use thiserror::Error;
 /// The failures that are not the sweep's own (a file that cannot be read or written, a
 /// directory another process holds, a run's scene refused or its solve failed, a damaged
 /// table) are the core [`enum@Error`], nested in [`SweepError::Core`]: `?` turns an [`enum@Error`]
-/// into a `SweepError`, and [`std::error::Error::source`] of `SweepError::Core` returns the
-/// core error, whose `Display` it repeats.
+/// into a `SweepError`. `SweepError::Core` is transparent: its `Display` and
+/// [`std::error::Error::source`] are the core error's own, so a report of the cause chain
+/// prints each cause once; match on the variant to reach the core error.
 ///
 /// ```
 /// use precursors::sweep::{Sweep, SweepError};
@@ -29,7 +30,7 @@ pub enum SweepError {
     /// a run's scene or solve ([`Error::InvalidCount`] for zero realizations or a bad
     /// shard, [`Error::SolverNotConverged`], ...), a run's damaged table when merging
     /// ([`Error::CorruptTable`], [`Error::NonFiniteCell`]).
-    #[error("{0}")]
+    #[error(transparent)]
     Core(#[from] Error),
     /// A sweep file ([`crate::sweep::Sweep::from_json_file`], or the text given to
     /// [`crate::sweep::Sweep::from_json_str`], or a sweep directory's `sweep.json` read by
@@ -37,9 +38,8 @@ pub enum SweepError {
     /// `docs/sweep-format.md` outside its axes (an axis's key or values:
     /// [`SweepError::Axis`]); also its base scene when it is not a scene file.
     #[error(
-        "sweep file{}: {}",
-        path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default(),
-        Bounded(&source.to_string())
+        "invalid sweep file{}",
+        path.as_ref().map(|p| format!(" {}", p.display())).unwrap_or_default()
     )]
     File {
         /// The file (`None` for JSON text given directly).
@@ -48,7 +48,7 @@ pub enum SweepError {
         line: usize,
         /// Column of the error (1-based; 0 when the parser gave none).
         column: usize,
-        /// What the parser reported.
+        /// What the parser reported (or what is wrong); `source()` returns it.
         #[source]
         source: Cause,
     },

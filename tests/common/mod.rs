@@ -178,3 +178,18 @@ pub mod allocations {
         COUNT.with(Cell::get)
     }
 }
+
+/// `e` and its causes ([`std::error::Error::source`]) joined by ": ", as `anyhow` prints
+/// `{:#}`: where a test looks for a cause's text (the parser's, the system's), since an
+/// error's own `Display` leaves its cause out.
+#[allow(dead_code)] // not every feature set has a test of a cause's text
+pub fn chain(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(cause) = source {
+        text.push_str(": ");
+        text.push_str(&cause.to_string());
+        source = cause.source();
+    }
+    text
+}
