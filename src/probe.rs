@@ -397,7 +397,7 @@ impl TryFrom<PlaneStressFields> for PlaneStress {
             }
         }
         // No vector holds more than `usize::MAX` values: an overflowing `Nx·Ny` mismatches.
-        let cells = f.nx.checked_mul(f.ny).unwrap_or(usize::MAX);
+        let cells = f.nx.saturating_mul(f.ny);
         for (name, values) in [
             ("shear", &f.shear),
             ("normal", &f.normal),
