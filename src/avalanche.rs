@@ -36,6 +36,7 @@ use crate::interface::SiteState;
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct Avalanche {
     /// The index (from 1, as `events.csv` numbers them) of its [`Event::LoadRaised`].

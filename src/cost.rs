@@ -42,6 +42,7 @@ const SOLVE_EXPONENT: f64 = 1.4;
 /// assert!(cost.memory_bytes > 1e10 && cost.solve_seconds > 3600.0);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct GridCost {
     /// `Nx·Ny` (exact).

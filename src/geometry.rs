@@ -15,6 +15,11 @@ use crate::error::{check_length, Error, Result};
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "BlockFields", into = "BlockFields")
+)]
 pub struct Block {
     lx: f64,
     ly: f64,
@@ -110,6 +115,11 @@ impl Block {
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub struct Point {
     /// x (m).
     pub x: f64,
@@ -151,6 +161,11 @@ impl Point {
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "GridFields", into = "GridFields")
+)]
 pub struct Grid {
     block: Block,
     nx: usize,
@@ -275,5 +290,57 @@ impl Grid {
     pub fn centre(&self, ix: usize, iy: usize) -> Option<(f64, f64)> {
         (ix < self.nx && iy < self.ny)
             .then(|| ((ix as f64 + 0.5) * self.dx(), (iy as f64 + 0.5) * self.dy()))
+    }
+}
+
+/// A [`Block`] as serde sees it (feature `serde`): the scene file's `block` keys, read
+/// back through [`Block::new`].
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BlockFields {
+    lx: f64,
+    ly: f64,
+    lz: f64,
+}
+
+#[cfg(feature = "serde")]
+impl From<Block> for BlockFields {
+    fn from(Block { lx, ly, lz }: Block) -> Self {
+        Self { lx, ly, lz }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<BlockFields> for Block {
+    type Error = Error;
+    fn try_from(BlockFields { lx, ly, lz }: BlockFields) -> Result<Self> {
+        Block::new(lx, ly, lz)
+    }
+}
+
+/// A [`Grid`] as serde sees it (feature `serde`): its block and the cell counts (the
+/// scene file's `cells` of kind `count`), read back through [`Grid::new`].
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GridFields {
+    block: Block,
+    nx: usize,
+    ny: usize,
+}
+
+#[cfg(feature = "serde")]
+impl From<Grid> for GridFields {
+    fn from(Grid { block, nx, ny }: Grid) -> Self {
+        Self { block, nx, ny }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<GridFields> for Grid {
+    type Error = Error;
+    fn try_from(GridFields { block, nx, ny }: GridFields) -> Result<Self> {
+        Grid::new(block, nx, ny)
     }
 }

@@ -29,6 +29,11 @@ use rand_distr::{Distribution, Normal};
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "MaterialFields", into = "MaterialFields")
+)]
 #[non_exhaustive]
 pub struct Material {
     young_modulus: f64,
@@ -195,6 +200,11 @@ pub enum AreaLaw {
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "SpringLawFields", into = "SpringLawFields")
+)]
 #[non_exhaustive]
 pub struct SpringLaw {
     c_x: f64,
@@ -296,6 +306,14 @@ impl SpringLaw {
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(
+        try_from = "HeightDistributionFields",
+        into = "HeightDistributionFields"
+    )
+)]
 #[non_exhaustive]
 pub struct HeightDistribution {
     mean: f64,
@@ -876,5 +894,115 @@ impl Interface {
                 }
             })
             .collect()
+    }
+}
+
+/// A [`Material`] as serde sees it (feature `serde`): the scene file's `material` keys
+/// (a missing one takes the default), read back through [`Material::new`].
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct MaterialFields {
+    young_modulus: f64,
+    poisson_ratio: f64,
+    friction_coefficient: f64,
+}
+
+#[cfg(feature = "serde")]
+impl Default for MaterialFields {
+    fn default() -> Self {
+        Material::default().into()
+    }
+}
+
+#[cfg(feature = "serde")]
+impl From<Material> for MaterialFields {
+    fn from(m: Material) -> Self {
+        Self {
+            young_modulus: m.young_modulus,
+            poisson_ratio: m.poisson_ratio,
+            friction_coefficient: m.friction_coefficient,
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<MaterialFields> for Material {
+    type Error = Error;
+    fn try_from(f: MaterialFields) -> Result<Self> {
+        Material::new(f.young_modulus, f.poisson_ratio, f.friction_coefficient)
+    }
+}
+
+/// A [`SpringLaw`] as serde sees it (feature `serde`): the scene file's `springs` keys (a
+/// missing one takes the default), read back through [`SpringLaw::new`].
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct SpringLawFields {
+    c_x: f64,
+    c_z: f64,
+    area_law: AreaLaw,
+}
+
+#[cfg(feature = "serde")]
+impl Default for SpringLawFields {
+    fn default() -> Self {
+        SpringLaw::default().into()
+    }
+}
+
+#[cfg(feature = "serde")]
+impl From<SpringLaw> for SpringLawFields {
+    fn from(law: SpringLaw) -> Self {
+        Self {
+            c_x: law.c_x,
+            c_z: law.c_z,
+            area_law: law.area_law,
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<SpringLawFields> for SpringLaw {
+    type Error = Error;
+    fn try_from(f: SpringLawFields) -> Result<Self> {
+        Ok(SpringLaw::new(f.c_x, f.c_z)?.with_area_law(f.area_law))
+    }
+}
+
+/// A [`HeightDistribution`] as serde sees it (feature `serde`): the scene file's
+/// `gaussian` heights keys `mean` and `std_dev` (a missing one takes the default), read
+/// back through [`HeightDistribution::new`].
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct HeightDistributionFields {
+    mean: f64,
+    std_dev: f64,
+}
+
+#[cfg(feature = "serde")]
+impl Default for HeightDistributionFields {
+    fn default() -> Self {
+        HeightDistribution::default().into()
+    }
+}
+
+#[cfg(feature = "serde")]
+impl From<HeightDistribution> for HeightDistributionFields {
+    fn from(d: HeightDistribution) -> Self {
+        Self {
+            mean: d.mean,
+            std_dev: d.std_dev,
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<HeightDistributionFields> for HeightDistribution {
+    type Error = Error;
+    fn try_from(f: HeightDistributionFields) -> Result<Self> {
+        HeightDistribution::new(f.mean, f.std_dev)
     }
 }

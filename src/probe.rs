@@ -72,6 +72,11 @@ const MAX_SHELLS: usize = 64;
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "ProbeSpecFields", into = "ProbeSpecFields")
+)]
 #[non_exhaustive]
 pub struct ProbeSpec {
     planes: Vec<f64>,
@@ -139,6 +144,50 @@ impl ProbeSpec {
     /// Whether nothing is requested.
     pub fn is_empty(&self) -> bool {
         self.planes.is_empty() && self.points.is_empty()
+    }
+}
+
+/// A [`ProbeSpec`] as serde sees it (feature `serde`): the scene file's `probes` keys,
+/// points as `[x, y, z]` (a missing key takes the default), read back through the `with_`
+/// modifiers.
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct ProbeSpecFields {
+    planes: Vec<f64>,
+    points: Vec<[f64; 3]>,
+    tolerance: f64,
+}
+
+#[cfg(feature = "serde")]
+impl Default for ProbeSpecFields {
+    fn default() -> Self {
+        ProbeSpec::default().into()
+    }
+}
+
+#[cfg(feature = "serde")]
+impl From<ProbeSpec> for ProbeSpecFields {
+    fn from(spec: ProbeSpec) -> Self {
+        Self {
+            points: spec.points.iter().map(Point::coords).collect(),
+            planes: spec.planes,
+            tolerance: spec.tolerance,
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<ProbeSpecFields> for ProbeSpec {
+    type Error = Error;
+    fn try_from(f: ProbeSpecFields) -> Result<Self> {
+        let spec = f.planes.iter().fold(
+            ProbeSpec::default().with_tolerance(f.tolerance)?,
+            |spec, &z| spec.with_plane(z),
+        );
+        Ok(f.points.iter().fold(spec, |spec, &[x, y, z]| {
+            spec.with_point(Point::new(x, y, z))
+        }))
     }
 }
 
@@ -285,6 +334,11 @@ impl<'a> ProbeInput<'a> {
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "PlaneStressFields", into = "PlaneStressFields")
+)]
 #[non_exhaustive]
 pub struct PlaneStress {
     /// Height of the plane (m).
@@ -301,6 +355,72 @@ pub struct PlaneStress {
     coulomb: Vec<f64>,
     /// The `μ` of the Coulomb stresses (the driver's, or [`ProbeInput`]'s).
     friction_coefficient: f64,
+}
+
+/// A [`PlaneStress`] as serde sees it (feature `serde`): its accessors' names, read back
+/// with the counts checked (`Nx, Ny ≥ 1`, `Nx·Ny` values of each field).
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PlaneStressFields {
+    z: f64,
+    nx: usize,
+    ny: usize,
+    shear: Vec<f64>,
+    normal: Vec<f64>,
+    coulomb: Vec<f64>,
+    friction_coefficient: f64,
+}
+
+#[cfg(feature = "serde")]
+impl From<PlaneStress> for PlaneStressFields {
+    fn from(p: PlaneStress) -> Self {
+        Self {
+            z: p.z,
+            nx: p.nx,
+            ny: p.ny,
+            shear: p.shear,
+            normal: p.normal,
+            coulomb: p.coulomb,
+            friction_coefficient: p.friction_coefficient,
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<PlaneStressFields> for PlaneStress {
+    type Error = Error;
+    fn try_from(f: PlaneStressFields) -> Result<Self> {
+        for (axis, n) in [("x", f.nx), ("y", f.ny)] {
+            if n == 0 {
+                return Err(Error::EmptyGrid { axis });
+            }
+        }
+        // No vector holds more than `usize::MAX` values: an overflowing `Nx·Ny` mismatches.
+        let cells = f.nx.saturating_mul(f.ny);
+        for (name, values) in [
+            ("shear", &f.shear),
+            ("normal", &f.normal),
+            ("coulomb", &f.coulomb),
+        ] {
+            if values.len() != cells {
+                return Err(Error::LengthMismatch {
+                    name,
+                    expected: cells,
+                    found: values.len(),
+                });
+            }
+        }
+        Ok(Self {
+            z: f.z,
+            nx: f.nx,
+            ny: f.ny,
+            shear: f.shear,
+            normal: f.normal,
+            coulomb: f.coulomb,
+            friction_coefficient: f.friction_coefficient,
+        })
+    }
 }
 
 /// Profiles along x, averaged over y (one value per column, Pa).
@@ -327,6 +447,7 @@ pub struct PlaneStress {
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct Profile {
     /// `τ(x, z) = (1/Ly) ∫ τ dy` (Pa).
@@ -360,6 +481,7 @@ pub struct Profile {
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct CellStress {
     /// Shear stress `τ = σ_xz` (Pa).
@@ -476,6 +598,7 @@ impl PlaneStress {
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct PointStress {
     /// Where (m).
@@ -510,6 +633,7 @@ pub struct PointStress {
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct Stresses {
     /// One per requested plane, in request order.

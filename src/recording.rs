@@ -21,6 +21,11 @@
 /// assert_eq!(RunOptions::default(), RunOptions::new()); // records nothing more
 /// ```
 #[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(from = "RunOptionsFields", into = "RunOptionsFields")
+)]
 #[non_exhaustive]
 pub struct RunOptions {
     pub(crate) fields: FieldRecording,
@@ -102,5 +107,60 @@ impl RunOptions {
     /// The heights `z` (m) of the planes of the profiles.
     pub fn profile_planes(&self) -> &[f64] {
         &self.profiles.planes
+    }
+}
+
+/// [`RunOptions`] as serde sees them (feature `serde`): the scene file's `fields` and
+/// `profiles` objects (a missing key records nothing), read back through
+/// [`RunOptions::record_fields`] and [`RunOptions::record_profiles`] (which sorts the
+/// loads and drops repeats).
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+struct RunOptionsFields {
+    fields: FieldsFields,
+    profiles: ProfilesFields,
+}
+
+/// `fields`: [`FieldRecording`].
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+struct FieldsFields {
+    every: usize,
+    planes: Vec<f64>,
+}
+
+/// `profiles`: [`ProfileRecording`].
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+struct ProfilesFields {
+    loads: Vec<f64>,
+    planes: Vec<f64>,
+}
+
+#[cfg(feature = "serde")]
+impl From<RunOptions> for RunOptionsFields {
+    fn from(o: RunOptions) -> Self {
+        Self {
+            fields: FieldsFields {
+                every: o.fields.every,
+                planes: o.fields.planes,
+            },
+            profiles: ProfilesFields {
+                loads: o.profiles.loads,
+                planes: o.profiles.planes,
+            },
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl From<RunOptionsFields> for RunOptions {
+    fn from(f: RunOptionsFields) -> Self {
+        RunOptions::new()
+            .record_fields(f.fields.every, &f.fields.planes)
+            .record_profiles(&f.profiles.loads, &f.profiles.planes)
     }
 }

@@ -58,6 +58,11 @@ const LATERAL_TOLERANCE: f64 = 1e-12;
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(from = "LateralFields", into = "LateralFields")
+)]
 #[non_exhaustive]
 pub enum Lateral {
     /// The paper's rod: a band `z ∈ [height - half_width, height + half_width]` (m).
@@ -101,6 +106,11 @@ pub enum Lateral {
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(from = "ForceLoadFields", into = "ForceLoadFields")
+)]
 #[non_exhaustive]
 pub enum ForceLoad {
     /// Uniform shear on the top face only.
@@ -146,6 +156,11 @@ impl From<Lateral> for ForceLoad {
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(from = "DriveFields", into = "DriveFields")
+)]
 #[non_exhaustive]
 pub enum Drive {
     /// Force control: the shear force `F` (N) is raised from threshold to threshold.
@@ -199,6 +214,11 @@ impl Default for Drive {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "HeightSourceFields", into = "HeightSourceFields")
+)]
 #[non_exhaustive]
 pub enum HeightSource {
     /// Truncated Gaussian heights from a seed ([`Heights::truncated_gaussian`]).
@@ -238,6 +258,265 @@ pub enum HeightSource {
         /// Seed of the surface's Fourier coefficients.
         seed: u64,
     },
+}
+
+/// A [`Lateral`] as serde sees it (feature `serde`): the scene file's `lateral` object,
+/// `{"kind": "rod", "height": h, "half_width": Δh}` or `{"kind": "side"}` (a struct
+/// variant, so that a key beside `kind` is refused).
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+enum LateralFields {
+    Rod { height: f64, half_width: f64 },
+    Side {},
+}
+
+#[cfg(feature = "serde")]
+impl From<Lateral> for LateralFields {
+    fn from(lateral: Lateral) -> Self {
+        match lateral {
+            Lateral::Rod { height, half_width } => Self::Rod { height, half_width },
+            Lateral::Side => Self::Side {},
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl From<LateralFields> for Lateral {
+    fn from(f: LateralFields) -> Self {
+        match f {
+            LateralFields::Rod { height, half_width } => Lateral::Rod { height, half_width },
+            LateralFields::Side {} => Lateral::Side,
+        }
+    }
+}
+
+/// A [`ForceLoad`] as serde sees it (feature `serde`): the scene file's `drive` object
+/// of kind `top`, `rod`, `side` or `mixed` (a lateral load only is `rod` or `side`).
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+enum ForceLoadFields {
+    Top {},
+    Rod { height: f64, half_width: f64 },
+    Side {},
+    Mixed { ratio: f64, lateral: Lateral },
+}
+
+#[cfg(feature = "serde")]
+impl From<ForceLoad> for ForceLoadFields {
+    fn from(load: ForceLoad) -> Self {
+        match load {
+            ForceLoad::Top => Self::Top {},
+            ForceLoad::Lateral(Lateral::Rod { height, half_width }) => {
+                Self::Rod { height, half_width }
+            }
+            ForceLoad::Lateral(Lateral::Side) => Self::Side {},
+            ForceLoad::Mixed { ratio, lateral } => Self::Mixed { ratio, lateral },
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl From<ForceLoadFields> for ForceLoad {
+    fn from(f: ForceLoadFields) -> Self {
+        match f {
+            ForceLoadFields::Top {} => ForceLoad::Top,
+            ForceLoadFields::Rod { height, half_width } => {
+                ForceLoad::Lateral(Lateral::Rod { height, half_width })
+            }
+            ForceLoadFields::Side {} => ForceLoad::Lateral(Lateral::Side),
+            ForceLoadFields::Mixed { ratio, lateral } => ForceLoad::Mixed { ratio, lateral },
+        }
+    }
+}
+
+/// A [`Drive`] as serde sees it (feature `serde`): the scene file's `drive` object, of
+/// kind `top`, `rod`, `side`, `mixed` (force control) or `spring`. The values are
+/// checked when a scene is built, as the Rust builder's.
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+enum DriveFields {
+    Top {},
+    Rod { height: f64, half_width: f64 },
+    Side {},
+    Mixed { ratio: f64, lateral: Lateral },
+    Spring { stiffness: f64, lateral: Lateral },
+}
+
+#[cfg(feature = "serde")]
+impl From<Drive> for DriveFields {
+    fn from(drive: Drive) -> Self {
+        match drive {
+            Drive::Force(load) => match ForceLoadFields::from(load) {
+                ForceLoadFields::Top {} => Self::Top {},
+                ForceLoadFields::Rod { height, half_width } => Self::Rod { height, half_width },
+                ForceLoadFields::Side {} => Self::Side {},
+                ForceLoadFields::Mixed { ratio, lateral } => Self::Mixed { ratio, lateral },
+            },
+            Drive::Spring { stiffness, lateral } => Self::Spring { stiffness, lateral },
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl From<DriveFields> for Drive {
+    fn from(f: DriveFields) -> Self {
+        let force = |load: ForceLoadFields| Drive::Force(load.into());
+        match f {
+            DriveFields::Top {} => force(ForceLoadFields::Top {}),
+            DriveFields::Rod { height, half_width } => {
+                force(ForceLoadFields::Rod { height, half_width })
+            }
+            DriveFields::Side {} => force(ForceLoadFields::Side {}),
+            DriveFields::Mixed { ratio, lateral } => {
+                force(ForceLoadFields::Mixed { ratio, lateral })
+            }
+            DriveFields::Spring { stiffness, lateral } => Drive::Spring { stiffness, lateral },
+        }
+    }
+}
+
+/// A [`HeightSource`] as serde sees it (feature `serde`): the scene file's `heights`
+/// object but the kind `file` (a source holds values, not a path): `gaussian`, `values`,
+/// `gaussian_surface` or `self_affine_surface`, with the scene file's keys and defaults,
+/// read back through [`HeightDistribution::new`] and the [`SurfaceSpectrum`] constructors.
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+enum HeightSourceFields {
+    Gaussian {
+        #[serde(default = "default_mean")]
+        mean: f64,
+        #[serde(default = "default_std_dev")]
+        std_dev: f64,
+        #[serde(default = "default_seed")]
+        seed: u64,
+    },
+    Values {
+        values: Vec<f64>,
+    },
+    GaussianSurface {
+        correlation_length: f64,
+        #[serde(default = "default_mean")]
+        mean: f64,
+        #[serde(default = "default_std_dev")]
+        std_dev: f64,
+        #[serde(default = "default_seed")]
+        seed: u64,
+    },
+    SelfAffineSurface {
+        hurst: f64,
+        roll_off: f64,
+        short_cutoff: f64,
+        long_cutoff: f64,
+        #[serde(default = "default_mean")]
+        mean: f64,
+        #[serde(default = "default_std_dev")]
+        std_dev: f64,
+        #[serde(default = "default_seed")]
+        seed: u64,
+    },
+}
+
+#[cfg(feature = "serde")]
+fn default_mean() -> f64 {
+    HeightDistribution::default().mean()
+}
+
+#[cfg(feature = "serde")]
+fn default_std_dev() -> f64 {
+    HeightDistribution::default().std_dev()
+}
+
+#[cfg(feature = "serde")]
+fn default_seed() -> u64 {
+    DEFAULT_SEED
+}
+
+#[cfg(feature = "serde")]
+impl From<HeightSource> for HeightSourceFields {
+    fn from(source: HeightSource) -> Self {
+        match source {
+            HeightSource::Random { distribution, seed } => Self::Gaussian {
+                mean: distribution.mean(),
+                std_dev: distribution.std_dev(),
+                seed,
+            },
+            HeightSource::Values(values) => Self::Values { values },
+            HeightSource::Surface {
+                spectrum,
+                distribution,
+                seed,
+            } => {
+                let (mean, std_dev) = (distribution.mean(), distribution.std_dev());
+                match spectrum {
+                    SurfaceSpectrum::Gaussian { correlation_length } => Self::GaussianSurface {
+                        correlation_length,
+                        mean,
+                        std_dev,
+                        seed,
+                    },
+                    SurfaceSpectrum::SelfAffine {
+                        hurst,
+                        roll_off,
+                        short_cutoff,
+                        long_cutoff,
+                    } => Self::SelfAffineSurface {
+                        hurst,
+                        roll_off,
+                        short_cutoff,
+                        long_cutoff,
+                        mean,
+                        std_dev,
+                        seed,
+                    },
+                }
+            }
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<HeightSourceFields> for HeightSource {
+    type Error = Error;
+    fn try_from(f: HeightSourceFields) -> Result<Self> {
+        Ok(match f {
+            HeightSourceFields::Gaussian {
+                mean,
+                std_dev,
+                seed,
+            } => HeightSource::Random {
+                distribution: HeightDistribution::new(mean, std_dev)?,
+                seed,
+            },
+            HeightSourceFields::Values { values } => HeightSource::Values(values),
+            HeightSourceFields::GaussianSurface {
+                correlation_length,
+                mean,
+                std_dev,
+                seed,
+            } => HeightSource::Surface {
+                spectrum: SurfaceSpectrum::gaussian(correlation_length)?,
+                distribution: HeightDistribution::new(mean, std_dev)?,
+                seed,
+            },
+            HeightSourceFields::SelfAffineSurface {
+                hurst,
+                roll_off,
+                short_cutoff,
+                long_cutoff,
+                mean,
+                std_dev,
+                seed,
+            } => HeightSource::Surface {
+                spectrum: SurfaceSpectrum::self_affine(hurst, roll_off, short_cutoff, long_cutoff)?,
+                distribution: HeightDistribution::new(mean, std_dev)?,
+                seed,
+            },
+        })
+    }
 }
 
 impl HeightSource {

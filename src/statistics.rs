@@ -39,6 +39,7 @@ use rand::{RngExt, SeedableRng};
 /// continuous density `p(x) = (α - 1) / x_min · (x / x_min)^(-α)` over `x ≥ x_min`.
 #[non_exhaustive]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Support {
     /// Integer samples (`x.fract() == 0`), e.g. the number of ruptures of an avalanche.
     Discrete,
@@ -59,6 +60,7 @@ pub enum Support {
 /// ```
 #[non_exhaustive]
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PowerLawOptions {
     /// Level of the bootstrap intervals of `α` and `x_min` (dimensionless, strictly
     /// between 0 and 1; default 0.95).
@@ -131,6 +133,7 @@ impl PowerLawOptions {
 /// the samples' unit (N for force drops, a count for avalanche sizes).
 #[non_exhaustive]
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PowerLawFit {
     /// Whether the samples were fitted as integers or reals.
     pub support: Support,
@@ -204,6 +207,7 @@ impl PowerLawFit {
 /// One bin of a log-binned histogram ([`log_binned`]). Values are in the samples' unit.
 #[non_exhaustive]
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct LogBin {
     /// Lower edge (included).
     pub low: f64,

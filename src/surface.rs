@@ -48,6 +48,11 @@ use std::f64::consts::{PI, SQRT_2, TAU};
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "SurfaceSpectrumFields", into = "SurfaceSpectrumFields")
+)]
 #[non_exhaustive]
 pub enum SurfaceSpectrum {
     /// Gaussian correlation `C(r) = exp(-r²/ξ²)`: `S(k) ∝ exp(-k²ξ²/4)`.
@@ -71,6 +76,65 @@ pub enum SurfaceSpectrum {
         /// The long-wavelength cut-off `λ_l` (m, `≥ λ_r`).
         long_cutoff: f64,
     },
+}
+
+/// A [`SurfaceSpectrum`] as serde sees it (feature `serde`): `{"kind": "gaussian",
+/// "correlation_length": ξ}` or `{"kind": "self_affine", "hurst": H, "roll_off": λ_r,
+/// "short_cutoff": λ_s, "long_cutoff": λ_l}` (the scene file's surface heights keys), read
+/// back through [`SurfaceSpectrum::gaussian`] and [`SurfaceSpectrum::self_affine`].
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+enum SurfaceSpectrumFields {
+    Gaussian {
+        correlation_length: f64,
+    },
+    SelfAffine {
+        hurst: f64,
+        roll_off: f64,
+        short_cutoff: f64,
+        long_cutoff: f64,
+    },
+}
+
+#[cfg(feature = "serde")]
+impl From<SurfaceSpectrum> for SurfaceSpectrumFields {
+    fn from(s: SurfaceSpectrum) -> Self {
+        match s {
+            SurfaceSpectrum::Gaussian { correlation_length } => {
+                Self::Gaussian { correlation_length }
+            }
+            SurfaceSpectrum::SelfAffine {
+                hurst,
+                roll_off,
+                short_cutoff,
+                long_cutoff,
+            } => Self::SelfAffine {
+                hurst,
+                roll_off,
+                short_cutoff,
+                long_cutoff,
+            },
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<SurfaceSpectrumFields> for SurfaceSpectrum {
+    type Error = Error;
+    fn try_from(f: SurfaceSpectrumFields) -> Result<Self> {
+        match f {
+            SurfaceSpectrumFields::Gaussian { correlation_length } => {
+                SurfaceSpectrum::gaussian(correlation_length)
+            }
+            SurfaceSpectrumFields::SelfAffine {
+                hurst,
+                roll_off,
+                short_cutoff,
+                long_cutoff,
+            } => SurfaceSpectrum::self_affine(hurst, roll_off, short_cutoff, long_cutoff),
+        }
+    }
 }
 
 /// The Gaussian spectrum is cut where `S(k)/S(0) = exp(-k²ξ²/4)` falls to `1e-16`: the

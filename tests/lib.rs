@@ -41,6 +41,8 @@ mod robustness;
 mod runs;
 #[cfg(feature = "serde")]
 mod scene_file;
+#[cfg(feature = "serde")]
+mod serde_types;
 mod solver;
 mod stability;
 #[cfg(feature = "serde")]

@@ -17,6 +17,7 @@ const NOMINAL_AREA_SLACK: f64 = 1e-9;
 /// The interface along `x`, averaged over `y` ([`Driver::slip_profile`]): one value per
 /// column `ix`, from the trailing edge.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct SlipProfile {
     /// `⟨u_x⟩_y`, the shear displacement of the bottom face (m).

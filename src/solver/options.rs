@@ -68,6 +68,11 @@ impl std::fmt::Display for Backend {
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "SolverOptionsFields", into = "SolverOptionsFields")
+)]
 #[non_exhaustive]
 pub struct SolverOptions {
     backend: Backend,
@@ -192,6 +197,53 @@ impl SolverOptions {
     /// whose `set_parallelism` checks it against the backend first.
     pub(crate) fn set_parallelism(&mut self, parallelism: Parallelism) {
         self.parallelism = parallelism;
+    }
+}
+
+/// [`SolverOptions`] as serde sees them (feature `serde`): the scene file's `solver` keys
+/// but `threads`, which is the [`Parallelism`] itself (a missing key takes the default),
+/// read back through the `with_` modifiers.
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct SolverOptionsFields {
+    backend: Backend,
+    tolerance: f64,
+    max_active_set_iterations: usize,
+    max_linear_iterations: usize,
+    parallelism: Parallelism,
+}
+
+#[cfg(feature = "serde")]
+impl Default for SolverOptionsFields {
+    fn default() -> Self {
+        SolverOptions::default().into()
+    }
+}
+
+#[cfg(feature = "serde")]
+impl From<SolverOptions> for SolverOptionsFields {
+    fn from(o: SolverOptions) -> Self {
+        Self {
+            backend: o.backend,
+            tolerance: o.tolerance,
+            max_active_set_iterations: o.max_active_set_iterations,
+            max_linear_iterations: o.max_linear_iterations,
+            parallelism: o.parallelism,
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<SolverOptionsFields> for SolverOptions {
+    type Error = Error;
+    fn try_from(f: SolverOptionsFields) -> Result<Self> {
+        SolverOptions::default()
+            .with_parallelism(f.parallelism)?
+            .with_backend(f.backend)?
+            .with_tolerance(f.tolerance)?
+            .with_max_active_set_iterations(f.max_active_set_iterations)?
+            .with_max_linear_iterations(f.max_linear_iterations)
     }
 }
 
