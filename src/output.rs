@@ -87,7 +87,7 @@ use crate::error::{Error, Result};
 use crate::files::{check_replaceable, read_text_if_exists, sync_dir, write_atomically};
 use crate::interface::SiteState;
 use crate::lock::DirLock;
-use crate::probe::{ProbeSpec, StressProbe};
+use crate::probe::StressProbe;
 use crate::recording::RunOptions;
 use profiles::ProfilesTable;
 use resume::{continuation, fields_continuation};
@@ -292,25 +292,12 @@ impl FieldsTable {
         file: impl FnOnce(&Path) -> Result<File>,
         stable: usize,
     ) -> Result<Option<Self>> {
-        let scene = driver.scene();
         let every = options.fields_every();
         if every == 0 {
             return Ok(None);
         }
         let planes = options.field_planes().to_vec();
-        let probe = if planes.is_empty() {
-            None
-        } else {
-            let spec = planes.iter().fold(
-                ProbeSpec::default().with_tolerance(scene.probes().tolerance())?,
-                |spec, &z| spec.with_plane(z),
-            );
-            Some(std::panic::AssertUnwindSafe(StressProbe::new(
-                scene.plan(),
-                &spec,
-                scene.lateral_load(),
-            )?))
-        };
+        let probe = profiles::planes_probe(driver, &planes)?;
         let (path, partial) = Self::paths(dir);
         Ok(Some(Self {
             file: BufWriter::new(file(&partial)?),

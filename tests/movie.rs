@@ -135,29 +135,7 @@ fn resumed_fields_end_as_the_uninterrupted_ones_and_another_recording_is_refused
     run(&scene, &whole);
     // The same run killed 30 events after a checkpoint at its 12th stable state.
     let cut = scratch("cut");
-    let mut driver = scene.driver().unwrap();
-    let mut tables = RunTables::create(&cut, &driver).unwrap();
-    let mut checkpoint = None;
-    let mut stable = 0;
-    let mut after = 0;
-    while let Some(event) = driver.step().unwrap() {
-        tables.record(&driver, &event).unwrap();
-        if checkpoint.is_some() {
-            after += 1;
-            if after == 30 {
-                break;
-            }
-        } else if matches!(event, Event::Stable { .. }) {
-            stable += 1;
-            if stable == 12 {
-                tables.flush().unwrap();
-                checkpoint = Some(driver.checkpoint());
-            }
-        }
-    }
-    tables.flush().unwrap();
-    drop(tables);
-    let checkpoint = checkpoint.unwrap();
+    let checkpoint = crate::common::killed_after_checkpoint(&scene, &cut, 12, 30);
     // Recorded every 3rd state instead: the table does not match, refused.
     let other = builder()
         .run_options(RunOptions::new().record_fields(3, &PLANES))

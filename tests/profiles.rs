@@ -206,27 +206,7 @@ fn resumed_profiles_end_as_the_uninterrupted_ones_and_other_loads_are_refused() 
     run(&scene, scene.run_options(), &whole);
     // The same run killed 40 events after a checkpoint at its 15th stable state.
     let cut = scratch("cut");
-    let mut driver = scene.driver().unwrap();
-    let mut tables = RunTables::create(&cut, &driver).unwrap();
-    let (mut checkpoint, mut stable, mut after) = (None, 0, 0);
-    while let Some(event) = driver.step().unwrap() {
-        tables.record(&driver, &event).unwrap();
-        if checkpoint.is_some() {
-            after += 1;
-            if after == 40 {
-                break;
-            }
-        } else if matches!(event, Event::Stable { .. }) {
-            stable += 1;
-            if stable == 15 {
-                tables.flush().unwrap();
-                checkpoint = Some(driver.checkpoint());
-            }
-        }
-    }
-    tables.flush().unwrap();
-    drop(tables);
-    let checkpoint = checkpoint.unwrap();
+    let checkpoint = crate::common::killed_after_checkpoint(&scene, &cut, 15, 40);
     // The checkpoint's state passed some loads already: recorded at other loads, the
     // table does not match and is refused, naming it.
     let driver = scene.resume(&checkpoint).unwrap();

@@ -131,6 +131,29 @@ pub(crate) fn groups(
     (out, rule)
 }
 
+/// The stresses on the recorded `planes`, planned on `driver`'s scene operator at its
+/// probes' tolerance (`None` without planes); `fields.csv`'s writer takes it too.
+/// Asserted unwind-safe so that the tables stay so: the probe is only read after it is
+/// built (its transforms' plans are immutable), so a panic cannot leave it half changed.
+pub(super) fn planes_probe(
+    driver: &Driver,
+    planes: &[f64],
+) -> Result<Option<std::panic::AssertUnwindSafe<StressProbe>>> {
+    if planes.is_empty() {
+        return Ok(None);
+    }
+    let scene = driver.scene();
+    let spec = planes.iter().fold(
+        ProbeSpec::default().with_tolerance(scene.probes().tolerance())?,
+        |spec, &z| spec.with_plane(z),
+    );
+    Ok(Some(std::panic::AssertUnwindSafe(StressProbe::new(
+        scene.plan(),
+        &spec,
+        scene.lateral_load(),
+    )?)))
+}
+
 /// A stable state's profiles, rendered (all but the level column).
 #[derive(Debug)]
 struct State {
@@ -179,21 +202,8 @@ impl ProfilesTable {
         if loads.is_empty() {
             return Ok(None);
         }
-        let scene = driver.scene();
         let planes = options.profile_planes().to_vec();
-        let probe = if planes.is_empty() {
-            None
-        } else {
-            let spec = planes.iter().fold(
-                ProbeSpec::default().with_tolerance(scene.probes().tolerance())?,
-                |spec, &z| spec.with_plane(z),
-            );
-            Some(std::panic::AssertUnwindSafe(StressProbe::new(
-                scene.plan(),
-                &spec,
-                scene.lateral_load(),
-            )?))
-        };
+        let probe = planes_probe(driver, &planes)?;
         let (path, partial) = Self::paths(dir);
         let resumed = rule.started;
         let mut table = Self {

@@ -193,3 +193,36 @@ pub fn chain(e: &(dyn std::error::Error + 'static)) -> String {
     }
     text
 }
+
+/// A run of `scene` into `dir` killed `after` events past a checkpoint taken at its
+/// `stable`-th stable state (its tables flushed there, as the program does): the tables
+/// are left `.partial` with rows beyond the checkpoint. Returns the checkpoint.
+#[cfg(feature = "serde")]
+#[allow(dead_code)] // not every feature set has a resume test
+pub fn killed_after_checkpoint(
+    scene: &precursors::Scene,
+    dir: &std::path::Path,
+    stable: usize,
+    after: usize,
+) -> precursors::Checkpoint {
+    let mut driver = scene.driver().unwrap();
+    let mut tables = precursors::output::RunTables::create(dir, &driver).unwrap();
+    let (mut checkpoint, mut states, mut past) = (None, 0, 0);
+    while let Some(event) = driver.step().unwrap() {
+        tables.record(&driver, &event).unwrap();
+        if checkpoint.is_some() {
+            past += 1;
+            if past == after {
+                break;
+            }
+        } else if matches!(event, precursors::Event::Stable { .. }) {
+            states += 1;
+            if states == stable {
+                tables.flush().unwrap();
+                checkpoint = Some(driver.checkpoint());
+            }
+        }
+    }
+    tables.flush().unwrap();
+    checkpoint.expect("the run reached the checkpoint's stable state")
+}
