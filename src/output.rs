@@ -535,72 +535,12 @@ impl RunTables {
         } else {
             None
         };
-        let nx = driver.grid().nx();
-        let fields_text = if options.fields_every() > 0 {
-            let (path, partial) = FieldsTable::paths(dir);
-            let (old, read) = read_old(&partial, &path)?;
-            Some(fields_continuation(
-                old.as_deref(),
-                &read,
-                &plan.stable,
-                (options.fields_every(), options.field_planes()),
-                (nx, driver.grid().ny()),
-            )?)
-        } else {
-            None
-        };
-        let profiles_kept = if options.profile_loads().is_empty() {
-            None
-        } else {
-            let (path, partial) = ProfilesTable::paths(dir);
-            let (old, read) = read_old(&partial, &path)?;
-            let states: Vec<(usize, f64)> = plan
-                .stable
-                .iter()
-                .copied()
-                .zip(plan.loads.iter().copied())
-                .collect();
-            Some(profiles::continuation(
-                old.as_deref(),
-                &read,
-                options,
-                nx,
-                &states,
-                |event| {
-                    states
-                        .iter()
-                        .find(|s| s.0 == event)
-                        .map(|s| format!("{:.12e}", s.1))
-                },
-            )?)
-        };
+        let kept = Recordings::kept(dir, driver, options, &plan)?;
         // Checked: now the directory is written.
         remove_stale_temporaries(dir)?;
         let continued = |t: usize| append_to(&partials[t], &plan.texts[t]).map(BufWriter::new);
         let (events, curve, map) = (continued(0)?, continued(1)?, continued(2)?);
-        // Recordings not asked for now would not cover the run: removed.
-        if fields_text.is_none() {
-            remove_fields(dir)?;
-        }
-        if profiles_kept.is_none() {
-            remove_profiles(dir)?;
-        }
-        let fields = match fields_text {
-            Some(text) => FieldsTable::new(
-                driver,
-                options,
-                dir,
-                |path| append_to(path, &text),
-                plan.stable.len(),
-            )?,
-            None => None,
-        };
-        let profiles = match profiles_kept {
-            Some((text, rule)) => {
-                ProfilesTable::new(driver, options, dir, |path| append_to(path, &text), rule)?
-            }
-            None => None,
-        };
+        let (fields, profiles) = kept.continue_in(dir, driver, options, plan.stable.len())?;
         Ok(Self {
             events,
             curve,
@@ -910,6 +850,100 @@ impl RunTables {
         }
         sync_dir(&self.dir).map_err(|e| Error::io("syncing directory", &self.dir, e))?;
         Ok(self.paths.clone())
+    }
+}
+
+/// What a resumed run keeps of what it recorded beside its tables, checked and cut back
+/// to the checkpoint (`None` where the options record nothing of the kind).
+struct Recordings {
+    /// `fields.csv`'s text.
+    fields: Option<String>,
+    /// `profiles.csv`'s text and the rule where it stands.
+    profiles: Option<(String, profiles::Levels)>,
+}
+
+impl Recordings {
+    /// Reads and checks the recordings of `dir` against the tables' continuation `plan`;
+    /// writes nothing.
+    fn kept(
+        dir: &Path,
+        driver: &Driver,
+        options: &RunOptions,
+        plan: &resume::Continuation,
+    ) -> Result<Self> {
+        let nx = driver.grid().nx();
+        let fields = if options.fields_every() > 0 {
+            let (path, partial) = FieldsTable::paths(dir);
+            let (old, read) = read_old(&partial, &path)?;
+            Some(fields_continuation(
+                old.as_deref(),
+                &read,
+                &plan.stable,
+                (options.fields_every(), options.field_planes()),
+                (nx, driver.grid().ny()),
+            )?)
+        } else {
+            None
+        };
+        let profiles = if options.profile_loads().is_empty() {
+            None
+        } else {
+            let (path, partial) = ProfilesTable::paths(dir);
+            let (old, read) = read_old(&partial, &path)?;
+            let states: Vec<(usize, f64)> = plan
+                .stable
+                .iter()
+                .copied()
+                .zip(plan.loads.iter().copied())
+                .collect();
+            // The loads as curve.csv writes them (a value read back prints the same).
+            let load_text = |event: usize| {
+                states
+                    .iter()
+                    .find(|s| s.0 == event)
+                    .map(|s| format!("{:.12e}", s.1))
+            };
+            Some(profiles::continuation(
+                old.as_deref(),
+                &read,
+                options,
+                nx,
+                &states,
+                load_text,
+            )?)
+        };
+        Ok(Self { fields, profiles })
+    }
+
+    /// The writers continuing the kept recordings in `dir` (`stable`: the stable states
+    /// kept); a recording the options no longer ask for is removed (it would not cover
+    /// the run).
+    fn continue_in(
+        self,
+        dir: &Path,
+        driver: &Driver,
+        options: &RunOptions,
+        stable: usize,
+    ) -> Result<(Option<FieldsTable>, Option<ProfilesTable>)> {
+        let fields = match self.fields {
+            Some(text) => {
+                FieldsTable::new(driver, options, dir, |path| append_to(path, &text), stable)?
+            }
+            None => {
+                remove_fields(dir)?;
+                None
+            }
+        };
+        let profiles = match self.profiles {
+            Some((text, rule)) => {
+                ProfilesTable::new(driver, options, dir, |path| append_to(path, &text), rule)?
+            }
+            None => {
+                remove_profiles(dir)?;
+                None
+            }
+        };
+        Ok((fields, profiles))
     }
 }
 

@@ -75,9 +75,67 @@ pub(super) fn draw_profiles(
     let Some(rows) = crate::output::profiles::read(dir, record)? else {
         return Ok(drawn);
     };
-    let loads = record.options.profile_loads();
+    let levels = levels(&rows, record.options.profile_loads());
+    if levels.is_empty() {
+        for name in names.iter().filter(|n| selection.wants(n)) {
+            let reason = "the run passed none of the loads of `profiles.loads`".to_string();
+            selection.skip(name, dir, reason, &mut drawn.notes)?;
+        }
+        return Ok(drawn);
+    }
+    let figures = Figures {
+        dir,
+        extensions,
+        size,
+        title,
+        selection,
+        levels: &levels,
+        dx_mm: record.grid.dx() * 1e3,
+        lx_mm: record.bounds.lx * 1e3,
+    };
+    let micro = |v: f64| v * 1e6;
+    let slip = figures.family(
+        "Slip profiles ⟨u_x⟩_y",
+        "⟨u_x⟩_y (µm)",
+        ("slip_m", 0.0),
+        &micro,
+    );
+    figures.save(slip, SLIP_PROFILES_FIGURE, &mut drawn)?;
+    let planes = record.options.profile_planes();
+    // Without a plane above the interface, the selection left the stress figures out
+    // (with a note).
+    let Some(z_p) = planes.iter().copied().filter(|&z| z > 0.0).reduce(f64::min) else {
+        return Ok(drawn);
+    };
+    let at = format!("z_P = {} mm", short(z_p * 1e3));
+    let shear = figures.family(
+        &format!("|τ(x, z_P)|, {at}"),
+        "|τ_{xz}| (MPa)",
+        ("shear_Pa", z_p),
+        &magnitude_mpa,
+    );
+    figures.save(shear, SHEAR_PROFILES_FIGURE, &mut drawn)?;
+    let normal = figures.family(
+        &format!("|σ(x, z_P)|, {at}"),
+        "|σ_{zz}| (MPa)",
+        ("normal_Pa", z_p),
+        &magnitude_mpa,
+    );
+    figures.save(normal, NORMAL_PROFILES_FIGURE, &mut drawn)?;
+    let coulomb = figures.coulomb((z_p, &at), planes.contains(&0.0), &mut drawn);
+    figures.save(coulomb, COULOMB_PROFILES_FIGURE, &mut drawn)?;
+    Ok(drawn)
+}
+
+/// `|v|` in MPa (`v` in Pa).
+fn magnitude_mpa(v: f64) -> f64 {
+    v.abs() * 1e-6
+}
+
+/// The rows of `profiles.csv` grouped by load, in the table's (increasing) order.
+fn levels<'a>(rows: &'a [ProfileRow], loads: &[f64]) -> Vec<Level<'a>> {
     let mut levels: Vec<Level> = Vec::new();
-    for row in &rows {
+    for row in rows {
         match levels.last_mut() {
             Some(l) if l.load == loads[row.level] => l.rows.push(row),
             _ => levels.push(Level {
@@ -86,110 +144,98 @@ pub(super) fn draw_profiles(
             }),
         }
     }
-    if levels.is_empty() {
-        for name in names.iter().filter(|n| selection.wants(n)) {
-            let reason = "the run passed none of the loads of `profiles.loads`".to_string();
-            selection.skip(name, dir, reason, &mut drawn.notes)?;
-        }
-        return Ok(drawn);
-    }
-    let dx_mm = record.grid.dx() * 1e3;
-    let lx_mm = record.bounds.lx * 1e3;
-    let save = |chart: Chart, name: &str, drawn: &mut Profiles| -> Result<(), PlotError> {
-        if !selection.wants(name) {
+    levels
+}
+
+/// What every profiles figure of a run shares.
+struct Figures<'a> {
+    dir: &'a Path,
+    extensions: &'a [&'a str],
+    size: (u32, u32),
+    title: &'a str,
+    selection: &'a Selection,
+    levels: &'a [Level<'a>],
+    /// The cell size and the block's length (mm).
+    dx_mm: f64,
+    lx_mm: f64,
+}
+
+impl Figures<'_> {
+    /// Writes `chart` as the figure `name` in each format, when the selection wants it.
+    fn save(&self, chart: Chart, name: &str, drawn: &mut Profiles) -> Result<(), PlotError> {
+        if !self.selection.wants(name) {
             return Ok(());
         }
-        for extension in extensions {
-            let path = dir.join(format!("{name}.{extension}"));
+        for extension in self.extensions {
+            let path = self.dir.join(format!("{name}.{extension}"));
             chart.save(&path)?;
             drawn.files.push(path);
         }
         Ok(())
-    };
-    let family = |what: &str, y: &str, field: &str, z: f64, f: &dyn Fn(f64) -> f64| {
-        levels.iter().fold(
-            Chart::new(&format!("{what}: {title}"), "x (mm)", y)
-                .size(size.0, size.1)
-                .x_range(0.0, lx_mm)
+    }
+
+    /// A chart against `x` (mm): the profile `field` at height `z`, one curve per load,
+    /// its values through `f`.
+    fn family(
+        &self,
+        what: &str,
+        y: &str,
+        (field, z): (&str, f64),
+        f: &dyn Fn(f64) -> f64,
+    ) -> Chart {
+        self.levels.iter().fold(
+            Chart::new(&format!("{what}: {}", self.title), "x (mm)", y)
+                .size(self.size.0, self.size.1)
+                .x_range(0.0, self.lx_mm)
                 .colours(Colours::Ordered)
                 .legend(Corner::UpperRight),
-            |chart, level| chart.line(&level.label(), &level.curve(field, z, dx_mm, f)),
+            |chart, level| chart.line(&level.label(), &level.curve(field, z, self.dx_mm, f)),
         )
-    };
-    let micro = |v: f64| v * 1e6;
-    save(
-        family(
-            "Slip profiles ⟨u_x⟩_y",
-            "⟨u_x⟩_y (µm)",
-            "slip_m",
-            0.0,
-            &micro,
-        ),
-        SLIP_PROFILES_FIGURE,
-        &mut drawn,
-    )?;
-    let planes = record.options.profile_planes();
-    let lowest = planes.iter().copied().filter(|&z| z > 0.0).reduce(f64::min);
-    // Without one, the selection left the stress figures out (with a note).
-    let Some(z_p) = lowest else {
-        return Ok(drawn);
-    };
-    let mpa = |v: f64| v.abs() * 1e-6;
-    let at = format!("z_P = {} mm", short(z_p * 1e3));
-    save(
-        family(
-            &format!("|τ(x, z_P)|, {at}"),
-            "|τ_{xz}| (MPa)",
-            "shear_Pa",
-            z_p,
-            &mpa,
-        ),
-        SHEAR_PROFILES_FIGURE,
-        &mut drawn,
-    )?;
-    save(
-        family(
-            &format!("|σ(x, z_P)|, {at}"),
-            "|σ_{zz}| (MPa)",
-            "normal_Pa",
-            z_p,
-            &mpa,
-        ),
-        NORMAL_PROFILES_FIGURE,
-        &mut drawn,
-    )?;
-    let first = &levels[0];
-    let signed = |v: f64| v * 1e-6;
-    let mut chart = Chart::new(
-        &format!("Stresses at {}, {at}: {title}", first.label()),
-        "x (mm)",
-        "stress (MPa)",
-    )
-    .size(size.0, size.1)
-    .x_range(0.0, lx_mm)
-    .legend(Corner::UpperRight)
-    .line("|τ(x, z_P)|", &first.curve("shear_Pa", z_p, dx_mm, mpa))
-    .line("|σ(x, z_P)|", &first.curve("normal_Pa", z_p, dx_mm, mpa))
-    .line(
-        "τ_C(x, z_P) = |τ| - μ|σ|",
-        &first.curve("coulomb_of_means_Pa", z_p, dx_mm, signed),
-    );
-    if planes.contains(&0.0) {
-        chart = chart
-            .line(
-                "τ_C(x, 0), averaged over y",
-                &first.curve("mean_coulomb_Pa", 0.0, dx_mm, signed),
-            )
-            .style(Style::new().dashed());
-    } else if selection.wants(COULOMB_PROFILES_FIGURE) {
-        drawn.notes.push(
-            "coulomb_profiles: no τ_C at the interface (record the plane z = 0 in \
-             `profiles.planes`)"
-                .into(),
-        );
     }
-    save(chart, COULOMB_PROFILES_FIGURE, &mut drawn)?;
-    Ok(drawn)
+
+    /// The paper's Fig. 7 at the first recorded load: `|τ|`, `|σ|` and `τ_C` of the
+    /// y-averages on the plane `z_p` (described by `at`), and with `interface` `τ_C`
+    /// averaged over `y` at `z = 0` (else a note, when the figure is wanted).
+    fn coulomb(&self, (z_p, at): (f64, &str), interface: bool, drawn: &mut Profiles) -> Chart {
+        let first = &self.levels[0];
+        let mpa = |v: f64| v * 1e-6;
+        let chart = Chart::new(
+            &format!("Stresses at {}, {at}: {}", first.label(), self.title),
+            "x (mm)",
+            "stress (MPa)",
+        )
+        .size(self.size.0, self.size.1)
+        .x_range(0.0, self.lx_mm)
+        .legend(Corner::UpperRight)
+        .line(
+            "|τ(x, z_P)|",
+            &first.curve("shear_Pa", z_p, self.dx_mm, magnitude_mpa),
+        )
+        .line(
+            "|σ(x, z_P)|",
+            &first.curve("normal_Pa", z_p, self.dx_mm, magnitude_mpa),
+        )
+        .line(
+            "τ_C(x, z_P) = |τ| - μ|σ|",
+            &first.curve("coulomb_of_means_Pa", z_p, self.dx_mm, mpa),
+        );
+        if interface {
+            return chart
+                .line(
+                    "τ_C(x, 0), averaged over y",
+                    &first.curve("mean_coulomb_Pa", 0.0, self.dx_mm, mpa),
+                )
+                .style(Style::new().dashed());
+        }
+        if self.selection.wants(COULOMB_PROFILES_FIGURE) {
+            drawn.notes.push(
+                "coulomb_profiles: no τ_C at the interface (record the plane z = 0 in \
+                 `profiles.planes`)"
+                    .into(),
+            );
+        }
+        chart
+    }
 }
 
 /// `v` with up to four significant digits, trailing zeros dropped.
