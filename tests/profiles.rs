@@ -359,3 +359,82 @@ fn plot_draws_a_curve_per_recorded_load_and_the_fig7_stresses() {
     std::fs::remove_dir_all(&dir).unwrap();
     std::fs::remove_dir_all(&bare).unwrap();
 }
+
+/// `plot` reads `profiles.csv` through its checks: a damaged or foreign table is refused
+/// with its file (and line), and no profiles figure is drawn from it.
+#[cfg(feature = "plot")]
+#[test]
+fn plot_refuses_a_damaged_or_foreign_profiles_table() {
+    use precursors::plot::{draw_with_options, DrawOptions, Format, PlotError};
+    let dir = scratch("damaged");
+    let options = RunOptions::new().record_profiles(&[0.2, 0.5], &[PLANE]);
+    run(&builder().build().unwrap(), &options, &dir);
+    let path = dir.join("profiles.csv");
+    let good = std::fs::read_to_string(&path).unwrap();
+    let lines: Vec<&str> = good.lines().collect();
+    let edit = |line: usize, from: &str, to: &str| {
+        let mut l = lines.clone();
+        let changed = l[line].replacen(from, to, 1);
+        l[line] = &changed;
+        l.join("\n") + "\n"
+    };
+    let damages = [
+        ("a row cut", good[..good.len() - 40].to_string()),
+        ("a group left out", lines[..8].join("\n") + "\n"),
+        (
+            "another level",
+            edit(1, "2.000000000000e-1", "3.000000000000e-1"),
+        ),
+        ("a field out of order", edit(1, "slip_m", "shear_Pa")),
+        (
+            "another plane",
+            edit(4, "2.000000000000e-3", "3.000000000000e-3"),
+        ),
+        (
+            "a NaN",
+            edit(2, ",0.000000000000e0,", ",0.000000000000e0,NaN,"),
+        ),
+        ("another state", {
+            let event = lines[1].split(',').nth(1).unwrap();
+            edit(
+                1,
+                &format!(",{event},"),
+                &format!(",{},", event.parse::<usize>().unwrap() + 1),
+            )
+        }),
+    ];
+    let figures = DrawOptions::default()
+        .formats(&[Format::Svg])
+        .figures(["slip_profiles"]);
+    for (what, text) in &damages {
+        std::fs::write(&path, text).unwrap();
+        match draw_with_options(&dir, &figures) {
+            Err(PlotError::Core(Error::CorruptTable { path: Some(p), .. }))
+            | Err(PlotError::Core(Error::NonFiniteCell { path: p, .. })) => {
+                assert!(p.ends_with("profiles.csv"), "{what}: {p:?}")
+            }
+            other => panic!("{what}: {other:?}"),
+        }
+        assert!(!dir.join("slip_profiles.svg").exists(), "{what}");
+    }
+    // A table the run's scene does not record (another run's) is not drawn from: left
+    // out when not named, refused when named.
+    let plain = scratch("foreign");
+    run(&builder().build().unwrap(), &RunOptions::new(), &plain);
+    std::fs::write(plain.join("profiles.csv"), &good).unwrap();
+    let drawn = precursors::plot::draw(&plain, &[Format::Svg]).unwrap();
+    let names: Vec<String> = drawn
+        .files
+        .iter()
+        .map(|f| f.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert!(names.iter().all(|n| !n.contains("profiles")), "{names:?}");
+    let e = draw_with_options(&plain, &figures).unwrap_err();
+    assert!(matches!(&e, PlotError::FigureUnavailable { .. }), "{e:?}");
+    // Whole again: drawn.
+    std::fs::write(&path, &good).unwrap();
+    draw_with_options(&dir, &figures).unwrap();
+    assert!(dir.join("slip_profiles.svg").is_file());
+    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(&plain).unwrap();
+}
