@@ -293,6 +293,22 @@ enum Phase {
 /// assert_eq!(driver.interface().broken_count(), 40);
 /// # Ok::<(), precursors::Error>(())
 /// ```
+///
+/// # Reading the state
+///
+/// The fields of the current equilibrium exist from the first event on (the stable state
+/// at zero shear). Seven readers return a `Result` only to report [`Error::NotSolved`]
+/// before it, and never fail after it: [`Driver::normal_traction`],
+/// [`Driver::normal_displacement`], [`Driver::shear_traction`],
+/// [`Driver::shear_displacement`], [`Driver::mean_shear_displacement`],
+/// [`Driver::slip_profile`] and [`Driver::area_exceeds_nominal`]. The contact areas
+/// ([`Driver::real_contact_area`], [`Driver::cell_contact_area`],
+/// [`Driver::column_contact_area`], and the precursor lengths) can also overflow
+/// ([`Error::NonFinite`], under the paper's unbounded area law only);
+/// [`Driver::stresses`] needs probes; the others that return a `Result` take input that
+/// can be refused, or solve. "Before the first event" is `event_count() == 0`, also when
+/// the first step failed. (2.0 is to solve the zero-shear state when the driver is made
+/// and drop these `Result`s: docs/compatibility.md.)
 #[derive(Debug)]
 pub struct Driver {
     /// The scene it runs, shared (its set-up is read from it; checkpoints record its
@@ -321,11 +337,18 @@ pub struct Driver {
     avalanche_ruptures: usize,
     events: usize,
     stats: SolveStats,
-    /// The message of the error that failed the driver (repeated by later steps).
+    /// Why the driver failed: the message, with its causes, of the error that failed it
+    /// (repeated by later steps as [`Error::DriverFailed`]); set on resuming a failed
+    /// driver's checkpoint too.
     failure: Option<String>,
+    /// Whether the failure was returned to the caller, by [`Driver::step`] or the
+    /// iterator: from then on the iterator ends.
+    failure_returned: bool,
 }
 
-/// Where a [`Driver`]'s run stands ([`Driver::state`]).
+/// Where a [`Driver`]'s run stands ([`Driver::state`]): running, at global slip, or
+/// failed. A loop over the events ends at global slip and, when it skips errors, at a
+/// failure too; the state tells the two apart.
 ///
 /// ```
 /// use precursors::{RunState, Scene};
@@ -339,11 +362,17 @@ pub struct Driver {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum RunState {
-    /// Events are still to come ([`Driver::step`] returns the next).
+    /// Events are still to come ([`Driver::step`] returns the next). A new driver is
+    /// running: its first step solves the normal equilibrium at zero shear (before it,
+    /// [`Driver::event_count`] is 0 and the state's fields are not solved yet: see
+    /// [`Driver`] on reading the state).
     Running,
-    /// Global slip was returned: the run is over (`step` returns `Ok(None)`).
+    /// [`Event::GlobalSlip`] was returned: every spring is broken, the block slides, the
+    /// run is over (`step` returns `Ok(None)`).
     GlobalSlip,
-    /// A step failed: the run cannot go on (`step` returns [`Error::DriverFailed`]).
+    /// A step failed: the run cannot go on (`step` returns [`Error::DriverFailed`], with
+    /// the first error's message; the iterator has yielded the error and ends). A driver
+    /// resumed from a failed driver's checkpoint is failed too.
     Failed,
 }
 
@@ -427,6 +456,7 @@ impl Scene {
             events: 0,
             stats: SolveStats::default(),
             failure: None,
+            failure_returned: false,
         })
     }
 }
@@ -436,7 +466,7 @@ impl Driver {
     /// stays failed ([`Driver::state`]): every later call returns
     /// [`Error::DriverFailed`] with the first error's message, never `Ok(None)`, so a
     /// failed run cannot pass for a finished one. (As an iterator, the driver yields the
-    /// first error and then ends.)
+    /// failure once and then ends: [`Driver::next`](#method.next).)
     ///
     /// # Errors
     /// The first failure of a solve ([`Error::SolverNotConverged`],
@@ -452,11 +482,10 @@ impl Driver {
             match self.phase {
                 Phase::Done => return Ok(None),
                 Phase::Failed => {
+                    self.failure_returned = true;
                     return Err(Error::DriverFailed {
-                        reason: self.failure.clone().unwrap_or_else(|| {
-                            "it was resumed from the checkpoint of a failed driver".into()
-                        }),
-                    })
+                        reason: self.failure.clone().unwrap_or_default(),
+                    });
                 }
                 _ => {}
             }
@@ -466,6 +495,7 @@ impl Driver {
                 self.phase = Phase::Failed;
                 // With its causes: the reason is all a later step reports of them.
                 self.failure = Some(crate::error::Chain(&e).to_string());
+                self.failure_returned = true;
                 self.pending.clear();
                 return Err(e);
             }
@@ -474,6 +504,27 @@ impl Driver {
 
     /// Where the run stands: running, at global slip (returned by [`Driver::step`]), or
     /// failed (a step returned an error; `step` repeats it as [`Error::DriverFailed`]).
+    ///
+    /// ```
+    /// use precursors::solver::{Backend, SolverOptions};
+    /// use precursors::{Error, RunState, Scene};
+    /// // One conjugate-gradient iteration per solve cannot reach the tolerance.
+    /// let options = SolverOptions::default()
+    ///     .with_backend(Backend::Spectral)?
+    ///     .with_max_linear_iterations(1)?;
+    /// let scene = Scene::builder()
+    ///     .block(0.020, 0.004, 0.010)
+    ///     .normal_load(100.0)
+    ///     .solver_options(options)
+    ///     .build()?;
+    /// let mut driver = scene.driver()?;
+    /// assert_eq!(driver.state(), RunState::Running);
+    /// assert!(matches!(driver.step(), Err(Error::SolverNotConverged { .. })));
+    /// assert_eq!(driver.state(), RunState::Failed);
+    /// assert!(matches!(driver.step(), Err(Error::DriverFailed { .. })));
+    /// assert!(driver.next().is_none()); // the iterator has nothing more
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
     pub fn state(&self) -> RunState {
         match self.phase {
             Phase::Failed => RunState::Failed,
@@ -795,10 +846,16 @@ impl Driver {
 impl Iterator for Driver {
     type Item = Result<Event>;
 
+    /// The next event of [`Driver::step`]; `None` after [`Event::GlobalSlip`].
+    ///
+    /// A failure is yielded once, then the iterator ends (it is fused: `None` for ever):
+    /// a loop that goes on after an error must not spin. Once is once per driver: after
+    /// the error of a step that failed, or after [`Error::DriverFailed`] from
+    /// [`Driver::step`], `next` gives `None` at once; a driver resumed from a failed
+    /// driver's checkpoint yields [`Error::DriverFailed`] first. A loop that skips errors
+    /// ends at the failure as it ends at global slip: [`Driver::state`] tells them apart.
     fn next(&mut self) -> Option<Self::Item> {
-        // The first error is yielded (by the step that failed), then the iterator ends:
-        // a loop over the events that goes on after an error must not spin.
-        if self.phase == Phase::Failed {
+        if self.phase == Phase::Failed && self.failure_returned {
             return None;
         }
         self.step().transpose()

@@ -605,18 +605,7 @@ fn precursor_drop_threshold_is_refused_outside_zero_to_one() {
 /// iterator it yields the first error and ends. A run to global slip says so too.
 #[test]
 fn a_failed_driver_is_told_apart_from_a_finished_one() {
-    // One CG iteration cannot reach the tolerance: the first equilibrium fails.
-    let options = SolverOptions::default()
-        .with_backend(Backend::Spectral)
-        .unwrap()
-        .with_max_linear_iterations(1)
-        .unwrap();
-    let scene = Scene::builder()
-        .block(0.020, 0.004, 0.010)
-        .normal_load(100.0)
-        .solver_options(options)
-        .build()
-        .unwrap();
+    let scene = failing_scene();
     let mut driver = scene.driver().unwrap();
     assert_eq!(driver.state(), RunState::Running);
     let first = driver.step().unwrap_err();
@@ -649,4 +638,94 @@ fn a_failed_driver_is_told_apart_from_a_finished_one() {
     }
     assert_eq!(whole.state(), RunState::GlobalSlip);
     assert!(whole.step().unwrap().is_none());
+}
+
+/// The scene of the failure tests: one conjugate-gradient iteration per linear solve
+/// cannot reach the tolerance, so the first equilibrium fails.
+fn failing_scene() -> Scene {
+    let options = SolverOptions::default()
+        .with_backend(Backend::Spectral)
+        .unwrap()
+        .with_max_linear_iterations(1)
+        .unwrap();
+    Scene::builder()
+        .block(0.020, 0.004, 0.010)
+        .normal_load(100.0)
+        .solver_options(options)
+        .build()
+        .unwrap()
+}
+
+/// The iterator yields a failure once per driver (issue 45 item 1): not again after
+/// `step()` returned it, and once, as `DriverFailed`, from a driver resumed from a failed
+/// driver's checkpoint (which reports `Failed`, not a run still to go).
+#[test]
+fn the_iterator_yields_a_failure_once_also_after_a_resume() {
+    let scene = failing_scene();
+    let mut driver = scene.driver().unwrap();
+    assert!(driver.step().is_err());
+    assert!(driver.next().is_none(), "the error was returned by step()");
+    assert!(matches!(driver.step(), Err(Error::DriverFailed { .. })));
+    let checkpoint = driver.checkpoint();
+    let mut resumed = scene.resume(&checkpoint).unwrap();
+    assert_eq!(resumed.state(), RunState::Failed);
+    match resumed.next() {
+        Some(Err(Error::DriverFailed { reason })) => {
+            assert!(reason.contains("checkpoint of a failed driver"), "{reason}")
+        }
+        other => panic!("a resumed failed driver yielded {other:?}"),
+    }
+    assert!(resumed.next().is_none() && resumed.next().is_none());
+    assert!(matches!(resumed.step(), Err(Error::DriverFailed { .. })));
+    assert_eq!(resumed.state(), RunState::Failed);
+}
+
+/// The seven readers that return a `Result` only for `NotSolved` (the `Driver` docs'
+/// "Reading the state") fail before the first event, also when the first step failed,
+/// and succeed from the first event to global slip.
+#[test]
+fn readers_fail_only_before_the_first_event() {
+    fn unsolved(driver: &Driver) -> Vec<bool> {
+        let not_solved = |e: Error| matches!(e, Error::NotSolved { .. });
+        vec![
+            driver.normal_traction().is_err_and(not_solved),
+            driver.normal_displacement().is_err_and(not_solved),
+            driver.shear_traction().is_err_and(not_solved),
+            driver.shear_displacement().is_err_and(not_solved),
+            driver.mean_shear_displacement().is_err_and(not_solved),
+            driver.slip_profile().is_err_and(not_solved),
+            driver.area_exceeds_nominal().is_err_and(not_solved),
+        ]
+    }
+    let fresh = failing_scene().driver().unwrap();
+    assert_eq!((fresh.state(), fresh.event_count()), (RunState::Running, 0));
+    assert_eq!(unsolved(&fresh), [true; 7]);
+    let mut failed = fresh;
+    assert!(failed.step().is_err());
+    assert_eq!(
+        (failed.state(), failed.event_count()),
+        (RunState::Failed, 0)
+    );
+    assert_eq!(unsolved(&failed), [true; 7]);
+
+    let mut driver = Scene::builder()
+        .block(0.010, 0.004, 0.010)
+        .normal_load(100.0)
+        .seed(4)
+        .build()
+        .unwrap()
+        .driver()
+        .unwrap();
+    while driver.step().unwrap().is_some() {
+        let readers_ok = driver.normal_traction().is_ok()
+            && driver.normal_displacement().is_ok()
+            && driver.shear_traction().is_ok()
+            && driver.shear_displacement().is_ok()
+            && driver.mean_shear_displacement().is_ok()
+            && driver.slip_profile().is_ok()
+            && driver.area_exceeds_nominal().is_ok();
+        assert!(readers_ok, "event {}", driver.event_count());
+    }
+    assert_eq!(driver.state(), RunState::GlobalSlip);
+    assert!(driver.normal_traction().is_ok() && driver.slip_profile().is_ok());
 }

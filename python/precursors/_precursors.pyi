@@ -2,7 +2,7 @@
 
 import os
 from pathlib import Path
-from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, Iterator, List, Literal, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -120,6 +120,8 @@ class Driver:
     def scene(self) -> Scene: ...
     @property
     def event_count(self) -> int: ...
+    @property
+    def state(self) -> Literal["running", "global_slip", "failed"]: ...
     @property
     def force(self) -> float: ...
     @property

@@ -668,6 +668,19 @@ impl Driver {
         self.inner.event_count()
     }
 
+    /// Where the run stands: `"running"` (a new driver too), `"global_slip"` (the run is
+    /// over: `step()` returns `None`) or `"failed"` (a step raised: later steps raise
+    /// again, kind `DriverFailed`, with the first error's message).
+    #[getter]
+    fn state(&self) -> String {
+        match self.inner.state() {
+            precursors::RunState::Running => "running".into(),
+            precursors::RunState::GlobalSlip => "global_slip".into(),
+            precursors::RunState::Failed => "failed".into(),
+            other => format!("{other:?}").to_lowercase(),
+        }
+    }
+
     /// The shear force `F` (N).
     #[getter]
     fn force(&self) -> f64 {

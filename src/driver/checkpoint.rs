@@ -328,6 +328,10 @@ impl Scene {
         driver.phase = checkpoint.phase;
         driver.avalanche_ruptures = checkpoint.avalanche_ruptures;
         driver.events = checkpoint.events;
+        if checkpoint.phase == Phase::Failed {
+            // A checkpoint does not hold the failure's message (layout version 3).
+            driver.failure = Some("it was resumed from the checkpoint of a failed driver".into());
+        }
         driver.refresh_shear();
         Ok(driver)
     }

@@ -48,7 +48,8 @@ impl Driver {
     /// Normal traction `φ_z` per cell (Pa).
     ///
     /// # Errors
-    /// [`Error::NotSolved`] before the first [`Driver::step`].
+    /// [`Error::NotSolved`] before the first event ([`Driver::event_count`] 0), never
+    /// after it.
     pub fn normal_traction(&self) -> Result<&[f64]> {
         Ok(&self.normal()?.traction)
     }
@@ -56,7 +57,8 @@ impl Driver {
     /// Normal displacement `u_z` of the bottom face per cell (m).
     ///
     /// # Errors
-    /// [`Error::NotSolved`] before the first [`Driver::step`].
+    /// [`Error::NotSolved`] before the first event ([`Driver::event_count`] 0), never
+    /// after it.
     pub fn normal_displacement(&self) -> Result<&[f64]> {
         Ok(&self.normal()?.displacement)
     }
@@ -64,7 +66,8 @@ impl Driver {
     /// Shear traction `φ_x` per cell (Pa; negative where the springs resist `+x`).
     ///
     /// # Errors
-    /// [`Error::NotSolved`] before the first [`Driver::step`].
+    /// [`Error::NotSolved`] before the first event ([`Driver::event_count`] 0), never
+    /// after it.
     pub fn shear_traction(&self) -> Result<&[f64]> {
         self.response()?;
         Ok(&self.shear_traction)
@@ -73,7 +76,8 @@ impl Driver {
     /// Shear displacement `u_x` of the bottom face per cell (m).
     ///
     /// # Errors
-    /// [`Error::NotSolved`] before the first [`Driver::step`].
+    /// [`Error::NotSolved`] before the first event ([`Driver::event_count`] 0), never
+    /// after it.
     pub fn shear_displacement(&self) -> Result<&[f64]> {
         self.response()?;
         Ok(&self.shear_displacement)
@@ -83,7 +87,8 @@ impl Driver {
     /// when a top shear acts).
     ///
     /// # Errors
-    /// [`Error::NotSolved`] before the first [`Driver::step`].
+    /// [`Error::NotSolved`] before the first event ([`Driver::event_count`] 0), never
+    /// after it.
     pub fn mean_shear_displacement(&self) -> Result<f64> {
         Ok(self.force() * self.response()?.offset_per_newton)
     }
@@ -118,7 +123,8 @@ impl Driver {
     /// ```
     ///
     /// # Errors
-    /// [`Error::NotSolved`] before the first [`Driver::step`].
+    /// [`Error::NotSolved`] before the first event ([`Driver::event_count`] 0), never
+    /// after it.
     pub fn slip_profile(&self) -> Result<SlipProfile> {
         let nx = self.grid().nx();
         let ny = self.grid().ny() as f64;
@@ -184,7 +190,7 @@ impl Driver {
     ///
     /// # Errors
     /// [`Error::NoProbes`] when the driver has no probes ([`crate::SceneBuilder::probes`],
-    /// [`Driver::add_probes`]); [`Error::NotSolved`] before the first equilibrium (call
+    /// [`Driver::add_probes`]); [`Error::NotSolved`] before the first event (call
     /// [`Driver::step`] first).
     pub fn stresses(&self) -> Result<Stresses> {
         if self.probes.is_empty() {
@@ -228,8 +234,9 @@ impl Driver {
     /// ([`crate::SceneBuilder::area_law`]).
     ///
     /// # Errors
-    /// [`Error::NotSolved`] before the first [`Driver::step`]; [`Error::NonFinite`] on
-    /// overflow.
+    /// [`Error::NotSolved`] before the first event ([`Driver::event_count`] 0);
+    /// [`Error::NonFinite`] when a cell's area overflows (under [`crate::AreaLaw::Paper`]
+    /// only: [`crate::AreaLaw::Capped`] caps it).
     pub fn real_contact_area(&self) -> Result<f64> {
         Ok(self.cell_contact_area()?.iter().sum())
     }
@@ -260,7 +267,8 @@ impl Driver {
     /// true under [`crate::AreaLaw::Capped`].
     ///
     /// # Errors
-    /// As [`Driver::real_contact_area`] before the first event.
+    /// [`Error::NotSolved`] before the first event ([`Driver::event_count`] 0), never
+    /// after it (an overflowing area exceeds the nominal one: `Ok(true)`).
     pub fn area_exceeds_nominal(&self) -> Result<bool> {
         match self.real_contact_area() {
             Ok(total) => Ok(total > self.nominal_area() * (1.0 + NOMINAL_AREA_SLACK)),
@@ -324,7 +332,7 @@ impl Driver {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] for a `drop` outside `[0, 1)` (or NaN); as
-    /// [`Driver::real_contact_area`] before the first event.
+    /// [`Driver::real_contact_area`].
     pub fn precursor_length_with_threshold(&self, drop: f64) -> Result<f64> {
         if !(0.0..1.0).contains(&drop) {
             return Err(Error::InvalidParameter {
