@@ -1,53 +1,50 @@
-//! The grid-convergence study's figures and table (issue 28; docs/convergence.md).
+//! The grid-convergence study's analysis, figures and tables (issues 28 and 44;
+//! docs/convergence.md).
 //!
-//! Reads the study's merged sweep directories (`OUTDIR/convergence_*/`, each run with
-//! `precursors sweep` and merged with `precursors merge`; docs/sweep-format.md gives the
-//! tables' layout) and, per heights kind (the Gaussian surface, the paper's white noise),
-//! draws into `FIGDIR` (default `docs/figures`):
+//! Reads the study's merged sweep directories (every directory under `OUTDIR` that holds
+//! a `sweep.json`, each run with `precursors sweep` and merged with `precursors merge`;
+//! docs/sweep-format.md gives the tables' layout), groups them by heights (the Gaussian
+//! surface of each correlation length `ξ`, the paper's white noise), and per group:
 //!
-//! * `convergence_KIND_precursor_length.png`: ℓ/Lx against F/(μF_N), ensemble mean and
-//!   95 % band (`curves.csv`), one curve per cell size;
-//! * `convergence_KIND_area.png`: `log₁₀(A_R/A_R(0) − 1)` against F/(μF_N) (the area's
-//!   relative growth spans 1e-5 to 10 under the paper's area law: a log axis shows every
-//!   load), same layout;
-//! * `convergence_KIND_first_precursor.png`: the first-precursor load (below) of every run
-//!   against the cell size, with the per-size mean and 95 % band;
-//! * `convergence_KIND_avalanches.png`: the avalanche-size distribution
-//!   (`avalanches.csv`, pooled over the realizations) as the fraction of avalanches of at
-//!   least a given slipped area (ruptures x cell area, mm²: a rupture count means another
-//!   area at each cell size, and the cumulative form needs no bins), log-log, one set of
-//!   markers per cell size.
-//!
-//! and prints (the figures' paths go to stderr), per kind, a markdown table: cell size | N | runs | cores x time (the sum of
-//! the runs' `seconds.total` from their `meta.json`: one core per run) | the distance to
-//! the finest size of that kind (the largest difference of the ensemble means of ℓ/Lx
-//! over the loads of `curves.csv`, the same for `A_R/A_R(0)`, the difference of the mean
-//! first-precursor loads; and their mean and band) with the observed order `ln(d_coarse/d_h)/ln(h_coarse/h)`
-//! between consecutive sizes (`log2(d_2h/d_h)` for halved cells). Then, for each size of
-//! every other kind, at how many loads its ℓ/Lx band overlaps the finest Gaussian
-//! surface's (the question whether the paper's 1 mm white noise lies in the converged
-//! band).
-//!
-//! The first-precursor load of a run is `F/(μF_N)` at its first stable state with ℓ > 0
-//! (`curve.csv`): the first detachment at the trailing edge (the paper's "force needed to
-//! nucleate the first precursor"; ℓ is docs/model.md's, the region whose y-averaged area
-//! fell below its zero-shear value).
+//! * measures per run the observables with physical cut-offs ([`OBSERVABLES`]): the real
+//!   contact area at zero shear per nominal area, the loads at which the precursor length
+//!   ℓ first reaches 5 mm and 20 mm and the damage front 5 mm, and ℓ/Lx at
+//!   `F/(μF_N)` = 0.75;
+//! * takes the three finest grids (cell sizes in a constant ratio) and prints per
+//!   observable the ensemble means, the differences between consecutive grids, the
+//!   observed order `p`, the Richardson limit `Q∞` and the error left on the finest grid,
+//!   each with a 95 % percentile-bootstrap interval over the realizations
+//!   (`support/richardson.rs`). The Gaussian surface with one seed is the same surface on
+//!   every grid, so its grids are *paired*: the realizations are resampled together and
+//!   the differences are taken between grids on the same realization. The white noise is
+//!   a new surface on every grid: its grids are resampled apart;
+//! * draws into `FIGDIR` (default `docs/figures`) `convergence_SLUG_precursor_length.png`
+//!   (ℓ/Lx against `F/(μF_N)`, ensemble mean and 95 % band per cell size, `curves.csv`),
+//!   `convergence_SLUG_thresholds.png` (the threshold loads against the cell size with
+//!   their intervals, and the Richardson limit at zero cell size where the differences
+//!   shrink) and `convergence_SLUG_avalanches.png` (the fraction of avalanches at least as
+//!   large as a slipped area, ruptures x cell area, pooled over the realizations,
+//!   log-log).
 //!
 //! Run: `cargo run --release --features plot --example convergence_figures -- OUTDIR
-//! [FIGDIR] [--up-to LOAD]` (`--up-to` takes the distances over the loads up to LOAD
-//! only, and draws the area figure up to it, e.g. 0.9 to leave out the last load, where
-//! the area law makes `A_R` jump by orders of magnitude just before global slip). Its arithmetic is unit-tested:
-//! `cargo test --features plot --example convergence_figures`.
+//! [FIGDIR]`. Its arithmetic is unit-tested:
+//! `cargo test --release --features plot --example convergence_figures`.
 
 #[path = "support/report.rs"]
 mod report;
+#[path = "support/richardson.rs"]
+mod richardson;
 
-use precursors::plot::{Chart, Corner};
-use precursors::sweep::mean_band;
+use precursors::plot::{Chart, Colours, Corner, Style};
 use report::AtPath;
+use richardson::{estimate, Estimate, Interval};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+
+/// Bootstrap resamples per estimate, and the stream's seed (fixed: the tables repeat).
+const RESAMPLES: usize = 4000;
+const BOOTSTRAP_SEED: u64 = 44;
 
 fn main() -> ExitCode {
     report::report(run())
@@ -130,103 +127,85 @@ impl Table {
     }
 }
 
-/// [`mean_band`] as `(mean, lo, hi)`.
-fn band(x: &[f64]) -> (f64, f64, f64) {
-    let b = mean_band(x);
-    (b.mean, b.lo, b.hi)
-}
+/// The observables of one run, each with a physical cut-off rather than a one-cell event.
+const OBSERVABLES: [&str; 5] = [
+    "A_R(0)/(Lx·Ly)",
+    "F/(μF_N) at ℓ ≥ 5 mm",
+    "F/(μF_N) at ℓ ≥ 20 mm",
+    "F/(μF_N) at front ≥ 5 mm",
+    "ℓ/Lx at F/(μF_N) = 0.75",
+];
 
-/// Two loads of `curves.csv` are the same grid load (written with 2 decimals).
-fn same_load(a: f64, b: f64) -> bool {
-    (a - b).abs() < 1e-9
-}
+/// The precursor-length and damage-front thresholds (m) and the load of the ℓ/Lx reading.
+const ELL_SHORT: f64 = 5e-3;
+const ELL_LONG: f64 = 20e-3;
+const FRONT: f64 = 5e-3;
+const READING_LOAD: f64 = 0.75;
 
-/// The largest `|a - b|` of two curves `(load, mean)` over the loads they share up to
-/// `up_to` (both values finite); `None` when they share no such load.
-fn max_difference(a: &[(f64, f64)], b: &[(f64, f64)], up_to: f64) -> Option<f64> {
-    let mut worst: Option<f64> = None;
-    for &(fa, ya) in a {
-        if fa > up_to + 1e-9 || !ya.is_finite() {
-            continue;
-        }
-        if let Some(&(_, yb)) = b
-            .iter()
-            .find(|(fb, yb)| same_load(fa, *fb) && yb.is_finite())
-        {
-            let d = (ya - yb).abs();
-            worst = Some(worst.map_or(d, |w: f64| w.max(d)));
-        }
-    }
-    worst
-}
-
-/// The observed order of convergence from the distances to the reference at a coarse and
-/// a fine cell size: `ln(d_coarse/d_fine)/ln(h_coarse/h_fine)` (`log2(d_2h/d_h)` when the
-/// cell is halved). `None` when a distance is zero or not finite or the sizes are not
-/// ordered (no order can be read).
-fn observed_order(d_coarse: f64, d_fine: f64, h_coarse: f64, h_fine: f64) -> Option<f64> {
-    let ok = |x: f64| x.is_finite() && x > 0.0;
-    if ok(d_coarse) && ok(d_fine) && ok(h_coarse) && ok(h_fine) && h_coarse > h_fine {
-        Some((d_coarse / d_fine).ln() / (h_coarse / h_fine).ln())
-    } else {
-        None
-    }
-}
-
-/// The first-precursor load of a run: `F/(μF_N)` at the first row of its `curve.csv`
-/// (the stable states) with ℓ > 0; `None` if there is none.
-fn first_precursor_load(curve: &Table) -> Result<Option<f64>, Box<dyn std::error::Error>> {
-    let load = curve.numbers("force_over_mu_FN")?;
-    let ell = curve.numbers("precursor_length_m")?;
-    Ok(load
+/// The load `F/(μF_N)` at the first stable state whose `value` reaches `threshold`
+/// (rows in the order of the run); NaN if none does.
+fn first_reaching(loads: &[f64], values: &[f64], threshold: f64) -> f64 {
+    loads
         .iter()
-        .zip(&ell)
-        .find(|(_, &l)| l > 0.0)
-        .map(|(&f, _)| f))
+        .zip(values)
+        .find(|(_, &v)| v >= threshold)
+        .map_or(f64::NAN, |(&f, _)| f)
 }
 
-/// At how many of the loads two banded curves `(load, lo, hi)` share, their bands
-/// overlap; and how many loads they share with finite bands.
-fn overlapping_loads(a: &[(f64, f64, f64)], b: &[(f64, f64, f64)]) -> (usize, usize) {
-    let (mut overlap, mut shared) = (0, 0);
-    for &(fa, la, ha) in a {
-        let found = b.iter().find(|(fb, _, _)| same_load(fa, *fb));
-        if let Some(&(_, lb, hb)) = found {
-            if [la, ha, lb, hb].iter().all(|v| v.is_finite()) {
-                shared += 1;
-                if la <= hb && lb <= ha {
-                    overlap += 1;
-                }
-            }
-        }
-    }
-    (overlap, shared)
+/// The value in effect at `load`: that of the last stable state at or below it (the
+/// contact map's rule); NaN before the first state.
+fn value_at(loads: &[f64], values: &[f64], load: f64) -> f64 {
+    loads
+        .iter()
+        .zip(values)
+        .take_while(|(&f, _)| f <= load + 1e-12)
+        .last()
+        .map_or(f64::NAN, |(_, &v)| v)
 }
 
-/// `(mean, lo, hi)`: an ensemble mean and its 95 % band.
-type Band = (f64, f64, f64);
+/// [`OBSERVABLES`] of one run from its `curve.csv` and `fronts.csv`.
+fn observe(
+    curve: &Table,
+    fronts: &Table,
+    nominal_area: f64,
+    lx: f64,
+) -> Result<[f64; 5], Box<dyn std::error::Error>> {
+    let loads = curve.numbers("force_over_mu_FN")?;
+    let ell = curve.numbers("precursor_length_m")?;
+    let area = curve.numbers("real_contact_area_m2")?;
+    let front_loads = fronts.numbers("force_over_mu_FN")?;
+    let front = fronts.numbers("damage_front_m")?;
+    let ell_over_lx: Vec<f64> = ell.iter().map(|l| l / lx).collect();
+    Ok([
+        area.first().map_or(f64::NAN, |a| a / nominal_area),
+        first_reaching(&loads, &ell, ELL_SHORT),
+        first_reaching(&loads, &ell, ELL_LONG),
+        first_reaching(&front_loads, &front, FRONT),
+        value_at(&loads, &ell_over_lx, READING_LOAD),
+    ])
+}
 
 /// One merged sweep directory: one cell size of one heights kind.
 struct Study {
-    /// The heights' description, e.g. `Gaussian surface, ξ = 3 mm`.
+    /// The heights' description, e.g. `Gaussian surface, ξ = 8 mm`.
     heights: String,
-    /// For file names: `surface`, `white` or the heights kind.
+    /// For file names: `xi8`, `white`, ...
     slug: String,
+    /// Correlation length (m); `None` for white noise.
+    xi: Option<f64>,
     /// Cell size along x and y (m).
     dx: f64,
     dy: f64,
     cells: usize,
-    runs: usize,
     runs_incomplete: usize,
     core_seconds: f64,
-    /// `curves.csv`: load, then (mean, lo, hi) of ℓ/Lx and of `A_R/A_R(0)`.
+    /// `curves.csv`: load, then (mean, lo, hi) of ℓ/Lx.
     loads: Vec<f64>,
     ell: Vec<(f64, f64, f64)>,
-    area: Vec<(f64, f64, f64)>,
-    /// The first-precursor load of each complete run with one.
-    first: Vec<f64>,
     /// `avalanches.csv`: (ruptures, count).
     avalanches: Vec<(f64, f64)>,
+    /// Per realization: its seed and [`OBSERVABLES`].
+    observed: BTreeMap<usize, (String, [f64; 5])>,
 }
 
 impl Study {
@@ -236,26 +215,6 @@ impl Study {
         } else {
             format!("{} x {} mm", mm(self.dx), mm(self.dy))
         }
-    }
-
-    fn ell_means(&self) -> Vec<(f64, f64)> {
-        self.loads
-            .iter()
-            .zip(&self.ell)
-            .map(|(&f, e)| (f, e.0))
-            .collect()
-    }
-
-    fn area_means(&self) -> Vec<(f64, f64)> {
-        self.loads
-            .iter()
-            .zip(&self.area)
-            .map(|(&f, a)| (f, a.0))
-            .collect()
-    }
-
-    fn first_mean(&self) -> f64 {
-        band(&self.first).0
     }
 }
 
@@ -274,11 +233,50 @@ fn number(v: &serde_json::Value, path: &[&str], file: &Path) -> Result<f64, Stri
         .ok_or_else(|| format!("{}: no number at `{}`", file.display(), path.join(".")))
 }
 
+fn read_json(path: &Path) -> Result<serde_json::Value, Box<dyn std::error::Error>> {
+    Ok(serde_json::from_str(&std::fs::read_to_string(path).at("read", path)?).at("parse", path)?)
+}
+
+/// The cell sizes `(dx, dy, nx, ny)` of a sweep's base scene.
+fn cells(base: &serde_json::Value, file: &Path) -> Result<(f64, f64, f64, f64), String> {
+    let lx = number(base, &["block", "lx"], file)?;
+    let ly = number(base, &["block", "ly"], file)?;
+    match base["cells"]["kind"].as_str() {
+        Some("size") => {
+            let dx = number(base, &["cells", "dx"], file)?;
+            let dy = number(base, &["cells", "dy"], file)?;
+            Ok((dx, dy, (lx / dx).round(), (ly / dy).round()))
+        }
+        Some("count") => {
+            let nx = number(base, &["cells", "nx"], file)?;
+            let ny = number(base, &["cells", "ny"], file)?;
+            Ok((lx / nx, ly / ny, nx, ny))
+        }
+        other => Err(format!("{}: cells kind {other:?}", file.display())),
+    }
+}
+
+/// The heights' description, file slug and correlation length.
+fn heights(base: &serde_json::Value, file: &Path) -> Result<(String, String, Option<f64>), String> {
+    Ok(
+        match base["heights"]["kind"].as_str().unwrap_or("gaussian") {
+            "gaussian" => ("white noise (the paper's)".into(), "white".into(), None),
+            "gaussian_surface" => {
+                let xi = number(base, &["heights", "correlation_length"], file)?;
+                (
+                    format!("Gaussian surface, ξ = {} mm", mm(xi)),
+                    format!("xi{}", mm(xi)),
+                    Some(xi),
+                )
+            }
+            other => (other.replace('_', " "), other.to_owned(), None),
+        },
+    )
+}
+
 fn read_study(dir: &Path) -> Result<Study, Box<dyn std::error::Error>> {
     let sweep_path = dir.join("sweep.json");
-    let sweep: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&sweep_path).at("read", &sweep_path)?)
-            .at("parse", &sweep_path)?;
+    let sweep = read_json(&sweep_path)?;
     if sweep["axes"].as_array().is_some_and(|a| !a.is_empty()) {
         return Err(format!(
             "{}: a sweep with axes; the study's sweeps have one point each",
@@ -287,33 +285,10 @@ fn read_study(dir: &Path) -> Result<Study, Box<dyn std::error::Error>> {
         .into());
     }
     let base = &sweep["base"];
+    let (dx, dy, nx, ny) = cells(base, &sweep_path)?;
+    let (heights, slug, xi) = heights(base, &sweep_path)?;
     let lx = number(base, &["block", "lx"], &sweep_path)?;
-    let ly = number(base, &["block", "ly"], &sweep_path)?;
-    let (dx, dy, nx, ny) = match base["cells"]["kind"].as_str() {
-        Some("size") => {
-            let dx = number(base, &["cells", "dx"], &sweep_path)?;
-            let dy = number(base, &["cells", "dy"], &sweep_path)?;
-            (dx, dy, (lx / dx).round(), (ly / dy).round())
-        }
-        Some("count") => {
-            let nx = number(base, &["cells", "nx"], &sweep_path)?;
-            let ny = number(base, &["cells", "ny"], &sweep_path)?;
-            (lx / nx, ly / ny, nx, ny)
-        }
-        other => return Err(format!("{}: cells kind {other:?}", sweep_path.display()).into()),
-    };
-    let kind = base["heights"]["kind"].as_str().unwrap_or("gaussian");
-    let (heights, slug) = match kind {
-        "gaussian" => ("white noise (the paper's)".to_owned(), "white".to_owned()),
-        "gaussian_surface" => {
-            let xi = number(base, &["heights", "correlation_length"], &sweep_path)?;
-            (
-                format!("Gaussian surface, ξ = {} mm", mm(xi)),
-                "surface".to_owned(),
-            )
-        }
-        other => (other.replace('_', " "), other.to_owned()),
-    };
+    let nominal_area = lx * number(base, &["block", "ly"], &sweep_path)?;
 
     let merged = dir.join("curves.csv");
     if !merged.exists() {
@@ -326,14 +301,12 @@ fn read_study(dir: &Path) -> Result<Study, Box<dyn std::error::Error>> {
     }
     let curves = Table::read(&merged)?;
     let loads = curves.numbers("force_over_mu_FN")?;
-    let triple = |name: &str| -> Result<Vec<Band>, Box<dyn std::error::Error>> {
-        let m = curves.numbers(&format!("{name}_mean"))?;
-        let lo = curves.numbers(&format!("{name}_lo"))?;
-        let hi = curves.numbers(&format!("{name}_hi"))?;
-        Ok((0..m.len()).map(|k| (m[k], lo[k], hi[k])).collect())
-    };
-    let ell = triple("precursor_over_Lx")?;
-    let area = triple("area_ratio")?;
+    let (m, lo, hi) = (
+        curves.numbers("precursor_over_Lx_mean")?,
+        curves.numbers("precursor_over_Lx_lo")?,
+        curves.numbers("precursor_over_Lx_hi")?,
+    );
+    let ell = (0..m.len()).map(|k| (m[k], lo[k], hi[k])).collect();
 
     let av = Table::read(&dir.join("avalanches.csv"))?;
     let avalanches = av
@@ -346,7 +319,9 @@ fn read_study(dir: &Path) -> Result<Study, Box<dyn std::error::Error>> {
     let points = runs_table.numbers("point")?;
     let realizations = runs_table.numbers("realization")?;
     let slips = runs_table.numbers("slip_over_mu_FN")?;
-    let (mut runs, mut runs_incomplete, mut core_seconds, mut first) = (0, 0, 0.0, Vec::new());
+    let seeds = runs_table.column("seed")?;
+    let (mut runs_incomplete, mut core_seconds) = (0, 0.0);
+    let mut observed = BTreeMap::new();
     for k in 0..points.len() {
         if !slips[k].is_finite() {
             runs_incomplete += 1;
@@ -357,68 +332,55 @@ fn read_study(dir: &Path) -> Result<Study, Box<dyn std::error::Error>> {
             points[k] as usize, realizations[k] as usize
         ));
         let meta_path = run.join("meta.json");
-        let meta: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&meta_path).at("read", &meta_path)?)
-                .at("parse", &meta_path)?;
-        core_seconds += number(&meta, &["seconds", "total"], &meta_path)?;
-        if let Some(f) = first_precursor_load(&Table::read(&run.join("curve.csv"))?)? {
-            first.push(f);
-        }
-        runs += 1;
+        core_seconds += number(&read_json(&meta_path)?, &["seconds", "total"], &meta_path)?;
+        let values = observe(
+            &Table::read(&run.join("curve.csv"))?,
+            &Table::read(&run.join("fronts.csv"))?,
+            nominal_area,
+            lx,
+        )?;
+        let seed = runs_table.rows[k][seeds].clone();
+        observed.insert(realizations[k] as usize, (seed, values));
     }
     Ok(Study {
         heights,
         slug,
+        xi,
         dx,
         dy,
         cells: (nx * ny) as usize,
-        runs,
         runs_incomplete,
         core_seconds,
         loads,
         ell,
-        area,
-        first,
         avalanches,
+        observed,
     })
 }
 
 struct Args {
     out: PathBuf,
     figures: PathBuf,
-    up_to: f64,
 }
 
 fn args() -> Result<Args, Box<dyn std::error::Error>> {
-    let usage = "usage: convergence_figures OUTDIR [FIGDIR] [--up-to LOAD]";
-    let mut positional = Vec::new();
-    let mut up_to = f64::INFINITY;
-    let mut argv = std::env::args().skip(1);
-    while let Some(a) = argv.next() {
-        if a == "--up-to" {
-            let v = argv.next().ok_or(usage)?;
-            up_to = v
-                .parse::<f64>()
-                .ok()
-                .filter(|x| *x > 0.0 && *x <= 1.0)
-                .ok_or_else(|| format!("--up-to {v}: a load F/(μF_N) in (0, 1] is needed"))?;
-        } else if a.starts_with("--") {
-            return Err(format!("unknown option {a}; {usage}").into());
-        } else {
-            positional.push(PathBuf::from(a));
-        }
-    }
+    let usage = "usage: convergence_figures OUTDIR [FIGDIR]";
+    let positional: Vec<PathBuf> = std::env::args().skip(1).map(PathBuf::from).collect();
     if positional.is_empty() || positional.len() > 2 {
         return Err(usage.into());
     }
-    let figures = positional
-        .get(1)
-        .cloned()
-        .unwrap_or_else(|| PathBuf::from("docs/figures"));
+    if let Some(flag) = positional
+        .iter()
+        .find(|p| p.to_string_lossy().starts_with("--"))
+    {
+        return Err(format!("unknown option {}; {usage}", flag.display()).into());
+    }
     Ok(Args {
-        out: positional.swap_remove(0),
-        figures,
-        up_to,
+        out: positional[0].clone(),
+        figures: positional
+            .get(1)
+            .cloned()
+            .unwrap_or_else(|| PathBuf::from("docs/figures")),
     })
 }
 
@@ -427,21 +389,16 @@ fn run() -> report::Outcome {
     let mut dirs: Vec<PathBuf> = std::fs::read_dir(&args.out)
         .at("list", &args.out)?
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.is_dir()
-                && p.file_name()
-                    .and_then(|n| n.to_str())
-                    .is_some_and(|n| n.starts_with("convergence_"))
-        })
+        .filter(|p| p.join("sweep.json").is_file())
         .collect();
     dirs.sort();
     if dirs.is_empty() {
-        return Err(format!("{} holds no convergence_* directory", args.out.display()).into());
+        return Err(format!("{} holds no sweep directory", args.out.display()).into());
     }
     report::writable_dir(&args.figures)?;
 
-    // Per heights kind, the sizes from the coarsest to the finest.
-    let mut kinds: BTreeMap<String, Vec<Study>> = BTreeMap::new();
+    // Per heights, the sizes from the coarsest to the finest.
+    let mut groups: BTreeMap<String, Vec<Study>> = BTreeMap::new();
     for dir in &dirs {
         let study = read_study(dir)?;
         if study.runs_incomplete > 0 {
@@ -451,49 +408,144 @@ fn run() -> report::Outcome {
                 study.runs_incomplete
             );
         }
-        kinds.entry(study.slug.clone()).or_default().push(study);
+        groups.entry(study.slug.clone()).or_default().push(study);
     }
-    for studies in kinds.values_mut() {
+    for studies in groups.values_mut() {
         studies.sort_by(|a, b| b.dx.total_cmp(&a.dx));
-        figures(studies, &args.figures, args.up_to)?;
-        table(studies, args.up_to);
-    }
-    if let Some(surface) = kinds.get("surface") {
-        let finest = surface.last().expect("a kind holds a study");
-        for (slug, studies) in &kinds {
-            if slug == "surface" {
-                continue;
-            }
-            println!(
-                "ℓ/Lx bands of {} against the finest {} ({}):\n",
-                studies[0].heights,
-                finest.heights,
-                finest.label()
-            );
-            println!("| cell size | loads where the 95 % bands overlap | largest Δ ℓ/Lx |");
-            println!("| --- | --- | --- |");
-            for s in studies {
-                let (overlap, shared) = overlapping_loads(
-                    &bands_with_loads(&s.loads, &s.ell, args.up_to),
-                    &bands_with_loads(&finest.loads, &finest.ell, args.up_to),
-                );
-                let d = max_difference(&s.ell_means(), &finest.ell_means(), args.up_to);
-                println!("| {} | {overlap} of {shared} | {} |", s.label(), fmt(d));
-            }
-            println!();
+        let finest: &[Study] = &studies[studies.len().saturating_sub(3)..];
+        cost_table(studies);
+        let estimates = estimates(finest);
+        if let Some(estimates) = &estimates {
+            estimate_table(finest, estimates);
         }
+        figures(studies, estimates.as_deref(), &args.figures)?;
     }
     Ok(())
 }
 
-/// `(load, lo, hi)` of a banded curve at the loads up to `up_to`.
-fn bands_with_loads(loads: &[f64], b: &[(f64, f64, f64)], up_to: f64) -> Vec<(f64, f64, f64)> {
-    loads
+/// Whether the grids are paired: the same surface kind with the same seed per
+/// realization on each (the Gaussian surface is then the same surface on every grid).
+fn paired(studies: &[Study]) -> bool {
+    studies[0].xi.is_some()
+        && studies[0].observed.iter().all(|(k, (seed, _))| {
+            studies[1..]
+                .iter()
+                .all(|s| s.observed.get(k).is_none_or(|(other, _)| other == seed))
+        })
+}
+
+/// The cell ratio of three grids if constant (within 1 %) along x.
+fn constant_ratio(studies: &[Study]) -> Option<f64> {
+    let (r1, r2) = (studies[0].dx / studies[1].dx, studies[1].dx / studies[2].dx);
+    ((r1 - r2).abs() < 0.01 * r1 && r1 > 1.0).then_some(r1)
+}
+
+/// The estimates of [`OBSERVABLES`] on the three grids; `None` (with a note) when the
+/// group has fewer than three or their ratio is not constant.
+fn estimates(studies: &[Study]) -> Option<Vec<Option<Estimate>>> {
+    let name = &studies[0].heights;
+    if studies.len() < 3 {
+        eprintln!("note: {name}: fewer than three cell sizes, no extrapolation");
+        return None;
+    }
+    let Some(r) = constant_ratio(studies) else {
+        eprintln!("note: {name}: the cell sizes are not in a constant ratio, no extrapolation");
+        return None;
+    };
+    let paired = paired(studies);
+    let realizations = studies
         .iter()
-        .zip(b)
-        .filter(|(&f, _)| f <= up_to + 1e-9)
-        .map(|(&f, t)| (f, t.1, t.2))
-        .collect()
+        .flat_map(|s| s.observed.keys().copied())
+        .max()
+        .map_or(0, |k| k + 1);
+    Some(
+        (0..OBSERVABLES.len())
+            .map(|q| {
+                let observed: [Vec<f64>; 3] = std::array::from_fn(|g| {
+                    (0..realizations)
+                        .map(|k| studies[g].observed.get(&k).map_or(f64::NAN, |o| o.1[q]))
+                        .collect()
+                });
+                estimate(&observed, r, paired, RESAMPLES, BOOTSTRAP_SEED + q as u64)
+            })
+            .collect(),
+    )
+}
+
+/// A number with three significant figures.
+fn sig(x: f64) -> String {
+    if !x.is_finite() {
+        return "—".into();
+    }
+    if x == 0.0 || (1e-2..1e3).contains(&x.abs()) {
+        let decimals = (2 - x.abs().log10().floor() as i32).clamp(0, 4) as usize;
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.2e}")
+    }
+}
+
+fn interval(i: Option<Interval>) -> String {
+    match i {
+        Some(i) => format!("{} [{}, {}]", sig(i.value), sig(i.lo), sig(i.hi)),
+        None => "—".into(),
+    }
+}
+
+fn cost_table(studies: &[Study]) {
+    println!("### {}: cost\n", studies[0].heights);
+    println!("| cell size | N | complete runs | CPU time of the runs (s) |");
+    println!("| --- | --- | --- | --- |");
+    for s in studies {
+        println!(
+            "| {} | {} | {} | {:.0} |",
+            s.label(),
+            s.cells,
+            s.observed.len(),
+            s.core_seconds
+        );
+    }
+    println!();
+}
+
+fn estimate_table(studies: &[Study], estimates: &[Option<Estimate>]) {
+    let paired = if paired(studies) {
+        "paired: differences on the same realization"
+    } else {
+        "unpaired: a new surface on every grid"
+    };
+    let labels: Vec<String> = studies.iter().map(Study::label).collect();
+    println!(
+        "### {}: cells {}, {}; {paired}\n",
+        studies[0].heights,
+        labels.join(", "),
+        "means and 95 % bootstrap intervals"
+    );
+    println!(
+        "| observable | {} | {} | {} | Δ {}→{} | Δ {}→{} | order p | resolved | limit h → 0 | error at {} |",
+        labels[0], labels[1], labels[2], labels[0], labels[1], labels[1], labels[2], labels[2]
+    );
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    for (name, e) in OBSERVABLES.iter().zip(estimates) {
+        let Some(e) = e else {
+            println!("| {name} | fewer than two realizations reach it | | | | | | | | |");
+            continue;
+        };
+        println!(
+            "| {name} ({} runs) | {} | {} | {} | {} | {} | {} | {:.0} % | {} | {} |",
+            e.realizations[2],
+            interval(Some(e.means[0])),
+            interval(Some(e.means[1])),
+            interval(Some(e.means[2])),
+            interval(Some(e.differences[0])),
+            interval(Some(e.differences[1])),
+            interval(e.order),
+            100.0 * e.resolved,
+            interval(e.limit),
+            interval(e.finest_error),
+        );
+    }
+    println!();
 }
 
 /// The fraction of avalanches of at least each size, from `(size, count)` rows: the
@@ -512,80 +564,21 @@ fn at_least(rows: &[(f64, f64)]) -> Vec<(f64, f64)> {
         .collect()
 }
 
-fn fmt(x: Option<f64>) -> String {
-    match x {
-        Some(0.0) => "0".into(),
-        Some(v) if v.is_finite() => format!("{v:.3e}"),
-        _ => "—".into(),
-    }
-}
-
-fn table(studies: &[Study], up_to: f64) {
-    let finest = studies.last().expect("a kind holds a study");
-    let loads = if up_to.is_finite() {
-        format!("loads F/(μF_N) ≤ {up_to}")
-    } else {
-        "all loads of curves.csv".to_owned()
-    };
-    println!(
-        "{}: distance to the finest ({}), {loads}\n",
-        finest.heights,
-        finest.label()
-    );
-    println!(
-        "| cell size | N | runs | cores x time (s) | max Δ ℓ/Lx | order | max Δ A_R/A_R(0) | \
-         order | Δ first-precursor load | order | first-precursor load, mean [95 % band] |"
-    );
-    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
-    let distances: Vec<[Option<f64>; 3]> = studies
-        .iter()
-        .map(|s| {
-            [
-                max_difference(&s.ell_means(), &finest.ell_means(), up_to),
-                max_difference(&s.area_means(), &finest.area_means(), up_to),
-                Some((s.first_mean() - finest.first_mean()).abs()).filter(|d| d.is_finite()),
-            ]
-        })
-        .collect();
-    for (k, s) in studies.iter().enumerate() {
-        let mut cells = vec![
-            s.label(),
-            s.cells.to_string(),
-            s.runs.to_string(),
-            format!("{:.1}", s.core_seconds),
-        ];
-        for (q, &distance) in distances[k].iter().enumerate() {
-            cells.push(fmt(distance));
-            let order = match (k.checked_sub(1), distance) {
-                (Some(c), Some(d)) => distances[c][q]
-                    .and_then(|dc| observed_order(dc, d, studies[c].dx, s.dx))
-                    .map(|p| format!("{p:.2}"))
-                    .unwrap_or_else(|| "—".into()),
-                _ => "—".into(),
-            };
-            cells.push(order);
-        }
-        let (m, lo, hi) = band(&s.first);
-        cells.push(format!(
-            "{m:.4} [{lo:.4}, {hi:.4}] ({} runs)",
-            s.first.len()
-        ));
-        println!("| {} |", cells.join(" | "));
-    }
-    println!();
-}
-
-fn figures(studies: &[Study], dir: &Path, up_to: f64) -> report::Outcome {
+fn figures(
+    studies: &[Study],
+    estimates: Option<&[Option<Estimate>]>,
+    dir: &Path,
+) -> report::Outcome {
     let heights = &studies[0].heights;
-    let slug = &studies[0].slug;
-    let path = |name: &str| dir.join(format!("convergence_{slug}_{name}.png"));
+    let path = |name: &str| dir.join(format!("convergence_{}_{name}.png", studies[0].slug));
 
     let mut ell = Chart::new(
-        &format!("Precursor length, {heights}: mean and 95 % band per cell size"),
+        &format!("Precursor length, {heights}"),
         "F/(μF_N)",
-        "ℓ/Lx",
+        "ℓ/Lx (ensemble mean, 95 % band)",
     )
     .x_range(0.0, 1.0)
+    .colours(Colours::Ordered)
     .legend(Corner::UpperLeft);
     for s in studies {
         let rows: Vec<_> = s
@@ -594,77 +587,75 @@ fn figures(studies: &[Study], dir: &Path, up_to: f64) -> report::Outcome {
             .zip(&s.ell)
             .map(|(&f, &(m, lo, hi))| (f, m, lo.max(0.0), hi.min(1.0)))
             .collect();
-        ell = ell.band(&format!("{} ({} runs)", s.label(), s.runs), &rows);
+        ell = ell.band(&format!("{} ({} runs)", s.label(), s.observed.len()), &rows);
     }
-    let p = path("precursor_length");
-    ell.save(&p)?;
-    eprintln!("wrote {}", p.display());
+    save(ell, &path("precursor_length"))?;
 
-    // The relative growth of the real contact area, on a log axis, up to `--up-to` (the
-    // area law's jump just before slip would set the axis otherwise).
-    let log_growth = |x: f64| if x > 1.0 { (x - 1.0).log10() } else { f64::NAN };
-    let mut area = Chart::new(
-        &format!("Real contact area, {heights}: mean and 95 % band per cell size"),
-        "F/(μF_N)",
-        "log₁₀(A_R/A_R(0) − 1)",
-    )
-    .x_range(0.0, up_to.min(1.0))
-    .legend(Corner::UpperLeft);
-    for s in studies {
-        let rows: Vec<_> = s
-            .loads
-            .iter()
-            .zip(&s.area)
-            .filter(|(&f, _)| f <= up_to + 1e-9)
-            .map(|(&f, &(m, lo, hi))| (f, log_growth(m), log_growth(lo), log_growth(hi)))
-            .collect();
-        area = area.band(&s.label(), &rows);
+    if let Some(estimates) = estimates {
+        thresholds(
+            &studies[studies.len() - 3..],
+            estimates,
+            &path("thresholds"),
+        )?;
     }
-    let p = path("area");
-    area.save(&p)?;
-    eprintln!("wrote {}", p.display());
-
-    let mut first = Chart::new(
-        &format!("First precursor (ℓ > 0), {heights}"),
-        "cell size Δx (mm)",
-        "F/(μF_N)",
-    )
-    .legend(Corner::UpperRight);
-    let band: Vec<_> = studies
-        .iter()
-        .map(|s| {
-            let (m, lo, hi) = band(&s.first);
-            (s.dx * 1e3, m, lo, hi)
-        })
-        .collect();
-    first = first.band("mean, 95 % band", &band);
-    let runs: Vec<_> = studies
-        .iter()
-        .flat_map(|s| s.first.iter().map(move |&f| (s.dx * 1e3, f)))
-        .collect();
-    first = first.markers("runs", &runs);
-    let p = path("first_precursor");
-    first.save(&p)?;
-    eprintln!("wrote {}", p.display());
 
     let mut aval = Chart::new(
-        &format!("Avalanche sizes, {heights}: pooled over the realizations"),
-        "log₁₀(slipped area: ruptures x cell area, mm²)",
-        "log₁₀(fraction of avalanches at least as large)",
+        &format!("Avalanche sizes, {heights}"),
+        "slipped area: ruptures x cell area (mm²)",
+        "fraction of avalanches at least as large",
     )
+    .log_x()
+    .log_y()
+    .colours(Colours::Ordered)
     .legend(Corner::UpperRight);
     for s in studies {
         let cell_mm2 = s.dx * s.dy * 1e6;
         let points: Vec<_> = at_least(&s.avalanches)
             .iter()
             .filter(|(n, _)| *n > 0.0)
-            .map(|(n, p)| ((n * cell_mm2).log10(), p.log10()))
+            .map(|(n, p)| (n * cell_mm2, *p))
             .collect();
         aval = aval.markers(&s.label(), &points);
     }
-    let p = path("avalanches");
-    aval.save(&p)?;
-    eprintln!("wrote {}", p.display());
+    save(aval, &path("avalanches"))
+}
+
+/// The threshold loads against the cell size, with the Richardson limit at zero cell
+/// size where the full sample gives one.
+fn thresholds(studies: &[Study], estimates: &[Option<Estimate>], path: &Path) -> report::Outcome {
+    let mut chart = Chart::new(
+        &format!(
+            "Threshold loads, {} (h = 0: Richardson limit)",
+            studies[0].heights
+        ),
+        "cell size Δx (mm)",
+        "F/(μF_N) (mean, 95 % interval)",
+    )
+    .x_range(0.0, studies[0].dx * 1e3 * 1.05)
+    .legend(Corner::UpperRight);
+    for q in 1..=3 {
+        let Some(e) = &estimates[q] else { continue };
+        let mut rows: Vec<(f64, f64, f64, f64)> = Vec::new();
+        if let Some(l) = e.limit {
+            rows.push((0.0, l.value, l.lo, l.hi));
+        }
+        for (s, m) in studies.iter().rev().zip(e.means.iter().rev()) {
+            rows.push((s.dx * 1e3, m.value, m.lo, m.hi));
+        }
+        chart = chart.band(OBSERVABLES[q], &rows);
+    }
+    // A load cannot pass global slip: an interval above it is the extrapolation's, not
+    // the model's.
+    let slip = [(0.0, 1.0), (studies[0].dx * 1e3 * 1.05, 1.0)];
+    chart = chart
+        .line("global slip", &slip)
+        .style(Style::new().colour(120, 120, 120).dashed());
+    save(chart, path)
+}
+
+fn save(chart: Chart, path: &Path) -> report::Outcome {
+    chart.save(path)?;
+    eprintln!("wrote {}", path.display());
     Ok(())
 }
 
@@ -673,64 +664,62 @@ mod tests {
     use super::*;
 
     #[test]
-    fn max_difference_takes_the_largest_gap_over_shared_loads_up_to_the_limit() {
-        // By hand: at 0.1 |0.2 - 0.25| = 0.05, at 0.2 |0.5 - 0.3| = 0.2, at 0.3 (only
-        // in a) nothing, at 0.4 |0.9 - 0.1| = 0.8 but beyond up_to = 0.35.
-        let a = [(0.1, 0.2), (0.2, 0.5), (0.3, 7.0), (0.4, 0.9)];
-        let b = [(0.1, 0.25), (0.2, 0.3), (0.4, 0.1)];
-        assert!((max_difference(&a, &b, 0.35).unwrap() - 0.2).abs() < 1e-15);
-        assert!((max_difference(&a, &b, f64::INFINITY).unwrap() - 0.8).abs() < 1e-15);
-        // A NaN mean (no realization at that load) is skipped, not propagated.
-        let c = [(0.1, f64::NAN), (0.2, 0.35)];
-        assert!((max_difference(&c, &b, 1.0).unwrap() - 0.05).abs() < 1e-15);
-        assert_eq!(max_difference(&a, &[(0.9, 1.0)], 1.0), None);
+    fn first_reaching_takes_the_first_state_at_the_threshold() {
+        // By hand: ℓ = 0, 3, 5, 4, 9 mm at loads 0, 0.1, 0.2, 0.3, 0.4: 5 mm is first
+        // reached at 0.2 (equal counts), 6 mm at 0.4, 10 mm never.
+        let loads = [0.0, 0.1, 0.2, 0.3, 0.4];
+        let ell = [0.0, 3e-3, 5e-3, 4e-3, 9e-3];
+        assert_eq!(first_reaching(&loads, &ell, 5e-3), 0.2);
+        assert_eq!(first_reaching(&loads, &ell, 6e-3), 0.4);
+        assert!(first_reaching(&loads, &ell, 10e-3).is_nan());
     }
 
     #[test]
-    fn observed_order_is_the_log_ratio_of_distances_over_that_of_cell_sizes() {
-        // Halved cells, distance quartered: order 2; from 2 mm to 0.5 mm a factor 8 in
-        // distance is order log(8)/log(4) = 1.5.
-        assert!((observed_order(0.04, 0.01, 2.0, 1.0).unwrap() - 2.0).abs() < 1e-12);
-        assert!((observed_order(0.8, 0.1, 2.0, 0.5).unwrap() - 1.5).abs() < 1e-12);
-        // No convergence: the distance grows, the order is negative.
-        assert!((observed_order(0.01, 0.02, 2.0, 1.0).unwrap() + 1.0).abs() < 1e-12);
-        assert_eq!(observed_order(0.0, 0.01, 2.0, 1.0), None);
-        assert_eq!(observed_order(0.1, 0.0, 2.0, 1.0), None);
-        assert_eq!(observed_order(0.1, 0.05, 1.0, 2.0), None);
+    fn value_at_is_the_state_in_effect() {
+        let loads = [0.0, 0.1, 0.25, 0.8];
+        let v = [1.0, 2.0, 3.0, 4.0];
+        assert_eq!(value_at(&loads, &v, 0.75), 3.0);
+        assert_eq!(value_at(&loads, &v, 0.8), 4.0);
+        assert!(value_at(&[0.1], &[1.0], 0.05).is_nan());
     }
 
     #[test]
-    fn first_precursor_is_the_first_stable_state_with_a_front() {
-        let text = "event,force_N,force_over_mu_FN,precursor_length_m\n\
-                    1,0,0,0\n4,65,0.037,0\n7,82,0.047,1e-3\n10,90,0.05,0\n13,95,0.06,2e-3\n";
-        let t = Table::parse(Path::new("curve.csv"), text).unwrap();
-        assert_eq!(first_precursor_load(&t).unwrap(), Some(0.047));
-        let none = "force_over_mu_FN,precursor_length_m\n0,0\n0.5,0\n";
-        let t = Table::parse(Path::new("curve.csv"), none).unwrap();
-        assert_eq!(first_precursor_load(&t).unwrap(), None);
-        // A ragged row or a cell that is not a number is refused with the line.
+    fn observe_reads_the_run_tables() {
+        let curve = Table::parse(
+            Path::new("curve.csv"),
+            "force_over_mu_FN,real_contact_area_m2,precursor_length_m\n\
+             0,2e-5,0\n0.3,2.1e-5,6e-3\n0.7,2.2e-5,21e-3\n0.9,2.3e-5,40e-3\n",
+        )
+        .unwrap();
+        let fronts = Table::parse(
+            Path::new("fronts.csv"),
+            "force_over_mu_FN,damage_front_m\n0,0\n0.3,1e-3\n0.7,5e-3\n",
+        )
+        .unwrap();
+        // A_R(0) over 1e-3 m² = 0.02; ℓ ≥ 5 mm at 0.3, ≥ 20 mm at 0.7; front at 0.7;
+        // ℓ/Lx at 0.75 is 21 mm / 0.14 m = 0.15.
+        let o = observe(&curve, &fronts, 1e-3, 0.14).unwrap();
+        assert!((o[0] - 0.02).abs() < 1e-15);
+        assert_eq!(&o[1..4], &[0.3, 0.7, 0.7]);
+        assert!((o[4] - 0.15).abs() < 1e-15);
+    }
+
+    #[test]
+    fn numbers_print_with_three_significant_figures() {
+        assert_eq!(sig(0.123456), "0.123");
+        assert_eq!(sig(12.3456), "12.3");
+        assert_eq!(sig(-0.0456), "-0.0456");
+        assert_eq!(sig(0.00123), "1.23e-3");
+        assert_eq!(sig(f64::NAN), "—");
+    }
+
+    #[test]
+    fn a_table_refuses_ragged_rows_and_words_in_number_columns() {
         let bad = Table::parse(Path::new("c.csv"), "a,b\n1\n");
         assert!(bad.err().unwrap().to_string().contains("line 2"));
-        let t = Table::parse(
-            Path::new("c.csv"),
-            "force_over_mu_FN,precursor_length_m\nx,0\n",
-        );
-        let e = first_precursor_load(&t.unwrap()).unwrap_err().to_string();
+        let t = Table::parse(Path::new("c.csv"), "a\nx\n").unwrap();
+        let e = t.numbers("a").unwrap_err().to_string();
         assert!(e.contains("line 2") && e.contains("`x`"), "{e}");
-    }
-
-    #[test]
-    fn bands_overlap_where_their_intervals_meet() {
-        // At 0.1 [0, 1] and [0.5, 2] meet; at 0.2 [0, 1] and [1.5, 2] do not; at 0.3 a
-        // NaN bound leaves the load out; 0.4 is only in a.
-        let a = [
-            (0.1, 0.0, 1.0),
-            (0.2, 0.0, 1.0),
-            (0.3, f64::NAN, 1.0),
-            (0.4, 0.0, 1.0),
-        ];
-        let b = [(0.1, 0.5, 2.0), (0.2, 1.5, 2.0), (0.3, 0.0, 1.0)];
-        assert_eq!(overlapping_loads(&a, &b), (1, 2));
     }
 
     #[test]

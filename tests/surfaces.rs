@@ -397,6 +397,55 @@ fn the_convergence_sweeps_share_their_surfaces_across_cell_sizes() {
     }
 }
 
+/// The correlation-length sweep of the convergence study (docs/convergence.md, issue 44):
+/// per ξ three grids halving the cell, every cell at most ξ/4, the correlation length its
+/// name says, and the same seeds on every grid of one ξ (the same surface: the study's
+/// differences are taken between grids on the same realization).
+#[cfg(feature = "serde")]
+#[test]
+fn the_correlation_length_sweeps_resolve_xi_and_share_their_surfaces() {
+    use precursors::sweep::Sweep;
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/sweeps/convergence");
+    for (xi_mm, sizes, runs) in [
+        (4.0, ["1mm", "0.5mm", "0.25mm"], 12),
+        (8.0, ["2mm", "1mm", "0.5mm"], 20),
+        (16.0, ["2mm", "1mm", "0.5mm"], 20),
+    ] {
+        let mut seeds = None;
+        let mut previous_dx: Option<f64> = None;
+        for size in sizes {
+            let path = dir.join(format!("xi{xi_mm}_{size}.json"));
+            let sweep = Sweep::from_json_file(&path).unwrap_or_else(|e| panic!("{path:?}: {e}"));
+            assert_eq!(sweep.runs().len(), runs, "{path:?}");
+            let scene = sweep.runs()[0].scene();
+            let grid = scene.grid().unwrap();
+            let (dx, dy) = (grid.dx(), grid.dy());
+            let expected_dx: f64 = size.trim_end_matches("mm").parse::<f64>().unwrap() * 1e-3;
+            assert!((dx - expected_dx).abs() < 1e-12, "{path:?}: dx {dx}");
+            assert!(
+                dx.max(dy) <= xi_mm * 1e-3 / 4.0 + 1e-12,
+                "{path:?}: cells above ξ/4"
+            );
+            if let Some(p) = previous_dx {
+                assert!(
+                    (p / dx - 2.0_f64).abs() < 1e-9,
+                    "{path:?}: not half the cell"
+                );
+            }
+            previous_dx = Some(dx);
+            let json: serde_json::Value = serde_json::from_str(&scene.to_json().unwrap()).unwrap();
+            assert_eq!(json["heights"]["kind"], "gaussian_surface", "{path:?}");
+            let xi = json["heights"]["correlation_length"].as_f64().unwrap();
+            assert!((xi - xi_mm * 1e-3).abs() < 1e-15, "{path:?}: ξ {xi}");
+            let these: Vec<u64> = sweep.runs().iter().map(|r| r.seed()).collect();
+            match &seeds {
+                None => seeds = Some(these),
+                Some(s) => assert_eq!(s, &these, "{path:?}"),
+            }
+        }
+    }
+}
+
 /// Heights without spread (`std_dev` 0, documented as valid) are the mean in every cell,
 /// for a surface as for white noise (issue 41: the cell averages' rule never converged).
 #[test]
