@@ -516,10 +516,9 @@ fn estimate_table(studies: &[Study], estimates: &[Option<Estimate>]) {
     };
     let labels: Vec<String> = studies.iter().map(Study::label).collect();
     println!(
-        "### {}: cells {}, {}; {paired}\n",
+        "### {}: cells {}, means and 95 % bootstrap intervals; {paired}\n",
         studies[0].heights,
         labels.join(", "),
-        "means and 95 % bootstrap intervals"
     );
     println!(
         "| observable | {} | {} | {} | Δ {}→{} | Δ {}→{} | order p | resolved | limit h → 0 | error at {} |",
