@@ -1074,14 +1074,22 @@ impl MapDrawing<'_> {
                 format!("{percent:.1} %")
             }
         };
-        let extreme = |v: f64| tick(v, c);
+        // The scale's ends as its ticks; an extreme far beyond in scientific notation
+        // (the area law near slip reaches 1e10 times the zero-shear area).
+        let extreme = |v: f64| {
+            if (1e-3..1e4).contains(&v.abs()) {
+                tick(v, c)
+            } else {
+                format!("{v:.2e}").replace('-', "−")
+            }
+        };
         let mut parts = Vec::new();
         if above > 0 {
             let top = finite.iter().copied().fold(f64::MIN, f64::max);
             parts.push(format!(
                 "{} of the cells above {} (up to {})",
                 share(above),
-                extreme(c.1),
+                tick(c.1, c),
                 extreme(top)
             ));
         }
@@ -1090,7 +1098,7 @@ impl MapDrawing<'_> {
             parts.push(format!(
                 "{} below {} (down to {})",
                 share(below),
-                extreme(c.0),
+                tick(c.0, c),
                 extreme(bottom)
             ));
         }

@@ -446,8 +446,10 @@ fn a_directory_without_recorded_fields_is_refused_saying_how_to_record_them() {
 fn the_program_draws_the_movies_and_refuses_a_directory_without_fields() {
     use std::process::Command;
     let (dir, _) = handwritten("hand3");
+    let frames = dir.join("frames");
     let out = Command::new(env!("CARGO_BIN_EXE_precursors"))
-        .args(["movie", "--max-frames", "3"])
+        .args(["movie", "--max-frames", "3", "--png-frames"])
+        .arg(&frames)
         .arg(&dir)
         .output()
         .unwrap();
@@ -456,6 +458,17 @@ fn the_program_draws_the_movies_and_refuses_a_directory_without_fields() {
     assert!(stderr.contains("3 frames of 5 recorded states"), "{stderr}");
     assert_eq!(decode_frames(&dir.join("contact_area.gif")).len(), 3);
     assert_eq!(decode_frames(&dir.join("coulomb_stress.gif")).len(), 3);
+    // `--png-frames`: both movies' frames, numbered, named after their GIFs.
+    let mut names: Vec<String> = std::fs::read_dir(&frames)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    let expected: Vec<String> = ["contact_area", "coulomb_stress"]
+        .iter()
+        .flat_map(|stem| (0..3).map(move |k| format!("{stem}_{k:04}.png")))
+        .collect();
+    assert_eq!(names, expected);
     std::fs::remove_file(dir.join(FIELDS_TABLE)).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_precursors"))
         .arg("movie")

@@ -690,6 +690,11 @@ fn draw_contact_map(
         figure.row_edges = Some(edges.clone());
         figure.overlay = vec![ell_line.clone()];
         figure.dashed_overlay = vec![front_line.clone()];
+        figure.notes = vec![
+            "solid: ℓ(F)/Lx, the precursor length of curve.csv; dashed: x_D(F)/Lx, the \
+             damage front of fronts.csv"
+                .into(),
+        ];
         figure.save(&path)?;
         drawn.files.push(path);
     }
