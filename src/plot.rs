@@ -1414,13 +1414,20 @@ fn typeset<DB: DrawingBackend>(
 }
 
 /// `text` cut into pieces, each `(text, is a subscript)`: `_X` makes the one character `X`
-/// a subscript, `_{...}` the braces' text; an `_` at the end, or before a space, stays.
+/// a subscript, `_{...}` the braces' text; an `_` at the end, or before a space, stays, and
+/// `\_` is an `_` as written (a name: `movie\_s1\_rod`).
 fn subscripts(text: &str) -> Vec<(String, bool)> {
     let mut pieces: Vec<(String, bool)> = Vec::new();
     let mut normal = String::new();
     let mut chars = text.chars().peekable();
     while let Some(c) = chars.next() {
         let sub = match (c, chars.peek()) {
+            // `\_`: an underscore as written (a directory's name in a scene line).
+            ('\\', Some('_')) => {
+                chars.next();
+                normal.push('_');
+                continue;
+            }
             ('_', Some('{')) => {
                 chars.next();
                 let inner: String = chars.by_ref().take_while(|&c| c != '}').collect();
@@ -1811,8 +1818,12 @@ mod tests {
                 piece("P", true)
             ]
         );
-        // Left as written: no character after it, or a space.
+        // Left as written: no character after it, or a space, or escaped.
         assert_eq!(subscripts("a_ b_"), [piece("a_ b_", false)]);
+        assert_eq!(
+            subscripts("movie\\_s1\\_rod, F_N"),
+            [piece("movie_s1_rod, F", false), piece("N", true)]
+        );
         assert!(subscripts("").is_empty());
     }
 

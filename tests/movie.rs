@@ -567,7 +567,7 @@ fn polygon_fills(svg: &str) -> Vec<String> {
 /// cells drawn, and the scene.
 #[test]
 fn a_coulomb_frame_ends_at_the_block_and_says_its_saturation_aspect_and_scene() {
-    let (dir, _) = handwritten_on("uneven", &[0.001, 0.004]);
+    let (dir, _) = handwritten_on("uneven_planes", &[0.001, 0.004]);
     let svg_path = dir.join("frame.svg");
     Movie::new(&dir, MovieKind::CoulombStress)
         .colour_range(-2.0, 0.5)

@@ -813,9 +813,10 @@ fn read_recording(dir: &Path) -> Result<Recording> {
         return Err(no_fields(format!("its {FIELDS_FILE} holds no state")));
     }
     let block = grid.block();
+    // The directory's name as written: its underscores are no subscripts.
     let scene = format!(
         "{}: {}, {nx} x {ny} cells",
-        super::figures::name(dir),
+        super::figures::name(dir).replace('_', "\\_"),
         super::figures::run_title(dir)
     );
     Ok(Recording {
