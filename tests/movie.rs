@@ -621,7 +621,10 @@ fn a_coulomb_frame_ends_at_the_block_and_says_its_saturation_aspect_and_scene() 
         .position(|t| t.starts_with(&format!("{name}: 10 x 4 x 10 mm, F")))
         .unwrap_or_else(|| panic!("{texts:?}"));
     assert_eq!(texts[scene + 1], "N");
-    assert!(texts[scene + 2].ends_with(", 10 x 4 cells"), "{texts:?}");
+    assert!(
+        texts[scene + 2].ends_with(", 10 x 4 cells, 2 planes"),
+        "{texts:?}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -814,11 +814,14 @@ fn read_recording(dir: &Path) -> Result<Recording> {
     }
     let block = grid.block();
     // The directory's name as written: its underscores are no subscripts.
-    let scene = format!(
+    let mut scene = format!(
         "{}: {}, {nx} x {ny} cells",
         super::figures::name(dir).replace('_', "\\_"),
         super::figures::run_title(dir)
     );
+    if !planes.is_empty() {
+        scene.push_str(&format!(", {} planes", planes.len()));
+    }
     Ok(Recording {
         nx,
         ny,
