@@ -98,7 +98,8 @@ fn run() -> report::Outcome {
                 "τ_C = |τ| − μ|σ| (MPa)",
             )
             .x_range(0.0, lx_mm)
-            .y_range(0.0, heights.len() as f64) // planes 1 mm apart
+            .y_range(0.0, heights.len() as f64) // planes 1 mm apart, to the top face
+            .same_unit_axes() // 200 x 100 mm: the line under the map states the aspect
             .colour_scale(Palette::Diverging, Some((-2.0, 2.0)))
             .size(1000, 600)
             .save(format!("{dir}/fig8_{name}.png"))?;

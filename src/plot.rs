@@ -689,6 +689,12 @@ impl Draw for ChartDrawing<'_> {
 /// A map of values on a regular grid of cells over `[x0, x1] x [y0, y1]`, with a colour
 /// bar labelled with the quantity and its unit.
 ///
+/// Values beyond the colour scale are drawn in its end colours (saturated): the bar then
+/// carries a triangle in the end colour beyond each end the values pass, and a line under
+/// the map gives the share of the cells beyond each end and the extreme value there
+/// (`colour scale saturated: 3.1 % of the cells above 2.26 (up to 16.04)`). A map of
+/// lengths ([`Map::same_unit_axes`]) states its aspect on that line.
+///
 /// ```
 /// use precursors::plot::{Map, Palette, PlotError};
 /// use precursors::Error;
@@ -731,6 +737,14 @@ pub struct Map {
     overlay: Vec<Vec<(f64, f64)>>,
     /// Lines drawn over the cells in black dashes (the damage front over a contact map).
     dashed_overlay: Vec<Vec<(f64, f64)>>,
+    /// Lines of text under the figure (a movie frame's scene line), above the line the
+    /// map writes itself (saturation, aspect).
+    notes: Vec<String>,
+    /// The ends of the colour scale marked saturated on the bar (below, above) when not
+    /// this map's own (a movie marks the ends its whole run saturates, on every frame).
+    extend: Option<(bool, bool)>,
+    /// Whether x and y are lengths in one unit: the figure then states its aspect.
+    same_units: bool,
 }
 
 impl Map {
@@ -777,6 +791,9 @@ impl Map {
             row_edges: None,
             overlay: Vec::new(),
             dashed_overlay: Vec::new(),
+            notes: Vec::new(),
+            extend: None,
+            same_units: false,
         })
     }
 
@@ -816,6 +833,16 @@ impl Map {
         self
     }
 
+    /// Says that x and y are lengths in the same unit (say mm, a face or a slab of the
+    /// block): the line under the map then states how much the drawing stretches one
+    /// against the other (`not to scale: y drawn 13.2 times stretched against x`), or
+    /// that it is true to scale (within 5 %). Without it the axes are taken as
+    /// different quantities (a position and a load) and no aspect is stated.
+    pub fn same_unit_axes(mut self) -> Self {
+        self.same_units = true;
+        self
+    }
+
     /// Writes the map to `path`: PNG for `.png`, SVG for `.svg`.
     ///
     /// # Errors
@@ -850,35 +877,22 @@ impl Draw for MapDrawing<'_> {
         &self,
         root: &DrawingArea<DB, Shift>,
     ) -> std::result::Result<(), String> {
-        let (me, x, y, c) = (self.map, self.x, self.y, self.c);
-        let font = |size: f64| (FAMILY, size).into_font();
-        let (width, _) = root.dim_in_pixel();
+        let (me, x, y) = (self.map, self.x, self.y);
+        let (width, height) = root.dim_in_pixel();
+        // Room under the figure for its notes and its own line (saturation, aspect).
+        let saturation = self.saturation_note();
+        let own = u32::from(saturation.is_some() || me.same_units);
+        let lines = me.notes.len() as u32 + own;
+        let footer = if lines == 0 {
+            0
+        } else {
+            (lines * NOTE_LINE + 6).min(height / 4)
+        };
+        let (upper, under) = root.split_vertically(height - footer);
         let bar_width = 130.min(width / 3);
-        let (main, bar) = root.split_horizontally(width - bar_width);
+        let (main, bar) = upper.split_horizontally(width - bar_width);
         let mut chart = axes(&main, &me.title, x, y)?;
-        let (dx, dy) = (
-            (x.1 - x.0) / me.columns as f64,
-            (y.1 - y.0) / me.rows as f64,
-        );
-        let grey = RGBColor(200, 200, 200);
-        chart
-            .draw_series((0..me.rows).flat_map(|r| {
-                (0..me.columns).map(move |col| {
-                    let v = me.values[r * me.columns + col];
-                    let fill = if v.is_finite() {
-                        me.palette.colour((v - c.0) / (c.1 - c.0))
-                    } else {
-                        grey
-                    };
-                    let x0 = x.0 + col as f64 * dx;
-                    let (y0, y1) = match &me.row_edges {
-                        Some(edges) => (edges[r], edges[r + 1]),
-                        None => (y.0 + r as f64 * dy, y.0 + (r + 1) as f64 * dy),
-                    };
-                    Rectangle::new([(x0, y0), (x0 + dx, y1)], fill.filled())
-                })
-            }))
-            .map_err(|e| e.to_string())?;
+        self.draw_cells(&mut chart)?;
         for line in &me.overlay {
             chart
                 .draw_series(std::iter::once(PathElement::new(
@@ -904,8 +918,76 @@ impl Draw for MapDrawing<'_> {
             (&me.y_label, y),
             (false, (false, false)),
         )?;
-        // The colour bar: a one-column chart of the colour scale, its values on the right.
-        let mut scale = ChartBuilder::on(&bar)
+        self.draw_colour_bar(&bar)?;
+        let (columns, rows) = chart.plotting_area().get_pixel_range();
+        let plot = (columns.end - columns.start, rows.end - rows.start);
+        let mut notes = me.notes.clone();
+        notes.push(
+            [saturation, self.aspect_note(plot)]
+                .into_iter()
+                .flatten()
+                .collect::<Vec<_>>()
+                .join("; "),
+        );
+        draw_notes(&under, &notes)
+    }
+}
+
+/// The height of a line of notes under a map (pixels).
+const NOTE_LINE: u32 = 19;
+
+impl MapDrawing<'_> {
+    /// The cells, each in its colour on the scale (grey where not finite).
+    fn draw_cells<DB: DrawingBackend>(
+        &self,
+        chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    ) -> std::result::Result<(), String> {
+        let (me, x, y, c) = (self.map, self.x, self.y, self.c);
+        let (dx, dy) = (
+            (x.1 - x.0) / me.columns as f64,
+            (y.1 - y.0) / me.rows as f64,
+        );
+        let grey = RGBColor(200, 200, 200);
+        chart
+            .draw_series((0..me.rows).flat_map(|r| {
+                (0..me.columns).map(move |col| {
+                    let v = me.values[r * me.columns + col];
+                    let fill = if v.is_finite() {
+                        me.palette.colour((v - c.0) / (c.1 - c.0))
+                    } else {
+                        grey
+                    };
+                    let x0 = x.0 + col as f64 * dx;
+                    let (y0, y1) = match &me.row_edges {
+                        Some(edges) => (edges[r], edges[r + 1]),
+                        None => (y.0 + r as f64 * dy, y.0 + (r + 1) as f64 * dy),
+                    };
+                    Rectangle::new([(x0, y0), (x0 + dx, y1)], fill.filled())
+                })
+            }))
+            .map_err(|e| e.to_string())?;
+        Ok(())
+    }
+
+    /// The ends of the scale the values pass (below its low end, above its high end).
+    fn saturated(&self) -> (usize, usize) {
+        let c = self.c;
+        let finite = || self.map.values.iter().filter(|v| v.is_finite());
+        (
+            finite().filter(|v| **v < c.0).count(),
+            finite().filter(|v| **v > c.1).count(),
+        )
+    }
+
+    /// The colour bar: a one-column chart of the colour scale, its values on the right,
+    /// its label right of them, a triangle in the end colour beyond each end the values
+    /// pass (the values there are drawn in the end colour: saturated).
+    fn draw_colour_bar<DB: DrawingBackend>(
+        &self,
+        bar: &DrawingArea<DB, Shift>,
+    ) -> std::result::Result<(), String> {
+        let (me, c) = (self.map, self.c);
+        let mut scale = ChartBuilder::on(bar)
             .margin_top(16 + 30)
             .margin_bottom(16 + 52)
             .margin_left(8)
@@ -926,23 +1008,43 @@ impl Draw for MapDrawing<'_> {
             .configure_mesh()
             .disable_mesh()
             .disable_x_axis()
-            .label_style(font(14.0))
+            .label_style((FAMILY, 14.0).into_font())
             .y_labels(8)
             .y_label_formatter(&|v| tick(*v, c))
             .draw()
             .map_err(|e| e.to_string())?;
-        // The colour bar's label right of its values, reading up along the bar (where
-        // plotters puts a right axis' label).
+        let (base_x, base_y) = bar.get_base_pixel();
+        let (columns, rows) = scale.plotting_area().get_pixel_range();
+        let (x0, x1) = (columns.start - base_x, columns.end - base_x);
+        let (y0, y1) = (rows.start - base_y, rows.end - base_y);
+        let (below, above) = me.extend.unwrap_or_else(|| {
+            let (below, above) = self.saturated();
+            (below > 0, above > 0)
+        });
+        // Triangles as tall as the bar is wide, pointing away from it.
+        let tall = (x1 - x0).min(28);
+        for (on, base, tip, t) in [
+            (above, y0 - 3, y0 - 3 - tall, 1.0),
+            (below, y1 + 2, y1 + 2 + tall, 0.0),
+        ] {
+            if on {
+                let points = vec![(x0, base), (x1, base), ((x0 + x1) / 2, tip)];
+                bar.draw(&Polygon::new(points.clone(), me.palette.colour(t).filled()))
+                    .map_err(|e| e.to_string())?;
+                let mut outline = points;
+                outline.push(outline[0]);
+                bar.draw(&PathElement::new(outline, BLACK.stroke_width(1)))
+                    .map_err(|e| e.to_string())?;
+            }
+        }
+        // The label where plotters puts a right axis' label, reading up along the bar.
         if !me.colour_label.is_empty() {
-            let (_, base_y) = bar.get_base_pixel();
-            let (_, rows) = scale.plotting_area().get_pixel_range();
-            let (y0, y1) = (rows.start - base_y, rows.end - base_y);
-            let size = fitting(&bar, &me.colour_label, 16.0, y1 - y0)?;
-            let width = typeset_width(&bar, &me.colour_label, size)?;
+            let size = fitting(bar, &me.colour_label, 16.0, y1 - y0)?;
+            let width = typeset_width(bar, &me.colour_label, size)?;
             let (bar_width, _) = bar.dim_in_pixel();
             let left = bar_width as i32 - 8 - (1.15 * size) as i32;
             typeset(
-                &bar,
+                bar,
                 &me.colour_label,
                 (left, (y0 + y1 + width) / 2),
                 size,
@@ -951,6 +1053,99 @@ impl Draw for MapDrawing<'_> {
         }
         Ok(())
     }
+
+    /// What the colour scale leaves out, as its line under the map says it: the share of
+    /// the cells beyond each end and the extreme value there; `None` when nothing is.
+    fn saturation_note(&self) -> Option<String> {
+        let c = self.c;
+        let finite: Vec<f64> = self
+            .map
+            .values
+            .iter()
+            .copied()
+            .filter(|v| v.is_finite())
+            .collect();
+        let (below, above) = self.saturated();
+        let share = |n: usize| {
+            let percent = 100.0 * n as f64 / finite.len() as f64;
+            if percent < 0.1 {
+                "< 0.1 %".to_string()
+            } else {
+                format!("{percent:.1} %")
+            }
+        };
+        // The scale's ends as its ticks; an extreme far beyond in scientific notation
+        // (the area law near slip reaches 1e10 times the zero-shear area).
+        let extreme = |v: f64| {
+            if (1e-3..1e4).contains(&v.abs()) {
+                tick(v, c)
+            } else {
+                format!("{v:.2e}").replace('-', "−")
+            }
+        };
+        let mut parts = Vec::new();
+        if above > 0 {
+            let top = finite.iter().copied().fold(f64::MIN, f64::max);
+            parts.push(format!(
+                "{} of the cells above {} (up to {})",
+                share(above),
+                tick(c.1, c),
+                extreme(top)
+            ));
+        }
+        if below > 0 {
+            let bottom = finite.iter().copied().fold(f64::MAX, f64::min);
+            parts.push(format!(
+                "{} below {} (down to {})",
+                share(below),
+                tick(c.0, c),
+                extreme(bottom)
+            ));
+        }
+        (!parts.is_empty()).then(|| format!("colour scale saturated: {}", parts.join(", ")))
+    }
+
+    /// The aspect of a map of lengths (`plot`: the plotting area's pixels): how much the
+    /// drawing stretches y against x, or that it is true to scale; `None` for axes of
+    /// different quantities.
+    fn aspect_note(&self, plot: (i32, i32)) -> Option<String> {
+        if !self.map.same_units {
+            return None;
+        }
+        let (x, y) = (self.x, self.y);
+        let per_x = f64::from(plot.0) / (x.1 - x.0);
+        let per_y = f64::from(plot.1) / (y.1 - y.0);
+        let stretch = per_y / per_x;
+        Some(if (0.95..=1.0 / 0.95).contains(&stretch) {
+            "true to scale".to_string()
+        } else if stretch > 1.0 {
+            format!("not to scale: y drawn {stretch:.1} times stretched against x")
+        } else {
+            format!(
+                "not to scale: x drawn {:.1} times stretched against y",
+                1.0 / stretch
+            )
+        })
+    }
+}
+
+/// Draws `notes` (one line each, typeset, left-aligned, shrunk to fit) on `area`.
+fn draw_notes<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    notes: &[String],
+) -> std::result::Result<(), String> {
+    let (width, _) = area.dim_in_pixel();
+    for (k, note) in notes.iter().enumerate().filter(|(_, n)| !n.is_empty()) {
+        let size = fitting(area, note, 13.0, width as i32 - 24)?;
+        typeset(
+            area,
+            note,
+            (12, (k as u32 * NOTE_LINE) as i32 + 2),
+            size,
+            Reading::Across,
+        )?;
+    }
+    Ok(())
 }
 
 /// A titled plotting area with room for tick values and axis labels.
@@ -1219,13 +1414,20 @@ fn typeset<DB: DrawingBackend>(
 }
 
 /// `text` cut into pieces, each `(text, is a subscript)`: `_X` makes the one character `X`
-/// a subscript, `_{...}` the braces' text; an `_` at the end, or before a space, stays.
+/// a subscript, `_{...}` the braces' text; an `_` at the end, or before a space, stays, and
+/// `\_` is an `_` as written (a name: `movie\_s1\_rod`).
 fn subscripts(text: &str) -> Vec<(String, bool)> {
     let mut pieces: Vec<(String, bool)> = Vec::new();
     let mut normal = String::new();
     let mut chars = text.chars().peekable();
     while let Some(c) = chars.next() {
         let sub = match (c, chars.peek()) {
+            // `\_`: an underscore as written (a directory's name in a scene line).
+            ('\\', Some('_')) => {
+                chars.next();
+                normal.push('_');
+                continue;
+            }
             ('_', Some('{')) => {
                 chars.next();
                 let inner: String = chars.by_ref().take_while(|&c| c != '}').collect();
@@ -1616,8 +1818,12 @@ mod tests {
                 piece("P", true)
             ]
         );
-        // Left as written: no character after it, or a space.
+        // Left as written: no character after it, or a space, or escaped.
         assert_eq!(subscripts("a_ b_"), [piece("a_ b_", false)]);
+        assert_eq!(
+            subscripts("movie\\_s1\\_rod, F_N"),
+            [piece("movie_s1_rod, F", false), piece("N", true)]
+        );
         assert!(subscripts("").is_empty());
     }
 

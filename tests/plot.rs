@@ -745,6 +745,86 @@ fn the_contact_map_carries_both_fronts() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// The contact map's colour scale ends at twice the zero-shear area: the share of its
+/// cells above (each column's area in `contact_map.csv` over the column's area in the
+/// first row, the documented `A_R(x, F)/A_R(x, 0)`, counted here from the table) is
+/// given under the map with the largest ratio, and the bar carries a triangle in the
+/// top colour (the diverging palette's documented red) and none below (no ratio is
+/// negative); the note under the map names the two lines and where they come from.
+#[test]
+fn the_contact_map_marks_the_ratios_above_its_scale() {
+    let dir = scratch("map-saturation");
+    let mut driver = Scene::builder()
+        .block(0.03, 0.005, 0.02)
+        .cell_size(1e-3, 1e-3)
+        .normal_load(500.0)
+        .seed(2)
+        .build()
+        .unwrap()
+        .driver()
+        .unwrap();
+    RunTables::create(&dir, &driver)
+        .unwrap()
+        .run_to_slip(&mut driver, None, |_, _| {})
+        .unwrap();
+    draw(&dir, &[Format::Svg]).unwrap();
+    let table = std::fs::read_to_string(dir.join("contact_map.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = table
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').skip(2).map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let ratios: Vec<f64> = rows
+        .iter()
+        .flat_map(|row| {
+            row.iter()
+                .zip(&rows[0])
+                .filter(|(_, r)| **r > 0.0)
+                .map(|(a, r)| a / r)
+        })
+        .collect();
+    let above = ratios.iter().filter(|v| **v > 2.0).count();
+    assert!(
+        above > 0,
+        "no ratio above 2: the test's scene must reach one"
+    );
+    let share = 100.0 * above as f64 / ratios.len() as f64;
+    let svg = std::fs::read_to_string(dir.join("contact_map.svg")).unwrap();
+    let fills: Vec<&str> = svg
+        .split("<polygon")
+        .skip(1)
+        .filter_map(|p| Some(p.split_once("fill=\"")?.1.split_once('"')?.0))
+        .collect();
+    assert_eq!(fills, ["#B2182B"]);
+    let texts: Vec<String> = svg_texts(&dir.join("contact_map.svg"))
+        .into_iter()
+        .map(|(_, t)| t)
+        .collect();
+    let line = texts
+        .iter()
+        .find(|t| t.starts_with("colour scale saturated: "))
+        .unwrap_or_else(|| panic!("{texts:?}"));
+    let said: f64 = line["colour scale saturated: ".len()..]
+        .split_once(" %")
+        .unwrap()
+        .0
+        .parse()
+        .unwrap();
+    assert!(
+        (said - share).abs() <= 0.05 + 1e-9,
+        "{line}: {share:.3} % above 2"
+    );
+    assert!(line.contains("of the cells above 2.0 (up to "), "{line}");
+    assert!(!line.contains("below"), "{line}");
+    assert!(
+        texts
+            .iter()
+            .any(|t| t.starts_with("solid: ℓ(F)/Lx, the precursor length of curve.csv")),
+        "{texts:?}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A run of a small block (30 x 5 cells of 1 mm, 500 N) driven through a spring on its
 /// side, to global slip, in `dir`.
 fn spring_run(dir: &Path) {

@@ -206,6 +206,11 @@ enum Command {
         /// DIR/coulomb_stress.gif].
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
+        /// Also writes every frame as a numbered PNG into FRAMES (made if missing):
+        /// contact_area_0000.png, ... (the GIF's name, then the frame's number), for a
+        /// video encoder of your choice.
+        #[arg(long, value_name = "FRAMES")]
+        png_frames: Option<PathBuf>,
     },
 }
 
@@ -485,6 +490,7 @@ fn main() -> ExitCode {
             height,
             frame_duration,
             out,
+            png_frames,
         } => movie(
             &dir,
             field,
@@ -493,6 +499,7 @@ fn main() -> ExitCode {
                 max_frames,
                 size: (width, height),
                 frame_duration,
+                png_frames,
             },
             out.as_deref(),
             progress,
@@ -897,6 +904,7 @@ struct MovieOptions {
     max_frames: u64,
     size: (u32, u32),
     frame_duration: f64,
+    png_frames: Option<PathBuf>,
 }
 
 fn movie(
@@ -922,11 +930,14 @@ fn movie(
     }
     for (kind, name) in kinds {
         let path = out.map_or_else(|| dir.join(name), Path::to_path_buf);
-        let movie = Movie::new(dir, kind)
+        let mut movie = Movie::new(dir, kind)
             .every(usize::try_from(options.every).unwrap_or(usize::MAX))?
             .max_frames(usize::try_from(options.max_frames).unwrap_or(usize::MAX))?
             .size(options.size.0, options.size.1)
             .frame_duration(options.frame_duration)?;
+        if let Some(frames) = &options.png_frames {
+            movie = movie.png_frames(frames);
+        }
         let mut bar = Progress::new(progress);
         let outcome = movie.save_with_progress(&path, |drawn, frames| {
             bar.show(drawn == frames, |elapsed| {
@@ -940,9 +951,10 @@ fn movie(
         bar.finish();
         match outcome {
             Ok(report) => say!(
-                "wrote {}: {} frames of {} recorded states (one in {} and the last), \
-                 colour scale {:.4} to {:.4} {}",
+                "wrote {} ({:.1} MB): {} frames of {} recorded states (one in {} and the \
+                 last), colour scale {:.4} to {:.4} {}{}",
                 path.display(),
+                std::fs::metadata(&path).map_or(0.0, |m| m.len() as f64 / 1e6),
                 report.frames,
                 report.states,
                 report.stride,
@@ -952,7 +964,14 @@ fn movie(
                     "mm²"
                 } else {
                     "MPa"
-                }
+                },
+                options
+                    .png_frames
+                    .as_ref()
+                    .map_or_else(String::new, |d| format!(
+                        "; its frames as PNGs in {}",
+                        d.display()
+                    ))
             ),
             // `all`: the Coulomb stress movie of a run that recorded no planes is skipped.
             Err(precursors::plot::PlotError::NoFields { reason, .. })

@@ -358,7 +358,7 @@ fn point_label(values: &[(String, String)], runs: usize) -> String {
 }
 
 /// The name figures give a directory: its last component.
-fn name(dir: &Path) -> String {
+pub(super) fn name(dir: &Path) -> String {
     dir.canonicalize()
         .ok()
         .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
@@ -367,7 +367,7 @@ fn name(dir: &Path) -> String {
 
 /// The scene of a run directory in a few words (block, `F_N`, drive, heights' seed), from
 /// its `scene.json`; the directory's name when it has none.
-fn run_title(dir: &Path) -> String {
+pub(super) fn run_title(dir: &Path) -> String {
     match crate::scene::SceneBuilder::from_json_file(dir.join("scene.json")) {
         Ok(scene) => describe(&crate::scene::file::all_keys(&scene)),
         Err(_) => name(dir),
@@ -690,6 +690,11 @@ fn draw_contact_map(
         figure.row_edges = Some(edges.clone());
         figure.overlay = vec![ell_line.clone()];
         figure.dashed_overlay = vec![front_line.clone()];
+        figure.notes = vec![
+            "solid: ℓ(F)/Lx, the precursor length of curve.csv; dashed: x_D(F)/Lx, the \
+             damage front of fronts.csv"
+                .into(),
+        ];
         figure.save(&path)?;
         drawn.files.push(path);
     }

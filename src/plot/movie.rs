@@ -10,10 +10,20 @@
 //!   `τ_C = 0` contour, drawn along the cells' edges) and the interface's precursor `ℓ`
 //!   (a black bar along the bottom from `x = 0` to `x = ℓ`).
 //!
-//! The GIF is encoded in memory (each frame quantised to its own 256 colours) and written
-//! atomically: no half movie is left on a full disk.
+//! Every frame carries a scene line (the directory, the block, `F_N`, the drive, the
+//! cells) and states its aspect (a face 140 x 7 mm is drawn stretched); the colour bar
+//! marks the ends the movie saturates, and each frame gives the share of its cells beyond
+//! them.
+//!
+//! The GIF is encoded in memory on one palette built from the colour map (192 colours
+//! along it, greys for the text, no banding), each frame after the first holding only
+//! the pixels that changed (the others transparent), and written atomically: no half
+//! movie is left on a full disk. The frames can also be written as numbered PNGs
+//! ([`Movie::png_frames`]).
 
-use super::{axis_range, paint, register_font, Map, MapDrawing, Palette, PlotError, Result};
+use super::{
+    axis_range, encode_png, paint, register_font, Map, MapDrawing, Palette, PlotError, Result,
+};
 use crate::error::Error;
 use crate::output::check::{fields_row, RunRecord};
 use crate::output::RUN_SCENE;
@@ -81,10 +91,13 @@ struct State {
 struct Recording {
     nx: usize,
     ny: usize,
-    /// `Lx, Ly` (m).
+    /// `Lx, Ly, Lz` (m).
     lx: f64,
     ly: f64,
+    lz: f64,
     planes: Vec<f64>,
+    /// The scene in a line: the directory, the block, `F_N`, the drive, the cells.
+    scene: String,
     states: Vec<State>,
 }
 
@@ -93,7 +106,11 @@ struct Recording {
 /// [`Movie::every`]-th, at most [`Movie::max_frames`]: a longer run is drawn every k-th
 /// state with k raised until the frames fit, the last state always drawn), each titled
 /// `F/(μF_N) = …, ℓ/Lx = …`, on one colour scale for the whole movie (a colour bar with its
-/// unit), with the precursor front drawn. Text is in the embedded font.
+/// unit, a triangle beyond each end the movie saturates), with the precursor front drawn.
+/// Under each frame: a scene line (the directory, the block, `F_N`, the drive, the cells),
+/// the share of the frame's cells beyond the colour scale, and the aspect (`not to scale:
+/// y drawn 13.2 times stretched against x`). The axes end at the block's faces. Text is in
+/// the embedded font. [`Movie::png_frames`] writes the frames as numbered PNGs too.
 ///
 /// ```
 /// use precursors::output::RunTables;
@@ -131,6 +148,7 @@ pub struct Movie {
     size: (u32, u32),
     delay: u16,
     colour_range: Option<(f64, f64)>,
+    png_frames: Option<PathBuf>,
 }
 
 /// The default bound on a movie's frames.
@@ -149,6 +167,7 @@ impl Movie {
             size: (900, 560),
             delay: 10,
             colour_range: None,
+            png_frames: None,
         }
     }
 
@@ -210,6 +229,17 @@ impl Movie {
         self
     }
 
+    /// Also writes every frame of the GIF as a PNG of the frame's size into the directory
+    /// `dir` (made if missing), numbered from 0 in the order shown, for an encoder of the
+    /// user's choice: `STEM_0000.png`, `STEM_0001.png`, … (`STEM` the GIF's file stem, as
+    /// many digits as the last number needs, at least 4; e.g. `ffmpeg -framerate 10 -i
+    /// contact_area_%04d.png movie.mp4`). A movie stopped by [`Movie::save_until`] leaves
+    /// the frames written so far.
+    pub fn png_frames(mut self, dir: impl AsRef<Path>) -> Self {
+        self.png_frames = Some(dir.as_ref().to_path_buf());
+        self
+    }
+
     fn refuse(&self, reason: &str) -> PlotError {
         PlotError::Figure {
             path: Some(self.dir.clone()),
@@ -233,8 +263,9 @@ impl Movie {
     /// `fields.csv`, or, for [`MovieKind::CoulombStress`], no planes recorded); in
     /// [`PlotError::Core`]: [`Error::Io`] (a file that cannot be read or written: the GIF is
     /// written atomically), [`Error::CorruptTable`] or [`Error::NonFiniteCell`] for a
-    /// damaged `fields.csv`, the scene record's errors; [`PlotError::Figure`] for a name
-    /// not ending in `.gif`, a size or colour range out of range.
+    /// damaged `fields.csv`, the scene record's errors, a PNG frame that cannot be
+    /// written ([`Movie::png_frames`]); [`PlotError::Figure`] for a name not ending in
+    /// `.gif`, a size or colour range out of range.
     pub fn save_with_progress(
         &self,
         path: impl AsRef<Path>,
@@ -272,32 +303,51 @@ impl Movie {
         }
         super::check_size(path, self.size)?;
         let (recording, report) = self.plan()?;
-        let (width, height) = self.size;
-        let mut bytes = Vec::new();
-        let fail = |e: gif::EncodingError| PlotError::Figure {
-            path: Some(path.to_path_buf()),
-            reason: format!("encoding the GIF: {e}"),
-        };
-        {
-            let mut encoder =
-                gif::Encoder::new(&mut bytes, width as u16, height as u16, &[]).map_err(fail)?;
-            encoder.set_repeat(gif::Repeat::Infinite).map_err(fail)?;
-            let states = report.events.len();
-            for (k, state) in self.frames(&recording, &report).enumerate() {
-                let map = self.frame_map(&recording, state, report.colour_range)?;
-                let pixels = map_pixels(&map, path)?;
-                // NeuQuant at speed 10: a few ms per frame, colours within a few units.
-                let mut frame =
-                    gif::Frame::from_rgb_speed(width as u16, height as u16, &pixels, 10);
-                frame.delay = self.delay;
-                encoder.write_frame(&frame).map_err(fail)?;
-                if progress(k + 1, states).is_break() {
-                    return Ok(None);
-                }
+        let extend = saturated_ends(self.kind, &recording, report.colour_range);
+        let frames_dir = self.png_frames_dir()?;
+        let stem = path
+            .file_stem()
+            .map_or_else(|| "frame".into(), |s| s.to_string_lossy().into_owned());
+        let digits = (report.frames.saturating_sub(1)).to_string().len().max(4);
+        let mut gif = GifWriter::new(path, self.size, self.delay, self.palette())?;
+        let states = report.events.len();
+        for (k, state) in self.frames(&recording, &report).enumerate() {
+            let map = self.frame_map(&recording, state, report.colour_range, extend)?;
+            let pixels = map_pixels(&map, path)?;
+            if let Some(dir) = &frames_dir {
+                let png = dir.join(format!("{stem}_{k:0digits$}.png"));
+                let bytes = encode_png(&pixels, self.size).map_err(|e| PlotError::Figure {
+                    path: Some(png.clone()),
+                    reason: format!("encoding the PNG: {e}"),
+                })?;
+                crate::files::write_atomically(&png, &bytes, "writing movie frame")?;
+            }
+            gif.push(&pixels)?;
+            if progress(k + 1, states).is_break() {
+                return Ok(None);
             }
         }
+        let bytes = gif.finish()?;
         crate::files::write_atomically(path, &bytes, "writing movie")?;
         Ok(Some(report))
+    }
+
+    /// The directory of the PNG frames, made if missing (`None`: no PNG frames).
+    fn png_frames_dir(&self) -> Result<Option<PathBuf>> {
+        let Some(dir) = &self.png_frames else {
+            return Ok(None);
+        };
+        std::fs::create_dir_all(dir)
+            .map_err(|e| Error::io("making the directory of the movie's PNG frames", dir, e))?;
+        Ok(Some(dir.clone()))
+    }
+
+    /// The colour map of this movie's kind.
+    fn palette(&self) -> Palette {
+        match self.kind {
+            MovieKind::CoulombStress => Palette::Diverging,
+            _ => Palette::Sequential,
+        }
     }
 
     /// Draws frame `frame` (0-based, of the frames [`Movie::save`] draws) as a still PNG
@@ -314,7 +364,8 @@ impl Movie {
                 report.frames - 1
             )));
         };
-        self.frame_map(&recording, state, report.colour_range)?
+        let extend = saturated_ends(self.kind, &recording, report.colour_range);
+        self.frame_map(&recording, state, report.colour_range, extend)?
             .save(path)?;
         Ok(report)
     }
@@ -391,19 +442,25 @@ impl Movie {
         }
     }
 
-    /// The map of one frame.
-    fn frame_map(&self, r: &Recording, state: &State, range: (f64, f64)) -> Result<Map> {
+    /// The map of one frame (`extend`: the ends of the colour scale the movie saturates).
+    fn frame_map(
+        &self,
+        r: &Recording,
+        state: &State,
+        range: (f64, f64),
+        extend: (bool, bool),
+    ) -> Result<Map> {
         let (lx, ly) = (r.lx * 1e3, r.ly * 1e3);
         let title = format!(
             "F/(μF_N) = {:.3}, ℓ/Lx = {:.3}  (event {})",
             state.load, state.ell, state.event
         );
         let ell = state.ell * lx;
-        let map = match self.kind {
+        let mut map = match self.kind {
             MovieKind::CoulombStress => {
                 let np = r.planes.len();
                 let values: Vec<f64> = state.coulomb.iter().map(|v| v / 1e6).collect();
-                let edges = plane_edges(&r.planes);
+                let edges = plane_edges(&r.planes, r.lz);
                 let mut overlay = zero_contour(&values, r.nx, &edges, lx);
                 // The interface's precursor: a bar along the bottom, a tick at its tip.
                 let (bottom, top) = (edges[0], edges[np]);
@@ -430,8 +487,24 @@ impl Movie {
                 map
             }
         };
-        Ok(map.size(self.size.0, self.size.1))
+        map.notes = vec![r.scene.clone()];
+        map.extend = Some(extend);
+        Ok(map.same_unit_axes().size(self.size.0, self.size.1))
     }
+}
+
+/// The ends of the colour scale `range` (below, above) that some recorded value of the
+/// movie passes: marked on every frame's colour bar, so that the bar stays the same.
+fn saturated_ends(kind: MovieKind, r: &Recording, range: (f64, f64)) -> (bool, bool) {
+    let values = r.states.iter().flat_map(|s| match kind {
+        MovieKind::CoulombStress => s.coulomb.iter().map(|v| v / 1e6).collect::<Vec<_>>(),
+        _ => s.area.iter().map(|a| a * 1e6).collect(),
+    });
+    values
+        .filter(|v| v.is_finite())
+        .fold((false, false), |(below, above), v| {
+            (below || v < range.0, above || v > range.1)
+        })
 }
 
 /// The 98th percentile of `values` (the value at rank `⌊0.98·n⌋` of the sorted values;
@@ -458,20 +531,17 @@ fn frame_indices(n: usize, stride: usize) -> Vec<usize> {
     indices
 }
 
-/// The rows' edges (mm) of planes at heights `planes` (m, increasing): midway between
-/// neighbours, half a spacing beyond the first and the last (1 mm for a single plane).
-fn plane_edges(planes: &[f64]) -> Vec<f64> {
+/// The rows' edges (mm) of planes at heights `planes` (m, increasing, within the block
+/// `0..=lz`): each plane owns the band of the heights nearer to it than to any other
+/// plane, from the midpoint to its lower neighbour (the interface, z = 0, for the
+/// lowest) to the midpoint to its upper one (the block's top face, z = Lz, for the
+/// highest). The rows thus tile the slab, ending at the block's faces.
+fn plane_edges(planes: &[f64], lz: f64) -> Vec<f64> {
     let z: Vec<f64> = planes.iter().map(|z| z * 1e3).collect();
-    let n = z.len();
-    if n == 1 {
-        return vec![z[0] - 0.5, z[0] + 0.5];
-    }
-    let mut edges = Vec::with_capacity(n + 1);
-    edges.push(z[0] - (z[1] - z[0]) / 2.0);
-    for k in 1..n {
-        edges.push((z[k - 1] + z[k]) / 2.0);
-    }
-    edges.push(z[n - 1] + (z[n - 1] - z[n - 2]) / 2.0);
+    let mut edges = Vec::with_capacity(z.len() + 1);
+    edges.push(0.0);
+    edges.extend(z.windows(2).map(|w| (w[0] + w[1]) / 2.0));
+    edges.push(lz * 1e3);
     edges
 }
 
@@ -515,6 +585,181 @@ fn map_pixels(map: &Map, path: &Path) -> Result<Vec<u8>> {
         reason,
     })?;
     Ok(pixels)
+}
+
+/// The indices a GIF has: 0..=254 colours, 255 transparent (a pixel as in the frame
+/// before).
+const TRANSPARENT: u8 = 255;
+/// Colours of the GIF's palette taken along the colour map (the rest are greys).
+const MAP_COLOURS: usize = 192;
+
+/// A GIF's one palette for the frames of a colour map, with each pixel's nearest entry
+/// (a table over all 2^24 colours, filled as colours are met: a frame has a few
+/// thousand).
+struct GifPalette {
+    colours: Vec<[u8; 3]>,
+    lookup: Vec<u8>,
+}
+
+impl GifPalette {
+    /// [`MAP_COLOURS`] colours evenly along `palette` (its ends included: a step is about
+    /// 2 units of a channel, below what the eye tells apart, so no band shows), the greys
+    /// from black to white for the text's anti-aliased edges, the grey of cells without
+    /// a value; 255 entries.
+    fn new(palette: Palette) -> Self {
+        let mut colours: Vec<[u8; 3]> = (0..MAP_COLOURS)
+            .map(|k| {
+                let c = palette.colour(k as f64 / (MAP_COLOURS - 1) as f64);
+                [c.0, c.1, c.2]
+            })
+            .collect();
+        colours.push([200, 200, 200]);
+        let greys = usize::from(TRANSPARENT) - colours.len();
+        colours.extend((0..greys).map(|k| {
+            let v = (255.0 * k as f64 / (greys - 1) as f64).round() as u8;
+            [v, v, v]
+        }));
+        Self {
+            colours,
+            lookup: vec![TRANSPARENT; 1 << 24],
+        }
+    }
+
+    /// The entries as the GIF's global colour table (256 entries, the last unused).
+    fn table(&self) -> Vec<u8> {
+        let mut table: Vec<u8> = self.colours.iter().flatten().copied().collect();
+        table.extend([255, 0, 255]);
+        table
+    }
+
+    /// The index of the entry nearest to `rgb`.
+    fn index(&mut self, rgb: &[u8]) -> u8 {
+        let key = (usize::from(rgb[0]) << 16) | (usize::from(rgb[1]) << 8) | usize::from(rgb[2]);
+        if self.lookup[key] == TRANSPARENT {
+            let distance = |c: &[u8; 3]| -> i32 {
+                (0..3)
+                    .map(|i| (i32::from(c[i]) - i32::from(rgb[i])).pow(2))
+                    .sum()
+            };
+            let nearest = (0..self.colours.len())
+                .min_by_key(|&k| distance(&self.colours[k]))
+                .unwrap_or(0);
+            self.lookup[key] = nearest as u8;
+        }
+        self.lookup[key]
+    }
+}
+
+/// An animated GIF encoded in memory: the first frame whole, each later one the
+/// rectangle of the pixels that changed, the unchanged ones in it transparent (the
+/// frame before shows through).
+struct GifWriter<'a> {
+    path: &'a Path,
+    encoder: gif::Encoder<Vec<u8>>,
+    palette: GifPalette,
+    size: (u16, u16),
+    delay: u16,
+    /// The indices shown after the frames so far (none before the first).
+    shown: Option<Vec<u8>>,
+}
+
+impl<'a> GifWriter<'a> {
+    fn new(path: &'a Path, size: (u32, u32), delay: u16, palette: Palette) -> Result<Self> {
+        let palette = GifPalette::new(palette);
+        // The size was checked (at most 16384, within a GIF's 65535).
+        let size = (size.0 as u16, size.1 as u16);
+        let mut encoder = gif::Encoder::new(Vec::new(), size.0, size.1, &palette.table())
+            .map_err(|e| gif_failed(path, e))?;
+        encoder
+            .set_repeat(gif::Repeat::Infinite)
+            .map_err(|e| gif_failed(path, e))?;
+        Ok(Self {
+            path,
+            encoder,
+            palette,
+            size,
+            delay,
+            shown: None,
+        })
+    }
+
+    /// Adds the frame of RGB `pixels`.
+    fn push(&mut self, pixels: &[u8]) -> Result<()> {
+        let indices: Vec<u8> = pixels
+            .chunks_exact(3)
+            .map(|p| self.palette.index(p))
+            .collect();
+        let width = usize::from(self.size.0);
+        let (left, top, w, h, buffer) = match &self.shown {
+            None => (0, 0, self.size.0, self.size.1, indices.clone()),
+            Some(shown) => changed(shown, &indices, width),
+        };
+        let frame = gif::Frame {
+            left,
+            top,
+            width: w,
+            height: h,
+            buffer: buffer.into(),
+            delay: self.delay,
+            dispose: gif::DisposalMethod::Keep,
+            transparent: self.shown.is_some().then_some(TRANSPARENT),
+            ..gif::Frame::default()
+        };
+        self.encoder
+            .write_frame(&frame)
+            .map_err(|e| gif_failed(self.path, e))?;
+        self.shown = Some(indices);
+        Ok(())
+    }
+
+    /// The GIF's bytes.
+    fn finish(self) -> Result<Vec<u8>> {
+        self.encoder
+            .into_inner()
+            .map_err(|e| gif_failed(self.path, e))
+    }
+}
+
+/// The rectangle of the pixels where `now` differs from `shown` (rows of `width`):
+/// its left, top, width, height and indices, the unchanged pixels in it transparent;
+/// one transparent pixel when none changed.
+fn changed(shown: &[u8], now: &[u8], width: usize) -> (u16, u16, u16, u16, Vec<u8>) {
+    let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
+    for (k, (a, b)) in shown.iter().zip(now).enumerate() {
+        if a != b {
+            let (x, y) = (k % width, k / width);
+            (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
+        }
+    }
+    if x0 == usize::MAX {
+        return (0, 0, 1, 1, vec![TRANSPARENT]);
+    }
+    let mut buffer = Vec::with_capacity((x1 - x0 + 1) * (y1 - y0 + 1));
+    for y in y0..=y1 {
+        let row = y * width;
+        buffer.extend((x0..=x1).map(|x| {
+            if shown[row + x] == now[row + x] {
+                TRANSPARENT
+            } else {
+                now[row + x]
+            }
+        }));
+    }
+    // Within the frame's size, itself within a GIF's 65535.
+    (
+        x0 as u16,
+        y0 as u16,
+        (x1 - x0 + 1) as u16,
+        (y1 - y0 + 1) as u16,
+        buffer,
+    )
+}
+
+fn gif_failed(path: &Path, e: gif::EncodingError) -> PlotError {
+    PlotError::Figure {
+        path: Some(path.to_path_buf()),
+        reason: format!("encoding the GIF: {e}"),
+    }
 }
 
 /// The fields recorded in `dir`: its scene record gives the grid and the planes,
@@ -568,12 +813,23 @@ fn read_recording(dir: &Path) -> Result<Recording> {
         return Err(no_fields(format!("its {FIELDS_FILE} holds no state")));
     }
     let block = grid.block();
+    // The directory's name as written: its underscores are no subscripts.
+    let mut scene = format!(
+        "{}: {}, {nx} x {ny} cells",
+        super::figures::name(dir).replace('_', "\\_"),
+        super::figures::run_title(dir)
+    );
+    if !planes.is_empty() {
+        scene.push_str(&format!(", {} planes", planes.len()));
+    }
     Ok(Recording {
         nx,
         ny,
         lx: block.lx(),
         ly: block.ly(),
+        lz: block.lz(),
         planes,
+        scene,
         states,
     })
 }
