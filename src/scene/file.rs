@@ -620,12 +620,12 @@ impl HeightsSpec {
 impl SolverSpec {
     /// The solver's options; iteration counts out of range name their key (a count of 0
     /// included).
-    fn to_options(&self) -> Result<SolverOptions> {
+    fn into_options(self) -> Result<SolverOptions> {
         super::bounds::solver_iterations(
             self.max_active_set_iterations,
             self.max_linear_iterations,
         )?;
-        Ok(SolverOptions::default()
+        SolverOptions::default()
             .with_parallelism(self.threads.into())?
             .with_backend(match self.backend {
                 BackendSpec::Auto => Backend::Auto,
@@ -634,7 +634,7 @@ impl SolverSpec {
             })?
             .with_tolerance(self.tolerance)?
             .with_max_active_set_iterations(self.max_active_set_iterations)?
-            .with_max_linear_iterations(self.max_linear_iterations)?)
+            .with_max_linear_iterations(self.max_linear_iterations)
     }
 }
 
@@ -677,7 +677,7 @@ impl SceneFile {
         )?;
         let law = SpringLaw::new(springs.c_x, springs.c_z)?.with_area_law(springs.area_law);
         let heights = heights.into_source(base, || grid_cells(block, cells, max_cells))?;
-        let solver = solver.to_options()?;
+        let solver = solver.into_options()?;
         let probes = probes.to_spec()?;
         Ok(SceneBuilder {
             lengths: (block.lx, block.ly, block.lz),
