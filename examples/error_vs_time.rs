@@ -22,6 +22,7 @@ mod report;
 
 use precursors::solver::{Parallelism, SolverOptions};
 use precursors::{Drive, Event, ForceLoad, Lateral, Scene, SceneBuilder};
+use report::AtPath;
 use std::io::Write;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -136,9 +137,9 @@ fn run() -> report::Outcome {
             Err(_) => return Err(format!("invalid thread count '{t}'").into()),
         },
     };
-    std::fs::create_dir_all("out").map_err(|e| format!("cannot create out/: {e}"))?;
+    report::writable_dir("out")?;
     let path = format!("out/error_vs_time_{name}.csv");
-    let mut csv = std::fs::File::create(&path).map_err(|e| format!("cannot write {path}: {e}"))?;
+    let mut csv = std::fs::File::create(&path).at("create", &path)?;
     eprintln!("reference run (solver 1e-14) ...");
     let reference = one(&base, 1e-14, threads)?;
     eprintln!(

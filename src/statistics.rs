@@ -303,22 +303,8 @@ pub fn fit_power_law(
     support: Support,
     options: &PowerLawOptions,
 ) -> Result<PowerLawFit> {
-    let confidence = options.confidence;
-    if !(confidence > 0.0 && confidence < 1.0) {
-        return Err(Error::InvalidParameter {
-            name: "confidence",
-            value: confidence,
-            reason: "the confidence level must lie strictly between 0 and 1",
-        });
-    }
+    check_fit_options(options)?;
     let min_tail = options.min_tail;
-    if min_tail < 2 {
-        return Err(Error::InvalidCount {
-            name: "min_tail",
-            value: min_tail as u64,
-            reason: "a tail needs at least 2 samples to fit an exponent",
-        });
-    }
     let xs = positive_sorted(samples, support)?;
     let n = xs.len();
     if n < min_tail {
@@ -335,54 +321,12 @@ pub fn fit_power_law(
         reason: "all positive samples are equal (or their logarithms are): a power law \
                  needs two distinct values",
     })?;
-    let alpha_std_error = match support {
-        Support::Continuous => (best.alpha - 1.0) / (best.tail as f64).sqrt(),
-        Support::Discrete => {
-            let (_, variance) = discrete_score(best.alpha, best.x_min, 0.0);
-            let fisher = best.tail as f64 * variance;
-            // Var(ln X) > 0 for any law over two integers or more; the guard only keeps a
-            // rounding accident from giving an infinite or NaN error.
-            if fisher > 0.0 && fisher.is_finite() {
-                1.0 / fisher.sqrt()
-            } else {
-                (best.alpha - 1.0) / (best.tail as f64).sqrt()
-            }
-        }
-    };
-
-    // The bootstrap: whole refits of resamples (counts per sorted index keep them sorted
-    // without a sort).
-    let (mut alpha_low, mut alpha_high) = (best.alpha, best.alpha);
-    let (mut x_min_low, mut x_min_high) = (best.x_min, best.x_min);
-    if options.bootstrap > 0 {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(options.seed);
-        let mut counts = vec![0usize; n];
-        let mut resample = Vec::with_capacity(n);
-        let mut alphas = Vec::with_capacity(options.bootstrap);
-        let mut x_mins = Vec::with_capacity(options.bootstrap);
-        for _ in 0..options.bootstrap {
-            counts.iter_mut().for_each(|c| *c = 0);
-            for _ in 0..n {
-                counts[rng.random_range(0..n)] += 1;
-            }
-            resample.clear();
-            for (&x, &c) in xs.iter().zip(&counts) {
-                resample.extend(std::iter::repeat_n(x, c));
-            }
-            if let Some(fit) = fit_sorted(&resample, support, min_tail, &mut scratch) {
-                alphas.push(fit.alpha);
-                x_mins.push(fit.x_min);
-            }
-        }
-        if let (Some(a), Some(x)) = (
-            percentile_interval(&mut alphas, confidence),
-            percentile_interval(&mut x_mins, confidence),
-        ) {
-            (alpha_low, alpha_high) = a;
-            (x_min_low, x_min_high) = x;
-        }
-    }
-
+    let alpha_std_error = alpha_std_error(&best, support);
+    // Without a bootstrap (or no resample fitted), the intervals are the estimate alone.
+    let ((alpha_low, alpha_high), (x_min_low, x_min_high)) = (options.bootstrap > 0)
+        .then(|| bootstrap_intervals(&xs, support, options, &mut scratch))
+        .flatten()
+        .unwrap_or(((best.alpha, best.alpha), (best.x_min, best.x_min)));
     let p_value = (options.goodness_samples > 0).then(|| {
         goodness_of_fit(
             &xs,
@@ -395,7 +339,6 @@ pub fn fit_power_law(
             &mut scratch,
         )
     });
-
     Ok(PowerLawFit {
         support,
         samples: n,
@@ -410,6 +353,82 @@ pub fn fit_power_law(
         ks_distance: best.ks,
         p_value,
     })
+}
+
+/// The options [`fit_power_law`] refuses: a confidence level outside `(0, 1)` (or NaN)
+/// and a minimum tail below 2.
+fn check_fit_options(options: &PowerLawOptions) -> Result<()> {
+    let confidence = options.confidence;
+    if !(confidence > 0.0 && confidence < 1.0) {
+        return Err(Error::InvalidParameter {
+            name: "confidence",
+            value: confidence,
+            reason: "the confidence level must lie strictly between 0 and 1",
+        });
+    }
+    if options.min_tail < 2 {
+        return Err(Error::InvalidCount {
+            name: "min_tail",
+            value: options.min_tail as u64,
+            reason: "a tail needs at least 2 samples to fit an exponent",
+        });
+    }
+    Ok(())
+}
+
+/// The asymptotic standard error of the maximum-likelihood `α`: `(α - 1)/√n` for
+/// continuous samples, `1/√(n Var(ln X))` (the Fisher information) for discrete ones.
+fn alpha_std_error(best: &TailFit, support: Support) -> f64 {
+    match support {
+        Support::Continuous => (best.alpha - 1.0) / (best.tail as f64).sqrt(),
+        Support::Discrete => {
+            let (_, variance) = discrete_score(best.alpha, best.x_min, 0.0);
+            let fisher = best.tail as f64 * variance;
+            // Var(ln X) > 0 for any law over two integers or more; the guard only keeps a
+            // rounding accident from giving an infinite or NaN error.
+            if fisher > 0.0 && fisher.is_finite() {
+                1.0 / fisher.sqrt()
+            } else {
+                (best.alpha - 1.0) / (best.tail as f64).sqrt()
+            }
+        }
+    }
+}
+
+/// The bootstrap's percentile intervals `((α_low, α_high), (x_min_low, x_min_high))`:
+/// whole refits of `options.bootstrap` resamples of the sorted samples `xs` (Clauset et
+/// al. sec. 3.4); `None` when no resample could be fitted. Counts per sorted index keep
+/// a resample sorted without a sort.
+fn bootstrap_intervals(
+    xs: &[f64],
+    support: Support,
+    options: &PowerLawOptions,
+    scratch: &mut Scratch,
+) -> Option<((f64, f64), (f64, f64))> {
+    let n = xs.len();
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(options.seed);
+    let mut counts = vec![0usize; n];
+    let mut resample = Vec::with_capacity(n);
+    let mut alphas = Vec::with_capacity(options.bootstrap);
+    let mut x_mins = Vec::with_capacity(options.bootstrap);
+    for _ in 0..options.bootstrap {
+        counts.iter_mut().for_each(|c| *c = 0);
+        for _ in 0..n {
+            counts[rng.random_range(0..n)] += 1;
+        }
+        resample.clear();
+        for (&x, &c) in xs.iter().zip(&counts) {
+            resample.extend(std::iter::repeat_n(x, c));
+        }
+        if let Some(fit) = fit_sorted(&resample, support, options.min_tail, scratch) {
+            alphas.push(fit.alpha);
+            x_mins.push(fit.x_min);
+        }
+    }
+    Some((
+        percentile_interval(&mut alphas, options.confidence)?,
+        percentile_interval(&mut x_mins, options.confidence)?,
+    ))
 }
 
 /// The most bins (edges) [`log_binned`] makes.
@@ -1466,7 +1485,7 @@ mod tests {
     }
 
     #[test]
-    fn bad_inputs_give_typed_errors() {
+    fn bad_samples_give_typed_errors() {
         let good = pareto(2.5, 1.0, 50, 1);
         let options = PowerLawOptions::default().bootstrap(0).goodness_samples(0);
         let fit = |xs: &[f64], support, o: &PowerLawOptions| fit_power_law(xs, support, o);
@@ -1503,6 +1522,27 @@ mod tests {
                 ..
             }
         ));
+        let e = fit(&[3.0; 20], Support::Discrete, &options).unwrap_err();
+        assert!(matches!(
+            e,
+            Error::InvalidParameter {
+                name: "samples",
+                value: 3.0,
+                ..
+            }
+        ));
+        let huge = [1.0, 2.0, 3.0, 1e16];
+        let e = fit(&huge, Support::Discrete, &options.clone().min_tail(2)).unwrap_err();
+        assert!(
+            matches!(e, Error::InvalidParameter { name: "samples", value, .. } if value == 1e16)
+        );
+    }
+
+    #[test]
+    fn bad_fit_options_give_typed_errors() {
+        let good = pareto(2.5, 1.0, 50, 1);
+        let options = PowerLawOptions::default().bootstrap(0).goodness_samples(0);
+        let fit = |xs: &[f64], support, o: &PowerLawOptions| fit_power_law(xs, support, o);
         // 9 positive samples (the zero and the negative one do not count) for min_tail 10.
         let few = [0.0, -1.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0];
         let e = fit(&few, Support::Discrete, &options).unwrap_err();
@@ -1534,15 +1574,11 @@ mod tests {
                 matches!(e, Error::InvalidCount { name: "min_tail", value, .. } if value == m as u64)
             );
         }
-        let e = fit(&[3.0; 20], Support::Discrete, &options).unwrap_err();
-        assert!(matches!(
-            e,
-            Error::InvalidParameter {
-                name: "samples",
-                value: 3.0,
-                ..
-            }
-        ));
+    }
+
+    #[test]
+    fn bad_bin_counts_give_typed_errors() {
+        let good = pareto(2.5, 1.0, 50, 1);
         let e = log_binned(&good, Support::Continuous, 0).unwrap_err();
         assert!(matches!(
             e,
@@ -1570,11 +1606,6 @@ mod tests {
                 ..
             }
         ));
-        let huge = [1.0, 2.0, 3.0, 1e16];
-        let e = fit(&huge, Support::Discrete, &options.clone().min_tail(2)).unwrap_err();
-        assert!(
-            matches!(e, Error::InvalidParameter { name: "samples", value, .. } if value == 1e16)
-        );
     }
 
     #[test]

@@ -265,6 +265,7 @@ fn a_checkpoint_is_refused_on_another_scene() {
 #[cfg(feature = "serde")]
 pub(crate) mod json {
     use super::*;
+    use crate::common::scratch;
 
     /// FNV-1a, 64 bits (offset basis 0xcbf29ce484222325, prime 0x100000001b3: the
     /// published constants), written here from its definition.
@@ -376,11 +377,6 @@ pub(crate) mod json {
         // Unedited, it resumes.
         let c = Checkpoint::from_json_str(&text).unwrap();
         assert!(c.scene().clone().build().unwrap().resume(&c).is_ok());
-    }
-
-    /// A fresh directory under the system's temporary directory.
-    fn scratch(name: &str) -> std::path::PathBuf {
-        crate::common::scratch("checkpoint", name)
     }
 
     #[test]
@@ -602,10 +598,7 @@ pub(crate) mod json {
     /// but not with the tables of its run: `RunTables::resume` refuses it before writing.
     #[test]
     fn a_checkpoint_whose_load_was_edited_does_not_resume_its_tables() {
-        let dir =
-            std::env::temp_dir().join(format!("precursors-{}-checkpoint-load", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = scratch("load");
         let scene = Scene::builder()
             .block(0.020, 0.004, 0.020)
             .normal_load(200.0)

@@ -7,11 +7,8 @@
 //! point's `scene.json`, run directories swapped, `sweep.json` edited.
 
 use crate::common::program::{contents, path, precursors, stderr};
+use crate::common::scratch;
 use std::path::{Path, PathBuf};
-
-fn scratch(name: &str) -> PathBuf {
-    crate::common::scratch("damage", name)
-}
 
 /// Two loads, two realizations of a tiny scene (30 x 5 cells) recording its fields.
 const SWEEP: &str = r#"{ "base": { "block": { "lx": 0.03, "ly": 0.005, "lz": 0.02 },

@@ -7,15 +7,10 @@
 //! before the split (commit 1b83f13, `precursors sweep/merge/plot` on the same inputs,
 //! its `error: ...` line): an earlier, independent computation of the same text.
 
+use crate::common::scratch;
 use precursors::sweep::{merge, Sweep, SweepError};
 use precursors::Error;
 use std::error::Error as _;
-use std::path::PathBuf;
-
-/// A fresh, empty directory under the system's temporary one.
-fn scratch(name: &str) -> PathBuf {
-    crate::common::scratch("error-types", name)
-}
 
 /// The tiny base scene of tests/sweep.rs (30 x 5 cells).
 const BASE: &str = r#"{ "block": { "lx": 0.03, "ly": 0.005, "lz": 0.02 },

@@ -75,11 +75,11 @@ use crate::common::program::SLURM_VARS;
 // Running the program under bounds
 // ---------------------------------------------------------------------------------------
 
-/// A fresh directory for one case.
+/// A fresh directory for one case (numbered: a case name may repeat).
 fn scratch(name: &str) -> PathBuf {
     static NEXT: AtomicUsize = AtomicUsize::new(0);
     let n = NEXT.fetch_add(1, Ordering::SeqCst);
-    crate::common::scratch("hostile", &format!("{name}-{n}"))
+    crate::common::scratch(&format!("{name}-{n}"))
 }
 
 /// How a command ended.

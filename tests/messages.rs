@@ -9,13 +9,10 @@
 //! with permissions 0o555 stands for the read-only disk (when they stop this user's
 //! writes), else a directory in the way of the file to write.
 
+use crate::common::scratch;
 use precursors::SceneBuilder;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
-
-fn scratch(name: &str) -> PathBuf {
-    crate::common::scratch("messages", name)
-}
 
 /// A tiny scene: 30 x 5 = 150 cells (a run to global slip: about 10 ms).
 const BASE: &str = r#"{ "block": { "lx": 0.03, "ly": 0.005, "lz": 0.02 },

@@ -7,6 +7,7 @@
 //! the movies against a hand-written `fields.csv` whose colours and frame order follow
 //! from the palette's documented stops (not from the code that draws them).
 
+use crate::common::scratch;
 use precursors::output::RunTables;
 use precursors::plot::{Movie, MovieKind, PlotError};
 use precursors::{Error, Event, ProbeSpec, RunOptions, Scene, SceneBuilder};
@@ -14,10 +15,6 @@ use std::path::{Path, PathBuf};
 
 // The documented file-format names and values (docs/cli.md, docs/sweep-format.md).
 const FIELDS_TABLE: &str = "fields.csv";
-
-fn scratch(name: &str) -> PathBuf {
-    crate::common::scratch("movie", name)
-}
 
 /// A 20 x 4-cell scene driven by the rod (the default drive) to global slip.
 fn builder() -> SceneBuilder {

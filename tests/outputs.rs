@@ -8,13 +8,10 @@
 //! directory's bytes before and after a refusal.
 
 use crate::common::program::{command, contents, path, precursors, stderr};
+use crate::common::scratch;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 use std::time::{Duration, Instant};
-
-fn scratch(name: &str) -> PathBuf {
-    crate::common::scratch("outputs", name)
-}
 
 /// A tiny scene (30 x 5 cells, about 10 ms to global slip) recording its fields (one
 /// plane) for the movies.

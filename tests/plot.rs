@@ -6,18 +6,15 @@
 //! series' colours are drawn, the text of the embedded font is drawn where the title
 //! goes) and by reading the SVG's text.
 
+use crate::common::scratch;
 use precursors::output::RunTables;
 use precursors::plot::{draw, Format};
 use precursors::plot::{Chart, Corner, Map, Palette, PlotError, Style};
 use precursors::{Drive, Error, Event, Lateral, Scene, SceneBuilder};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 // The documented file-format names and values (docs/cli.md, docs/sweep-format.md).
 const CONTACT_MAP_STEP: f64 = 0.005;
-
-fn scratch(name: &str) -> PathBuf {
-    crate::common::scratch("plot", name)
-}
 
 /// A 40 x 5-cell rod-driven scene: about 200 events to global slip.
 fn scene() -> Scene {

@@ -9,13 +9,10 @@
 //! Recording must leave the other tables byte for byte as they are, and a resumed run
 //! must end with the uninterrupted run's table.
 
+use crate::common::scratch;
 use precursors::output::RunTables;
 use precursors::{Drive, Error, Event, ProbeSpec, RunOptions, Scene, SceneBuilder};
-use std::path::{Path, PathBuf};
-
-fn scratch(name: &str) -> PathBuf {
-    crate::common::scratch("profiles", name)
-}
+use std::path::Path;
 
 /// A 20 x 4-cell scene driven by the rod (the default drive) to global slip.
 fn builder() -> SceneBuilder {

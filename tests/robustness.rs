@@ -600,8 +600,7 @@ mod file {
 #[test]
 fn the_contact_map_refuses_loads_beyond_the_friction_limit() {
     use precursors::output::RunTables;
-    let dir = std::env::temp_dir().join(format!("precursors-{}-map-guard", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::scratch("map-guard");
     let scene = Scene::builder()
         .block(0.02, 0.004, 0.01)
         .cells(20, 4)

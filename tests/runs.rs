@@ -6,6 +6,7 @@
 //! random moments and continued ends with the tables of an undisturbed run. The reference
 //! is always an undisturbed run or sweep of the same scene.
 
+use crate::common::scratch;
 use precursors::output::RunTables;
 use precursors::sweep::{merge, Sweep, SweepError, SweepOptions};
 use precursors::{Error, Scene};
@@ -15,11 +16,6 @@ use std::path::{Path, PathBuf};
 const PARTIAL_SUFFIX: &str = ".partial";
 const TABLE_NAMES: [&str; 3] = ["events.csv", "curve.csv", "contact_map.csv"];
 const DONE_FILE: &str = "done";
-
-/// A fresh, empty directory under the system's temporary one.
-fn scratch(name: &str) -> PathBuf {
-    crate::common::scratch("runs", name)
-}
 
 /// A tiny scene: 30 x 5 = 150 cells, about 330 events to global slip.
 const SCENE: &str = r#"{ "block": { "lx": 0.03, "ly": 0.005, "lz": 0.02 },

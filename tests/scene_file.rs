@@ -3,17 +3,13 @@
 //! calibration scene's, mistakes are typed errors, and the documented examples and the
 //! files in `examples/scenes/` stay valid.
 
+use crate::common::scratch;
 use precursors::solver::{Backend, Parallelism, SolverOptions};
 use precursors::*;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 // The documented file-format names and values (docs/cli.md, docs/sweep-format.md).
 const MAX_RUNS: usize = 100_000;
-
-/// A fresh directory under the system's temporary one.
-fn scratch(name: &str) -> PathBuf {
-    crate::common::scratch("scene-file", name)
-}
 
 /// A builder with every option away from its default.
 fn everything() -> SceneBuilder {

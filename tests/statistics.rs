@@ -102,7 +102,7 @@ fn read_avalanches(events: &[HashMap<String, String>]) -> Vec<Read> {
 
 #[test]
 fn the_calibration_runs_avalanches_and_damage_front() {
-    let dir = scratch("statistics", "calibration");
+    let dir = scratch("calibration");
     run(&calibration(), &dir);
     let events = table(&dir.join("events.csv"));
     let rows = table(&dir.join("per_avalanche.csv"));
@@ -177,7 +177,7 @@ fn a_spring_drive_drops_its_force_in_avalanches() {
         })
         .build()
         .unwrap();
-    let dir = scratch("statistics", "spring");
+    let dir = scratch("spring");
     run(&scene, &dir);
     let events = table(&dir.join("events.csv"));
     let rows = table(&dir.join("per_avalanche.csv"));
@@ -200,7 +200,7 @@ fn a_spring_drive_drops_its_force_in_avalanches() {
 #[test]
 fn the_observers_agree_with_the_tables_and_a_resumed_run_derives_the_same() {
     let scene = calibration();
-    let dir = scratch("statistics", "observers");
+    let dir = scratch("observers");
     let mut driver = scene.driver().unwrap();
     let first = driver.step().unwrap().unwrap();
     let mut front = DamageFront::new(driver.grid(), driver.site_states()).unwrap();
@@ -276,7 +276,7 @@ const SWEEP: &str = r#"{
 #[test]
 fn stats_pool_each_points_realizations() {
     use precursors::sweep::{statistics, StatsOptions, Sweep, SweepOptions};
-    let dir = scratch("statistics", "sweep");
+    let dir = scratch("sweep");
     let sweep = Sweep::from_json_str(SWEEP).unwrap();
     sweep.execute(&dir, &SweepOptions::new(), |_| {}).unwrap();
     let options = StatsOptions::default().fit(
@@ -341,7 +341,7 @@ mod cli {
 
     #[test]
     fn stats_of_a_run_and_its_refusals() {
-        let dir = scratch("statistics", "cli");
+        let dir = scratch("cli");
         let run_dir = dir.join("run");
         std::fs::create_dir_all(&run_dir).unwrap();
         run(&calibration(), &run_dir);

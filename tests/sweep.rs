@@ -2,20 +2,13 @@
 //! seeds are stable, complete runs are skipped and cut ones redone, and the tables do not
 //! depend on the jobs or the shards. The program's side (feature `cli`) is at the end.
 
+use crate::common::scratch;
 use precursors::sweep::{derive_seed, merge, Sweep, SweepError, SweepOptions};
 use precursors::Error;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 // The documented file-format names and values (docs/cli.md, docs/sweep-format.md).
 const DONE_FILE: &str = "done";
-
-/// A fresh, empty directory under the system's temporary one.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("precursors-{}-sweep-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// A tiny base scene: 30 x 5 = 150 cells (a run to global slip: about 10 ms).
 const BASE: &str = r#"{ "block": { "lx": 0.03, "ly": 0.005, "lz": 0.02 },

@@ -10,7 +10,8 @@
 use super::schema::{observes, schema_enum, schema_leaf, schema_struct, Schema};
 use super::{Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder};
 use crate::interface::AreaLaw;
-use crate::solver::{Backend, Parallelism};
+use crate::probe::ProbeSpec;
+use crate::solver::{Backend, Parallelism, SolverOptions};
 use crate::surface::SurfaceSpectrum;
 use std::path::PathBuf;
 #[cfg(feature = "serde")]
@@ -19,9 +20,7 @@ use {
     crate::error::{Error, Result},
     crate::geometry::Point,
     crate::interface::{HeightDistribution, Material, SpringLaw},
-    crate::probe::ProbeSpec,
     crate::recording::RunOptions,
-    crate::solver::SolverOptions,
     serde::{Deserialize, Serialize},
     std::path::Path,
 };
@@ -388,26 +387,9 @@ impl From<LateralSpec> for Lateral {
     }
 }
 
-impl From<&SceneBuilder> for SceneFile {
-    fn from(b: &SceneBuilder) -> Self {
-        // Every field of the builder, by name: a field added to the builder and not to
-        // the file does not compile.
-        let SceneBuilder {
-            lengths: (lx, ly, lz),
-            cells,
-            material,
-            law,
-            heights,
-            seed: _,
-            normal_load,
-            drive,
-            solver,
-            plan_tolerance,
-            probes,
-            max_cells,
-            run,
-        } = b;
-        let drive = match *drive {
+impl From<Drive> for DriveSpec {
+    fn from(drive: Drive) -> Self {
+        match drive {
             Drive::Force(ForceLoad::Top) => DriveSpec::Top {},
             Drive::Force(ForceLoad::Lateral(Lateral::Rod { height, half_width })) => {
                 DriveSpec::Rod { height, half_width }
@@ -421,8 +403,53 @@ impl From<&SceneBuilder> for SceneFile {
                 stiffness,
                 lateral: lateral.into(),
             },
-        };
-        let heights = match heights {
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl From<DriveSpec> for Drive {
+    fn from(drive: DriveSpec) -> Self {
+        match drive {
+            DriveSpec::Top {} => Drive::Force(ForceLoad::Top),
+            DriveSpec::Rod { height, half_width } => {
+                Drive::Force(ForceLoad::Lateral(Lateral::Rod { height, half_width }))
+            }
+            DriveSpec::Side {} => Drive::Force(ForceLoad::Lateral(Lateral::Side)),
+            DriveSpec::Mixed { ratio, lateral } => Drive::Force(ForceLoad::Mixed {
+                ratio,
+                lateral: lateral.into(),
+            }),
+            DriveSpec::Spring { stiffness, lateral } => Drive::Spring {
+                stiffness,
+                lateral: lateral.into(),
+            },
+        }
+    }
+}
+
+impl From<Cells> for CellsSpec {
+    fn from(cells: Cells) -> Self {
+        match cells {
+            Cells::Size(dx, dy) => CellsSpec::Size { dx, dy },
+            Cells::Count(nx, ny) => CellsSpec::Count { nx, ny },
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl From<CellsSpec> for Cells {
+    fn from(cells: CellsSpec) -> Self {
+        match cells {
+            CellsSpec::Size { dx, dy } => Cells::Size(dx, dy),
+            CellsSpec::Count { nx, ny } => Cells::Count(nx, ny),
+        }
+    }
+}
+
+impl From<&HeightSource> for HeightsSpec {
+    fn from(heights: &HeightSource) -> Self {
+        match heights {
             HeightSource::Random { distribution, seed } => HeightsSpec::Gaussian {
                 mean: distribution.mean(),
                 std_dev: distribution.std_dev(),
@@ -457,22 +484,62 @@ impl From<&SceneBuilder> for SceneFile {
                     seed: *seed,
                 },
             },
-        };
-        let backend = match solver.backend() {
-            Backend::Dense => BackendSpec::Dense,
-            Backend::Spectral => BackendSpec::Spectral,
-            _ => BackendSpec::Auto,
-        };
+        }
+    }
+}
+
+impl From<&SolverOptions> for SolverSpec {
+    fn from(solver: &SolverOptions) -> Self {
+        SolverSpec {
+            backend: match solver.backend() {
+                Backend::Dense => BackendSpec::Dense,
+                Backend::Spectral => BackendSpec::Spectral,
+                _ => BackendSpec::Auto,
+            },
+            tolerance: solver.tolerance(),
+            max_active_set_iterations: solver.max_active_set_iterations(),
+            max_linear_iterations: solver.max_linear_iterations(),
+            threads: solver.parallelism().into(),
+        }
+    }
+}
+
+impl From<&ProbeSpec> for ProbesSpec {
+    fn from(probes: &ProbeSpec) -> Self {
+        ProbesSpec {
+            planes: probes.planes().to_vec(),
+            points: probes.points().iter().map(|p| [p.x, p.y, p.z]).collect(),
+            tolerance: probes.tolerance(),
+        }
+    }
+}
+
+impl From<&SceneBuilder> for SceneFile {
+    fn from(b: &SceneBuilder) -> Self {
+        // Every field of the builder, by name: a field added to the builder and not to
+        // the file does not compile.
+        let SceneBuilder {
+            lengths: (lx, ly, lz),
+            cells,
+            material,
+            law,
+            heights,
+            seed: _,
+            normal_load,
+            drive,
+            solver,
+            plan_tolerance,
+            probes,
+            max_cells,
+            run,
+        } = b;
         SceneFile {
             block: BlockSpec {
                 lx: *lx,
                 ly: *ly,
                 lz: *lz,
             },
-            cells: match *cells {
-                Cells::Size(dx, dy) => CellsSpec::Size { dx, dy },
-                Cells::Count(nx, ny) => CellsSpec::Count { nx, ny },
-            },
+            cells: (*cells).into(),
             material: MaterialSpec {
                 young_modulus: material.young_modulus(),
                 poisson_ratio: material.poisson_ratio(),
@@ -483,22 +550,12 @@ impl From<&SceneBuilder> for SceneFile {
                 c_z: law.c_z(),
                 area_law: law.area_law(),
             },
-            heights,
+            heights: heights.into(),
             normal_load: *normal_load,
-            drive,
-            solver: SolverSpec {
-                backend,
-                tolerance: solver.tolerance(),
-                max_active_set_iterations: solver.max_active_set_iterations(),
-                max_linear_iterations: solver.max_linear_iterations(),
-                threads: solver.parallelism().into(),
-            },
+            drive: (*drive).into(),
+            solver: solver.into(),
             plan_tolerance: *plan_tolerance,
-            probes: ProbesSpec {
-                planes: probes.planes().to_vec(),
-                points: probes.points().iter().map(|p| [p.x, p.y, p.z]).collect(),
-                tolerance: probes.tolerance(),
-            },
+            probes: probes.into(),
             max_cells: *max_cells,
             fields: FieldsSpec {
                 every: run.fields_every(),
@@ -513,17 +570,15 @@ impl From<&SceneBuilder> for SceneFile {
 }
 
 #[cfg(feature = "serde")]
-impl SceneFile {
-    /// The builder; a heights file is read relative to `base`.
-    fn into_builder(self, base: &Path) -> Result<SceneBuilder> {
-        let material = Material::new(
-            self.material.young_modulus,
-            self.material.poisson_ratio,
-            self.material.friction_coefficient,
-        )?;
-        let law = SpringLaw::new(self.springs.c_x, self.springs.c_z)?
-            .with_area_law(self.springs.area_law);
-        let heights = match self.heights {
+impl HeightsSpec {
+    /// The height source; a heights file is read relative to `base`, bounded by
+    /// `grid_cells` (asked only for a file).
+    fn into_source(
+        self,
+        base: &Path,
+        grid_cells: impl FnOnce() -> Option<usize>,
+    ) -> Result<HeightSource> {
+        Ok(match self {
             HeightsSpec::Gaussian {
                 mean,
                 std_dev,
@@ -556,78 +611,106 @@ impl SceneFile {
                 distribution: HeightDistribution::new(mean, std_dev)?,
                 seed,
             },
-            HeightsSpec::File { path } => {
-                // The file is bounded by the grid's cells before it is read (when the grid
-                // is valid; otherwise by the memory available).
-                let cells = SceneBuilder::default()
-                    .block(self.block.lx, self.block.ly, self.block.lz)
-                    .max_cells(self.max_cells);
-                let cells = match self.cells {
-                    CellsSpec::Size { dx, dy } => cells.cell_size(dx, dy),
-                    CellsSpec::Count { nx, ny } => cells.cells(nx, ny),
-                };
-                let cells = cells.grid().ok().map(|g| g.len());
-                HeightSource::read_file(&base.join(path), cells)?
-            }
-        };
-        let drive = match self.drive {
-            DriveSpec::Top {} => Drive::Force(ForceLoad::Top),
-            DriveSpec::Rod { height, half_width } => {
-                Drive::Force(ForceLoad::Lateral(Lateral::Rod { height, half_width }))
-            }
-            DriveSpec::Side {} => Drive::Force(ForceLoad::Lateral(Lateral::Side)),
-            DriveSpec::Mixed { ratio, lateral } => Drive::Force(ForceLoad::Mixed {
-                ratio,
-                lateral: lateral.into(),
-            }),
-            DriveSpec::Spring { stiffness, lateral } => Drive::Spring {
-                stiffness,
-                lateral: lateral.into(),
-            },
-        };
-        // Iteration counts out of range name their key (a count of 0 included).
+            HeightsSpec::File { path } => HeightSource::read_file(&base.join(path), grid_cells())?,
+        })
+    }
+}
+
+#[cfg(feature = "serde")]
+impl SolverSpec {
+    /// The solver's options; iteration counts out of range name their key (a count of 0
+    /// included).
+    fn into_options(self) -> Result<SolverOptions> {
         super::bounds::solver_iterations(
-            self.solver.max_active_set_iterations,
-            self.solver.max_linear_iterations,
+            self.max_active_set_iterations,
+            self.max_linear_iterations,
         )?;
-        let solver = SolverOptions::default()
-            .with_parallelism(self.solver.threads.into())?
-            .with_backend(match self.solver.backend {
+        SolverOptions::default()
+            .with_parallelism(self.threads.into())?
+            .with_backend(match self.backend {
                 BackendSpec::Auto => Backend::Auto,
                 BackendSpec::Dense => Backend::Dense,
                 BackendSpec::Spectral => Backend::Spectral,
             })?
-            .with_tolerance(self.solver.tolerance)?
-            .with_max_active_set_iterations(self.solver.max_active_set_iterations)?
-            .with_max_linear_iterations(self.solver.max_linear_iterations)?;
-        let probes = self.probes.planes.iter().fold(
-            ProbeSpec::default().with_tolerance(self.probes.tolerance)?,
+            .with_tolerance(self.tolerance)?
+            .with_max_active_set_iterations(self.max_active_set_iterations)?
+            .with_max_linear_iterations(self.max_linear_iterations)
+    }
+}
+
+#[cfg(feature = "serde")]
+impl ProbesSpec {
+    fn to_spec(&self) -> Result<ProbeSpec> {
+        let probes = self.planes.iter().fold(
+            ProbeSpec::default().with_tolerance(self.tolerance)?,
             |spec, &z| spec.with_plane(z),
         );
-        let probes = self.probes.points.iter().fold(probes, |spec, [x, y, z]| {
+        Ok(self.points.iter().fold(probes, |spec, [x, y, z]| {
             spec.with_point(Point::new(*x, *y, *z))
-        });
+        }))
+    }
+}
+
+#[cfg(feature = "serde")]
+impl SceneFile {
+    /// The builder; a heights file is read relative to `base`.
+    fn into_builder(self, base: &Path) -> Result<SceneBuilder> {
+        let SceneFile {
+            block,
+            cells,
+            material,
+            springs,
+            heights,
+            normal_load,
+            drive,
+            solver,
+            plan_tolerance,
+            probes,
+            max_cells,
+            fields,
+            profiles,
+        } = self;
+        let material = Material::new(
+            material.young_modulus,
+            material.poisson_ratio,
+            material.friction_coefficient,
+        )?;
+        let law = SpringLaw::new(springs.c_x, springs.c_z)?.with_area_law(springs.area_law);
+        let heights = heights.into_source(base, || grid_cells(block, cells, max_cells))?;
+        let solver = solver.into_options()?;
+        let probes = probes.to_spec()?;
         Ok(SceneBuilder {
-            lengths: (self.block.lx, self.block.ly, self.block.lz),
-            cells: match self.cells {
-                CellsSpec::Size { dx, dy } => Cells::Size(dx, dy),
-                CellsSpec::Count { nx, ny } => Cells::Count(nx, ny),
-            },
+            lengths: (block.lx, block.ly, block.lz),
+            cells: cells.into(),
             material,
             law,
             heights,
             seed: None,
-            normal_load: self.normal_load,
-            drive,
+            normal_load,
+            drive: drive.into(),
             solver,
-            plan_tolerance: self.plan_tolerance,
+            plan_tolerance,
             probes,
-            max_cells: self.max_cells,
+            max_cells,
             run: RunOptions::new()
-                .record_fields(self.fields.every, &self.fields.planes)
-                .record_profiles(&self.profiles.loads, &self.profiles.planes),
+                .record_fields(fields.every, &fields.planes)
+                .record_profiles(&profiles.loads, &profiles.planes),
         })
     }
+}
+
+/// The grid's cell count, which bounds a heights file before it is read (`None` when the
+/// grid is not valid: then the memory available bounds it).
+#[cfg(feature = "serde")]
+fn grid_cells(block: BlockSpec, cells: CellsSpec, max_cells: usize) -> Option<usize> {
+    let builder = SceneBuilder::default()
+        .block(block.lx, block.ly, block.lz)
+        .max_cells(max_cells);
+    let builder = match cells {
+        CellsSpec::Size { dx, dy } => builder.cell_size(dx, dy),
+        CellsSpec::Count { nx, ny } => builder.cells(nx, ny),
+    };
+    builder.grid().ok().map(|g| g.len())
 }
 
 /// What the format has at a key path: an object (serde would also take an array, its

@@ -183,10 +183,23 @@ impl Fsai {
     /// (a rupture touches a few): the others are the same function of the same inputs.
     /// Why: visiting all rows cost about 0.4 ms per solve, on one thread.
     pub(crate) fn update(&mut self, entries: &Entries, set: &[usize], d: &[f64]) {
-        let (nx, ny) = (entries.nx, entries.ny);
-        let n = nx * ny;
-        // Sites that joined, left, or changed compliance (both lists ascending).
         let mut changed = std::mem::take(&mut self.changed);
+        self.changed_sites(set, d, &mut changed);
+        self.enter_set(set, d);
+        let mut dirty = std::mem::take(&mut self.dirty);
+        self.rows_seeing(&changed, entries.nx, entries.ny, &mut dirty);
+        let mut pattern = Vec::with_capacity(self.stride);
+        let mut slots = Vec::with_capacity(self.stride);
+        for &i in &dirty {
+            self.refresh_row(entries, i, &mut pattern, &mut slots);
+        }
+        self.changed = changed;
+        self.dirty = dirty;
+    }
+
+    /// Sites that joined, left, or changed compliance between the current set and `set`
+    /// (both ascending), into `changed`.
+    fn changed_sites(&self, set: &[usize], d: &[f64], changed: &mut Vec<usize>) {
         changed.clear();
         let (old, mut a, mut b) = (&self.sites, 0, 0);
         while a < old.len() || b < set.len() {
@@ -213,6 +226,10 @@ impl Fsai {
                 (None, None) => break,
             }
         }
+    }
+
+    /// Makes `set` with compliances `d` the current set (membership, compliance per site).
+    fn enter_set(&mut self, set: &[usize], d: &[f64]) {
         for &i in &self.sites {
             self.member[i] = false;
         }
@@ -222,11 +239,14 @@ impl Fsai {
         }
         self.sites.clear();
         self.sites.extend_from_slice(set);
-        // Rows that may see a change: the box of half-width r around each changed site.
+    }
+
+    /// Rows that may see a change, into `dirty` (each once, marked): the box of half-width
+    /// `r` around each changed site.
+    fn rows_seeing(&mut self, changed: &[usize], nx: usize, ny: usize, dirty: &mut Vec<usize>) {
         let r = self.radius as isize;
-        let mut dirty = std::mem::take(&mut self.dirty);
         dirty.clear();
-        for &c in &changed {
+        for &c in changed {
             let (x, y) = ((c % nx) as isize, (c / nx) as isize);
             for yy in (y - r).max(0)..=(y + r).min(ny as isize - 1) {
                 for xx in (x - r).max(0)..=(x + r).min(nx as isize - 1) {
@@ -238,66 +258,86 @@ impl Fsai {
                 }
             }
         }
-        let mut pattern = Vec::with_capacity(self.stride);
-        let mut slots = Vec::with_capacity(self.stride);
-        for &i in &dirty {
-            self.marked[i] = false;
-            for q in 0..self.stride {
-                self.planes[q * n + i] = 0.0;
+    }
+
+    /// Row `i` of `G` on the current set and its weights in the planes (all zero off the
+    /// set). The row is rebuilt only if its pattern or the compliances on it changed.
+    fn refresh_row(
+        &mut self,
+        entries: &Entries,
+        i: usize,
+        pattern: &mut Vec<usize>,
+        slots: &mut Vec<usize>,
+    ) {
+        let n = entries.nx * entries.ny;
+        self.marked[i] = false;
+        for q in 0..self.stride {
+            self.planes[q * n + i] = 0.0;
+        }
+        if !self.member[i] {
+            return;
+        }
+        self.lower_pattern(i, entries.nx, entries.ny, pattern, slots);
+        let base = i * self.stride;
+        let k = pattern.len();
+        let same = self.len[i] == k
+            && self.cols[base..base + k] == pattern[..]
+            && pattern
+                .iter()
+                .zip(&self.diag[base..base + k])
+                .all(|(&j, &dj)| self.dsite[j].to_bits() == dj.to_bits());
+        if !same {
+            self.len[i] = k;
+            self.cols[base..base + k].copy_from_slice(pattern);
+            self.slots[base..base + k].copy_from_slice(slots);
+            for (slot, &j) in pattern.iter().enumerate() {
+                self.diag[base + slot] = self.dsite[j];
             }
-            if !self.member[i] {
-                continue;
-            }
-            let (x, y) = ((i % nx) as isize, (i / nx) as isize);
-            pattern.clear();
-            slots.clear();
-            // Lower neighbours in site order: rows y - r..=y, and on row y only x' < x.
-            let mut slot = 0;
-            for dy in -r..=0 {
-                let hi = if dy == 0 { -1 } else { r };
-                for dx in -r..=hi {
-                    let (xx, yy) = (x + dx, y + dy);
-                    if xx >= 0 && xx < nx as isize && yy >= 0 && yy < ny as isize {
-                        let j = yy as usize * nx + xx as usize;
-                        if self.member[j] {
-                            pattern.push(j);
-                            slots.push(slot);
-                        }
+            build_row(
+                entries,
+                pattern,
+                &self.diag[base..base + k],
+                &mut self.small,
+                &mut self.g[base..base + k],
+            );
+        }
+        for q in 0..k {
+            self.planes[self.slots[base + q] * n + i] = self.g[base + q];
+        }
+    }
+
+    /// The pattern of row `i` (site `i` a member) and the slot of each of its sites: the
+    /// members among its lower neighbours in site order (rows `y - r ..= y`, and on row
+    /// `y` only `x' < x`), then `i` itself.
+    fn lower_pattern(
+        &self,
+        i: usize,
+        nx: usize,
+        ny: usize,
+        pattern: &mut Vec<usize>,
+        slots: &mut Vec<usize>,
+    ) {
+        let r = self.radius as isize;
+        let (x, y) = ((i % nx) as isize, (i / nx) as isize);
+        pattern.clear();
+        slots.clear();
+        let mut slot = 0;
+        for dy in -r..=0 {
+            let hi = if dy == 0 { -1 } else { r };
+            for dx in -r..=hi {
+                let (xx, yy) = (x + dx, y + dy);
+                if xx >= 0 && xx < nx as isize && yy >= 0 && yy < ny as isize {
+                    let j = yy as usize * nx + xx as usize;
+                    if self.member[j] {
+                        pattern.push(j);
+                        slots.push(slot);
                     }
-                    slot += 1;
                 }
-            }
-            pattern.push(i);
-            slots.push(slot);
-            let base = i * self.stride;
-            let k = pattern.len();
-            let same = self.len[i] == k
-                && self.cols[base..base + k] == pattern[..]
-                && pattern
-                    .iter()
-                    .zip(&self.diag[base..base + k])
-                    .all(|(&j, &dj)| self.dsite[j].to_bits() == dj.to_bits());
-            if !same {
-                self.len[i] = k;
-                self.cols[base..base + k].copy_from_slice(&pattern);
-                self.slots[base..base + k].copy_from_slice(&slots);
-                for (slot, &j) in pattern.iter().enumerate() {
-                    self.diag[base + slot] = self.dsite[j];
-                }
-                build_row(
-                    entries,
-                    &pattern,
-                    &self.diag[base..base + k],
-                    &mut self.small,
-                    &mut self.g[base..base + k],
-                );
-            }
-            for q in 0..k {
-                self.planes[self.slots[base + q] * n + i] = self.g[base + q];
+                slot += 1;
             }
         }
-        self.changed = changed;
-        self.dirty = dirty;
+        pattern.push(i);
+        slots.push(slot);
     }
 
     /// Cells `G` reaches back (and `Gᵀ` forward): the largest slot offset.

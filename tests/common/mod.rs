@@ -5,10 +5,17 @@
 pub mod program;
 
 /// A new, empty directory for one test: `precursors-<pid>-<module>-<name>` under the
-/// temporary directory (the pid keeps two test processes apart, `module` and `name` the
-/// tests of one process), emptied if a run before left it.
+/// temporary directory, emptied if a run before left it. `module` is the calling test
+/// file's name (`sweep` for tests/sweep.rs): the pid keeps two test processes apart,
+/// `module` and `name` the tests of one process.
 #[allow(dead_code)] // not every feature set has a test that writes files
-pub fn scratch(module: &str, name: &str) -> std::path::PathBuf {
+#[track_caller]
+pub fn scratch(name: &str) -> std::path::PathBuf {
+    let caller = std::path::Path::new(std::panic::Location::caller().file());
+    let module = caller
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("tests");
     let dir =
         std::env::temp_dir().join(format!("precursors-{}-{module}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
