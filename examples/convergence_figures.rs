@@ -7,7 +7,7 @@
 //!
 //! * `convergence_KIND_precursor_length.png`: ℓ/Lx against F/(μF_N), ensemble mean and
 //!   95 % band (`curves.csv`), one curve per cell size;
-//! * `convergence_KIND_area.png`: `log₁₀(A_R/A_R(0) − 1)` against F/(μF_N) (the area's
+//! * `convergence_KIND_area.png`: `A_R/A_R(0) − 1` on a log axis against F/(μF_N) (the area's
 //!   relative growth spans 1e-5 to 10 under the paper's area law: a log axis shows every
 //!   load), same layout;
 //! * `convergence_KIND_first_precursor.png`: the first-precursor load (below) of every run
@@ -42,7 +42,7 @@
 #[path = "support/report.rs"]
 mod report;
 
-use precursors::plot::{Chart, Corner};
+use precursors::plot::{Chart, Colours, Corner};
 use precursors::sweep::mean_band;
 use report::AtPath;
 use std::collections::BTreeMap;
@@ -586,6 +586,7 @@ fn figures(studies: &[Study], dir: &Path, up_to: f64) -> report::Outcome {
         "ℓ/Lx",
     )
     .x_range(0.0, 1.0)
+    .colours(Colours::Ordered)
     .legend(Corner::UpperLeft);
     for s in studies {
         let rows: Vec<_> = s
@@ -602,13 +603,15 @@ fn figures(studies: &[Study], dir: &Path, up_to: f64) -> report::Outcome {
 
     // The relative growth of the real contact area, on a log axis, up to `--up-to` (the
     // area law's jump just before slip would set the axis otherwise).
-    let log_growth = |x: f64| if x > 1.0 { (x - 1.0).log10() } else { f64::NAN };
+    let growth = |x: f64| x - 1.0;
     let mut area = Chart::new(
         &format!("Real contact area, {heights}: mean and 95 % band per cell size"),
         "F/(μF_N)",
-        "log₁₀(A_R/A_R(0) − 1)",
+        "A_R/A_R(0) − 1",
     )
     .x_range(0.0, up_to.min(1.0))
+    .log_y()
+    .colours(Colours::Ordered)
     .legend(Corner::UpperLeft);
     for s in studies {
         let rows: Vec<_> = s
@@ -616,7 +619,7 @@ fn figures(studies: &[Study], dir: &Path, up_to: f64) -> report::Outcome {
             .iter()
             .zip(&s.area)
             .filter(|(&f, _)| f <= up_to + 1e-9)
-            .map(|(&f, &(m, lo, hi))| (f, log_growth(m), log_growth(lo), log_growth(hi)))
+            .map(|(&f, &(m, lo, hi))| (f, growth(m), growth(lo), growth(hi)))
             .collect();
         area = area.band(&s.label(), &rows);
     }
@@ -649,16 +652,19 @@ fn figures(studies: &[Study], dir: &Path, up_to: f64) -> report::Outcome {
 
     let mut aval = Chart::new(
         &format!("Avalanche sizes, {heights}: pooled over the realizations"),
-        "log₁₀(slipped area: ruptures x cell area, mm²)",
-        "log₁₀(fraction of avalanches at least as large)",
+        "slipped area: ruptures x cell area (mm²)",
+        "fraction of avalanches at least as large",
     )
+    .log_x()
+    .log_y()
+    .colours(Colours::Ordered)
     .legend(Corner::UpperRight);
     for s in studies {
         let cell_mm2 = s.dx * s.dy * 1e6;
         let points: Vec<_> = at_least(&s.avalanches)
             .iter()
             .filter(|(n, _)| *n > 0.0)
-            .map(|(n, p)| ((n * cell_mm2).log10(), p.log10()))
+            .map(|(n, p)| (n * cell_mm2, *p))
             .collect();
         aval = aval.markers(&s.label(), &points);
     }
