@@ -289,6 +289,74 @@ impl Palette {
     }
 }
 
+/// The size (1/150 inch) and the PNGs' resolution every figure of a directory is drawn at.
+#[derive(Debug, Clone, Copy)]
+struct Canvas {
+    size: (u32, u32),
+    dpi: u32,
+}
+
+impl Canvas {
+    /// An empty chart of this size and resolution.
+    fn chart(self, title: &str, x_label: &str, y_label: &str) -> Chart {
+        Chart::new(title, x_label, y_label)
+            .size(self.size.0, self.size.1)
+            .dpi(self.dpi)
+    }
+}
+
+/// How a sweep's points (each its axes' values) are coloured and in which order they are
+/// drawn: along the sequential map ([`Colours::Ordered`]), sorted by their values, when
+/// every axis that differs between them holds numbers and they rise or fall together
+/// along all of them (one axis, or axes zipped as Ly and Lz of the Fig. 6c study); else
+/// distinct colours in the sweep's order (a product of axes, a kind of drive).
+fn point_order(points: &[&[(String, String)]]) -> (Colours, Vec<usize>) {
+    let given = (Colours::Distinct, (0..points.len()).collect());
+    let Some(first) = points.first() else {
+        return given;
+    };
+    let same_keys = points
+        .iter()
+        .all(|p| p.len() == first.len() && p.iter().zip(first.iter()).all(|(a, b)| a.0 == b.0));
+    if !same_keys {
+        return given;
+    }
+    let mut columns: Vec<Vec<f64>> = Vec::new();
+    for axis in 0..first.len() {
+        if points.iter().all(|p| p[axis].1 == first[axis].1) {
+            continue;
+        }
+        let values: Option<Vec<f64>> = points
+            .iter()
+            .map(|p| p[axis].1.parse::<f64>().ok().filter(|v| v.is_finite()))
+            .collect();
+        match values {
+            Some(values) => columns.push(values),
+            None => return given,
+        }
+    }
+    let Some(lead) = columns.first() else {
+        return given;
+    };
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by(|&a, &b| lead[a].total_cmp(&lead[b]));
+    let monotone = |column: &Vec<f64>, strict: bool| {
+        let steps: Vec<f64> = order
+            .windows(2)
+            .map(|w| column[w[1]] - column[w[0]])
+            .collect();
+        let rising = steps
+            .iter()
+            .all(|d| if strict { *d > 0.0 } else { *d >= 0.0 });
+        rising || (!strict && steps.iter().all(|d| *d <= 0.0))
+    };
+    if monotone(lead, true) && columns.iter().all(|c| monotone(c, false)) {
+        (Colours::Ordered, order)
+    } else {
+        given
+    }
+}
+
 /// The colour at `t ∈ [0, 1]` of the gradient through `N` evenly spaced stops.
 fn gradient<const N: usize>(stops: [[f64; 3]; N], t: f64) -> RGBColor {
     let at = t.clamp(0.0, 1.0) * (N - 1) as f64;
@@ -2124,6 +2192,45 @@ mod tests {
         );
         // The diverging palette keeps its white middle.
         assert_eq!(Palette::Diverging.colour(0.5), RGBColor(247, 247, 247));
+    }
+
+    /// A sweep's points: ordered along one numeric axis (given out of order) or along
+    /// axes that rise together; categorical for a product of axes or words.
+    #[test]
+    fn points_are_ordered_when_their_axes_rise_together() {
+        let point = |pairs: &[(&str, &str)]| -> Vec<(String, String)> {
+            pairs
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect()
+        };
+        let order = |points: &[Vec<(String, String)>]| {
+            point_order(&points.iter().map(|p| &p[..]).collect::<Vec<_>>())
+        };
+        let heights = [
+            point(&[("drive.height", "0.006"), ("normal_load", "100")]),
+            point(&[("drive.height", "0.002"), ("normal_load", "100")]),
+            point(&[("drive.height", "0.004"), ("normal_load", "100")]),
+        ];
+        assert_eq!(order(&heights), (Colours::Ordered, vec![1, 2, 0]));
+        let zipped = [
+            point(&[("block.ly", "0.007"), ("block.lz", "0.0194")]),
+            point(&[("block.ly", "0.014"), ("block.lz", "0.0389")]),
+        ];
+        assert_eq!(order(&zipped), (Colours::Ordered, vec![0, 1]));
+        let product = [
+            point(&[("a", "1"), ("b", "1")]),
+            point(&[("a", "1"), ("b", "2")]),
+            point(&[("a", "2"), ("b", "1")]),
+            point(&[("a", "2"), ("b", "2")]),
+        ];
+        assert_eq!(order(&product), (Colours::Distinct, vec![0, 1, 2, 3]));
+        let words = [
+            point(&[("drive.kind", "\"rod\"")]),
+            point(&[("drive.kind", "\"top\"")]),
+        ];
+        assert_eq!(order(&words), (Colours::Distinct, vec![0, 1]));
+        assert_eq!(order(&heights[..1]), (Colours::Distinct, vec![0]));
     }
 
     #[test]

@@ -719,10 +719,7 @@ fn statistics_figures_show_the_runs_fit_and_fronts() {
     };
     for n in (low.log10().ceil() as i32)..=(high.log10().floor() as i32) {
         let label = superscript(n);
-        assert!(
-            texts.iter().any(|t| *t == label),
-            "{label} not in {texts:?}"
-        );
+        assert!(texts.contains(&label), "{label} not in {texts:?}");
     }
     assert!(texts.iter().all(|t| !t.contains("log")));
     let fronts: Vec<String> = svg_texts(&dir.join("fronts.svg"))

@@ -6,9 +6,8 @@
 //! load). The samples are derived from the checked tables, as `precursors stats` derives
 //! them; the goodness of fit is `stats`' (it is not drawn).
 
-use super::figures::{point_order, Canvas};
 use super::selection::Selection;
-use super::{series_colour, short, Colours, Corner, PlotError, Style};
+use super::{point_order, series_colour, short, Canvas, Colours, Corner, PlotError, Style};
 use crate::output::derived::derive;
 use crate::output::layout::{DROPS_FIGURE, FRONTS_FIGURE, SIZES_FIGURE};
 use crate::statistics::{fit_power_law, log_binned, PowerLawOptions, Support};

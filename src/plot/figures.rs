@@ -22,7 +22,7 @@ use super::paper::{draw_archard, draw_stick_slip};
 use super::profiles::draw_profiles;
 use super::selection::{Selection, NORMAL_LOAD};
 use super::PlotError;
-use super::{short, Chart, Colours, Corner, Map, Palette};
+use super::{point_order, short, Canvas, Chart, Colours, Corner, Map, Palette};
 use crate::error::{Error, Result};
 use crate::output::check::RunRecord;
 use crate::output::derived::derive;
@@ -380,74 +380,6 @@ pub fn draw_with_options(dir: &Path, options: &DrawOptions) -> Result<Drawn, Plo
     drawn.notes.extend(statistics.notes);
     drawn.notes.extend(skipped);
     Ok(drawn)
-}
-
-/// The size (1/150 inch) and the PNGs' resolution every figure of a directory is drawn at.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Canvas {
-    pub size: (u32, u32),
-    pub dpi: u32,
-}
-
-impl Canvas {
-    /// An empty chart of this size and resolution.
-    pub(super) fn chart(self, title: &str, x_label: &str, y_label: &str) -> Chart {
-        Chart::new(title, x_label, y_label)
-            .size(self.size.0, self.size.1)
-            .dpi(self.dpi)
-    }
-}
-
-/// How a sweep's points (each its axes' values) are coloured and in which order they are
-/// drawn: along the sequential map ([`Colours::Ordered`]), sorted by their values, when
-/// every axis that differs between them holds numbers and they rise or fall together
-/// along all of them (one axis, or axes zipped as Ly and Lz of the Fig. 6c study); else
-/// distinct colours in the sweep's order (a product of axes, a kind of drive).
-pub(super) fn point_order(points: &[&[(String, String)]]) -> (Colours, Vec<usize>) {
-    let given = (Colours::Distinct, (0..points.len()).collect());
-    let Some(first) = points.first() else {
-        return given;
-    };
-    let same_keys = points
-        .iter()
-        .all(|p| p.len() == first.len() && p.iter().zip(first.iter()).all(|(a, b)| a.0 == b.0));
-    if !same_keys {
-        return given;
-    }
-    let mut columns: Vec<Vec<f64>> = Vec::new();
-    for axis in 0..first.len() {
-        if points.iter().all(|p| p[axis].1 == first[axis].1) {
-            continue;
-        }
-        let values: Option<Vec<f64>> = points
-            .iter()
-            .map(|p| p[axis].1.parse::<f64>().ok().filter(|v| v.is_finite()))
-            .collect();
-        match values {
-            Some(values) => columns.push(values),
-            None => return given,
-        }
-    }
-    let Some(lead) = columns.first() else {
-        return given;
-    };
-    let mut order: Vec<usize> = (0..points.len()).collect();
-    order.sort_by(|&a, &b| lead[a].total_cmp(&lead[b]));
-    let monotone = |column: &Vec<f64>, strict: bool| {
-        let steps: Vec<f64> = order
-            .windows(2)
-            .map(|w| column[w[1]] - column[w[0]])
-            .collect();
-        let rising = steps
-            .iter()
-            .all(|d| if strict { *d > 0.0 } else { *d >= 0.0 });
-        rising || (!strict && steps.iter().all(|d| *d <= 0.0))
-    };
-    if monotone(lead, true) && columns.iter().all(|c| monotone(c, false)) {
-        (Colours::Ordered, order)
-    } else {
-        given
-    }
 }
 
 /// A sweep's point in a legend: its axes' values in the user's units, and its runs.

@@ -4,8 +4,7 @@
 //! contact area at zero shear against the normal load, over a sweep's points).
 
 use super::distributions::{PointLabel, Statistics};
-use super::figures::{point_order, Canvas};
-use super::{series_colour, Corner, PlotError, Style};
+use super::{point_order, series_colour, Canvas, Corner, PlotError, Style};
 use crate::driver::Event;
 use crate::error::Error;
 use crate::output::check::RunRecord;

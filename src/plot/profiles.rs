@@ -11,9 +11,8 @@
 //! One curve per load, coloured along the sequential map [`Colours::Ordered`] (dark at
 //! the lowest load).
 
-use super::figures::Canvas;
 use super::selection::Selection;
-use super::{short, Chart, Colours, Corner, PlotError, Style};
+use super::{short, Canvas, Chart, Colours, Corner, PlotError, Style};
 use crate::output::check::RunRecord;
 use crate::output::layout::{
     COULOMB_PROFILES_FIGURE, NORMAL_PROFILES_FIGURE, SHEAR_PROFILES_FIGURE, SLIP_PROFILES_FIGURE,
