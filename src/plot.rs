@@ -1146,11 +1146,11 @@ fn axes<'a, DB: DrawingBackend>(
 const TITLE_TOP: i32 = 12;
 /// A title's size (pixels) when it fits the picture's width.
 const TITLE_SIZE: f64 = 22.0;
-/// A title that would be set smaller than this on one line goes on two (at most this
-/// size: the tick values' size and a bit).
-const TITLE_WRAP_SIZE: f64 = 16.0;
+/// The largest size of a title on two lines (the tick values' size and a bit).
+const WRAPPED_TITLE_SIZE: f64 = 16.0;
 /// The smallest size (pixels at 150 dpi: 6.7 points) a title, an axis label or a legend
-/// entry is set at; text that does not fit at it is shortened with `…`.
+/// entry is set at: a title that would be smaller on one line goes on two, a text that
+/// does not fit even so is shortened with `…`.
 const SMALLEST_TEXT: f64 = 14.0;
 
 /// The room above the plotting area for a title of `lines` lines at `size` (50 pixels for
@@ -1161,9 +1161,10 @@ fn title_room(lines: usize, size: f64) -> u32 {
 }
 
 /// `title` laid out in `room` pixels: one line at up to [`TITLE_SIZE`], or, where that
-/// would be smaller than [`TITLE_WRAP_SIZE`], two lines cut after the `,`, `:` or `;`
-/// (else the space) that lets them be set largest; never smaller than [`SMALLEST_TEXT`],
-/// a line still too long shortened with `…`. No lines for an empty title.
+/// would be smaller than [`SMALLEST_TEXT`], two lines of up to [`WRAPPED_TITLE_SIZE`] cut
+/// after the `,`, `:` or `;` (else the space) that lets them be set largest; never
+/// smaller than [`SMALLEST_TEXT`], a line still too long shortened with `…`. No lines for
+/// an empty title.
 fn title_lines<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     title: &str,
@@ -1173,7 +1174,7 @@ fn title_lines<DB: DrawingBackend>(
         return Ok((Vec::new(), TITLE_SIZE));
     }
     let one = fitting(area, title, TITLE_SIZE, room)?;
-    if one >= TITLE_WRAP_SIZE {
+    if one >= SMALLEST_TEXT {
         return Ok((vec![title.to_string()], one));
     }
     let cuts = |punctuated: bool| {
@@ -1194,10 +1195,10 @@ fn title_lines<DB: DrawingBackend>(
     let mut best: Option<(Vec<String>, f64, i32)> = None;
     for k in candidates {
         let lines = vec![title[..k].to_string(), title[k + 1..].to_string()];
-        let (mut size, mut longest) = (TITLE_WRAP_SIZE, 0);
+        let (mut size, mut longest) = (WRAPPED_TITLE_SIZE, 0);
         for line in &lines {
-            size = size.min(fitting(area, line, TITLE_WRAP_SIZE, room)?);
-            longest = longest.max(typeset_width(area, line, TITLE_WRAP_SIZE)?);
+            size = size.min(fitting(area, line, WRAPPED_TITLE_SIZE, room)?);
+            longest = longest.max(typeset_width(area, line, WRAPPED_TITLE_SIZE)?);
         }
         if best
             .as_ref()

@@ -491,7 +491,7 @@ fn describe(keys: &[(String, String)]) -> String {
             None => format!("top and {} shear", lateral()),
         }),
         Some("spring") => parts.push(match num("drive.stiffness") {
-            Some(k) => format!("spring K_S = {k:.3e} N/m on the {}", lateral()),
+            Some(k) => format!("spring K_S = {} N/m on the {}", short(k), lateral()),
             None => format!("spring on the {}", lateral()),
         }),
         _ => {}
@@ -522,15 +522,15 @@ fn axis_value(key: &str, value: &str) -> String {
         "drive.height" | "drive.lateral.height" => length("h"),
         "drive.half_width" | "drive.lateral.half_width" => length("Δh"),
         "drive.ratio" => format!("n = {}", short(v)),
-        "drive.stiffness" => format!("K_S = {v:.3e} N/m"),
+        "drive.stiffness" => format!("K_S = {} N/m", short(v)),
         "heights.correlation_length" => length("ξ"),
         "heights.mean" => format!("mean u0 = {} µm", short(v * 1e6)),
         "heights.std_dev" => format!("sd u0 = {} µm", short(v * 1e6)),
         "material.friction_coefficient" => format!("μ = {}", short(v)),
         "material.young_modulus" => format!("E = {} GPa", short(v / 1e9)),
         "material.poisson_ratio" => format!("ν = {}", short(v)),
-        "springs.c_x" => format!("c_x = {v:.3e} N/m³"),
-        "springs.c_z" => format!("c_z = {v:.3e} N/m²"),
+        "springs.c_x" => format!("c_x = {} N/m³", short(v)),
+        "springs.c_z" => format!("c_z = {} N/m²", short(v)),
         _ => format!("{key} = {value}"),
     }
 }
@@ -887,12 +887,41 @@ mod tests {
             "ξ = 3 mm"
         );
         assert_eq!(axis_value("drive.ratio", "0.25"), "n = 0.25");
+        assert_eq!(axis_value("drive.stiffness", "4000000"), "K_S = 4e6 N/m");
+        assert_eq!(axis_value("springs.c_z", "2.5e10"), "c_z = 2.5e10 N/m²");
         // Keys without a symbol, and values that are not numbers, as written.
         assert_eq!(
             axis_value("solver.backend", "\"dense\""),
             "solver.backend = \"dense\""
         );
         assert_eq!(axis_value("heights.seed", "x"), "heights.seed = x");
+    }
+
+    /// A key that is a sweep's axis is not in the sweep's title: the drive is named
+    /// without its value (not "rod at h =  mm", "K_S = NaN N/m").
+    #[test]
+    fn a_drive_without_its_swept_value_is_named_alone() {
+        let keys = |pairs: &[(&str, &str)]| {
+            pairs
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(describe(&keys(&[("drive.kind", "rod")])), "rod");
+        assert_eq!(
+            describe(&keys(&[
+                ("drive.kind", "mixed"),
+                ("drive.lateral.kind", "rod")
+            ])),
+            "top and rod shear"
+        );
+        assert_eq!(
+            describe(&keys(&[
+                ("drive.kind", "spring"),
+                ("drive.lateral.kind", "side")
+            ])),
+            "spring on the side"
+        );
     }
 
     #[test]
@@ -925,7 +954,7 @@ mod tests {
         ]);
         assert_eq!(
             describe(&spring),
-            "Lx = 30 mm, F_N = 750 N, spring K_S = 4.000e6 N/m on the side"
+            "Lx = 30 mm, F_N = 750 N, spring K_S = 4e6 N/m on the side"
         );
     }
 
