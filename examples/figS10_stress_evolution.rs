@@ -6,7 +6,7 @@
 //!
 //! Writes `figS10.csv` (force_over_mu_FN, x_m, abs_sigma_Pa, abs_tau_Pa) and
 //! `figS10_sigma.png`, `figS10_tau.png`: |σ_zz(x, z_P)| and |τ_xz(x, z_P)| (MPa) against
-//! x (mm), one colour per load, blue through grey to red as the load grows, with legend
+//! x (mm), one colour per load along a sequential map (viridis, dark to green) as the load grows, with legend
 //! entries `F/(μF_N) = 0.0`, ..., `0.9`.
 //! Run: `cargo run --release --example figS10_stress_evolution [output directory] [realizations]`.
 

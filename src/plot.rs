@@ -30,6 +30,7 @@ mod figures;
 mod movie;
 mod paper;
 mod profiles;
+mod scaled;
 mod selection;
 
 pub use error::PlotError;
@@ -41,6 +42,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -107,13 +109,16 @@ pub enum Corner {
     LowerRight,
 }
 
-/// How a chart colours its series.
+/// How a chart colours its series: categorical colours for unordered things (drives,
+/// observables, samples), a sequential map for an ordered family (the same curve at
+/// increasing loads, cell sizes, heights or normal loads), so that the order of the
+/// curves reads from their colours.
 ///
 /// ```
 /// use precursors::plot::{Chart, Colours};
 /// let dir = std::env::temp_dir().join(format!("precursors-doc-{}", std::process::id()));
 /// std::fs::create_dir_all(&dir)?;
-/// // The shear traction profile φ_x(x) (kPa) at three increasing loads: blue to red.
+/// // The shear traction profile φ_x(x) (kPa) at three increasing loads: dark to green.
 /// let profile = |f: f64| -> Vec<(f64, f64)> {
 ///     (0..=20).map(|k| (k as f64 / 20.0, f * (-4.0 * k as f64 / 20.0).exp())).collect()
 /// };
@@ -124,7 +129,8 @@ pub enum Corner {
 ///     .colours(Colours::Ordered)
 ///     .save(dir.join("profiles.svg"))?;
 /// let svg = std::fs::read_to_string(dir.join("profiles.svg"))?;
-/// assert!(svg.contains("#2166AC") && svg.contains("#B2182B")); // first blue, last red
+/// // viridis from its first colour (#440154) to its three-quarter point (#5EC962).
+/// assert!(svg.contains("#440154") && svg.contains("#5EC962"));
 /// assert_eq!(Colours::default(), Colours::Distinct);           // Tableau 10 in turn
 /// std::fs::remove_dir_all(&dir)?;
 /// # Ok::<(), Box<dyn std::error::Error>>(())
@@ -132,12 +138,45 @@ pub enum Corner {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub enum Colours {
-    /// Ten distinct colours in turn (the default).
+    /// Ten distinct colours in turn (the default): unordered series.
     #[default]
     Distinct,
-    /// From blue (first series) through grey to red (last): an ordered family of curves,
-    /// e.g. the same profile at increasing loads.
+    /// A sequential map for an ordered family of curves, first series to last: viridis
+    /// (perceptually uniform, readable in grey and by colour-blind readers) from its dark
+    /// end to its three-quarter point, which stays visible on white (its yellow end would
+    /// not).
     Ordered,
+}
+
+/// viridis (matplotlib's, van der Walt and Smith) at `t = 0, 1/8, ..., 1`.
+const VIRIDIS: [[f64; 3]; 9] = [
+    [68.0, 1.0, 84.0],
+    [71.0, 45.0, 123.0],
+    [59.0, 82.0, 139.0],
+    [44.0, 114.0, 142.0],
+    [33.0, 145.0, 140.0],
+    [40.0, 174.0, 128.0],
+    [94.0, 201.0, 98.0],
+    [173.0, 220.0, 48.0],
+    [253.0, 231.0, 37.0],
+];
+
+/// Where an ordered family's last series sits on viridis.
+const ORDERED_END: f64 = 0.75;
+
+/// The colour of series `k` of `n` coloured by `colours`.
+fn series_colour(colours: Colours, k: usize, n: usize) -> RGBColor {
+    match colours {
+        Colours::Distinct => DISTINCT[k % DISTINCT.len()],
+        Colours::Ordered => {
+            let t = if n > 1 {
+                k as f64 / (n - 1) as f64
+            } else {
+                0.0
+            };
+            gradient(VIRIDIS, ORDERED_END * t)
+        }
+    }
 }
 
 /// How one series of a [`Chart`] is drawn ([`Chart::style`]): by default in the chart's
@@ -250,13 +289,80 @@ impl Palette {
     }
 }
 
-/// The colour at `t ∈ [0, 1]` of the gradient through three stops (the middle at 0.5).
-fn gradient(stops: [[f64; 3]; 3], t: f64) -> RGBColor {
-    let (a, b, s) = if t < 0.5 {
-        (stops[0], stops[1], 2.0 * t)
-    } else {
-        (stops[1], stops[2], 2.0 * t - 1.0)
+/// The size (1/150 inch) and the PNGs' resolution every figure of a directory is drawn at.
+#[derive(Debug, Clone, Copy)]
+struct Canvas {
+    size: (u32, u32),
+    dpi: u32,
+}
+
+impl Canvas {
+    /// An empty chart of this size and resolution.
+    fn chart(self, title: &str, x_label: &str, y_label: &str) -> Chart {
+        Chart::new(title, x_label, y_label)
+            .size(self.size.0, self.size.1)
+            .dpi(self.dpi)
+    }
+}
+
+/// How a sweep's points (each its axes' values) are coloured and in which order they are
+/// drawn: along the sequential map ([`Colours::Ordered`]), sorted by their values, when
+/// every axis that differs between them holds numbers and they rise or fall together
+/// along all of them (one axis, or axes zipped as Ly and Lz of the Fig. 6c study); else
+/// distinct colours in the sweep's order (a product of axes, a kind of drive).
+fn point_order(points: &[&[(String, String)]]) -> (Colours, Vec<usize>) {
+    let given = (Colours::Distinct, (0..points.len()).collect());
+    let Some(first) = points.first() else {
+        return given;
     };
+    let same_keys = points
+        .iter()
+        .all(|p| p.len() == first.len() && p.iter().zip(first.iter()).all(|(a, b)| a.0 == b.0));
+    if !same_keys {
+        return given;
+    }
+    let mut columns: Vec<Vec<f64>> = Vec::new();
+    for axis in 0..first.len() {
+        if points.iter().all(|p| p[axis].1 == first[axis].1) {
+            continue;
+        }
+        let values: Option<Vec<f64>> = points
+            .iter()
+            .map(|p| p[axis].1.parse::<f64>().ok().filter(|v| v.is_finite()))
+            .collect();
+        match values {
+            Some(values) => columns.push(values),
+            None => return given,
+        }
+    }
+    let Some(lead) = columns.first() else {
+        return given;
+    };
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by(|&a, &b| lead[a].total_cmp(&lead[b]));
+    let monotone = |column: &Vec<f64>, strict: bool| {
+        let steps: Vec<f64> = order
+            .windows(2)
+            .map(|w| column[w[1]] - column[w[0]])
+            .collect();
+        let rising = steps
+            .iter()
+            .all(|d| if strict { *d > 0.0 } else { *d >= 0.0 });
+        rising || (!strict && steps.iter().all(|d| *d <= 0.0))
+    };
+    if monotone(lead, true) && columns.iter().all(|c| monotone(c, false)) {
+        (Colours::Ordered, order)
+    } else {
+        given
+    }
+}
+
+/// The colour at `t ∈ [0, 1]` of the gradient through `N` evenly spaced stops.
+fn gradient<const N: usize>(stops: [[f64; 3]; N], t: f64) -> RGBColor {
+    let at = t.clamp(0.0, 1.0) * (N - 1) as f64;
+    let k = (at.floor() as usize).min(N.saturating_sub(2));
+    let s = at - k as f64;
+    let (a, b) = (stops[k], stops[(k + 1).min(N - 1)]);
     RGBColor(
         (a[0] + (b[0] - a[0]) * s).round() as u8,
         (a[1] + (b[1] - a[1]) * s).round() as u8,
@@ -341,6 +447,10 @@ pub struct Chart {
     orphan_style: bool,
     /// Logarithmic x and y axes ([`Chart::log_x`], [`Chart::log_y`]).
     log: (bool, bool),
+    /// Lines of text under the legend's entries ([`Chart::note`]).
+    notes: Vec<String>,
+    /// The PNG's resolution ([`Chart::dpi`]).
+    dpi: u32,
 }
 
 impl Chart {
@@ -358,12 +468,17 @@ impl Chart {
             series: Vec::new(),
             orphan_style: false,
             log: (false, false),
+            notes: Vec::new(),
+            dpi: DEFAULT_DPI,
         }
     }
 
     /// A logarithmic x axis (base 10, for values spanning decades: a distribution's
-    /// sizes): ticks labelled with the values; points with `x ≤ 0` are not drawn; a range
-    /// given by [`Chart::x_range`] is in the data's units and must be positive.
+    /// sizes, a relative growth): ticks at the powers of ten, labelled `10⁻³`, `10⁰`,
+    /// `10²` (over less than two decades at 1, 2 and 5 times them: `2×10⁻¹`), a light
+    /// grid line at 2 and 5 times each; points with `x ≤ 0` are not drawn; a range given
+    /// by [`Chart::x_range`] is in the data's units and must be positive. Give the
+    /// quantity in the axis label, not its logarithm: `"S"`, not `"log₁₀ S"`.
     ///
     /// ```
     /// use precursors::plot::Chart;
@@ -378,8 +493,10 @@ impl Chart {
     /// let texts: Vec<&str> = svg.split("<text").skip(1)
     ///     .filter_map(|t| t.split_once('>')?.1.split_once("</text>").map(|x| x.0.trim()))
     ///     .collect();
-    /// // The ticks print values: 10 on the x axis, powers of ten like 1e−4 on the y axis.
-    /// assert!(texts.contains(&"10") && texts.iter().any(|t| t.starts_with("1e−")), "{texts:?}");
+    /// // The decades: 10⁰ to 10³ along x, 10⁻⁶ to 10⁰ along y.
+    /// for decade in ["10⁰", "10¹", "10²", "10³", "10⁻⁶", "10⁻³"] {
+    ///     assert!(texts.contains(&decade), "{decade} not in {texts:?}");
+    /// }
     /// // A range on a log axis must be positive.
     /// assert!(Chart::new("t", "x", "y").log_x().x_range(0.0, 1.0).line("", &p)
     ///     .save(dir.join("bad.svg")).is_err());
@@ -409,9 +526,44 @@ impl Chart {
         self
     }
 
-    /// The picture's size in pixels (PNG) or user units (SVG).
+    /// The picture's size in pixels at 150 dpi, that is in 1/150 inch (800 x 560: 5.33 x
+    /// 3.73 inches); the SVG's user units, and a PNG's pixels at the default resolution
+    /// ([`Chart::dpi`]).
     pub fn size(mut self, width: u32, height: u32) -> Self {
         self.size = (width, height);
+        self
+    }
+
+    /// The PNG's resolution in dots per inch (default 150): the picture keeps its size in
+    /// inches ([`Chart::size`]) and everything on it (text, lines, markers) its size
+    /// relative to the picture, drawn with `dpi/150` times as many pixels along each side
+    /// (800 x 560 at 300 dpi: 1600 x 1120 pixels). An SVG is drawn in its user units,
+    /// whatever the resolution. [`Chart::save`] refuses a resolution outside 50 to 1200.
+    ///
+    /// ```
+    /// use precursors::plot::{Chart, PlotError};
+    /// let dir = std::env::temp_dir().join(format!("precursors-doc-dpi-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// let line = [(0.0, 0.0), (1.0, 1.0)];
+    /// Chart::new("t", "x", "y").line("", &line).dpi(300).save(dir.join("print.png"))?;
+    /// let png = std::fs::read(dir.join("print.png"))?;
+    /// let width = u32::from_be_bytes([png[16], png[17], png[18], png[19]]);
+    /// assert_eq!(width, 1600);                        // 800 · 300/150
+    /// let e = Chart::new("t", "x", "y").dpi(20).save(dir.join("coarse.png")).unwrap_err();
+    /// assert!(matches!(e, PlotError::InvalidDpi { dpi: 20, .. }));
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn dpi(mut self, dpi: u32) -> Self {
+        self.dpi = dpi;
+        self
+    }
+
+    /// A line of text under the legend's entries (no glyph): what holds for several
+    /// series, said once instead of in each entry ("no interval below 6 runs"). Notes
+    /// are drawn in the order given, in the legend's box (with no entries, alone in it).
+    pub fn note(mut self, text: &str) -> Self {
+        self.notes.push(text.into());
         self
     }
 
@@ -482,16 +634,8 @@ impl Chart {
         }
         let auto = |s: &&Series| s.style.colour.is_none();
         let k = self.series[..index].iter().filter(auto).count();
-        match self.colours {
-            Colours::Distinct => DISTINCT[k % DISTINCT.len()],
-            Colours::Ordered => {
-                // Blue, grey, red: every step visible on white (the diverging palette's
-                // middle is white).
-                let n = self.series.iter().filter(auto).count().max(2) - 1;
-                let t = k as f64 / n as f64;
-                gradient([[33.0, 102.0, 172.0], [110.0; 3], [178.0, 24.0, 43.0]], t)
-            }
-        }
+        let n = self.series.iter().filter(auto).count();
+        series_colour(self.colours, k, n)
     }
 
     /// Writes the chart to `path`: PNG for `.png`, SVG for `.svg`.
@@ -499,7 +643,9 @@ impl Chart {
     /// # Errors
     /// [`PlotError::Figure`] for another extension, an axis range that is not finite and
     /// increasing, a size outside 200 x 150 to 16384 x 16384, a [`Style`] given before any
-    /// series or a dashed style on markers, or a drawing backend that fails;
+    /// series or a dashed style on markers, a PNG of more than 16384 pixels along a side at
+    /// its resolution, or a drawing backend that fails; [`PlotError::InvalidDpi`] for a
+    /// resolution outside 50 to 1200 dpi ([`Chart::dpi`]);
     /// [`Error::Io`] (in [`PlotError::Core`]) when the file cannot be written (it is written atomically: no half
     /// file is left under its name).
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
@@ -554,7 +700,7 @@ impl Chart {
             let (x, y) = drawn.ranges(path)?;
             return render(
                 path,
-                self.size,
+                (self.size, self.dpi),
                 &ChartDrawing {
                     chart: &drawn,
                     x,
@@ -566,7 +712,7 @@ impl Chart {
         let (x, y) = self.ranges(path)?;
         render(
             path,
-            self.size,
+            (self.size, self.dpi),
             &ChartDrawing {
                 chart: self,
                 x,
@@ -680,6 +826,7 @@ impl Draw for ChartDrawing<'_> {
         draw_legend(
             &chart.plotting_area().strip_coord_spec(),
             &legend,
+            &me.notes,
             me.legend,
         )?;
         Ok(())
@@ -745,6 +892,8 @@ pub struct Map {
     extend: Option<(bool, bool)>,
     /// Whether x and y are lengths in one unit: the figure then states its aspect.
     same_units: bool,
+    /// The PNG's resolution ([`Map::dpi`]).
+    dpi: u32,
 }
 
 impl Map {
@@ -794,6 +943,7 @@ impl Map {
             notes: Vec::new(),
             extend: None,
             same_units: false,
+            dpi: DEFAULT_DPI,
         })
     }
 
@@ -827,7 +977,7 @@ impl Map {
         self
     }
 
-    /// The picture's size in pixels (PNG) or user units (SVG).
+    /// The picture's size in 1/150 inch, as [`Chart::size`].
     pub fn size(mut self, width: u32, height: u32) -> Self {
         self.size = (width, height);
         self
@@ -843,13 +993,20 @@ impl Map {
         self
     }
 
+    /// The PNG's resolution in dots per inch (default 150), as [`Chart::dpi`].
+    pub fn dpi(mut self, dpi: u32) -> Self {
+        self.dpi = dpi;
+        self
+    }
+
     /// Writes the map to `path`: PNG for `.png`, SVG for `.svg`.
     ///
     /// # Errors
     /// [`PlotError::Figure`] for another extension, a range that is not finite and
-    /// increasing, a size outside 200 x 150 to 16384 x 16384, or a drawing backend that
-    /// fails; [`Error::Io`] (in [`PlotError::Core`]) when the file cannot be written (atomically, as
-    /// [`Chart::save`]).
+    /// increasing, a size outside 200 x 150 to 16384 x 16384 (a PNG's pixels at its
+    /// resolution too), or a drawing backend that fails; [`PlotError::InvalidDpi`] for a
+    /// resolution outside 50 to 1200 dpi; [`Error::Io`] (in [`PlotError::Core`]) when the
+    /// file cannot be written (atomically, as [`Chart::save`]).
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = path.as_ref();
         let x = axis_range(path, "x", Some(self.x_range), std::iter::empty())?;
@@ -860,7 +1017,11 @@ impl Map {
             self.colour_range,
             self.values.iter().copied(),
         )?;
-        render(path, self.size, &MapDrawing { map: self, x, y, c })
+        render(
+            path,
+            (self.size, self.dpi),
+            &MapDrawing { map: self, x, y, c },
+        )
     }
 }
 
@@ -1156,21 +1317,161 @@ fn axes<'a, DB: DrawingBackend>(
     y: (f64, f64),
 ) -> std::result::Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String>
 {
-    // The title typeset by hand (plotters' caption has no subscripts), in the room a
-    // caption of this size takes.
+    // The title typeset by hand (plotters' caption has no subscripts), on one line or two,
+    // above the plotting area.
     let mut builder = ChartBuilder::on(area);
-    builder.margin(16).margin_top(16 + 34);
-    if !title.is_empty() {
-        let (width, _) = area.dim_in_pixel();
-        let size = fitting(area, title, 22.0, width as i32 - 16)?;
-        let left = (width as i32 - typeset_width(area, title, size)?) / 2;
-        typeset(area, title, (left, 12), size, Reading::Across)?;
+    let (width, _) = area.dim_in_pixel();
+    let (lines, size) = title_lines(area, title, width as i32 - 16)?;
+    let line_height = (1.25 * size) as i32;
+    for (k, line) in lines.iter().enumerate() {
+        let left = (width as i32 - typeset_width(area, line, size)?) / 2;
+        let top = TITLE_TOP + k as i32 * line_height;
+        typeset(area, line, (left, top), size, Reading::Across)?;
     }
     builder
+        .margin(16)
+        .margin_top(title_room(lines.len(), size))
         .x_label_area_size(X_LABEL_AREA)
         .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(x.0..x.1, y.0..y.1)
         .map_err(|e| e.to_string())
+}
+
+/// The top of a title's first line (pixels from the picture's top).
+const TITLE_TOP: i32 = 12;
+/// A title's size (pixels) when it fits the picture's width.
+const TITLE_SIZE: f64 = 22.0;
+/// The largest size of a title on two lines (the tick values' size and a bit).
+const WRAPPED_TITLE_SIZE: f64 = 16.0;
+/// The smallest size (pixels at 150 dpi: 6.7 points) a title, an axis label or a legend
+/// entry is set at: a title that would be smaller on one line goes on two, a text that
+/// does not fit even so is shortened with `…`.
+const SMALLEST_TEXT: f64 = 14.0;
+
+/// The room above the plotting area for a title of `lines` lines at `size` (50 pixels for
+/// none or one line at the full size, as plotters' caption of that size).
+fn title_room(lines: usize, size: f64) -> u32 {
+    let used = TITLE_TOP + lines as i32 * (1.25 * size) as i32 + 10;
+    used.max(16 + 34) as u32
+}
+
+/// `title` laid out in `room` pixels: one line at up to [`TITLE_SIZE`], or, where that
+/// would be smaller than [`SMALLEST_TEXT`], two lines of up to [`WRAPPED_TITLE_SIZE`] cut
+/// after the `,`, `:` or `;` (else the space) that lets them be set largest; never
+/// smaller than [`SMALLEST_TEXT`], a line still too long shortened with `…`. No lines for
+/// an empty title.
+fn title_lines<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+    room: i32,
+) -> std::result::Result<(Vec<String>, f64), String> {
+    if title.is_empty() {
+        return Ok((Vec::new(), TITLE_SIZE));
+    }
+    let one = fitting(area, title, TITLE_SIZE, room)?;
+    if one >= SMALLEST_TEXT {
+        return Ok((vec![title.to_string()], one));
+    }
+    let cuts = |punctuated: bool| {
+        title
+            .char_indices()
+            .filter(move |&(k, c)| {
+                c == ' ' && k > 0 && (!punctuated || title[..k].ends_with([',', ':', ';']))
+            })
+            .map(|(k, _)| k)
+            .collect::<Vec<usize>>()
+    };
+    let mut candidates = cuts(true);
+    if candidates.is_empty() {
+        candidates = cuts(false);
+    }
+    // The cut that lets the lines be set largest; of those, the one that balances them
+    // best (its longer line the shortest).
+    let mut best: Option<(Vec<String>, f64, i32)> = None;
+    for k in candidates {
+        let lines = vec![title[..k].to_string(), title[k + 1..].to_string()];
+        let (mut size, mut longest) = (WRAPPED_TITLE_SIZE, 0);
+        for line in &lines {
+            size = size.min(fitting(area, line, WRAPPED_TITLE_SIZE, room)?);
+            longest = longest.max(typeset_width(area, line, WRAPPED_TITLE_SIZE)?);
+        }
+        if best
+            .as_ref()
+            .is_none_or(|b| size > b.1 || (size == b.1 && longest < b.2))
+        {
+            best = Some((lines, size, longest));
+        }
+    }
+    let (mut lines, size) = match best {
+        Some((lines, size, _)) if size > one => (lines, size),
+        _ => (vec![title.to_string()], one),
+    };
+    let size = size.max(SMALLEST_TEXT);
+    if lines.len() == 2 && typeset_width(area, &lines[0], size)? > room {
+        // Too long for two balanced lines even at the smallest size: the first line as
+        // long as fits, the rest shortened on the second.
+        let mut first = 0;
+        for k in cuts(false) {
+            if typeset_width(area, &title[..k], size)? <= room {
+                first = k;
+            }
+        }
+        if first > 0 {
+            lines = vec![title[..first].to_string(), title[first + 1..].to_string()];
+        }
+    }
+    let mut shortened = Vec::with_capacity(lines.len());
+    for line in &lines {
+        shortened.push(abbreviated(area, line, size, room)?);
+    }
+    Ok((shortened, size))
+}
+
+/// `text` as it fits `room` pixels at `size`: whole, or cut (at a space where one is near
+/// the end) and ended with `…`.
+fn abbreviated<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    text: &str,
+    size: f64,
+    room: i32,
+) -> std::result::Result<String, String> {
+    if typeset_width(area, text, size)? <= room {
+        return Ok(text.to_string());
+    }
+    let ends: Vec<usize> = text.char_indices().map(|(k, _)| k).collect();
+    // The longest prefix that fits with the ellipsis (widths grow with the prefix).
+    let (mut fits, mut fails) = (0, ends.len());
+    while fails - fits > 1 {
+        let mid = (fits + fails) / 2;
+        let candidate = format!("{}…", &text[..ends[mid]]);
+        if typeset_width(area, &candidate, size)? <= room {
+            fits = mid;
+        } else {
+            fails = mid;
+        }
+    }
+    let prefix = &text[..ends[fits]];
+    // A cut at a word's end when one lies in the last fifth of the prefix.
+    let prefix = match prefix.rfind(' ') {
+        Some(space) if 5 * space >= 4 * prefix.len() => &prefix[..space],
+        _ => prefix,
+    };
+    Ok(format!(
+        "{}…",
+        prefix.trim_end_matches([' ', ',', ':', ';', '_'])
+    ))
+}
+
+/// `text` set at `size`, or smaller (not below [`SMALLEST_TEXT`]) to fit `room` pixels,
+/// shortened with `…` where it does not fit even so: the text and its size.
+fn fitted<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    text: &str,
+    size: f64,
+    room: i32,
+) -> std::result::Result<(String, f64), String> {
+    let size = fitting(area, text, size, room)?.max(SMALLEST_TEXT.min(size));
+    Ok((abbreviated(area, text, size, room)?, size))
 }
 
 /// The room below the plotting area for the x tick values and label (pixels).
@@ -1179,9 +1480,16 @@ const X_LABEL_AREA: i32 = 52;
 const Y_LABEL_AREA: i32 = 72;
 /// The size of the axis labels' font (pixels).
 const AXIS_LABEL_SIZE: f64 = 18.0;
+/// The size of the tick values' font (pixels).
+const TICK_SIZE: f64 = 15.0;
+/// The grid: lines at the labelled ticks, and light ones between them.
+const GRID: RGBColor = RGBColor(218, 218, 218);
+const LIGHT_GRID: RGBColor = RGBColor(242, 242, 242);
 
-/// The axes' tick values and labels, with a light grid when `grid` (charts; not on maps).
-/// The labels are typeset on `area`, the area the chart was built on.
+/// The axes' tick values and labels, with a light grid when `grid` (charts; not on maps);
+/// a logarithmic axis (`log`, its values `log10` of the data's) with ticks at the powers
+/// of ten ([`log_ticks`]). The labels are typeset on `area`, the area the chart was built
+/// on.
 fn draw_axes<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
@@ -1190,22 +1498,27 @@ fn draw_axes<DB: DrawingBackend>(
     (grid, log): (bool, (bool, bool)),
 ) -> std::result::Result<(), String> {
     let font = |size: f64| (FAMILY, size).into_font();
-    let x_ticks = |v: &f64| if log.0 { log_tick(*v) } else { tick(*v, x) };
-    let y_ticks = |v: &f64| if log.1 { log_tick(*v) } else { tick(*v, y) };
+    let x_ticks = |v: &f64| tick(*v, x);
+    let y_ticks = |v: &f64| tick(*v, y);
     let mut mesh = chart.configure_mesh();
     if grid {
-        mesh.light_line_style(RGBColor(235, 235, 235))
-            .bold_line_style(RGBColor(215, 215, 215));
+        // One light line between two labelled ticks at most: a dense minor grid hides the
+        // curves.
+        mesh.light_line_style(LIGHT_GRID)
+            .bold_line_style(GRID)
+            .max_light_lines(2);
     } else {
         mesh.disable_mesh();
     }
-    mesh.label_style(font(15.0))
-        .x_labels(8)
-        .y_labels(8)
+    // A logarithmic axis gets its ticks from `draw_log_ticks`: none from plotters.
+    mesh.label_style(font(TICK_SIZE))
+        .x_labels(if log.0 { 0 } else { 8 })
+        .y_labels(if log.1 { 0 } else { 8 })
         .x_label_formatter(&x_ticks)
         .y_label_formatter(&y_ticks)
         .draw()
         .map_err(|e| e.to_string())?;
+    draw_log_ticks(area, chart, (x, y), log, grid)?;
     // The labels where plotters puts its own: the x label at the bottom of its room,
     // centred under the plotting area; the y label at the left edge of its room, reading
     // up, centred along the plotting area.
@@ -1214,28 +1527,82 @@ fn draw_axes<DB: DrawingBackend>(
     let (x0, x1) = (columns.start - base_x, columns.end - base_x);
     let (y0, y1) = (rows.start - base_y, rows.end - base_y);
     if !x_label.is_empty() {
-        let size = fitting(area, x_label, AXIS_LABEL_SIZE, x1 - x0)?;
-        let width = typeset_width(area, x_label, size)?;
+        let (text, size) = fitted(area, x_label, AXIS_LABEL_SIZE, x1 - x0)?;
+        let width = typeset_width(area, &text, size)?;
         let top = y1 + X_LABEL_AREA - (1.25 * size) as i32;
         typeset(
             area,
-            x_label,
+            &text,
             ((x0 + x1 - width) / 2, top),
             size,
             Reading::Across,
         )?;
     }
     if !y_label.is_empty() {
-        let size = fitting(area, y_label, AXIS_LABEL_SIZE, y1 - y0)?;
-        let width = typeset_width(area, y_label, size)?;
+        let (text, size) = fitted(area, y_label, AXIS_LABEL_SIZE, y1 - y0)?;
+        let width = typeset_width(area, &text, size)?;
         let left = (x0 - Y_LABEL_AREA).max(0);
         typeset(
             area,
-            y_label,
+            &text,
             (left, (y0 + y1 + width) / 2),
             size,
             Reading::Up,
         )?;
+    }
+    Ok(())
+}
+
+/// The ticks of the logarithmic axes among `log` (x, y), whose ranges `(x, y)` are in
+/// `log10` of the data: grid lines (with `grid`), tick marks and the values of
+/// [`log_ticks`], as plotters draws a linear axis'.
+fn draw_log_ticks<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    (x, y): ((f64, f64), (f64, f64)),
+    log: (bool, bool),
+    grid: bool,
+) -> std::result::Result<(), String> {
+    const MARK: i32 = 5;
+    let (base_x, base_y) = area.get_base_pixel();
+    let font = (FAMILY, TICK_SIZE).into_font().color(&BLACK);
+    for (is_x, range) in [(true, x), (false, y)] {
+        if !(if is_x { log.0 } else { log.1 }) {
+            continue;
+        }
+        for (v, label) in log_ticks(range) {
+            let ends = if is_x {
+                [(v, y.0), (v, y.1)]
+            } else {
+                [(x.0, v), (x.1, v)]
+            };
+            if grid {
+                let colour = if label.is_some() { GRID } else { LIGHT_GRID };
+                chart
+                    .draw_series(std::iter::once(PathElement::new(ends.to_vec(), colour)))
+                    .map_err(|e| e.to_string())?;
+            }
+            let Some(label) = label else { continue };
+            let (px, py) = chart.backend_coord(&ends[0]);
+            let (px, py) = (px - base_x, py - base_y);
+            let (mark, at, anchor) = if is_x {
+                (
+                    [(px, py), (px, py + MARK)],
+                    (px, py + MARK + 3),
+                    Pos::new(HPos::Center, VPos::Top),
+                )
+            } else {
+                (
+                    [(px - MARK, py), (px, py)],
+                    (px - MARK - 3, py),
+                    Pos::new(HPos::Right, VPos::Center),
+                )
+            };
+            area.draw(&PathElement::new(mark.to_vec(), BLACK))
+                .map_err(|e| e.to_string())?;
+            area.draw(&Text::new(label, at, font.pos(anchor)))
+                .map_err(|e| e.to_string())?;
+        }
     }
     Ok(())
 }
@@ -1248,12 +1615,14 @@ enum Glyph {
     Marker,
 }
 
-/// Draws a legend of `entries` (label, glyph, colour) in `corner` of `area` (a chart's
-/// plotting area): a framed, almost opaque box as plotters draws its own, with the labels
-/// typeset (plotters' legend draws them as plain text).
+/// Draws a legend of `entries` (label, glyph, colour) and, under them, `notes` (text
+/// without a glyph) in `corner` of `area` (a chart's plotting area): a framed, almost
+/// opaque box as plotters draws its own, with the labels typeset (plotters' legend draws
+/// them as plain text), each shortened with `…` where the area is too narrow for it.
 fn draw_legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     entries: &[(String, Glyph, RGBColor)],
+    notes: &[String],
     corner: Corner,
 ) -> std::result::Result<(), String> {
     const SIZE: f64 = 15.0;
@@ -1261,16 +1630,28 @@ fn draw_legend<DB: DrawingBackend>(
     const GLYPH_ROOM: i32 = 30;
     // A row holds a letter and its lowered subscript.
     let row = (1.5 * SIZE) as i32;
-    if entries.is_empty() {
+    if entries.is_empty() && notes.is_empty() {
         return Ok(());
     }
-    let mut widest = 0;
-    for (label, _, _) in entries {
-        widest = widest.max(typeset_width(area, label, SIZE)?);
-    }
-    let width = widest + GLYPH_ROOM + 2 * MARGIN;
-    let height = entries.len() as i32 * row + 2 * MARGIN;
     let (area_width, area_height) = area.dim_in_pixel();
+    let room = area_width as i32 - 10 - 2 * MARGIN;
+    let mut labels = Vec::with_capacity(entries.len());
+    for (label, _, _) in entries {
+        labels.push(abbreviated(area, label, SIZE, room - GLYPH_ROOM)?);
+    }
+    let mut lines = Vec::with_capacity(notes.len());
+    for note in notes {
+        lines.push(abbreviated(area, note, SIZE, room)?);
+    }
+    let mut widest = 0;
+    for label in &labels {
+        widest = widest.max(GLYPH_ROOM + typeset_width(area, label, SIZE)?);
+    }
+    for line in &lines {
+        widest = widest.max(typeset_width(area, line, SIZE)?);
+    }
+    let width = widest + 2 * MARGIN;
+    let height = (labels.len() + lines.len()) as i32 * row + 2 * MARGIN;
     let left = match corner {
         Corner::UpperLeft | Corner::LowerLeft => 5,
         Corner::UpperRight | Corner::LowerRight => area_width as i32 - width - 5,
@@ -1287,7 +1668,7 @@ fn draw_legend<DB: DrawingBackend>(
     let (_, letter) = area
         .estimate_text_size("0", &piece_font(SIZE, false, Reading::Across))
         .map_err(|e| e.to_string())?;
-    for (k, (label, glyph, colour)) in entries.iter().enumerate() {
+    for (k, (label, (_, glyph, colour))) in labels.iter().zip(entries).enumerate() {
         let (x, y) = (left + MARGIN, top + MARGIN + k as i32 * row + row / 2);
         let drawn = match glyph {
             Glyph::Marker => area.draw(&Circle::new((x + 11, y), 4, colour.filled())),
@@ -1305,6 +1686,16 @@ fn draw_legend<DB: DrawingBackend>(
         drawn.map_err(|e| e.to_string())?;
         let start = (x + GLYPH_ROOM, y - letter as i32 / 2);
         typeset(area, label, start, SIZE, Reading::Across)?;
+    }
+    for (k, line) in lines.iter().enumerate() {
+        let y = top + MARGIN + (labels.len() + k) as i32 * row + row / 2;
+        typeset(
+            area,
+            line,
+            (left + MARGIN, y - letter as i32 / 2),
+            SIZE,
+            Reading::Across,
+        )?;
     }
     Ok(())
 }
@@ -1455,6 +1846,32 @@ fn subscripts(text: &str) -> Vec<(String, bool)> {
     pieces
 }
 
+/// The resolution at which a figure's size in pixels is its size in 1/150 inch, the
+/// default of [`Chart::dpi`], [`Map::dpi`] and [`DrawOptions::dpi`].
+const DEFAULT_DPI: u32 = 150;
+
+/// The resolutions a PNG may be drawn at (dots per inch).
+pub(crate) const DPI_RANGE: std::ops::RangeInclusive<u32> = 50..=1200;
+
+/// Refuses a resolution outside [`DPI_RANGE`].
+fn check_dpi(dpi: u32) -> Result<()> {
+    if DPI_RANGE.contains(&dpi) {
+        Ok(())
+    } else {
+        Err(PlotError::InvalidDpi {
+            dpi,
+            low: *DPI_RANGE.start(),
+            high: *DPI_RANGE.end(),
+        })
+    }
+}
+
+/// The pixels of a PNG of `size` (in 1/150 inch) at `dpi`: each side `· dpi/150`, rounded.
+fn png_pixels(size: (u32, u32), dpi: u32) -> (u32, u32) {
+    let side = |n: u32| ((u64::from(n) * u64::from(dpi) + 75) / 150) as u32;
+    (side(size.0), side(size.1))
+}
+
 /// Refuses a figure size outside 200 x 150 to [`LARGEST_SIDE`] squared.
 fn check_size(path: &Path, size: (u32, u32)) -> Result<()> {
     let fail = |reason: String| PlotError::Figure {
@@ -1478,13 +1895,16 @@ fn check_size(path: &Path, size: (u32, u32)) -> Result<()> {
 
 /// Draws in memory through the backend that `path`'s extension names, then writes the
 /// file atomically (temporary file and rename, as checkpoints): a full disk or a kill
-/// never leaves a half or empty figure under its name.
-fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
+/// never leaves a half or empty figure under its name. `size` is the figure's in 1/150
+/// inch (an SVG's user units); a PNG has `size · dpi/150` pixels ([`png_pixels`]), the
+/// figure drawn at that scale ([`scaled::Scaled`]).
+fn render(path: &Path, (size, dpi): ((u32, u32), u32), figure: &impl Draw) -> Result<()> {
     register_font()?;
     let fail = |reason: String| PlotError::Figure {
         path: Some(path.to_path_buf()),
         reason,
     };
+    check_dpi(dpi)?;
     check_size(path, size)?;
     let extension = path
         .extension()
@@ -1492,13 +1912,23 @@ fn render(path: &Path, size: (u32, u32), figure: &impl Draw) -> Result<()> {
         .map(str::to_ascii_lowercase);
     let bytes = match extension.as_deref() {
         Some("png") => {
-            let mut pixels = vec![0u8; 3 * size.0 as usize * size.1 as usize];
+            let pixels_size = png_pixels(size, dpi);
+            if pixels_size.0 > LARGEST_SIDE || pixels_size.1 > LARGEST_SIDE {
+                return Err(fail(format!(
+                    "{} x {} at {dpi} dpi is a PNG of {} x {} pixels: at most \
+                     {LARGEST_SIDE} x {LARGEST_SIDE}",
+                    size.0, size.1, pixels_size.0, pixels_size.1
+                )));
+            }
+            let mut pixels = vec![0u8; 3 * pixels_size.0 as usize * pixels_size.1 as usize];
+            let backend = BitMapBackend::with_buffer(&mut pixels, pixels_size);
+            let scale = f64::from(dpi) / f64::from(DEFAULT_DPI);
             paint(
-                BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area(),
+                scaled::Scaled::new(backend, size, scale).into_drawing_area(),
                 figure,
             )
             .map_err(fail)?;
-            encode_png(&pixels, size).map_err(|e| fail(format!("encoding the PNG: {e}")))?
+            encode_png(&pixels, pixels_size).map_err(|e| fail(format!("encoding the PNG: {e}")))?
         }
         Some("svg") => {
             let mut text = String::new();
@@ -1724,23 +2154,105 @@ fn tick(v: f64, range: (f64, f64)) -> String {
     text.replace('-', "−")
 }
 
-/// The tick at `v = log10(x)` of a logarithmic axis: the value `x`, with two significant
-/// digits (`1e−3`, `0.02`, `300`, `2.5e4`); `−` as the minus.
-fn log_tick(v: f64) -> String {
-    let x = 10f64.powf(v);
-    let text = if (1e-2..1e4).contains(&x) {
-        let digits = (1.0 - x.log10().floor()).max(0.0) as usize;
-        let t = format!("{x:.digits$}");
-        if t.contains('.') {
-            t.trim_end_matches('0').trim_end_matches('.').to_string()
-        } else {
-            t
+/// The ticks of a logarithmic axis over `range` (in `log10` of the data): `(log10 of the
+/// value, its label)`, unlabelled where `None` (a grid line only). Over two decades and
+/// more, the powers of ten, labelled `10⁻³`, `10⁰`, `10²` (every second, fifth, ... one
+/// where more than eight would crowd the axis), with unlabelled lines at 2 and 5 times
+/// each up to seven decades (a sparse minor grid); over less, 1, 2 and 5 times the powers
+/// of ten, all labelled (`0.2`, `1`, `50`, and `2×10⁻⁶` outside `[10⁻³, 10⁴)`).
+fn log_ticks(range: (f64, f64)) -> Vec<(f64, Option<String>)> {
+    if !(range.0.is_finite() && range.1.is_finite()) {
+        return Vec::new();
+    }
+    let (low, high) = (range.0.min(range.1), range.0.max(range.1));
+    let inside = |v: f64| v >= low - 1e-9 && v <= high + 1e-9;
+    let (first, last) = (low.floor() as i64, high.ceil() as i64);
+    let decades: Vec<i64> = (first..=last).filter(|&d| inside(d as f64)).collect();
+    let mut ticks = Vec::new();
+    if decades.len() >= 2 {
+        let every = decades.len().div_ceil(8) as i64;
+        let every = [1, 2, 5, 10, 20, 50, 100]
+            .into_iter()
+            .find(|&e| e >= every)
+            .unwrap_or(every);
+        let minor = decades.len() <= 7;
+        for d in first..=last {
+            if inside(d as f64) {
+                let label = (d.rem_euclid(every) == 0).then(|| power_of_ten(1, d));
+                ticks.push((d as f64, label));
+            }
+            for m in [2, 5].into_iter().filter(|_| minor) {
+                let v = d as f64 + f64::from(m).log10();
+                if inside(v) {
+                    ticks.push((v, None));
+                }
+            }
         }
     } else {
-        let t = format!("{x:.1e}");
-        t.replace(".0e", "e")
+        for d in first..=last {
+            for m in [1, 2, 5] {
+                let v = d as f64 + f64::from(m).log10();
+                // Numbers where they are short: 0.2, 1, 50.
+                let value = f64::from(m) * 10f64.powf(d as f64);
+                let label = if (1e-3..1e4).contains(&value) {
+                    short(value)
+                } else {
+                    power_of_ten(m, d)
+                };
+                if inside(v) {
+                    ticks.push((v, Some(label)));
+                }
+            }
+        }
+    }
+    ticks
+}
+
+/// `m × 10^d` as a tick value: `10⁻³`, `10⁰`, `2×10⁴` (superscript digits and minus).
+fn power_of_ten(m: u32, d: i64) -> String {
+    const DIGITS: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    let exponent: String = d
+        .to_string()
+        .chars()
+        .map(|c| match c.to_digit(10) {
+            Some(k) => DIGITS[k as usize],
+            None => '⁻',
+        })
+        .collect();
+    if m == 1 {
+        format!("10{exponent}")
+    } else {
+        format!("{m}×10{exponent}")
+    }
+}
+
+/// `v` in a label: up to four significant digits, trailing zeros dropped (`140`, `19.4`,
+/// `0.25`, `0.3512`), powers of ten outside `[10⁻³, 10⁴)` (`7.3e−5`, `2.5e6`); `−` as the
+/// minus. The one number format of the figures' titles and legends.
+fn short(v: f64) -> String {
+    if !v.is_finite() {
+        return format!("{v}");
+    }
+    let text = if v == 0.0 {
+        "0".to_string()
+    } else if (1e-3..1e4).contains(&v.abs()) {
+        let digits = (3.0 - v.abs().log10().floor()).max(0.0) as usize;
+        trim_zeros(&format!("{v:.digits$}")).to_string()
+    } else {
+        let text = format!("{v:.3e}");
+        let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+        format!("{}e{exponent}", trim_zeros(mantissa))
     };
     text.replace('-', "−")
+}
+
+/// A decimal's trailing zeros (and point) dropped: `0.2500` to `0.25`, `3.000` to `3`.
+fn trim_zeros(text: &str) -> &str {
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        text
+    }
 }
 
 /// The maximal runs of consecutive items whose coordinates are all finite.
@@ -1827,15 +2339,33 @@ mod tests {
         assert!(subscripts("").is_empty());
     }
 
+    /// Decades written out by hand: 10⁻³ to 10² over [1e-3, 1e2], with the minor lines at
+    /// log10(2) and log10(5) between; a narrow range gets 1, 2 and 5 times the powers of ten.
     #[test]
-    fn log_ticks_print_the_values() {
-        assert_eq!(log_tick(0.0), "1");
-        assert_eq!(log_tick(2.0), "100");
-        assert_eq!(log_tick(-1.0), "0.1");
-        assert_eq!(log_tick(-3.0), "1e−3");
-        assert_eq!(log_tick(5.0), "1e5");
-        assert_eq!(log_tick(0.5), "3.2");
-        assert_eq!(log_tick(4.5_f64.log10() + 4.0), "4.5e4");
+    fn log_ticks_are_the_powers_of_ten() {
+        let labels = |range: (f64, f64)| -> Vec<String> {
+            log_ticks(range).into_iter().filter_map(|t| t.1).collect()
+        };
+        assert_eq!(
+            labels((-3.0, 2.0)),
+            ["10⁻³", "10⁻²", "10⁻¹", "10⁰", "10¹", "10²"]
+        );
+        let all = log_ticks((-3.0, 2.0));
+        // 6 decades and 2 minor lines in each of the 5 decades between.
+        assert_eq!(all.len(), 6 + 5 * 2);
+        assert!(all
+            .iter()
+            .any(|t| (t.0 - (-3.0 + 2f64.log10())).abs() < 1e-12 && t.1.is_none()));
+        // 17 decades: every fifth labelled (more than eight would crowd), no minor lines.
+        assert_eq!(labels((-5.0, 12.0)), ["10⁻⁵", "10⁰", "10⁵", "10¹⁰"]);
+        assert_eq!(log_ticks((-5.0, 12.0)).len(), 18);
+        // Less than two decades: 1, 2, 5 times, as numbers between the powers of ten.
+        assert_eq!(
+            labels((0.2f64.log10(), 3f64.log10())),
+            ["0.2", "0.5", "1", "2"]
+        );
+        assert_eq!(labels((-6.0, -5.5)), ["10⁻⁶", "2×10⁻⁶"]);
+        assert!(log_ticks((f64::NAN, 1.0)).is_empty());
     }
 
     #[test]
@@ -1850,17 +2380,77 @@ mod tests {
         assert_eq!(tick(-1e-17, (-1.0, 1.0)), "0.0");
     }
 
+    /// matplotlib's viridis: #440154 at 0, #2C728E at 0.375, #5EC962 at 0.75 (its
+    /// published colour table); three ordered series take 0, 0.375 and 0.75 of it.
     #[test]
-    fn ordered_colours_run_blue_grey_red_and_stay_visible() {
+    fn ordered_colours_run_along_viridis() {
         let chart = Chart::new("", "", "")
             .colours(Colours::Ordered)
             .line("a", &[])
             .line("b", &[])
             .line("c", &[]);
-        assert_eq!(chart.colour(0), RGBColor(33, 102, 172));
-        assert_eq!(chart.colour(1), RGBColor(110, 110, 110));
-        assert_eq!(chart.colour(2), RGBColor(178, 24, 43));
+        assert_eq!(chart.colour(0), RGBColor(0x44, 0x01, 0x54));
+        assert_eq!(chart.colour(2), RGBColor(0x5e, 0xc9, 0x62));
+        // viridis at 0.375: #2C728E.
+        assert_eq!(chart.colour(1), RGBColor(0x2c, 0x72, 0x8e));
+        assert_eq!(
+            series_colour(Colours::Ordered, 0, 1),
+            RGBColor(0x44, 0x01, 0x54)
+        );
+        // The diverging palette keeps its white middle.
         assert_eq!(Palette::Diverging.colour(0.5), RGBColor(247, 247, 247));
+    }
+
+    /// A sweep's points: ordered along one numeric axis (given out of order) or along
+    /// axes that rise together; categorical for a product of axes or words.
+    #[test]
+    fn points_are_ordered_when_their_axes_rise_together() {
+        let point = |pairs: &[(&str, &str)]| -> Vec<(String, String)> {
+            pairs
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect()
+        };
+        let order = |points: &[Vec<(String, String)>]| {
+            point_order(&points.iter().map(|p| &p[..]).collect::<Vec<_>>())
+        };
+        let heights = [
+            point(&[("drive.height", "0.006"), ("normal_load", "100")]),
+            point(&[("drive.height", "0.002"), ("normal_load", "100")]),
+            point(&[("drive.height", "0.004"), ("normal_load", "100")]),
+        ];
+        assert_eq!(order(&heights), (Colours::Ordered, vec![1, 2, 0]));
+        let zipped = [
+            point(&[("block.ly", "0.007"), ("block.lz", "0.0194")]),
+            point(&[("block.ly", "0.014"), ("block.lz", "0.0389")]),
+        ];
+        assert_eq!(order(&zipped), (Colours::Ordered, vec![0, 1]));
+        let product = [
+            point(&[("a", "1"), ("b", "1")]),
+            point(&[("a", "1"), ("b", "2")]),
+            point(&[("a", "2"), ("b", "1")]),
+            point(&[("a", "2"), ("b", "2")]),
+        ];
+        assert_eq!(order(&product), (Colours::Distinct, vec![0, 1, 2, 3]));
+        let words = [
+            point(&[("drive.kind", "\"rod\"")]),
+            point(&[("drive.kind", "\"top\"")]),
+        ];
+        assert_eq!(order(&words), (Colours::Distinct, vec![0, 1]));
+        assert_eq!(order(&heights[..1]), (Colours::Distinct, vec![0]));
+    }
+
+    #[test]
+    fn numbers_are_short() {
+        assert_eq!(short(140.0), "140");
+        assert_eq!(short(19.400000000000002), "19.4");
+        assert_eq!(short(0.25), "0.25");
+        assert_eq!(short(-0.0), "0");
+        assert_eq!(short(0.351_23), "0.3512");
+        assert_eq!(short(7.3e-5), "7.3e−5");
+        assert_eq!(short(2.5e6), "2.5e6");
+        assert_eq!(short(12346.0), "1.235e4");
+        assert_eq!(short(f64::NAN), "NaN");
     }
 
     #[test]

@@ -31,7 +31,7 @@ pub(crate) mod stats;
 pub use error::SweepError;
 pub(crate) use merge::GRID_LOADS;
 #[cfg(feature = "plot")]
-pub(crate) use merge::{ensemble_curves, MEDIAN_BAND_RUNS};
+pub(crate) use merge::{ensemble_curves, EnsembleCurves, MEDIAN_BAND_RUNS};
 pub use merge::{mean_band, merge, Band, MergeSummary};
 pub use stats::{statistics, StatsOptions, StatsSummary};
 

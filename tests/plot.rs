@@ -647,8 +647,8 @@ fn figures_take_the_size_asked_for_within_limits() {
 
 /// The statistics figures show what the run's tables give: `avalanche_sizes` the power
 /// law fitted to the sizes of `per_avalanche.csv` (read here, the last avalanche, global
-/// slip, left out) with its exponent and interval in the legend, on logarithmic axes whose
-/// ticks print values; `fronts` both fronts.
+/// slip, left out) with its exponent and interval in the legend, on logarithmic axes
+/// labelled at the powers of ten; `fronts` both fronts.
 #[test]
 fn statistics_figures_show_the_runs_fit_and_fronts() {
     use precursors::statistics::{fit_power_law, PowerLawOptions, Support};
@@ -691,8 +691,33 @@ fn statistics_figures_show_the_runs_fit_and_fronts() {
     assert!(texts
         .iter()
         .any(|t| t.starts_with("Distribution of avalanche sizes")));
-    // Log axes: ticks at values spanning decades, printed as values (no "log").
-    assert!(texts.iter().any(|t| t == "10") && texts.iter().any(|t| t == "0.01"));
+    // Log axes: the y axis (the densities span more than two decades) labelled at every
+    // power of ten between the binned densities, written 10⁻ⁿ; no "log" in any label.
+    let densities: Vec<f64> = precursors::statistics::log_binned(&sizes, Support::Discrete, 5)
+        .unwrap()
+        .iter()
+        .filter(|b| b.count > 0)
+        .map(|b| b.density)
+        .collect();
+    let (low, high) = densities
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), d| (a.min(*d), b.max(*d)));
+    assert!(high / low > 100.0, "{densities:?}");
+    let superscript = |n: i32| -> String {
+        let digits = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+        let sign = if n < 0 { "⁻" } else { "" };
+        let magnitude: String = n
+            .unsigned_abs()
+            .to_string()
+            .chars()
+            .map(|c| digits[c.to_digit(10).unwrap() as usize])
+            .collect();
+        format!("10{sign}{magnitude}")
+    };
+    for n in (low.log10().ceil() as i32)..=(high.log10().floor() as i32) {
+        let label = superscript(n);
+        assert!(texts.contains(&label), "{label} not in {texts:?}");
+    }
     assert!(texts.iter().all(|t| !t.contains("log")));
     let fronts: Vec<String> = svg_texts(&dir.join("fronts.svg"))
         .into_iter()
@@ -1209,4 +1234,325 @@ mod cli {
         );
         std::fs::remove_dir_all(&dir).unwrap();
     }
+
+    /// `precursors plot --dpi`: the PNG's pixels at that resolution (800 x 560 at 300
+    /// dpi: 1600 x 1120); a resolution out of range is a bad command line (code 2) that
+    /// says the range, and nothing is drawn.
+    #[test]
+    fn plot_dpi_sets_the_pixels() {
+        let dir = scratch("cli-dpi");
+        spring_run(&dir);
+        let args = |dpi: &'static str| ["plot", path(&dir), "--figure", "stick_slip", "--dpi", dpi];
+        let o = precursors(&args("300"));
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let (_, w, h) = decode(&dir.join("stick_slip.png"));
+        assert_eq!((w, h), (1600, 1120));
+        std::fs::remove_file(dir.join("stick_slip.png")).unwrap();
+        let o = precursors(&args("20"));
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains("20 dpi") && stderr(&o).contains("50 to 1200"),
+            "{}",
+            stderr(&o)
+        );
+        assert!(!dir.join("stick_slip.png").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
+/// An attribute's number in a tag's attributes (`y`, `font-size`).
+fn attribute(attributes: &str, name: &str) -> f64 {
+    let tail = attributes
+        .split_once(&format!(" {name}=\""))
+        .unwrap_or_else(|| panic!("no {name} in {attributes}"))
+        .1;
+    tail.split_once('"').unwrap().0.parse().unwrap()
+}
+
+/// The smallest font-size an SVG text of a line may have (pixels of font height
+/// SMALLEST in the PNG, written in em of DejaVu Sans: 2384/2048 em of height, the
+/// font's hhea ascender − descender over its units per em, from DejaVuSans.sfd).
+fn svg_font_size(pixels: f64) -> f64 {
+    pixels * 2048.0 / 2384.0
+}
+
+/// The vertices of each `<polyline>` of an SVG drawn `width` wide, with its stroke.
+fn svg_polylines(svg: &str, width: u32) -> Vec<(String, Vec<(f64, f64)>)> {
+    svg.split("<polyline")
+        .skip(1)
+        .filter_map(|rest| {
+            let tag = rest.split_once("/>")?.0;
+            if !tag.contains(&format!("stroke-width=\"{width}\"")) {
+                return None;
+            }
+            let stroke = tag
+                .split_once("stroke=\"")?
+                .1
+                .split_once('"')?
+                .0
+                .to_string();
+            let points = tag.split_once("points=\"")?.1.split_once('"')?.0;
+            let vertices = points
+                .split_whitespace()
+                .map(|p| {
+                    let (x, y) = p.split_once(',').unwrap();
+                    (x.parse().unwrap(), y.parse().unwrap())
+                })
+                .collect();
+            Some((stroke, vertices))
+        })
+        .collect()
+}
+
+/// A sweep over the rod's height (given out of order, two runs a point): the titles of
+/// `precursor_length` and `contact_area` name the rod without the value the axis gives
+/// (no "h =  mm"), are set no smaller than 14 pixels, and the legend gives each height,
+/// in increasing order, coloured along viridis (its published colours at 0, 0.375 and
+/// 0.75: #440154, #2C728E, #5EC962); that no interval is drawn below 6 runs is said once,
+/// in a note, not in every entry.
+#[test]
+fn a_sweep_over_the_rod_height_is_titled_whole_and_coloured_in_order() {
+    use precursors::plot::{draw_with_options, DrawOptions};
+    use precursors::sweep::{Sweep, SweepOptions};
+    let dir = scratch("height-sweep");
+    let base = r#"{ "block": { "lx": 0.02, "ly": 0.004, "lz": 0.01 },
+        "cells": { "kind": "count", "nx": 20, "ny": 4 }, "normal_load": 100.0,
+        "drive": { "kind": "rod", "height": 0.004, "half_width": 0.001 } }"#;
+    let sweep = Sweep::from_json_str(&format!(
+        r#"{{ "base": {base}, "axes": [ {{ "key": "drive.height",
+              "values": [0.006, 0.002, 0.004] }} ], "realizations": 2, "seed": 4 }}"#
+    ))
+    .unwrap();
+    sweep.execute(&dir, &SweepOptions::new(), |_| {}).unwrap();
+    let options = DrawOptions::default()
+        .formats(&[Format::Svg])
+        .figures(["precursor_length", "contact_area"]);
+    draw_with_options(&dir, &options).unwrap();
+    for name in ["precursor_length", "contact_area"] {
+        let path = dir.join(format!("{name}.svg"));
+        let texts = svg_texts(&path);
+        // The title: the texts above the plotting area (its top at 50 pixels or lower).
+        let title: Vec<&(String, String)> = texts
+            .iter()
+            .filter(|(a, _)| attribute(a, "y") < 45.0)
+            .collect();
+        let words: String = title.iter().map(|(_, t)| t.as_str()).collect();
+        assert!(
+            words.contains("rod,") && words.contains("2 realizations"),
+            "{name}: {words}"
+        );
+        assert!(
+            !words.contains("h =") && !words.contains('…'),
+            "{name}: {words}"
+        );
+        for (a, t) in title.iter().filter(|(_, t)| t.len() > 2) {
+            assert!(
+                attribute(a, "font-size") >= svg_font_size(14.0) - 1e-9,
+                "{t}: {a}"
+            );
+        }
+        let entries: Vec<&str> = texts
+            .iter()
+            .map(|(_, t)| t.as_str())
+            .filter(|t| t.starts_with("h = "))
+            .collect();
+        assert_eq!(
+            entries,
+            [
+                "h = 2 mm (2 runs)",
+                "h = 4 mm (2 runs)",
+                "h = 6 mm (2 runs)"
+            ],
+            "{name}"
+        );
+        // The curves (2 pixels wide, after the axes' 1-pixel lines): along viridis.
+        let svg = std::fs::read_to_string(&path).unwrap();
+        let mut strokes: Vec<String> = Vec::new();
+        for (stroke, _) in svg_polylines(&svg, 2) {
+            if !strokes.contains(&stroke) {
+                strokes.push(stroke);
+            }
+        }
+        assert_eq!(strokes, ["#440154", "#2C728E", "#5EC962"], "{name}");
+    }
+    let area = svg_words(&dir.join("contact_area.svg"));
+    let notes = area
+        .iter()
+        .filter(|t| t.contains("runs: the median"))
+        .count();
+    assert_eq!(notes, 1, "{area:?}");
+    assert!(area.iter().all(|t| !t.contains("no interval")), "{area:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A title too long for one line at a readable size goes on two, and one too long for two
+/// is cut with `…`; both stay at 14 pixels or more.
+#[test]
+fn long_titles_wrap_and_shorten_instead_of_shrinking() {
+    let dir = scratch("long-title");
+    let line = [(0.0, 0.0), (1.0, 1.0)];
+    let clause = "median and 95 % interval of the real contact area";
+    for (k, repeats) in [(0, 3), (1, 12)] {
+        let title = vec![clause; repeats].join(", ");
+        let path = dir.join(format!("title{k}.svg"));
+        Chart::new(&title, "x", "y")
+            .line("", &line)
+            .save(&path)
+            .unwrap();
+        let title: Vec<(String, String)> = svg_texts(&path)
+            .into_iter()
+            .filter(|(a, _)| attribute(a, "y") < 45.0)
+            .collect();
+        let rows: Vec<f64> = title.iter().map(|(a, _)| attribute(a, "y")).collect();
+        assert_eq!(rows.len(), 2, "{title:?}");
+        assert!(rows[1] > rows[0] + 14.0, "{rows:?}");
+        for (a, t) in &title {
+            assert!(
+                attribute(a, "font-size") >= svg_font_size(14.0) - 1e-9,
+                "{t}: {a}"
+            );
+        }
+        // The first line whole, the second cut where too long.
+        assert!(!title[0].1.ends_with('…'), "{title:?}");
+        assert_eq!(title[1].1.ends_with('…'), repeats == 12, "{title:?}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A logarithmic axis is labelled at the powers of ten (10⁻³ to 10² for values from
+/// 1e-3 to 1e2: the decades written out here), its label the quantity, not its log; a
+/// staircase's polyline holds each value until the next x (vertices alternate horizontal
+/// and vertical moves, 2n − 1 of them for n points); a note is drawn once.
+#[test]
+fn log_axes_show_decades_and_staircases_their_jumps() {
+    let dir = scratch("log-steps");
+    let growth: Vec<(f64, f64)> = (0..=50)
+        .map(|k| (k as f64 / 50.0, 10f64.powf(-3.0 + 5.0 * k as f64 / 50.0)))
+        .collect();
+    let path = dir.join("log.svg");
+    Chart::new("Growth", "F/(μF_N)", "A_R/A_R(0) − 1")
+        .log_y()
+        .line("growth", &growth)
+        .note("said once")
+        .save(&path)
+        .unwrap();
+    let words = svg_words(&path);
+    for decade in ["10⁻³", "10⁻²", "10⁻¹", "10⁰", "10¹", "10²"] {
+        assert!(words.iter().any(|w| w == decade), "{decade}: {words:?}");
+    }
+    assert!(words.iter().all(|w| !w.contains("log")), "{words:?}");
+    assert_eq!(words.iter().filter(|w| *w == "said once").count(), 1);
+    // Along y the decades are evenly spaced: 10⁻³ to 10² at equal steps.
+    let ys: Vec<f64> = svg_texts(&path)
+        .iter()
+        .filter(|(_, t)| t.starts_with("10"))
+        .map(|(a, _)| attribute(a, "y"))
+        .collect();
+    let steps: Vec<f64> = ys.windows(2).map(|w| w[0] - w[1]).collect();
+    assert!(
+        steps
+            .iter()
+            .all(|s| (s - steps[0]).abs() <= 1.0 && *s > 40.0),
+        "{ys:?}"
+    );
+    // A staircase through three points: five vertices, horizontal then vertical moves.
+    let steps_path = dir.join("steps.svg");
+    Chart::new("Staircase", "F/(μF_N)", "ℓ/Lx")
+        .steps("ℓ", &[(0.0, 0.1), (0.5, 0.4), (1.0, 0.9)])
+        .save(&steps_path)
+        .unwrap();
+    let svg = std::fs::read_to_string(&steps_path).unwrap();
+    let lines = svg_polylines(&svg, 2);
+    assert_eq!(lines.len(), 1, "{lines:?}");
+    let v = &lines[0].1;
+    assert_eq!(v.len(), 5, "{v:?}");
+    for k in 0..4 {
+        let horizontal = k % 2 == 0;
+        let same = if horizontal {
+            v[k].1 == v[k + 1].1
+        } else {
+            v[k].0 == v[k + 1].0
+        };
+        assert!(same, "move {k} of {v:?}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Fig. 7's legend: `|τ_{xz}|` and `|σ_{zz}|` are typeset whole, the two letters of each
+/// subscript one smaller piece after the symbol.
+#[test]
+fn two_letter_subscripts_are_typeset_whole_in_a_legend() {
+    let dir = scratch("fig7-legend");
+    let path = dir.join("legend.svg");
+    Chart::new("Stresses", "x (mm)", "stress (MPa)")
+        .line("|τ_{xz}| at z_P = 2 mm", &[(0.0, 0.0), (1.0, 1.0)])
+        .line("|σ_{zz}| at z_P = 2 mm", &[(0.0, 1.0), (1.0, 0.0)])
+        .legend(Corner::UpperRight)
+        .save(&path)
+        .unwrap();
+    let texts = svg_texts(&path);
+    for symbol in ["|τ", "|σ"] {
+        let sub = if symbol == "|τ" { "xz" } else { "zz" };
+        let pieces = [
+            (symbol, false),
+            (sub, true),
+            ("| at z", false),
+            ("P", true),
+            ("= 2 mm", false),
+        ];
+        assert!(typeset_in(&texts, &pieces, false), "{symbol}: {texts:?}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A PNG at a resolution: `size · dpi/150` pixels (800 x 560 at 300 dpi: 1600 x 1120; at
+/// 75: 400 x 280), its title's ink scaled with it (about four times the dark pixels at
+/// twice the resolution); a resolution outside 50 to 1200 dpi is an `InvalidDpi`, a PNG
+/// over 16384 pixels a side a `Figure` error, both before anything is drawn.
+#[test]
+fn a_png_has_the_pixels_of_its_resolution() {
+    use precursors::plot::{draw_with_options, DrawOptions};
+    let dir = scratch("dpi");
+    let mut driver = scene().driver().unwrap();
+    RunTables::create(&dir, &driver)
+        .unwrap()
+        .run_to_slip(&mut driver, None, |_, _| {})
+        .unwrap();
+    let options = DrawOptions::default().figures(["precursor_length"]);
+    let mut ink = Vec::new();
+    for (dpi, pixels) in [(75, (400, 280)), (150, (800, 560)), (300, (1600, 1120))] {
+        let drawn = draw_with_options(&dir, &options.clone().dpi(dpi)).unwrap();
+        let (rgb, w, h) = decode(&drawn.files[0]);
+        assert_eq!((w, h), pixels, "{dpi} dpi");
+        // The title's band: the top 40 of 560 rows.
+        let band = (w * (h * 40 / 560) * 3) as usize;
+        ink.push(
+            rgb[..band]
+                .chunks_exact(3)
+                .filter(|p| p.iter().all(|c| *c < 100))
+                .count() as f64,
+        );
+    }
+    let ratio = ink[2] / ink[1];
+    assert!((3.0..5.0).contains(&ratio), "{ink:?}");
+    for dpi in [49, 1201, 0] {
+        let e = draw_with_options(&dir, &options.clone().dpi(dpi)).unwrap_err();
+        assert!(
+            matches!(e, PlotError::InvalidDpi { dpi: d, low: 50, high: 1200 } if d == dpi),
+            "{e:?}"
+        );
+    }
+    let e = draw_with_options(&dir, &options.clone().size(8000, 5600).dpi(600)).unwrap_err();
+    assert!(matches!(e, PlotError::Figure { .. }), "{e:?}");
+    assert!(e.to_string().contains("32000 x 22400 pixels"), "{e}");
+    // An SVG does not depend on the resolution.
+    let svg = options.clone().formats(&[Format::Svg]);
+    draw_with_options(&dir, &svg.clone().dpi(300)).unwrap();
+    let at_300 = std::fs::read(dir.join("precursor_length.svg")).unwrap();
+    draw_with_options(&dir, &svg).unwrap();
+    assert_eq!(
+        at_300,
+        std::fs::read(dir.join("precursor_length.svg")).unwrap()
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -631,9 +631,15 @@ mod cli {
             assert!(svg.contains(label), "{label}");
         }
         assert!(!svg.contains("F_N"));
-        // The area figure: the median without an interval (2 runs are too few), said.
+        // The area figure: the median without an interval (2 runs are too few), said once
+        // in a note, not in each entry.
         let svg = std::fs::read_to_string(out.join("contact_area.svg")).unwrap();
-        assert!(svg.contains("(2 runs), no interval below 6 runs"));
+        assert_eq!(
+            svg.matches("below 6 runs: the median without an interval")
+                .count(),
+            1
+        );
+        assert!(!svg.contains("(2 runs), no interval"));
         // A run of the sweep is a run directory: its three figures.
         let run = out.join("p0000-r0000");
         let o = precursors(&["plot", path(&run)]);

@@ -3,7 +3,7 @@
 #![allow(dead_code)] // each example uses its own part
 
 use precursors::calibration::{length_at, precursor_curve};
-use precursors::plot::{Chart, Corner};
+use precursors::plot::{Chart, Colours, Corner};
 use precursors::{Drive, ForceLoad, Lateral, Result, Scene, SceneBuilder};
 
 /// The block of Figs. 7, 8 and S10: 200 x 7 x 100 mm, F_N = 6.25 kN, rod (h = 6 mm,
@@ -129,7 +129,8 @@ impl Curve {
 /// Realization-averaged precursor curves `ℓ/Lx` of several scenes on one grid of
 /// `F/(μF_N)` (step 0.005): writes `<name>.csv` (one column per curve) and `<name>.png`
 /// (titled `<title>, mean of <k> realizations`; ℓ/Lx against F/(μF_N), both from 0 to 1;
-/// one colour per curve, in column order, with its legend entry in the upper left) and
+/// one colour per curve along a sequential map, in column order (each panel's curves are
+/// one parameter in increasing order), with its legend entry in the upper left) and
 /// prints where each curve reaches ℓ/Lx = 0.1 and 0.5.
 pub fn precursor_panel(
     dir: &str,
@@ -178,6 +179,7 @@ pub fn precursor_panel(
     )
     .x_range(0.0, 1.0)
     .y_range(0.0, 1.0)
+    .colours(Colours::Ordered)
     .legend(Corner::UpperLeft)
     .size(900, 600);
     for (curve, c) in curves.iter().zip(&columns) {

@@ -165,14 +165,18 @@ enum Command {
         /// File format(s).
         #[arg(long, value_enum, default_value_t = FormatArg::Png)]
         format: FormatArg,
-        /// Figure width in pixels (200 to 16384; 2400 x 1680 prints 8 x 5.6 in at 300 dpi).
+        /// Figure width in 1/150 inch: pixels at 150 dpi (200 to 16384; 800 is 5.33 in).
         #[arg(long, default_value_t = 800,
               value_parser = clap::value_parser!(u32).range(200..=16384))]
         width: u32,
-        /// Figure height in pixels (200 to 16384).
+        /// Figure height in 1/150 inch (200 to 16384).
         #[arg(long, default_value_t = 560,
               value_parser = clap::value_parser!(u32).range(200..=16384))]
         height: u32,
+        /// Resolution of the PNGs in dots per inch (50 to 1200): the same figure, drawn
+        /// with dpi/150 times the pixels along each side (300 for print).
+        #[arg(long, default_value_t = 150)]
+        dpi: u32,
     },
     /// Draws a run's recorded fields (the scene key "fields") as an animated GIF:
     /// the real contact area per cell (Movie S1, DIR/contact_area.gif) or the y-averaged
@@ -399,8 +403,11 @@ impl From<PlotError> for Failure {
         let code = match &e {
             PlotError::Core(e) => core_code(e),
             PlotError::Sweep(e) => sweep_code(e),
-            // --figure naming no figure, or one the directory cannot give.
-            PlotError::UnknownFigure { .. } | PlotError::FigureUnavailable { .. } => 2,
+            // --figure naming no figure, or one the directory cannot give; --dpi out of
+            // range.
+            PlotError::UnknownFigure { .. }
+            | PlotError::FigureUnavailable { .. }
+            | PlotError::InvalidDpi { .. } => 2,
             // A figure that cannot be drawn (a directory neither a run's nor a sweep's).
             _ => 3,
         };
@@ -480,7 +487,8 @@ fn main() -> ExitCode {
             format,
             width,
             height,
-        } => plot(&dir, format, (width, height), &figures),
+            dpi,
+        } => plot(&dir, format, ((width, height), dpi), &figures),
         Command::Movie {
             dir,
             field,
@@ -867,7 +875,7 @@ fn run_sweep(
 fn plot(
     dir: &Path,
     format: FormatArg,
-    size: (u32, u32),
+    (size, dpi): ((u32, u32), u32),
     figures: &[String],
 ) -> Result<(), Failure> {
     use precursors::plot::{draw_with_options, DrawOptions, Format};
@@ -879,6 +887,7 @@ fn plot(
     let options = DrawOptions::default()
         .formats(formats)
         .size(size.0, size.1)
+        .dpi(dpi)
         .figures(figures);
     let drawn = draw_with_options(dir, &options)?;
     if let Some(summary) = &drawn.merge {

@@ -7,7 +7,7 @@
 //! them; the goodness of fit is `stats`' (it is not drawn).
 
 use super::selection::Selection;
-use super::{Chart, Corner, PlotError, Style, DISTINCT};
+use super::{point_order, series_colour, short, Canvas, Colours, Corner, PlotError, Style};
 use crate::output::derived::derive;
 use crate::output::layout::{DROPS_FIGURE, FRONTS_FIGURE, SIZES_FIGURE};
 use crate::statistics::{fit_power_law, log_binned, PowerLawOptions, Support};
@@ -25,10 +25,17 @@ pub(super) struct Statistics {
 /// A sweep point's name in a legend, from its axes' values and its runs.
 pub(super) type PointLabel = fn(&[(String, String)], usize) -> String;
 
-/// One point's series of a distribution: its label, samples and support.
+/// One point's series of a distribution: its label and samples.
 struct Pooled {
     label: String,
     samples: Vec<f64>,
+}
+
+/// The points' series of a distribution, in the order they are drawn, and their colours
+/// ([`point_order`]).
+struct Family {
+    pooled: Vec<Pooled>,
+    colours: Colours,
 }
 
 /// Draws `avalanche_sizes`, `force_drops` and (for a run) `fronts` of `dir` (a run's or a
@@ -37,7 +44,7 @@ struct Pooled {
 pub(super) fn draw_statistics(
     dir: &Path,
     extensions: &[&str],
-    size: (u32, u32),
+    canvas: Canvas,
     (title, label): (&str, PointLabel),
     selection: &Selection,
 ) -> Result<Statistics, PlotError> {
@@ -49,9 +56,10 @@ pub(super) fn draw_statistics(
         return Ok(drawn);
     }
     let (_, points, _) = points(dir)?;
+    let (colours, order) = point_order(&points.iter().map(|p| &p.values[..]).collect::<Vec<_>>());
     let mut sizes = Vec::new();
     let mut drops = Vec::new();
-    for point in points.iter().filter(|_| pooled) {
+    for point in order.iter().map(|&k| &points[k]).filter(|_| pooled) {
         let (mut s, mut d) = (Vec::new(), Vec::new());
         point.for_each_record(|run_dir, record| {
             let [ruptures, drop, ..] = samples(record, run_dir)?;
@@ -75,10 +83,14 @@ pub(super) fn draw_statistics(
     }
     let sizes_axes = ("S (ruptures of an avalanche)", "P(S)", "avalanche sizes");
     if selection.wants(SIZES_FIGURE) {
+        let sizes = Family {
+            pooled: sizes,
+            colours,
+        };
         distribution(
             dir,
             extensions,
-            size,
+            canvas,
             (SIZES_FIGURE, title, sizes_axes),
             (&sizes, Support::Discrete),
             &mut drawn,
@@ -90,10 +102,14 @@ pub(super) fn draw_statistics(
         selection.skip(DROPS_FIGURE, dir, reason.into(), &mut drawn.notes)?;
     } else if selection.wants(DROPS_FIGURE) {
         let drops_axes = ("ΔF (N)", "P(ΔF) (1/N)", "force drops");
+        let drops = Family {
+            pooled: drops,
+            colours,
+        };
         distribution(
             dir,
             extensions,
-            size,
+            canvas,
             (DROPS_FIGURE, title, drops_axes),
             (&drops, Support::Continuous),
             &mut drawn,
@@ -104,7 +120,7 @@ pub(super) fn draw_statistics(
         let mut figure = Ok(());
         for point in &points {
             point.for_each_record(|_, record| {
-                figure = fronts(dir, extensions, size, title, record, &mut drawn);
+                figure = fronts(dir, extensions, canvas, title, record, &mut drawn);
                 Ok(())
             })?;
         }
@@ -117,24 +133,26 @@ pub(super) fn draw_statistics(
 fn distribution(
     dir: &Path,
     extensions: &[&str],
-    size: (u32, u32),
+    canvas: Canvas,
     (name, title, (x_label, y_label, what)): (&str, &str, (&str, &str, &str)),
-    (pooled, support): (&[Pooled], Support),
+    (family, support): (&Family, Support),
     drawn: &mut Statistics,
 ) -> Result<(), PlotError> {
     // The interval from the bootstrap; the goodness of fit is `stats`' to compute.
     let options = PowerLawOptions::default().goodness_samples(0);
-    let mut chart = Chart::new(
-        &format!("Distribution of {what}: {title}"),
-        x_label,
-        y_label,
-    )
-    .size(size.0, size.1)
-    .log_x()
-    .log_y()
-    .legend(Corner::LowerLeft);
+    let mut chart = canvas
+        .chart(
+            &format!("Distribution of {what}: {title}"),
+            x_label,
+            y_label,
+        )
+        .log_x()
+        .log_y()
+        .legend(Corner::LowerLeft);
+    let pooled = &family.pooled;
     for (k, p) in pooled.iter().enumerate() {
-        let colour = DISTINCT[k % DISTINCT.len()];
+        // The markers and the fit of a point in one colour.
+        let colour = series_colour(family.colours, k, pooled.len());
         let style = Style::new().colour(colour.0, colour.1, colour.2);
         let positive = p.samples.iter().filter(|x| **x > 0.0).count();
         if positive == 0 {
@@ -193,7 +211,7 @@ fn distribution(
 fn fronts(
     dir: &Path,
     extensions: &[&str],
-    size: (u32, u32),
+    canvas: Canvas,
     title: &str,
     record: &crate::output::check::RunRecord,
     drawn: &mut Statistics,
@@ -214,34 +232,19 @@ fn fronts(
     let top = record.slip.max(1.0);
     for extension in extensions {
         let path = dir.join(format!("{FRONTS_FIGURE}.{extension}"));
-        Chart::new(
-            &format!("Precursor and damage fronts: {title}"),
-            "F/(μF_N)",
-            "x/Lx",
-        )
-        .size(size.0, size.1)
-        .x_range(0.0, top)
-        .y_range(0.0, 1.0)
-        .steps("ℓ/Lx: columns below their zero-shear area", &ell)
-        .steps("x_D/Lx: columns with half their contacts lost", &front)
-        .legend(Corner::UpperLeft)
-        .save(&path)?;
+        canvas
+            .chart(
+                &format!("Precursor and damage fronts: {title}"),
+                "F/(μF_N)",
+                "x/Lx",
+            )
+            .x_range(0.0, top)
+            .y_range(0.0, 1.0)
+            .steps("ℓ/Lx: columns below their zero-shear area", &ell)
+            .steps("x_D/Lx: columns with half their contacts lost", &front)
+            .legend(Corner::UpperLeft)
+            .save(&path)?;
         drawn.files.push(path);
     }
     Ok(())
-}
-
-/// `v` with three significant digits, trailing zeros dropped (`12`, `0.351`, `7.3e-5`).
-fn short(v: f64) -> String {
-    if (1e-3..1e5).contains(&v.abs()) {
-        let digits = (2.0 - v.abs().log10().floor()).max(0.0) as usize;
-        let text = format!("{v:.digits$}");
-        if text.contains('.') {
-            text.trim_end_matches('0').trim_end_matches('.').to_string()
-        } else {
-            text
-        }
-    } else {
-        format!("{v:.2e}")
-    }
 }

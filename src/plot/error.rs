@@ -55,6 +55,22 @@ pub enum PlotError {
         /// What is wrong.
         reason: String,
     },
+    /// A PNG's resolution ([`crate::plot::Chart::dpi`], [`crate::plot::Map::dpi`],
+    /// [`crate::plot::DrawOptions::dpi`], `precursors plot --dpi`) outside `low` to
+    /// `high` dots per inch: coarser draws the text too few pixels to read, finer makes
+    /// pictures of hundreds of megabytes for no print that resolves them.
+    #[error(
+        "a resolution of {dpi} dpi: a figure is drawn at {low} to {high} dots per inch \
+         (150, the default, for the screen; 300 or 600 for print)"
+    )]
+    InvalidDpi {
+        /// The resolution given (dots per inch).
+        dpi: u32,
+        /// The lowest resolution allowed (dots per inch).
+        low: u32,
+        /// The highest resolution allowed (dots per inch).
+        high: u32,
+    },
     /// A figure name ([`crate::plot::DrawOptions::figures`], `precursors plot --figure`)
     /// that is not one of the figures `plot` draws; the message lists them.
     #[error(

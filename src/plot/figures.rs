@@ -22,7 +22,7 @@ use super::paper::{draw_archard, draw_stick_slip};
 use super::profiles::draw_profiles;
 use super::selection::{Selection, NORMAL_LOAD};
 use super::PlotError;
-use super::{Chart, Corner, Map, Palette};
+use super::{point_order, short, Canvas, Chart, Colours, Corner, Map, Palette};
 use crate::error::{Error, Result};
 use crate::output::check::RunRecord;
 use crate::output::derived::derive;
@@ -138,9 +138,10 @@ pub fn draw(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
     draw_with_size(dir, formats, (800, 560))
 }
 
-/// [`draw`] with the figures' size in pixels `(width, height)` (for print: a PNG of
-/// 2400 x 1680 is 8 x 5.6 inches at 300 dpi; [`draw`] uses 800 x 560). The SVG figures
-/// take the size as their view box.
+/// [`draw`] with the figures' size `(width, height)` in 1/150 inch (pixels at the
+/// default 150 dpi; [`draw`] uses 800 x 560, 5.33 x 3.73 inches). The SVG figures take
+/// the size as their view box. For print, keep the size and raise the resolution
+/// ([`DrawOptions::dpi`]).
 ///
 /// ```
 /// use precursors::{output::RunTables, plot::{draw_with_size, Format}, Scene};
@@ -169,20 +170,27 @@ pub fn draw_with_size(
     )
 }
 
-/// What [`draw_with_options`] draws: the formats, the size in pixels and which figures.
-/// Setters never fail; [`draw_with_options`] checks the values.
+/// What [`draw_with_options`] draws: the formats, the size, the PNGs' resolution and
+/// which figures. Setters never fail; [`draw_with_options`] checks the values.
+///
+/// A figure's size is in 1/150 inch: at the default 150 dpi its PNG has as many pixels
+/// (800 x 560 for a figure of 5.33 x 3.73 inches); at `dpi` it has `size · dpi/150`
+/// (1600 x 1120 at 300 dpi), with its text, lines and markers as large relative to the
+/// figure as at 150 dpi. An SVG takes the size as its view box, whatever the resolution.
 ///
 /// ```
 /// use precursors::plot::{DrawOptions, Format};
 /// let options = DrawOptions::default()
 ///     .formats(&[Format::Svg])
 ///     .size(1200, 840)
+///     .dpi(300)
 ///     .figures(["precursor_length", "stick_slip"]);
-/// assert_eq!(options.size, (1200, 840));
+/// assert_eq!((options.size, options.dpi), ((1200, 840), 300));
 /// assert_eq!(options.figures, ["precursor_length", "stick_slip"]);
-/// // The default: PNG, 800 x 560 pixels, every figure the directory allows.
+/// // The default: PNG, 800 x 560 at 150 dpi, every figure the directory allows.
 /// let default = DrawOptions::default();
 /// assert_eq!((default.formats, default.size), (vec![Format::Png], (800, 560)));
+/// assert_eq!(default.dpi, 150);
 /// assert!(default.figures.is_empty());
 /// ```
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -190,9 +198,12 @@ pub fn draw_with_size(
 pub struct DrawOptions {
     /// The file formats, each figure written once in each (default PNG).
     pub formats: Vec<Format>,
-    /// The figures' size in pixels `(width, height)`, each side from 200 to 16384
-    /// (default 800 x 560; a PNG of 2400 x 1680 prints 8 x 5.6 inches at 300 dpi).
+    /// The figures' size `(width, height)` in 1/150 inch, each side from 200 to 16384
+    /// (default 800 x 560: 5.33 x 3.73 inches; the PNG's pixels at 150 dpi).
     pub size: (u32, u32),
+    /// The PNGs' resolution in dots per inch, 50 to 1200 (default 150): a PNG has
+    /// `size · dpi/150` pixels (at most 16384 along a side).
+    pub dpi: u32,
     /// The names of the figures to draw (`precursor_length`, `contact_area`,
     /// `contact_map`, `stick_slip`, `archard`, `fronts`, `avalanche_sizes`,
     /// `force_drops`, `slip_profiles`, `shear_profiles`, `normal_profiles`,
@@ -205,6 +216,7 @@ impl Default for DrawOptions {
         Self {
             formats: vec![Format::Png],
             size: (800, 560),
+            dpi: super::DEFAULT_DPI,
             figures: Vec::new(),
         }
     }
@@ -217,9 +229,15 @@ impl DrawOptions {
         self
     }
 
-    /// The size in pixels.
+    /// The size in 1/150 inch.
     pub fn size(mut self, width: u32, height: u32) -> Self {
         self.size = (width, height);
+        self
+    }
+
+    /// The PNGs' resolution in dots per inch.
+    pub fn dpi(mut self, dpi: u32) -> Self {
+        self.dpi = dpi;
         self
     }
 
@@ -265,8 +283,9 @@ impl DrawOptions {
 /// ```
 ///
 /// # Errors
-/// As [`draw`]; [`PlotError::Figure`] also for a side below 200 or above 16384 pixels;
-/// [`PlotError::UnknownFigure`] for a name in [`DrawOptions::figures`] that is no figure;
+/// As [`draw`]; [`PlotError::Figure`] also for a side below 200 or above 16384, or a PNG
+/// of more than 16384 pixels along a side at the resolution; [`PlotError::InvalidDpi`]
+/// for a resolution outside 50 to 1200 dpi; [`PlotError::UnknownFigure`] for a name in [`DrawOptions::figures`] that is no figure;
 /// [`PlotError::FigureUnavailable`] for a named figure the directory cannot give (a
 /// run's figure of a sweep, `archard` of a run or of a sweep without the axis
 /// `normal_load`, `stick_slip` without a driving spring, `force_drops` where the force
@@ -281,11 +300,30 @@ pub fn draw_with_options(dir: &Path, options: &DrawOptions) -> Result<Drawn, Plo
         return Err(PlotError::Figure {
             path: None,
             reason: format!(
-                "a figure of {width} x {height} pixels: each side must lie in [200, {}]",
+                "a figure of {width} x {height}: each side must lie in [200, {}]",
                 super::LARGEST_SIDE
             ),
         });
     }
+    super::check_dpi(options.dpi)?;
+    let pixels = super::png_pixels(size, options.dpi);
+    if options.formats.contains(&Format::Png) && pixels.0.max(pixels.1) > super::LARGEST_SIDE {
+        return Err(PlotError::Figure {
+            path: None,
+            reason: format!(
+                "a figure of {width} x {height} at {} dpi is a PNG of {} x {} pixels: at most \
+                 {} along a side",
+                options.dpi,
+                pixels.0,
+                pixels.1,
+                super::LARGEST_SIDE
+            ),
+        });
+    }
+    let canvas = Canvas {
+        size,
+        dpi: options.dpi,
+    };
     let mut named = Vec::new();
     for name in &options.figures {
         let Some(figure) = FIGURES.iter().find(|f| **f == name.trim()) else {
@@ -331,13 +369,13 @@ pub fn draw_with_options(dir: &Path, options: &DrawOptions) -> Result<Drawn, Plo
     let (selection, skipped) = Selection::of(dir, sweep, named)?;
     let (mut drawn, title) = if sweep {
         (
-            draw_sweep(dir, formats, size, &selection)?,
+            draw_sweep(dir, formats, canvas, &selection)?,
             sweep_title(dir),
         )
     } else {
-        (draw_run(dir, formats, size, &selection)?, run_title(dir))
+        (draw_run(dir, formats, canvas, &selection)?, run_title(dir))
     };
-    let statistics = draw_statistics(dir, &extensions, size, (&title, point_label), &selection)?;
+    let statistics = draw_statistics(dir, &extensions, canvas, (&title, point_label), &selection)?;
     drawn.files.extend(statistics.files);
     drawn.notes.extend(statistics.notes);
     drawn.notes.extend(skipped);
@@ -391,17 +429,6 @@ fn sweep_title(dir: &Path) -> String {
     format!("{}, {realizations} realizations", describe(&keys))
 }
 
-/// `v` with at most four decimals, trailing zeros dropped (`140`, `19.4`, `0.5`).
-fn short(v: f64) -> String {
-    let text = format!("{v:.4}");
-    let text = text.trim_end_matches('0').trim_end_matches('.');
-    if text == "-0" {
-        "0".into()
-    } else {
-        text.to_string()
-    }
-}
-
 /// `v` clipped to `[low, high]`; a `NaN` (no band: fewer than two runs) stays `NaN`.
 fn clip(v: f64, low: f64, high: f64) -> f64 {
     if v.is_nan() {
@@ -445,30 +472,28 @@ fn describe(keys: &[(String, String)]) -> String {
     if let Some(f) = num("normal_load") {
         parts.push(format!("F_N = {}", newtons(f)));
     }
+    // A key that is a sweep's axis is left out of its title (the legend gives it): the
+    // drive is then named without that value.
+    let rod = |key: &str| match mm(key) {
+        Some(h) => format!("rod at h = {h} mm"),
+        None => "rod".to_string(),
+    };
     let lateral = || match get("drive.lateral.kind") {
-        Some("rod") => format!(
-            "rod at h = {} mm",
-            mm("drive.lateral.height").unwrap_or_default()
-        ),
+        Some("rod") => rod("drive.lateral.height"),
         _ => "side".to_string(),
     };
     match get("drive.kind") {
-        Some("rod") => parts.push(format!(
-            "rod at h = {} mm",
-            mm("drive.height").unwrap_or_default()
-        )),
+        Some("rod") => parts.push(rod("drive.height")),
         Some("top") => parts.push("top shear".into()),
         Some("side") => parts.push("side shear".into()),
-        Some("mixed") => parts.push(format!(
-            "top and {} shear, n = {}",
-            lateral(),
-            num("drive.ratio").map(short).unwrap_or_default()
-        )),
-        Some("spring") => parts.push(format!(
-            "spring K_S = {:.3e} N/m on the {}",
-            num("drive.stiffness").unwrap_or(f64::NAN),
-            lateral()
-        )),
+        Some("mixed") => parts.push(match num("drive.ratio") {
+            Some(n) => format!("top and {} shear, n = {}", lateral(), short(n)),
+            None => format!("top and {} shear", lateral()),
+        }),
+        Some("spring") => parts.push(match num("drive.stiffness") {
+            Some(k) => format!("spring K_S = {} N/m on the {}", short(k), lateral()),
+            None => format!("spring on the {}", lateral()),
+        }),
         _ => {}
     }
     if let Some(xi) = mm("heights.correlation_length") {
@@ -497,15 +522,15 @@ fn axis_value(key: &str, value: &str) -> String {
         "drive.height" | "drive.lateral.height" => length("h"),
         "drive.half_width" | "drive.lateral.half_width" => length("Δh"),
         "drive.ratio" => format!("n = {}", short(v)),
-        "drive.stiffness" => format!("K_S = {v:.3e} N/m"),
+        "drive.stiffness" => format!("K_S = {} N/m", short(v)),
         "heights.correlation_length" => length("ξ"),
         "heights.mean" => format!("mean u0 = {} µm", short(v * 1e6)),
         "heights.std_dev" => format!("sd u0 = {} µm", short(v * 1e6)),
         "material.friction_coefficient" => format!("μ = {}", short(v)),
         "material.young_modulus" => format!("E = {} GPa", short(v / 1e9)),
         "material.poisson_ratio" => format!("ν = {}", short(v)),
-        "springs.c_x" => format!("c_x = {v:.3e} N/m³"),
-        "springs.c_z" => format!("c_z = {v:.3e} N/m²"),
+        "springs.c_x" => format!("c_x = {} N/m³", short(v)),
+        "springs.c_z" => format!("c_z = {} N/m²", short(v)),
         _ => format!("{key} = {value}"),
     }
 }
@@ -521,7 +546,7 @@ fn corrupt(path: &Path, reason: String) -> Error {
 fn draw_run(
     dir: &Path,
     formats: &[Format],
-    size: (u32, u32),
+    canvas: Canvas,
     selection: &Selection,
 ) -> Result<Drawn, PlotError> {
     let title = run_title(dir);
@@ -547,10 +572,12 @@ fn draw_run(
         .filter(|a| a.is_finite())
         .fold(1.0, f64::max);
     let above = area.iter().filter(|p| p.1 > 2.0).count();
-    let area_label = match above {
-        0 => "A_R/A_R(0) at the stable states".to_string(),
-        k => format!("A_R/A_R(0) at the stable states ({k} above 2, up to {area_top:.3e})"),
-    };
+    let area_note = (above > 0).then(|| {
+        format!(
+            "{above} states above 2 (off the chart), up to {}",
+            short(area_top)
+        )
+    });
     let top = force
         .iter()
         .copied()
@@ -564,8 +591,8 @@ fn draw_run(
     };
     for &format in formats.iter().filter(|_| selection.wants(PRECURSOR_FIGURE)) {
         let path = dir.join(format!("{PRECURSOR_FIGURE}.{}", format.extension()));
-        let mut chart = Chart::new(&format!("Precursor length: {title}"), "F/(μF_N)", "ℓ/Lx")
-            .size(size.0, size.1)
+        let mut chart = canvas
+            .chart(&format!("Precursor length: {title}"), "F/(μF_N)", "ℓ/Lx")
             .x_range(0.0, top)
             .y_range(0.0, 1.0)
             .steps("ℓ/Lx at the stable states", &ell)
@@ -581,29 +608,39 @@ fn draw_run(
     }
     for &format in formats.iter().filter(|_| selection.wants(AREA_FIGURE)) {
         let path = dir.join(format!("{AREA_FIGURE}.{}", format.extension()));
-        Chart::new(
-            &format!("Real contact area: {title}"),
-            "F/(μF_N)",
-            "A_R/A_R(0)",
-        )
-        .size(size.0, size.1)
-        .x_range(0.0, top)
-        .y_range(0.0, (1.04 * area_top).min(2.0))
-        .steps(&area_label, &area)
-        .legend(Corner::LowerLeft)
-        .save(&path)?;
+        let mut chart = canvas
+            .chart(
+                &format!("Real contact area: {title}"),
+                "F/(μF_N)",
+                "A_R/A_R(0)",
+            )
+            .x_range(0.0, top)
+            .y_range(0.0, (1.04 * area_top).min(2.0))
+            .steps("A_R/A_R(0) at the stable states", &area)
+            .legend(Corner::LowerLeft);
+        if let Some(note) = &area_note {
+            chart = chart.note(note);
+        }
+        chart.save(&path)?;
         drawn.files.push(path);
     }
     if selection.wants(MAP_FIGURE) {
-        draw_contact_map(dir, formats, size, (&title, &record), selection, &mut drawn)?;
+        draw_contact_map(
+            dir,
+            formats,
+            canvas,
+            (&title, &record),
+            selection,
+            &mut drawn,
+        )?;
     }
     let extensions: Vec<&str> = formats.iter().map(|f| f.extension()).collect();
     if selection.wants(STICK_SLIP_FIGURE) {
         drawn
             .files
-            .extend(draw_stick_slip(dir, &extensions, size, &title, &record)?);
+            .extend(draw_stick_slip(dir, &extensions, canvas, &title, &record)?);
     }
-    let profiles = draw_profiles(dir, &extensions, size, (&title, &record), selection)?;
+    let profiles = draw_profiles(dir, &extensions, canvas, (&title, &record), selection)?;
     drawn.files.extend(profiles.files);
     drawn.notes.extend(profiles.notes);
     Ok(drawn)
@@ -615,7 +652,7 @@ fn draw_run(
 fn draw_contact_map(
     dir: &Path,
     formats: &[Format],
-    size: (u32, u32),
+    canvas: Canvas,
     (title, record): (&str, &RunRecord),
     selection: &Selection,
     drawn: &mut Drawn,
@@ -683,7 +720,8 @@ fn draw_contact_map(
                 "F/(μF_N)",
                 &reference_label,
             )
-            .size(size.0, size.1)
+            .size(canvas.size.0, canvas.size.1)
+            .dpi(canvas.dpi)
             .x_range(0.0, 1.0)
             .y_range(low - half, y_top)
             .colour_scale(Palette::Diverging, Some((0.0, 2.0)));
@@ -728,7 +766,7 @@ fn front_lines(record: &RunRecord, y_top: f64) -> Result<(Line, Line)> {
 fn draw_sweep(
     dir: &Path,
     formats: &[Format],
-    size: (u32, u32),
+    canvas: Canvas,
     selection: &Selection,
 ) -> Result<Drawn, PlotError> {
     let summary = merge(dir)?;
@@ -740,33 +778,24 @@ fn draw_sweep(
     };
     let title = sweep_title(dir);
     let label = point_label;
-    // As for a run: near slip the unbounded area law can reach many times A_R(0).
-    let area_top = points
-        .iter()
-        .flat_map(|p| p.area.iter().flat_map(|r| [r.1, r.3]))
-        .filter(|a| a.is_finite())
-        .fold(1.0, f64::max);
-    let area_note = if area_top > 2.0 {
-        format!(" (up to {area_top:.2e}: above 2 off the chart)")
-    } else {
-        String::new()
-    };
+    let (colours, order) = point_order(&points.iter().map(|p| &p.values[..]).collect::<Vec<_>>());
     let mut drawn = Drawn {
         files: Vec::new(),
         merge: None,
         notes: Vec::new(),
     };
     for &format in formats.iter().filter(|_| selection.wants(PRECURSOR_FIGURE)) {
-        let mut chart = Chart::new(
-            &format!("Precursor length: {title}, mean and 95 % band"),
-            "F/(μF_N)",
-            "ℓ/Lx",
-        )
-        .size(size.0, size.1)
-        .x_range(0.0, 1.0)
-        .y_range(0.0, 1.0)
-        .legend(Corner::UpperLeft);
-        for p in &points {
+        let mut chart = canvas
+            .chart(
+                &format!("Precursor length: {title}, mean and 95 % band"),
+                "F/(μF_N)",
+                "ℓ/Lx",
+            )
+            .x_range(0.0, 1.0)
+            .y_range(0.0, 1.0)
+            .colours(colours)
+            .legend(Corner::UpperLeft);
+        for p in order.iter().map(|&k| &points[k]) {
             // ℓ/Lx lies in [0, 1]: so does its band (the t-band of few runs can reach out).
             let clipped: Vec<(f64, f64, f64, f64)> = p
                 .precursor
@@ -779,33 +808,17 @@ fn draw_sweep(
         chart.save(&path)?;
         drawn.files.push(path);
     }
-    for &format in formats.iter().filter(|_| selection.wants(AREA_FIGURE)) {
-        // The median and its distribution-free interval, not the mean's t-band: near slip
-        // the area law spreads the realizations over orders of magnitude, a few of them
-        // carry the mean, and a t-band of it spans the whole chart.
-        let mut chart = Chart::new(
-            &format!("Real contact area: {title}, median and 95 % interval{area_note}"),
-            "F/(μF_N)",
-            "A_R/A_R(0)",
-        )
-        .size(size.0, size.1)
-        .x_range(0.0, 1.0)
-        .y_range(0.0, (1.04 * area_top).min(2.0))
-        .legend(Corner::LowerLeft);
-        for p in &points {
-            let mut text = label(&p.values, p.runs);
-            if p.runs < MEDIAN_BAND_RUNS {
-                text.push_str(&format!(", no interval below {MEDIAN_BAND_RUNS} runs"));
-            }
-            chart = chart.band(&text, &p.area);
+    if selection.wants(AREA_FIGURE) {
+        let chart = area_chart(canvas, &title, (colours, &order), &points);
+        for &format in formats {
+            let path = dir.join(format!("{AREA_FIGURE}.{}", format.extension()));
+            chart.save(&path)?;
+            drawn.files.push(path);
         }
-        let path = dir.join(format!("{AREA_FIGURE}.{}", format.extension()));
-        chart.save(&path)?;
-        drawn.files.push(path);
     }
     if selection.wants(ARCHARD_FIGURE) {
         let extensions: Vec<&str> = formats.iter().map(|f| f.extension()).collect();
-        let archard = draw_archard(dir, &extensions, size, (&title, point_label), NORMAL_LOAD)?;
+        let archard = draw_archard(dir, &extensions, canvas, (&title, point_label), NORMAL_LOAD)?;
         drawn.files.extend(archard.files);
         drawn.notes.extend(archard.notes);
     }
@@ -817,6 +830,51 @@ fn draw_sweep(
     }
     drawn.merge = Some(summary);
     Ok(drawn)
+}
+
+/// A sweep's `contact_area`: each point's median of `A_R/A_R(0)` and its interval, the
+/// points in `order` coloured by `colours`; what holds for several curves (no interval
+/// below [`MEDIAN_BAND_RUNS`] runs, values off the chart) said once, in notes.
+fn area_chart(
+    canvas: Canvas,
+    title: &str,
+    (colours, order): (Colours, &[usize]),
+    points: &[crate::sweep::EnsembleCurves],
+) -> Chart {
+    // As for a run: near slip the unbounded area law can reach many times A_R(0).
+    let area_top = points
+        .iter()
+        .flat_map(|p| p.area.iter().flat_map(|r| [r.1, r.3]))
+        .filter(|a| a.is_finite())
+        .fold(1.0, f64::max);
+    // The median and its distribution-free interval, not the mean's t-band: near slip
+    // the area law spreads the realizations over orders of magnitude, a few of them
+    // carry the mean, and a t-band of it spans the whole chart.
+    let mut chart = canvas
+        .chart(
+            &format!("Real contact area: {title}, median and 95 % interval"),
+            "F/(μF_N)",
+            "A_R/A_R(0)",
+        )
+        .x_range(0.0, 1.0)
+        .y_range(0.0, (1.04 * area_top).min(2.0))
+        .colours(colours)
+        .legend(Corner::LowerLeft);
+    for p in order.iter().map(|&k| &points[k]) {
+        chart = chart.band(&point_label(&p.values, p.runs), &p.area);
+    }
+    if points.iter().any(|p| p.runs < MEDIAN_BAND_RUNS) {
+        chart = chart.note(&format!(
+            "below {MEDIAN_BAND_RUNS} runs: the median without an interval"
+        ));
+    }
+    if area_top > 2.0 {
+        chart = chart.note(&format!(
+            "above 2 off the chart (up to {})",
+            short(area_top)
+        ));
+    }
+    chart
 }
 
 #[cfg(test)]
@@ -834,12 +892,41 @@ mod tests {
             "ξ = 3 mm"
         );
         assert_eq!(axis_value("drive.ratio", "0.25"), "n = 0.25");
+        assert_eq!(axis_value("drive.stiffness", "4000000"), "K_S = 4e6 N/m");
+        assert_eq!(axis_value("springs.c_z", "2.5e10"), "c_z = 2.5e10 N/m²");
         // Keys without a symbol, and values that are not numbers, as written.
         assert_eq!(
             axis_value("solver.backend", "\"dense\""),
             "solver.backend = \"dense\""
         );
         assert_eq!(axis_value("heights.seed", "x"), "heights.seed = x");
+    }
+
+    /// A key that is a sweep's axis is not in the sweep's title: the drive is named
+    /// without its value (not "rod at h =  mm", "K_S = NaN N/m").
+    #[test]
+    fn a_drive_without_its_swept_value_is_named_alone() {
+        let keys = |pairs: &[(&str, &str)]| {
+            pairs
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(describe(&keys(&[("drive.kind", "rod")])), "rod");
+        assert_eq!(
+            describe(&keys(&[
+                ("drive.kind", "mixed"),
+                ("drive.lateral.kind", "rod")
+            ])),
+            "top and rod shear"
+        );
+        assert_eq!(
+            describe(&keys(&[
+                ("drive.kind", "spring"),
+                ("drive.lateral.kind", "side")
+            ])),
+            "spring on the side"
+        );
     }
 
     #[test]
@@ -872,7 +959,7 @@ mod tests {
         ]);
         assert_eq!(
             describe(&spring),
-            "Lx = 30 mm, F_N = 750 N, spring K_S = 4.000e6 N/m on the side"
+            "Lx = 30 mm, F_N = 750 N, spring K_S = 4e6 N/m on the side"
         );
     }
 

@@ -4,7 +4,7 @@
 //! contact area at zero shear against the normal load, over a sweep's points).
 
 use super::distributions::{PointLabel, Statistics};
-use super::{Chart, Corner, PlotError, Style, DISTINCT};
+use super::{point_order, series_colour, Canvas, Corner, PlotError, Style};
 use crate::driver::Event;
 use crate::error::Error;
 use crate::output::check::RunRecord;
@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 pub(super) fn draw_stick_slip(
     dir: &Path,
     extensions: &[&str],
-    size: (u32, u32),
+    canvas: Canvas,
     title: &str,
     record: &RunRecord,
 ) -> Result<Vec<PathBuf>, PlotError> {
@@ -62,8 +62,8 @@ pub(super) fn draw_stick_slip(
     let mut files = Vec::new();
     for extension in extensions {
         let path = dir.join(format!("{STICK_SLIP_FIGURE}.{extension}"));
-        let mut chart = Chart::new(&format!("Stick-slip: {title}"), "U_S (µm)", "F/(μF_N)")
-            .size(size.0, size.1)
+        let mut chart = canvas
+            .chart(&format!("Stick-slip: {title}"), "U_S (µm)", "F/(μF_N)")
             .x_range(0.0, if u_top > 0.0 { 1.05 * u_top } else { 1.0 })
             .y_range(0.0, 1.1 * f_top)
             .line(
@@ -108,7 +108,7 @@ struct Series {
 pub(super) fn draw_archard(
     dir: &Path,
     extensions: &[&str],
-    size: (u32, u32),
+    canvas: Canvas,
     (title, label): (&str, PointLabel),
     key: &str,
 ) -> Result<Statistics, PlotError> {
@@ -176,17 +176,19 @@ pub(super) fn draw_archard(
         .flat_map(|s| s.loads.iter().map(|l| l.0))
         .fold(0.0, f64::max)
         * 1.05;
-    let mut chart = Chart::new(
-        &format!("Real contact area at zero shear: {title}"),
-        "F_N (N)",
-        "A_R(0)/(Lx Ly) (%)",
-    )
-    .size(size.0, size.1)
-    .legend(Corner::UpperLeft);
+    let mut chart = canvas
+        .chart(
+            &format!("Real contact area at zero shear: {title}"),
+            "F_N (N)",
+            "A_R(0)/(Lx Ly) (%)",
+        )
+        .legend(Corner::UpperLeft);
     let mut y_top: f64 = 0.0;
     let single = all.len() == 1 && all[0].rest.is_empty();
-    for (k, series) in all.iter().enumerate() {
-        let colour = DISTINCT[k % DISTINCT.len()];
+    // The series differ in the other axes: ordered along them where they are numbers.
+    let (colours, order) = point_order(&all.iter().map(|s| &s.rest[..]).collect::<Vec<_>>());
+    for (k, series) in order.iter().map(|&k| &all[k]).enumerate() {
+        let colour = series_colour(colours, k, all.len());
         let style = Style::new().colour(colour.0, colour.1, colour.2);
         let percent = 100.0 / series.nominal;
         let runs: usize = series.loads.iter().map(|l| l.1.len()).sum();

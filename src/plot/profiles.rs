@@ -8,10 +8,11 @@
 //!   and `τ_C = |τ| - μ|σ|` of the y-averages on that plane, and `τ_C` averaged over `y`
 //!   at the interface when the plane `z = 0` is recorded too.
 //!
-//! One curve per load, coloured from blue (lowest) to red (highest).
+//! One curve per load, coloured along the sequential map [`Colours::Ordered`] (dark at
+//! the lowest load).
 
 use super::selection::Selection;
-use super::{Chart, Colours, Corner, PlotError, Style};
+use super::{short, Canvas, Chart, Colours, Corner, PlotError, Style};
 use crate::output::check::RunRecord;
 use crate::output::layout::{
     COULOMB_PROFILES_FIGURE, NORMAL_PROFILES_FIGURE, SHEAR_PROFILES_FIGURE, SLIP_PROFILES_FIGURE,
@@ -58,7 +59,7 @@ impl Level<'_> {
 pub(super) fn draw_profiles(
     dir: &Path,
     extensions: &[&str],
-    size: (u32, u32),
+    canvas: Canvas,
     (title, record): (&str, &RunRecord),
     selection: &Selection,
 ) -> Result<Profiles, PlotError> {
@@ -86,7 +87,7 @@ pub(super) fn draw_profiles(
     let figures = Figures {
         dir,
         extensions,
-        size,
+        canvas,
         title,
         selection,
         levels: &levels,
@@ -151,7 +152,7 @@ fn levels<'a>(rows: &'a [ProfileRow], loads: &[f64]) -> Vec<Level<'a>> {
 struct Figures<'a> {
     dir: &'a Path,
     extensions: &'a [&'a str],
-    size: (u32, u32),
+    canvas: Canvas,
     title: &'a str,
     selection: &'a Selection,
     levels: &'a [Level<'a>],
@@ -184,8 +185,8 @@ impl Figures<'_> {
         f: &dyn Fn(f64) -> f64,
     ) -> Chart {
         self.levels.iter().fold(
-            Chart::new(&format!("{what}: {}", self.title), "x (mm)", y)
-                .size(self.size.0, self.size.1)
+            self.canvas
+                .chart(&format!("{what}: {}", self.title), "x (mm)", y)
                 .x_range(0.0, self.lx_mm)
                 .colours(Colours::Ordered)
                 .legend(Corner::UpperRight),
@@ -199,26 +200,27 @@ impl Figures<'_> {
     fn coulomb(&self, (z_p, at): (f64, &str), interface: bool, drawn: &mut Profiles) -> Chart {
         let first = &self.levels[0];
         let mpa = |v: f64| v * 1e-6;
-        let chart = Chart::new(
-            &format!("Stresses at {}, {at}: {}", first.label(), self.title),
-            "x (mm)",
-            "stress (MPa)",
-        )
-        .size(self.size.0, self.size.1)
-        .x_range(0.0, self.lx_mm)
-        .legend(Corner::UpperRight)
-        .line(
-            "|τ(x, z_P)|",
-            &first.curve("shear_Pa", z_p, self.dx_mm, magnitude_mpa),
-        )
-        .line(
-            "|σ(x, z_P)|",
-            &first.curve("normal_Pa", z_p, self.dx_mm, magnitude_mpa),
-        )
-        .line(
-            "τ_C(x, z_P) = |τ| - μ|σ|",
-            &first.curve("coulomb_of_means_Pa", z_p, self.dx_mm, mpa),
-        );
+        let chart = self
+            .canvas
+            .chart(
+                &format!("Stresses at {}, {at}: {}", first.label(), self.title),
+                "x (mm)",
+                "stress (MPa)",
+            )
+            .x_range(0.0, self.lx_mm)
+            .legend(Corner::UpperRight)
+            .line(
+                "|τ(x, z_P)|",
+                &first.curve("shear_Pa", z_p, self.dx_mm, magnitude_mpa),
+            )
+            .line(
+                "|σ(x, z_P)|",
+                &first.curve("normal_Pa", z_p, self.dx_mm, magnitude_mpa),
+            )
+            .line(
+                "τ_C(x, z_P) = |τ| - μ|σ|",
+                &first.curve("coulomb_of_means_Pa", z_p, self.dx_mm, mpa),
+            );
         if interface {
             return chart
                 .line(
@@ -235,15 +237,5 @@ impl Figures<'_> {
             );
         }
         chart
-    }
-}
-
-/// `v` with up to four significant digits, trailing zeros dropped.
-fn short(v: f64) -> String {
-    let text = format!("{v:.4}");
-    if text.contains('.') {
-        text.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        text
     }
 }
