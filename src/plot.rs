@@ -1079,8 +1079,9 @@ impl Draw for MapDrawing<'_> {
             (&me.y_label, y),
             (false, (false, false)),
         )?;
-        self.draw_colour_bar(&bar)?;
         let (columns, rows) = chart.plotting_area().get_pixel_range();
+        // The bar's top level with the map's, under a title of one line or two.
+        self.draw_colour_bar(&bar, rows.start.max(0) as u32)?;
         let plot = (columns.end - columns.start, rows.end - rows.start);
         let mut notes = me.notes.clone();
         notes.push(
@@ -1142,14 +1143,16 @@ impl MapDrawing<'_> {
 
     /// The colour bar: a one-column chart of the colour scale, its values on the right,
     /// its label right of them, a triangle in the end colour beyond each end the values
-    /// pass (the values there are drawn in the end colour: saturated).
+    /// pass (the values there are drawn in the end colour: saturated); its top `top`
+    /// pixels below the picture's.
     fn draw_colour_bar<DB: DrawingBackend>(
         &self,
         bar: &DrawingArea<DB, Shift>,
+        top: u32,
     ) -> std::result::Result<(), String> {
         let (me, c) = (self.map, self.c);
         let mut scale = ChartBuilder::on(bar)
-            .margin_top(16 + 30)
+            .margin_top(top)
             .margin_bottom(16 + 52)
             .margin_left(8)
             .margin_right(8)

@@ -782,3 +782,52 @@ fn a_runs_movie_stays_within_its_size_budget() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A map's colour bar starts level with its cells under a title of one line and of two
+/// (issue 44: a fixed margin left the bar about 20 px above a map whose title wrapped).
+/// Read back from the SVG: the cells (all at the top of the scale, `#081D58`) and the
+/// bar's slices (right of the cells) have the same top.
+#[test]
+fn a_map_colour_bar_is_level_with_the_cells_under_a_wrapped_title() {
+    use precursors::plot::{Map, Palette};
+    let dir = scratch("bar-top");
+    std::fs::create_dir_all(&dir).unwrap();
+    let long = "The real contact area per column of a very long scene description, \
+                over the whole run, at every recorded state of the interface";
+    let mut tops = Vec::new();
+    for (name, title) in [("short", "Contact area"), ("long", long)] {
+        let path = dir.join(format!("{name}.svg"));
+        Map::new(4, 2, vec![1.0; 8])
+            .unwrap()
+            .labels(title, "x (mm)", "y (mm)", "A_R (mm²)")
+            .colour_scale(Palette::Sequential, Some((0.0, 1.0)))
+            .save(&path)
+            .unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        let cells = rects(&svg, "#081D58");
+        assert_eq!(cells.len(), 8, "{name}: {cells:?}");
+        let cells_right = cells.iter().map(|r| r[0] + r[2]).fold(0.0, f64::max);
+        let cells_top = cells.iter().map(|r| r[1]).fold(f64::INFINITY, f64::min);
+        let bar_top = svg
+            .split("<rect")
+            .skip(1)
+            .filter_map(|r| {
+                let r = r.split_once('>').map_or(r, |(e, _)| e);
+                let x = attribute(r, "x")?;
+                (x > cells_right + 1.0 && !r.contains("fill=\"#FFFFFF\"")).then_some(())?;
+                attribute(r, "y")
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(bar_top.is_finite(), "{name}: no colour bar found");
+        assert!(
+            (bar_top - cells_top).abs() <= 2.0,
+            "{name}: bar top {bar_top}, cells top {cells_top}"
+        );
+        tops.push(cells_top);
+    }
+    assert!(
+        tops[1] > tops[0] + 10.0,
+        "the long title did not wrap: {tops:?}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
