@@ -494,7 +494,7 @@ fn interval(i: Option<Interval>) -> String {
 
 fn cost_table(studies: &[Study]) {
     println!("### {}: cost\n", studies[0].heights);
-    println!("| cell size | N | complete runs | CPU time of the runs (s) |");
+    println!("| cell size | N | complete runs | run time, one core per run (s) |");
     println!("| --- | --- | --- | --- |");
     for s in studies {
         println!(
