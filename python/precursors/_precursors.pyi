@@ -219,6 +219,7 @@ def plot(
     width: int = ...,
     height: int = ...,
     figures: Optional[Sequence[str]] = ...,
+    dpi: int = ...,
 ) -> List[Path]: ...
 def movie(
     dir: _Path,

@@ -1258,10 +1258,12 @@ fn fit_power_law<'py>(
 
 /// Draws the figures of a run or sweep directory into it (`precursors plot`); `formats`
 /// of `"png"`, `"svg"`; `width` x `height` pixels (200 to 16384 each, as `--width` and
-/// `--height`); `figures` the names of the figures to draw (as `--figure`; `None`: every
-/// figure the directory allows). Returns the paths of the figures.
+/// `--height`, in 1/150 inch); `figures` the names of the figures to draw (as `--figure`;
+/// `None`: every figure the directory allows); `dpi` the PNGs' resolution (50 to 1200, as
+/// `--dpi`: a PNG has `width·dpi/150` x `height·dpi/150` pixels). Returns the paths of the
+/// figures.
 #[pyfunction]
-#[pyo3(signature = (dir, *, formats=vec!["png".to_string()], width=800, height=560, figures=None))]
+#[pyo3(signature = (dir, *, formats=vec!["png".to_string()], width=800, height=560, figures=None, dpi=150))]
 fn plot(
     py: Python<'_>,
     dir: PathBuf,
@@ -1269,6 +1271,7 @@ fn plot(
     width: u32,
     height: u32,
     figures: Option<Vec<String>>,
+    dpi: u32,
 ) -> PyResult<Vec<PathBuf>> {
     let formats = formats
         .iter()
@@ -1283,6 +1286,7 @@ fn plot(
     let options = precursors::plot::DrawOptions::default()
         .formats(&formats)
         .size(width, height)
+        .dpi(dpi)
         .figures(figures.unwrap_or_default());
     let drawn = py
         .detach(|| precursors::plot::draw_with_options(&dir, &options))

@@ -103,3 +103,13 @@ def test_plot_draws_the_figures_named(tmp_path):
         precursors.plot(tmp_path, figures=["fig4"])
     with pytest.raises(precursors.PrecursorsError, match="no stick_slip figure"):
         precursors.plot(tmp_path, figures=["stick_slip"])
+
+
+def test_plot_draws_pngs_at_the_resolution_asked_for(tmp_path):
+    # A figure's size is in 1/150 inch: at 300 dpi the default 800 x 560 is 1600 x 1120
+    # pixels (docs/cli.md, `--dpi`); outside 50 to 1200 dpi it is refused.
+    precursors.run(precursors.Scene.from_dict(SMALL), tmp_path)
+    figures = precursors.plot(tmp_path, figures=["contact_area"], dpi=300)
+    assert figures and all(png_size(f) == (1600, 1120) for f in figures)
+    with pytest.raises(precursors.PrecursorsError, match=r"a resolution of 10 dpi"):
+        precursors.plot(tmp_path, dpi=10)
