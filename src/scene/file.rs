@@ -553,9 +553,17 @@ impl From<&SceneBuilder> for SceneFile {
             heights: heights.into(),
             normal_load: *normal_load,
             drive: (*drive).into(),
-            solver: solver.into(),
+            // The run options' probes and threads, where given, are those the scene's
+            // drivers use: the file's keys for them.
+            solver: SolverSpec {
+                threads: match run.thread_count() {
+                    0 => solver.parallelism().into(),
+                    n => Parallelism::Threads(n).into(),
+                },
+                ..solver.into()
+            },
             plan_tolerance: *plan_tolerance,
-            probes: probes.into(),
+            probes: run.probe_spec().unwrap_or(probes).into(),
             max_cells: *max_cells,
             fields: FieldsSpec {
                 every: run.fields_every(),
