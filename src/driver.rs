@@ -464,7 +464,7 @@ impl Scene {
     /// [`Error::OutOfRange`] or [`Error::InvalidParameter`] naming the key `probes.*`;
     /// [`Error::DenseThreads`] for more than one thread when the scene's solver options
     /// ask for the dense backend.
-    pub fn driver_with(&self, options: &crate::RunOptions) -> Result<Driver> {
+    pub fn driver_with(&self, options: &crate::recording::RunOptions) -> Result<Driver> {
         let probes = match options.probe_spec() {
             Some(spec) if spec != self.probes() => {
                 crate::scene::check_probes(spec, self.grid())?;

@@ -893,7 +893,9 @@ impl SceneBuilder {
     /// default none): planned and validated at build, read with
     /// [`crate::Driver::stresses`]. A driver adds more at any time with
     /// [`crate::Driver::add_probes`]. The probes are not part of the scene's identity: a
-    /// checkpoint resumes on the scene with other probes.
+    /// checkpoint resumes on the scene with other probes. The scene file's key `probes`;
+    /// [`RunOptions::probes`] gives a run other probes (docs/compatibility.md,
+    /// "Observers").
     pub fn probes(mut self, probes: ProbeSpec) -> Self {
         self.probes = probes;
         self

@@ -316,7 +316,7 @@ impl Scene {
     pub fn resume_with(
         &self,
         checkpoint: &Checkpoint,
-        options: &crate::RunOptions,
+        options: &crate::recording::RunOptions,
     ) -> Result<Driver> {
         self.check_checkpoint_scene(checkpoint)?;
         let started = self.check_checkpoint_state(checkpoint)?;
