@@ -432,15 +432,60 @@ impl Scene {
     /// [`EquilibriumSolverBuilder::build`](crate::solver::EquilibriumSolverBuilder::build)
     /// ([`Error::TooLargeForDense`], [`Error::DenseThreads`], ...).
     pub fn driver(&self) -> Result<Driver> {
+        self.driver_with(self.run_options())
+    }
+
+    /// A driver at zero shear, as [`Scene::driver`], observed as `options` ask: it starts
+    /// with the probes of [`RunOptions::probes`](crate::RunOptions::probes) where given
+    /// (else the scene's, [`Scene::probes`]) and solves with
+    /// [`RunOptions::threads`](crate::RunOptions::threads) threads where given (else the
+    /// scene's solver options'). Neither changes an event; the options' recordings
+    /// (fields, profiles) are [`crate::output::RunTables::create_with`]'s, given the same
+    /// options.
+    ///
+    /// ```
+    /// use precursors::{ProbeSpec, RunOptions, Scene};
+    /// let scene = Scene::builder().block(0.010, 0.004, 0.010).normal_load(100.0).build()?;
+    /// let options = RunOptions::new().probes(ProbeSpec::default().with_plane(0.002)).threads(2);
+    /// let mut driver = scene.driver_with(&options)?;
+    /// driver.step()?;
+    /// assert_eq!(driver.stresses()?.planes.len(), 1);
+    /// // At most 2 threads (a grid below 2048 cells is one part: 1).
+    /// assert!(driver.threads() <= 2);
+    /// // Observers: the events are those of the plain driver.
+    /// let plain: Vec<_> = scene.driver()?.collect::<Result<_, _>>()?;
+    /// let observed: Vec<_> = scene.driver_with(&options)?.collect::<Result<_, _>>()?;
+    /// assert_eq!(plain, observed);
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Scene::driver`]; for probes that do not fit the scene,
+    /// [`Error::OutOfRange`] or [`Error::InvalidParameter`] naming the key `probes.*`;
+    /// [`Error::DenseThreads`] for more than one thread when the scene's solver options
+    /// ask for the dense backend.
+    pub fn driver_with(&self, options: &crate::recording::RunOptions) -> Result<Driver> {
+        let probes = match options.probe_spec() {
+            Some(spec) if spec != self.probes() => {
+                crate::scene::check_probes(spec, self.grid())?;
+                crate::scene::plan_probes(self.plan(), spec, self.lateral_load())?
+            }
+            _ => self.stress_probe().cloned(),
+        };
+        let mut solver_options = self.solver_options();
+        if options.thread_count() > 0 {
+            solver_options = solver_options
+                .with_parallelism(crate::solver::Parallelism::Threads(options.thread_count()))?;
+        }
         let solver = EquilibriumSolver::builder(self.plan().clone())
             .material(self.material())
-            .solver_options(self.solver_options())
+            .solver_options(solver_options)
             .build()?;
         let n = self.grid().len();
         Ok(Driver {
             scene: self.clone(),
             unit_load: self.unit_load_displacement(),
-            probes: self.stress_probe().into_iter().cloned().collect(),
+            probes: probes.into_iter().collect(),
             interface: self.interface().clone(),
             solver,
             normal: None,

@@ -371,7 +371,9 @@ impl RunTables {
     /// what `options` ask beside the three tables (`fields.csv`, `profiles.csv`): the
     /// options are checked against the scene, the directory is locked, the tables of an
     /// earlier run there removed, the scene recorded with these options (`scene.json`,
-    /// feature `serde`; a resume and `precursors movie` read them there).
+    /// feature `serde`; a resume and `precursors movie` read them there). The driver
+    /// starts with the options' probes and thread count when built by
+    /// [`crate::Scene::driver_with`] with the same options.
     ///
     /// ```
     /// use precursors::{output::RunTables, RunOptions, Scene};
@@ -1047,7 +1049,8 @@ fn read_old(partial: &Path, path: &Path) -> Result<(Option<String>, PathBuf)> {
 
 /// Refuses run options that `driver`'s scene cannot record, naming the key.
 fn check_options(driver: &Driver, options: &RunOptions) -> Result<()> {
-    crate::scene::check_run_options(options, driver.grid(), driver.scene().probes().tolerance())
+    let probes = options.probe_spec().unwrap_or(driver.scene().probes());
+    crate::scene::check_run_options(options, driver.grid(), probes.tolerance())
 }
 
 /// Refuses a directory whose recorded scene is not `driver`'s, or that records none.

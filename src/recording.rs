@@ -1,9 +1,14 @@
-//! What a run records beside its three tables ([`RunOptions`]): observers, never part of
-//! the physics. They change neither the events nor the scene's identity.
+//! What a run records and how it runs beside its three tables ([`RunOptions`]):
+//! observers, never part of the physics. They change neither the events nor the scene's
+//! identity.
+
+use crate::probe::ProbeSpec;
 
 /// What a run records beside `events.csv`, `curve.csv` and `contact_map.csv`: the fields
 /// for the movies (`fields.csv`) and the interface and stress profiles at requested loads
-/// (`profiles.csv`; layouts in the `output` module's docs).
+/// (`profiles.csv`; layouts in the `output` module's docs); and what observes a run
+/// without changing its events: the stress probes its driver starts with and the
+/// solver's thread count ([`crate::Scene::driver_with`]).
 ///
 /// The setters never fail; the values are checked against the scene when a run starts
 /// ([`crate::output::RunTables::create_with`]) or when a scene that carries them is built
@@ -19,6 +24,8 @@
 /// assert_eq!(options.profile_loads(), [0.1, 0.5, 0.9]); // in increasing order
 /// assert_eq!(options.profile_planes(), [0.0, 0.002]);
 /// assert_eq!(RunOptions::default(), RunOptions::new()); // records nothing more
+/// assert_eq!(options.probe_spec(), None); // the scene's probes
+/// assert_eq!(options.thread_count(), 0); // the scene's thread count
 /// ```
 #[derive(Debug, Clone, PartialEq, Default)]
 #[cfg_attr(
@@ -30,6 +37,10 @@
 pub struct RunOptions {
     pub(crate) fields: FieldRecording,
     pub(crate) profiles: ProfileRecording,
+    /// The probes a driver starts with instead of the scene's (`None`: the scene's).
+    pub(crate) probes: Option<ProbeSpec>,
+    /// The solver's thread count (0: the scene's).
+    pub(crate) threads: usize,
 }
 
 /// What a run records of its fields ([`RunOptions::record_fields`]): every `every`-th
@@ -89,6 +100,36 @@ impl RunOptions {
         self
     }
 
+    /// The stress probes (planes and points) a driver of the run starts with, in place of
+    /// its scene's ([`crate::SceneBuilder::probes`], scene-file key `probes`): planned
+    /// and checked by [`crate::Scene::driver_with`], read with
+    /// [`crate::Driver::stresses`]. An empty `ProbeSpec` starts with none. Probes
+    /// observe: the events do not depend on them.
+    pub fn probes(mut self, probes: ProbeSpec) -> Self {
+        self.probes = Some(probes);
+        self
+    }
+
+    /// The number of threads the run's solves use ([`crate::solver::Parallelism`]: `1`
+    /// the calling thread only, `n > 1` the calling thread and `n - 1` helpers), in place
+    /// of its scene's (the scene file's `solver.threads`); `0`, the default, keeps the
+    /// scene's. Applied by [`crate::Scene::driver_with`]. The events are bit for bit the
+    /// same for every thread count.
+    pub fn threads(mut self, threads: usize) -> Self {
+        self.threads = threads;
+        self
+    }
+
+    /// The probes given with [`RunOptions::probes`] (`None`: the scene's, the default).
+    pub fn probe_spec(&self) -> Option<&ProbeSpec> {
+        self.probes.as_ref()
+    }
+
+    /// The thread count given with [`RunOptions::threads`] (0: the scene's, the default).
+    pub fn thread_count(&self) -> usize {
+        self.threads
+    }
+
     /// Every how many stable states the fields are recorded (0: never, the default).
     pub fn fields_every(&self) -> usize {
         self.fields.every
@@ -113,13 +154,24 @@ impl RunOptions {
 /// [`RunOptions`] as serde sees them (feature `serde`): the scene file's `fields` and
 /// `profiles` objects (a missing key records nothing), read back through
 /// [`RunOptions::record_fields`] and [`RunOptions::record_profiles`] (which sorts the
-/// loads and drops repeats).
+/// loads and drops repeats); `probes` (a [`ProbeSpec`]) and `threads` (a count) only when
+/// given (missing: the scene's), so options written before they existed read the same.
 #[cfg(feature = "serde")]
 #[derive(serde::Serialize, serde::Deserialize, Default)]
 #[serde(deny_unknown_fields, default)]
 struct RunOptionsFields {
     fields: FieldsFields,
     profiles: ProfilesFields,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    probes: Option<ProbeSpec>,
+    #[serde(skip_serializing_if = "is_zero")]
+    threads: usize,
+}
+
+/// Whether a thread count is the default (the scene's).
+#[cfg(feature = "serde")]
+fn is_zero(threads: &usize) -> bool {
+    *threads == 0
 }
 
 /// `fields`: [`FieldRecording`].
@@ -152,6 +204,8 @@ impl From<RunOptions> for RunOptionsFields {
                 loads: o.profiles.loads,
                 planes: o.profiles.planes,
             },
+            probes: o.probes,
+            threads: o.threads,
         }
     }
 }
@@ -159,8 +213,13 @@ impl From<RunOptions> for RunOptionsFields {
 #[cfg(feature = "serde")]
 impl From<RunOptionsFields> for RunOptions {
     fn from(f: RunOptionsFields) -> Self {
-        RunOptions::new()
+        let options = RunOptions::new()
             .record_fields(f.fields.every, &f.fields.planes)
             .record_profiles(&f.profiles.loads, &f.profiles.planes)
+            .threads(f.threads);
+        match f.probes {
+            Some(probes) => options.probes(probes),
+            None => options,
+        }
     }
 }

@@ -31,7 +31,7 @@ use crate::solver::SolverOptions;
 use crate::surface::SurfaceSpectrum;
 
 mod bounds;
-pub(crate) use bounds::run_options as check_run_options;
+pub(crate) use bounds::{probes as check_probes, run_options as check_run_options};
 pub(crate) mod file;
 pub(crate) mod schema;
 
@@ -893,7 +893,9 @@ impl SceneBuilder {
     /// default none): planned and validated at build, read with
     /// [`crate::Driver::stresses`]. A driver adds more at any time with
     /// [`crate::Driver::add_probes`]. The probes are not part of the scene's identity: a
-    /// checkpoint resumes on the scene with other probes.
+    /// checkpoint resumes on the scene with other probes. The scene file's key `probes`;
+    /// [`RunOptions::probes`] gives a run other probes (docs/compatibility.md,
+    /// "Observers").
     pub fn probes(mut self, probes: ProbeSpec) -> Self {
         self.probes = probes;
         self
@@ -934,6 +936,12 @@ impl SceneBuilder {
     pub fn record_fields(mut self, every: usize, planes: &[f64]) -> Self {
         self.run = self.run.record_fields(every, planes);
         self
+    }
+
+    /// The probes a scene built from this builder starts its drivers with: the run
+    /// options' where given, else those of [`SceneBuilder::probes`].
+    pub(crate) fn effective_probes(&self) -> &ProbeSpec {
+        self.run.probe_spec().unwrap_or(&self.probes)
     }
 
     /// The spring constants set so far (the builder's getters are the crate's; users
@@ -1151,11 +1159,7 @@ impl SceneBuilder {
         let interface = Interface::new(grid, heights, self.law)?;
         // The seed is in the heights now: `to_builder` then takes given values.
         self.seed = None;
-        let probe = if self.probes.is_empty() {
-            None
-        } else {
-            Some(StressProbe::new(&plan, &self.probes, rod.as_ref())?)
-        };
+        let probe = plan_probes(&plan, self.effective_probes(), rod.as_ref())?;
         Ok(Scene {
             inner: std::sync::Arc::new(Built {
                 probe,
@@ -1167,6 +1171,19 @@ impl SceneBuilder {
                 builder: self,
             }),
         })
+    }
+}
+
+/// `spec` planned on `plan` (`None` when it has no probe).
+pub(crate) fn plan_probes(
+    plan: &InfluencePlan,
+    spec: &ProbeSpec,
+    lateral: Option<&RodLoad>,
+) -> Result<Option<StressProbe>> {
+    if spec.is_empty() {
+        Ok(None)
+    } else {
+        StressProbe::new(plan, spec, lateral).map(Some)
     }
 }
 
@@ -1272,10 +1289,11 @@ impl Scene {
         &self.inner.plan
     }
 
-    /// The stress probes every driver of the scene starts with ([`SceneBuilder::probes`];
-    /// empty by default).
+    /// The stress probes every driver of the scene starts with: those of its run options'
+    /// [`RunOptions::probes`] where given, else [`SceneBuilder::probes`] (empty by
+    /// default).
     pub fn probes(&self) -> &ProbeSpec {
-        &self.inner.builder.probes
+        self.inner.builder.effective_probes()
     }
 
     /// What a run of the scene records beside its tables

@@ -138,6 +138,23 @@ fn any_thread_count_repeats_the_sequential_run_and_resumes_it() {
         assert!(got == events, "{par:?}: events differ");
         assert_eq!(bits(&t), bits(&traction), "{par:?}: tractions differ");
     }
+    // The thread count of the run options, on the sequential scene (and a scene of 3
+    // threads set back to 1 by them).
+    for (scene, n) in [
+        (&one, 3),
+        (&one, 4),
+        (&builder(Parallelism::Threads(3)).build().unwrap(), 1),
+    ] {
+        let driver = scene.driver_with(&RunOptions::new().threads(n)).unwrap();
+        assert_eq!(driver.threads(), n);
+        let (got, t) = first(driver, count);
+        assert!(got == events, "RunOptions::threads({n}): events differ");
+        assert_eq!(
+            bits(&t),
+            bits(&traction),
+            "RunOptions::threads({n}): tractions differ"
+        );
+    }
     // One driver switching counts between events.
     let mut driver = one.driver().unwrap();
     let mut switched = Vec::new();

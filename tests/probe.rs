@@ -463,3 +463,69 @@ fn the_driver_reports_probes_only_when_requested() {
     let profile = s.planes[1].profile();
     assert_eq!(profile.shear.len(), scene.grid().nx());
 }
+
+/// The probes of `RunOptions::probes` are the scene's probes, planned on the same plan:
+/// a driver of a plain scene given them reports, at every event, the stresses a driver
+/// of the scene that carries them reports (the reference: the scene's own probe path,
+/// `SceneBuilder::probes`), bit for bit, and the same events.
+#[test]
+fn probes_from_run_options_give_the_stresses_of_the_scenes_probes() {
+    let spec = ProbeSpec::default()
+        .with_plane(0.0)
+        .with_plane(2e-3)
+        .with_point(Point::new(0.01, 0.002, 3e-3));
+    let base = Scene::builder()
+        .block(0.020, 0.004, 0.010)
+        .normal_load(60.0)
+        .seed(3);
+    let carried = base.clone().probes(spec.clone()).build().unwrap();
+    // Another scene's probes are replaced, not added to.
+    let other = base
+        .probes(ProbeSpec::default().with_plane(5e-3))
+        .build()
+        .unwrap();
+    let mut reference = carried.driver().unwrap();
+    let mut observed = other.driver_with(&RunOptions::new().probes(spec)).unwrap();
+    let mut states = 0;
+    loop {
+        let (a, b) = (reference.step().unwrap(), observed.step().unwrap());
+        assert_eq!(a, b);
+        let Some(event) = a else { break };
+        if matches!(event, Event::LoadRaised { .. }) {
+            states += 1;
+            let (sa, sb) = (reference.stresses().unwrap(), observed.stresses().unwrap());
+            assert_eq!((sa.planes.len(), sa.points.len()), (2, 1));
+            assert_eq!(sa, sb);
+        }
+    }
+    assert!(states > 2, "{states}");
+    // Empty probes in the options: the driver starts with none.
+    let mut none = carried
+        .driver_with(&RunOptions::new().probes(ProbeSpec::default()))
+        .unwrap();
+    none.step().unwrap();
+    assert!(matches!(none.stresses(), Err(Error::NoProbes)));
+}
+
+/// Probes of the run options that do not fit the scene are refused by
+/// `Scene::driver_with`, naming the key as the scene's own probes would be.
+#[test]
+fn probes_from_run_options_are_checked_by_key() {
+    let scene = Scene::builder().block(0.020, 0.004, 0.010).build().unwrap();
+    let outside = RunOptions::new().probes(ProbeSpec::default().with_plane(0.02));
+    match scene.driver_with(&outside) {
+        Err(Error::OutOfRange { key, .. }) => assert_eq!(key, "probes.planes"),
+        other => panic!("{other:?}"),
+    }
+    let refused = Scene::builder()
+        .block(0.020, 0.004, 0.010)
+        .probes(ProbeSpec::default().with_plane(0.02))
+        .build();
+    assert!(matches!(
+        refused,
+        Err(Error::OutOfRange {
+            key: "probes.planes",
+            ..
+        })
+    ));
+}

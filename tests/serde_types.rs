@@ -159,6 +159,20 @@ fn probes_and_run_options_round_trip_and_keep_their_invariants() {
     );
     let e = refused::<RunOptions>(r#"{"fields":{"every":2,"plane":[]}}"#);
     names(&e, &["unknown field", "plane"]);
+    // Probes and threads: written only when given, so options without them read and
+    // write as before they existed.
+    let observed = options
+        .clone()
+        .probes(ProbeSpec::default().with_plane(0.002))
+        .threads(3);
+    let text = round_trip(&observed);
+    assert!(
+        text.contains(r#""probes":{"#) && text.contains(r#""threads":3"#),
+        "{text}"
+    );
+    assert!(!round_trip(&options).contains("probes"));
+    let read: RunOptions = serde_json::from_str(r#"{"threads":2}"#).unwrap();
+    assert_eq!((read.thread_count(), read.probe_spec()), (2, None));
 }
 
 #[test]

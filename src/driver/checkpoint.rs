@@ -304,9 +304,23 @@ impl Scene {
     /// scene was edited since (the digest differs); [`Error::InvalidCheckpoint`] when it
     /// is of another layout version or inconsistent; those of [`Scene::driver`].
     pub fn resume(&self, checkpoint: &Checkpoint) -> Result<Driver> {
+        self.resume_with(checkpoint, self.run_options())
+    }
+
+    /// [`Scene::resume`] with the driver observed as `options` ask (probes, threads: as
+    /// [`Scene::driver_with`]); give [`crate::output::RunTables::resume_with`] the same
+    /// options.
+    ///
+    /// # Errors
+    /// As [`Scene::resume`] and [`Scene::driver_with`].
+    pub fn resume_with(
+        &self,
+        checkpoint: &Checkpoint,
+        options: &crate::recording::RunOptions,
+    ) -> Result<Driver> {
         self.check_checkpoint_scene(checkpoint)?;
         let started = self.check_checkpoint_state(checkpoint)?;
-        let mut driver = self.driver()?;
+        let mut driver = self.driver_with(options)?;
         for (i, state) in checkpoint.states.iter().enumerate() {
             driver.interface.set_state(i, *state);
         }

@@ -173,11 +173,9 @@ impl Driver {
     /// # Errors
     /// As [`StressProbe::new`]: a plane or point outside the block, a bad tolerance.
     pub fn add_probes(&mut self, spec: &ProbeSpec) -> Result<()> {
-        if spec.is_empty() {
-            return Ok(());
-        }
-        let probe = StressProbe::new(self.scene.plan(), spec, self.scene.lateral_load())?;
-        self.probes.push(probe);
+        let planned =
+            crate::scene::plan_probes(self.scene.plan(), spec, self.scene.lateral_load())?;
+        self.probes.extend(planned);
         Ok(())
     }
 

@@ -147,11 +147,8 @@ pub(super) fn planes_probe(
         ProbeSpec::default().with_tolerance(scene.probes().tolerance())?,
         |spec, &z| spec.with_plane(z),
     );
-    Ok(Some(std::panic::AssertUnwindSafe(StressProbe::new(
-        scene.plan(),
-        &spec,
-        scene.lateral_load(),
-    )?)))
+    let probe = crate::scene::plan_probes(scene.plan(), &spec, scene.lateral_load())?;
+    Ok(probe.map(std::panic::AssertUnwindSafe))
 }
 
 /// A stable state's profiles, rendered (all but the level column).

@@ -15,6 +15,7 @@
 use super::{Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder};
 use crate::error::{Error, Num, Result};
 use crate::geometry::Grid;
+use crate::probe::ProbeSpec;
 use crate::surface::SurfaceSpectrum;
 
 /// Block lengths `Lx, Ly, Lz` (m).
@@ -259,12 +260,30 @@ pub(super) fn solver_iterations(active_set: usize, linear: usize) -> Result<()> 
     )
 }
 
+/// The probes `probes` on `grid` (scene-file key `probes`): their tolerance, their
+/// positions ([`probe_positions`]) and how many.
+pub(crate) fn probes(probes: &ProbeSpec, grid: &Grid) -> Result<()> {
+    within(
+        "probes.tolerance",
+        probes.tolerance(),
+        PROBE_TOLERANCE,
+        "",
+        "below 1e-15 the alias sums cannot reach it, above 1e-2 the stresses are noise",
+    )?;
+    probe_positions(probes, grid)?;
+    count_within(
+        "probes.points",
+        probes.points().len(),
+        (0, MAX_PROBES),
+        "each probe costs a kernel of Nx·Ny values",
+    )
+}
+
 /// The heights of the recorded and probed planes and the probe points: inside the block,
 /// and at the interface or high enough for their alias sums to converge within their
 /// budget at the probes' tolerance (refused here, by `info` as by `run`, not when the run
 /// has begun).
-fn probe_positions(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
-    let probes = &builder.probes;
+fn probe_positions(probes: &ProbeSpec, grid: &Grid) -> Result<()> {
     planes_within("probes.planes", probes.planes(), grid, probes.tolerance())?;
     let lz = grid.block().lz();
     let block = grid.block();
@@ -337,6 +356,9 @@ pub(crate) fn run_options(
     grid: &Grid,
     tolerance: f64,
 ) -> Result<()> {
+    if let Some(probes) = options.probe_spec() {
+        self::probes(probes, grid)?;
+    }
     planes_within("fields.planes", options.field_planes(), grid, tolerance)?;
     planes_within("profiles.planes", options.profile_planes(), grid, tolerance)?;
     for &load in options.profile_loads() {
@@ -408,22 +430,10 @@ pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
              relative error accepted, and above 1e-2 it accepts anything",
         ));
     }
-    let probes = &builder.probes;
-    within(
-        "probes.tolerance",
-        probes.tolerance(),
-        PROBE_TOLERANCE,
-        "",
-        "below 1e-15 the alias sums cannot reach it, above 1e-2 the stresses are noise",
-    )?;
-    probe_positions(builder, grid)?;
-    count_within(
-        "probes.points",
-        probes.points().len(),
-        (0, MAX_PROBES),
-        "each probe costs a kernel of Nx·Ny values",
-    )?;
-    run_options(&builder.run, grid, probes.tolerance())?;
+    // The scene's own probes, and those of its run options (which its drivers start
+    // with in their place).
+    probes(&builder.probes, grid)?;
+    run_options(&builder.run, grid, builder.effective_probes().tolerance())?;
     // The last site attached carries the whole normal load: its tangential stiffness and
     // area grow like e^{F_N/(ΔA c_z)}.
     let exponent = builder.normal_load / (grid.cell_area() * builder.law.c_z());

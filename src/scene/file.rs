@@ -7,7 +7,7 @@
 //! scene fills the gaps) and unknown keys are refused: a misspelt key must not silently
 //! fall back to a default.
 
-use super::schema::{observes, schema_enum, schema_leaf, schema_struct, Schema};
+use super::schema::{schema_enum, schema_leaf, schema_struct, Schema, Walk};
 use super::{Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder};
 use crate::interface::AreaLaw;
 use crate::probe::ProbeSpec;
@@ -40,18 +40,20 @@ schema_struct! {
         drive: DriveSpec,
         solver: SolverSpec,
         plan_tolerance: f64,
-        probes: ProbesSpec,
+        // The observers (`[observer]`: not in the identity) are the run options' keys
+        // (`RunOptions`), which 1.x scene files keep carrying.
+        [observer] probes: ProbesSpec,
         /// Written only when it is not the default, so files of scenes within the default
         /// limit stay as they were.
         #[cfg_attr(feature = "serde", serde(skip_serializing_if = "is_default_max_cells"))]
-        max_cells: usize,
+        [observer] max_cells: usize,
         /// Written only when fields are recorded, so files of other scenes stay as they
         /// were.
         #[cfg_attr(feature = "serde", serde(skip_serializing_if = "FieldsSpec::is_off"))]
-        fields: FieldsSpec,
+        [observer] fields: FieldsSpec,
         /// Written only when profiles are recorded.
         #[cfg_attr(feature = "serde", serde(skip_serializing_if = "ProfilesSpec::is_off"))]
-        profiles: ProfilesSpec,
+        [observer] profiles: ProfilesSpec,
     }
 }
 
@@ -247,7 +249,7 @@ schema_struct! {
         tolerance: f64,
         max_active_set_iterations: usize,
         max_linear_iterations: usize,
-        threads: ThreadsSpec,
+        [observer] threads: ThreadsSpec,
     }
 }
 
@@ -553,9 +555,17 @@ impl From<&SceneBuilder> for SceneFile {
             heights: heights.into(),
             normal_load: *normal_load,
             drive: (*drive).into(),
-            solver: solver.into(),
+            // The run options' probes and threads, where given, are those the scene's
+            // drivers use: the file's keys for them.
+            solver: SolverSpec {
+                threads: match run.thread_count() {
+                    0 => solver.parallelism().into(),
+                    n => Parallelism::Threads(n).into(),
+                },
+                ..solver.into()
+            },
             plan_tolerance: *plan_tolerance,
-            probes: probes.into(),
+            probes: run.probe_spec().unwrap_or(probes).into(),
             max_cells: *max_cells,
             fields: FieldsSpec {
                 every: run.fields_every(),
@@ -1020,18 +1030,19 @@ impl<'de> Deserialize<'de> for SceneBuilder {
 }
 
 /// Every key of `scene` with its exact value, in the file's order (observers included).
+#[cfg(any(feature = "plot", test))]
 pub(crate) fn all_keys(scene: &SceneBuilder) -> Vec<(String, String)> {
     let mut keys = Vec::new();
-    SceneFile::from(scene).keys("", &mut keys);
+    SceneFile::from(scene).keys("", Walk::All, &mut keys);
     keys
 }
 
-/// The scene's identity: every key that identifies the run (all but the [`OBSERVERS`](super::schema::OBSERVERS))
-/// with its exact value, as `(key path, value)` in the file's order. Checkpoints store a
-/// digest of it.
+/// The scene's identity: every key that identifies the run (all but the observers,
+/// declared `[observer]` in the file's types: [`Walk::Identity`]) with its exact value,
+/// as `(key path, value)` in the file's order. Checkpoints store a digest of it.
 pub(crate) fn identity(scene: &SceneBuilder) -> Vec<(String, String)> {
-    let mut keys = all_keys(scene);
-    keys.retain(|(key, _)| !observes(key));
+    let mut keys = Vec::new();
+    SceneFile::from(scene).keys("", Walk::Identity, &mut keys);
     keys
 }
 
@@ -1151,6 +1162,17 @@ mod tests {
                     .record_profiles(&[0.5], &[1e-3]),
             );
         assert_eq!(first_difference(&a, &b), None);
+        // The run options' probes and threads, which the file writes as `probes` and
+        // `solver.threads`.
+        let c = a.clone().run_options(
+            RunOptions::new()
+                .probes(ProbeSpec::default().with_plane(2e-3))
+                .threads(4),
+        );
+        let file = SceneFile::from(&c);
+        assert_ne!(file, SceneFile::from(&a));
+        assert_eq!(first_difference(&a, &c), None);
+        assert_eq!(identity(&a), identity(&c));
         assert_eq!(
             first_difference(&a, &a.clone().normal_load(1.0)).as_deref(),
             Some("normal_load")
@@ -1269,7 +1291,14 @@ mod tests {
             "",
             &mut keys,
         );
-        keys.retain(|k| !observes(k));
+        // The observers, as docs/scene-format.md lists them (the run options' keys).
+        let observer = |k: &str| {
+            ["solver.threads", "max_cells"].contains(&k)
+                || ["probes.", "fields.", "profiles."]
+                    .iter()
+                    .any(|p| k.starts_with(p))
+        };
+        keys.retain(|k| !observer(k));
         keys.sort();
         let mut from_identity: Vec<String> =
             identity(&builder).into_iter().map(|(k, _)| k).collect();

@@ -3,8 +3,8 @@
 //!
 //! The types of the scene file (`scene/file.rs`) are declared through `schema_struct!`
 //! and `schema_enum!`: one field list gives the serde form (the file; feature `serde`),
-//! the walk of every key with its exact value ([`Schema::keys`]: with the [`OBSERVERS`]
-//! left out, the checkpoint's identity, `file::identity`), the typed setter of a dotted
+//! the walk of every key with its exact value ([`Schema::keys`]: with the fields declared
+//! `[observer]` left out, [`Walk::Identity`], the checkpoint's identity, `file::identity`), the typed setter of a dotted
 //! key ([`Schema::set`]: a sweep's axes; feature `serde`) and where the file has objects
 //! ([`Schema::object_at`]: the shape check that refuses positional arrays). This file
 //! holds the machinery and the leaves; `scene/file.rs` the file's types and what derives
@@ -12,23 +12,25 @@
 
 use crate::interface::AreaLaw;
 
-/// The keys of the scene file that do not change a run's events: the solver's parallelism
-/// (results are bit for bit the same for every choice), the probes (observers, which a
-/// driver may add at any time) and the cell limit (a bound, not a value). They are not
-/// part of a scene's identity: a checkpoint resumes across them.
-pub(crate) const OBSERVERS: [&str; 5] = [
-    "solver.threads",
-    "probes",
-    "max_cells",
-    "fields",
-    "profiles",
-];
+/// Which keys a walk of the schema ([`Schema::keys`]) gives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Walk {
+    /// Every key of the file.
+    All,
+    /// The keys of the scene's identity: all but the observers, the fields declared
+    /// `[observer]` in `schema_struct!` (keys that do not change a run's events: the
+    /// solver's parallelism, with results bit for bit the same for every choice; the
+    /// probes and the recordings, which observe; the cell limit, a bound, not a value).
+    /// A checkpoint resumes across them.
+    Identity,
+}
 
 /// A node of the scene's schema: a value of the scene file.
 pub(crate) trait Schema {
-    /// Appends `(dotted key path, exact value)` for every leaf below `path`: floats as
-    /// `{:?}` (which round-trips), counts in decimal, kinds and names in lower case.
-    fn keys(&self, path: &str, out: &mut Vec<(String, String)>);
+    /// Appends `(dotted key path, exact value)` for every leaf below `path` that `walk`
+    /// gives: floats as `{:?}` (which round-trips), counts in decimal, kinds and names in
+    /// lower case.
+    fn keys(&self, path: &str, walk: Walk, out: &mut Vec<(String, String)>);
 
     /// Sets the value at the key path `rest` below this node (at the dotted path `at`),
     /// read as the file reads it.
@@ -114,7 +116,12 @@ pub(crate) fn replace<T: serde::de::DeserializeOwned>(
 macro_rules! schema_leaf {
     ($ty:ty, $exact:expr) => {
         impl $crate::scene::schema::Schema for $ty {
-            fn keys(&self, path: &str, out: &mut Vec<(String, String)>) {
+            fn keys(
+                &self,
+                path: &str,
+                _: $crate::scene::schema::Walk,
+                out: &mut Vec<(String, String)>,
+            ) {
                 let exact: fn(&$ty) -> String = $exact;
                 out.push((path.to_string(), exact(self)));
             }
@@ -153,12 +160,13 @@ schema_leaf!(std::path::PathBuf, |v| format!("{}", v.display()));
 schema_leaf!(AreaLaw, |v| format!("{v:?}").to_lowercase());
 
 /// Declares a struct of the scene file (an object of named keys) and its [`Schema`]: the
-/// field names are the file's keys.
+/// field names are the file's keys. A field written `[observer] name: Type` is an
+/// observer: left out of the identity walk ([`Walk::Identity`]), with all below it.
 macro_rules! schema_struct {
     (
         $(#[$meta:meta])*
         $vis:vis struct $name:ident {
-            $( $(#[$field_meta:meta])* $field:ident : $ty:ty ),* $(,)?
+            $( $(#[$field_meta:meta])* $([$role:ident])? $field:ident : $ty:ty ),* $(,)?
         }
     ) => {
         $(#[$meta])*
@@ -167,9 +175,18 @@ macro_rules! schema_struct {
         }
 
         impl $crate::scene::schema::Schema for $name {
-            fn keys(&self, path: &str, out: &mut Vec<(String, String)>) {
-                use $crate::scene::schema::join;
-                $( self.$field.keys(&join(path, stringify!($field)), out); )*
+            fn keys(
+                &self,
+                path: &str,
+                walk: $crate::scene::schema::Walk,
+                out: &mut Vec<(String, String)>,
+            ) {
+                use $crate::scene::schema::{join, schema_role, Walk};
+                $(
+                    if walk == Walk::All || !schema_role!($($role)?) {
+                        self.$field.keys(&join(path, stringify!($field)), walk, out);
+                    }
+                )*
             }
 
             #[cfg(feature = "serde")]
@@ -227,12 +244,17 @@ macro_rules! schema_enum {
         }
 
         impl $crate::scene::schema::Schema for $name {
-            fn keys(&self, path: &str, out: &mut Vec<(String, String)>) {
+            fn keys(
+                &self,
+                path: &str,
+                walk: $crate::scene::schema::Walk,
+                out: &mut Vec<(String, String)>,
+            ) {
                 use $crate::scene::schema::join;
                 out.push((join(path, "kind"), self.kind().to_string()));
                 match self {
                     $( $name::$variant { $($field),* } => {
-                        $( $field.keys(&join(path, stringify!($field)), out); )*
+                        $( $field.keys(&join(path, stringify!($field)), walk, out); )*
                     } )*
                 }
             }
@@ -296,12 +318,14 @@ macro_rules! schema_enum {
     };
 }
 
-pub(crate) use {schema_enum, schema_leaf, schema_struct};
-
-/// Whether `key` is one of the [`OBSERVERS`] or below one.
-pub(crate) fn observes(key: &str) -> bool {
-    OBSERVERS.iter().any(|o| {
-        key.strip_prefix(o)
-            .is_some_and(|rest| rest.is_empty() || rest.starts_with('.'))
-    })
+/// Whether a field of `schema_struct!` is an observer: `[observer]` before its name.
+macro_rules! schema_role {
+    () => {
+        false
+    };
+    (observer) => {
+        true
+    };
 }
+
+pub(crate) use {schema_enum, schema_leaf, schema_role, schema_struct};
