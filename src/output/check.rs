@@ -547,8 +547,10 @@ pub(crate) struct RunRecord {
     /// `F/(μF_N)` of global slip.
     pub slip: f64,
     /// `contact_map.csv` (`None` for a directory without it).
+    #[cfg_attr(not(feature = "plot"), allow(dead_code))] // the figures read it
     pub map: Option<Vec<MapRow>>,
     /// What the run recorded beside its tables (from its scene record).
+    #[cfg_attr(not(feature = "plot"), allow(dead_code))] // the figures read it
     pub options: crate::recording::RunOptions,
 }
 

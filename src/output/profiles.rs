@@ -501,6 +501,7 @@ pub(super) fn continuation(
 /// [`Error::CorruptTable`] naming the file, line and column; [`Error::NonFiniteCell`];
 /// [`Error::Io`].
 #[cfg(feature = "serde")]
+#[cfg_attr(not(feature = "plot"), allow(dead_code))] // the figures read it
 pub(crate) fn read(dir: &Path, record: &check::RunRecord) -> Result<Option<Vec<ProfileRow>>> {
     let path = dir.join(PROFILES_TABLE);
     let options = &record.options;
