@@ -15,6 +15,9 @@ callers). docs/compatibility.md says what semver covers.
 `check` sorts the differences into removed or changed lines (an incompatible change: the
 major version must change) and added lines (a compatible addition: update the listing in
 the same commit, with a CHANGELOG entry). Either fails, so the listing is always the API.
+It also compares the API with each release's listing of the crate's major version
+(`api/public-api-X.Y.Z.txt`, written at the release): a line of a release that is gone
+fails, so 1.x only adds to what 1.0.0 promised, whatever the working listing says.
 """
 import json
 import os
@@ -24,6 +27,7 @@ import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LISTING = os.path.join(ROOT, "api", "public-api.txt")
+RELEASE = re.compile(r"public-api-(\d+)\.(\d+)\.(\d+)\.txt$")
 CRATE = "precursors"
 # rustdoc's JSON changes its format between toolchains; these are the versions this
 # script was written against (an unknown one is refused with this message).
@@ -366,9 +370,36 @@ def main():
               "CHANGELOG entry):")
         for line in added:
             print("  + " + line)
-    if removed or added:
+    broken = releases_broken(set(current))
+    if removed or added or broken:
         sys.exit(1)
     print(f"public API unchanged ({len(current)} lines)")
+
+
+def crate_major():
+    with open(os.path.join(ROOT, "Cargo.toml")) as f:
+        version = re.search(r'^version = "(\d+)\.', f.read(), re.M)
+    return int(version.group(1))
+
+
+def releases_broken(current):
+    """Whether an item of a release of this major version is gone (printing each)."""
+    major, broken = crate_major(), False
+    folder = os.path.dirname(LISTING)
+    for name in sorted(os.listdir(folder)):
+        m = RELEASE.search(name)
+        if not m or int(m.group(1)) != major:
+            continue
+        with open(os.path.join(folder, name)) as f:
+            promised = {line for line in f.read().splitlines() if line}
+        gone = sorted(promised - current)
+        if gone:
+            broken = True
+            print(f"Items of the release listing {name} are gone or changed (an "
+                  f"incompatible change within {major}.x, docs/compatibility.md):")
+            for line in gone:
+                print("  - " + line)
+    return broken
 
 
 if __name__ == "__main__":
