@@ -6,8 +6,9 @@
 //! area_ratio) and `fig3_<drive>.png`: a map over x (mm) along the block (trailing edge
 //! left) and F/(μF_N) from 0 (bottom) to 1 (top), each load showing the last stable state
 //! at or below it; the colour bar gives log₁₀(A_R(x)/A_R(x, 0)): blue where the area fell
-//! (the precursor; a column that lost all contact is at the blue end), red where it
-//! grew, white unchanged, saturating at a factor 10. Prints the precursor length ℓ/Lx at
+//! (the precursor), red where it grew, white unchanged, saturating at a factor 10 (the
+//! colour bar's triangles and the line under the map give the share beyond it); a column
+//! that lost all contact is grey. Prints the precursor length ℓ/Lx at
 //! a few loads.
 //! Run: `cargo run --release --example fig3_contact_maps [output directory]`.
 
@@ -90,8 +91,9 @@ fn run() -> report::Outcome {
             let f = (r as f64 + 0.5) / load_rows as f64;
             if let Some((_, ratio, _)) = states.iter().take_while(|s| s.0 <= f).last() {
                 for (ix, v) in ratio.iter().enumerate() {
-                    // A column without contact (log10(0) = -inf) is at the blue end.
-                    map[r * nx + ix] = v.log10().clamp(-1.0, 1.0);
+                    // Beyond a factor 10 the map saturates and marks it on its colour
+                    // bar; a column without contact (log10(0) = -inf) is drawn grey.
+                    map[r * nx + ix] = if *v > 0.0 { v.log10() } else { f64::NAN };
                 }
             }
         }
@@ -103,7 +105,7 @@ fn run() -> report::Outcome {
                 ),
                 "x (mm)",
                 "F/(μF_N)",
-                "log₁₀(A_R(x)/A_R(x, 0))",
+                "log₁₀(A_R(x)/A_R(x, 0)); grey: no contact",
             )
             .x_range(0.0, lx_mm)
             .y_range(0.0, 1.0)
