@@ -258,7 +258,7 @@ fn archard_curves(
 /// The mean `A_R(0)` at each load of `series` in % of `Lx Ly` (`percent` = 100 / `Lx Ly`),
 /// the ± one sample standard deviation bars of the loads with several runs (segments cut
 /// by a non-finite point), and the top of the highest bar or mean (%).
-fn archard_means(series: &Series, percent: f64) -> (Vec<(f64, f64)>, Vec<(f64, f64)>, f64) {
+fn archard_means(series: &Series, percent: f64) -> (Points, Points, f64) {
     let mut y_top: f64 = 0.0;
     let mut means = Vec::new();
     let mut bars = Vec::new();
@@ -282,6 +282,9 @@ fn archard_means(series: &Series, percent: f64) -> (Vec<(f64, f64)>, Vec<(f64, f
     }
     (means, bars, y_top)
 }
+
+/// The `(F_N, %)` points of a curve of `archard`.
+type Points = Vec<(f64, f64)>;
 
 /// `α = Σ F_N A_R / Σ F_N²` (m²/N): the least-squares line through the origin over every
 /// run of `series`.
