@@ -228,45 +228,8 @@ pub(crate) fn event_row(line: usize, row: &str, b: &Bounds) -> Row<EventRow> {
             format!("{:?} is not an event kind ({})", c[1], KINDS.join(", ")),
         )
     })?;
-    let site = matches!(kind, "rupture" | "detach" | "attach");
-    let mut at_site = [0; 2];
-    for (k, n) in [(2, b.nx), (3, b.ny)] {
-        if site {
-            let v = count(line, &header, &c, k)?;
-            if v >= n {
-                return Err(at(
-                    line,
-                    header[k],
-                    format!("{v} is outside the grid's 0 to {}", n - 1),
-                ));
-            }
-            at_site[k - 2] = v;
-        } else if !c[k].is_empty() {
-            return Err(at(
-                line,
-                header[k],
-                format!("a {kind} has no site, the cell holds {:?}", c[k]),
-            ));
-        }
-    }
-    let loaded = !matches!(kind, "detach" | "attach");
-    let force = if loaded {
-        Some(number(line, &header, &c, 4)?)
-    } else {
-        optional(line, &header, &c, 4)?.map_or(Ok(None), |_| {
-            Err(at(line, "force_N", format!("a {kind} carries no load")))
-        })?
-    };
-    // The writer refuses a stable state beyond the limit (`map_rows_below`).
-    if let (Some(f), "stable") = (force, kind) {
-        if f.abs() > LOAD_LIMIT * b.mu_fn {
-            return Err(at(
-                line,
-                "force_N",
-                format!("{f} N is beyond the friction limit μF_N = {} N", b.mu_fn),
-            ));
-        }
-    }
+    let site = event_site(line, (&header, &c), kind, b)?;
+    let force = event_force(line, (&header, &c), kind, b)?;
     let drive_displacement = optional(line, &header, &c, 5)?;
     let energy = optional(line, &header, &c, 6)?;
     if energy.is_some() != (kind == "rupture") {
@@ -291,12 +254,6 @@ pub(crate) fn event_row(line: usize, row: &str, b: &Bounds) -> Row<EventRow> {
         return Err(at(line, "ruptures", format!("a {kind} counts no ruptures")));
     };
     flag(line, &header, &c, 8)?;
-    let [ix, iy] = at_site;
-    let site = Site {
-        index: iy * b.nx + ix,
-        ix,
-        iy,
-    };
     let load = Load {
         force: force.unwrap_or(0.0),
         drive_displacement,
@@ -324,6 +281,67 @@ pub(crate) fn event_row(line: usize, row: &str, b: &Bounds) -> Row<EventRow> {
         ruptures,
         event,
     })
+}
+
+/// The site of an event row (`ix`, `iy` within the grid for a rupture, a detachment or
+/// an attachment; both cells empty, and site 0, for the other kinds).
+fn event_site(line: usize, (header, c): (&[&str], &[&str]), kind: &str, b: &Bounds) -> Row<Site> {
+    let site = matches!(kind, "rupture" | "detach" | "attach");
+    let mut at_site = [0; 2];
+    for (k, n) in [(2, b.nx), (3, b.ny)] {
+        if site {
+            let v = count(line, header, c, k)?;
+            if v >= n {
+                return Err(at(
+                    line,
+                    header[k],
+                    format!("{v} is outside the grid's 0 to {}", n - 1),
+                ));
+            }
+            at_site[k - 2] = v;
+        } else if !c[k].is_empty() {
+            return Err(at(
+                line,
+                header[k],
+                format!("a {kind} has no site, the cell holds {:?}", c[k]),
+            ));
+        }
+    }
+    let [ix, iy] = at_site;
+    Ok(Site {
+        index: iy * b.nx + ix,
+        ix,
+        iy,
+    })
+}
+
+/// The force of an event row (N): a number for every kind but a detachment or an
+/// attachment (which carry none), a stable state's within the friction limit.
+fn event_force(
+    line: usize,
+    (header, c): (&[&str], &[&str]),
+    kind: &str,
+    b: &Bounds,
+) -> Row<Option<f64>> {
+    let loaded = !matches!(kind, "detach" | "attach");
+    let force = if loaded {
+        Some(number(line, header, c, 4)?)
+    } else {
+        optional(line, header, c, 4)?.map_or(Ok(None), |_| {
+            Err(at(line, "force_N", format!("a {kind} carries no load")))
+        })?
+    };
+    // The writer refuses a stable state beyond the limit (`map_rows_below`).
+    if let (Some(f), "stable") = (force, kind) {
+        if f.abs() > LOAD_LIMIT * b.mu_fn {
+            return Err(at(
+                line,
+                "force_N",
+                format!("{f} N is beyond the friction limit μF_N = {} N", b.mu_fn),
+            ));
+        }
+    }
+    Ok(force)
 }
 
 /// Checks a row of `curve.csv` (line `line`).

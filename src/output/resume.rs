@@ -298,30 +298,26 @@ impl Cut<'_> {
         stable: &[usize],
         loads: &[f64],
     ) -> Result<(usize, u64)> {
-        let k = self.k;
+        let kept_levels = self.map_levels(map, map_header, stable)?;
+        let first = self.map_reach(&kept_levels, stable, loads)?;
+        let next_level = kept_levels.last().map_or(first, |&l| l + 1);
+        Ok((kept_levels.len(), next_level))
+    }
+
+    /// The levels of the rows of `contact_map.csv` up to the event `k`: consecutive, in
+    /// the order of the events, each row checked and a stable state's.
+    fn map_levels(
+        &self,
+        map: &[(usize, &str)],
+        map_header: &str,
+        stable: &[usize],
+    ) -> Result<Vec<u64>> {
         let mut kept_levels: Vec<u64> = Vec::new();
         let mut previous: Option<(u64, usize)> = None;
         let map_cells: Vec<&str> = map_header.split(',').collect();
         for &(line, row) in map {
             let event = index_of(line, row).map_err(|r| self.corrupt(2, r))?;
-            let level = row.split(',').nth(1).and_then(|f| f.parse::<f64>().ok());
-            let step = level.map(|l| (l / MAP_STEP).round());
-            let level = match (level, step) {
-                (Some(l), Some(s))
-                    if l.is_finite() && s >= 0.0 && (s * MAP_STEP - l).abs() < 1e-9 =>
-                {
-                    s as u64
-                }
-                _ => {
-                    return Err(self.corrupt(
-                        2,
-                        format!(
-                            "line {line}: force_over_mu_FN is not a load level (a multiple of \
-                             {MAP_STEP})"
-                        ),
-                    ))
-                }
-            };
+            let level = self.map_level(line, row)?;
             if let Some((l, e)) = previous {
                 if level != l + 1 || event < e {
                     return Err(self.corrupt(
@@ -336,7 +332,8 @@ impl Cut<'_> {
                 }
             }
             previous = Some((level, event));
-            if event > k {
+            // The first row past the checkpoint ends what is kept, once its level follows.
+            if event > self.k {
                 break;
             }
             check::map_row(line, &map_cells, row).map_err(|b| b.at(&self.paths[2]))?;
@@ -348,6 +345,32 @@ impl Cut<'_> {
             }
             kept_levels.push(level);
         }
+        Ok(kept_levels)
+    }
+
+    /// The level of the row `row` (line `line`) of `contact_map.csv`: its
+    /// `force_over_mu_FN` as a whole number of [`MAP_STEP`]s.
+    fn map_level(&self, line: usize, row: &str) -> Result<u64> {
+        let level = row.split(',').nth(1).and_then(|f| f.parse::<f64>().ok());
+        let step = level.map(|l| (l / MAP_STEP).round());
+        match (level, step) {
+            (Some(l), Some(s)) if l.is_finite() && s >= 0.0 && (s * MAP_STEP - l).abs() < 1e-9 => {
+                Ok(s as u64)
+            }
+            _ => Err(self.corrupt(
+                2,
+                format!(
+                    "line {line}: force_over_mu_FN is not a load level (a multiple of \
+                     {MAP_STEP})"
+                ),
+            )),
+        }
+    }
+
+    /// Checks that the kept levels of `contact_map.csv` start at the first stable state's
+    /// load and reach the levels below the highest load of the states in `loads`; returns
+    /// the first state's level.
+    fn map_reach(&self, kept_levels: &[u64], stable: &[usize], loads: &[f64]) -> Result<u64> {
         let first = loads.first().map_or(0, |&x| first_level_at_or_above(x));
         if let Some(&l) = kept_levels.first() {
             if l != first {
@@ -390,8 +413,7 @@ impl Cut<'_> {
                 ));
             }
         }
-        let next_level = kept_levels.last().map_or(first, |&l| l + 1);
-        Ok((kept_levels.len(), next_level))
+        Ok(first)
     }
 }
 

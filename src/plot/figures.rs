@@ -552,77 +552,25 @@ fn draw_run(
     let title = run_title(dir);
     // The tables checked against the scene, each other and their bounds.
     let record = RunRecord::read(dir)?;
-    // The staircase ends at the last stable state; the run ends at global slip, where the
-    // whole interface slides (ℓ = Lx): a marker there.
-    let slip = Some(record.slip);
-    let force: Vec<f64> = record.curve.iter().map(|c| c.load).collect();
-    let ell: Vec<(f64, f64)> = record
-        .curve
-        .iter()
-        .map(|c| (c.load, c.precursor_over_lx))
-        .collect();
-    let a0 = record.curve.first().map_or(f64::NAN, |c| c.area);
-    let area: Vec<(f64, f64)> = record.curve.iter().map(|c| (c.load, c.area / a0)).collect();
-    // Near slip the paper's unbounded area law can reach many times A_R(0) (flagged in
-    // area_exceeds_nominal): the chart shows up to 2 and its legend says how many
-    // states lie above.
-    let area_top = area
-        .iter()
-        .map(|p| p.1)
-        .filter(|a| a.is_finite())
-        .fold(1.0, f64::max);
-    let above = area.iter().filter(|p| p.1 > 2.0).count();
-    let area_note = (above > 0).then(|| {
-        format!(
-            "{above} states above 2 (off the chart), up to {}",
-            short(area_top)
-        )
-    });
-    let top = force
-        .iter()
-        .copied()
-        .chain(slip)
-        .filter(|f| f.is_finite())
-        .fold(1.0, f64::max);
     let mut drawn = Drawn {
         files: Vec::new(),
         merge: None,
         notes: Vec::new(),
     };
-    for &format in formats.iter().filter(|_| selection.wants(PRECURSOR_FIGURE)) {
-        let path = dir.join(format!("{PRECURSOR_FIGURE}.{}", format.extension()));
-        let mut chart = canvas
-            .chart(&format!("Precursor length: {title}"), "F/(μF_N)", "ℓ/Lx")
-            .x_range(0.0, top)
-            .y_range(0.0, 1.0)
-            .steps("ℓ/Lx at the stable states", &ell)
-            .legend(Corner::UpperLeft);
-        if let Some(slip) = slip {
-            chart = chart.markers(
-                &format!("global slip at F/(μF_N) = {slip:.3}"),
-                &[(slip, 1.0)],
-            );
-        }
-        chart.save(&path)?;
-        drawn.files.push(path);
+    // Both staircases share the load axis, up to the highest force or the slip.
+    let top = record
+        .curve
+        .iter()
+        .map(|c| c.load)
+        .chain(Some(record.slip))
+        .filter(|f| f.is_finite())
+        .fold(1.0, f64::max);
+    let run = (dir, formats, canvas, title.as_str(), &record);
+    if selection.wants(PRECURSOR_FIGURE) {
+        drawn.files.extend(draw_precursor(run, top)?);
     }
-    for &format in formats.iter().filter(|_| selection.wants(AREA_FIGURE)) {
-        let path = dir.join(format!("{AREA_FIGURE}.{}", format.extension()));
-        let mut chart = canvas
-            .chart(
-                &format!("Real contact area: {title}"),
-                "F/(μF_N)",
-                "A_R/A_R(0)",
-            )
-            .x_range(0.0, top)
-            .y_range(0.0, (1.04 * area_top).min(2.0))
-            .steps("A_R/A_R(0) at the stable states", &area)
-            .legend(Corner::LowerLeft);
-        if let Some(note) = &area_note {
-            chart = chart.note(note);
-        }
-        chart.save(&path)?;
-        drawn.files.push(path);
+    if selection.wants(AREA_FIGURE) {
+        drawn.files.extend(draw_area(run, top)?);
     }
     if selection.wants(MAP_FIGURE) {
         draw_contact_map(
@@ -644,6 +592,90 @@ fn draw_run(
     drawn.files.extend(profiles.files);
     drawn.notes.extend(profiles.notes);
     Ok(drawn)
+}
+
+/// A run's directory, formats, canvas, title and checked tables: what each of its
+/// figures is drawn from.
+type Run<'a> = (&'a Path, &'a [Format], Canvas, &'a str, &'a RunRecord);
+
+/// The precursor figure of a run: `ℓ/Lx` at the stable states against the load, up to
+/// `top` (`F/(μF_N)`).
+fn draw_precursor(
+    (dir, formats, canvas, title, record): Run<'_>,
+    top: f64,
+) -> Result<Vec<PathBuf>, PlotError> {
+    // The staircase ends at the last stable state; the run ends at global slip, where the
+    // whole interface slides (ℓ = Lx): a marker there.
+    let slip = Some(record.slip);
+    let ell: Vec<(f64, f64)> = record
+        .curve
+        .iter()
+        .map(|c| (c.load, c.precursor_over_lx))
+        .collect();
+    let mut files = Vec::new();
+    for &format in formats {
+        let path = dir.join(format!("{PRECURSOR_FIGURE}.{}", format.extension()));
+        let mut chart = canvas
+            .chart(&format!("Precursor length: {title}"), "F/(μF_N)", "ℓ/Lx")
+            .x_range(0.0, top)
+            .y_range(0.0, 1.0)
+            .steps("ℓ/Lx at the stable states", &ell)
+            .legend(Corner::UpperLeft);
+        if let Some(slip) = slip {
+            chart = chart.markers(
+                &format!("global slip at F/(μF_N) = {slip:.3}"),
+                &[(slip, 1.0)],
+            );
+        }
+        chart.save(&path)?;
+        files.push(path);
+    }
+    Ok(files)
+}
+
+/// The area figure of a run: `A_R/A_R(0)` at the stable states against the load, up to
+/// `top` (`F/(μF_N)`).
+fn draw_area(
+    (dir, formats, canvas, title, record): Run<'_>,
+    top: f64,
+) -> Result<Vec<PathBuf>, PlotError> {
+    let a0 = record.curve.first().map_or(f64::NAN, |c| c.area);
+    let area: Vec<(f64, f64)> = record.curve.iter().map(|c| (c.load, c.area / a0)).collect();
+    // Near slip the paper's unbounded area law can reach many times A_R(0) (flagged in
+    // area_exceeds_nominal): the chart shows up to 2 and its legend says how many
+    // states lie above.
+    let area_top = area
+        .iter()
+        .map(|p| p.1)
+        .filter(|a| a.is_finite())
+        .fold(1.0, f64::max);
+    let above = area.iter().filter(|p| p.1 > 2.0).count();
+    let area_note = (above > 0).then(|| {
+        format!(
+            "{above} states above 2 (off the chart), up to {}",
+            short(area_top)
+        )
+    });
+    let mut files = Vec::new();
+    for &format in formats {
+        let path = dir.join(format!("{AREA_FIGURE}.{}", format.extension()));
+        let mut chart = canvas
+            .chart(
+                &format!("Real contact area: {title}"),
+                "F/(μF_N)",
+                "A_R/A_R(0)",
+            )
+            .x_range(0.0, top)
+            .y_range(0.0, (1.04 * area_top).min(2.0))
+            .steps("A_R/A_R(0) at the stable states", &area)
+            .legend(Corner::LowerLeft);
+        if let Some(note) = &area_note {
+            chart = chart.note(note);
+        }
+        chart.save(&path)?;
+        files.push(path);
+    }
+    Ok(files)
 }
 
 /// The contact map of a run (`contact_map.csv`: each column's real contact area relative

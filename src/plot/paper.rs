@@ -4,7 +4,7 @@
 //! contact area at zero shear against the normal load, over a sweep's points).
 
 use super::distributions::{PointLabel, Statistics};
-use super::{point_order, series_colour, Canvas, Corner, PlotError, Style};
+use super::{point_order, series_colour, Canvas, Chart, Corner, PlotError, Style};
 use crate::driver::Event;
 use crate::error::Error;
 use crate::output::check::RunRecord;
@@ -113,6 +113,54 @@ pub(super) fn draw_archard(
     key: &str,
 ) -> Result<Statistics, PlotError> {
     let mut drawn = Statistics::default();
+    let all = archard_series(dir, key)?;
+    if all.is_empty() {
+        drawn.notes.push(format!(
+            "no {ARCHARD_FIGURE} figure: the sweep has no complete run"
+        ));
+        return Ok(drawn);
+    }
+    let f_top = all
+        .iter()
+        .flat_map(|s| s.loads.iter().map(|l| l.0))
+        .fold(0.0, f64::max)
+        * 1.05;
+    let mut chart = canvas
+        .chart(
+            &format!("Real contact area at zero shear: {title}"),
+            "F_N (N)",
+            "A_R(0)/(Lx Ly) (%)",
+        )
+        .legend(Corner::UpperLeft);
+    let mut y_top: f64 = 0.0;
+    let single = all.len() == 1 && all[0].rest.is_empty();
+    // The series differ in the other axes: ordered along them where they are numbers.
+    let (colours, order) = point_order(&all.iter().map(|s| &s.rest[..]).collect::<Vec<_>>());
+    for (k, series) in order.iter().map(|&k| &all[k]).enumerate() {
+        let colour = series_colour(colours, k, all.len());
+        let style = Style::new().colour(colour.0, colour.1, colour.2);
+        let prefix = (!single).then_some(label);
+        let top;
+        (chart, top) = archard_curves(chart, series, style, prefix, f_top);
+        y_top = y_top.max(top);
+    }
+    let chart = chart
+        .x_range(0.0, if f_top > 0.0 { f_top } else { 1.0 })
+        .y_range(0.0, if y_top > 0.0 { 1.15 * y_top } else { 1.0 });
+    for extension in extensions {
+        let path = dir.join(format!("{ARCHARD_FIGURE}.{extension}"));
+        chart.save(&path)?;
+        drawn.files.push(path);
+    }
+    Ok(drawn)
+}
+
+/// The series of `archard`: every complete run's `A_R(0)` of the sweep in `dir`, grouped
+/// by the axes other than `key` (the load) and the drive's, then by load.
+///
+/// # Errors
+/// As [`draw_archard`].
+fn archard_series(dir: &Path, key: &str) -> Result<Vec<Series>, PlotError> {
     let (_, points, _) = points(dir)?;
     let mut all: Vec<Series> = Vec::new();
     for point in &points {
@@ -165,91 +213,86 @@ pub(super) fn draw_archard(
             None => all[k].loads.push((f_n, areas)),
         }
     }
-    if all.is_empty() {
-        drawn.notes.push(format!(
-            "no {ARCHARD_FIGURE} figure: the sweep has no complete run"
-        ));
-        return Ok(drawn);
-    }
-    let f_top = all
-        .iter()
-        .flat_map(|s| s.loads.iter().map(|l| l.0))
-        .fold(0.0, f64::max)
-        * 1.05;
-    let mut chart = canvas
-        .chart(
-            &format!("Real contact area at zero shear: {title}"),
-            "F_N (N)",
-            "A_R(0)/(Lx Ly) (%)",
-        )
-        .legend(Corner::UpperLeft);
-    let mut y_top: f64 = 0.0;
-    let single = all.len() == 1 && all[0].rest.is_empty();
-    // The series differ in the other axes: ordered along them where they are numbers.
-    let (colours, order) = point_order(&all.iter().map(|s| &s.rest[..]).collect::<Vec<_>>());
-    for (k, series) in order.iter().map(|&k| &all[k]).enumerate() {
-        let colour = series_colour(colours, k, all.len());
-        let style = Style::new().colour(colour.0, colour.1, colour.2);
-        let percent = 100.0 / series.nominal;
-        let runs: usize = series.loads.iter().map(|l| l.1.len()).sum();
-        let mut means = Vec::new();
-        let mut bars = Vec::new();
-        for (f_n, areas) in &series.loads {
-            let n = areas.len() as f64;
-            let mean = areas.iter().sum::<f64>() / n;
-            let sd = if areas.len() > 1 {
-                (areas.iter().map(|a| (a - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
-            } else {
-                f64::NAN
-            };
-            means.push((*f_n, mean * percent));
-            y_top = y_top.max((mean + if sd.is_nan() { 0.0 } else { sd }) * percent);
-            if sd.is_finite() {
-                bars.extend([
-                    (*f_n, (mean - sd) * percent),
-                    (*f_n, (mean + sd) * percent),
-                    (f64::NAN, f64::NAN),
-                ]);
-            }
-        }
-        // Least squares through the origin over every run.
-        let (fa, ff) = series
-            .loads
-            .iter()
-            .flat_map(|(f, areas)| areas.iter().map(move |a| (f * a, f * f)))
-            .fold((0.0, 0.0), |(x, y), (a, b)| (x + a, y + b));
-        let alpha = fa / ff;
-        y_top = y_top.max(alpha * f_top * percent);
-        let prefix = if single {
-            String::new()
-        } else {
-            format!("{}: ", label(&series.rest, runs))
-        };
-        let mean_label = if single {
-            format!("mean at each load ({runs} runs)")
-        } else {
-            format!("{prefix}mean at each load")
-        };
-        chart = chart.markers(&mean_label, &means).style(style);
-        if !bars.is_empty() {
-            chart = chart
-                .line(&format!("{prefix}± one standard deviation"), &bars)
-                .style(style);
-        }
+    Ok(all)
+}
+
+/// Adds one series of `archard` to `chart` in `style`: its means, their error bars and its
+/// least-squares line up to `f_top` (N), the labels prefixed by `label` of its axes where
+/// there are several series. Returns the chart and the highest value drawn (%).
+fn archard_curves(
+    mut chart: Chart,
+    series: &Series,
+    style: Style,
+    label: Option<PointLabel>,
+    f_top: f64,
+) -> (Chart, f64) {
+    let percent = 100.0 / series.nominal;
+    let runs: usize = series.loads.iter().map(|l| l.1.len()).sum();
+    let (means, bars, mut y_top) = archard_means(series, percent);
+    let alpha = archard_slope(series);
+    y_top = y_top.max(alpha * f_top * percent);
+    let prefix = match label {
+        None => String::new(),
+        Some(label) => format!("{}: ", label(&series.rest, runs)),
+    };
+    let mean_label = if label.is_none() {
+        format!("mean at each load ({runs} runs)")
+    } else {
+        format!("{prefix}mean at each load")
+    };
+    chart = chart.markers(&mean_label, &means).style(style);
+    if !bars.is_empty() {
         chart = chart
-            .line(
-                &format!("{prefix}least squares A_R = α F_N, α = {alpha:.4e} m²/N"),
-                &[(0.0, 0.0), (f_top, alpha * f_top * percent)],
-            )
-            .style(style.dashed());
+            .line(&format!("{prefix}± one standard deviation"), &bars)
+            .style(style);
     }
-    let chart = chart
-        .x_range(0.0, if f_top > 0.0 { f_top } else { 1.0 })
-        .y_range(0.0, if y_top > 0.0 { 1.15 * y_top } else { 1.0 });
-    for extension in extensions {
-        let path = dir.join(format!("{ARCHARD_FIGURE}.{extension}"));
-        chart.save(&path)?;
-        drawn.files.push(path);
+    chart = chart
+        .line(
+            &format!("{prefix}least squares A_R = α F_N, α = {alpha:.4e} m²/N"),
+            &[(0.0, 0.0), (f_top, alpha * f_top * percent)],
+        )
+        .style(style.dashed());
+    (chart, y_top)
+}
+
+/// The mean `A_R(0)` at each load of `series` in % of `Lx Ly` (`percent` = 100 / `Lx Ly`),
+/// the ± one sample standard deviation bars of the loads with several runs (segments cut
+/// by a non-finite point), and the top of the highest bar or mean (%).
+fn archard_means(series: &Series, percent: f64) -> (Points, Points, f64) {
+    let mut y_top: f64 = 0.0;
+    let mut means = Vec::new();
+    let mut bars = Vec::new();
+    for (f_n, areas) in &series.loads {
+        let n = areas.len() as f64;
+        let mean = areas.iter().sum::<f64>() / n;
+        let sd = if areas.len() > 1 {
+            (areas.iter().map(|a| (a - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+        } else {
+            f64::NAN
+        };
+        means.push((*f_n, mean * percent));
+        y_top = y_top.max((mean + if sd.is_nan() { 0.0 } else { sd }) * percent);
+        if sd.is_finite() {
+            bars.extend([
+                (*f_n, (mean - sd) * percent),
+                (*f_n, (mean + sd) * percent),
+                (f64::NAN, f64::NAN),
+            ]);
+        }
     }
-    Ok(drawn)
+    (means, bars, y_top)
+}
+
+/// The `(F_N, %)` points of a curve of `archard`.
+type Points = Vec<(f64, f64)>;
+
+/// `α = Σ F_N A_R / Σ F_N²` (m²/N): the least-squares line through the origin over every
+/// run of `series`.
+fn archard_slope(series: &Series) -> f64 {
+    let (fa, ff) = series
+        .loads
+        .iter()
+        .flat_map(|(f, areas)| areas.iter().map(move |a| (f * a, f * f)))
+        .fold((0.0, 0.0), |(x, y), (a, b)| (x + a, y + b));
+    fa / ff
 }
