@@ -134,19 +134,8 @@ pub(crate) fn projected_pcg<S: SetSystem>(
     };
     let norm_b = max_abs(b);
     let outcome = with_crew(effort.parallelism, parts, &work, |crew| {
-        Leader {
-            crew,
-            sys,
-            n: n as f64,
-            norm_a: sys.norm_bound(),
-            norm_b,
-            total,
-            effort,
-            pending: Pre::default(),
-            s1: 0.0,
-            offset: 0.0,
-        }
-        .solve()
+        let phases = HostPhases { crew, sys };
+        run_cg(phases, n, norm_b, total, effort)
     })?;
     for (k, v) in work.vectors.iter().enumerate() {
         f[sys.range(k)].copy_from_slice(&lock(v).f);
@@ -170,27 +159,27 @@ struct Vectors {
 
 /// Local updates a phase applies on its part before its main work, in this order.
 #[derive(Clone, Copy, Default)]
-struct Pre {
+pub(crate) struct Pre {
     /// `best = f`.
-    keep_best: bool,
+    pub(crate) keep_best: bool,
     /// `f = best`.
-    restore_best: bool,
+    pub(crate) restore_best: bool,
     /// `f += shift` (the sum fix).
-    shift_f: Option<f64>,
+    pub(crate) shift_f: Option<f64>,
     /// `f += α p`, and `r += α q` when the flag is set.
-    step: Option<(f64, bool)>,
+    pub(crate) step: Option<(f64, bool)>,
     /// `z += u w`, `r += u` (the projection, the multiplier folded into `r`).
-    project: Option<f64>,
+    pub(crate) project: Option<f64>,
     /// `w = z`.
-    w_from_z: bool,
+    pub(crate) w_from_z: bool,
     /// `p = β p - z` (`None` inside: `p = -z`, a restart).
-    direction: Option<Option<f64>>,
+    pub(crate) direction: Option<Option<f64>>,
     /// `r = 1` (to form `w = M⁻¹ 1`).
-    fill_r_one: bool,
+    pub(crate) fill_r_one: bool,
     /// `f -= Z y` (the coarse start), after the updates above.
-    coarse_f: bool,
+    pub(crate) coarse_f: bool,
     /// `z += Z y` (the coarse correction), after the updates above.
-    coarse_z: bool,
+    pub(crate) coarse_z: bool,
 }
 
 impl Pre {
@@ -249,7 +238,7 @@ impl Pre {
 
 /// The main work of a phase.
 #[derive(Clone, Copy)]
-enum Main {
+pub(crate) enum Main {
     /// Only the local updates.
     Nothing,
     /// `Σ f`.
@@ -272,10 +261,11 @@ enum Main {
     Restrict,
 }
 
+/// One phase of the CG: local updates, then its main work.
 #[derive(Clone, Copy)]
-struct Phase {
-    pre: Pre,
-    main: Main,
+pub(crate) struct Phase {
+    pub(crate) pre: Pre,
+    pub(crate) main: Main,
 }
 
 struct Work<'a, S> {
@@ -345,10 +335,84 @@ impl<S: SetSystem> Tasks for Work<'_, S> {
     }
 }
 
-/// The CG's scalar logic, on the calling thread.
-struct Leader<'c, 'a, S: SetSystem> {
+/// What runs the CG's phases: on the host the crew over the system's parts
+/// ([`HostPhases`]), on a device its kernels. The CG's scalar logic ([`run_cg`]) is the
+/// same for both.
+pub(crate) trait PhaseRunner {
+    /// Runs `phase`; returns slots 1-3 combined over the parts: for [`Main::Measure`]
+    /// `[max |r|, max |f|, rᵀz]`, otherwise `[the main work's value, the stage's carry
+    /// for the next stage, 0]`.
+    fn run(&mut self, phase: Phase) -> [f64; 3];
+    /// Stages of the product `y = A x`.
+    fn product_stages(&self) -> usize;
+    /// Stages of the preconditioner `z = M⁻¹ r`.
+    fn precondition_stages(&self) -> usize;
+    /// An upper bound of `‖A‖₂` (m/Pa), the scale of the backward error.
+    fn norm_bound(&self) -> f64;
+    /// Whether a coarse space corrects the preconditioner (A-DEF2).
+    fn has_coarse(&self) -> bool;
+    /// The coarse solve of the last restriction.
+    fn coarse_solve(&mut self);
+}
+
+/// The host's phases: the crew runs each on every part of `sys`, the partial values added
+/// in part order.
+struct HostPhases<'c, 'a, S: SetSystem> {
     crew: &'c Crew<'c, Work<'a, S>>,
     sys: &'a S,
+}
+
+impl<S: SetSystem> PhaseRunner for HostPhases<'_, '_, S> {
+    fn run(&mut self, phase: Phase) -> [f64; 3] {
+        let p = self.crew.run(phase);
+        match phase.main {
+            Main::Measure => [p.max(1), p.max(2), p.sum(3)],
+            _ => [p.sum(1), p.sum(0), 0.0],
+        }
+    }
+    fn product_stages(&self) -> usize {
+        self.sys.product_stages()
+    }
+    fn precondition_stages(&self) -> usize {
+        self.sys.precondition_stages()
+    }
+    fn norm_bound(&self) -> f64 {
+        self.sys.norm_bound()
+    }
+    fn has_coarse(&self) -> bool {
+        self.sys.has_coarse()
+    }
+    fn coarse_solve(&mut self) {
+        self.sys.coarse_solve()
+    }
+}
+
+/// The projected CG on `runner`'s vectors (`n` values, `‖b‖∞ = norm_b`, `1ᵀ f = total`
+/// kept): the one CG of every backend.
+pub(crate) fn run_cg<R: PhaseRunner>(
+    runner: R,
+    n: usize,
+    norm_b: f64,
+    total: f64,
+    effort: Effort,
+) -> PcgOutcome {
+    Leader {
+        norm_a: runner.norm_bound(),
+        runner,
+        n: n as f64,
+        norm_b,
+        total,
+        effort,
+        pending: Pre::default(),
+        s1: 0.0,
+        offset: 0.0,
+    }
+    .solve()
+}
+
+/// The CG's scalar logic, on the calling thread.
+struct Leader<R: PhaseRunner> {
+    runner: R,
     n: f64,
     norm_a: f64,
     norm_b: f64,
@@ -362,16 +426,12 @@ struct Leader<'c, 'a, S: SetSystem> {
     offset: f64,
 }
 
-impl<S: SetSystem> Leader<'_, '_, S> {
+impl<R: PhaseRunner> Leader<R> {
     /// Runs `main` with the pending updates; returns slots 1-3 combined (sums, or maxima
     /// for `Measure`'s first two).
     fn phase(&mut self, main: Main) -> [f64; 3] {
         let pre = std::mem::take(&mut self.pending);
-        let p = self.crew.run(Phase { pre, main });
-        match main {
-            Main::Measure => [p.max(1), p.max(2), p.sum(3)],
-            _ => [p.sum(1), p.sum(0), 0.0],
-        }
+        self.runner.run(Phase { pre, main })
     }
 
     /// Runs the stages of a product or a preconditioner (`make(stage, carry)`), the
@@ -396,7 +456,7 @@ impl<S: SetSystem> Leader<'_, '_, S> {
     /// `r = A f + U - b`.
     fn residual(&mut self) {
         let offset = self.offset;
-        self.staged(self.sys.product_stages(), |stage, carry| Main::Residual {
+        self.staged(self.runner.product_stages(), |stage, carry| Main::Residual {
             stage,
             carry,
             offset,
@@ -416,11 +476,11 @@ impl<S: SetSystem> Leader<'_, '_, S> {
         let u = -sz / self.s1;
         self.pending.project = Some(u);
         self.offset += u;
-        if self.sys.has_coarse() {
-            self.staged(self.sys.product_stages(), |stage, carry| {
+        if self.runner.has_coarse() {
+            self.staged(self.runner.product_stages(), |stage, carry| {
                 Main::CoarseProduct { stage, carry }
             });
-            self.sys.coarse_solve();
+            self.runner.coarse_solve();
             self.pending.coarse_z = true;
         }
     }
@@ -429,14 +489,14 @@ impl<S: SetSystem> Leader<'_, '_, S> {
     fn coarse_start(&mut self) {
         self.residual();
         self.phase(Main::Restrict);
-        self.sys.coarse_solve();
+        self.runner.coarse_solve();
         self.pending.coarse_f = true;
         self.fix_sum();
     }
 
     /// `z = M⁻¹ r`; returns `Σ z`.
     fn precondition(&mut self) -> f64 {
-        self.staged(self.sys.precondition_stages(), |stage, carry| {
+        self.staged(self.runner.precondition_stages(), |stage, carry| {
             Main::Precondition { stage, carry }
         })
     }
@@ -460,7 +520,7 @@ impl<S: SetSystem> Leader<'_, '_, S> {
     fn solve(mut self) -> PcgOutcome {
         let tol = self.effort.tolerance;
         self.fix_sum();
-        if self.sys.has_coarse() {
+        if self.runner.has_coarse() {
             self.coarse_start();
         }
         // w = M⁻¹ 1.
@@ -481,7 +541,7 @@ impl<S: SetSystem> Leader<'_, '_, S> {
         let mut confirmed = false;
         while iterations < self.effort.max_iterations {
             iterations += 1;
-            let pq = self.staged(self.sys.product_stages(), |stage, carry| Main::Direction {
+            let pq = self.staged(self.runner.product_stages(), |stage, carry| Main::Direction {
                 stage,
                 carry,
             });
