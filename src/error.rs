@@ -662,6 +662,48 @@ pub enum Error {
         /// What to change.
         hint: &'static str,
     },
+    /// The CUDA backend ([`crate::solver::Backend::Cuda`]) cannot run here: this build has
+    /// no feature `cuda`, or no NVIDIA driver or GPU answers, or a library it needs
+    /// (`libcuda`, `libcufft`, `libnvrtc`) is missing or too old, or its kernels do not
+    /// compile for the GPU (`EquilibriumSolverBuilder::build`, `Scene::driver`,
+    /// `solver::cuda_device`). The reason names what was searched or what failed, the hint
+    /// what to install or set (docs/gpu.md).
+    #[error("the CUDA backend is unavailable: {}; {hint}", Bounded(reason))]
+    CudaUnavailable {
+        /// What is missing or failed (the libraries searched, the driver's answer).
+        reason: String,
+        /// What to install, build or set.
+        hint: String,
+    },
+    /// The device memory a CUDA solver would need exceeds what its GPU has free, refused
+    /// before anything is allocated (`EquilibriumSolverBuilder::build` with
+    /// [`crate::solver::Backend::Cuda`]).
+    #[cfg(feature = "cuda")]
+    #[error(
+        "the CUDA backend would need about {needed} on {device}, which has {free} free: use \
+         a smaller grid, a GPU with more memory, or backend \"spectral\"",
+        needed = format_bytes(*needed_bytes),
+        free = format_bytes(*free_bytes)
+    )]
+    DeviceOutOfMemory {
+        /// The GPU (its name and ordinal).
+        device: String,
+        /// Estimated bytes needed.
+        needed_bytes: f64,
+        /// Bytes free on the device.
+        free_bytes: f64,
+    },
+    /// A CUDA call failed during a solve (a launch, a copy, an FFT): the device, its
+    /// driver or its memory failed after the backend was set up. The solver's state is
+    /// the one before the failing solve.
+    #[cfg(feature = "cuda")]
+    #[error("CUDA call {call} failed: {}", Bounded(message))]
+    Cuda {
+        /// The call (`cuMemcpyDtoH`, `cufftExecD2Z`, a kernel's name).
+        call: &'static str,
+        /// What the driver or library reported.
+        message: String,
+    },
     /// A statistic asked of fewer samples than it needs: a power-law fit
     /// ([`crate::statistics::fit_power_law`]) of fewer than its options' `min_tail` samples
     /// (after the non-positive ones, which a power law cannot hold, are counted out).

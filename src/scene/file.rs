@@ -236,9 +236,15 @@ enum BackendSpec {
     Auto,
     Dense,
     Spectral,
+    Cuda,
 }
 
-schema_leaf!(BackendSpec, |v| format!("{v:?}").to_lowercase());
+// The identity names the rule, not the device: `cuda` solves the `spectral` rule (the
+// same events within the solver tolerance), so a checkpoint resumes across the two.
+schema_leaf!(BackendSpec, walk |v: &BackendSpec, walk: Walk| match (v, walk) {
+    (BackendSpec::Cuda, Walk::Identity) => "spectral".to_string(),
+    _ => format!("{v:?}").to_lowercase(),
+});
 
 schema_struct! {
     #[derive(Debug, Clone, Copy, PartialEq)]
@@ -496,6 +502,7 @@ impl From<&SolverOptions> for SolverSpec {
             backend: match solver.backend() {
                 Backend::Dense => BackendSpec::Dense,
                 Backend::Spectral => BackendSpec::Spectral,
+                Backend::Cuda => BackendSpec::Cuda,
                 _ => BackendSpec::Auto,
             },
             tolerance: solver.tolerance(),
@@ -641,6 +648,7 @@ impl SolverSpec {
                 BackendSpec::Auto => Backend::Auto,
                 BackendSpec::Dense => Backend::Dense,
                 BackendSpec::Spectral => Backend::Spectral,
+                BackendSpec::Cuda => Backend::Cuda,
             })?
             .with_tolerance(self.tolerance)?
             .with_max_active_set_iterations(self.max_active_set_iterations)?

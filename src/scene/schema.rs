@@ -112,18 +112,26 @@ pub(crate) fn replace<T: serde::de::DeserializeOwned>(
     Ok(())
 }
 
-/// A leaf: a value without keys below it, written exactly by `exact`.
+/// A leaf: a value without keys below it, written exactly by `exact`; or, with `walk`
+/// before the function, by a function of the value and the walk (a value whose identity
+/// is another value's: the backend `cuda` runs the `spectral` rule).
 macro_rules! schema_leaf {
     ($ty:ty, $exact:expr) => {
+        schema_leaf!($ty, walk | v: &$ty, _: $crate::scene::schema::Walk | {
+            let exact: fn(&$ty) -> String = $exact;
+            exact(v)
+        });
+    };
+    ($ty:ty, walk $exact:expr) => {
         impl $crate::scene::schema::Schema for $ty {
             fn keys(
                 &self,
                 path: &str,
-                _: $crate::scene::schema::Walk,
+                walk: $crate::scene::schema::Walk,
                 out: &mut Vec<(String, String)>,
             ) {
-                let exact: fn(&$ty) -> String = $exact;
-                out.push((path.to_string(), exact(self)));
+                let exact: fn(&$ty, $crate::scene::schema::Walk) -> String = $exact;
+                out.push((path.to_string(), exact(self, walk)));
             }
 
             #[cfg(feature = "serde")]

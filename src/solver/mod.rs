@@ -31,6 +31,8 @@
 
 mod active_set;
 mod coarse;
+#[cfg(feature = "cuda")]
+mod cuda;
 mod dense;
 mod fsai;
 mod options;
@@ -45,6 +47,8 @@ pub use options::{
     Backend, NormalEquilibrium, SolveReport, SolverOptions, TangentialResponse, AUTO_DENSE_LIMIT,
 };
 pub use parallel::Parallelism;
+#[cfg(feature = "cuda")]
+pub use cuda::{cuda_device, CudaDevice};
 
 use crate::error::{Error, Result};
 use crate::geometry::Grid;
@@ -76,6 +80,8 @@ pub(crate) struct SolverState {
 enum Core {
     Dense(Box<DenseCore>),
     Spectral(Box<SpectralCore>),
+    #[cfg(feature = "cuda")]
+    Cuda(Box<cuda::CudaCore>),
 }
 
 /// Builder of an [`EquilibriumSolver`].
@@ -163,6 +169,7 @@ impl EquilibriumSolverBuilder {
                 let spectral = SpectralCore::new(&self.plan, compliance, Partition::single(nx, ny));
                 Core::Dense(Box::new(DenseCore::new(c, spectral)))
             }
+            Backend::Cuda => cuda_core(&self.plan, compliance)?,
             _ => Core::Spectral(Box::new(SpectralCore::new(
                 &self.plan,
                 compliance,
@@ -180,6 +187,23 @@ impl EquilibriumSolverBuilder {
             warm_tangential: Vec::new(),
         })
     }
+}
+
+/// The CUDA backend's core on the plan's grid.
+#[cfg(feature = "cuda")]
+fn cuda_core(plan: &InfluencePlan, compliance: Compliance) -> Result<Core> {
+    Ok(Core::Cuda(Box::new(cuda::CudaCore::new(plan, compliance)?)))
+}
+
+/// Without the feature `cuda` there is no CUDA backend to build.
+#[cfg(not(feature = "cuda"))]
+fn cuda_core(_: &InfluencePlan, _: Compliance) -> Result<Core> {
+    Err(Error::CudaUnavailable {
+        reason: "this build of precursors has no CUDA backend (feature `cuda` is off)".into(),
+        hint: "rebuild with `--features cuda` (`cargo build --release --features cli,cuda`; \
+               docs/gpu.md), or use backend \"spectral\""
+            .into(),
+    })
 }
 
 /// Solves the interface equilibria of one geometry; build once, reuse for every load
@@ -290,6 +314,8 @@ impl EquilibriumSolver {
         let parts = match &self.core {
             Core::Dense(_) => 1,
             Core::Spectral(s) => s.parts(),
+            #[cfg(feature = "cuda")]
+            Core::Cuda(_) => 1,
         };
         self.options.parallelism().threads().min(parts).max(1)
     }
@@ -310,6 +336,8 @@ impl EquilibriumSolver {
         match &self.core {
             Core::Spectral(core) => core.built(),
             Core::Dense(core) => core.spectral.built(),
+            #[cfg(feature = "cuda")]
+            Core::Cuda(_) => false,
         }
     }
 
@@ -317,6 +345,8 @@ impl EquilibriumSolver {
         let (preconditioner_mean, factor) = match &self.core {
             Core::Dense(d) => (d.spectral.preconditioner_mean(), Some(d.normal.state())),
             Core::Spectral(s) => (s.preconditioner_mean(), None),
+            #[cfg(feature = "cuda")]
+            Core::Cuda(c) => (c.preconditioner_mean(), None),
         };
         SolverState {
             backend: self.backend,
@@ -331,7 +361,13 @@ impl EquilibriumSolver {
     pub(crate) fn restore(&mut self, state: SolverState, solved: bool) -> Result<()> {
         let n = self.grid.len();
         let bad = |reason: String| Err(Error::InvalidCheckpoint { reason });
-        if state.backend != self.backend {
+        // The spectral and CUDA backends solve one rule with one state (warm starts and
+        // the spectral preconditioner's d̄): a checkpoint resumes across them.
+        let rule = |b: Backend| match b {
+            Backend::Cuda => Backend::Spectral,
+            b => b,
+        };
+        if rule(state.backend) != rule(self.backend) {
             return bad(format!(
                 "the checkpoint's solver ran backend \"{}\", this scene's runs backend \"{}\"",
                 state.backend, self.backend
@@ -371,6 +407,8 @@ impl EquilibriumSolver {
                     .restore_preconditioner(state.preconditioner_mean);
             }
             (Core::Spectral(core), None) => core.restore_preconditioner(state.preconditioner_mean),
+            #[cfg(feature = "cuda")]
+            (Core::Cuda(core), None) => core.restore_preconditioner(state.preconditioner_mean),
             _ => return bad("the dense factor does not match the backend".into()),
         }
         self.warm_normal = state.warm_normal;
@@ -394,13 +432,13 @@ impl EquilibriumSolver {
     fn explores(&self, set: &[usize]) -> bool {
         match &self.core {
             Core::Dense(c) => c.normal.needs_refactor(set, self.grid.len()),
-            Core::Spectral(_) => true,
+            _ => true,
         }
     }
 
     /// Whether the backend explores cold sets at all (the dense one always may).
     fn explores_cold_only(&self) -> bool {
-        matches!(self.core, Core::Spectral(_))
+        !matches!(self.core, Core::Dense(_))
     }
 
     /// One equality-constrained solve on a set, whichever backend; `warm` is the start.
@@ -447,6 +485,16 @@ impl EquilibriumSolver {
                     Precond::Spectral
                 } else {
                     spectral::warm_precond(tangential, self.grid.len())
+                };
+                core.solve(problem, precond, warm, effort)?
+            }
+            #[cfg(feature = "cuda")]
+            Core::Cuda(core) => {
+                // Jacobi for warm solves: the device has no FSAI yet (docs/gpu.md).
+                let precond = if cold {
+                    Precond::Spectral
+                } else {
+                    Precond::Jacobi
                 };
                 core.solve(problem, precond, warm, effort)?
             }

@@ -38,15 +38,24 @@ pub enum Backend {
     Dense,
     /// Matrix-free: the DCT operator in projected conjugate gradients, memory `O(N)`.
     Spectral,
+    /// The spectral backend's rule on an NVIDIA GPU (feature `cuda`; docs/gpu.md): the
+    /// DCT operator through cuFFT and the projected CG on the device, memory `O(N)` on the
+    /// device. Its events are the spectral backend's within the solver tolerance, not
+    /// bit for bit; a run repeats bit for bit on the same GPU. Without the feature, or
+    /// without a usable GPU and its libraries, building a solver returns
+    /// [`Error::CudaUnavailable`](crate::Error::CudaUnavailable).
+    Cuda,
 }
 
-/// The backend as a scene file spells it (`solver.backend`): `auto`, `dense`, `spectral`.
+/// The backend as a scene file spells it (`solver.backend`): `auto`, `dense`, `spectral`,
+/// `cuda`.
 impl std::fmt::Display for Backend {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
             Backend::Auto => "auto",
             Backend::Dense => "dense",
             Backend::Spectral => "spectral",
+            Backend::Cuda => "cuda",
         })
     }
 }

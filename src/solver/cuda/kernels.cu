@@ -1,0 +1,249 @@
+// The CUDA backend's kernels (compiled by NVRTC when a solver is built; docs/gpu.md).
+//
+// Grid: Nx x Ny cells, cell i = iy * Nx + ix. A set vector holds one value per site of
+// the attached set `set` (ascending cells); `pos[i]` is the cell's position in the set or
+// -1.
+//
+// The operator y = C3(W . C2(x)) + d x, with C2 the unnormalised 2-D DCT-II
+// (X_k = sum_n x_n cos(pi k (2n+1) / 2N) along each axis) and C3 = C2^T, each axis by
+// Makhoul's algorithm: C2 x = Re(T . F(P x)) with v = P x the even-then-reversed-odd
+// order, F the real FFT and T_k = exp(-i pi k / 2N); C2^T Y = P^T F^H(z_H) with z_H the
+// Hermitian part of conj(T) . Y: z_H[0] = Y_0, z_H[k] = conj(T_k) (Y_k - i Y_{N-k}) / 2.
+// The x axis (rows, contiguous) is transformed first; the y-axis data are stored
+// column by column (Nx lines of Ny values) so that both FFTs are batched over contiguous
+// lines.
+//
+// Reductions run in a fixed order (fixed block count, grid-stride loops, a tree in shared
+// memory, one block for the final pass), so a run repeats bit for bit on the same GPU.
+
+#define THREADS 256
+
+// The position of source index n in Makhoul's order v (v[m] = x[perm(m)]).
+__device__ __forceinline__ int makhoul_source(int m, int n) {
+    return (m < (n + 1) / 2) ? 2 * m : 2 * (n - 1 - m) + 1;
+}
+
+// Where x[j] lands in Makhoul's order.
+__device__ __forceinline__ int makhoul_slot(int j, int n) {
+    return (j % 2 == 0) ? j / 2 : n - 1 - (j - 1) / 2;
+}
+
+// T_k = exp(-i pi k / 2n) applied to (re, im), real part only.
+__device__ __forceinline__ double twiddle_re(double re, double im, int k, int n) {
+    double s, c;
+    sincospi((double)k / (2.0 * n), &s, &c);
+    return c * re + s * im;
+}
+
+// Element k of a full length-n spectrum held as its first n/2 + 1 values (Hermitian).
+__device__ __forceinline__ double2 hermitian_at(const double2* half, int k, int n) {
+    if (k <= n / 2) return half[k];
+    double2 v = half[n - k];
+    v.y = -v.y;
+    return v;
+}
+
+// z_H[k] of C2^T from the real spectrum Y (Y_n := 0 is never read: k >= 1 reads n - k).
+__device__ __forceinline__ double2 inverse_input(double yk, double ynk, int k, int n) {
+    double2 out;
+    if (k == 0) {
+        out.x = yk;
+        out.y = 0.0;
+        return out;
+    }
+    // conj(T_k) = cos + i sin (angle pi k / 2n); (Y_k - i Y_{n-k}) / 2.
+    double s, c;
+    sincospi((double)k / (2.0 * n), &s, &c);
+    double a = 0.5 * yk, b = -0.5 * ynk;
+    out.x = c * a - s * b;
+    out.y = c * b + s * a;
+    return out;
+}
+
+// Step 1: the set vector x scattered onto the grid (zero off the set), rows in Makhoul's
+// order. v: Ny x Nx.
+extern "C" __global__ void scatter_rows(const double* x, const int* pos, double* v, int nx, int ny) {
+    int idx = blockIdx.x * blockDim.x + threadIdx.x;
+    if (idx >= nx * ny) return;
+    int iy = idx / nx, m = idx % nx;
+    int p = pos[iy * nx + makhoul_source(m, nx)];
+    v[idx] = p >= 0 ? x[p] : 0.0;
+}
+
+// Step 1 for a whole-grid vector (the preconditioner's full-grid input is the set's).
+// Step 3: the x-axis DCT-II from the rows' spectra (Ny x (Nx/2 + 1)), written column by
+// column in Makhoul's order along y. u: Nx x Ny.
+extern "C" __global__ void rows_to_columns(const double2* spec, double* u, int nx, int ny) {
+    int idx = blockIdx.x * blockDim.x + threadIdx.x;
+    if (idx >= nx * ny) return;
+    int kx = idx / ny, m = idx % ny;
+    int iy = makhoul_source(m, ny);
+    double2 v = hermitian_at(spec + (size_t)iy * (nx / 2 + 1), kx, nx);
+    u[idx] = twiddle_re(v.x, v.y, kx, nx);
+}
+
+// The 2-D coefficient (ky, kx) of C2 x from the columns' spectra (Nx x (Ny/2 + 1)).
+__device__ __forceinline__ double column_coefficient(const double2* spec, int kx, int ky, int ny) {
+    double2 v = hermitian_at(spec + (size_t)kx * (ny / 2 + 1), ky, ny);
+    return twiddle_re(v.x, v.y, ky, ny);
+}
+
+// Step 5: the diagonal W (Ny x Nx, row-major) applied and the y-axis C2^T prepared:
+// out[kx][k] = z_H[k] of the column kx of W . C2 x, k = 0 .. Ny/2.
+extern "C" __global__ void filter_columns(const double2* spec, const double* table, double2* out,
+                                          int nx, int ny) {
+    int half = ny / 2 + 1;
+    int idx = blockIdx.x * blockDim.x + threadIdx.x;
+    if (idx >= nx * half) return;
+    int kx = idx / half, k = idx % half;
+    double yk = table[(size_t)k * nx + kx] * column_coefficient(spec, kx, k, ny);
+    double ynk = 0.0;
+    if (k > 0) {
+        int j = ny - k;
+        ynk = table[(size_t)j * nx + kx] * column_coefficient(spec, kx, j, ny);
+    }
+    out[idx] = inverse_input(yk, ynk, k, ny);
+}
+
+// Step 7: after the y-axis inverse (w: Nx x Ny, Makhoul's order along y), the x-axis
+// C2^T prepared: out[iy][k] = z_H[k] of row iy, k = 0 .. Nx/2.
+extern "C" __global__ void columns_to_rows(const double* w, double2* out, int nx, int ny) {
+    int half = nx / 2 + 1;
+    int idx = blockIdx.x * blockDim.x + threadIdx.x;
+    if (idx >= ny * half) return;
+    int iy = idx / half, k = idx % half;
+    int slot = makhoul_slot(iy, ny);
+    double yk = w[(size_t)k * ny + slot];
+    double ynk = k > 0 ? w[(size_t)(nx - k) * ny + slot] : 0.0;
+    out[idx] = inverse_input(yk, ynk, k, nx);
+}
+
+// Step 9: the product on the set, y[j] = s(cell of j) + d[j] x[j] (s: Ny x Nx rows in
+// Makhoul's order; d null for none).
+extern "C" __global__ void gather_set(const double* s, const int* set, const double* d,
+                                      const double* x, double* y, int m, int nx) {
+    int j = blockIdx.x * blockDim.x + threadIdx.x;
+    if (j >= m) return;
+    int i = set[j];
+    int iy = i / nx, ix = i % nx;
+    double v = s[(size_t)iy * nx + makhoul_slot(ix, nx)];
+    y[j] = d ? v + d[j] * x[j] : v;
+}
+
+// The product on every cell (the displacements' C_s f after a solve).
+extern "C" __global__ void gather_grid(const double* s, double* out, int nx, int ny) {
+    int i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i >= nx * ny) return;
+    int iy = i / nx, ix = i % nx;
+    out[i] = s[(size_t)iy * nx + makhoul_slot(ix, nx)];
+}
+
+// The residual's tail: r = y + offset - b.
+extern "C" __global__ void residual_tail(double* r, const double* b, double offset, int m) {
+    int j = blockIdx.x * blockDim.x + threadIdx.x;
+    if (j >= m) return;
+    r[j] += offset - b[j];
+}
+
+// Jacobi: z = r / (diag_c + d).
+extern "C" __global__ void jacobi(const double* r, const double* d, double diag_c, double* z, int m) {
+    int j = blockIdx.x * blockDim.x + threadIdx.x;
+    if (j >= m) return;
+    z[j] = r[j] / (diag_c + d[j]);
+}
+
+// The CG's local updates of a phase, in the order of pcg.rs's `Pre::apply`. Flags:
+// 1 keep_best, 2 restore_best, 4 shift_f, 8 step, 16 step updates r, 32 project,
+// 64 w = z, 128 p = -z, 256 p = beta p - z, 512 r = 1.
+extern "C" __global__ void pre_updates(double* f, double* r, double* z, double* p, const double* q,
+                                       double* w, double* best, int flags, double shift,
+                                       double alpha, double u, double beta, int m) {
+    int j = blockIdx.x * blockDim.x + threadIdx.x;
+    if (j >= m) return;
+    double fj = f[j];
+    if (flags & 1) best[j] = fj;
+    if (flags & 2) fj = best[j];
+    if (flags & 4) fj += shift;
+    if (flags & 8) {
+        fj += alpha * p[j];
+        if (flags & 16) r[j] += alpha * q[j];
+    }
+    f[j] = fj;
+    if (flags & 32) {
+        z[j] += u * w[j];
+        r[j] += u;
+    }
+    if (flags & 64) w[j] = z[j];
+    if (flags & 128) p[j] = -z[j];
+    if (flags & 256) p[j] = beta * p[j] - z[j];
+    if (flags & 512) r[j] = 1.0;
+}
+
+// Reductions. mode 0: sum a; 1: sum a b; 2: max |a|, max |b|, sum a c (three values).
+__device__ __forceinline__ void reduce_terms(int mode, const double* a, const double* b,
+                                             const double* c, int j, double* acc) {
+    if (mode == 0) {
+        acc[0] += a[j];
+    } else if (mode == 1) {
+        acc[0] += a[j] * b[j];
+    } else {
+        acc[0] = fmax(acc[0], fabs(a[j]));
+        acc[1] = fmax(acc[1], fabs(b[j]));
+        acc[2] += a[j] * c[j];
+    }
+}
+
+__device__ __forceinline__ void combine(int mode, double* acc, const double* other) {
+    if (mode == 2) {
+        acc[0] = fmax(acc[0], other[0]);
+        acc[1] = fmax(acc[1], other[1]);
+        acc[2] += other[2];
+    } else {
+        acc[0] += other[0];
+    }
+}
+
+// The tree of one block over shared memory (3 x THREADS values); thread 0 ends with it.
+__device__ void block_tree(int mode, double* acc, double* shared) {
+    int t = threadIdx.x;
+    for (int v = 0; v < 3; v++) shared[v * THREADS + t] = acc[v];
+    __syncthreads();
+    for (int width = THREADS / 2; width > 0; width /= 2) {
+        if (t < width) {
+            double mine[3], other[3];
+            for (int v = 0; v < 3; v++) {
+                mine[v] = shared[v * THREADS + t];
+                other[v] = shared[v * THREADS + t + width];
+            }
+            combine(mode, mine, other);
+            for (int v = 0; v < 3; v++) shared[v * THREADS + t] = mine[v];
+        }
+        __syncthreads();
+    }
+    for (int v = 0; v < 3; v++) acc[v] = shared[v * THREADS];
+}
+
+// First pass: partials[3 * block + v] over a fixed grid-stride split of 0 .. m.
+extern "C" __global__ void reduce_partial(int mode, const double* a, const double* b,
+                                          const double* c, int m, double* partials) {
+    __shared__ double shared[3 * THREADS];
+    double acc[3] = {0.0, 0.0, 0.0};
+    for (int j = blockIdx.x * THREADS + threadIdx.x; j < m; j += gridDim.x * THREADS)
+        reduce_terms(mode, a, b, c, j, acc);
+    block_tree(mode, acc, shared);
+    if (threadIdx.x == 0)
+        for (int v = 0; v < 3; v++) partials[3 * blockIdx.x + v] = acc[v];
+}
+
+// Second pass, one block: out[v] over the blocks' partials in a fixed order.
+extern "C" __global__ void reduce_final(int mode, const double* partials, int blocks, double* out) {
+    __shared__ double shared[3 * THREADS];
+    double acc[3] = {0.0, 0.0, 0.0};
+    for (int k = threadIdx.x; k < blocks; k += THREADS) {
+        double other[3] = {partials[3 * k], partials[3 * k + 1], partials[3 * k + 2]};
+        combine(mode, acc, other);
+    }
+    block_tree(mode, acc, shared);
+    if (threadIdx.x == 0)
+        for (int v = 0; v < 3; v++) out[v] = acc[v];
+}
