@@ -43,12 +43,12 @@ mod spectral;
 mod system;
 mod tangential;
 
+#[cfg(feature = "cuda")]
+pub use cuda::{cuda_device, CudaDevice};
 pub use options::{
     Backend, NormalEquilibrium, SolveReport, SolverOptions, TangentialResponse, AUTO_DENSE_LIMIT,
 };
 pub use parallel::Parallelism;
-#[cfg(feature = "cuda")]
-pub use cuda::{cuda_device, CudaDevice};
 
 use crate::error::{Error, Result};
 use crate::geometry::Grid;
@@ -408,7 +408,7 @@ impl EquilibriumSolver {
             }
             (Core::Spectral(core), None) => core.restore_preconditioner(state.preconditioner_mean),
             #[cfg(feature = "cuda")]
-            (Core::Cuda(core), None) => core.restore_preconditioner(state.preconditioner_mean),
+            (Core::Cuda(core), None) => core.restore_preconditioner(state.preconditioner_mean)?,
             _ => return bad("the dense factor does not match the backend".into()),
         }
         self.warm_normal = state.warm_normal;

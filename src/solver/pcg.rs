@@ -355,6 +355,27 @@ pub(crate) trait PhaseRunner {
     fn coarse_solve(&mut self);
 }
 
+impl<R: PhaseRunner + ?Sized> PhaseRunner for &mut R {
+    fn run(&mut self, phase: Phase) -> [f64; 3] {
+        (**self).run(phase)
+    }
+    fn product_stages(&self) -> usize {
+        (**self).product_stages()
+    }
+    fn precondition_stages(&self) -> usize {
+        (**self).precondition_stages()
+    }
+    fn norm_bound(&self) -> f64 {
+        (**self).norm_bound()
+    }
+    fn has_coarse(&self) -> bool {
+        (**self).has_coarse()
+    }
+    fn coarse_solve(&mut self) {
+        (**self).coarse_solve()
+    }
+}
+
 /// The host's phases: the crew runs each on every part of `sys`, the partial values added
 /// in part order.
 struct HostPhases<'c, 'a, S: SetSystem> {
@@ -456,10 +477,12 @@ impl<R: PhaseRunner> Leader<R> {
     /// `r = A f + U - b`.
     fn residual(&mut self) {
         let offset = self.offset;
-        self.staged(self.runner.product_stages(), |stage, carry| Main::Residual {
-            stage,
-            carry,
-            offset,
+        self.staged(self.runner.product_stages(), |stage, carry| {
+            Main::Residual {
+                stage,
+                carry,
+                offset,
+            }
         });
     }
 
@@ -541,9 +564,8 @@ impl<R: PhaseRunner> Leader<R> {
         let mut confirmed = false;
         while iterations < self.effort.max_iterations {
             iterations += 1;
-            let pq = self.staged(self.runner.product_stages(), |stage, carry| Main::Direction {
-                stage,
-                carry,
+            let pq = self.staged(self.runner.product_stages(), |stage, carry| {
+                Main::Direction { stage, carry }
             });
             if !(pq > 0.0 && rz.is_finite()) {
                 break; // no curvature left: rounding has taken over

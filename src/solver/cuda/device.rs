@@ -103,7 +103,14 @@ impl Gpu {
             // SAFETY: every launch and copy of the backend goes to this one stream.
             unsafe { ctx.disable_event_tracking() };
             let stream = ctx.default_stream();
-            Ok((ctx, stream, name, (major, minor), (free, total), driver_version))
+            Ok((
+                ctx,
+                stream,
+                name,
+                (major, minor),
+                (free, total),
+                driver_version,
+            ))
         })
         .map_err(unavailable)?;
         let (ctx, stream, name, (major, minor), (free, total), driver_version) = opened;

@@ -16,7 +16,9 @@
 // Reductions run in a fixed order (fixed block count, grid-stride loops, a tree in shared
 // memory, one block for the final pass), so a run repeats bit for bit on the same GPU.
 
+#ifndef THREADS
 #define THREADS 256
+#endif
 
 // The position of source index n in Makhoul's order v (v[m] = x[perm(m)]).
 __device__ __forceinline__ int makhoul_source(int m, int n) {
@@ -70,7 +72,6 @@ extern "C" __global__ void scatter_rows(const double* x, const int* pos, double*
     v[idx] = p >= 0 ? x[p] : 0.0;
 }
 
-// Step 1 for a whole-grid vector (the preconditioner's full-grid input is the set's).
 // Step 3: the x-axis DCT-II from the rows' spectra (Ny x (Nx/2 + 1)), written column by
 // column in Makhoul's order along y. u: Nx x Ny.
 extern "C" __global__ void rows_to_columns(const double2* spec, double* u, int nx, int ny) {
@@ -118,16 +119,16 @@ extern "C" __global__ void columns_to_rows(const double* w, double2* out, int nx
     out[idx] = inverse_input(yk, ynk, k, nx);
 }
 
-// Step 9: the product on the set, y[j] = s(cell of j) + d[j] x[j] (s: Ny x Nx rows in
-// Makhoul's order; d null for none).
+// Step 9: the product on the set, y[j] = s(cell of j) (+ d[j] x[j] when with_d; s: Ny x Nx,
+// rows in Makhoul's order).
 extern "C" __global__ void gather_set(const double* s, const int* set, const double* d,
-                                      const double* x, double* y, int m, int nx) {
+                                      const double* x, double* y, int with_d, int m, int nx) {
     int j = blockIdx.x * blockDim.x + threadIdx.x;
     if (j >= m) return;
     int i = set[j];
     int iy = i / nx, ix = i % nx;
     double v = s[(size_t)iy * nx + makhoul_slot(ix, nx)];
-    y[j] = d ? v + d[j] * x[j] : v;
+    y[j] = with_d ? v + d[j] * x[j] : v;
 }
 
 // The product on every cell (the displacements' C_s f after a solve).

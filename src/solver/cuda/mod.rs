@@ -1,4 +1,12 @@
-//! The CUDA backend (feature `cuda`): the spectral backend's rule on an NVIDIA GPU.
+//! The CUDA backend (feature `cuda`; docs/gpu.md): the spectral backend's rule on an
+//! NVIDIA GPU. The set system `A = C_SS + diag(d)` is applied through the DCT-diagonal
+//! operator on the device (cuFFT, `operator.rs`, kernels.cu), and pcg.rs's one CG runs its
+//! phases there (`phases.rs`): per iteration only the reductions' scalars cross to the
+//! host. Per set solve the set, `d`, `b` and the warm start go up and the tractions and
+//! the displacements' grid product come back (a few `O(N)` copies).
+//!
+//! Preconditioners: Jacobi for warm solves, the restricted spectral inverse for cold ones
+//! (the host's choice for cold solves); FSAI and the coarse space stay on the host for now.
 
 // Kernel launches, copies and libraries opened by path are unsafe calls of the bindings;
 // each says why it is sound.
@@ -6,51 +14,214 @@
 
 mod device;
 mod libraries;
+mod memory;
+mod operator;
+mod phases;
+
+#[cfg(test)]
+mod emulated;
 
 pub use device::{cuda_device, CudaDevice};
 
-use super::pcg::Effort;
+use super::pcg::{max_abs, run_cg, Effort};
 use super::set::{SetProblem, SetSolve};
 use super::spectral::Precond;
 use super::system::Compliance;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::green::InfluencePlan;
-use device::Gpu;
+use cudarc::driver::CudaSlice;
+use device::{cuda_error, Gpu};
+use operator::{Kernels, Transforms};
+use phases::{DevicePhases, DevicePrecond, SetVectors};
 
-/// The device's state kept between solves.
-#[derive(Debug)]
+/// The device's state kept between solves: kernels, plans, buffers, the operator's table
+/// and the spectral preconditioner's with its `d̄`.
 pub(crate) struct CudaCore {
-    _gpu: Gpu,
-    inverse_mean: Option<f64>,
+    gpu: Gpu,
+    kernels: Kernels,
+    transforms: Transforms,
+    vectors: SetVectors,
+    plan: InfluencePlan,
+    compliance: Compliance,
+    /// Mean diagonal of `C_s` (m/Pa), Jacobi's elastic part.
+    diag_c: f64,
+    operator: CudaSlice<f64>,
+    inverse: Option<(f64, CudaSlice<f64>)>,
+    /// The grid product of the last solve (`C_s f` on every cell).
+    grid: CudaSlice<f64>,
+}
+
+impl std::fmt::Debug for CudaCore {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CudaCore")
+            .field("gpu", &self.gpu)
+            .finish_non_exhaustive()
+    }
 }
 
 impl CudaCore {
-    pub(crate) fn new(_plan: &InfluencePlan, _compliance: Compliance) -> Result<Self> {
-        let _gpu = Gpu::open()?;
-        Err(Error::CudaUnavailable {
-            reason: "the device solves are not built yet".into(),
-            hint: "use backend \"spectral\"".into(),
+    /// Opens the GPU, checks its free memory against the estimate, compiles the kernels
+    /// and allocates everything the solves use.
+    pub(crate) fn new(plan: &InfluencePlan, compliance: Compliance) -> Result<Self> {
+        let gpu = Gpu::open()?;
+        let (nx, ny) = (plan.grid().nx(), plan.grid().ny());
+        let n = nx * ny;
+        memory::check_fits(
+            &gpu.info.to_string(),
+            memory::device_bytes(nx, ny),
+            gpu.free_bytes()?,
+        )?;
+        let kernels = Kernels::compile(&gpu)?;
+        let stream = &gpu.stream;
+        let transforms = Transforms::new(stream, nx, ny)?;
+        let vectors = SetVectors::new(stream, n)?;
+        let operator = upload(&gpu, &operator::table(plan, compliance, |e| e))?;
+        let grid = stream
+            .alloc_zeros::<f64>(n)
+            .map_err(|e| cuda_error("cuMemAlloc", e))?;
+        let mut trace = 0.0;
+        for m in 0..ny {
+            for p in 0..nx {
+                trace += plan.eigenvalue(p, m).unwrap_or(0.0);
+            }
+        }
+        Ok(CudaCore {
+            diag_c: compliance.scale * (trace / n as f64 - compliance.shift),
+            gpu,
+            kernels,
+            transforms,
+            vectors,
+            plan: plan.clone(),
+            compliance,
+            operator,
+            inverse: None,
+            grid,
         })
     }
 
+    /// The `d̄` of the spectral preconditioner's table, if one was built (checkpoints).
     pub(crate) fn preconditioner_mean(&self) -> Option<f64> {
-        self.inverse_mean
+        self.inverse.as_ref().map(|(d, _)| *d)
     }
 
-    pub(crate) fn restore_preconditioner(&mut self, mean: Option<f64>) {
-        self.inverse_mean = mean;
+    /// Rebuilds the spectral preconditioner's table for `d̄` (or drops it), as the host's
+    /// backend does: a restored solver preconditions as before.
+    pub(crate) fn restore_preconditioner(&mut self, mean: Option<f64>) -> Result<()> {
+        match mean {
+            Some(d) => self.build_inverse(d),
+            None => {
+                self.inverse = None;
+                Ok(())
+            }
+        }
     }
 
+    fn build_inverse(&mut self, mean_d: f64) -> Result<()> {
+        let values = operator::table(&self.plan, self.compliance, |e| 1.0 / (e + mean_d));
+        self.inverse = Some((mean_d, upload(&self.gpu, &values)?));
+        Ok(())
+    }
+
+    /// Solves `problem` with `precond` (Jacobi or the spectral inverse); `f` holds the
+    /// warm start.
     pub(crate) fn solve(
         &mut self,
-        _problem: SetProblem<'_>,
-        _precond: Precond,
-        _f: Vec<f64>,
-        _effort: Effort,
+        problem: SetProblem<'_>,
+        precond: Precond,
+        mut f: Vec<f64>,
+        effort: Effort,
     ) -> Result<SetSolve> {
-        Err(Error::CudaUnavailable {
-            reason: "the device solves are not built yet".into(),
-            hint: "use backend \"spectral\"".into(),
+        let m = problem.set.len();
+        let n = self.plan.grid().len();
+        if precond == Precond::Spectral {
+            // The host's rule: rebuild when the mean compliance moved by more than 5 %.
+            let mean_d = problem.d.iter().sum::<f64>() / m.max(1) as f64;
+            let stale = match &self.inverse {
+                Some((old, _)) => (old - mean_d).abs() > 0.05 * mean_d.abs().max(f64::MIN_POSITIVE),
+                None => true,
+            };
+            if stale {
+                self.build_inverse(mean_d)?;
+            }
+        }
+        self.upload_problem(problem, &f)?;
+        let stream = &self.gpu.stream;
+        let precond = match (precond, &self.inverse) {
+            (Precond::Spectral, Some((_, table))) => DevicePrecond::Spectral { table },
+            _ => DevicePrecond::Jacobi {
+                diag_c: self.diag_c,
+            },
+        };
+        let mut phases = DevicePhases {
+            stream,
+            kernels: &self.kernels,
+            transforms: &mut self.transforms,
+            operator: &self.operator,
+            v: &mut self.vectors,
+            precond,
+            m,
+            norm: self.compliance.norm + problem.d.iter().fold(0.0f64, |a, x| a.max(*x)),
+            error: None,
+        };
+        let outcome = run_cg(&mut phases, m, max_abs(problem.b), problem.total, effort);
+        if let Some(e) = phases.error {
+            return Err(e);
+        }
+        // The displacements' product `C_s f` on every cell, of the returned `f`.
+        let v = &self.vectors;
+        self.transforms
+            .filter(stream, &self.kernels, &self.operator, &v.f, &v.pos)?;
+        self.transforms
+            .gather_grid(stream, &self.kernels, &mut self.grid)?;
+        let mut grid_product = vec![0.0; n];
+        if m > 0 {
+            stream
+                .memcpy_dtoh(&v.f.slice(0..m), f.as_mut_slice())
+                .map_err(|e| cuda_error("cuMemcpyDtoH", e))?;
+        }
+        stream
+            .memcpy_dtoh(&self.grid, grid_product.as_mut_slice())
+            .map_err(|e| cuda_error("cuMemcpyDtoH", e))?;
+        stream
+            .synchronize()
+            .map_err(|e| cuda_error("cuStreamSynchronize", e))?;
+        Ok(SetSolve {
+            f,
+            outcome,
+            grid_product,
         })
     }
+
+    /// The set, its positions on the grid, `d`, `b` and the warm start `f` to the device.
+    fn upload_problem(&mut self, problem: SetProblem<'_>, f: &[f64]) -> Result<()> {
+        let m = problem.set.len();
+        let n = self.plan.grid().len();
+        let set: Vec<i32> = problem.set.iter().map(|&i| i as i32).collect();
+        let mut pos = vec![-1i32; n];
+        for (j, &i) in problem.set.iter().enumerate() {
+            pos[i] = j as i32;
+        }
+        let stream = &self.gpu.stream;
+        let v = &mut self.vectors;
+        let copy = |e| cuda_error("cuMemcpyHtoD", e);
+        stream.memcpy_htod(&pos, &mut v.pos).map_err(copy)?;
+        if m > 0 {
+            stream
+                .memcpy_htod(&set, &mut v.set.slice_mut(0..m))
+                .map_err(copy)?;
+            for (host, device) in [(problem.d, &mut v.d), (problem.b, &mut v.b), (f, &mut v.f)] {
+                stream
+                    .memcpy_htod(host, &mut device.slice_mut(0..m))
+                    .map_err(copy)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A host table to the device.
+fn upload(gpu: &Gpu, values: &[f64]) -> Result<CudaSlice<f64>> {
+    gpu.stream
+        .clone_htod(values)
+        .map_err(|e| cuda_error("cuMemcpyHtoD", e))
 }

@@ -1,0 +1,118 @@
+// kernels.cu run on the host, for the tests of src/solver/cuda/emulated.rs: every block
+// has one thread (THREADS 1, so a block's tree in shared memory is its one value), blocks
+// run one after the other, and the batched FFTs are naive DFTs in long double. The launch
+// sequence is operator.rs's `Transforms::filter` and `gather_set`/`gather_grid`.
+//
+// Input (stdin, whitespace separated): nx ny m with_d, the table (Ny x Nx), then m lines
+// of "cell x d". Output (stdout): the m values of the set product, then the Nx·Ny values
+// of the grid product (cell order).
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+struct double2 {
+    double x, y;
+};
+struct Dim {
+    unsigned x, y, z;
+};
+static Dim blockIdx, threadIdx, blockDim, gridDim;
+#define __device__
+#define __forceinline__ inline
+#define __global__
+#define __shared__ static
+#define __syncthreads()
+static inline void sincospi(double a, double* s, double* c) {
+    long double pi = 3.141592653589793238462643383279502884L;
+    *s = (double)std::sin(pi * a);
+    *c = (double)std::cos(pi * a);
+}
+using std::fabs;
+using std::fmax;
+#define THREADS 1
+#include "kernels.cu"
+
+template <class F>
+static void launch(size_t blocks, F kernel) {
+    blockDim = {1, 1, 1};
+    threadIdx = {0, 0, 0};
+    gridDim = {(unsigned)blocks, 1, 1};
+    for (size_t b = 0; b < blocks; b++) {
+        blockIdx = {(unsigned)b, 0, 0};
+        kernel();
+    }
+}
+
+static const long double PI = 3.141592653589793238462643383279502884L;
+
+// cufftExecD2Z: batch lines of n reals -> n/2 + 1 complex values each.
+static void d2z(const std::vector<double>& in, std::vector<double2>& out, int n, int batch) {
+    int half = n / 2 + 1;
+    for (int b = 0; b < batch; b++)
+        for (int k = 0; k < half; k++) {
+            long double re = 0, im = 0;
+            for (int j = 0; j < n; j++) {
+                long double a = -2 * PI * (long double)((long long)j * k % n) / n;
+                re += in[(size_t)b * n + j] * std::cos(a);
+                im += in[(size_t)b * n + j] * std::sin(a);
+            }
+            out[(size_t)b * half + k] = {(double)re, (double)im};
+        }
+}
+
+// cufftExecZ2D: batch Hermitian half spectra -> n reals each, unnormalised.
+static void z2d(const std::vector<double2>& in, std::vector<double>& out, int n, int batch) {
+    int half = n / 2 + 1;
+    for (int b = 0; b < batch; b++)
+        for (int j = 0; j < n; j++) {
+            long double s = 0;
+            for (int k = 0; k < n; k++) {
+                double2 z = k < half ? in[(size_t)b * half + k] : in[(size_t)b * half + (n - k)];
+                long double zi = k < half ? z.y : -z.y;
+                long double a = 2 * PI * (long double)((long long)j * k % n) / n;
+                s += z.x * std::cos(a) - zi * std::sin(a);
+            }
+            out[(size_t)b * n + j] = (double)s;
+        }
+}
+
+int main() {
+    int nx, ny, m, with_d;
+    if (std::scanf("%d %d %d %d", &nx, &ny, &m, &with_d) != 4) return 2;
+    size_t n = (size_t)nx * ny;
+    std::vector<double> table(n), x(m), d(m), y(m), grid(n);
+    std::vector<int> set(m), pos(n, -1);
+    for (size_t i = 0; i < n; i++)
+        if (std::scanf("%lf", &table[i]) != 1) return 2;
+    for (int j = 0; j < m; j++) {
+        if (std::scanf("%d %lf %lf", &set[j], &x[j], &d[j]) != 3) return 2;
+        pos[set[j]] = j;
+    }
+    std::vector<double> real_a(n), real_b(n);
+    std::vector<double2> rows((size_t)ny * (nx / 2 + 1)), columns((size_t)nx * (ny / 2 + 1)),
+        filtered((size_t)nx * (ny / 2 + 1));
+    launch(n, [&] { scatter_rows(x.data(), pos.data(), real_a.data(), nx, ny); });
+    d2z(real_a, rows, nx, ny);
+    launch(n, [&] { rows_to_columns(rows.data(), real_b.data(), nx, ny); });
+    d2z(real_b, columns, ny, nx);
+    launch((size_t)nx * (ny / 2 + 1),
+           [&] { filter_columns(columns.data(), table.data(), filtered.data(), nx, ny); });
+    z2d(filtered, real_a, ny, nx);
+    launch((size_t)ny * (nx / 2 + 1), [&] { columns_to_rows(real_a.data(), rows.data(), nx, ny); });
+    z2d(rows, real_b, nx, ny);
+    launch(m, [&] { gather_set(real_b.data(), set.data(), d.data(), x.data(), y.data(), with_d, m, nx); });
+    launch(n, [&] { gather_grid(real_b.data(), grid.data(), nx, ny); });
+    for (int j = 0; j < m; j++) std::printf("%.17g\n", y[j]);
+    for (size_t i = 0; i < n; i++) std::printf("%.17g\n", grid[i]);
+    // The reductions over y (modes 0, 1 with x, 2 with y, x, y), blocks as the device's
+    // first pass splits them (here one thread each).
+    std::vector<double> partials(3 * 7), out(3);
+    for (int mode = 0; mode < 3; mode++) {
+        const double* a = y.data();
+        const double* b = mode == 1 ? x.data() : x.data();
+        launch(7, [&] { reduce_partial(mode, a, b, y.data(), m, partials.data()); });
+        launch(1, [&] { reduce_final(mode, partials.data(), 7, out.data()); });
+        std::printf("%.17g %.17g %.17g\n", out[0], out[1], out[2]);
+    }
+    return 0;
+}

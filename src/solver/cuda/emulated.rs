@@ -1,0 +1,205 @@
+//! kernels.cu checked without a GPU: emulated.cpp compiles the kernels' own source for
+//! the host (the C++ compiler every Rust toolchain's machine here has; one thread per
+//! block, naive DFTs for cuFFT) and runs operator.rs's launch sequence. The products are
+//! compared with the dense `Ĝ` (`InfluencePlan::dense`, explicit cosine sums: independent
+//! of any DCT) and the reductions with plain sums.
+
+use super::operator::table;
+use crate::geometry::{Block, Grid};
+use crate::green::InfluencePlan;
+use crate::solver::system::Compliance;
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+
+/// Compiles emulated.cpp once per test process.
+fn program() -> PathBuf {
+    static PROGRAM: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    PROGRAM
+        .get_or_init(|| {
+            let here = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("src/solver/cuda");
+            let out =
+                std::env::temp_dir().join(format!("precursors-emulated-{}", std::process::id()));
+            let status = Command::new("c++")
+                .args(["-O2", "-std=c++17", "-o"])
+                .arg(&out)
+                .arg(here.join("emulated.cpp"))
+                .arg("-I")
+                .arg(&here)
+                .status()
+                .expect("a C++ compiler (c++) runs kernels.cu on the host");
+            assert!(status.success(), "emulated.cpp does not compile");
+            out
+        })
+        .clone()
+}
+
+/// What emulated.cpp prints.
+struct Emulated {
+    set_product: Vec<f64>,
+    grid_product: Vec<f64>,
+    reductions: Vec<[f64; 3]>,
+}
+
+fn run(grid: &Grid, w: &[f64], sites: &[(usize, f64, f64)], with_d: bool) -> Emulated {
+    use std::io::Write;
+    let mut input = format!(
+        "{} {} {} {}\n",
+        grid.nx(),
+        grid.ny(),
+        sites.len(),
+        i32::from(with_d)
+    );
+    for v in w {
+        input += &format!("{v:e}\n");
+    }
+    for (i, x, d) in sites {
+        input += &format!("{i} {x:e} {d:e}\n");
+    }
+    let mut child = Command::new(program())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("the emulator runs");
+    child
+        .stdin
+        .take()
+        .expect("stdin")
+        .write_all(input.as_bytes())
+        .expect("input written");
+    let output = child.wait_with_output().expect("the emulator ends");
+    assert!(output.status.success());
+    let text = String::from_utf8(output.stdout).expect("text");
+    let values: Vec<f64> = text
+        .split_whitespace()
+        .map(|v| v.parse().expect("a number"))
+        .collect();
+    let (m, n) = (sites.len(), grid.len());
+    assert_eq!(values.len(), m + n + 9);
+    let r = &values[m + n..];
+    Emulated {
+        set_product: values[..m].to_vec(),
+        grid_product: values[m..m + n].to_vec(),
+        reductions: (0..3)
+            .map(|k| [r[3 * k], r[3 * k + 1], r[3 * k + 2]])
+            .collect(),
+    }
+}
+
+/// Deterministic values in (-1, 1).
+fn values(count: usize, seed: u64) -> Vec<f64> {
+    let mut state = seed;
+    (0..count)
+        .map(|_| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        })
+        .collect()
+}
+
+fn max_rel(a: &[f64], b: &[f64]) -> f64 {
+    let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs() / scale))
+}
+
+/// Odd and even lengths on both axes, and a grid of one row (a length-1 transform).
+const GRIDS: [(usize, usize); 4] = [(7, 5), (8, 6), (6, 1), (5, 4)];
+
+#[test]
+fn the_kernels_apply_the_set_system_as_the_dense_matrix_does() {
+    for (nx, ny) in GRIDS {
+        let grid = Grid::new(
+            Block::new(nx as f64 * 1e-3, ny as f64 * 1e-3, 0.01).unwrap(),
+            nx,
+            ny,
+        )
+        .unwrap();
+        let plan = InfluencePlan::builder(grid).build().unwrap();
+        let compliance = Compliance {
+            scale: 2.5e-9,
+            shift: 0.3,
+            norm: 0.0,
+        };
+        let w = table(&plan, compliance, |e| e);
+        // Every other cell is in the set.
+        let x = values(grid.len(), 1);
+        let d = values(grid.len(), 2);
+        let sites: Vec<(usize, f64, f64)> = (0..grid.len())
+            .step_by(2)
+            .map(|i| (i, x[i], d[i].abs() * 1e-9))
+            .collect();
+        let emulated = run(&grid, &w, &sites, true);
+        // C_s x = scale (Ĝ x - shift Σx) on every cell, x zero off the set.
+        let g = plan.dense().unwrap();
+        let n = grid.len();
+        let sum: f64 = sites.iter().map(|s| s.1).sum();
+        let grid_ref: Vec<f64> = (0..n)
+            .map(|i| {
+                let gx: f64 = sites.iter().map(|&(k, xk, _)| g[i * n + k] * xk).sum();
+                compliance.scale * (gx - compliance.shift * sum)
+            })
+            .collect();
+        let set_ref: Vec<f64> = sites
+            .iter()
+            .map(|&(i, xi, di)| grid_ref[i] + di * xi)
+            .collect();
+        let (e_grid, e_set) = (
+            max_rel(&emulated.grid_product, &grid_ref),
+            max_rel(&emulated.set_product, &set_ref),
+        );
+        assert!(
+            e_grid < 1e-12,
+            "{nx} x {ny}: grid product off by {e_grid:e}"
+        );
+        assert!(e_set < 1e-12, "{nx} x {ny}: set product off by {e_set:e}");
+        // The reductions: Σ y, yᵀx, [max |y|, max |x|, yᵀy].
+        let y = &emulated.set_product;
+        let xs: Vec<f64> = sites.iter().map(|s| s.1).collect();
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();
+        let max = |a: &[f64]| a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let r = &emulated.reductions;
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1e-300);
+        assert!(close(r[0][0], y.iter().sum::<f64>()));
+        assert!(close(r[1][0], dot(y, &xs)));
+        assert_eq!((r[2][0], r[2][1]), (max(y), max(&xs)));
+        assert!(close(r[2][2], dot(y, y)));
+    }
+}
+
+#[test]
+fn the_spectral_table_inverts_the_full_grid_system() {
+    for (nx, ny) in GRIDS {
+        let grid = Grid::new(
+            Block::new(nx as f64 * 1e-3, ny as f64 * 1e-3, 0.02).unwrap(),
+            nx,
+            ny,
+        )
+        .unwrap();
+        let plan = InfluencePlan::builder(grid).build().unwrap();
+        let compliance = Compliance {
+            scale: 1e-9,
+            shift: 0.1,
+            norm: 0.0,
+        };
+        let mean_d = 3e-10;
+        // y = (C_s + d̄ I) x on every cell, by the dense matrix.
+        let g = plan.dense().unwrap();
+        let n = grid.len();
+        let x = values(n, 3);
+        let sum: f64 = x.iter().sum();
+        let y: Vec<f64> = (0..n)
+            .map(|i| {
+                let gx: f64 = (0..n).map(|k| g[i * n + k] * x[k]).sum();
+                compliance.scale * (gx - compliance.shift * sum) + mean_d * x[i]
+            })
+            .collect();
+        let w = table(&plan, compliance, |e| 1.0 / (e + mean_d));
+        let sites: Vec<(usize, f64, f64)> = (0..n).map(|i| (i, y[i], 0.0)).collect();
+        let back = run(&grid, &w, &sites, false).set_product;
+        let e = max_rel(&back, &x);
+        assert!(e < 1e-11, "{nx} x {ny}: the inverse is off by {e:e}");
+    }
+}

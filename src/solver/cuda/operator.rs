@@ -1,0 +1,324 @@
+//! The DCT-diagonal products on the device: the kernels compiled once per solver, the four
+//! batched cuFFT plans, the grid's buffers, and `y = C3(W ⊙ C2 x)` for a set vector `x`
+//! and a diagonal `W` (the operator's, the spectral preconditioner's). The algebra is in
+//! kernels.cu's header.
+
+use super::device::{cuda_error, guarded, Gpu};
+use crate::error::{Error, Result};
+use crate::green::InfluencePlan;
+use crate::solver::system::Compliance;
+use cudarc::cufft::sys::{cufftType, double2};
+use cudarc::cufft::CudaFft;
+use cudarc::driver::{CudaFunction, CudaSlice, CudaStream, LaunchConfig, PushKernelArg};
+use cudarc::nvrtc::{compile_ptx_with_opts, CompileOptions};
+use std::sync::Arc;
+
+/// The kernels' source (NVRTC compiles it when a solver is built).
+const SOURCE: &str = include_str!("kernels.cu");
+
+/// Threads per block (kernels.cu's `THREADS`).
+pub(super) const THREADS: u32 = 256;
+
+/// One thread per element of `n`, `None` for none (a launch of no blocks is an error).
+pub(super) fn over(n: usize) -> Option<LaunchConfig> {
+    (n > 0).then(|| LaunchConfig {
+        grid_dim: ((n as u32).div_ceil(THREADS), 1, 1),
+        block_dim: (THREADS, 1, 1),
+        shared_mem_bytes: 0,
+    })
+}
+
+/// The compiled kernels.
+pub(super) struct Kernels {
+    pub(super) scatter_rows: CudaFunction,
+    pub(super) rows_to_columns: CudaFunction,
+    pub(super) filter_columns: CudaFunction,
+    pub(super) columns_to_rows: CudaFunction,
+    pub(super) gather_set: CudaFunction,
+    pub(super) gather_grid: CudaFunction,
+    pub(super) residual_tail: CudaFunction,
+    pub(super) jacobi: CudaFunction,
+    pub(super) pre_updates: CudaFunction,
+    pub(super) reduce_partial: CudaFunction,
+    pub(super) reduce_final: CudaFunction,
+}
+
+impl Kernels {
+    /// Compiles kernels.cu for `gpu` and loads its functions.
+    pub(super) fn compile(gpu: &Gpu) -> Result<Self> {
+        let unavailable = |reason: String| Error::CudaUnavailable {
+            reason,
+            hint: "report it with the output of `precursors info` (docs/gpu.md); use backend \
+                   \"spectral\" meanwhile"
+                .into(),
+        };
+        let module = guarded("compiling the kernels (NVRTC)", || {
+            let options = CompileOptions {
+                name: Some("precursors_kernels.cu".into()),
+                ..Default::default()
+            };
+            let ptx = compile_ptx_with_opts(SOURCE, options)
+                .map_err(|e| format!("the kernels do not compile with NVRTC: {e:?}"))?;
+            gpu.ctx
+                .load_module(ptx)
+                .map_err(|e| format!("the driver does not load the compiled kernels: {e}"))
+        })
+        .map_err(unavailable)?;
+        let load = |name: &str| {
+            module
+                .load_function(name)
+                .map_err(|e| unavailable(format!("kernel {name} is missing from the module: {e}")))
+        };
+        Ok(Kernels {
+            scatter_rows: load("scatter_rows")?,
+            rows_to_columns: load("rows_to_columns")?,
+            filter_columns: load("filter_columns")?,
+            columns_to_rows: load("columns_to_rows")?,
+            gather_set: load("gather_set")?,
+            gather_grid: load("gather_grid")?,
+            residual_tail: load("residual_tail")?,
+            jacobi: load("jacobi")?,
+            pre_updates: load("pre_updates")?,
+            reduce_partial: load("reduce_partial")?,
+            reduce_final: load("reduce_final")?,
+        })
+    }
+}
+
+/// The diagonals in the DCT basis, row-major `Ny x Nx`, in the scaling of kernels.cu's
+/// unnormalised transforms: `w = e · α_p² α_m²` for the eigenvalue `e` of the operator.
+pub(super) fn table(
+    plan: &InfluencePlan,
+    compliance: Compliance,
+    map: impl Fn(f64) -> f64,
+) -> Vec<f64> {
+    let (nx, ny) = (plan.grid().nx(), plan.grid().ny());
+    let n = (nx * ny) as f64;
+    let mut values = Vec::with_capacity(nx * ny);
+    for m in 0..ny {
+        let ay = if m == 0 { 1.0 } else { 2.0 } / ny as f64;
+        for p in 0..nx {
+            let ax = if p == 0 { 1.0 } else { 2.0 } / nx as f64;
+            let eigen = plan.eigenvalue(p, m).unwrap_or(0.0);
+            // The mean mode lowered (solver/mod.rs), as the host's tables do.
+            let e = if p == 0 && m == 0 {
+                eigen - compliance.shift * n
+            } else {
+                eigen
+            };
+            values.push(map(compliance.scale * e) * ax * ay);
+        }
+    }
+    values
+}
+
+/// The grid's buffers and FFT plans.
+pub(super) struct Transforms {
+    nx: usize,
+    ny: usize,
+    rows_forward: CudaFft,
+    columns_forward: CudaFft,
+    columns_inverse: CudaFft,
+    rows_inverse: CudaFft,
+    /// Real grids (`Nx·Ny`): the rows in, then the columns, then the results.
+    real_a: CudaSlice<f64>,
+    real_b: CudaSlice<f64>,
+    /// Half spectra of the rows (`Ny x (Nx/2 + 1)`) and of the columns (`Nx x (Ny/2 + 1)`).
+    rows: CudaSlice<double2>,
+    columns: CudaSlice<double2>,
+    filtered: CudaSlice<double2>,
+}
+
+/// The bytes of [`Transforms`]' buffers on an `nx x ny` grid (the FFT plans' work areas
+/// are cuFFT's and counted apart, `memory.rs`).
+pub(super) fn transform_bytes(nx: usize, ny: usize) -> f64 {
+    let n = (nx * ny) as f64;
+    let rows = (ny * (nx / 2 + 1)) as f64;
+    let columns = (nx * (ny / 2 + 1)) as f64;
+    2.0 * 8.0 * n + 16.0 * (rows + 2.0 * columns)
+}
+
+impl Transforms {
+    pub(super) fn new(stream: &Arc<CudaStream>, nx: usize, ny: usize) -> Result<Self> {
+        let plan = |n: usize, batch: usize, kind: cufftType| {
+            CudaFft::plan_many(
+                &[n as i32],
+                None,
+                1,
+                0,
+                None,
+                1,
+                0,
+                kind,
+                batch as i32,
+                stream.clone(),
+            )
+            .map_err(|e| cuda_error("cufftPlanMany", e))
+        };
+        let alloc = |n: usize| {
+            stream
+                .alloc_zeros::<f64>(n)
+                .map_err(|e| cuda_error("cuMemAlloc", e))
+        };
+        let complex = |n: usize| {
+            stream
+                .alloc_zeros::<double2>(n)
+                .map_err(|e| cuda_error("cuMemAlloc", e))
+        };
+        Ok(Transforms {
+            nx,
+            ny,
+            rows_forward: plan(nx, ny, cufftType::CUFFT_D2Z)?,
+            columns_forward: plan(ny, nx, cufftType::CUFFT_D2Z)?,
+            columns_inverse: plan(ny, nx, cufftType::CUFFT_Z2D)?,
+            rows_inverse: plan(nx, ny, cufftType::CUFFT_Z2D)?,
+            real_a: alloc(nx * ny)?,
+            real_b: alloc(nx * ny)?,
+            rows: complex(ny * (nx / 2 + 1))?,
+            columns: complex(nx * (ny / 2 + 1))?,
+            filtered: complex(nx * (ny / 2 + 1))?,
+        })
+    }
+
+    /// `real_b = C3(W ⊙ C2 x)` on the grid in kernels.cu's row order, `x` the set vector
+    /// placed by `pos`.
+    pub(super) fn filter(
+        &mut self,
+        stream: &Arc<CudaStream>,
+        k: &Kernels,
+        table: &CudaSlice<f64>,
+        x: &CudaSlice<f64>,
+        pos: &CudaSlice<i32>,
+    ) -> Result<()> {
+        let (nx, ny) = (self.nx as i32, self.ny as i32);
+        let n = self.nx * self.ny;
+        let launch = |call: &'static str, e| cuda_error(call, e);
+        if let Some(cfg) = over(n) {
+            // SAFETY: the argument list matches kernels.cu's signature; every buffer holds
+            // the Nx·Ny values the kernel reads or writes.
+            unsafe {
+                stream
+                    .launch_builder(&k.scatter_rows)
+                    .arg(x)
+                    .arg(pos)
+                    .arg(&mut self.real_a)
+                    .arg(&nx)
+                    .arg(&ny)
+                    .launch(cfg)
+            }
+            .map_err(|e| launch("scatter_rows", e))?;
+        }
+        self.rows_forward
+            .exec_d2z(&self.real_a, &mut self.rows)
+            .map_err(|e| cuda_error("cufftExecD2Z (rows)", e))?;
+        if let Some(cfg) = over(n) {
+            // SAFETY: as above; `rows` holds Ny·(Nx/2 + 1) values.
+            unsafe {
+                stream
+                    .launch_builder(&k.rows_to_columns)
+                    .arg(&self.rows)
+                    .arg(&mut self.real_b)
+                    .arg(&nx)
+                    .arg(&ny)
+                    .launch(cfg)
+            }
+            .map_err(|e| launch("rows_to_columns", e))?;
+        }
+        self.columns_forward
+            .exec_d2z(&self.real_b, &mut self.columns)
+            .map_err(|e| cuda_error("cufftExecD2Z (columns)", e))?;
+        if let Some(cfg) = over(self.nx * (self.ny / 2 + 1)) {
+            // SAFETY: as above; `columns` and `filtered` hold Nx·(Ny/2 + 1) values, the
+            // table Nx·Ny.
+            unsafe {
+                stream
+                    .launch_builder(&k.filter_columns)
+                    .arg(&self.columns)
+                    .arg(table)
+                    .arg(&mut self.filtered)
+                    .arg(&nx)
+                    .arg(&ny)
+                    .launch(cfg)
+            }
+            .map_err(|e| launch("filter_columns", e))?;
+        }
+        self.columns_inverse
+            .exec_z2d(&mut self.filtered, &mut self.real_a)
+            .map_err(|e| cuda_error("cufftExecZ2D (columns)", e))?;
+        if let Some(cfg) = over(self.ny * (self.nx / 2 + 1)) {
+            // SAFETY: as above.
+            unsafe {
+                stream
+                    .launch_builder(&k.columns_to_rows)
+                    .arg(&self.real_a)
+                    .arg(&mut self.rows)
+                    .arg(&nx)
+                    .arg(&ny)
+                    .launch(cfg)
+            }
+            .map_err(|e| launch("columns_to_rows", e))?;
+        }
+        self.rows_inverse
+            .exec_z2d(&mut self.rows, &mut self.real_b)
+            .map_err(|e| cuda_error("cufftExecZ2D (rows)", e))
+    }
+
+    /// `y = (last filter on the set) + d ⊙ x` (`with_d`) over the `m` sites of `set`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn gather_set(
+        &self,
+        stream: &Arc<CudaStream>,
+        k: &Kernels,
+        set: &CudaSlice<i32>,
+        d: &CudaSlice<f64>,
+        x: &CudaSlice<f64>,
+        y: &mut CudaSlice<f64>,
+        with_d: bool,
+        m: usize,
+    ) -> Result<()> {
+        let (with_d, m32, nx) = (i32::from(with_d), m as i32, self.nx as i32);
+        let Some(cfg) = over(m) else { return Ok(()) };
+        // SAFETY: the argument list matches kernels.cu; set, d, x and y hold at least m
+        // values and the set's cells are below Nx·Ny.
+        unsafe {
+            stream
+                .launch_builder(&k.gather_set)
+                .arg(&self.real_b)
+                .arg(set)
+                .arg(d)
+                .arg(x)
+                .arg(y)
+                .arg(&with_d)
+                .arg(&m32)
+                .arg(&nx)
+                .launch(cfg)
+        }
+        .map(|_| ())
+        .map_err(|e| cuda_error("gather_set", e))
+    }
+
+    /// The last filter on every cell (cell order) into `out`.
+    pub(super) fn gather_grid(
+        &self,
+        stream: &Arc<CudaStream>,
+        k: &Kernels,
+        out: &mut CudaSlice<f64>,
+    ) -> Result<()> {
+        let (nx, ny) = (self.nx as i32, self.ny as i32);
+        let Some(cfg) = over(self.nx * self.ny) else {
+            return Ok(());
+        };
+        // SAFETY: the argument list matches kernels.cu; `out` holds Nx·Ny values.
+        unsafe {
+            stream
+                .launch_builder(&k.gather_grid)
+                .arg(&self.real_b)
+                .arg(out)
+                .arg(&nx)
+                .arg(&ny)
+                .launch(cfg)
+        }
+        .map(|_| ())
+        .map_err(|e| cuda_error("gather_grid", e))
+    }
+}

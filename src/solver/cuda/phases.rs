@@ -1,0 +1,376 @@
+//! The CG's phases on the device ([`PhaseRunner`]): pcg.rs's scalar logic asks for a
+//! phase, the kernels run its local updates and main work on the set vectors, and only
+//! the phase's three scalars cross to the host (one small copy per reduction).
+
+use super::device::cuda_error;
+use super::operator::{over, Kernels, Transforms, THREADS};
+use crate::error::{Error, Result};
+use crate::solver::pcg::{Main, Phase, PhaseRunner, Pre};
+use cudarc::driver::{CudaSlice, CudaStream, LaunchConfig, PushKernelArg};
+use std::sync::Arc;
+
+/// Blocks of a reduction's first pass, at most: fixed by the vector's length alone, so the
+/// order of the additions (hence the bits) is too.
+const REDUCTION_BLOCKS: usize = 1024;
+
+/// The set's vectors on the device, each of capacity `N` (the set's first `m` values are
+/// used), and the reductions' buffers.
+pub(super) struct SetVectors {
+    pub(super) set: CudaSlice<i32>,
+    /// The set position of every cell, or -1.
+    pub(super) pos: CudaSlice<i32>,
+    pub(super) d: CudaSlice<f64>,
+    pub(super) b: CudaSlice<f64>,
+    pub(super) f: CudaSlice<f64>,
+    pub(super) r: CudaSlice<f64>,
+    pub(super) z: CudaSlice<f64>,
+    pub(super) p: CudaSlice<f64>,
+    pub(super) q: CudaSlice<f64>,
+    pub(super) w: CudaSlice<f64>,
+    pub(super) best: CudaSlice<f64>,
+    partials: CudaSlice<f64>,
+    scalars: CudaSlice<f64>,
+}
+
+/// The bytes of [`SetVectors`] on a grid of `n` cells.
+pub(super) fn vector_bytes(n: usize) -> f64 {
+    (2.0 * 4.0 + 9.0 * 8.0) * n as f64 + 8.0 * (3 * REDUCTION_BLOCKS + 3) as f64
+}
+
+impl SetVectors {
+    pub(super) fn new(stream: &Arc<CudaStream>, n: usize) -> Result<Self> {
+        let real = |len: usize| {
+            stream
+                .alloc_zeros::<f64>(len)
+                .map_err(|e| cuda_error("cuMemAlloc", e))
+        };
+        let int = |len: usize| {
+            stream
+                .alloc_zeros::<i32>(len)
+                .map_err(|e| cuda_error("cuMemAlloc", e))
+        };
+        Ok(SetVectors {
+            set: int(n)?,
+            pos: int(n)?,
+            d: real(n)?,
+            b: real(n)?,
+            f: real(n)?,
+            r: real(n)?,
+            z: real(n)?,
+            p: real(n)?,
+            q: real(n)?,
+            w: real(n)?,
+            best: real(n)?,
+            partials: real(3 * REDUCTION_BLOCKS)?,
+            scalars: real(3)?,
+        })
+    }
+}
+
+/// The preconditioner of a device solve.
+pub(super) enum DevicePrecond<'a> {
+    /// `z = r / (diag_c + d)`.
+    Jacobi { diag_c: f64 },
+    /// `z = P_S (C_s + d̄ I)⁻¹ P_S r` through its DCT table.
+    Spectral { table: &'a CudaSlice<f64> },
+}
+
+/// One set solve's phases on the device.
+pub(super) struct DevicePhases<'a> {
+    pub(super) stream: &'a Arc<CudaStream>,
+    pub(super) kernels: &'a Kernels,
+    pub(super) transforms: &'a mut Transforms,
+    pub(super) operator: &'a CudaSlice<f64>,
+    pub(super) v: &'a mut SetVectors,
+    pub(super) precond: DevicePrecond<'a>,
+    /// Sites in the set.
+    pub(super) m: usize,
+    /// `‖A‖₂` bound (m/Pa).
+    pub(super) norm: f64,
+    /// The first failed CUDA call: later phases do nothing and return NaN, which stops
+    /// the CG; the solve returns this error.
+    pub(super) error: Option<Error>,
+}
+
+/// Which vectors a product reads and writes.
+#[derive(Clone, Copy)]
+enum Product {
+    /// `q = A p`.
+    Direction,
+    /// `r = A f`.
+    Residual,
+}
+
+impl DevicePhases<'_> {
+    fn try_run(&mut self, phase: Phase) -> Result<[f64; 3]> {
+        self.pre(phase.pre)?;
+        match phase.main {
+            Main::Nothing => Ok([0.0; 3]),
+            Main::SumF => {
+                let [s, _, _] = self.reduce(0, Vector::F, Vector::F, Vector::F)?;
+                Ok([s, 0.0, 0.0])
+            }
+            Main::Direction { .. } => {
+                self.product(Product::Direction)?;
+                let [pq, _, _] = self.reduce(1, Vector::P, Vector::Q, Vector::Q)?;
+                Ok([pq, 0.0, 0.0])
+            }
+            Main::Residual { offset, .. } => {
+                self.product(Product::Residual)?;
+                self.residual_tail(offset)?;
+                Ok([0.0; 3])
+            }
+            Main::Precondition { .. } => {
+                self.precondition()?;
+                let [s, _, _] = self.reduce(0, Vector::Z, Vector::Z, Vector::Z)?;
+                Ok([s, 0.0, 0.0])
+            }
+            Main::Measure => self.reduce(2, Vector::R, Vector::F, Vector::Z),
+            // No coarse space on the device (`has_coarse` is false): never asked.
+            Main::CoarseProduct { .. } | Main::Restrict => Ok([0.0; 3]),
+        }
+    }
+
+    /// The local updates of `pre` (pcg.rs's `Pre::apply`, kernels.cu's flags).
+    fn pre(&mut self, pre: Pre) -> Result<()> {
+        let mut flags = 0i32;
+        let (mut shift, mut alpha, mut u, mut beta) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        if pre.keep_best {
+            flags |= 1;
+        }
+        if pre.restore_best {
+            flags |= 2;
+        }
+        if let Some(s) = pre.shift_f {
+            flags |= 4;
+            shift = s;
+        }
+        if let Some((a, update_r)) = pre.step {
+            flags |= 8;
+            alpha = a;
+            if update_r {
+                flags |= 16;
+            }
+        }
+        if let Some(value) = pre.project {
+            flags |= 32;
+            u = value;
+        }
+        if pre.w_from_z {
+            flags |= 64;
+        }
+        match pre.direction {
+            Some(None) => flags |= 128,
+            Some(Some(b)) => {
+                flags |= 256;
+                beta = b;
+            }
+            None => {}
+        }
+        if pre.fill_r_one {
+            flags |= 512;
+        }
+        let Some(cfg) = over(self.m).filter(|_| flags != 0) else {
+            return Ok(());
+        };
+        let m = self.m as i32;
+        let v = &mut *self.v;
+        // SAFETY: the argument list matches kernels.cu's pre_updates; every vector holds
+        // at least m values.
+        unsafe {
+            self.stream
+                .launch_builder(&self.kernels.pre_updates)
+                .arg(&mut v.f)
+                .arg(&mut v.r)
+                .arg(&mut v.z)
+                .arg(&mut v.p)
+                .arg(&v.q)
+                .arg(&mut v.w)
+                .arg(&mut v.best)
+                .arg(&flags)
+                .arg(&shift)
+                .arg(&alpha)
+                .arg(&u)
+                .arg(&beta)
+                .arg(&m)
+                .launch(cfg)
+        }
+        .map(|_| ())
+        .map_err(|e| cuda_error("pre_updates", e))
+    }
+
+    /// `q = A p` or `r = A f` (`A = C_SS + diag(d)`).
+    fn product(&mut self, which: Product) -> Result<()> {
+        let v = &mut *self.v;
+        let (x, y) = match which {
+            Product::Direction => (&v.p, &mut v.q),
+            Product::Residual => (&v.f, &mut v.r),
+        };
+        self.transforms
+            .filter(self.stream, self.kernels, self.operator, x, &v.pos)?;
+        self.transforms
+            .gather_set(self.stream, self.kernels, &v.set, &v.d, x, y, true, self.m)
+    }
+
+    /// `r += offset - b`.
+    fn residual_tail(&mut self, offset: f64) -> Result<()> {
+        let Some(cfg) = over(self.m) else {
+            return Ok(());
+        };
+        let m = self.m as i32;
+        let v = &mut *self.v;
+        // SAFETY: the argument list matches kernels.cu; r and b hold at least m values.
+        unsafe {
+            self.stream
+                .launch_builder(&self.kernels.residual_tail)
+                .arg(&mut v.r)
+                .arg(&v.b)
+                .arg(&offset)
+                .arg(&m)
+                .launch(cfg)
+        }
+        .map(|_| ())
+        .map_err(|e| cuda_error("residual_tail", e))
+    }
+
+    /// `z = M⁻¹ r`.
+    fn precondition(&mut self) -> Result<()> {
+        let v = &mut *self.v;
+        match self.precond {
+            DevicePrecond::Jacobi { diag_c } => {
+                let Some(cfg) = over(self.m) else {
+                    return Ok(());
+                };
+                let m = self.m as i32;
+                // SAFETY: the argument list matches kernels.cu; r, d, z hold m values.
+                unsafe {
+                    self.stream
+                        .launch_builder(&self.kernels.jacobi)
+                        .arg(&v.r)
+                        .arg(&v.d)
+                        .arg(&diag_c)
+                        .arg(&mut v.z)
+                        .arg(&m)
+                        .launch(cfg)
+                }
+                .map(|_| ())
+                .map_err(|e| cuda_error("jacobi", e))
+            }
+            DevicePrecond::Spectral { table } => {
+                self.transforms
+                    .filter(self.stream, self.kernels, table, &v.r, &v.pos)?;
+                self.transforms.gather_set(
+                    self.stream,
+                    self.kernels,
+                    &v.set,
+                    &v.d,
+                    &v.r,
+                    &mut v.z,
+                    false,
+                    self.m,
+                )
+            }
+        }
+    }
+
+    /// A reduction in a fixed order (kernels.cu's modes: 0 `Σ a`, 1 `aᵀ b`, 2
+    /// `[max |a|, max |b|, aᵀ c]`), its three values copied to the host.
+    fn reduce(&mut self, mode: i32, a: Vector, b: Vector, c: Vector) -> Result<[f64; 3]> {
+        let blocks = self.m.div_ceil(THREADS as usize).clamp(1, REDUCTION_BLOCKS);
+        let (m, blocks32) = (self.m as i32, blocks as i32);
+        let v = &mut *self.v;
+        let first = LaunchConfig {
+            grid_dim: (blocks as u32, 1, 1),
+            block_dim: (THREADS, 1, 1),
+            shared_mem_bytes: 0,
+        };
+        let last = LaunchConfig {
+            grid_dim: (1, 1, 1),
+            ..first
+        };
+        let (a, b, c) = (a.of(v), b.of(v), c.of(v));
+        // SAFETY: the argument lists match kernels.cu; a, b, c hold at least m values,
+        // `partials` 3 per block, `scalars` 3.
+        unsafe {
+            self.stream
+                .launch_builder(&self.kernels.reduce_partial)
+                .arg(&mode)
+                .arg(a)
+                .arg(b)
+                .arg(c)
+                .arg(&m)
+                .arg(&v.partials)
+                .launch(first)
+        }
+        .map_err(|e| cuda_error("reduce_partial", e))?;
+        // SAFETY: as above.
+        unsafe {
+            self.stream
+                .launch_builder(&self.kernels.reduce_final)
+                .arg(&mode)
+                .arg(&v.partials)
+                .arg(&blocks32)
+                .arg(&v.scalars)
+                .launch(last)
+        }
+        .map_err(|e| cuda_error("reduce_final", e))?;
+        let mut out = [0.0f64; 3];
+        self.stream
+            .memcpy_dtoh(&v.scalars, out.as_mut_slice())
+            .map_err(|e| cuda_error("cuMemcpyDtoH", e))?;
+        self.stream
+            .synchronize()
+            .map_err(|e| cuda_error("cuStreamSynchronize", e))?;
+        Ok(out)
+    }
+}
+
+/// A set vector a reduction reads.
+#[derive(Clone, Copy)]
+enum Vector {
+    F,
+    R,
+    Z,
+    P,
+    Q,
+}
+
+impl Vector {
+    fn of(self, v: &SetVectors) -> &CudaSlice<f64> {
+        match self {
+            Vector::F => &v.f,
+            Vector::R => &v.r,
+            Vector::Z => &v.z,
+            Vector::P => &v.p,
+            Vector::Q => &v.q,
+        }
+    }
+}
+
+impl PhaseRunner for DevicePhases<'_> {
+    fn run(&mut self, phase: Phase) -> [f64; 3] {
+        if self.error.is_some() {
+            return [f64::NAN; 3];
+        }
+        match self.try_run(phase) {
+            Ok(values) => values,
+            Err(e) => {
+                self.error = Some(e);
+                [f64::NAN; 3]
+            }
+        }
+    }
+    fn product_stages(&self) -> usize {
+        1
+    }
+    fn precondition_stages(&self) -> usize {
+        1
+    }
+    fn norm_bound(&self) -> f64 {
+        self.norm
+    }
+    fn has_coarse(&self) -> bool {
+        false
+    }
+    fn coarse_solve(&mut self) {}
+}
