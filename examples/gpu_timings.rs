@@ -1,0 +1,82 @@
+//! The cost of an event and of a CG iteration on a backend, for docs/gpu.md's
+//! measurements (scripts/gpu-check.sh runs it): `Nx x Ny` cells of 1 mm, `Lz = 75 mm`,
+//! 3.5 MPa normal pressure, rod drive, seed 1. Prints the first equilibrium's time, then
+//! the time per event and per CG iteration over the next `EVENTS` events.
+//!
+//! Run: `cargo run --release --features cuda --example gpu_timings -- BACKEND NX NY
+//! EVENTS` (`BACKEND`: `cuda` or `spectral`; `spectral` runs on 16 threads at most).
+
+#[path = "support/report.rs"]
+mod report;
+
+use precursors::solver::{Backend, Parallelism, SolverOptions};
+use precursors::Scene;
+use std::process::ExitCode;
+use std::time::Instant;
+
+fn main() -> ExitCode {
+    report::report(run())
+}
+
+fn run() -> report::Outcome {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    const USAGE: &str = "the arguments are BACKEND (cuda or spectral) NX NY EVENTS";
+    if args.len() != 4 {
+        return Err(USAGE.into());
+    }
+    let backend = match args[0].as_str() {
+        "cuda" => Backend::Cuda,
+        "spectral" => Backend::Spectral,
+        other => return Err(format!("unknown backend '{other}': {USAGE}").into()),
+    };
+    let count = |i: usize| -> Result<usize, String> {
+        args[i]
+            .parse()
+            .map_err(|_| format!("invalid count '{}' ({USAGE})", args[i]))
+    };
+    let (nx, ny, events) = (count(1)?, count(2)?, count(3)?);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get().min(16));
+    let parallelism = match backend {
+        Backend::Spectral => Parallelism::Threads(threads),
+        _ => Parallelism::Sequential,
+    };
+    let options = SolverOptions::default()
+        .with_backend(backend)?
+        .with_parallelism(parallelism)?;
+    let (lx, ly) = (nx as f64 * 1e-3, ny as f64 * 1e-3);
+    let scene = Scene::builder()
+        .block(lx, ly, 0.075)
+        .cells(nx, ny)
+        .normal_load(3.5e6 * lx * ly)
+        .seed(1)
+        .max_cells(nx * ny)
+        .solver_options(options)
+        .build()?;
+    let mut driver = scene.driver()?;
+    let start = Instant::now();
+    driver.step()?;
+    let first = start.elapsed().as_secs_f64();
+    let before = driver.solve_stats();
+    let start = Instant::now();
+    let mut done = 0;
+    while done < events {
+        match driver.step()? {
+            Some(_) => done += 1,
+            None => break,
+        }
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    let after = driver.solve_stats();
+    let iterations = (after.normal_iterations + after.tangential_iterations)
+        - (before.normal_iterations + before.tangential_iterations);
+    let solving = (after.normal_seconds + after.tangential_seconds)
+        - (before.normal_seconds + before.tangential_seconds);
+    println!(
+        "backend {backend} N = {} ({nx} x {ny}): first equilibrium {first:.3} s; {done} events \
+         in {seconds:.3} s ({:.3} ms per event); {iterations} CG iterations ({:.4} ms each)",
+        nx * ny,
+        1e3 * seconds / done.max(1) as f64,
+        1e3 * solving / iterations.max(1) as f64
+    );
+    Ok(())
+}
