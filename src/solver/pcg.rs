@@ -236,6 +236,27 @@ impl Pre {
     }
 }
 
+/// `pre` applied to the vectors `[f, r, z, p, q, w, best]` (the tests' reference for the
+/// device's local updates).
+#[cfg(all(test, feature = "cuda"))]
+pub(crate) fn apply_pre(pre: Pre, vectors: &mut [Vec<f64>]) {
+    let [f, r, z, p, q, w, best] = vectors else {
+        panic!("seven vectors")
+    };
+    let mut v = Vectors {
+        f: std::mem::take(f),
+        r: std::mem::take(r),
+        z: std::mem::take(z),
+        p: std::mem::take(p),
+        q: std::mem::take(q),
+        w: std::mem::take(w),
+        best: std::mem::take(best),
+        t: Vec::new(),
+    };
+    pre.apply(&mut v);
+    (*f, *r, *z, *p, *q, *w, *best) = (v.f, v.r, v.z, v.p, v.q, v.w, v.best);
+}
+
 /// The main work of a phase.
 #[derive(Clone, Copy)]
 pub(crate) enum Main {

@@ -3,11 +3,12 @@
 // run one after the other, and the batched FFTs are naive DFTs in long double. The launch
 // sequence is operator.rs's `Transforms::filter` and `gather_set`/`gather_grid`.
 //
-// Input (stdin, whitespace separated): nx ny m with_d, the table (Ny x Nx), then m lines
+// Input (stdin, whitespace separated): "operator nx ny m with_d", the table (Ny x Nx), then m lines
 // of "cell x d". Output (stdout): the m values of the set product, then the Nx·Ny values
 // of the grid product (cell order).
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 struct double2 {
@@ -76,7 +77,32 @@ static void z2d(const std::vector<double2>& in, std::vector<double>& out, int n,
         }
 }
 
+// "pre m flags shift alpha u beta", then m lines "f r z p q w best": the vectors after
+// pre_updates, one line per site.
+static int pre() {
+    int m, flags;
+    double shift, alpha, u, beta;
+    if (std::scanf("%d %d %lf %lf %lf %lf", &m, &flags, &shift, &alpha, &u, &beta) != 6) return 2;
+    std::vector<double> v[7];
+    for (auto& x : v) x.resize(m);
+    for (int j = 0; j < m; j++)
+        for (auto& x : v)
+            if (std::scanf("%lf", &x[j]) != 1) return 2;
+    launch(m, [&] {
+        pre_updates(v[0].data(), v[1].data(), v[2].data(), v[3].data(), v[4].data(), v[5].data(),
+                    v[6].data(), flags, shift, alpha, u, beta, m);
+    });
+    for (int j = 0; j < m; j++) {
+        for (auto& x : v) std::printf("%.17g ", x[j]);
+        std::printf("\n");
+    }
+    return 0;
+}
+
 int main() {
+    char mode[16];
+    if (std::scanf("%15s", mode) != 1) return 2;
+    if (std::string(mode) == "pre") return pre();
     int nx, ny, m, with_d;
     if (std::scanf("%d %d %d %d", &nx, &ny, &m, &with_d) != 4) return 2;
     size_t n = (size_t)nx * ny;

@@ -40,21 +40,9 @@ struct Emulated {
     reductions: Vec<[f64; 3]>,
 }
 
-fn run(grid: &Grid, w: &[f64], sites: &[(usize, f64, f64)], with_d: bool) -> Emulated {
+/// Runs the emulator on `input`; its output as numbers.
+fn emulate(input: &str) -> Vec<f64> {
     use std::io::Write;
-    let mut input = format!(
-        "{} {} {} {}\n",
-        grid.nx(),
-        grid.ny(),
-        sites.len(),
-        i32::from(with_d)
-    );
-    for v in w {
-        input += &format!("{v:e}\n");
-    }
-    for (i, x, d) in sites {
-        input += &format!("{i} {x:e} {d:e}\n");
-    }
     let mut child = Command::new(program())
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
@@ -68,11 +56,28 @@ fn run(grid: &Grid, w: &[f64], sites: &[(usize, f64, f64)], with_d: bool) -> Emu
         .expect("input written");
     let output = child.wait_with_output().expect("the emulator ends");
     assert!(output.status.success());
-    let text = String::from_utf8(output.stdout).expect("text");
-    let values: Vec<f64> = text
+    String::from_utf8(output.stdout)
+        .expect("text")
         .split_whitespace()
         .map(|v| v.parse().expect("a number"))
-        .collect();
+        .collect()
+}
+
+fn run(grid: &Grid, w: &[f64], sites: &[(usize, f64, f64)], with_d: bool) -> Emulated {
+    let mut input = format!(
+        "operator {} {} {} {}\n",
+        grid.nx(),
+        grid.ny(),
+        sites.len(),
+        i32::from(with_d)
+    );
+    for v in w {
+        input += &format!("{v:e}\n");
+    }
+    for (i, x, d) in sites {
+        input += &format!("{i} {x:e} {d:e}\n");
+    }
+    let values = emulate(&input);
     let (m, n) = (sites.len(), grid.len());
     assert_eq!(values.len(), m + n + 9);
     let r = &values[m + n..];
@@ -201,5 +206,82 @@ fn the_spectral_table_inverts_the_full_grid_system() {
         let back = run(&grid, &w, &sites, false).set_product;
         let e = max_rel(&back, &x);
         assert!(e < 1e-11, "{nx} x {ny}: the inverse is off by {e:e}");
+    }
+}
+
+/// Every phase's local updates as pcg.rs applies them on the host (`Pre::apply`, the
+/// reference) and as pre_updates applies them, for updates the CG combines.
+#[test]
+fn the_local_updates_are_the_hosts() {
+    use crate::solver::pcg::{apply_pre, Pre};
+    let m = 11;
+    let combos = [
+        Pre {
+            keep_best: true,
+            shift_f: Some(0.25),
+            step: Some((0.7, true)),
+            project: Some(-1.5),
+            direction: Some(Some(0.3)),
+            ..Pre::default()
+        },
+        Pre {
+            restore_best: true,
+            step: Some((-0.2, false)),
+            w_from_z: true,
+            direction: Some(None),
+            ..Pre::default()
+        },
+        Pre {
+            fill_r_one: true,
+            project: Some(2.0),
+            ..Pre::default()
+        },
+    ];
+    for (k, pre) in combos.into_iter().enumerate() {
+        let mut host: Vec<Vec<f64>> = (0..7).map(|v| values(m, 10 * k as u64 + v)).collect();
+        let mut flags = 0;
+        for (set, bit) in [
+            (pre.keep_best, 1),
+            (pre.restore_best, 2),
+            (pre.shift_f.is_some(), 4),
+            (pre.step.is_some(), 8),
+            (pre.step.is_some_and(|s| s.1), 16),
+            (pre.project.is_some(), 32),
+            (pre.w_from_z, 64),
+            (pre.direction == Some(None), 128),
+            (matches!(pre.direction, Some(Some(_))), 256),
+            (pre.fill_r_one, 512),
+        ] {
+            if set {
+                flags |= bit;
+            }
+        }
+        let beta = match pre.direction {
+            Some(Some(b)) => b,
+            _ => 0.0,
+        };
+        let mut input = format!(
+            "pre {m} {flags} {:e} {:e} {:e} {beta:e}\n",
+            pre.shift_f.unwrap_or(0.0),
+            pre.step.map_or(0.0, |s| s.0),
+            pre.project.unwrap_or(0.0)
+        );
+        for j in 0..m {
+            for v in &host {
+                input += &format!("{:e} ", v[j]);
+            }
+            input += "\n";
+        }
+        let device = emulate(&input);
+        apply_pre(pre, &mut host);
+        for j in 0..m {
+            for (v, vector) in host.iter().enumerate() {
+                let (h, d) = (vector[j], device[7 * j + v]);
+                assert!(
+                    (h - d).abs() <= 1e-15 * h.abs().max(1.0),
+                    "combination {k}, vector {v}, site {j}: host {h}, kernel {d}"
+                );
+            }
+        }
     }
 }
