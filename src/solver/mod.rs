@@ -276,7 +276,7 @@ impl EquilibriumSolver {
         }
     }
 
-    /// The backend in use (`Dense` or `Spectral`).
+    /// The backend in use (`Dense`, `Spectral` or `Cuda`: never `Auto`).
     pub fn backend(&self) -> Backend {
         self.backend
     }
