@@ -334,6 +334,46 @@ pub(crate) mod json {
         check_resume(&spectral, &[100], round_trip);
     }
 
+    /// A checkpoint of the CUDA backend resumes on the spectral one and the reverse (issue
+    /// 42): the scene identity counts "cuda" as "spectral" and both keep one solver state.
+    /// The CUDA run's checkpoint is the spectral one's with its solver state's backend set
+    /// to `Cuda` (what a GPU run writes; no GPU here): resumed on the spectral backend it
+    /// ends exactly as the uninterrupted run. A spectral checkpoint resumed on a "cuda"
+    /// scene passes the checkpoint's checks and stops only at the device where there is
+    /// none (`CudaUnavailable`, not a scene mismatch).
+    #[test]
+    fn a_checkpoint_resumes_across_the_spectral_and_cuda_backends() {
+        let scene = |backend| {
+            Scene::builder()
+                .block(0.040, 0.010, 0.030)
+                .normal_load(1.0e3)
+                .solver_options(SolverOptions::default().with_backend(backend).unwrap())
+                .seed(5)
+                .build()
+                .unwrap()
+        };
+        let spectral = scene(Backend::Spectral);
+        let as_cuda = |c: Checkpoint| {
+            let text = c.to_json().unwrap();
+            let from = "\"backend\":\"Spectral\"";
+            // The solver state's and the two equilibria's reports.
+            assert_eq!(text.matches(from).count(), 3, "{text}");
+            assert!(text.contains("\"solver\":{\"backend\":\"Spectral\""));
+            Checkpoint::from_json_str(&resigned(&text.replace(from, "\"backend\":\"Cuda\"")))
+                .unwrap()
+        };
+        check_resume(&spectral, &[100], as_cuda);
+        let mut driver = spectral.driver().unwrap();
+        for _ in 0..50 {
+            driver.step().unwrap();
+        }
+        match scene(Backend::Cuda).resume(&driver.checkpoint()) {
+            Ok(_) => {} // a machine with a GPU
+            Err(Error::CudaUnavailable { .. }) => {}
+            Err(e) => panic!("a spectral checkpoint on a cuda scene: {e}"),
+        }
+    }
+
     #[test]
     fn a_checkpoint_whose_scene_was_edited_is_refused_naming_the_key() {
         let scene = Scene::builder()
