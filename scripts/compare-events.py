@@ -103,6 +103,11 @@ def compare(dir_a, dir_b, k, rtol):
     limit = both if k is None else min(k, both)
     complete = k is None and len(ev_a) == len(ev_b)
     if k is not None:
+        if limit == 0:
+            return False, (
+                f"DIFFERENT: nothing compared, {ruptures(ev_a)} ruptures in {dir_a} and "
+                f"{ruptures(ev_b)} in {dir_b} (a run stopped before its first?)"
+            )
         ev_a, ev_b = up_to_rupture(ev_a, limit), up_to_rupture(ev_b, limit)
     elif not complete:
         return False, (

@@ -79,6 +79,11 @@ expect 0 "SAME: 3 events, 2 ruptures (of the 3 asked: a run stopped early)" a st
 expect 0 "SAME: 2 events, 1 ruptures" a site --ruptures 1
 expect 1 "DIFFERENT" a site --ruptures 2
 expect 2 "ERROR" a missing
+# A run stopped before its first rupture: nothing to compare is not the same.
+mkdir -p "$tmp/none"
+head -2 "$tmp/stopped-full/events.csv" >"$tmp/none/events.csv.partial"
+head -1 "$tmp/stopped-full/curve.csv" >"$tmp/none/curve.csv.partial"
+expect 1 "DIFFERENT: nothing compared, 3 ruptures" a none --ruptures 5
 
 if [ "$failures" -ne 0 ]; then
     echo "$failures comparison(s) wrong"

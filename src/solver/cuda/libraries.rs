@@ -251,7 +251,11 @@ fn open(path: &Path) -> std::result::Result<Opened, String> {
             path: path.to_path_buf(),
             _library: library,
         })
-        .map_err(|e| e.to_string())
+        // libloading's `dlopen failed`, then the loader's own message (its source).
+        .map_err(|e| match std::error::Error::source(&e) {
+            Some(cause) => format!("{e}: {cause}"),
+            None => e.to_string(),
+        })
 }
 
 /// Shared objects are loaded by `dlopen` on Unix only.
@@ -545,6 +549,11 @@ mod tests {
         assert!(reason.contains(&empty.display().to_string()), "{reason}");
         assert!(
             reason.contains(&format!("{} did not open", garbage.display())),
+            "{reason}"
+        );
+        // The loader's own words (glibc: "file too short" or "invalid ELF header").
+        assert!(
+            reason.contains("too short") || reason.contains("ELF"),
             "{reason}"
         );
         assert!(!reason.contains("loader's search"), "{reason}");
