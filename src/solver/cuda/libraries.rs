@@ -595,7 +595,7 @@ mod tests {
         let dir = s.dir("lib");
         s.file("lib/libcufft.so.13", b"garbage, tried after .so.12");
         std::os::unix::fs::symlink(&libc, dir.join("libcufft.so.12")).unwrap();
-        let opened = open_first(&LIBCUFFT, &[dir.clone()], false).unwrap();
+        let opened = open_first(&LIBCUFFT, std::slice::from_ref(&dir), false).unwrap();
         assert_eq!(opened.path, dir.join("libcufft.so.12"));
     }
 
