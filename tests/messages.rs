@@ -765,3 +765,68 @@ fn scene_messages_say_what_is_valid() {
         "{text}"
     );
 }
+
+/// `info` says whether the CUDA backend has a GPU: which one, or why none is usable (the
+/// libraries or the driver; without the feature, the feature). CI has no GPU.
+#[test]
+fn info_says_whether_a_gpu_is_usable() {
+    let dir = scratch("info-gpu");
+    let scene = dir.join("scene.json");
+    std::fs::write(&scene, BASE).unwrap();
+    let o = precursors(&["info", path(&scene)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let text = String::from_utf8(o.stdout).unwrap();
+    let lines: Vec<&str> = text.lines().filter(|l| l.starts_with("gpu ")).collect();
+    assert_eq!(lines.len(), 1, "{text}");
+    let gpu = lines[0]
+        .strip_prefix("gpu        ")
+        .expect("aligned as the others");
+    if !cfg!(feature = "cuda") {
+        assert_eq!(gpu, "this build has no CUDA backend (feature cuda)");
+    } else if let Some(why) = gpu.strip_prefix("none usable: ") {
+        assert!(
+            why.starts_with("the CUDA backend is unavailable: ") && why.contains("LD_LIBRARY_PATH"),
+            "{why}"
+        );
+    } else {
+        assert!(gpu.contains("compute capability"), "{gpu}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A scene asking for the CUDA backend where it cannot run ends with code 6 and the
+/// reason (docs/cli.md), from `run` and `info` alike, with nothing written.
+#[test]
+fn a_cuda_scene_without_a_gpu_ends_with_code_6() {
+    #[cfg(feature = "cuda")]
+    if precursors::solver::cuda_device().is_ok() {
+        return; // a GPU here: the scene runs (tests/scene_file.rs builds its driver)
+    }
+    let dir = scratch("cuda-code");
+    let scene = dir.join("scene.json");
+    let cuda = BASE.replace(
+        r#""normal_load""#,
+        r#""solver": { "backend": "cuda" }, "normal_load""#,
+    );
+    std::fs::write(&scene, cuda).unwrap();
+    let out = dir.join("o");
+    let run = precursors(&["run", path(&scene), "--out", path(&out), "-q"]);
+    let info = precursors(&["info", path(&scene)]);
+    for o in [&run, &info] {
+        assert_eq!(o.status.code(), Some(6), "{}", stderr(o));
+        let message = stderr(o);
+        assert!(
+            message.contains("the CUDA backend is unavailable"),
+            "{message}"
+        );
+        let names = if cfg!(feature = "cuda") {
+            "LD_LIBRARY_PATH"
+        } else {
+            "feature `cuda` is off"
+        };
+        assert!(message.contains(names), "{message}");
+    }
+    assert_eq!(stderr(&info), stderr(&run));
+    assert!(!out.join("events.csv").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -660,3 +660,69 @@ fn a_heights_file_is_reported_by_its_resolved_path() {
         other => panic!("{other:?}"),
     }
 }
+
+/// A tiny scene (15 x 3 cells) with the CUDA backend.
+const CUDA_SCENE: &str = r#"{
+    "block": {"lx": 0.030, "ly": 0.006, "lz": 0.020},
+    "cells": {"kind": "count", "nx": 15, "ny": 3},
+    "solver": {"backend": "cuda"}
+}"#;
+
+/// The backend `cuda` is read, written back as `cuda` and reaches the solver's options
+/// (docs/scene-format.md, docs/gpu.md).
+#[test]
+fn the_cuda_backend_round_trips() {
+    let builder = SceneBuilder::from_json_str(CUDA_SCENE).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&builder.to_json().unwrap()).unwrap();
+    assert_eq!(json["solver"]["backend"], "cuda");
+    let again = SceneBuilder::from_json_str(&json.to_string()).unwrap();
+    assert_eq!(again, builder);
+    let spectral = SceneBuilder::from_json_str(&CUDA_SCENE.replace("cuda", "spectral")).unwrap();
+    assert_ne!(
+        builder, spectral,
+        "the backend is kept, not mapped to spectral"
+    );
+    let cuda = builder.clone().solver_options(
+        SolverOptions::default()
+            .with_backend(Backend::Cuda)
+            .unwrap(),
+    );
+    assert_eq!(cuda, builder);
+}
+
+/// Without a usable GPU (CI, this feature off) a driver of a `cuda` scene is refused with
+/// [`Error::CudaUnavailable`], whose message says what is missing: the feature, or (with
+/// it) the library or the driver, and what to do. With a usable GPU it builds.
+#[test]
+fn a_cuda_scene_without_a_gpu_says_what_is_missing() {
+    let scene = SceneBuilder::from_json_str(CUDA_SCENE)
+        .unwrap()
+        .build()
+        .unwrap();
+    #[cfg(feature = "cuda")]
+    if precursors::solver::cuda_device().is_ok() {
+        scene.driver().unwrap();
+        return;
+    }
+    let e = scene.driver().unwrap_err();
+    assert!(matches!(e, Error::CudaUnavailable { .. }), "{e:?}");
+    let message = e.to_string();
+    assert!(
+        message.starts_with("the CUDA backend is unavailable: "),
+        "{message}"
+    );
+    if cfg!(feature = "cuda") {
+        // The libraries searched (one not found: named, with the directories) or the
+        // driver's answer; and where to point the loader.
+        let names_what = (message.contains("not found") && message.contains("lib"))
+            || message.contains("CUDA driver")
+            || message.contains("LD_LIBRARY_PATH lists");
+        assert!(names_what, "{message}");
+        assert!(message.contains("LD_LIBRARY_PATH"), "{message}");
+        assert!(!message.contains("feature `cuda` is off"), "{message}");
+    } else {
+        assert!(message.contains("feature `cuda` is off"), "{message}");
+        assert!(message.contains("--features cuda"), "{message}");
+        assert!(message.contains("backend \"spectral\""), "{message}");
+    }
+}

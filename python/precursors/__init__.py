@@ -12,6 +12,7 @@ from typing import Any, Dict, Union
 import numpy as np
 
 from ._errors import (
+    CudaUnavailableError,
     NotConvergedError,
     PrecursorsError,
     PrecursorsOSError,
@@ -46,6 +47,7 @@ __all__ = [
     "Checkpoint",
     "Driver",
     "Event",
+    "CudaUnavailableError",
     "NotConvergedError",
     "PlaneStress",
     "PointStress",

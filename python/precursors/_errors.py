@@ -21,5 +21,11 @@ class PrecursorsOSError(PrecursorsError, OSError):
     one or is locked by another run."""
 
 
+class CudaUnavailableError(PrecursorsError, RuntimeError):
+    """The CUDA backend (``backend="cuda"``) cannot run here: this build has no CUDA
+    backend (the package is built without it), or no NVIDIA driver, GPU or CUDA library
+    answers (docs/gpu.md)."""
+
+
 class NotConvergedError(PrecursorsError):
     """A solve, a series or a fit that did not converge within its budget."""

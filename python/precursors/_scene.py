@@ -288,7 +288,7 @@ def scene_dict(
     elif drive is not None:
         scene["drive"] = {"kind": drive}
     if backend is not None:
-        _choice("backend", backend, ("auto", "dense", "spectral"))
+        _choice("backend", backend, ("auto", "dense", "spectral", "cuda"))
     if isinstance(threads, str):
         _choice("threads", threads, ("all", "current"))
     elif threads is not None:

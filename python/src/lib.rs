@@ -31,6 +31,8 @@ enum Class {
     Os,
     /// A solve or a series that did not converge.
     NotConverged,
+    /// The CUDA backend cannot run here (`RuntimeError` too).
+    Cuda,
     /// Anything else: `PrecursorsError` itself.
     Base,
 }
@@ -41,6 +43,7 @@ impl Class {
             Class::Value => "PrecursorsValueError",
             Class::Os => "PrecursorsOSError",
             Class::NotConverged => "NotConvergedError",
+            Class::Cuda => "CudaUnavailableError",
             Class::Base => "PrecursorsError",
         }
     }
@@ -89,6 +92,9 @@ fn core_class(e: &precursors::Error) -> Class {
         | E::OutputCollision { .. }
         | E::LoadBeyondFriction { .. }
         | E::TooFewSamples { .. } => Class::Value,
+        // (`DeviceOutOfMemory` and `Cuda`, of the crate's feature `cuda` only, are
+        // `PrecursorsError` itself, as `OutOfMemory` and a failed computation are.)
+        E::CudaUnavailable { .. } => Class::Cuda,
         _ => Class::Base,
     }
 }
@@ -157,13 +163,28 @@ struct Failure {
 
 impl From<precursors::Error> for Failure {
     fn from(e: precursors::Error) -> Self {
+        let mut message = message(&e);
+        if matches!(e, precursors::Error::CudaUnavailable { .. }) {
+            message.push_str(WITHOUT_CUDA);
+        }
         Failure {
             class: core_class(&e),
             kind: kind(&format!("{e:?}")),
-            message: message(&e),
+            message,
         }
     }
 }
+
+/// What a user of the package can do about the CUDA backend: the crate's hint speaks of
+/// cargo features, which a wheel's user does not choose.
+#[cfg(not(feature = "cuda"))]
+const WITHOUT_CUDA: &str = " (this Python package is built without the CUDA backend: run \
+    scenes with backend \"cuda\" with the program `precursors` built with \
+    `--features cli,cuda`, or build the package with its feature `cuda`; docs/gpu.md)";
+
+/// Built with the CUDA backend: the crate's message says it all.
+#[cfg(feature = "cuda")]
+const WITHOUT_CUDA: &str = "";
 
 impl From<SweepError> for Failure {
     fn from(e: SweepError) -> Self {

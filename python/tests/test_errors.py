@@ -207,3 +207,31 @@ def test_help_lists_the_scene_keywords():
     for keyword in ("block", "cells", "normal_load", "heights", "seed", "probe_planes"):
         assert keyword in signature
     assert "heights=array of shape (Ny, Nx)" in (precursors.Scene.__doc__ or "")
+
+
+# Issue 42: the CUDA backend. The package is built without it (python/Cargo.toml), so a
+# scene asking for it is refused, typed, with what to do instead.
+
+
+def test_cuda_backend_reaches_the_crate_and_is_refused_typed():
+    from precursors import CudaUnavailableError
+
+    assert issubclass(CudaUnavailableError, PrecursorsError)
+    assert issubclass(CudaUnavailableError, RuntimeError)
+    scene = precursors.Scene(cells=(10, 4), block=(0.010, 0.004, 0.010), normal_load=40.0,
+                             backend="cuda")
+    assert scene.to_dict()["solver"]["backend"] == "cuda"
+    with pytest.raises(CudaUnavailableError) as raised:
+        scene.driver()
+    error = raised.value
+    assert error.kind == "CudaUnavailable"
+    message = str(error)
+    assert "CUDA backend is unavailable" in message
+    assert "feature `cuda`" in message and "--features cli,cuda" in message
+    assert "Python package is built without the CUDA backend" in message
+
+
+def test_an_unknown_backend_lists_cuda():
+    with pytest.raises(PrecursorsValueError) as raised:
+        precursors.Scene(backend="gpu")
+    assert "'cuda'" in str(raised.value)

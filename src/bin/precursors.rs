@@ -50,7 +50,10 @@ Exit codes:
      path that is not a regular file (a FIFO, a device, a directory) named as a file, or
      another process is writing the directory (run, resume: the holder is named)
   5  merge, stats, plot: some runs of the sweep are not complete (the tables and figures
-     of the others written)";
+     of the others written)
+  6  run, resume, info, sweep: the scene asks for backend \"cuda\" and it cannot run here
+     (no feature cuda in this build, no NVIDIA driver or GPU, a CUDA library missing:
+     docs/gpu.md)";
 
 /// Quasi-static friction precursors: runs scene files and sweeps (docs/cli.md).
 #[derive(Debug, Parser)]
@@ -353,7 +356,8 @@ struct Failure {
 /// The exit code of a core error (docs/cli.md): 1 a computation that failed, 4 a file or
 /// directory that could not be read or written (or is locked by another process), 3
 /// invalid input (bytes that are not UTF-8 text included: a binary given as a scene file
-/// is bad input, not a failure to read).
+/// is bad input, not a failure to read), 6 the CUDA backend unavailable here (no feature
+/// `cuda`, driver, GPU or library).
 fn core_code(e: &Error) -> u8 {
     match e {
         Error::Io { source, .. } if source.kind() == std::io::ErrorKind::InvalidData => 3,
@@ -367,6 +371,16 @@ fn core_code(e: &Error) -> u8 {
         | Error::LoadBeyondFriction { .. } => 1,
         // An output option naming a file the command writes or reads: a bad command line.
         Error::OutputCollision { .. } => 2,
+        // The scene asks for the CUDA backend and this machine or build cannot give it: the
+        // same scene runs elsewhere (or with backend "spectral").
+        Error::CudaUnavailable { .. } => 6,
+        // A CUDA call that failed during the solves: the computation failed.
+        #[cfg(feature = "cuda")]
+        Error::Cuda { .. } => 1,
+        // A scene too large for the GPU's memory does not fit, as one too large for the
+        // machine's (`OutOfMemory`).
+        #[cfg(feature = "cuda")]
+        Error::DeviceOutOfMemory { .. } => 3,
         _ => 3,
     }
 }
@@ -738,6 +752,9 @@ fn info(path: &Path) -> Result<(), Failure> {
     }
     let cost = GridCost::of(grid.nx(), grid.ny());
     let backend = file["solver"]["backend"].as_str().unwrap_or("auto");
+    if backend == "cuda" {
+        check_cuda()?;
+    }
     let resolved = match backend {
         "auto" if n <= precursors::solver::AUTO_DENSE_LIMIT => "dense (auto)",
         "auto" => "spectral (auto)",
@@ -763,7 +780,8 @@ fn info(path: &Path) -> Result<(), Failure> {
          equilibrium ~{} per cold normal + tangential solve (estimate, one thread)\n\
          run        ~{} to global slip (rough: 0.84 s·(N/980)^1.9 up to N = 1e4, then \
          growing as N^2.1; fitted to the calibration scene, N = 1e4 and 1e5; the events \
-         depend on the scene)\n",
+         depend on the scene)\n\
+         gpu        {}\n",
         path.display(),
         metres(block.lx()),
         metres(block.ly()),
@@ -777,8 +795,47 @@ fn info(path: &Path) -> Result<(), Failure> {
         format_seconds(cost.plan_seconds),
         format_seconds(cost.solve_seconds),
         format_seconds(run),
+        gpu(),
     );
     print_out(&text)
+}
+
+/// A scene for the CUDA backend: `info` refuses it where `run` would, with the same
+/// error (no usable GPU, a library missing).
+#[cfg(feature = "cuda")]
+fn check_cuda() -> Result<(), Failure> {
+    precursors::solver::cuda_device()?;
+    Ok(())
+}
+
+/// Without the feature `cuda`: the library's own refusal (its words, not a copy), from the
+/// solver of a tiny scene with the backend `cuda`.
+#[cfg(not(feature = "cuda"))]
+fn check_cuda() -> Result<(), Failure> {
+    use precursors::solver::{Backend, SolverOptions};
+    let options = SolverOptions::default().with_backend(Backend::Cuda)?;
+    SceneBuilder::default()
+        .cells(4, 2)
+        .solver_options(options)
+        .build()?
+        .driver()?;
+    Ok(())
+}
+
+/// The GPU the CUDA backend would run on (`precursors::solver::cuda_device`), or why
+/// there is none usable.
+#[cfg(feature = "cuda")]
+fn gpu() -> String {
+    match precursors::solver::cuda_device() {
+        Ok(device) => device.to_string(),
+        Err(e) => format!("none usable: {e}"),
+    }
+}
+
+/// Without the feature `cuda` no GPU is looked for.
+#[cfg(not(feature = "cuda"))]
+fn gpu() -> String {
+    "this build has no CUDA backend (feature cuda)".into()
 }
 
 /// Writes `text` to stdout. A reader that went away (`precursors info x | head -1`) has

@@ -1195,6 +1195,28 @@ mod tests {
         assert_eq!(first_difference(&top, &a).as_deref(), Some("drive.kind"));
     }
 
+    /// `cuda` solves the `spectral` rule: one identity, so a checkpoint resumes across the
+    /// two; `dense` is another rule.
+    #[test]
+    fn the_cuda_backend_has_the_spectral_identity() {
+        let with = |backend| {
+            SceneBuilder::default()
+                .solver_options(SolverOptions::default().with_backend(backend).unwrap())
+        };
+        let (cuda, spectral) = (with(Backend::Cuda), with(Backend::Spectral));
+        assert_ne!(SceneFile::from(&cuda), SceneFile::from(&spectral));
+        assert_eq!(identity(&cuda), identity(&spectral));
+        assert_eq!(first_difference(&cuda, &spectral), None);
+        assert_eq!(first_difference(&spectral, &cuda), None);
+        assert!(identity(&cuda).contains(&("solver.backend".into(), "spectral".into())));
+        // Every key's exact value: the backend as written.
+        assert!(all_keys(&cuda).contains(&("solver.backend".into(), "cuda".into())));
+        assert_eq!(
+            first_difference(&cuda, &with(Backend::Dense)).as_deref(),
+            Some("solver.backend")
+        );
+    }
+
     #[cfg(feature = "serde")]
     #[test]
     fn the_objects_of_the_file() {
