@@ -263,6 +263,29 @@ else
 fi
 wait
 
+# Item 6's timings: a CG iteration and an event at N = 1e4 ... 1e7 (examples/gpu_timings,
+# built by `cargo build --release --features cuda --example gpu_timings`; carried beside
+# the program or in BIN_DIR/examples/).
+timings="$bin_dir/gpu_timings"
+[ -x "$timings" ] || timings="$bin_dir/examples/gpu_timings"
+echo "== 4. timings (examples/gpu_timings)"
+if [ -x "$timings" ]; then
+    # NAME NX NY EVENTS LIMIT BACKEND
+    for spec in "t1e4 200 50 1000 20 cuda" "t1e5 1000 100 1000 30 cuda" \
+        "t1e6 2000 500 10000 90 cuda" "t1e7 10000 1000 20 45 cuda" \
+        "t1e4 200 50 1000 20 spectral" "t1e5 1000 100 200 30 spectral"; do
+        read -r name nx ny events limit backend <<<"$spec"
+        timed "$name.$backend" "$limit" "$timings" "$backend" "$nx" "$ny" "$events"
+        line=$(grep '^backend' "$out/$name.$backend.stdout" || echo "exit $rc: see $out/$name.$backend.log")
+        echo "$line ($secs)"
+        row "timing $name $backend" "$([ "$rc" -eq 0 ] && echo measured || echo "exit $rc")" \
+            "$([ "$backend" = cuda ] && echo "$secs" || echo -)" "$([ "$backend" = spectral ] && echo "$secs" || echo -)"
+    done
+else
+    echo "   no gpu_timings beside $program: skipped"
+    row "timings" SKIPPED "-" "no gpu_timings binary"
+fi
+
 echo
 echo "== summary (times: wall seconds, peak resident memory of the process)"
 printf '%-34s | %-9s | %-20s | %-20s\n' "check" "result" "GPU (cuda)" "CPU (spectral)"
