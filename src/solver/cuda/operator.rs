@@ -10,8 +10,8 @@ use crate::solver::system::Compliance;
 use cudarc::cufft::sys::{cufftType, double2};
 use cudarc::cufft::CudaFft;
 use cudarc::driver::{CudaFunction, CudaSlice, CudaStream, LaunchConfig, PushKernelArg};
-use cudarc::nvrtc::{compile_ptx_with_opts, CompileOptions};
-use std::sync::Arc;
+use cudarc::nvrtc::{compile_ptx_with_opts, CompileOptions, Ptx};
+use std::sync::{Arc, OnceLock};
 
 /// The kernels' source (NVRTC compiles it when a solver is built).
 const SOURCE: &str = include_str!("kernels.cu");
@@ -44,7 +44,7 @@ pub(super) struct Kernels {
 }
 
 impl Kernels {
-    /// Compiles kernels.cu for `gpu` and loads its functions.
+    /// Compiles kernels.cu (once per process) and loads its functions on `gpu`.
     pub(super) fn compile(gpu: &Gpu) -> Result<Self> {
         let unavailable = |reason: String| Error::CudaUnavailable {
             reason,
@@ -52,13 +52,22 @@ impl Kernels {
                    \"spectral\" meanwhile"
                 .into(),
         };
-        let module = guarded("compiling the kernels (NVRTC)", || {
-            let options = CompileOptions {
-                name: Some("precursors_kernels.cu".into()),
-                ..Default::default()
-            };
-            let ptx = compile_ptx_with_opts(SOURCE, options)
-                .map_err(|e| format!("the kernels do not compile with NVRTC: {e:?}"))?;
+        // Compiled once per process (NVRTC takes about 250 ms); loaded per solver.
+        static PTX: OnceLock<std::result::Result<Ptx, String>> = OnceLock::new();
+        let ptx = PTX
+            .get_or_init(|| {
+                guarded("compiling the kernels (NVRTC)", || {
+                    let options = CompileOptions {
+                        name: Some("precursors_kernels.cu".into()),
+                        ..Default::default()
+                    };
+                    compile_ptx_with_opts(SOURCE, options)
+                        .map_err(|e| format!("the kernels do not compile with NVRTC: {e:?}"))
+                })
+            })
+            .clone()
+            .map_err(unavailable)?;
+        let module = guarded("loading the kernels", || {
             gpu.ctx
                 .load_module(ptx)
                 .map_err(|e| format!("the driver does not load the compiled kernels: {e}"))
