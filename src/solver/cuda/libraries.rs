@@ -72,6 +72,57 @@ const LIBNVRTC: Wanted = Wanted {
     by_name: &["libnvrtc.so.13", "libnvrtc.so.12"],
 };
 
+/// cuFFT for a CUDA 12 driver: CUDA 12's `libcufft.so.11` first.
+const LIBCUFFT_12: Wanted = Wanted {
+    files: &[
+        "libcufft.so.11",
+        "libcufft.so.12",
+        "libcufft.so.13",
+        "libcufft.so",
+    ],
+    by_name: &["libcufft.so.11", "libcufft.so.12", "libcufft.so.13"],
+    ..LIBCUFFT
+};
+
+/// NVRTC for a CUDA 12 driver: `libnvrtc.so.12` first.
+const LIBNVRTC_12: Wanted = Wanted {
+    files: &["libnvrtc.so.12", "libnvrtc.so.13", "libnvrtc.so"],
+    by_name: &["libnvrtc.so.12", "libnvrtc.so.13"],
+    ..LIBNVRTC
+};
+
+/// Library `i` of [`WANTED`] in the order for a driver of CUDA `major`: cuFFT and NVRTC
+/// of the driver's major version first (the driver is opened first), since a CUDA 13
+/// library does not run on a CUDA 12 driver.
+fn for_driver(i: usize, default: &'static Wanted, major: Option<u32>) -> &'static Wanted {
+    match (i, major) {
+        (1, Some(12)) => &LIBCUFFT_12,
+        (2, Some(12)) => &LIBNVRTC_12,
+        _ => default,
+    }
+}
+
+/// The CUDA major version of the opened driver library (`cuDriverGetVersion`, which
+/// needs no `cuInit`), if it answers.
+#[cfg(unix)]
+fn driver_major(driver: &Opened) -> Option<u32> {
+    type Version = unsafe extern "C" fn(*mut std::ffi::c_int) -> std::ffi::c_int;
+    let mut version: std::ffi::c_int = 0;
+    // SAFETY: `cuDriverGetVersion(int*)` of the driver API, which writes one int and
+    // returns 0 on success; the library stays loaded (`LOADED`).
+    let status = unsafe {
+        let symbol = driver.library.get::<Version>(b"cuDriverGetVersion").ok()?;
+        symbol(&mut version)
+    };
+    (status == 0 && version > 0).then_some(version as u32 / 1000)
+}
+
+/// No driver library off Unix.
+#[cfg(not(unix))]
+fn driver_major(_: &Opened) -> Option<u32> {
+    None
+}
+
 /// The libraries, in the order they are opened (the driver first: without it nothing
 /// else matters).
 const WANTED: [Wanted; 3] = [LIBCUDA, LIBCUFFT, LIBNVRTC];
@@ -230,7 +281,7 @@ pub(crate) struct Opened {
     pub(crate) path: PathBuf,
     /// The handle: dropping it would let the library go.
     #[cfg(unix)]
-    _library: libloading::os::unix::Library,
+    library: libloading::os::unix::Library,
 }
 
 /// Opens `path` (a path, or a plain name for the loader's own search) with
@@ -249,7 +300,7 @@ fn open(path: &Path) -> std::result::Result<Opened, String> {
     library
         .map(|library| Opened {
             path: path.to_path_buf(),
-            _library: library,
+            library,
         })
         // libloading's `dlopen failed`, then the loader's own message (its source).
         .map_err(|e| match std::error::Error::source(&e) {
@@ -375,14 +426,15 @@ pub(crate) fn load() -> Result<Vec<PathBuf>> {
         )));
     }
     // A poisoned lock means a panic while opening; the handles it holds are still valid.
-    let mut loaded = LOADED.lock().unwrap_or_else(|e| e.into_inner());
+    let mut loaded = crate::lock::lock(&LOADED);
     let mut dirs: Option<Vec<PathBuf>> = None;
     let mut paths = Vec::with_capacity(WANTED.len());
-    for (i, wanted) in WANTED.iter().enumerate() {
+    for (i, default) in WANTED.iter().enumerate() {
         if let Some(opened) = loaded.get(i) {
             paths.push(opened.path.clone());
             continue;
         }
+        let wanted = for_driver(i, default, loaded.first().and_then(driver_major));
         let dirs = dirs.get_or_insert_with(|| search_dirs(&var, Path::new("/")));
         let opened = open_first(wanted, dirs, true).map_err(unavailable)?;
         paths.push(opened.path.clone());
@@ -608,6 +660,20 @@ mod tests {
         assert_eq!(stub_in_library_path(&var), None);
         s.file("cuda/lib64/stubs/libcuda.so", b"");
         assert_eq!(stub_in_library_path(&var), Some(stubs));
+    }
+
+    /// A CUDA 12 driver takes CUDA 12's cuFFT (`.so.11`) and NVRTC (`.so.12`) first, a
+    /// CUDA 13 driver (or one that does not say) CUDA 13's (`.so.12`, `.so.13`).
+    #[test]
+    fn the_libraries_of_the_drivers_version_come_first() {
+        let first = |i: usize, major| for_driver(i, &WANTED[i], major).files[0];
+        assert_eq!(first(1, Some(12)), "libcufft.so.11");
+        assert_eq!(first(2, Some(12)), "libnvrtc.so.12");
+        for major in [Some(13), None] {
+            assert_eq!(first(1, major), "libcufft.so.12");
+            assert_eq!(first(2, major), "libnvrtc.so.13");
+        }
+        assert_eq!(first(0, Some(12)), "libcuda.so.1");
     }
 
     #[test]

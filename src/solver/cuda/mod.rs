@@ -27,7 +27,7 @@ use super::pcg::{max_abs, run_cg, Effort};
 use super::set::{SetProblem, SetSolve};
 use super::spectral::Precond;
 use super::system::Compliance;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::green::InfluencePlan;
 use cudarc::driver::CudaSlice;
 use device::{cuda_error, Gpu};
@@ -73,7 +73,14 @@ impl CudaCore {
         )?;
         let kernels = Kernels::compile(&gpu)?;
         let stream = &gpu.stream;
-        let transforms = Transforms::new(stream, nx, ny)?;
+        // cuFFT's symbols load with its first plan: a panic there is a library problem.
+        let transforms = device::guarded("creating the cuFFT plans", || {
+            Transforms::new(stream, nx, ny).map_err(|e| e.to_string())
+        })
+        .map_err(|reason| Error::CudaUnavailable {
+            reason,
+            hint: libraries::HINT.to_string(),
+        })?;
         let vectors = SetVectors::new(stream, n)?;
         let operator = upload(&gpu, &operator::table(plan, compliance, |e| e))?;
         let grid = stream
@@ -133,6 +140,27 @@ impl CudaCore {
     ) -> Result<SetSolve> {
         let m = problem.set.len();
         let n = self.plan.grid().len();
+        // The copies below assume these lengths (the bindings would panic otherwise).
+        for (name, found) in [
+            ("d (one compliance per set site)", problem.d.len()),
+            ("b (one right-hand side per set site)", problem.b.len()),
+            ("f (one warm start per set site)", f.len()),
+        ] {
+            if found != m {
+                return Err(Error::LengthMismatch {
+                    name,
+                    expected: m,
+                    found,
+                });
+            }
+        }
+        if m > n || problem.set.iter().any(|&i| i >= n) {
+            return Err(Error::LengthMismatch {
+                name: "set (distinct sites of the grid)",
+                expected: n,
+                found: m,
+            });
+        }
         if precond == Precond::Spectral {
             // The host's rule: rebuild when the mean compliance moved by more than 5 %.
             let mean_d = problem.d.iter().sum::<f64>() / m.max(1) as f64;
@@ -216,6 +244,15 @@ impl CudaCore {
             }
         }
         Ok(())
+    }
+}
+
+/// The buffers free themselves on the context's stream, which is the calling thread's
+/// current context's: a solver dropped on another thread (Python's garbage collector)
+/// would leak them without this.
+impl Drop for CudaCore {
+    fn drop(&mut self) {
+        let _ = self.gpu.ctx.bind_to_thread();
     }
 }
 

@@ -52,21 +52,17 @@ impl Kernels {
                    \"spectral\" meanwhile"
                 .into(),
         };
-        // Compiled once per process (NVRTC takes about 250 ms); loaded per solver.
-        static PTX: OnceLock<std::result::Result<Ptx, String>> = OnceLock::new();
-        let ptx = PTX
-            .get_or_init(|| {
-                guarded("compiling the kernels (NVRTC)", || {
-                    let options = CompileOptions {
-                        name: Some("precursors_kernels.cu".into()),
-                        ..Default::default()
-                    };
-                    compile_ptx_with_opts(SOURCE, options)
-                        .map_err(|e| format!("the kernels do not compile with NVRTC: {e:?}"))
-                })
-            })
-            .clone()
-            .map_err(unavailable)?;
+        // Compiled once per process (NVRTC takes about 250 ms; the backend uses device 0
+        // only, so one compute capability), loaded per solver.
+        static IMAGE: OnceLock<((u32, u32), std::result::Result<Ptx, String>)> = OnceLock::new();
+        let capability = gpu.info.compute_capability;
+        let (compiled_for, image) = IMAGE.get_or_init(|| (capability, compile(capability)));
+        let ptx = if *compiled_for == capability {
+            image.clone()
+        } else {
+            compile(capability)
+        }
+        .map_err(unavailable)?;
         let module = guarded("loading the kernels", || {
             gpu.ctx
                 .load_module(ptx)
@@ -92,6 +88,66 @@ impl Kernels {
             reduce_final: load("reduce_final")?,
         })
     }
+}
+
+/// kernels.cu compiled for the GPU's architecture (`sm_XY`, a binary the driver loads as
+/// it is), else as PTX for the driver to compile. Why a binary first: PTX carries the
+/// ISA version of the NVRTC that wrote it, which a driver older than that NVRTC refuses
+/// (`CUDA_ERROR_UNSUPPORTED_PTX_VERSION`); a binary of the same major version loads.
+fn compile((major, minor): (u32, u32)) -> std::result::Result<Ptx, String> {
+    guarded("compiling the kernels (NVRTC)", || {
+        let binary = compile_binary(major, minor);
+        binary.map(Ptx::from_binary).or_else(|binary_error| {
+            let options = CompileOptions {
+                name: Some("precursors_kernels.cu".into()),
+                ..Default::default()
+            };
+            compile_ptx_with_opts(SOURCE, options).map_err(|e| {
+                format!(
+                    "the kernels do not compile with NVRTC (for sm_{major}{minor}: \
+                     {binary_error}; as PTX: {e:?})"
+                )
+            })
+        })
+    })
+}
+
+/// kernels.cu as a binary for `sm_{major}{minor}` (NVRTC's `nvrtcGetCUBIN`, which the
+/// bindings' safe API does not wrap).
+fn compile_binary(major: u32, minor: u32) -> std::result::Result<Vec<u8>, String> {
+    use cudarc::nvrtc::{result, sys};
+    use std::ffi::{CStr, CString};
+    let source = CString::new(SOURCE).map_err(|e| e.to_string())?;
+    let name = CString::new("precursors_kernels.cu").map_err(|e| e.to_string())?;
+    let program = result::create_program(&source, Some(&name)).map_err(|e| e.to_string())?;
+    let options = [format!("--gpu-architecture=sm_{major}{minor}")];
+    // SAFETY: `program` is a live NVRTC program until destroyed below; the log and the
+    // binary are read into buffers of the sizes NVRTC reports.
+    let outcome = unsafe {
+        match result::compile_program(program, &options) {
+            Err(e) => {
+                let log = result::get_program_log(program)
+                    .map(|log| CStr::from_ptr(log.as_ptr()).to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                Err(format!("{e:?}: {log}"))
+            }
+            Ok(()) => {
+                let mut size = 0usize;
+                sys::nvrtcGetCUBINSize(program, &mut size)
+                    .result()
+                    .and_then(|()| {
+                        let mut binary = vec![0u8; size];
+                        sys::nvrtcGetCUBIN(program, binary.as_mut_ptr().cast())
+                            .result()
+                            .map(|()| binary)
+                    })
+                    .map_err(|e| format!("{e:?}"))
+            }
+        }
+    };
+    // SAFETY: destroyed once, after its last use.
+    let _ = unsafe { result::destroy_program(program) };
+    outcome
 }
 
 /// The diagonals in the DCT basis, row-major `Ny x Nx`, in the scaling of kernels.cu's
