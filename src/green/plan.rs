@@ -343,6 +343,14 @@ impl InfluencePlan {
     /// The table of the operator with the same eigenvectors as `Ĝ` and eigenvalues
     /// `map(p', m', eigenvalue(p', m'))`.
     pub(crate) fn spectral_table(&self, map: impl Fn(usize, usize, f64) -> f64) -> SpectralTable {
+        SpectralTable(dct_diagonal(&self.inner.grid, &self.mode_weights(map)))
+    }
+
+    /// The weights `map(p', m', eigenvalue(p', m')) α_p'² α_m'²` of an operator with the
+    /// eigenvectors of `Ĝ`, row-major `Ny x Nx`: its diagonal between the unnormalised
+    /// DCT-II and its transpose (the CUDA backend's tables; the host's add the DCT-III's
+    /// halved first term, [`InfluencePlan::spectral_table`]).
+    pub(crate) fn mode_weights(&self, map: impl Fn(usize, usize, f64) -> f64) -> Vec<f64> {
         let (nx, ny) = (self.inner.grid.nx(), self.inner.grid.ny());
         let mut values = vec![0.0; nx * ny];
         for m in 0..ny {
@@ -354,7 +362,7 @@ impl InfluencePlan {
                 values[k] = map(p, m, eigen) * (ax * ay);
             }
         }
-        SpectralTable(dct_diagonal(&self.inner.grid, &values))
+        values
     }
 
     /// The dense matrix `Ĝ` (m⁻¹), row-major `N x N`, assembled from the eigenvalue table

@@ -82,16 +82,7 @@ impl SpectralCore {
 
     /// On `partition` (the plan's own for the spectral backend, one part for the dense).
     pub(crate) fn new(plan: &InfluencePlan, compliance: Compliance, partition: Partition) -> Self {
-        let (nx, ny) = (plan.grid().nx(), plan.grid().ny());
-        let n = nx * ny;
-        // trace(Ĝ) = Σ eigenvalues; the diagonal varies only near the edges.
-        let mut trace = 0.0;
-        for m in 0..ny {
-            for p in 0..nx {
-                trace += plan.eigenvalue(p, m).unwrap_or(0.0);
-            }
-        }
-        let diag_c = compliance.scale * (trace / n as f64 - compliance.shift);
+        let diag_c = compliance.mean_diagonal(plan);
         Self {
             staging: Staging::new(plan, partition),
             plan: plan.clone(),
@@ -124,15 +115,9 @@ impl SpectralCore {
 
     /// Builds the table of `(C_s + d̄ I)⁻¹` for `d̄ = mean_d`.
     fn build_inverse(&mut self, mean_d: f64) {
-        let Compliance { scale, shift, .. } = self.compliance;
-        let n = self.plan.grid().len() as f64;
+        let (compliance, n) = (self.compliance, self.plan.grid().len());
         let table = self.plan.spectral_table(|p, m, eigen| {
-            let e = if p == 0 && m == 0 {
-                eigen - shift * n
-            } else {
-                eigen
-            };
-            1.0 / (scale * e + mean_d)
+            1.0 / (compliance.eigenvalue(n, p, m, eigen) + mean_d)
         });
         let staging = match self.inverse.take() {
             Some((staging, _, _)) => staging,

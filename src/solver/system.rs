@@ -68,6 +68,32 @@ pub(crate) struct Compliance {
     pub norm: f64,
 }
 
+impl Compliance {
+    /// The eigenvalue of `C_s` (m/Pa) for the DCT mode `(p', m')` of `Ĝ`'s `eigen` on a
+    /// grid of `n` cells: `scale · eigen`, the mean mode lowered by `shift · n`.
+    pub(crate) fn eigenvalue(&self, n: usize, p: usize, m: usize, eigen: f64) -> f64 {
+        let e = if p == 0 && m == 0 {
+            eigen - self.shift * n as f64
+        } else {
+            eigen
+        };
+        self.scale * e
+    }
+
+    /// The mean diagonal of `C_s` (m/Pa): `trace(Ĝ)/N` (the sum of the eigenvalues; the
+    /// diagonal varies only near the edges) scaled and shifted. Jacobi's elastic part.
+    pub(crate) fn mean_diagonal(&self, plan: &crate::green::InfluencePlan) -> f64 {
+        let (nx, ny) = (plan.grid().nx(), plan.grid().ny());
+        let mut trace = 0.0;
+        for m in 0..ny {
+            for p in 0..nx {
+                trace += plan.eigenvalue(p, m).unwrap_or(0.0);
+            }
+        }
+        self.scale * (trace / (nx * ny) as f64 - self.shift)
+    }
+}
+
 impl<'a> StagedSystem<'a> {
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn new(

@@ -86,14 +86,8 @@ impl CudaCore {
         let grid = stream
             .alloc_zeros::<f64>(n)
             .map_err(|e| cuda_error("cuMemAlloc", e))?;
-        let mut trace = 0.0;
-        for m in 0..ny {
-            for p in 0..nx {
-                trace += plan.eigenvalue(p, m).unwrap_or(0.0);
-            }
-        }
         Ok(CudaCore {
-            diag_c: compliance.scale * (trace / n as f64 - compliance.shift),
+            diag_c: compliance.mean_diagonal(plan),
             gpu,
             kernels,
             transforms,

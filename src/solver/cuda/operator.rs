@@ -150,31 +150,15 @@ fn compile_binary(major: u32, minor: u32) -> std::result::Result<Vec<u8>, String
     outcome
 }
 
-/// The diagonals in the DCT basis, row-major `Ny x Nx`, in the scaling of kernels.cu's
-/// unnormalised transforms: `w = e · α_p² α_m²` for the eigenvalue `e` of the operator.
+/// The diagonal of the operator with eigenvalues `map(eigenvalue of C_s)` between
+/// kernels.cu's unnormalised transforms, row-major `Ny x Nx`.
 pub(super) fn table(
     plan: &InfluencePlan,
     compliance: Compliance,
     map: impl Fn(f64) -> f64,
 ) -> Vec<f64> {
-    let (nx, ny) = (plan.grid().nx(), plan.grid().ny());
-    let n = (nx * ny) as f64;
-    let mut values = Vec::with_capacity(nx * ny);
-    for m in 0..ny {
-        let ay = if m == 0 { 1.0 } else { 2.0 } / ny as f64;
-        for p in 0..nx {
-            let ax = if p == 0 { 1.0 } else { 2.0 } / nx as f64;
-            let eigen = plan.eigenvalue(p, m).unwrap_or(0.0);
-            // The mean mode lowered (solver/mod.rs), as the host's tables do.
-            let e = if p == 0 && m == 0 {
-                eigen - compliance.shift * n
-            } else {
-                eigen
-            };
-            values.push(map(compliance.scale * e) * ax * ay);
-        }
-    }
-    values
+    let n = plan.grid().len();
+    plan.mode_weights(|p, m, eigen| map(compliance.eigenvalue(n, p, m, eigen)))
 }
 
 /// The grid's buffers and FFT plans.
