@@ -116,9 +116,9 @@ impl SpectralCore {
     /// Builds the table of `(C_s + d̄ I)⁻¹` for `d̄ = mean_d`.
     fn build_inverse(&mut self, mean_d: f64) {
         let (compliance, n) = (self.compliance, self.plan.grid().len());
-        let table = self.plan.spectral_table(|p, m, eigen| {
-            1.0 / (compliance.eigenvalue(n, p, m, eigen) + mean_d)
-        });
+        let table = self
+            .plan
+            .spectral_table(|p, m, eigen| 1.0 / (compliance.eigenvalue(n, p, m, eigen) + mean_d));
         let staging = match self.inverse.take() {
             Some((staging, _, _)) => staging,
             None => Staging::new(&self.plan, self.staging.partition().clone()),

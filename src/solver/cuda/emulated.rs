@@ -110,19 +110,20 @@ fn max_rel(a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0f64, |m, (x, y)| m.max((x - y).abs() / scale))
 }
 
+/// `nx x ny` cells of 1 mm under a block `lz` (m) tall, and its plan.
+fn planned(nx: usize, ny: usize, lz: f64) -> (Grid, InfluencePlan) {
+    let block = Block::new(nx as f64 * 1e-3, ny as f64 * 1e-3, lz).unwrap();
+    let grid = Grid::new(block, nx, ny).unwrap();
+    (grid, InfluencePlan::builder(grid).build().unwrap())
+}
+
 /// Odd and even lengths on both axes, and a grid of one row (a length-1 transform).
 const GRIDS: [(usize, usize); 4] = [(7, 5), (8, 6), (6, 1), (5, 4)];
 
 #[test]
 fn the_kernels_apply_the_set_system_as_the_dense_matrix_does() {
     for (nx, ny) in GRIDS {
-        let grid = Grid::new(
-            Block::new(nx as f64 * 1e-3, ny as f64 * 1e-3, 0.01).unwrap(),
-            nx,
-            ny,
-        )
-        .unwrap();
-        let plan = InfluencePlan::builder(grid).build().unwrap();
+        let (grid, plan) = planned(nx, ny, 0.01);
         let compliance = Compliance {
             scale: 2.5e-9,
             shift: 0.3,
@@ -177,13 +178,7 @@ fn the_kernels_apply_the_set_system_as_the_dense_matrix_does() {
 #[test]
 fn the_spectral_table_inverts_the_full_grid_system() {
     for (nx, ny) in GRIDS {
-        let grid = Grid::new(
-            Block::new(nx as f64 * 1e-3, ny as f64 * 1e-3, 0.02).unwrap(),
-            nx,
-            ny,
-        )
-        .unwrap();
-        let plan = InfluencePlan::builder(grid).build().unwrap();
+        let (grid, plan) = planned(nx, ny, 0.02);
         let compliance = Compliance {
             scale: 1e-9,
             shift: 0.1,

@@ -83,9 +83,7 @@ impl CudaCore {
         })?;
         let vectors = SetVectors::new(stream, n)?;
         let operator = upload(&gpu, &operator::table(plan, compliance, |e| e))?;
-        let grid = stream
-            .alloc_zeros::<f64>(n)
-            .map_err(|e| cuda_error("cuMemAlloc", e))?;
+        let grid = device::zeros::<f64>(stream, n)?;
         Ok(CudaCore {
             diag_c: compliance.mean_diagonal(plan),
             gpu,

@@ -3,7 +3,7 @@
 //! and a diagonal `W` (the operator's, the spectral preconditioner's). The algebra is in
 //! kernels.cu's header.
 
-use super::device::{cuda_error, guarded, Gpu};
+use super::device::{cuda_error, guarded, zeros, Gpu};
 use crate::error::{Error, Result};
 use crate::green::InfluencePlan;
 use crate::solver::system::Compliance;
@@ -204,16 +204,8 @@ impl Transforms {
             )
             .map_err(|e| cuda_error("cufftPlanMany", e))
         };
-        let alloc = |n: usize| {
-            stream
-                .alloc_zeros::<f64>(n)
-                .map_err(|e| cuda_error("cuMemAlloc", e))
-        };
-        let complex = |n: usize| {
-            stream
-                .alloc_zeros::<double2>(n)
-                .map_err(|e| cuda_error("cuMemAlloc", e))
-        };
+        let alloc = |n: usize| zeros::<f64>(stream, n);
+        let complex = |n: usize| zeros::<double2>(stream, n);
         Ok(Transforms {
             nx,
             ny,

@@ -2,7 +2,7 @@
 //! phase, the kernels run its local updates and main work on the set vectors, and only
 //! the phase's three scalars cross to the host (one small copy per reduction).
 
-use super::device::cuda_error;
+use super::device::{cuda_error, zeros};
 use super::operator::{over, Kernels, Transforms, THREADS};
 use crate::error::{Error, Result};
 use crate::solver::pcg::{Main, Phase, PhaseRunner, Pre};
@@ -39,16 +39,8 @@ pub(super) fn vector_bytes(n: usize) -> f64 {
 
 impl SetVectors {
     pub(super) fn new(stream: &Arc<CudaStream>, n: usize) -> Result<Self> {
-        let real = |len: usize| {
-            stream
-                .alloc_zeros::<f64>(len)
-                .map_err(|e| cuda_error("cuMemAlloc", e))
-        };
-        let int = |len: usize| {
-            stream
-                .alloc_zeros::<i32>(len)
-                .map_err(|e| cuda_error("cuMemAlloc", e))
-        };
+        let real = |len: usize| zeros::<f64>(stream, len);
+        let int = |len: usize| zeros::<i32>(stream, len);
         Ok(SetVectors {
             set: int(n)?,
             pos: int(n)?,
