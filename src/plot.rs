@@ -988,6 +988,22 @@ impl Map {
     /// against the other (`not to scale: y drawn 13.2 times stretched against x`), or
     /// that it is true to scale (within 5 %). Without it the axes are taken as
     /// different quantities (a position and a load) and no aspect is stated.
+    ///
+    /// ```
+    /// use precursors::plot::Map;
+    /// let dir = std::env::temp_dir().join(format!("precursors-doc-aspect-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// // A 40 x 2 mm face drawn in a 4:3 picture: y is stretched, and the map says so.
+    /// let face = |map: Map| map.x_range(0.0, 40.0).y_range(0.0, 2.0).size(600, 450);
+    /// face(Map::new(4, 2, vec![1.0; 8])?.same_unit_axes()).save(dir.join("face.svg"))?;
+    /// let svg = std::fs::read_to_string(dir.join("face.svg"))?;
+    /// assert!(svg.contains("not to scale: y drawn"));
+    /// // Without it, no aspect is stated.
+    /// face(Map::new(4, 2, vec![1.0; 8])?).save(dir.join("plain.svg"))?;
+    /// assert!(!std::fs::read_to_string(dir.join("plain.svg"))?.contains("to scale"));
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn same_unit_axes(mut self) -> Self {
         self.same_units = true;
         self

@@ -235,6 +235,34 @@ impl Movie {
     /// many digits as the last number needs, at least 4; e.g. `ffmpeg -framerate 10 -i
     /// contact_area_%04d.png movie.mp4`). A movie stopped by [`Movie::save_until`] leaves
     /// the frames written so far.
+    ///
+    /// ```
+    /// use precursors::output::RunTables;
+    /// use precursors::plot::{Movie, MovieKind};
+    /// use precursors::{RunOptions, Scene};
+    /// let dir = std::env::temp_dir().join(format!("precursors-doc-png-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// let scene = Scene::builder()
+    ///     .block(0.010, 0.004, 0.010)
+    ///     .normal_load(100.0)
+    ///     .run_options(RunOptions::new().record_fields(2, &[]))
+    ///     .build()?;
+    /// let mut driver = scene.driver()?;
+    /// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
+    /// let report = Movie::new(&dir, MovieKind::ContactArea)
+    ///     .max_frames(3)?
+    ///     .size(480, 300)
+    ///     .png_frames(dir.join("frames"))
+    ///     .save(dir.join("s1.gif"))?;
+    /// // One PNG per frame of the GIF, numbered from 0 after the GIF's stem.
+    /// for k in 0..report.frames {
+    ///     let png = std::fs::read(dir.join("frames").join(format!("s1_{k:04}.png")))?;
+    ///     assert!(png.starts_with(b"\x89PNG"));
+    /// }
+    /// assert!(!dir.join("frames").join(format!("s1_{:04}.png", report.frames)).exists());
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn png_frames(mut self, dir: impl AsRef<Path>) -> Self {
         self.png_frames = Some(dir.as_ref().to_path_buf());
         self
@@ -282,6 +310,33 @@ impl Movie {
     /// [`Movie::save`], calling `progress(drawn, frames)` after each frame drawn, which
     /// may stop it (`ControlFlow::Break`: a cancel button, Ctrl-C): then nothing is
     /// written and `Ok(None)` is returned.
+    ///
+    /// ```
+    /// use precursors::output::RunTables;
+    /// use precursors::plot::{Movie, MovieKind};
+    /// use precursors::{RunOptions, Scene};
+    /// use std::ops::ControlFlow;
+    /// let dir = std::env::temp_dir().join(format!("precursors-doc-stop-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// let scene = Scene::builder()
+    ///     .block(0.010, 0.004, 0.010)
+    ///     .normal_load(100.0)
+    ///     .run_options(RunOptions::new().record_fields(2, &[]))
+    ///     .build()?;
+    /// let mut driver = scene.driver()?;
+    /// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
+    /// let movie = Movie::new(&dir, MovieKind::ContactArea).max_frames(4)?.size(480, 300);
+    /// // Stopped after the first frame drawn (a cancel button): nothing is written.
+    /// let stopped = movie.save_until(dir.join("s1.gif"), |drawn, _frames| {
+    ///     if drawn >= 1 { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
+    /// })?;
+    /// assert!(stopped.is_none() && !dir.join("s1.gif").exists());
+    /// // Let through, it is the movie `save` draws.
+    /// let report = movie.save_until(dir.join("s1.gif"), |_, _| ControlFlow::Continue(()))?;
+    /// assert!(report.is_some_and(|r| r.frames >= 2) && dir.join("s1.gif").exists());
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     ///
     /// # Errors
     /// As [`Movie::save_with_progress`].
