@@ -231,4 +231,5 @@ def movie(
     height: int = ...,
     frame_duration: float = ...,
     out: Optional[_Path] = ...,
+    png_frames: Optional[_Path] = ...,
 ) -> List[Path]: ...

@@ -1320,10 +1320,12 @@ fn plot(
 /// (Movie S2, `DIR/coulomb_stress.gif`) or `"all"` (both; S2 left out, without an error,
 /// when no planes were recorded); every `every`-th recorded state and the last, at most
 /// `max_frames` frames, `width` x `height` pixels, `frame_duration` seconds per frame;
-/// `out` names the file of a single movie. Returns the paths of the movies written.
+/// `out` names the file of a single movie; `png_frames` a directory that also gets every
+/// frame as a numbered PNG (`contact_area_0000.png`, ...; `precursors movie
+/// --png-frames`). Returns the paths of the movies written.
 #[pyfunction]
 #[pyo3(signature = (dir, *, field="all", every=1, max_frames=200, width=900, height=560,
-                    frame_duration=0.1, out=None))]
+                    frame_duration=0.1, out=None, png_frames=None))]
 #[allow(clippy::too_many_arguments)]
 fn movie(
     py: Python<'_>,
@@ -1335,6 +1337,7 @@ fn movie(
     height: u32,
     frame_duration: f64,
     out: Option<PathBuf>,
+    png_frames: Option<PathBuf>,
 ) -> PyResult<Vec<PathBuf>> {
     use precursors::plot::{Movie, MovieKind, PlotError};
     let all = [
@@ -1361,21 +1364,24 @@ fn movie(
         let path = out.clone().unwrap_or_else(|| dir.join(name));
         let mut interrupt = None;
         let outcome = py.detach(|| {
-            Movie::new(&dir, kind)
+            let mut movie = Movie::new(&dir, kind)
                 .every(every)?
                 .max_frames(max_frames)?
                 .size(width, height)
-                .frame_duration(frame_duration)?
-                // Ctrl-C between frames: nothing written.
-                .save_until(&path, |_, _| {
-                    match Python::attach(|py| py.check_signals()) {
-                        Ok(()) => ControlFlow::Continue(()),
-                        Err(e) => {
-                            interrupt = Some(e);
-                            ControlFlow::Break(())
-                        }
+                .frame_duration(frame_duration)?;
+            if let Some(frames) = &png_frames {
+                movie = movie.png_frames(frames);
+            }
+            // Ctrl-C between frames: nothing written.
+            movie.save_until(&path, |_, _| {
+                match Python::attach(|py| py.check_signals()) {
+                    Ok(()) => ControlFlow::Continue(()),
+                    Err(e) => {
+                        interrupt = Some(e);
+                        ControlFlow::Break(())
                     }
-                })
+                }
+            })
         });
         if let Some(interrupt) = interrupt {
             return Err(interrupt);

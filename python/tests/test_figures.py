@@ -76,6 +76,23 @@ def test_movie_draws_the_recorded_fields_as_the_program_does(tmp_path):
     assert gif_frames(out) == (900, 560, 2)
 
 
+def test_movie_writes_its_frames_as_pngs_too(tmp_path):
+    scene = precursors.Scene.from_dict(
+        {**SMALL, "fields": {"every": 1, "planes": [0.002, 0.006]}}
+    )
+    precursors.run(scene, tmp_path)
+    frames = tmp_path / "frames"
+    movies = precursors.movie(
+        tmp_path, max_frames=3, width=400, height=300, png_frames=frames
+    )
+    for m in movies:
+        _, _, count = gif_frames(m)
+        # One PNG per GIF frame, numbered from 0 after the GIF's stem, of the frame's size.
+        pngs = sorted(frames.glob(m.stem + "_*.png"))
+        assert [p.name for p in pngs] == [f"{m.stem}_{k:04d}.png" for k in range(count)]
+        assert all(png_size(p) == (400, 300) for p in pngs)
+
+
 def test_movie_refusals(tmp_path):
     precursors.run(precursors.Scene.from_dict(SMALL), tmp_path)
     # No fields recorded: the error says which key records them.
