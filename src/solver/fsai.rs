@@ -146,6 +146,12 @@ pub(crate) struct Fsai {
     small: Vec<f64>,
 }
 
+/// The pattern slots of a row for `radius`: the lower neighbours in the `(2r+1)²` box
+/// (`r` rows of `2r+1`, then `r` on the site's row) and the site.
+pub(crate) const fn pattern_slots(radius: usize) -> usize {
+    radius * (2 * radius + 1) + radius + 1
+}
+
 impl Fsai {
     pub(crate) fn new(nx: usize, n: usize, radius: usize) -> Self {
         let r = radius as isize;
@@ -158,6 +164,7 @@ impl Fsai {
         }
         offsets.push(0);
         let stride = offsets.len();
+        debug_assert_eq!(stride, pattern_slots(radius));
         Self {
             radius,
             stride,
@@ -338,6 +345,32 @@ impl Fsai {
         }
         pattern.push(i);
         slots.push(slot);
+    }
+
+    /// The pattern slots of a row: the weight planes per cell (the CUDA backend's copy).
+    #[cfg(feature = "cuda")]
+    pub(crate) fn stride(&self) -> usize {
+        self.stride
+    }
+
+    /// Per slot, how many cells back its neighbour lies (`i - offset`; the last is 0).
+    #[cfg(feature = "cuda")]
+    pub(crate) fn offsets(&self) -> &[usize] {
+        &self.offsets
+    }
+
+    /// The weight planes, `stride` planes of one value per cell (slot `k` of cell `i` at
+    /// `k N + i`).
+    #[cfg(feature = "cuda")]
+    pub(crate) fn planes(&self) -> &[f64] {
+        &self.planes
+    }
+
+    /// The cells whose weights the last [`Fsai::update`] wrote: every other cell kept
+    /// its weights, so a copy of the planes is brought up to date by these alone.
+    #[cfg(feature = "cuda")]
+    pub(crate) fn refreshed(&self) -> &[usize] {
+        &self.dirty
     }
 
     /// Cells `G` reaches back (and `Gᵀ` forward): the largest slot offset.

@@ -490,11 +490,10 @@ impl EquilibriumSolver {
             }
             #[cfg(feature = "cuda")]
             Core::Cuda(core) => {
-                // Jacobi for warm solves: the device has no FSAI yet (docs/gpu.md).
                 let precond = if cold {
                     Precond::Spectral
                 } else {
-                    Precond::Jacobi
+                    spectral::warm_precond(tangential, self.grid.len())
                 };
                 core.solve(problem, precond, warm, effort)?
             }

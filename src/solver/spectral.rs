@@ -14,7 +14,7 @@ use crate::green::{InfluencePlan, Partition, SpectralTable, Staging};
 /// Pattern radius (cells) of the FSAI preconditioner. Measured on the N = 1e4 run (first
 /// 1000 ruptures, warm normal solves): Jacobi 68.3 CG iterations, 13.3 ms per solve;
 /// radius 1: 37.6, 9.6 ms; radius 2: 27.4, 9.9 ms (its `Gᵀ G` costs 2.2x radius 1's).
-const FSAI_RADIUS: usize = 1;
+pub(crate) const FSAI_RADIUS: usize = 1;
 
 /// Fewest cells for the two-level preconditioner of the normal equilibrium. Measured on
 /// the rod-driven runs of `examples/large_run` (docs/performance.md, "A two-level

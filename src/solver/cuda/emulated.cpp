@@ -3,9 +3,10 @@
 // run one after the other, and the batched FFTs are naive DFTs in long double. The launch
 // sequence is operator.rs's `Transforms::filter` and `gather_set`/`gather_grid`.
 //
-// Input (stdin, whitespace separated): "operator nx ny m with_d", the table (Ny x Nx), then m lines
-// of "cell x d". Output (stdout): the m values of the set product, then the Nx·Ny values
-// of the grid product (cell order).
+// Input (stdin, whitespace separated), for the products: "operator nx ny m with_d", the
+// table (Ny x Nx), then m lines of "cell x d". Output (stdout): the m values of the set
+// product, then the Nx·Ny values of the grid product (cell order). Modes "pre" and "fsai"
+// below run the CG's local updates and the FSAI product.
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -99,10 +100,55 @@ static int pre() {
     return 0;
 }
 
+// "fsai nx ny stride", the stride offsets, "rounds R", then per round "count" and count
+// lines "cell w_0 .. w_{stride-1}" (fsai_scatter onto zero planes, round after round),
+// then "m" and m lines "cell r": z = G^T G r on the set, one value per line.
+static int fsai() {
+    int nx, ny, stride, rounds;
+    if (std::scanf("%d %d %d", &nx, &ny, &stride) != 3) return 2;
+    int n = nx * ny;
+    std::vector<int> offsets(stride);
+    for (auto& o : offsets)
+        if (std::scanf("%d", &o) != 1) return 2;
+    std::vector<double> planes((size_t)stride * n, 0.0);
+    if (std::scanf(" rounds %d", &rounds) != 1) return 2;
+    for (int k = 0; k < rounds; k++) {
+        int count;
+        if (std::scanf("%d", &count) != 1) return 2;
+        std::vector<int> cells(count);
+        std::vector<double> weights((size_t)count * stride);
+        for (int c = 0; c < count; c++) {
+            if (std::scanf("%d", &cells[c]) != 1) return 2;
+            for (int s = 0; s < stride; s++)
+                if (std::scanf("%lf", &weights[(size_t)c * stride + s]) != 1) return 2;
+        }
+        launch((size_t)count * stride, [&] {
+            fsai_scatter(cells.data(), weights.data(), count, planes.data(), stride, n);
+        });
+    }
+    int m;
+    if (std::scanf("%d", &m) != 1) return 2;
+    std::vector<int> set(m), pos(n, -1);
+    std::vector<double> r(m), y(m), z(m);
+    for (int j = 0; j < m; j++) {
+        if (std::scanf("%d %lf", &set[j], &r[j]) != 2) return 2;
+        pos[set[j]] = j;
+    }
+    launch(m, [&] {
+        fsai_g(planes.data(), offsets.data(), stride, set.data(), pos.data(), r.data(), y.data(), m, n);
+    });
+    launch(m, [&] {
+        fsai_gt(planes.data(), offsets.data(), stride, set.data(), pos.data(), y.data(), z.data(), m, n);
+    });
+    for (int j = 0; j < m; j++) std::printf("%.17g\n", z[j]);
+    return 0;
+}
+
 int main() {
     char mode[16];
     if (std::scanf("%15s", mode) != 1) return 2;
     if (std::string(mode) == "pre") return pre();
+    if (std::string(mode) == "fsai") return fsai();
     int nx, ny, m, with_d;
     if (std::scanf("%d %d %d %d", &nx, &ny, &m, &with_d) != 4) return 2;
     size_t n = (size_t)nx * ny;

@@ -248,3 +248,55 @@ extern "C" __global__ void reduce_final(int mode, const double* partials, int bl
     if (threadIdx.x == 0)
         for (int v = 0; v < 3; v++) out[v] = acc[v];
 }
+
+// FSAI (solver/fsai.rs): M^-1 = G^T G with G stored as one weight plane per pattern slot,
+// planes[k * n + i] the weight of cell i on cell i - offsets[k] (zero off the set and for
+// missing neighbours); the last slot is the site itself (offset 0). The sums run in
+// fsai.rs's order: the site's own slot first, then the slots downward.
+
+// The host's refreshed rows onto the planes: weights[c * stride + k] is row cells[c]'s
+// weight in slot k.
+extern "C" __global__ void fsai_scatter(const int* cells, const double* weights, int count,
+                                        double* planes, int stride, int n) {
+    int t = blockIdx.x * blockDim.x + threadIdx.x;
+    if (t >= count * stride) return;
+    int c = t / stride, k = t % stride;
+    planes[(size_t)k * n + cells[c]] = weights[t];
+}
+
+// y = G r on the set: y[j] = sum_k w_k[i] r(i - o_k), i = set[j].
+extern "C" __global__ void fsai_g(const double* planes, const int* offsets, int stride,
+                                  const int* set, const int* pos, const double* r, double* y,
+                                  int m, int n) {
+    int j = blockIdx.x * blockDim.x + threadIdx.x;
+    if (j >= m) return;
+    int i = set[j];
+    double acc = planes[(size_t)(stride - 1) * n + i] * r[j];
+    for (int k = stride - 2; k >= 0; k--) {
+        double w = planes[(size_t)k * n + i];
+        int c = i - offsets[k];
+        if (w == 0.0 || c < 0) continue;
+        int p = pos[c];
+        if (p >= 0) acc += w * r[p];
+    }
+    y[j] = acc;
+}
+
+// z = G^T y on the set: z[j] = sum_k w_k[i + o_k] y(i + o_k), i = set[j].
+extern "C" __global__ void fsai_gt(const double* planes, const int* offsets, int stride,
+                                   const int* set, const int* pos, const double* y, double* z,
+                                   int m, int n) {
+    int j = blockIdx.x * blockDim.x + threadIdx.x;
+    if (j >= m) return;
+    int i = set[j];
+    double acc = planes[(size_t)(stride - 1) * n + i] * y[j];
+    for (int k = stride - 2; k >= 0; k--) {
+        int c = i + offsets[k];
+        if (c >= n) continue;
+        double w = planes[(size_t)k * n + c];
+        if (w == 0.0) continue;
+        int p = pos[c];
+        if (p >= 0) acc += w * y[p];
+    }
+    z[j] = acc;
+}

@@ -1,9 +1,12 @@
 //! The device memory a CUDA solver needs, estimated and checked against what the GPU has
 //! free before anything is allocated.
 
+use super::fsai::fsai_bytes;
 use super::operator::transform_bytes;
 use super::phases::vector_bytes;
 use crate::error::{Error, Result};
+use crate::solver::fsai::pattern_slots;
+use crate::solver::spectral::FSAI_RADIUS;
 
 /// cuFFT's work areas, at most (bytes per cell): a batched real transform's work area is
 /// at most the size of its complex output, and the four plans hold one each.
@@ -14,11 +17,13 @@ const FIXED_BYTES: f64 = 64.0 * 1024.0 * 1024.0;
 
 /// The bytes a CUDA solver of an `nx x ny` grid allocates on its device, at most: the set
 /// vectors, the transforms' buffers, two diagonal tables (the operator's and the spectral
-/// preconditioner's), the grid product, the FFT work areas and a fixed part.
+/// preconditioner's), the grid product, the FSAI factor's copy, the FFT work areas and a
+/// fixed part.
 pub(super) fn device_bytes(nx: usize, ny: usize) -> f64 {
     let n = (nx * ny) as f64;
     vector_bytes(nx * ny)
         + transform_bytes(nx, ny)
+        + fsai_bytes(nx * ny, pattern_slots(FSAI_RADIUS))
         + 3.0 * 8.0 * n
         + FFT_WORK_PER_CELL * n
         + FIXED_BYTES
@@ -41,19 +46,20 @@ mod tests {
     use super::*;
 
     /// The estimate counted by hand for a 4 x 3 grid (12 cells): per cell 2 index arrays
-    /// (4 B) and 9 set vectors (8 B), 2 real grids (8 B), 3 tables/grid outputs (8 B) and
-    /// 64 B of FFT work; half spectra 3·3 (rows) and 4·2 twice (columns) of 16 B; the
-    /// reductions' 3·1024 + 3 values; 64 MiB fixed.
+    /// (4 B) and 9 set vectors (8 B), 2 real grids (8 B), 3 tables/grid outputs (8 B),
+    /// FSAI's 5 weight planes and its scratch vector (8 B) and 64 B of FFT work; half
+    /// spectra 3·3 (rows) and 4·2 twice (columns) of 16 B; the reductions' 3·1024 + 3
+    /// values; FSAI's 5 offsets (4 B); 64 MiB fixed.
     #[test]
     fn the_estimate_counts_every_buffer() {
-        let per_cell = 2.0 * 4.0 + 9.0 * 8.0 + 2.0 * 8.0 + 3.0 * 8.0 + 64.0;
+        let per_cell = 2.0 * 4.0 + 9.0 * 8.0 + 2.0 * 8.0 + 3.0 * 8.0 + 6.0 * 8.0 + 64.0;
         let spectra = 16.0 * (9.0 + 2.0 * 8.0);
         let reductions = 8.0 * (3.0 * 1024.0 + 3.0);
-        let expected = 12.0 * per_cell + spectra + reductions + 64.0 * 1024.0 * 1024.0;
+        let expected = 12.0 * per_cell + spectra + reductions + 5.0 * 4.0 + 64.0 * 1024.0 * 1024.0;
         assert_eq!(device_bytes(4, 3), expected);
     }
 
-    /// N = 1e7 fits an 80 GB GPU with room to spare (about 2 GB): memory O(N).
+    /// N = 1e7 fits an 80 GB GPU with room to spare (about 2.5 GB): memory O(N).
     #[test]
     fn ten_million_cells_need_a_few_gigabytes() {
         let bytes = device_bytes(10_000, 1_000);

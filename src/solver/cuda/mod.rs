@@ -5,14 +5,17 @@
 //! host. Per set solve the set, `d`, `b` and the warm start go up and the tractions and
 //! the displacements' grid product come back (a few `O(N)` copies).
 //!
-//! Preconditioners: Jacobi for warm solves, the restricted spectral inverse for cold ones
-//! (the host's choice for cold solves); FSAI and the coarse space stay on the host for now.
+//! Preconditioners: the host's choices but the coarse space. Cold solves take the
+//! restricted spectral inverse; warm normal solves FSAI (its rows built on the host,
+//! `fsai.rs`), also on the grids where the host adds the coarse space; warm tangential
+//! solves Jacobi.
 
 // Kernel launches, copies and libraries opened by path are unsafe calls of the bindings;
 // each says why it is sound.
 #![allow(unsafe_code)]
 
 mod device;
+mod fsai;
 mod libraries;
 mod memory;
 mod operator;
@@ -23,14 +26,16 @@ mod emulated;
 
 pub use device::{cuda_device, CudaDevice};
 
+use super::fsai::{Entries, Fsai};
 use super::pcg::{max_abs, run_cg, Effort};
 use super::set::{SetProblem, SetSolve};
-use super::spectral::Precond;
+use super::spectral::{Precond, FSAI_RADIUS};
 use super::system::Compliance;
 use crate::error::{Error, Result};
 use crate::green::InfluencePlan;
 use cudarc::driver::CudaSlice;
 use device::{cuda_error, Gpu};
+use fsai::DeviceFsai;
 use operator::{Kernels, Transforms};
 use phases::{DevicePhases, DevicePrecond, SetVectors};
 
@@ -47,6 +52,9 @@ pub(crate) struct CudaCore {
     diag_c: f64,
     operator: CudaSlice<f64>,
     inverse: Option<(f64, CudaSlice<f64>)>,
+    /// FSAI: the exact local entries of `C_s` and the factor on the host (built on first
+    /// use), its copy on the device.
+    fsai: Option<(Entries, Fsai, DeviceFsai)>,
     /// The grid product of the last solve (`C_s f` on every cell).
     grid: CudaSlice<f64>,
 }
@@ -94,6 +102,7 @@ impl CudaCore {
             compliance,
             operator,
             inverse: None,
+            fsai: None,
             grid,
         })
     }
@@ -121,8 +130,8 @@ impl CudaCore {
         Ok(())
     }
 
-    /// Solves `problem` with `precond` (Jacobi or the spectral inverse); `f` holds the
-    /// warm start.
+    /// Solves `problem` with `precond` (FSAI for the two-level one: the device has no
+    /// coarse space); `f` holds the warm start.
     pub(crate) fn solve(
         &mut self,
         problem: SetProblem<'_>,
@@ -164,10 +173,16 @@ impl CudaCore {
                 self.build_inverse(mean_d)?;
             }
         }
+        if matches!(precond, Precond::Fsai | Precond::TwoLevel) {
+            self.prepare_fsai(problem)?;
+        }
         self.upload_problem(problem, &f)?;
         let stream = &self.gpu.stream;
-        let precond = match (precond, &self.inverse) {
-            (Precond::Spectral, Some((_, table))) => DevicePrecond::Spectral { table },
+        let precond = match (precond, &self.inverse, &mut self.fsai) {
+            (Precond::Spectral, Some((_, table)), _) => DevicePrecond::Spectral { table },
+            (Precond::Fsai | Precond::TwoLevel, _, Some((_, _, device))) => {
+                DevicePrecond::Fsai(device)
+            }
             _ => DevicePrecond::Jacobi {
                 diag_c: self.diag_c,
             },
@@ -210,6 +225,24 @@ impl CudaCore {
             outcome,
             grid_product,
         })
+    }
+
+    /// The FSAI factor brought up to date for the problem's set and compliances on the
+    /// host (the rows around changed sites), then its refreshed rows copied.
+    fn prepare_fsai(&mut self, problem: SetProblem<'_>) -> Result<()> {
+        let stream = &self.gpu.stream;
+        let (entries, fsai, device) = match &mut self.fsai {
+            Some(built) => built,
+            slot => {
+                let grid = self.plan.grid();
+                let Compliance { scale, shift, .. } = self.compliance;
+                let fsai = Fsai::new(grid.nx(), grid.len(), FSAI_RADIUS);
+                let device = DeviceFsai::new(stream, &fsai, grid.len())?;
+                slot.insert((Entries::new(&self.plan, scale, shift), fsai, device))
+            }
+        };
+        fsai.update(entries, problem.set, problem.d);
+        device.sync(stream, &self.kernels, fsai)
     }
 
     /// The set, its positions on the grid, `d`, `b` and the warm start `f` to the device.

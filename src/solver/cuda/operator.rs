@@ -41,6 +41,9 @@ pub(super) struct Kernels {
     pub(super) pre_updates: CudaFunction,
     pub(super) reduce_partial: CudaFunction,
     pub(super) reduce_final: CudaFunction,
+    pub(super) fsai_scatter: CudaFunction,
+    pub(super) fsai_g: CudaFunction,
+    pub(super) fsai_gt: CudaFunction,
 }
 
 impl Kernels {
@@ -86,6 +89,9 @@ impl Kernels {
             pre_updates: load("pre_updates")?,
             reduce_partial: load("reduce_partial")?,
             reduce_final: load("reduce_final")?,
+            fsai_scatter: load("fsai_scatter")?,
+            fsai_g: load("fsai_g")?,
+            fsai_gt: load("fsai_gt")?,
         })
     }
 }

@@ -3,6 +3,7 @@
 //! the phase's three scalars cross to the host (one small copy per reduction).
 
 use super::device::{cuda_error, zeros};
+use super::fsai::DeviceFsai;
 use super::operator::{over, Kernels, Transforms, THREADS};
 use crate::error::{Error, Result};
 use crate::solver::pcg::{Main, Phase, PhaseRunner, Pre};
@@ -65,6 +66,8 @@ pub(super) enum DevicePrecond<'a> {
     Jacobi { diag_c: f64 },
     /// `z = P_S (C_s + d̄ I)⁻¹ P_S r` through its DCT table.
     Spectral { table: &'a CudaSlice<f64> },
+    /// `z = Gᵀ G r`, the host's FSAI factor copied to the device.
+    Fsai(&'a mut DeviceFsai),
 }
 
 /// One set solve's phases on the device.
@@ -228,7 +231,7 @@ impl DevicePhases<'_> {
     /// `z = M⁻¹ r`.
     fn precondition(&mut self) -> Result<()> {
         let v = &mut *self.v;
-        match self.precond {
+        match &mut self.precond {
             DevicePrecond::Jacobi { diag_c } => {
                 let Some(cfg) = over(self.m) else {
                     return Ok(());
@@ -240,7 +243,7 @@ impl DevicePhases<'_> {
                         .launch_builder(&self.kernels.jacobi)
                         .arg(&v.r)
                         .arg(&v.d)
-                        .arg(&diag_c)
+                        .arg(&*diag_c)
                         .arg(&mut v.z)
                         .arg(&m)
                         .launch(cfg)
@@ -262,6 +265,15 @@ impl DevicePhases<'_> {
                     self.m,
                 )
             }
+            DevicePrecond::Fsai(fsai) => fsai.apply(
+                self.stream,
+                self.kernels,
+                &v.set,
+                &v.pos,
+                &v.r,
+                &mut v.z,
+                self.m,
+            ),
         }
     }
 

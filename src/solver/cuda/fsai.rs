@@ -1,0 +1,165 @@
+//! The FSAI preconditioner on the device: the host builds and caches `G`'s rows (solver/
+//! fsai.rs, the spectral backend's own factor), the device keeps a copy of its weight
+//! planes and applies `z = Gᵀ G r` with two stencil kernels (kernels.cu).
+//!
+//! Why the rows stay on the host: a rupture changes a few rows (the pattern box around
+//! each changed site), each a small dense solve, so per set solve only those rows cross
+//! (`(4 + 8 stride)` bytes each), not the planes.
+
+use super::device::{cuda_error, zeros};
+use super::operator::{over, Kernels};
+use crate::error::Result;
+use crate::solver::fsai::Fsai;
+use cudarc::driver::{CudaSlice, CudaStream, PushKernelArg};
+use std::sync::Arc;
+
+/// The device's copy of a [`Fsai`] factor and the scratch of its product.
+pub(super) struct DeviceFsai {
+    stride: usize,
+    /// `stride` planes of one weight per cell.
+    planes: CudaSlice<f64>,
+    /// Per slot, cells back to the neighbour.
+    offsets: CudaSlice<i32>,
+    /// `G r` on the set.
+    pub(super) y: CudaSlice<f64>,
+    /// Whether the planes equal the host's after its last update. False until the first
+    /// copy, and after a failed one: then every row is copied again.
+    synced: bool,
+}
+
+/// The bytes of a [`DeviceFsai`] of `stride` slots on a grid of `n` cells.
+pub(super) fn fsai_bytes(n: usize, stride: usize) -> f64 {
+    8.0 * ((stride + 1) * n) as f64 + 4.0 * stride as f64
+}
+
+/// The rows to copy: every set row (`all`) or the ones the last update refreshed, as
+/// their cells and their `stride` weights each (zero weights for a row off the set).
+pub(super) fn rows_to_copy(fsai: &Fsai, all: bool) -> (Vec<i32>, Vec<f64>) {
+    let stride = fsai.stride();
+    let planes = fsai.planes();
+    let n = planes.len() / stride;
+    let cells: Vec<usize> = if all {
+        (0..n).collect()
+    } else {
+        fsai.refreshed().to_vec()
+    };
+    let weights = cells
+        .iter()
+        .flat_map(|&i| (0..stride).map(move |k| planes[k * n + i]))
+        .collect();
+    (cells.into_iter().map(|i| i as i32).collect(), weights)
+}
+
+impl DeviceFsai {
+    /// Zero planes for `fsai`'s pattern on a grid of `n` cells.
+    pub(super) fn new(stream: &Arc<CudaStream>, fsai: &Fsai, n: usize) -> Result<Self> {
+        let offsets: Vec<i32> = fsai.offsets().iter().map(|&o| o as i32).collect();
+        Ok(DeviceFsai {
+            stride: fsai.stride(),
+            planes: zeros(stream, fsai.stride() * n)?,
+            offsets: stream
+                .clone_htod(&offsets)
+                .map_err(|e| cuda_error("cuMemcpyHtoD", e))?,
+            y: zeros(stream, n)?,
+            synced: false,
+        })
+    }
+
+    /// Brings the planes up to date with `fsai` after its update: the refreshed rows, or
+    /// every row when the copy is not known to be current.
+    pub(super) fn sync(
+        &mut self,
+        stream: &Arc<CudaStream>,
+        kernels: &Kernels,
+        fsai: &Fsai,
+    ) -> Result<()> {
+        let all = !self.synced;
+        self.synced = false;
+        let (cells, weights) = rows_to_copy(fsai, all);
+        let Some(cfg) = over(weights.len()) else {
+            self.synced = true;
+            return Ok(());
+        };
+        let copy = |e| cuda_error("cuMemcpyHtoD", e);
+        let cells_d = stream.clone_htod(&cells).map_err(copy)?;
+        let weights_d = stream.clone_htod(&weights).map_err(copy)?;
+        let (count, stride, n) = (
+            cells.len() as i32,
+            self.stride as i32,
+            (self.planes.len() / self.stride) as i32,
+        );
+        // SAFETY: the argument list matches kernels.cu's fsai_scatter; `cells` holds
+        // `count` cells of the grid, `weights` `count * stride` values, the planes
+        // `stride * n`.
+        unsafe {
+            stream
+                .launch_builder(&kernels.fsai_scatter)
+                .arg(&cells_d)
+                .arg(&weights_d)
+                .arg(&count)
+                .arg(&mut self.planes)
+                .arg(&stride)
+                .arg(&n)
+                .launch(cfg)
+        }
+        .map_err(|e| cuda_error("fsai_scatter", e))?;
+        self.synced = true;
+        Ok(())
+    }
+
+    /// `z = Gᵀ G r` on the `m` sites of `set` (`pos` the set position of every cell).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn apply(
+        &mut self,
+        stream: &Arc<CudaStream>,
+        kernels: &Kernels,
+        set: &CudaSlice<i32>,
+        pos: &CudaSlice<i32>,
+        r: &CudaSlice<f64>,
+        z: &mut CudaSlice<f64>,
+        m: usize,
+    ) -> Result<()> {
+        let Some(cfg) = over(m) else {
+            return Ok(());
+        };
+        let (stride, m32, n) = (
+            self.stride as i32,
+            m as i32,
+            (self.planes.len() / self.stride) as i32,
+        );
+        // SAFETY: the argument lists match kernels.cu's fsai_g and fsai_gt; set, r, y and z
+        // hold at least m values, pos and every plane n, offsets `stride`.
+        unsafe {
+            stream
+                .launch_builder(&kernels.fsai_g)
+                .arg(&self.planes)
+                .arg(&self.offsets)
+                .arg(&stride)
+                .arg(set)
+                .arg(pos)
+                .arg(r)
+                .arg(&mut self.y)
+                .arg(&m32)
+                .arg(&n)
+                .launch(cfg)
+        }
+        .map_err(|e| cuda_error("fsai_g", e))?;
+        // SAFETY: as above.
+        unsafe {
+            stream
+                .launch_builder(&kernels.fsai_gt)
+                .arg(&self.planes)
+                .arg(&self.offsets)
+                .arg(&stride)
+                .arg(set)
+                .arg(pos)
+                .arg(&self.y)
+                .arg(z)
+                .arg(&m32)
+                .arg(&n)
+                .launch(cfg)
+        }
+        .map(|_| ())
+        .map_err(|e| cuda_error("fsai_gt", e))
+    }
+}
