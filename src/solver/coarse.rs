@@ -31,16 +31,17 @@ use std::sync::{Mutex, RwLock};
 /// The most coarse unknowns: the block size doubles from [`MIN_BLOCK`] until the blocks
 /// of the grid are at most this many. Why: the factor is recomputed when the set changes
 /// (`k³/3` flops), which must stay small against a solve.
-const MAX_AGGREGATES: usize = 512;
+pub(crate) const MAX_AGGREGATES: usize = 512;
 /// The smallest block (cells per side).
 const MIN_BLOCK: usize = 8;
 /// Tasks the entries of `E`'s changed rows are cut into: more than threads, so that
 /// pairs of uneven cost (`|S_a| |S_b|` terms each) even out.
 const PAIR_TASKS: usize = 16;
 
-/// Aggregates, `E`'s factor and the scratch of the coarse solves.
+/// The aggregates of a grid: its `b x b` blocks of cells, and per block its sites on the
+/// current set and their compliances (both backends' coarse spaces keep these).
 #[derive(Debug)]
-pub(crate) struct Coarse {
+pub(crate) struct Aggregates {
     nx: usize,
     /// Cells per block side.
     block: usize,
@@ -49,32 +50,18 @@ pub(crate) struct Coarse {
     /// Per block: its sites on the current set (ascending) and their compliances.
     members: Vec<Vec<usize>>,
     dmembers: Vec<Vec<f64>>,
-    /// `Zᵀ C_SS Z` over all blocks, row-major (zero rows for empty blocks).
-    g: Vec<f64>,
-    /// The coarse unknowns: the non-empty blocks, ascending.
-    unknowns: Vec<usize>,
-    /// `L` of `E = L Lᵀ`, row-major `k x k` (lower triangle used).
-    lower: Vec<f64>,
-    /// `E⁻¹ c` and `cᵀ E⁻¹ c`.
-    w: Vec<f64>,
-    cw: f64,
-    /// Whether `E` was positive definite (the correction is skipped otherwise).
-    valid: bool,
-    /// Scratch of [`Coarse::update`].
+    /// Per block: whether the last [`Aggregates::enter`] changed its sites, or its sites
+    /// or their compliances.
+    moved: Vec<bool>,
+    touched: Vec<bool>,
+    /// Scratch of [`Aggregates::enter`].
     fresh: Vec<Vec<usize>>,
     dfresh: Vec<Vec<f64>>,
-    changed: Vec<bool>,
-    /// Per part: its partial `Zᵀ t` per block.
-    partial: Vec<Mutex<Vec<f64>>>,
-    /// The coarse solution per block (zero on empty blocks).
-    solution: RwLock<Vec<f64>>,
-    /// The restriction per unknown, then the solution (the leader's scratch).
-    rhs: Mutex<Vec<f64>>,
 }
 
-impl Coarse {
-    /// The aggregates of an `nx x ny` grid whose solves run over `parts` parts.
-    pub(crate) fn new(nx: usize, ny: usize, parts: usize) -> Self {
+impl Aggregates {
+    /// The blocks of an `nx x ny` grid, no sites yet.
+    pub(crate) fn new(nx: usize, ny: usize) -> Self {
         let mut block = MIN_BLOCK;
         while nx.div_ceil(block) * ny.div_ceil(block) > MAX_AGGREGATES {
             block *= 2;
@@ -87,15 +74,128 @@ impl Coarse {
             bx,
             members: vec![Vec::new(); count],
             dmembers: vec![Vec::new(); count],
+            moved: vec![false; count],
+            touched: vec![false; count],
+            fresh: vec![Vec::new(); count],
+            dfresh: vec![Vec::new(); count],
+        }
+    }
+
+    /// The blocks (at most [`MAX_AGGREGATES`]).
+    pub(crate) fn count(&self) -> usize {
+        self.members.len()
+    }
+
+    /// Cells per block side.
+    #[cfg(any(test, feature = "cuda"))]
+    pub(crate) fn block(&self) -> usize {
+        self.block
+    }
+
+    /// Blocks along x.
+    #[cfg(feature = "cuda")]
+    pub(crate) fn blocks_x(&self) -> usize {
+        self.bx
+    }
+
+    /// The block of a site.
+    pub(crate) fn aggregate(&self, site: usize) -> usize {
+        let (x, y) = (site % self.nx, site / self.nx);
+        (y / self.block) * self.bx + x / self.block
+    }
+
+    /// Block `a`'s sites on the current set, ascending.
+    pub(crate) fn members(&self, a: usize) -> &[usize] {
+        &self.members[a]
+    }
+
+    /// The sum of block `a`'s compliances (sites in order).
+    fn dsum(&self, a: usize) -> f64 {
+        self.dmembers[a].iter().sum()
+    }
+
+    /// Whether the last [`Aggregates::enter`] changed block `a`'s sites.
+    fn moved(&self, a: usize) -> bool {
+        self.moved[a]
+    }
+
+    /// Whether the last [`Aggregates::enter`] changed block `a`'s sites or their
+    /// compliances.
+    #[cfg(feature = "cuda")]
+    pub(crate) fn touched(&self, a: usize) -> bool {
+        self.touched[a]
+    }
+
+    /// Makes `set` (ascending sites) with compliances `d` the current one; returns the
+    /// first block whose sites or compliances changed.
+    pub(crate) fn enter(&mut self, set: &[usize], d: &[f64]) -> Option<usize> {
+        let mut fresh = std::mem::take(&mut self.fresh);
+        let mut dfresh = std::mem::take(&mut self.dfresh);
+        fresh.iter_mut().for_each(Vec::clear);
+        dfresh.iter_mut().for_each(Vec::clear);
+        for (&i, &di) in set.iter().zip(d) {
+            let a = self.aggregate(i);
+            fresh[a].push(i);
+            dfresh[a].push(di);
+        }
+        let mut first = None;
+        for a in 0..self.count() {
+            let sites = fresh[a] != self.members[a];
+            let comp = sites
+                || dfresh[a]
+                    .iter()
+                    .map(|x| x.to_bits())
+                    .ne(self.dmembers[a].iter().map(|x| x.to_bits()));
+            self.moved[a] = sites;
+            self.touched[a] = comp;
+            if comp && first.is_none() {
+                first = Some(a);
+            }
+        }
+        std::mem::swap(&mut self.members, &mut fresh);
+        std::mem::swap(&mut self.dmembers, &mut dfresh);
+        self.fresh = fresh;
+        self.dfresh = dfresh;
+        first
+    }
+}
+
+/// Aggregates, `E`'s factor and the scratch of the coarse solves.
+#[derive(Debug)]
+pub(crate) struct Coarse {
+    aggregates: Aggregates,
+    /// `Zᵀ C_SS Z` over all blocks, row-major (zero rows for empty blocks).
+    g: Vec<f64>,
+    /// The coarse unknowns: the non-empty blocks, ascending.
+    unknowns: Vec<usize>,
+    /// `L` of `E = L Lᵀ`, row-major `k x k` (lower triangle used).
+    lower: Vec<f64>,
+    /// `E⁻¹ c` and `cᵀ E⁻¹ c`.
+    w: Vec<f64>,
+    cw: f64,
+    /// Whether `E` was positive definite (the correction is skipped otherwise).
+    valid: bool,
+    /// Per part: its partial `Zᵀ t` per block.
+    partial: Vec<Mutex<Vec<f64>>>,
+    /// The coarse solution per block (zero on empty blocks).
+    solution: RwLock<Vec<f64>>,
+    /// The restriction per unknown, then the solution (the leader's scratch).
+    rhs: Mutex<Vec<f64>>,
+}
+
+impl Coarse {
+    /// The aggregates of an `nx x ny` grid whose solves run over `parts` parts.
+    pub(crate) fn new(nx: usize, ny: usize, parts: usize) -> Self {
+        let aggregates = Aggregates::new(nx, ny);
+        let count = aggregates.count();
+        Self {
+            aggregates,
             g: vec![0.0; count * count],
             unknowns: Vec::new(),
             lower: Vec::new(),
             w: Vec::new(),
             cw: 0.0,
             valid: false,
-            fresh: vec![Vec::new(); count],
-            dfresh: vec![Vec::new(); count],
-            changed: vec![false; count],
             partial: (0..parts).map(|_| Mutex::new(vec![0.0; count])).collect(),
             solution: RwLock::new(vec![0.0; count]),
             rhs: Mutex::new(Vec::new()),
@@ -105,7 +205,7 @@ impl Coarse {
     /// Cells per block side.
     #[cfg(test)]
     pub(crate) fn block(&self) -> usize {
-        self.block
+        self.aggregates.block()
     }
 
     /// The coarse unknowns (non-empty blocks) of the current set.
@@ -114,14 +214,19 @@ impl Coarse {
         self.unknowns.len()
     }
 
+    /// The coarse solution per block of the last [`Coarse::solve`].
+    #[cfg(test)]
+    pub(crate) fn solution(&self) -> Vec<f64> {
+        read(&self.solution).clone()
+    }
+
     /// Whether the coarse correction applies (`E` positive definite).
     pub(crate) fn valid(&self) -> bool {
         self.valid
     }
 
     fn aggregate(&self, site: usize) -> usize {
-        let (x, y) = (site % self.nx, site / self.nx);
-        (y / self.block) * self.bx + x / self.block
+        self.aggregates.aggregate(site)
     }
 
     /// Brings `E` and its factor up to date for `set` (ascending sites) with compliances
@@ -139,43 +244,18 @@ impl Coarse {
         d: &[f64],
         parallelism: Parallelism,
     ) -> Result<()> {
-        let count = self.members.len();
-        let mut fresh = std::mem::take(&mut self.fresh);
-        let mut dfresh = std::mem::take(&mut self.dfresh);
-        fresh.iter_mut().for_each(Vec::clear);
-        dfresh.iter_mut().for_each(Vec::clear);
-        for (&i, &di) in set.iter().zip(d) {
-            let a = self.aggregate(i);
-            fresh[a].push(i);
-            dfresh[a].push(di);
-        }
-        let mut first = None; // first block whose row of E changed
-        for a in 0..count {
-            let sites = fresh[a] != self.members[a];
-            let comp = sites
-                || dfresh[a]
-                    .iter()
-                    .map(|x| x.to_bits())
-                    .ne(self.dmembers[a].iter().map(|x| x.to_bits()));
-            self.changed[a] = sites;
-            if comp && first.is_none() {
-                first = Some(a);
-            }
-        }
-        std::mem::swap(&mut self.members, &mut fresh);
-        std::mem::swap(&mut self.dmembers, &mut dfresh);
-        self.fresh = fresh;
-        self.dfresh = dfresh;
+        let count = self.aggregates.count();
+        let first = self.aggregates.enter(set, d); // first block whose row of E changed
         let Some(first) = first else {
             return Ok(());
         };
         // A pair of changed blocks once (the first build: every pair once).
-        let changed = &self.changed;
+        let aggregates = &self.aggregates;
         let pairs: Vec<(usize, usize)> = (0..count)
-            .filter(|&a| changed[a])
+            .filter(|&a| aggregates.moved(a))
             .flat_map(|a| {
                 (0..count)
-                    .filter(move |&b| !(changed[b] && b < a))
+                    .filter(move |&b| !(aggregates.moved(b) && b < a))
                     .map(move |b| (a.min(b), a.max(b)))
             })
             .collect();
@@ -194,26 +274,26 @@ impl Coarse {
         let from = self.unknowns.partition_point(|&u| u < first);
         self.unknowns.truncate(from);
         self.unknowns
-            .extend((first..count).filter(|&a| !self.members[a].is_empty()));
+            .extend((first..count).filter(|&a| !self.aggregates.members(a).is_empty()));
         self.factor();
         Ok(())
     }
 
     /// `1_{S_a}ᵀ C 1_{S_b}` (`a ≤ b`): a pure function of the two blocks' sites.
     fn pair(&self, entries: &Entries, a: usize, b: usize) -> f64 {
-        entries.block_sum(&self.members[a], &self.members[b])
+        entries.block_sum(self.aggregates.members(a), self.aggregates.members(b))
     }
 
     /// `E`'s diagonal compliance term of block `a` (sites in order).
     fn dsum(&self, a: usize) -> f64 {
-        self.dmembers[a].iter().sum()
+        self.aggregates.dsum(a)
     }
 
     /// The Cholesky factor of `E` (faer's, one thread: a pure function of `E`), then
     /// `w = E⁻¹ c`.
     fn factor(&mut self) {
         let k = self.unknowns.len();
-        let count = self.members.len();
+        let count = self.aggregates.count();
         let mut e = Mat::<f64>::zeros(k, k);
         for (q, &uq) in self.unknowns.iter().enumerate() {
             let col = e.col_as_slice_mut(q);
@@ -249,7 +329,7 @@ impl Coarse {
         let c: Vec<f64> = self
             .unknowns
             .iter()
-            .map(|&a| self.members[a].len() as f64)
+            .map(|&a| self.aggregates.members(a).len() as f64)
             .collect();
         let mut w = c.clone();
         self.valid = result.is_ok() && pivots_ok;
@@ -313,7 +393,9 @@ impl Coarse {
             .unknowns
             .iter()
             .zip(rhs.iter())
-            .fold(0.0, |s, (&a, y)| s + self.members[a].len() as f64 * y)
+            .fold(0.0, |s, (&a, y)| {
+                s + self.aggregates.members(a).len() as f64 * y
+            })
             / self.cw;
         let mut solution = write(&self.solution);
         for ((&a, y), w) in self.unknowns.iter().zip(rhs.iter()).zip(&self.w) {
@@ -365,7 +447,7 @@ mod tests {
         coarse
             .update(&entries, &set, &d, Parallelism::Threads(2))
             .unwrap();
-        let count = coarse.members.len();
+        let count = coarse.aggregates.count();
         let mut e = vec![0.0; count * count];
         for (p, &i) in set.iter().enumerate() {
             for (q, &j) in set.iter().enumerate() {
@@ -440,8 +522,10 @@ mod tests {
         coarse.restrict(0, &set, &r, None);
         coarse.solve();
         let y = read(&coarse.solution).clone();
-        let count = coarse.members.len();
-        let c: Vec<f64> = coarse.members.iter().map(|m| m.len() as f64).collect();
+        let count = coarse.aggregates.count();
+        let c: Vec<f64> = (0..count)
+            .map(|a| coarse.aggregates.members(a).len() as f64)
+            .collect();
         let mut g = vec![0.0; count];
         for (&i, ri) in set.iter().zip(&r) {
             g[coarse.aggregate(i)] += ri;

@@ -31,6 +31,9 @@ static inline void sincospi(double a, double* s, double* c) {
 }
 using std::fabs;
 using std::fmax;
+using std::isfinite;
+using std::min;
+using std::sqrt;
 #define THREADS 1
 #include "kernels.cu"
 
@@ -100,6 +103,99 @@ static int pre() {
     return 0;
 }
 
+// y = the set product of x (with d x when with_d) and grid = the product on every cell:
+// operator.rs's launch sequence (`Transforms::filter`, then `gather_set`, `gather_grid`).
+static void product(const std::vector<double>& table, const std::vector<double>& x,
+                    const std::vector<int>& set, const std::vector<int>& pos,
+                    const std::vector<double>& d, std::vector<double>& y,
+                    std::vector<double>& grid, int with_d, int nx, int ny) {
+    size_t n = (size_t)nx * ny;
+    int m = (int)set.size();
+    std::vector<double> real_a(n), real_b(n);
+    std::vector<double2> rows((size_t)ny * (nx / 2 + 1)), columns((size_t)nx * (ny / 2 + 1)),
+        filtered((size_t)nx * (ny / 2 + 1));
+    launch(n, [&] { scatter_rows(x.data(), pos.data(), real_a.data(), nx, ny); });
+    d2z(real_a, rows, nx, ny);
+    launch(n, [&] { rows_to_columns(rows.data(), real_b.data(), nx, ny); });
+    d2z(real_b, columns, ny, nx);
+    launch((size_t)nx * (ny / 2 + 1),
+           [&] { filter_columns(columns.data(), table.data(), filtered.data(), nx, ny); });
+    z2d(filtered, real_a, ny, nx);
+    launch((size_t)ny * (nx / 2 + 1), [&] { columns_to_rows(real_a.data(), rows.data(), nx, ny); });
+    z2d(rows, real_b, nx, ny);
+    launch(m, [&] { gather_set(real_b.data(), set.data(), d.data(), x.data(), y.data(), with_d, m, nx); });
+    launch(n, [&] { gather_grid(real_b.data(), grid.data(), nx, ny); });
+}
+
+// "coarse nx ny block bx count", the operator's table (Ny x Nx), "rounds R", then per
+// round "m", m lines "cell d", "columns K" and K aggregates: the device's coarse upkeep
+// (DeviceCoarse::update) for each round's set, E kept from round to round: the listed
+// columns of E from the products of their indicators, the empty aggregates fixed, the
+// factor, the inverse, the border. Then m values r on the last set: its restriction, the
+// bordered solve, and r with the solution prolonged (sign +1). Output: info[0] info[1],
+// E (count x count), the solution (count), the prolonged r (m).
+static int coarse() {
+    int nx, ny, block, bx, count, rounds;
+    if (std::scanf("%d %d %d %d %d", &nx, &ny, &block, &bx, &count) != 5) return 2;
+    size_t n = (size_t)nx * ny;
+    std::vector<double> table(n);
+    for (auto& t : table)
+        if (std::scanf("%lf", &t) != 1) return 2;
+    size_t kk = (size_t)count * count;
+    std::vector<double> e(kk, 0.0), l(kk), inv(kk), c(count), w(count), g(count), sol(count),
+        info(2);
+    std::vector<int> set, pos(n, -1);
+    std::vector<double> d, x, y, grid(n);
+    if (std::scanf(" rounds %d", &rounds) != 1) return 2;
+    for (int round = 0; round < rounds; round++) {
+        int m, columns;
+        if (std::scanf("%d", &m) != 1) return 2;
+        set.assign(m, 0);
+        d.assign(m, 0.0);
+        x.assign(m, 0.0);
+        y.assign(m, 0.0);
+        pos.assign(n, -1);
+        for (int j = 0; j < m; j++) {
+            if (std::scanf("%d %lf", &set[j], &d[j]) != 2) return 2;
+            pos[set[j]] = j;
+        }
+        c.assign(count, 0.0);
+        for (int j = 0; j < m; j++) c[aggregate_of(set[j], nx, block, bx)] += 1.0;
+        if (std::scanf(" columns %d", &columns) != 1) return 2;
+        for (int k = 0; k < columns; k++) {
+            int a;
+            if (std::scanf("%d", &a) != 1) return 2;
+            launch(m, [&] { coarse_indicator(set.data(), m, nx, block, bx, a, x.data()); });
+            product(table, x, set, pos, d, y, grid, 1, nx, ny);
+            launch(count, [&] {
+                coarse_restrict(y.data(), y.data(), 0, pos.data(), nx, ny, block, bx, e.data(), a,
+                                count);
+            });
+        }
+        launch(count, [&] { coarse_fix_empty(e.data(), c.data(), count); });
+        l = e;
+        launch(1, [&] { coarse_factor(l.data(), count, info.data()); });
+        launch(count, [&] { coarse_invert(l.data(), count, inv.data()); });
+        launch(1, [&] { coarse_border(inv.data(), c.data(), count, w.data(), info.data()); });
+    }
+    int m = (int)set.size();
+    std::vector<double> r(m);
+    for (auto& v : r)
+        if (std::scanf("%lf", &v) != 1) return 2;
+    launch(count, [&] {
+        coarse_restrict(r.data(), r.data(), 0, pos.data(), nx, ny, block, bx, g.data(), -1, count);
+    });
+    launch(1, [&] {
+        coarse_solve(inv.data(), g.data(), c.data(), w.data(), info.data(), count, sol.data());
+    });
+    launch(m, [&] { coarse_prolong(r.data(), sol.data(), 1.0, set.data(), m, nx, block, bx); });
+    std::printf("%.17g %.17g\n", info[0], info[1]);
+    for (double v : e) std::printf("%.17g\n", v);
+    for (double v : sol) std::printf("%.17g\n", v);
+    for (double v : r) std::printf("%.17g\n", v);
+    return 0;
+}
+
 // "fsai nx ny stride", the stride offsets, "rounds R", then per round "count" and count
 // lines "cell w_0 .. w_{stride-1}" (fsai_scatter onto zero planes, round after round),
 // then "m" and m lines "cell r": z = G^T G r on the set, one value per line.
@@ -149,6 +245,7 @@ int main() {
     if (std::scanf("%15s", mode) != 1) return 2;
     if (std::string(mode) == "pre") return pre();
     if (std::string(mode) == "fsai") return fsai();
+    if (std::string(mode) == "coarse") return coarse();
     int nx, ny, m, with_d;
     if (std::scanf("%d %d %d %d", &nx, &ny, &m, &with_d) != 4) return 2;
     size_t n = (size_t)nx * ny;
@@ -160,20 +257,7 @@ int main() {
         if (std::scanf("%d %lf %lf", &set[j], &x[j], &d[j]) != 3) return 2;
         pos[set[j]] = j;
     }
-    std::vector<double> real_a(n), real_b(n);
-    std::vector<double2> rows((size_t)ny * (nx / 2 + 1)), columns((size_t)nx * (ny / 2 + 1)),
-        filtered((size_t)nx * (ny / 2 + 1));
-    launch(n, [&] { scatter_rows(x.data(), pos.data(), real_a.data(), nx, ny); });
-    d2z(real_a, rows, nx, ny);
-    launch(n, [&] { rows_to_columns(rows.data(), real_b.data(), nx, ny); });
-    d2z(real_b, columns, ny, nx);
-    launch((size_t)nx * (ny / 2 + 1),
-           [&] { filter_columns(columns.data(), table.data(), filtered.data(), nx, ny); });
-    z2d(filtered, real_a, ny, nx);
-    launch((size_t)ny * (nx / 2 + 1), [&] { columns_to_rows(real_a.data(), rows.data(), nx, ny); });
-    z2d(rows, real_b, nx, ny);
-    launch(m, [&] { gather_set(real_b.data(), set.data(), d.data(), x.data(), y.data(), with_d, m, nx); });
-    launch(n, [&] { gather_grid(real_b.data(), grid.data(), nx, ny); });
+    product(table, x, set, pos, d, y, grid, with_d, nx, ny);
     for (int j = 0; j < m; j++) std::printf("%.17g\n", y[j]);
     for (size_t i = 0; i < n; i++) std::printf("%.17g\n", grid[i]);
     // The reductions over y (modes 0, 1 with x, 2 with y, x, y), blocks as the device's

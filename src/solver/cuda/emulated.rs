@@ -353,3 +353,131 @@ fn the_fsai_kernels_apply_the_hosts_factor_after_its_updates() {
         assert!(max_rel(&stale, &host) > 1e-6, "{nx} x {ny}");
     }
 }
+
+/// The coarse space on the device over two sets, as `DeviceCoarse::update` runs it: the
+/// columns of `E` the host finds stale (`stale_columns`) from the products of their
+/// aggregates' indicators, then the factor, the inverse and the border; then a bordered
+/// solve and the prolongation on the second set. `E` is compared with the dense `Ĝ`'s
+/// sums over the aggregates' sites (`InfluencePlan::dense`), the solution with the
+/// host's `Coarse` built for the second set alone (its `E` from FSAI's exact entries,
+/// faer's Cholesky factor). The second set empties an aggregate, moves sites and changes
+/// a compliance; without its stale columns `E` is wrong, so a missed column fails.
+#[test]
+fn the_coarse_kernels_solve_the_hosts_coarse_problem() {
+    use super::coarse::stale_columns;
+    use crate::solver::coarse::{Aggregates, Coarse};
+    use crate::solver::fsai::Entries;
+    use crate::solver::parallel::Parallelism;
+    let (nx, ny) = (24, 17);
+    let (grid, plan) = planned(nx, ny, 0.02);
+    let n = grid.len();
+    let compliance = Compliance {
+        scale: 3.6e-16,
+        shift: 1e-3,
+        norm: 0.0,
+    };
+    let mut aggregates = Aggregates::new(nx, ny);
+    let (block, count) = (aggregates.block(), aggregates.count());
+    let bx = nx.div_ceil(block);
+    assert_eq!(count, 9);
+    let d_of = |set: &[usize], bump: usize| -> Vec<f64> {
+        set.iter()
+            .map(|&i| 1e-13 * (1.0 + (i % 3) as f64) * if i == bump { 2.0 } else { 1.0 })
+            .collect()
+    };
+    // About 60 % of the sites; the second set has none in the middle aggregate, two more
+    // sites in the first and one compliance changed in the last.
+    let first: Vec<usize> = (0..n).filter(|&i| (i * 7919 + 5) % 10 < 6).collect();
+    let mut second: Vec<usize> = first
+        .iter()
+        .copied()
+        .filter(|&i| aggregates.aggregate(i) != 4)
+        .collect();
+    second.extend(
+        (0..n)
+            .filter(|&i| aggregates.aggregate(i) == 0 && !first.contains(&i))
+            .take(2),
+    );
+    second.sort_unstable();
+    let bump = second[second.len() - 1];
+    let (d1, d2) = (d_of(&first, n), d_of(&second, bump));
+    let mut rounds = Vec::new();
+    for (set, d) in [(&first, &d1), (&second, &d2)] {
+        aggregates.enter(set, d);
+        rounds.push((set, d, stale_columns(&aggregates)));
+    }
+    assert_eq!(rounds[0].2.len(), count, "the first set: every column");
+    assert_eq!(
+        rounds[1].2,
+        vec![0, 4, 8],
+        "the changed aggregates' columns"
+    );
+    let r = values(second.len(), 31);
+    let emulate_rounds = |columns_of_second: &[usize]| -> Vec<f64> {
+        let mut input = format!("coarse {nx} {ny} {block} {bx} {count}\n");
+        for v in table(&plan, compliance, |e| e) {
+            input += &format!("{v:e}\n");
+        }
+        input += &format!("rounds {}\n", rounds.len());
+        for (k, (set, d, columns)) in rounds.iter().enumerate() {
+            input += &format!("{}\n", set.len());
+            for (i, di) in set.iter().zip(d.iter()) {
+                input += &format!("{i} {di:e}\n");
+            }
+            let columns = if k == 1 { columns_of_second } else { columns };
+            input += &format!("columns {}", columns.len());
+            for a in columns {
+                input += &format!(" {a}");
+            }
+            input += "\n";
+        }
+        for ri in &r {
+            input += &format!("{ri:e}\n");
+        }
+        emulate(&input)
+    };
+    let out = emulate_rounds(&rounds[1].2);
+    assert_eq!(out.len(), 2 + count * count + count + second.len());
+    let (info, rest) = out.split_at(2);
+    let (e, rest) = rest.split_at(count * count);
+    let (solution, prolonged) = rest.split_at(count);
+    assert_eq!(info[0], 1.0, "E is definite");
+    // E against the dense sums on the second set.
+    let dense = plan.dense().unwrap();
+    let mut want = vec![0.0; count * count];
+    for (p, &i) in second.iter().enumerate() {
+        for (q, &j) in second.iter().enumerate() {
+            let v = compliance.scale * (dense[i * n + j] - compliance.shift)
+                + if p == q { d2[p] } else { 0.0 };
+            want[aggregates.aggregate(i) * count + aggregates.aggregate(j)] += v;
+        }
+    }
+    // The empty aggregate's row is the identity's; the others are compared on their
+    // own scale.
+    assert_eq!(e[4 * count + 4], 1.0);
+    let off_identity = |e: &[f64]| -> Vec<f64> {
+        let mut e = e.to_vec();
+        e[4 * count + 4] = 0.0;
+        e
+    };
+    let err = max_rel(&off_identity(e), &want);
+    assert!(err < 1e-11, "E off by {err:e}");
+    let entries = Entries::new(&plan, compliance.scale, compliance.shift);
+    let mut host = Coarse::new(nx, ny, 1);
+    host.update(&entries, &second, &d2, Parallelism::Sequential)
+        .unwrap();
+    assert!(host.valid());
+    host.restrict(0, &second, &r, None);
+    host.solve();
+    let err = max_rel(solution, &host.solution());
+    assert!(err < 1e-9, "coarse solution off by {err:e}");
+    assert_eq!(solution[4], 0.0);
+    let mut x = r.clone();
+    host.prolong(&second, &mut x, 1.0);
+    let err = max_rel(prolonged, &x);
+    assert!(err < 1e-12, "prolongation off by {err:e}");
+    // Without the second set's columns E is stale.
+    let stale = emulate_rounds(&[]);
+    let err = max_rel(&off_identity(&stale[2..2 + count * count]), &want);
+    assert!(err > 1e-3, "stale E off by only {err:e}");
+}

@@ -300,3 +300,145 @@ extern "C" __global__ void fsai_gt(const double* planes, const int* offsets, int
     }
     z[j] = acc;
 }
+
+// The coarse space of the two-level preconditioner (solver/coarse.rs; A-DEF2 in the CG).
+// Aggregates are the blocks of block x block cells, bx along x, count in all. The device
+// keeps E = Z^T A Z over all of them (row-major; an empty aggregate's row is the
+// identity's), its Cholesky factor, its inverse, w = E^-1 c and info = [valid, c^T w]
+// (c: the aggregates' site counts).
+
+__device__ __forceinline__ int aggregate_of(int cell, int nx, int block, int bx) {
+    return (cell / nx / block) * bx + (cell % nx) / block;
+}
+
+// x = the indicator of aggregate a's sites, on the set.
+extern "C" __global__ void coarse_indicator(const int* set, int m, int nx, int block, int bx,
+                                            int a, double* x) {
+    int j = blockIdx.x * blockDim.x + threadIdx.x;
+    if (j >= m) return;
+    x[j] = aggregate_of(set[j], nx, block, bx) == a ? 1.0 : 0.0;
+}
+
+// The restriction Z^T (v - t) (t when subtract) or Z^T v: one block of threads per
+// aggregate b, its cells in a fixed order, then the block's tree. Into E's column and row
+// `column` when column >= 0 (count x count), else into out[b].
+extern "C" __global__ void coarse_restrict(const double* v, const double* t, int subtract,
+                                           const int* pos, int nx, int ny, int block, int bx,
+                                           double* out, int column, int count) {
+    __shared__ double shared[3 * THREADS];
+    int b = blockIdx.x;
+    int x0 = (b % bx) * block, y0 = (b / bx) * block;
+    int w = min(block, nx - x0), h = min(block, ny - y0);
+    double acc[3] = {0.0, 0.0, 0.0};
+    for (int c = threadIdx.x; c < w * h; c += THREADS) {
+        int p = pos[(y0 + c / w) * nx + x0 + c % w];
+        if (p >= 0) acc[0] += subtract ? v[p] - t[p] : v[p];
+    }
+    block_tree(0, acc, shared);
+    if (threadIdx.x != 0) return;
+    if (column >= 0) {
+        out[(size_t)b * count + column] = acc[0];
+        out[(size_t)column * count + b] = acc[0];
+    } else {
+        out[b] = acc[0];
+    }
+}
+
+// An empty aggregate's row and column of E are zero: its diagonal becomes 1, so that E
+// stays definite and the aggregate's coarse value 0.
+extern "C" __global__ void coarse_fix_empty(double* e, const double* c, int count) {
+    int a = blockIdx.x * blockDim.x + threadIdx.x;
+    if (a < count && c[a] == 0.0) e[(size_t)a * count + a] = 1.0;
+}
+
+// E = L L^T in place (the lower triangle of l, count x count; one block of threads, the
+// pivots in order); info[0] = 1 when every pivot is positive and finite, else 0.
+extern "C" __global__ void coarse_factor(double* l, int k, double* info) {
+    __shared__ int ok;
+    if (threadIdx.x == 0) ok = 1;
+    __syncthreads();
+    for (int p = 0; p < k; p++) {
+        if (threadIdx.x == 0) {
+            double d = l[(size_t)p * k + p];
+            if (d > 0.0 && isfinite(d))
+                l[(size_t)p * k + p] = sqrt(d);
+            else
+                ok = 0;
+        }
+        __syncthreads();
+        if (!ok) break;
+        double pivot = l[(size_t)p * k + p];
+        for (int q = p + 1 + threadIdx.x; q < k; q += THREADS) l[(size_t)q * k + p] /= pivot;
+        __syncthreads();
+        for (int q = p + 1 + threadIdx.x; q < k; q += THREADS) {
+            double lqp = l[(size_t)q * k + p];
+            for (int r = p + 1; r <= q; r++) l[(size_t)q * k + r] -= lqp * l[(size_t)r * k + p];
+        }
+        __syncthreads();
+    }
+    if (threadIdx.x == 0) info[0] = ok ? 1.0 : 0.0;
+}
+
+// E^-1 from its factor, one thread per column q: L y = e_q, then L^T x = y, x written to
+// inv[p * k + q] (adjacent threads, adjacent values).
+extern "C" __global__ void coarse_invert(const double* l, int k, double* inv) {
+    int q = blockIdx.x * blockDim.x + threadIdx.x;
+    if (q >= k) return;
+    for (int p = 0; p < q; p++) inv[(size_t)p * k + q] = 0.0;
+    for (int p = q; p < k; p++) {
+        double s = p == q ? 1.0 : 0.0;
+        for (int r = q; r < p; r++) s -= l[(size_t)p * k + r] * inv[(size_t)r * k + q];
+        inv[(size_t)p * k + q] = s / l[(size_t)p * k + p];
+    }
+    for (int p = k - 1; p >= 0; p--) {
+        double s = inv[(size_t)p * k + q];
+        for (int r = p + 1; r < k; r++) s -= l[(size_t)r * k + p] * inv[(size_t)r * k + q];
+        inv[(size_t)p * k + q] = s / l[(size_t)p * k + p];
+    }
+}
+
+// out = E^-1 x (E^-1 symmetric: row a read as column a, adjacent threads adjacent values).
+__device__ void inverse_product(const double* inv, const double* x, int k, double* out) {
+    for (int a = threadIdx.x; a < k; a += THREADS) {
+        double s = 0.0;
+        for (int b = 0; b < k; b++) s += inv[(size_t)b * k + a] * x[b];
+        out[a] = s;
+    }
+}
+
+// w = E^-1 c and info[1] = c^T w; info[0] cleared unless c^T w is positive and finite.
+// One block of threads.
+extern "C" __global__ void coarse_border(const double* inv, const double* c, int k, double* w,
+                                         double* info) {
+    inverse_product(inv, c, k, w);
+    __syncthreads();
+    if (threadIdx.x != 0) return;
+    double cw = 0.0;
+    for (int a = 0; a < k; a++) cw += c[a] * w[a];
+    info[1] = cw;
+    if (!(cw > 0.0 && isfinite(cw))) info[0] = 0.0;
+}
+
+// The bordered coarse solve of g (solver/coarse.rs): y = E^-1 g, mu = c^T y / c^T w,
+// sol = y - mu w. One block of threads.
+extern "C" __global__ void coarse_solve(const double* inv, const double* g, const double* c,
+                                        const double* w, const double* info, int k, double* sol) {
+    __shared__ double mu;
+    inverse_product(inv, g, k, sol);
+    __syncthreads();
+    if (threadIdx.x == 0) {
+        double cy = 0.0;
+        for (int a = 0; a < k; a++) cy += c[a] * sol[a];
+        mu = cy / info[1];
+    }
+    __syncthreads();
+    for (int a = threadIdx.x; a < k; a += THREADS) sol[a] -= mu * w[a];
+}
+
+// x[j] += sign * sol[the aggregate of set[j]].
+extern "C" __global__ void coarse_prolong(double* x, const double* sol, double sign,
+                                          const int* set, int m, int nx, int block, int bx) {
+    int j = blockIdx.x * blockDim.x + threadIdx.x;
+    if (j >= m) return;
+    x[j] += sign * sol[aggregate_of(set[j], nx, block, bx)];
+}

@@ -1,10 +1,12 @@
 //! The device memory a CUDA solver needs, estimated and checked against what the GPU has
 //! free before anything is allocated.
 
+use super::coarse::coarse_bytes;
 use super::fsai::fsai_bytes;
 use super::operator::transform_bytes;
 use super::phases::vector_bytes;
 use crate::error::{Error, Result};
+use crate::solver::coarse::Aggregates;
 use crate::solver::fsai::pattern_slots;
 use crate::solver::spectral::FSAI_RADIUS;
 
@@ -24,6 +26,7 @@ pub(super) fn device_bytes(nx: usize, ny: usize) -> f64 {
     vector_bytes(nx * ny)
         + transform_bytes(nx, ny)
         + fsai_bytes(nx * ny, pattern_slots(FSAI_RADIUS))
+        + coarse_bytes(Aggregates::new(nx, ny).count())
         + 3.0 * 8.0 * n
         + FFT_WORK_PER_CELL * n
         + FIXED_BYTES
@@ -46,16 +49,19 @@ mod tests {
     use super::*;
 
     /// The estimate counted by hand for a 4 x 3 grid (12 cells): per cell 2 index arrays
-    /// (4 B) and 9 set vectors (8 B), 2 real grids (8 B), 3 tables/grid outputs (8 B),
+    /// (4 B) and 10 set vectors (8 B), 2 real grids (8 B), 3 tables/grid outputs (8 B),
     /// FSAI's 5 weight planes and its scratch vector (8 B) and 64 B of FFT work; half
     /// spectra 3·3 (rows) and 4·2 twice (columns) of 16 B; the reductions' 3·1024 + 3
-    /// values; FSAI's 5 offsets (4 B); 64 MiB fixed.
+    /// values; FSAI's 5 offsets (4 B); the coarse space of one aggregate: `E`, its factor
+    /// and inverse (1 value each), 5 vectors of 1 and 2 more values (8 B); 64 MiB fixed.
     #[test]
     fn the_estimate_counts_every_buffer() {
-        let per_cell = 2.0 * 4.0 + 9.0 * 8.0 + 2.0 * 8.0 + 3.0 * 8.0 + 6.0 * 8.0 + 64.0;
+        let per_cell = 2.0 * 4.0 + 10.0 * 8.0 + 2.0 * 8.0 + 3.0 * 8.0 + 6.0 * 8.0 + 64.0;
         let spectra = 16.0 * (9.0 + 2.0 * 8.0);
         let reductions = 8.0 * (3.0 * 1024.0 + 3.0);
-        let expected = 12.0 * per_cell + spectra + reductions + 5.0 * 4.0 + 64.0 * 1024.0 * 1024.0;
+        let coarse = 8.0 * (3.0 + 5.0 + 2.0);
+        let expected =
+            12.0 * per_cell + spectra + reductions + 5.0 * 4.0 + coarse + 64.0 * 1024.0 * 1024.0;
         assert_eq!(device_bytes(4, 3), expected);
     }
 

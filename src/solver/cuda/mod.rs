@@ -5,15 +5,16 @@
 //! host. Per set solve the set, `d`, `b` and the warm start go up and the tractions and
 //! the displacements' grid product come back (a few `O(N)` copies).
 //!
-//! Preconditioners: the host's choices but the coarse space. Cold solves take the
-//! restricted spectral inverse; warm normal solves FSAI (its rows built on the host,
-//! `fsai.rs`), also on the grids where the host adds the coarse space; warm tangential
-//! solves Jacobi.
+//! Preconditioners: the host's choices. Cold solves take the restricted spectral inverse;
+//! warm normal solves FSAI (its rows built on the host, `fsai.rs`) with the coarse space
+//! of aggregates on large grids (`coarse.rs`, kept on the device); warm tangential solves
+//! Jacobi.
 
 // Kernel launches, copies and libraries opened by path are unsafe calls of the bindings;
 // each says why it is sound.
 #![allow(unsafe_code)]
 
+mod coarse;
 mod device;
 mod fsai;
 mod libraries;
@@ -33,6 +34,7 @@ use super::spectral::{Precond, FSAI_RADIUS};
 use super::system::Compliance;
 use crate::error::{Error, Result};
 use crate::green::InfluencePlan;
+use coarse::DeviceCoarse;
 use cudarc::driver::CudaSlice;
 use device::{cuda_error, Gpu};
 use fsai::DeviceFsai;
@@ -55,6 +57,8 @@ pub(crate) struct CudaCore {
     /// FSAI: the exact local entries of `C_s` and the factor on the host (built on first
     /// use), its copy on the device.
     fsai: Option<(Entries, Fsai, DeviceFsai)>,
+    /// The two-level preconditioner's coarse space (built on first use).
+    coarse: Option<DeviceCoarse>,
     /// The grid product of the last solve (`C_s f` on every cell).
     grid: CudaSlice<f64>,
 }
@@ -103,6 +107,7 @@ impl CudaCore {
             operator,
             inverse: None,
             fsai: None,
+            coarse: None,
             grid,
         })
     }
@@ -130,8 +135,7 @@ impl CudaCore {
         Ok(())
     }
 
-    /// Solves `problem` with `precond` (FSAI for the two-level one: the device has no
-    /// coarse space); `f` holds the warm start.
+    /// Solves `problem` with `precond`; `f` holds the warm start.
     pub(crate) fn solve(
         &mut self,
         problem: SetProblem<'_>,
@@ -177,8 +181,11 @@ impl CudaCore {
             self.prepare_fsai(problem)?;
         }
         self.upload_problem(problem, &f)?;
+        if precond == Precond::TwoLevel {
+            self.prepare_coarse(problem)?;
+        }
         let stream = &self.gpu.stream;
-        let precond = match (precond, &self.inverse, &mut self.fsai) {
+        let device_precond = match (precond, &self.inverse, &mut self.fsai) {
             (Precond::Spectral, Some((_, table)), _) => DevicePrecond::Spectral { table },
             (Precond::Fsai | Precond::TwoLevel, _, Some((_, _, device))) => {
                 DevicePrecond::Fsai(device)
@@ -193,7 +200,11 @@ impl CudaCore {
             transforms: &mut self.transforms,
             operator: &self.operator,
             v: &mut self.vectors,
-            precond,
+            precond: device_precond,
+            coarse: match precond {
+                Precond::TwoLevel => self.coarse.as_mut().filter(|c| c.valid()),
+                _ => None,
+            },
             m,
             norm: self.compliance.norm + problem.d.iter().fold(0.0f64, |a, x| a.max(*x)),
             error: None,
@@ -243,6 +254,33 @@ impl CudaCore {
         };
         fsai.update(entries, problem.set, problem.d);
         device.sync(stream, &self.kernels, fsai)
+    }
+
+    /// The coarse space brought up to date for the problem's set and compliances (already
+    /// on the device). After a failure its state is dropped: the next solve builds it
+    /// anew rather than trust a half-updated `E`.
+    fn prepare_coarse(&mut self, problem: SetProblem<'_>) -> Result<()> {
+        let stream = &self.gpu.stream;
+        let coarse = match &mut self.coarse {
+            Some(built) => built,
+            slot => {
+                let grid = self.plan.grid();
+                slot.insert(DeviceCoarse::new(stream, grid.nx(), grid.ny())?)
+            }
+        };
+        let updated = coarse.update(
+            stream,
+            &self.kernels,
+            &mut self.transforms,
+            &self.operator,
+            &mut self.vectors,
+            problem.set,
+            problem.d,
+        );
+        if updated.is_err() {
+            self.coarse = None;
+        }
+        updated
     }
 
     /// The set, its positions on the grid, `d`, `b` and the warm start `f` to the device.

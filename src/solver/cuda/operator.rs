@@ -44,6 +44,14 @@ pub(super) struct Kernels {
     pub(super) fsai_scatter: CudaFunction,
     pub(super) fsai_g: CudaFunction,
     pub(super) fsai_gt: CudaFunction,
+    pub(super) coarse_indicator: CudaFunction,
+    pub(super) coarse_restrict: CudaFunction,
+    pub(super) coarse_fix_empty: CudaFunction,
+    pub(super) coarse_factor: CudaFunction,
+    pub(super) coarse_invert: CudaFunction,
+    pub(super) coarse_border: CudaFunction,
+    pub(super) coarse_solve: CudaFunction,
+    pub(super) coarse_prolong: CudaFunction,
 }
 
 impl Kernels {
@@ -92,6 +100,14 @@ impl Kernels {
             fsai_scatter: load("fsai_scatter")?,
             fsai_g: load("fsai_g")?,
             fsai_gt: load("fsai_gt")?,
+            coarse_indicator: load("coarse_indicator")?,
+            coarse_restrict: load("coarse_restrict")?,
+            coarse_fix_empty: load("coarse_fix_empty")?,
+            coarse_factor: load("coarse_factor")?,
+            coarse_invert: load("coarse_invert")?,
+            coarse_border: load("coarse_border")?,
+            coarse_solve: load("coarse_solve")?,
+            coarse_prolong: load("coarse_prolong")?,
         })
     }
 }

@@ -2,6 +2,7 @@
 //! phase, the kernels run its local updates and main work on the set vectors, and only
 //! the phase's three scalars cross to the host (one small copy per reduction).
 
+use super::coarse::{DeviceCoarse, Target};
 use super::device::{cuda_error, zeros};
 use super::fsai::DeviceFsai;
 use super::operator::{over, Kernels, Transforms, THREADS};
@@ -29,13 +30,15 @@ pub(super) struct SetVectors {
     pub(super) q: CudaSlice<f64>,
     pub(super) w: CudaSlice<f64>,
     pub(super) best: CudaSlice<f64>,
+    /// `A z` of the coarse correction.
+    pub(super) t: CudaSlice<f64>,
     partials: CudaSlice<f64>,
     scalars: CudaSlice<f64>,
 }
 
 /// The bytes of [`SetVectors`] on a grid of `n` cells.
 pub(super) fn vector_bytes(n: usize) -> f64 {
-    (2.0 * 4.0 + 9.0 * 8.0) * n as f64 + 8.0 * (3 * REDUCTION_BLOCKS + 3) as f64
+    (2.0 * 4.0 + 10.0 * 8.0) * n as f64 + 8.0 * (3 * REDUCTION_BLOCKS + 3) as f64
 }
 
 impl SetVectors {
@@ -54,6 +57,7 @@ impl SetVectors {
             q: real(n)?,
             w: real(n)?,
             best: real(n)?,
+            t: real(n)?,
             partials: real(3 * REDUCTION_BLOCKS)?,
             scalars: real(3)?,
         })
@@ -82,6 +86,8 @@ pub(super) struct DevicePhases<'a> {
     pub(super) m: usize,
     /// `‖A‖₂` bound (m/Pa).
     pub(super) norm: f64,
+    /// The coarse space, when it applies (A-DEF2: pcg.rs).
+    pub(super) coarse: Option<&'a mut DeviceCoarse>,
     /// The first failed CUDA call: later phases do nothing and return NaN, which stops
     /// the CG; the solve returns this error.
     pub(super) error: Option<Error>,
@@ -94,11 +100,14 @@ enum Product {
     Direction,
     /// `r = A f`.
     Residual,
+    /// `t = A z` (the coarse correction's).
+    Coarse,
 }
 
 impl DevicePhases<'_> {
     fn try_run(&mut self, phase: Phase) -> Result<[f64; 3]> {
         self.pre(phase.pre)?;
+        self.prolong(phase.pre)?;
         match phase.main {
             Main::Nothing => Ok([0.0; 3]),
             Main::SumF => {
@@ -121,9 +130,43 @@ impl DevicePhases<'_> {
                 Ok([s, 0.0, 0.0])
             }
             Main::Measure => self.reduce(2, Vector::R, Vector::F, Vector::Z),
-            // No coarse space on the device (`has_coarse` is false): never asked.
-            Main::CoarseProduct { .. } | Main::Restrict => Ok([0.0; 3]),
+            Main::CoarseProduct { .. } => {
+                self.product(Product::Coarse)?;
+                self.restrict(true)?;
+                Ok([0.0; 3])
+            }
+            Main::Restrict => {
+                self.restrict(false)?;
+                Ok([0.0; 3])
+            }
         }
+    }
+
+    /// `Zᵀ (r - t)` (`with_t`) or `Zᵀ r`, for the next coarse solve (asked only when the
+    /// coarse space applies).
+    fn restrict(&mut self, with_t: bool) -> Result<()> {
+        let Some(coarse) = self.coarse.as_deref_mut() else {
+            return Ok(());
+        };
+        let v = &*self.v;
+        let t = with_t.then_some(&v.t);
+        coarse.restrict(self.stream, self.kernels, &v.r, t, &v.pos, Target::Rhs)
+    }
+
+    /// The prolongations a phase's updates ask for, after the others: `f -= Z y`,
+    /// `z += Z y`.
+    fn prolong(&mut self, pre: Pre) -> Result<()> {
+        let Some(coarse) = self.coarse.as_deref() else {
+            return Ok(());
+        };
+        let v = &mut *self.v;
+        if pre.coarse_f {
+            coarse.prolong(self.stream, self.kernels, &mut v.f, -1.0, &v.set, self.m)?;
+        }
+        if pre.coarse_z {
+            coarse.prolong(self.stream, self.kernels, &mut v.z, 1.0, &v.set, self.m)?;
+        }
+        Ok(())
     }
 
     /// The local updates of `pre` (pcg.rs's `Pre::apply`, kernels.cu's flags).
@@ -200,6 +243,7 @@ impl DevicePhases<'_> {
         let (x, y) = match which {
             Product::Direction => (&v.p, &mut v.q),
             Product::Residual => (&v.f, &mut v.r),
+            Product::Coarse => (&v.z, &mut v.t),
         };
         self.transforms
             .filter(self.stream, self.kernels, self.operator, x, &v.pos)?;
@@ -374,7 +418,16 @@ impl PhaseRunner for DevicePhases<'_> {
         self.norm
     }
     fn has_coarse(&self) -> bool {
-        false
+        self.coarse.as_ref().is_some_and(|c| c.valid())
     }
-    fn coarse_solve(&mut self) {}
+    fn coarse_solve(&mut self) {
+        if self.error.is_some() {
+            return;
+        }
+        if let Some(coarse) = self.coarse.as_deref_mut() {
+            if let Err(e) = coarse.solve(self.stream, self.kernels) {
+                self.error = Some(e);
+            }
+        }
+    }
 }
