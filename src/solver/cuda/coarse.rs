@@ -13,7 +13,7 @@
 
 use super::device::{cuda_error, zeros};
 use super::operator::{over, Kernels, Transforms, THREADS};
-use super::phases::SetVectors;
+use super::vectors::SetVectors;
 use crate::error::Result;
 use crate::solver::coarse::Aggregates;
 use cudarc::driver::{CudaSlice, CudaStream, LaunchConfig, PushKernelArg};

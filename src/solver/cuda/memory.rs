@@ -4,7 +4,7 @@
 use super::coarse::coarse_bytes;
 use super::fsai::fsai_bytes;
 use super::operator::transform_bytes;
-use super::phases::vector_bytes;
+use super::vectors::vector_bytes;
 use crate::error::{Error, Result};
 use crate::solver::coarse::Aggregates;
 use crate::solver::fsai::pattern_slots;

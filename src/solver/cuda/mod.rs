@@ -21,6 +21,7 @@ mod libraries;
 mod memory;
 mod operator;
 mod phases;
+mod vectors;
 
 #[cfg(test)]
 mod emulated;
@@ -39,7 +40,8 @@ use cudarc::driver::CudaSlice;
 use device::{cuda_error, Gpu};
 use fsai::DeviceFsai;
 use operator::{Kernels, Transforms};
-use phases::{DevicePhases, DevicePrecond, SetVectors};
+use phases::{DevicePhases, DevicePrecond};
+use vectors::SetVectors;
 
 /// The device's state kept between solves: kernels, plans, buffers, the operator's table
 /// and the spectral preconditioner's with its `d̄`.

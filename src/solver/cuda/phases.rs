@@ -3,66 +3,14 @@
 //! the phase's three scalars cross to the host (one small copy per reduction).
 
 use super::coarse::{DeviceCoarse, Target};
-use super::device::{cuda_error, zeros};
+use super::device::cuda_error;
 use super::fsai::DeviceFsai;
 use super::operator::{over, Kernels, Transforms, THREADS};
+use super::vectors::{SetVectors, REDUCTION_BLOCKS};
 use crate::error::{Error, Result};
 use crate::solver::pcg::{Main, Phase, PhaseRunner, Pre};
 use cudarc::driver::{CudaSlice, CudaStream, LaunchConfig, PushKernelArg};
 use std::sync::Arc;
-
-/// Blocks of a reduction's first pass, at most: fixed by the vector's length alone, so the
-/// order of the additions (hence the bits) is too.
-const REDUCTION_BLOCKS: usize = 1024;
-
-/// The set's vectors on the device, each of capacity `N` (the set's first `m` values are
-/// used), and the reductions' buffers.
-pub(super) struct SetVectors {
-    pub(super) set: CudaSlice<i32>,
-    /// The set position of every cell, or -1.
-    pub(super) pos: CudaSlice<i32>,
-    pub(super) d: CudaSlice<f64>,
-    pub(super) b: CudaSlice<f64>,
-    pub(super) f: CudaSlice<f64>,
-    pub(super) r: CudaSlice<f64>,
-    pub(super) z: CudaSlice<f64>,
-    pub(super) p: CudaSlice<f64>,
-    pub(super) q: CudaSlice<f64>,
-    pub(super) w: CudaSlice<f64>,
-    pub(super) best: CudaSlice<f64>,
-    /// `A z` of the coarse correction.
-    pub(super) t: CudaSlice<f64>,
-    partials: CudaSlice<f64>,
-    scalars: CudaSlice<f64>,
-}
-
-/// The bytes of [`SetVectors`] on a grid of `n` cells.
-pub(super) fn vector_bytes(n: usize) -> f64 {
-    (2.0 * 4.0 + 10.0 * 8.0) * n as f64 + 8.0 * (3 * REDUCTION_BLOCKS + 3) as f64
-}
-
-impl SetVectors {
-    pub(super) fn new(stream: &Arc<CudaStream>, n: usize) -> Result<Self> {
-        let real = |len: usize| zeros::<f64>(stream, len);
-        let int = |len: usize| zeros::<i32>(stream, len);
-        Ok(SetVectors {
-            set: int(n)?,
-            pos: int(n)?,
-            d: real(n)?,
-            b: real(n)?,
-            f: real(n)?,
-            r: real(n)?,
-            z: real(n)?,
-            p: real(n)?,
-            q: real(n)?,
-            w: real(n)?,
-            best: real(n)?,
-            t: real(n)?,
-            partials: real(3 * REDUCTION_BLOCKS)?,
-            scalars: real(3)?,
-        })
-    }
-}
 
 /// The preconditioner of a device solve.
 pub(super) enum DevicePrecond<'a> {
