@@ -267,16 +267,6 @@ fn field<'py>(
     Ok(array.into_pyarray(py))
 }
 
-/// `threads=` as the scene file's `solver.threads` reads a count: 1 the calling thread
-/// only, 0 every core, `n` a pool of `n`.
-fn parallelism(threads: usize) -> Parallelism {
-    match threads {
-        0 => Parallelism::all_cores(),
-        1 => Parallelism::Sequential,
-        n => Parallelism::Threads(n),
-    }
-}
-
 /// A dict in the scene-file format as JSON text, through `precursors._scene.dumps`
 /// (numpy scalars and arrays become numbers and lists).
 fn dumps(py: Python<'_>, value: &Bound<'_, PyAny>) -> PyResult<String> {
@@ -587,7 +577,7 @@ struct Driver {
 impl Driver {
     fn with_threads(mut inner: precursors::Driver, threads: Option<usize>) -> PyResult<Self> {
         if let Some(n) = threads {
-            inner.set_parallelism(parallelism(n)).or_raise()?;
+            inner.set_parallelism(Parallelism::from_count(n)).or_raise()?;
         }
         Ok(Driver { inner })
     }

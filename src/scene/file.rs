@@ -331,9 +331,8 @@ impl From<Parallelism> for ThreadsSpec {
 impl From<ThreadsSpec> for Parallelism {
     fn from(t: ThreadsSpec) -> Self {
         match t {
-            ThreadsSpec::Count(0) | ThreadsSpec::Name(ThreadsName::All) => Parallelism::all_cores(),
-            ThreadsSpec::Count(1) => Parallelism::Sequential,
-            ThreadsSpec::Count(n) => Parallelism::Threads(n),
+            ThreadsSpec::Count(n) => Parallelism::from_count(n),
+            ThreadsSpec::Name(ThreadsName::All) => Parallelism::all_cores(),
             ThreadsSpec::Name(ThreadsName::Current) => Parallelism::CurrentPool,
         }
     }

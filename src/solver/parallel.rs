@@ -78,6 +78,24 @@ impl Parallelism {
         Self::Threads(n)
     }
 
+    /// The parallelism a thread count asks for, as the scene file's `solver.threads`
+    /// reads it (Python's `threads=` too): `0` every core ([`Parallelism::all_cores`]),
+    /// `1` the calling thread only, `n` the caller and `n - 1` helpers.
+    ///
+    /// ```
+    /// use precursors::solver::Parallelism;
+    /// assert_eq!(Parallelism::from_count(1), Parallelism::Sequential);
+    /// assert_eq!(Parallelism::from_count(3), Parallelism::Threads(3));
+    /// assert_eq!(Parallelism::from_count(0), Parallelism::all_cores());
+    /// ```
+    pub fn from_count(threads: usize) -> Self {
+        match threads {
+            0 => Self::all_cores(),
+            1 => Self::Sequential,
+            n => Self::Threads(n),
+        }
+    }
+
     /// Threads a solve uses: the caller plus its helpers.
     pub fn threads(&self) -> usize {
         match self {
