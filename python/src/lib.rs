@@ -577,7 +577,9 @@ struct Driver {
 impl Driver {
     fn with_threads(mut inner: precursors::Driver, threads: Option<usize>) -> PyResult<Self> {
         if let Some(n) = threads {
-            inner.set_parallelism(Parallelism::from_count(n)).or_raise()?;
+            inner
+                .set_parallelism(Parallelism::from_count(n))
+                .or_raise()?;
         }
         Ok(Driver { inner })
     }

@@ -4,10 +4,11 @@
 #[cfg(feature = "cli")]
 pub mod program;
 
-/// A new, empty directory for one test: `precursors-<pid>-<module>-<name>` under the
-/// temporary directory, emptied if a run before left it. `module` is the calling test
-/// file's name (`sweep` for tests/sweep.rs): the pid keeps two test processes apart,
-/// `module` and `name` the tests of one process.
+/// A new, empty directory for one test: `precursors-<pid>-<module>-<name>` under cargo's
+/// scratch directory for integration tests (`target/tmp`, which `cargo clean` removes,
+/// not the system's temporary directory), emptied if a run before left it. `module` is
+/// the calling test file's name (`sweep` for tests/sweep.rs): the pid keeps two test
+/// processes apart, `module` and `name` the tests of one process.
 #[allow(dead_code)] // not every feature set has a test that writes files
 #[track_caller]
 pub fn scratch(name: &str) -> std::path::PathBuf {
@@ -16,8 +17,8 @@ pub fn scratch(name: &str) -> std::path::PathBuf {
         .file_stem()
         .and_then(|s| s.to_str())
         .unwrap_or("tests");
-    let dir =
-        std::env::temp_dir().join(format!("precursors-{}-{module}-{name}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("precursors-{}-{module}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir

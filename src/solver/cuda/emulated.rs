@@ -11,23 +11,45 @@ use crate::solver::system::Compliance;
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
 
-/// Compiles emulated.cpp once per test process.
+/// Compiles emulated.cpp, once per version of its sources: the program sits beside the
+/// test binary (under `target/`), named by a hash of emulated.cpp and kernels.cu, so
+/// later test processes reuse it and nothing is left in the system's temporary
+/// directory. Written under a name of this process's, then renamed: two test processes
+/// never see half a program.
 fn program() -> PathBuf {
+    use std::hash::{Hash, Hasher};
     static PROGRAM: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
     PROGRAM
         .get_or_init(|| {
             let here = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("src/solver/cuda");
-            let out =
-                std::env::temp_dir().join(format!("precursors-emulated-{}", std::process::id()));
+            let mut hasher = std::collections::hash_map::DefaultHasher::new();
+            for file in ["emulated.cpp", "kernels.cu"] {
+                std::fs::read(here.join(file))
+                    .expect("the emulator's sources")
+                    .hash(&mut hasher);
+            }
+            let dir = std::env::current_exe()
+                .ok()
+                .and_then(|exe| exe.parent().map(PathBuf::from))
+                .unwrap_or_else(std::env::temp_dir);
+            let out = dir.join(format!("precursors-emulated-{:016x}", hasher.finish()));
+            if out.exists() {
+                return out;
+            }
+            let partial = dir.join(format!(
+                "precursors-emulated-{}.partial",
+                std::process::id()
+            ));
             let status = Command::new("c++")
                 .args(["-O2", "-std=c++17", "-o"])
-                .arg(&out)
+                .arg(&partial)
                 .arg(here.join("emulated.cpp"))
                 .arg("-I")
                 .arg(&here)
                 .status()
                 .expect("a C++ compiler (c++) runs kernels.cu on the host");
             assert!(status.success(), "emulated.cpp does not compile");
+            std::fs::rename(&partial, &out).expect("the emulator renamed into place");
             out
         })
         .clone()
