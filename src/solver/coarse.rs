@@ -437,7 +437,7 @@ mod tests {
         let plan = plan(nx, ny);
         let n = nx * ny;
         let scale = 3.6e-16;
-        let entries = Entries::new(&plan, scale, 0.0);
+        let entries = Entries::new(&plan, scale, 0.0, Parallelism::Sequential).unwrap();
         let dense = plan.dense().unwrap();
         let set = set_of(n, 3);
         let d: Vec<f64> = set.iter().map(|i| 1e-13 * (1.0 + (i % 3) as f64)).collect();
@@ -475,7 +475,7 @@ mod tests {
     fn factor_is_history_free() {
         let (nx, ny) = (48, 24);
         let plan = plan(nx, ny);
-        let entries = Entries::new(&plan, 3.6e-16, 1e-3);
+        let entries = Entries::new(&plan, 3.6e-16, 1e-3, Parallelism::Sequential).unwrap();
         let dof = |set: &[usize]| -> Vec<f64> {
             set.iter().map(|i| 1e-13 * (1.0 + (i % 5) as f64)).collect()
         };
@@ -511,7 +511,7 @@ mod tests {
     fn coarse_correction_solves_the_bordered_problem() {
         let (nx, ny) = (40, 20);
         let plan = plan(nx, ny);
-        let entries = Entries::new(&plan, 3.6e-16, 0.0);
+        let entries = Entries::new(&plan, 3.6e-16, 0.0, Parallelism::Sequential).unwrap();
         let set = set_of(nx * ny, 7);
         let d = vec![2e-13; set.len()];
         let mut coarse = Coarse::new(nx, ny, 1);

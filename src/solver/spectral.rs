@@ -161,9 +161,10 @@ impl SpectralCore {
         match precond {
             Precond::Fsai | Precond::TwoLevel => {
                 let Compliance { scale, shift, .. } = self.compliance;
-                let entries = self
-                    .entries
-                    .get_or_insert_with(|| Entries::new(&self.plan, scale, shift));
+                let entries = match &mut self.entries {
+                    Some(entries) => entries,
+                    slot => slot.insert(Entries::new(&self.plan, scale, shift, parallelism)?),
+                };
                 let grid = self.plan.grid();
                 let partition = self.staging.partition();
                 let (fsai, _) = self.fsai.get_or_insert_with(|| {

@@ -303,7 +303,7 @@ fn the_local_updates_are_the_hosts() {
     }
 }
 
-/// FSAI on the device: the host's factor copied as the backend copies it (every row for
+/// FSAI on the device: the host's factor copied as the backend copies it (the planes for
 /// the first set, then only the rows the update of a second set refreshed) and applied by
 /// fsai_g and fsai_gt, against the host's own `Fsai::apply` on the second set (fsai.rs,
 /// itself tested against the factor's dense rows).
@@ -311,10 +311,11 @@ fn the_local_updates_are_the_hosts() {
 fn the_fsai_kernels_apply_the_hosts_factor_after_its_updates() {
     use super::fsai::rows_to_copy;
     use crate::solver::fsai::{Entries, Fsai};
+    use crate::solver::parallel::Parallelism;
     for (nx, ny) in [(16, 12), (9, 7), (6, 1)] {
         let (grid, plan) = planned(nx, ny, 0.02);
         let n = grid.len();
-        let entries = Entries::new(&plan, 3.6e-16, 1e-3);
+        let entries = Entries::new(&plan, 3.6e-16, 1e-3, Parallelism::Sequential).unwrap();
         let first: Vec<usize> = (0..n).filter(|i| (i * 7919 + 3) % 10 < 6).collect();
         let d_of = |set: &[usize], bump: usize| -> Vec<f64> {
             set.iter()
@@ -323,7 +324,14 @@ fn the_fsai_kernels_apply_the_hosts_factor_after_its_updates() {
         };
         let mut fsai = Fsai::new(nx, n, crate::solver::spectral::FSAI_RADIUS);
         fsai.update(&entries, &first, &d_of(&first, n));
-        let all = rows_to_copy(&fsai, true);
+        // The first copy is the planes as they are: every cell's row.
+        let all: (Vec<i32>, Vec<f64>) = {
+            let (stride, planes) = (fsai.stride(), fsai.planes());
+            let weights = (0..n)
+                .flat_map(|i| (0..stride).map(move |k| planes[k * n + i]))
+                .collect();
+            ((0..n as i32).collect(), weights)
+        };
         // The second set: two sites leave, two join, one compliance changes.
         let mut second: Vec<usize> = first.clone();
         second.retain(|&i| i != first[1] && i != first[first.len() / 2]);
@@ -331,7 +339,7 @@ fn the_fsai_kernels_apply_the_hosts_factor_after_its_updates() {
         second.sort_unstable();
         let bump = second[second.len() - 1];
         fsai.update(&entries, &second, &d_of(&second, bump));
-        let refreshed = rows_to_copy(&fsai, false);
+        let refreshed = rows_to_copy(&fsai);
         // Five changed sites: at most their 3 x 3 boxes of rows.
         assert!(
             refreshed.0.len() <= 45.min(n),
@@ -484,7 +492,13 @@ fn the_coarse_kernels_solve_the_hosts_coarse_problem() {
     };
     let err = max_rel(&off_identity(e), &want);
     assert!(err < 1e-11, "E off by {err:e}");
-    let entries = Entries::new(&plan, compliance.scale, compliance.shift);
+    let entries = Entries::new(
+        &plan,
+        compliance.scale,
+        compliance.shift,
+        Parallelism::Sequential,
+    )
+    .unwrap();
     let mut host = Coarse::new(nx, ny, 1);
     host.update(&entries, &second, &d2, Parallelism::Sequential)
         .unwrap();

@@ -32,22 +32,18 @@ pub(super) fn fsai_bytes(n: usize, stride: usize) -> f64 {
     8.0 * ((stride + 1) * n) as f64 + 4.0 * stride as f64
 }
 
-/// The rows to copy: every set row (`all`) or the ones the last update refreshed, as
-/// their cells and their `stride` weights each (zero weights for a row off the set).
-pub(super) fn rows_to_copy(fsai: &Fsai, all: bool) -> (Vec<i32>, Vec<f64>) {
+/// The rows the last update refreshed, as their cells and their `stride` weights each
+/// (zero weights for a row off the set).
+pub(super) fn rows_to_copy(fsai: &Fsai) -> (Vec<i32>, Vec<f64>) {
     let stride = fsai.stride();
     let planes = fsai.planes();
     let n = planes.len() / stride;
-    let cells: Vec<usize> = if all {
-        (0..n).collect()
-    } else {
-        fsai.refreshed().to_vec()
-    };
+    let cells = fsai.refreshed();
     let weights = cells
         .iter()
         .flat_map(|&i| (0..stride).map(move |k| planes[k * n + i]))
         .collect();
-    (cells.into_iter().map(|i| i as i32).collect(), weights)
+    (cells.iter().map(|&i| i as i32).collect(), weights)
 }
 
 impl DeviceFsai {
@@ -65,17 +61,25 @@ impl DeviceFsai {
         })
     }
 
-    /// Brings the planes up to date with `fsai` after its update: the refreshed rows, or
-    /// every row when the copy is not known to be current.
+    /// Brings the planes up to date with `fsai` after its update: the refreshed rows
+    /// through a scatter kernel, or the whole planes when the copy is not known to be
+    /// current.
     pub(super) fn sync(
         &mut self,
         stream: &Arc<CudaStream>,
         kernels: &Kernels,
         fsai: &Fsai,
     ) -> Result<()> {
-        let all = !self.synced;
+        if !self.synced {
+            // Every row: the planes as they are (no lists, no scratch on the device).
+            stream
+                .memcpy_htod(fsai.planes(), &mut self.planes)
+                .map_err(|e| cuda_error("cuMemcpyHtoD", e))?;
+            self.synced = true;
+            return Ok(());
+        }
         self.synced = false;
-        let (cells, weights) = rows_to_copy(fsai, all);
+        let (cells, weights) = rows_to_copy(fsai);
         let Some(cfg) = over(weights.len()) else {
             self.synced = true;
             return Ok(());

@@ -29,6 +29,7 @@ mod emulated;
 pub use device::{cuda_device, CudaDevice};
 
 use super::fsai::{Entries, Fsai};
+use super::parallel::Parallelism;
 use super::pcg::{max_abs, run_cg, Effort};
 use super::set::{SetProblem, SetSolve};
 use super::spectral::{Precond, FSAI_RADIUS};
@@ -180,7 +181,7 @@ impl CudaCore {
             }
         }
         if matches!(precond, Precond::Fsai | Precond::TwoLevel) {
-            self.prepare_fsai(problem)?;
+            self.prepare_fsai(problem, effort.parallelism)?;
         }
         self.upload_problem(problem, &f)?;
         if precond == Precond::TwoLevel {
@@ -241,8 +242,9 @@ impl CudaCore {
     }
 
     /// The FSAI factor brought up to date for the problem's set and compliances on the
-    /// host (the rows around changed sites), then its refreshed rows copied.
-    fn prepare_fsai(&mut self, problem: SetProblem<'_>) -> Result<()> {
+    /// host (the rows around changed sites), then its refreshed rows copied. Its table of
+    /// exact entries is built on first use on `parallelism`'s threads.
+    fn prepare_fsai(&mut self, problem: SetProblem<'_>, parallelism: Parallelism) -> Result<()> {
         let stream = &self.gpu.stream;
         let (entries, fsai, device) = match &mut self.fsai {
             Some(built) => built,
@@ -251,7 +253,8 @@ impl CudaCore {
                 let Compliance { scale, shift, .. } = self.compliance;
                 let fsai = Fsai::new(grid.nx(), grid.len(), FSAI_RADIUS);
                 let device = DeviceFsai::new(stream, &fsai, grid.len())?;
-                slot.insert((Entries::new(&self.plan, scale, shift), fsai, device))
+                let entries = Entries::new(&self.plan, scale, shift, parallelism)?;
+                slot.insert((entries, fsai, device))
             }
         };
         fsai.update(entries, problem.set, problem.d);
