@@ -1,6 +1,6 @@
-// kernels.cu run on the host, for the tests of src/solver/cuda/emulated.rs: every block
-// has one thread (THREADS 1, so a block's tree in shared memory is its one value), blocks
-// run one after the other, and the batched FFTs are naive DFTs in long double. The launch
+// kernels.cu run on the host, for the tests of src/solver/cuda/emulated.rs: blocks run one
+// after the other, each of EMULATED_THREADS threads (below), and the batched FFTs are
+// naive DFTs in long double. The launch
 // sequence is operator.rs's `Transforms::filter` and `gather_set`/`gather_grid`.
 //
 // Input (stdin, whitespace separated), for the products: "operator nx ny m with_d", the
@@ -12,18 +12,35 @@
 #include <string>
 #include <vector>
 
+// Threads per block: 1 (each block one thread, `__syncthreads` a no-op), or more, run as
+// real threads meeting at a barrier for `__syncthreads`, so that a missing or misplaced
+// barrier in a kernel shows.
+#ifndef EMULATED_THREADS
+#define EMULATED_THREADS 1
+#endif
+#define THREADS EMULATED_THREADS
+
 struct double2 {
     double x, y;
 };
 struct Dim {
     unsigned x, y, z;
 };
-static Dim blockIdx, threadIdx, blockDim, gridDim;
+static Dim blockIdx, blockDim, gridDim;
+#if EMULATED_THREADS > 1
+#include <barrier>
+#include <thread>
+static thread_local Dim threadIdx;
+static std::barrier<>* block_barrier;
+#define __syncthreads() block_barrier->arrive_and_wait()
+#else
+static Dim threadIdx;
+#define __syncthreads()
+#endif
 #define __device__
 #define __forceinline__ inline
 #define __global__
 #define __shared__ static
-#define __syncthreads()
 static inline void sincospi(double a, double* s, double* c) {
     long double pi = 3.141592653589793238462643383279502884L;
     *s = (double)std::sin(pi * a);
@@ -34,19 +51,34 @@ using std::fmax;
 using std::isfinite;
 using std::min;
 using std::sqrt;
-#define THREADS 1
 #include "kernels.cu"
 
+// Runs `blocks` blocks of THREADS threads each, one block after the other.
 template <class F>
 static void launch(size_t blocks, F kernel) {
-    blockDim = {1, 1, 1};
-    threadIdx = {0, 0, 0};
+    blockDim = {THREADS, 1, 1};
     gridDim = {(unsigned)blocks, 1, 1};
     for (size_t b = 0; b < blocks; b++) {
         blockIdx = {(unsigned)b, 0, 0};
+#if EMULATED_THREADS > 1
+        std::barrier<> barrier(THREADS);
+        block_barrier = &barrier;
+        std::vector<std::thread> threads;
+        for (unsigned t = 0; t < THREADS; t++)
+            threads.emplace_back([&kernel, t] {
+                threadIdx = {t, 0, 0};
+                kernel();
+            });
+        for (auto& t : threads) t.join();
+#else
+        threadIdx = {0, 0, 0};
         kernel();
+#endif
     }
 }
+
+// Blocks of one thread per element of n (operator.rs's `over`).
+static size_t over(size_t n) { return (n + THREADS - 1) / THREADS; }
 
 static const long double PI = 3.141592653589793238462643383279502884L;
 
@@ -92,7 +124,7 @@ static int pre() {
     for (int j = 0; j < m; j++)
         for (auto& x : v)
             if (std::scanf("%lf", &x[j]) != 1) return 2;
-    launch(m, [&] {
+    launch(over(m), [&] {
         pre_updates(v[0].data(), v[1].data(), v[2].data(), v[3].data(), v[4].data(), v[5].data(),
                     v[6].data(), flags, shift, alpha, u, beta, m);
     });
@@ -114,17 +146,17 @@ static void product(const std::vector<double>& table, const std::vector<double>&
     std::vector<double> real_a(n), real_b(n);
     std::vector<double2> rows((size_t)ny * (nx / 2 + 1)), columns((size_t)nx * (ny / 2 + 1)),
         filtered((size_t)nx * (ny / 2 + 1));
-    launch(n, [&] { scatter_rows(x.data(), pos.data(), real_a.data(), nx, ny); });
+    launch(over(n), [&] { scatter_rows(x.data(), pos.data(), real_a.data(), nx, ny); });
     d2z(real_a, rows, nx, ny);
-    launch(n, [&] { rows_to_columns(rows.data(), real_b.data(), nx, ny); });
+    launch(over(n), [&] { rows_to_columns(rows.data(), real_b.data(), nx, ny); });
     d2z(real_b, columns, ny, nx);
-    launch((size_t)nx * (ny / 2 + 1),
+    launch(over((size_t)nx * (ny / 2 + 1)),
            [&] { filter_columns(columns.data(), table.data(), filtered.data(), nx, ny); });
     z2d(filtered, real_a, ny, nx);
-    launch((size_t)ny * (nx / 2 + 1), [&] { columns_to_rows(real_a.data(), rows.data(), nx, ny); });
+    launch(over((size_t)ny * (nx / 2 + 1)), [&] { columns_to_rows(real_a.data(), rows.data(), nx, ny); });
     z2d(rows, real_b, nx, ny);
-    launch(m, [&] { gather_set(real_b.data(), set.data(), d.data(), x.data(), y.data(), with_d, m, nx); });
-    launch(n, [&] { gather_grid(real_b.data(), grid.data(), nx, ny); });
+    launch(over(m), [&] { gather_set(real_b.data(), set.data(), d.data(), x.data(), y.data(), with_d, m, nx); });
+    launch(over(n), [&] { gather_grid(real_b.data(), grid.data(), nx, ny); });
 }
 
 // "coarse nx ny block bx count", the operator's table (Ny x Nx), "rounds R", then per
@@ -165,17 +197,17 @@ static int coarse() {
         for (int k = 0; k < columns; k++) {
             int a;
             if (std::scanf("%d", &a) != 1) return 2;
-            launch(m, [&] { coarse_indicator(set.data(), m, nx, block, bx, a, x.data()); });
+            launch(over(m), [&] { coarse_indicator(set.data(), m, nx, block, bx, a, x.data()); });
             product(table, x, set, pos, d, y, grid, 1, nx, ny);
             launch(count, [&] {
                 coarse_restrict(y.data(), y.data(), 0, pos.data(), nx, ny, block, bx, e.data(), a,
                                 count);
             });
         }
-        launch(count, [&] { coarse_fix_empty(e.data(), c.data(), count); });
+        launch(over(count), [&] { coarse_fix_empty(e.data(), c.data(), count); });
         l = e;
         launch(1, [&] { coarse_factor(l.data(), count, info.data()); });
-        launch(count, [&] { coarse_invert(l.data(), count, inv.data()); });
+        launch(over(count), [&] { coarse_invert(l.data(), count, inv.data()); });
         launch(1, [&] { coarse_border(inv.data(), c.data(), count, w.data(), info.data()); });
     }
     int m = (int)set.size();
@@ -188,7 +220,7 @@ static int coarse() {
     launch(1, [&] {
         coarse_solve(inv.data(), g.data(), c.data(), w.data(), info.data(), count, sol.data());
     });
-    launch(m, [&] { coarse_prolong(r.data(), sol.data(), 1.0, set.data(), m, nx, block, bx); });
+    launch(over(m), [&] { coarse_prolong(r.data(), sol.data(), 1.0, set.data(), m, nx, block, bx); });
     std::printf("%.17g %.17g\n", info[0], info[1]);
     for (double v : e) std::printf("%.17g\n", v);
     for (double v : sol) std::printf("%.17g\n", v);
@@ -218,7 +250,7 @@ static int fsai() {
             for (int s = 0; s < stride; s++)
                 if (std::scanf("%lf", &weights[(size_t)c * stride + s]) != 1) return 2;
         }
-        launch((size_t)count * stride, [&] {
+        launch(over((size_t)count * stride), [&] {
             fsai_scatter(cells.data(), weights.data(), count, planes.data(), stride, n);
         });
     }
@@ -230,10 +262,10 @@ static int fsai() {
         if (std::scanf("%d %lf", &set[j], &r[j]) != 2) return 2;
         pos[set[j]] = j;
     }
-    launch(m, [&] {
+    launch(over(m), [&] {
         fsai_g(planes.data(), offsets.data(), stride, set.data(), pos.data(), r.data(), y.data(), m, n);
     });
-    launch(m, [&] {
+    launch(over(m), [&] {
         fsai_gt(planes.data(), offsets.data(), stride, set.data(), pos.data(), y.data(), z.data(), m, n);
     });
     for (int j = 0; j < m; j++) std::printf("%.17g\n", z[j]);

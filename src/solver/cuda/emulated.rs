@@ -11,48 +11,58 @@ use crate::solver::system::Compliance;
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
 
-/// Compiles emulated.cpp, once per version of its sources: the program sits beside the
-/// test binary (under `target/`), named by a hash of emulated.cpp and kernels.cu, so
-/// later test processes reuse it and nothing is left in the system's temporary
-/// directory. Written under a name of this process's, then renamed: two test processes
-/// never see half a program.
-fn program() -> PathBuf {
+/// Threads per block of the two emulators: one (the sequential reference), and four run
+/// as real threads meeting at a barrier for `__syncthreads` (a missing barrier or a race
+/// in a block's cooperation shows as a wrong or varying result).
+const EMULATED_THREADS: [usize; 2] = [1, 4];
+
+/// Compiles emulated.cpp with `threads` threads per block, once per version of its
+/// sources: the program sits beside the test binary (under `target/`), named by a hash of
+/// emulated.cpp and kernels.cu, so later test processes reuse it and nothing is left in
+/// the system's temporary directory. Written under a name of this process's, then
+/// renamed: two test processes never see half a program.
+fn program(threads: usize) -> PathBuf {
     use std::hash::{Hash, Hasher};
-    static PROGRAM: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
-    PROGRAM
-        .get_or_init(|| {
-            let here = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("src/solver/cuda");
-            let mut hasher = std::collections::hash_map::DefaultHasher::new();
-            for file in ["emulated.cpp", "kernels.cu"] {
-                std::fs::read(here.join(file))
-                    .expect("the emulator's sources")
-                    .hash(&mut hasher);
-            }
-            let dir = std::env::current_exe()
-                .ok()
-                .and_then(|exe| exe.parent().map(PathBuf::from))
-                .unwrap_or_else(std::env::temp_dir);
-            let out = dir.join(format!("precursors-emulated-{:016x}", hasher.finish()));
-            if out.exists() {
-                return out;
-            }
-            let partial = dir.join(format!(
-                "precursors-emulated-{}.partial",
-                std::process::id()
-            ));
-            let status = Command::new("c++")
-                .args(["-O2", "-std=c++17", "-o"])
-                .arg(&partial)
-                .arg(here.join("emulated.cpp"))
-                .arg("-I")
-                .arg(&here)
-                .status()
-                .expect("a C++ compiler (c++) runs kernels.cu on the host");
-            assert!(status.success(), "emulated.cpp does not compile");
-            std::fs::rename(&partial, &out).expect("the emulator renamed into place");
-            out
-        })
-        .clone()
+    static PROGRAMS: std::sync::Mutex<Vec<(usize, PathBuf)>> = std::sync::Mutex::new(Vec::new());
+    let mut programs = PROGRAMS.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, path)) = programs.iter().find(|(t, _)| *t == threads) {
+        return path.clone();
+    }
+    let here = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("src/solver/cuda");
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    for file in ["emulated.cpp", "kernels.cu"] {
+        std::fs::read(here.join(file))
+            .expect("the emulator's sources")
+            .hash(&mut hasher);
+    }
+    let dir = std::env::current_exe()
+        .ok()
+        .and_then(|exe| exe.parent().map(PathBuf::from))
+        .unwrap_or_else(std::env::temp_dir);
+    let out = dir.join(format!(
+        "precursors-emulated-{threads}-{:016x}",
+        hasher.finish()
+    ));
+    if !out.exists() {
+        let partial = dir.join(format!(
+            "precursors-emulated-{threads}-{}.partial",
+            std::process::id()
+        ));
+        let status = Command::new("c++")
+            .args(["-O2", "-std=c++20", "-pthread"])
+            .arg(format!("-DEMULATED_THREADS={threads}"))
+            .arg("-o")
+            .arg(&partial)
+            .arg(here.join("emulated.cpp"))
+            .arg("-I")
+            .arg(&here)
+            .status()
+            .expect("a C++ compiler (c++) runs kernels.cu on the host");
+        assert!(status.success(), "emulated.cpp does not compile");
+        std::fs::rename(&partial, &out).expect("the emulator renamed into place");
+    }
+    programs.push((threads, out.clone()));
+    out
 }
 
 /// What emulated.cpp prints.
@@ -62,23 +72,74 @@ struct Emulated {
     reductions: Vec<[f64; 3]>,
 }
 
-/// Runs the emulator on `input`; its output as numbers.
+/// Runs the emulators on `input`, each thread count of [`EMULATED_THREADS`]; their
+/// outputs as numbers, in that order.
+fn emulate_all(input: &str) -> Vec<Vec<f64>> {
+    EMULATED_THREADS
+        .iter()
+        .map(|&threads| emulate_with(threads, input))
+        .collect()
+}
+
+/// Runs the emulators on `input`; the one-thread output, after checking that the
+/// threaded one agrees with it (within rounding: its reductions add in another order).
 fn emulate(input: &str) -> Vec<f64> {
-    use std::io::Write;
-    let mut child = Command::new(program())
+    let mut outputs = emulate_all(input).into_iter();
+    let reference = outputs.next().expect("a one-thread emulator");
+    for (other, threads) in outputs.zip(&EMULATED_THREADS[1..]) {
+        assert_eq!(other.len(), reference.len());
+        let scale = reference.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for (k, (a, b)) in reference.iter().zip(&other).enumerate() {
+            let tolerance = 1e-12 * scale.max(f64::MIN_POSITIVE) + 1e-9 * a.abs();
+            assert!(
+                (a - b).abs() <= tolerance,
+                "value {k}: {a} with one thread per block, {b} with {threads}"
+            );
+        }
+    }
+    reference
+}
+
+/// Runs the emulator of `threads` threads per block on `input`. A run that does not end
+/// within a minute is killed and fails the test: threads that disagree on a barrier
+/// (one leaves a loop the others stay in) wait for each other forever.
+fn emulate_with(threads: usize, input: &str) -> Vec<f64> {
+    use std::io::{Read, Write};
+    use std::time::{Duration, Instant};
+    let mut child = Command::new(program(threads))
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .spawn()
         .expect("the emulator runs");
-    child
-        .stdin
-        .take()
-        .expect("stdin")
-        .write_all(input.as_bytes())
+    let mut stdout = child.stdout.take().expect("stdout");
+    let reader = std::thread::spawn(move || {
+        let mut text = String::new();
+        stdout.read_to_string(&mut text).map(|_| text)
+    });
+    // Written from a thread too: a hung emulator may stop reading its input.
+    let mut stdin = child.stdin.take().expect("stdin");
+    let input = input.to_string();
+    let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("the emulator's status") {
+            break status;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("the emulator with {threads} threads per block hangs (a barrier not reached by every thread?)");
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    };
+    assert!(status.success());
+    writer
+        .join()
+        .expect("the writer ends")
         .expect("input written");
-    let output = child.wait_with_output().expect("the emulator ends");
-    assert!(output.status.success());
-    String::from_utf8(output.stdout)
+    reader
+        .join()
+        .expect("the reader ends")
         .expect("text")
         .split_whitespace()
         .map(|v| v.parse().expect("a number"))
