@@ -178,7 +178,11 @@ impl SpectralCore {
                         let coarse = Coarse::new(grid.nx(), grid.ny(), partition.parts());
                         (coarse, Staging::new(&self.plan, partition.clone()))
                     });
-                    coarse.update(entries, set, d, parallelism)?;
+                    // A failed update may leave `E` half built: dropped, rebuilt next time.
+                    if let Err(e) = coarse.update(entries, set, d, parallelism) {
+                        self.coarse = None;
+                        return Err(e);
+                    }
                 }
             }
             Precond::Spectral => {
