@@ -408,13 +408,21 @@ __device__ void inverse_product(const double* inv, const double* x, int k, doubl
 
 // w = E^-1 c and info[1] = c^T w; info[0] cleared unless c^T w is positive and finite.
 // One block of threads.
+// c^T x over the block's threads (strided terms, then the block's tree: a fixed order).
+__device__ double block_dot(const double* c, const double* x, int k) {
+    __shared__ double shared[3 * THREADS];
+    double acc[3] = {0.0, 0.0, 0.0};
+    for (int a = threadIdx.x; a < k; a += THREADS) acc[0] += c[a] * x[a];
+    block_tree(0, acc, shared);
+    return acc[0];
+}
+
 extern "C" __global__ void coarse_border(const double* inv, const double* c, int k, double* w,
                                          double* info) {
     inverse_product(inv, c, k, w);
     __syncthreads();
+    double cw = block_dot(c, w, k);
     if (threadIdx.x != 0) return;
-    double cw = 0.0;
-    for (int a = 0; a < k; a++) cw += c[a] * w[a];
     info[1] = cw;
     if (!(cw > 0.0 && isfinite(cw))) info[0] = 0.0;
 }
@@ -423,15 +431,9 @@ extern "C" __global__ void coarse_border(const double* inv, const double* c, int
 // sol = y - mu w. One block of threads.
 extern "C" __global__ void coarse_solve(const double* inv, const double* g, const double* c,
                                         const double* w, const double* info, int k, double* sol) {
-    __shared__ double mu;
     inverse_product(inv, g, k, sol);
     __syncthreads();
-    if (threadIdx.x == 0) {
-        double cy = 0.0;
-        for (int a = 0; a < k; a++) cy += c[a] * sol[a];
-        mu = cy / info[1];
-    }
-    __syncthreads();
+    double mu = block_dot(c, sol, k) / info[1];
     for (int a = threadIdx.x; a < k; a += THREADS) sol[a] -= mu * w[a];
 }
 
