@@ -672,7 +672,7 @@ impl Driver {
             Phase::Avalanche { forced } => {
                 let force = self.force();
                 let u_z = &self.normal()?.displacement;
-                let u_x = &self.response()?.displacement;
+                let traction = &self.response()?.traction;
                 let grid = *self.grid();
                 let cell = grid.cell_area();
                 let mut best: Option<(usize, f64)> = None;
@@ -681,15 +681,20 @@ impl Driver {
                         continue;
                     }
                     if self.breaking[i] <= force || forced == Some(i) {
-                        // k_x of the candidates only (an exponential per site).
-                        let k_x = self.interface.tangential_stiffness_at(i, u_z[i])?;
-                        let u = force * u_x[i];
-                        let energy = 0.5 * k_x * u * u * cell;
-                        if best.is_none_or(|(_, e)| energy > e) {
-                            best = Some((i, energy));
+                        let phi = force * traction[i];
+                        let key = self.interface.log_rupture_energy(i, u_z[i], phi, cell);
+                        if best.is_none_or(|(_, k)| key > k) {
+                            best = Some((i, key));
                         }
                     }
                 }
+                let best = match best {
+                    Some((i, _)) => {
+                        let phi = force * traction[i];
+                        Some((i, self.interface.rupture_energy(i, u_z[i], phi, cell)?))
+                    }
+                    None => None,
+                };
                 match best {
                     None => {
                         self.pending.push_back(Event::Stable {

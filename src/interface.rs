@@ -820,6 +820,28 @@ impl Interface {
         }
     }
 
+    /// The elastic energy (J) of site `index`'s tangential spring under the shear traction
+    /// `phi` (Pa) at the normal displacement `u_z` (m): `½ k_x u_x² ΔA`, written as
+    /// `½ φ_x² ΔA / k_x`. The traction is what the tangential solve determines; `u_x =
+    /// -φ_x/k_x` comes out of the elastic product as a difference of large terms whose
+    /// rounding `k_x` (up to `c_x e^649` under strong compression) would multiply into
+    /// energies of pure noise (docs/stability.md).
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`] when the compliance overflows (as
+    /// [`Interface::tangential_compliance_at`]).
+    pub(crate) fn rupture_energy(&self, index: usize, u_z: f64, phi: f64, cell: f64) -> Result<f64> {
+        let compliance = self.tangential_compliance_at(index, u_z)?;
+        Ok(0.5 * phi * phi * cell * compliance)
+    }
+
+    /// `ln` of [`Interface::rupture_energy`], without an exponential: the key that orders
+    /// the candidates of a rupture, which neither underflow (energies below 1e-308 J at the
+    /// corners of the valid ranges) nor overflow can tie. `-∞` for a zero traction.
+    pub(crate) fn log_rupture_energy(&self, index: usize, u_z: f64, phi: f64, cell: f64) -> f64 {
+        2.0 * phi.abs().ln() + (0.5 * cell).ln() + u_z / self.heights()[index] - self.law.c_x.ln()
+    }
+
     /// Tangential stiffness per unit area (N/m³) at the normal displacements `u_z` (m):
     /// `k_x = c_x exp(-u_z / u0)` on attached sites, 0 on detached and broken ones (as in
     /// the paper). An overflow (a huge penetration of a tiny asperity) is reported as
