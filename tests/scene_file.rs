@@ -109,6 +109,28 @@ fn a_hand_written_file_gives_the_rust_builder() {
     assert_eq!(SceneBuilder::from_json_str(&text).unwrap(), everything());
 }
 
+/// A scene or sweep file that starts with a UTF-8 byte order mark (as editors on Windows
+/// write them) reads as the same file without it; serde_json alone refused it with
+/// "expected value at line 1 column 1" (issue 53).
+#[test]
+fn a_byte_order_mark_is_ignored() {
+    let dir = scratch("bom");
+    let text = r#"{"block": {"lx": 0.012, "ly": 0.002, "lz": 0.01}, "normal_load": 50.0}"#;
+    let (plain, marked) = (dir.join("plain.json"), dir.join("marked.json"));
+    std::fs::write(&plain, text).unwrap();
+    std::fs::write(&marked, [&b"\xEF\xBB\xBF"[..], text.as_bytes()].concat()).unwrap();
+    assert_eq!(
+        SceneBuilder::from_json_file(&marked).unwrap(),
+        SceneBuilder::from_json_file(&plain).unwrap()
+    );
+    let sweep = format!(r#"{{"base": {text}, "axes": [], "realizations": 1}}"#);
+    std::fs::write(&marked, [&b"\xEF\xBB\xBF"[..], sweep.as_bytes()].concat()).unwrap();
+    assert!(sweep::Sweep::from_json_file(&marked).is_ok());
+    // Only at the start: a mark inside the text is still an error with its place.
+    std::fs::write(&marked, format!(" \u{feff}{text}")).unwrap();
+    assert!(SceneBuilder::from_json_file(&marked).is_err());
+}
+
 #[test]
 fn missing_keys_take_the_calibration_defaults() {
     assert_eq!(SceneBuilder::from_json_str("{}").unwrap(), Scene::builder());

@@ -42,6 +42,27 @@ fn pinned_gaussian_surface() {
     }
 }
 
+/// Heights with a spread far below the mean's rounding (`std_dev` 1e-13 to 1e-20 m on a
+/// mean of 2 µm) are the mean to a few ulps: the two rules' sums differ by their
+/// rounding, which the rule used to compare with `1e-10 s` alone, refusing such surfaces
+/// as "cells too large" (issue 53). A spread of 0 was already valid.
+#[test]
+fn a_spread_below_the_rounding_of_the_mean_gives_the_mean() {
+    let grid = Grid::new(block(), 4, 2).unwrap();
+    for sd in [1e-13, 1e-16, 1e-20] {
+        let heights = Heights::random_surface(
+            &grid,
+            SurfaceSpectrum::gaussian(2e-3).unwrap(),
+            HeightDistribution::new(2e-6, sd).unwrap(),
+            7,
+        )
+        .unwrap_or_else(|e| panic!("std_dev {sd:e}: {e}"));
+        for h in heights.values() {
+            assert!((h - 2e-6).abs() <= 10.0 * sd + 1e-19, "std_dev {sd:e}: {h:e}");
+        }
+    }
+}
+
 /// As [`pinned_gaussian_surface`], for a self-affine surface (H = 0.7, λ_r = 3 mm,
 /// λ_s = 0.6 mm, λ_l = 5 mm; 2 mm cells hold many wavelengths: the rule's order is high).
 #[test]

@@ -337,7 +337,7 @@ fn event_force(
             return Err(at(
                 line,
                 "force_N",
-                format!("{f} N is beyond the friction limit μF_N = {} N", b.mu_fn),
+                format!("{f:?} N is beyond the friction limit μF_N = {:?} N", b.mu_fn),
             ));
         }
     }
@@ -355,25 +355,25 @@ pub(crate) fn curve_row(line: usize, row: &str, b: &Bounds) -> Row<CurveRow> {
         return Err(at(
             line,
             header[2],
-            format!("{load} is beyond the friction limit 1"),
+            format!("{load:?} is beyond the friction limit 1"),
         ));
     }
     if (force / b.mu_fn - load).abs() > 1e-9 * (1.0 + load.abs()) {
         return Err(at(
             line,
             header[2],
-            format!("{load} is not force_N / μF_N = {force} / {} N", b.mu_fn),
+            format!("{load:?} is not force_N / μF_N = {force:?} / {:?} N", b.mu_fn),
         ));
     }
     optional(line, &header, &c, 3)?;
     let area = number(line, &header, &c, 4)?;
     if area < 0.0 {
-        return Err(at(line, header[4], format!("{area} m² is negative")));
+        return Err(at(line, header[4], format!("{area:?} m² is negative")));
     }
     let length = number(line, &header, &c, 5)?;
     let ratio = number(line, &header, &c, 6)?;
     if !(0.0..=1.0).contains(&ratio) {
-        return Err(at(line, header[6], format!("{ratio} is outside 0 to 1")));
+        return Err(at(line, header[6], format!("{ratio:?} is outside 0 to 1")));
     }
     if (length / b.lx - ratio).abs() > 1e-9 {
         return Err(at(
@@ -419,14 +419,14 @@ pub(crate) fn map_row(line: usize, header: &[&str], row: &str) -> Row<MapRow> {
         return Err(at(
             line,
             header[1],
-            format!("{x} is not a load level (a multiple of {MAP_STEP} from 0 to 1)"),
+            format!("{x:?} is not a load level (a multiple of {MAP_STEP} from 0 to 1)"),
         ));
     }
     let mut columns = Vec::with_capacity(c.len() - 2);
     for k in 2..c.len() {
         let a = number(line, header, &c, k)?;
         if a < 0.0 {
-            return Err(at(line, header[k], format!("{a} m² is negative")));
+            return Err(at(line, header[k], format!("{a:?} m² is negative")));
         }
         columns.push(a);
     }
@@ -737,7 +737,7 @@ pub(crate) fn fields_row<'a>(
         return Err(at(
             line,
             header[1],
-            format!("{load} is beyond the friction limit 1"),
+            format!("{load:?} is beyond the friction limit 1"),
         ));
     }
     let precursor = number(line, header, &c, 2)?;
@@ -745,7 +745,7 @@ pub(crate) fn fields_row<'a>(
         return Err(at(
             line,
             header[2],
-            format!("{precursor} is outside 0 to 1"),
+            format!("{precursor:?} is outside 0 to 1"),
         ));
     }
     let (field, index, z) = if within < ny {
@@ -780,7 +780,7 @@ pub(crate) fn fields_row<'a>(
     for k in 6..c.len() {
         let v = number(line, header, &c, k)?;
         if field == super::FIELD_AREA && v < 0.0 {
-            return Err(at(line, header[k], format!("{v} m² is negative")));
+            return Err(at(line, header[k], format!("{v:?} m² is negative")));
         }
         values.push(v);
     }
@@ -792,4 +792,34 @@ pub(crate) fn fields_row<'a>(
         precursor_over_lx: precursor,
         values,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A huge value in a cell is echoed in exponent form: `{}` wrote 1e308 as its 309
+    /// digits, a 310-character message (issue 53).
+    #[test]
+    fn messages_echo_huge_values_briefly() {
+        let b = Bounds {
+            nx: 4,
+            ny: 2,
+            lx: 0.004,
+            mu_fn: 10.0,
+        };
+        let rows = [
+            "2,1e308,1e308,,1e-6,0,0,0,8,0",
+            "2,1.0,0.1,,-1e308,0,0,0,8,0",
+            "2,1e300,0.1,,1e-6,0,0,0,8,0",
+        ];
+        for row in rows {
+            let message = match curve_row(2, row, &b) {
+                Err(Bad::Reason(m)) => m,
+                other => panic!("{row}: {other:?}"),
+            };
+            assert!(message.len() < 120, "{row}: {message}");
+            assert!(message.contains("e30"), "{row}: {message}");
+        }
+    }
 }

@@ -871,12 +871,22 @@ pub(crate) fn read_json_text<E: From<Error>>(
     operation: &'static str,
     content_error: impl FnOnce(usize, usize, String) -> E,
 ) -> Result<String, E> {
-    let bytes = crate::files::read_bytes(path, operation)?;
+    let mut bytes = crate::files::read_bytes(path, operation)?;
+    // A UTF-8 byte order mark (editors on Windows write one) is not JSON, and serde_json
+    // would report only "expected value at line 1 column 1"; RFC 8259 section 8.1 lets a
+    // parser ignore it.
+    if bytes.starts_with(BYTE_ORDER_MARK) {
+        bytes.drain(..BYTE_ORDER_MARK.len());
+    }
     String::from_utf8(bytes).map_err(|e| {
         let (line, column, reason) = not_utf8(e.as_bytes(), e.utf8_error());
         content_error(line, column, reason)
     })
 }
+
+/// The UTF-8 encoding of U+FEFF, which some editors put at the start of a text file.
+#[cfg(feature = "serde")]
+const BYTE_ORDER_MARK: &[u8] = b"\xEF\xBB\xBF";
 
 /// The line and column (1-based) of the first byte that is not UTF-8, and a message.
 #[cfg(feature = "serde")]
