@@ -65,6 +65,20 @@ pub struct Avalanche {
     pub flash_ruptures: usize,
     /// Whether it ended in global slip (the block slides): the run's last.
     pub global_slip: bool,
+    /// Sites in contact (attached) when it started; `None` when the recorder was not
+    /// told the contacts at zero shear ([`Avalanches::with_zero_shear`]).
+    pub contacts_before: Option<usize>,
+    /// Sites in contact when it ended (`None` as [`Avalanche::contacts_before`]).
+    pub contacts_after: Option<usize>,
+    /// Whether it is the run's spanning avalanche: the first that leaves at most half of
+    /// the sites that were in contact when it started (`2 · contacts_after ≤
+    /// contacts_before`), the one that takes the precursor across the interface
+    /// (docs/statistics.md). A run has at most one; under top loading it is the last,
+    /// global slip. `false` when the contacts are not known.
+    pub spanning: bool,
+    /// Whether it comes after the run's spanning avalanche (the few sites left carry the
+    /// whole normal load: a regime of its own, which statistics leave out by default).
+    pub after_spanning: bool,
 }
 
 impl Avalanche {
@@ -85,6 +99,10 @@ pub struct Avalanches {
     current: Option<Avalanche>,
     /// The sites that attached in the current avalanche.
     attached: Vec<usize>,
+    /// Sites in contact now, when the zero-shear contacts were given.
+    contacts: Option<usize>,
+    /// Whether the spanning avalanche has ended.
+    spanned: bool,
 }
 
 impl Avalanches {
@@ -95,7 +113,60 @@ impl Avalanches {
             events: 0,
             current: None,
             attached: Vec::new(),
+            contacts: None,
+            spanned: false,
         }
+    }
+
+    /// A recorder that also counts the sites in contact, and so finds the spanning
+    /// avalanche ([`Avalanche::spanning`]), for a run whose sites were in `zero_shear` at
+    /// its first stable state (`driver.site_states()` after the first step, or
+    /// [`DamageFront::zero_shear_states`] of a whole run's events).
+    ///
+    /// ```
+    /// use precursors::{Avalanches, Scene};
+    /// let scene = Scene::builder()
+    ///     .block(0.012, 0.002, 0.010)
+    ///     .cells(12, 2)
+    ///     .normal_load(50.0)
+    ///     .seed(0)
+    ///     .build()?;
+    /// let mut driver = scene.driver()?;
+    /// let first = driver.step()?.unwrap();             // the stable state at zero shear
+    /// let mut avalanches = Avalanches::with_zero_shear(driver.grid(), driver.site_states())?;
+    /// avalanches.observe(&first);
+    /// let mut all = Vec::new();
+    /// while let Some(event) = driver.step()? {
+    ///     all.extend(avalanches.observe(&event));
+    /// }
+    /// // One spanning avalanche; every later one is flagged as after it.
+    /// let k = all.iter().position(|a| a.spanning).unwrap();
+    /// assert_eq!(all.iter().filter(|a| a.spanning).count(), 1);
+    /// assert!(all[k + 1..].iter().all(|a| a.after_spanning));
+    /// assert!(all[..k].iter().all(|a| !a.after_spanning));
+    /// let (before, after) = (all[k].contacts_before.unwrap(), all[k].contacts_after.unwrap());
+    /// assert!(2 * after <= before);
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] when `zero_shear` does not hold one state per site.
+    pub fn with_zero_shear(grid: &Grid, zero_shear: &[SiteState]) -> Result<Self> {
+        if zero_shear.len() != grid.len() {
+            return Err(Error::LengthMismatch {
+                name: "zero_shear",
+                expected: grid.len(),
+                found: zero_shear.len(),
+            });
+        }
+        let mut out = Self::new(grid);
+        out.contacts = Some(
+            zero_shear
+                .iter()
+                .filter(|s| **s == SiteState::Attached)
+                .count(),
+        );
+        Ok(out)
     }
 
     /// Takes the run's next event; returns the avalanche it ends, if it ends one (a
@@ -117,10 +188,15 @@ impl Avalanches {
                     detaches: 0,
                     flash_ruptures: 0,
                     global_slip: false,
+                    contacts_before: self.contacts,
+                    contacts_after: self.contacts,
+                    spanning: false,
+                    after_spanning: false,
                 });
                 None
             }
             Event::Rupture { site, load, energy } => {
+                self.count(-1);
                 if let Some(a) = &mut self.current {
                     a.ruptures += 1;
                     a.broken_area += self.cell_area;
@@ -133,6 +209,7 @@ impl Avalanches {
                 None
             }
             Event::Attach { site } => {
+                self.count(1);
                 if let Some(a) = &mut self.current {
                     a.attaches += 1;
                     self.attached.push(site.index);
@@ -140,6 +217,7 @@ impl Avalanches {
                 None
             }
             Event::Detach { .. } => {
+                self.count(-1);
                 if let Some(a) = &mut self.current {
                     a.detaches += 1;
                 }
@@ -155,7 +233,21 @@ impl Avalanches {
         a.end_event = self.events;
         a.load_after = load;
         a.global_slip = global_slip;
+        a.contacts_after = self.contacts;
+        if self.spanned {
+            a.after_spanning = true;
+        } else if let (Some(before), Some(after)) = (a.contacts_before, a.contacts_after) {
+            a.spanning = 2 * after <= before;
+            self.spanned = a.spanning;
+        }
         Some(a)
+    }
+
+    /// A site came into (`+1`) or out of (`-1`) contact.
+    fn count(&mut self, change: isize) {
+        if let Some(n) = &mut self.contacts {
+            *n = n.saturating_add_signed(change);
+        }
     }
 }
 
@@ -399,6 +491,73 @@ mod tests {
             };
             assert_eq!(*s, expected, "site {i}");
         }
+    }
+
+    #[test]
+    fn the_spanning_avalanche_is_the_first_that_leaves_half_the_contacts() {
+        let g = grid();
+        let all = [SiteState::Attached; 8];
+        let rupture = |i: usize| Event::Rupture {
+            site: site(&g, i % 4, i / 4),
+            load: load(1.0),
+            energy: 1.0,
+        };
+        let raise = Event::LoadRaised { load: load(1.0) };
+        let stable = Event::Stable {
+            load: load(1.0),
+            ruptures: 0,
+        };
+        let detach = |i: usize| Event::Detach {
+            site: site(&g, i % 4, i / 4),
+        };
+        let attach = |i: usize| Event::Attach {
+            site: site(&g, i % 4, i / 4),
+        };
+        // 8 -> 7; 7 -> 4 (three ruptures, a detachment and an attachment: 2·4 > 7);
+        // 4 -> 2 (2·2 ≤ 4: spanning); 2 -> 1 after it; 1 -> 0 global slip after it.
+        let events = [
+            stable,
+            raise,
+            rupture(0),
+            stable,
+            raise,
+            rupture(1),
+            detach(5),
+            rupture(2),
+            attach(5),
+            rupture(3),
+            stable,
+            raise,
+            rupture(4),
+            rupture(5),
+            stable,
+            raise,
+            rupture(6),
+            stable,
+            raise,
+            rupture(7),
+            Event::GlobalSlip { load: load(1.0) },
+        ];
+        let mut rec = Avalanches::with_zero_shear(&g, &all).unwrap();
+        let out: Vec<Avalanche> = events.iter().filter_map(|e| rec.observe(e)).collect();
+        let contacts: Vec<(Option<usize>, Option<usize>)> = out
+            .iter()
+            .map(|a| (a.contacts_before, a.contacts_after))
+            .collect();
+        let some = |a, b| (Some(a), Some(b));
+        assert_eq!(
+            contacts,
+            [some(8, 7), some(7, 4), some(4, 2), some(2, 1), some(1, 0)]
+        );
+        let spanning: Vec<bool> = out.iter().map(|a| a.spanning).collect();
+        let after: Vec<bool> = out.iter().map(|a| a.after_spanning).collect();
+        assert_eq!(spanning, [false, false, true, false, false]);
+        assert_eq!(after, [false, false, false, true, true]);
+        // Without the zero-shear contacts nothing is known, and nothing flagged.
+        let mut blind = Avalanches::new(&g);
+        let out: Vec<Avalanche> = events.iter().filter_map(|e| blind.observe(e)).collect();
+        assert!(out.iter().all(|a| a.contacts_before.is_none() && !a.spanning));
+        assert!(Avalanches::with_zero_shear(&g, &all[..7]).is_err());
     }
 
     #[test]

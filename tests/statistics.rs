@@ -47,7 +47,10 @@ fn num(row: &HashMap<String, String>, key: &str) -> f64 {
 
 /// The avalanches of `events.csv` as this test reads them: for each `load_raised`, the
 /// ruptures, attachments and flash ruptures (a site that attached earlier in the same
-/// avalanche) up to the next `stable` or `global_slip`, and the forces at both ends.
+/// avalanche) up to the next `stable` or `global_slip`, the forces at both ends, and the
+/// sites in contact at both ends (those in contact at zero shear are the sites whose first
+/// event is a rupture or a detachment; a rupture or a detachment takes one out, an
+/// attachment brings one back).
 #[derive(Debug, PartialEq)]
 struct Read {
     start: usize,
@@ -57,13 +60,38 @@ struct Read {
     flash: usize,
     before: String,
     after: String,
+    contacts: (usize, usize),
+}
+
+/// The index of the spanning avalanche as docs/statistics.md defines it: the first that
+/// leaves at most half of the sites in contact when it started.
+fn spanning(avalanches: &[Read]) -> usize {
+    avalanches
+        .iter()
+        .position(|a| 2 * a.contacts.1 <= a.contacts.0)
+        .unwrap()
 }
 
 fn read_avalanches(events: &[HashMap<String, String>]) -> Vec<Read> {
     let mut out = Vec::new();
     let mut open: Option<(Read, Vec<(String, String)>)> = None;
+    let mut seen = std::collections::HashSet::new();
+    let mut contacts = 0usize;
     for e in events {
         let site = (e["ix"].clone(), e["iy"].clone());
+        if matches!(e["kind"].as_str(), "rupture" | "detach") && seen.insert(site.clone()) {
+            contacts += 1;
+        } else if e["kind"] == "attach" {
+            seen.insert(site.clone());
+        }
+    }
+    for e in events {
+        let site = (e["ix"].clone(), e["iy"].clone());
+        match e["kind"].as_str() {
+            "rupture" | "detach" => contacts -= 1,
+            "attach" => contacts += 1,
+            _ => {}
+        }
         match e["kind"].as_str() {
             "load_raised" => {
                 let read = Read {
@@ -74,6 +102,7 @@ fn read_avalanches(events: &[HashMap<String, String>]) -> Vec<Read> {
                     flash: 0,
                     before: e["force_N"].clone(),
                     after: String::new(),
+                    contacts: (contacts, contacts),
                 };
                 open = Some((read, Vec::new()));
             }
@@ -91,6 +120,7 @@ fn read_avalanches(events: &[HashMap<String, String>]) -> Vec<Read> {
                 if let Some((mut a, _)) = open.take() {
                     a.end = e["index"].parse().unwrap();
                     a.after = e["force_N"].clone();
+                    a.contacts.1 = contacts;
                     out.push(a);
                 }
             }
@@ -117,8 +147,19 @@ fn the_calibration_runs_avalanches_and_damage_front() {
             flash: row["flash_ruptures"].parse().unwrap(),
             before: row["force_before_N"].clone(),
             after: row["force_after_N"].clone(),
+            contacts: (
+                row["contacts_before"].parse().unwrap(),
+                row["contacts_after"].parse().unwrap(),
+            ),
         };
         assert_eq!(&got, e, "avalanche {}", k + 1);
+        let span = spanning(&expected);
+        assert_eq!(row["spanning"], if k == span { "1" } else { "0" });
+        assert_eq!(row["after_spanning"], if k > span { "1" } else { "0" });
+        assert_eq!(
+            num(row, "ruptures_without_flash") as usize,
+            got.ruptures - got.flash
+        );
         // The paper's rod drive is force control: the force does not drop.
         assert_eq!(num(row, "force_drop_N"), 0.0);
         assert!((num(row, "broken_area_m2") - got.ruptures as f64 * 1e-6).abs() < 1e-18);
@@ -296,7 +337,8 @@ fn stats_pool_each_points_realizations() {
     for run in sweep.runs() {
         let events = table(&dir.join(run.dir_name()).join("events.csv"));
         let all = read_avalanches(&events);
-        for a in &all[..all.len() - 1] {
+        // `stats` leaves out the spanning avalanche and those after it by default.
+        for a in &all[..spanning(&all)] {
             sizes[run.point()].push(a.ruptures);
             let drop = a.before.parse::<f64>().unwrap() - a.after.parse::<f64>().unwrap();
             drops[run.point()] += usize::from(drop > 0.0);

@@ -88,7 +88,8 @@ def stats(directory: Union[str, Path], **options: Any) -> Dict[str, Dict[str, np
     and log-binned distributions, written as ``power_laws.csv`` and ``distributions.csv``
     in it), returned by file name without ``.csv`` as dicts of columns. ``options``:
     ``bootstrap``, ``goodness``, ``confidence``, ``min_tail``, ``bins_per_decade``,
-    ``seed`` (docs/statistics.md)."""
+    ``seed``, ``include_spanning`` (pool the spanning avalanche and those after it too;
+    docs/statistics.md)."""
     return {Path(p).stem: read_table(p) for p in _stats_files(directory, **options)}
 
 

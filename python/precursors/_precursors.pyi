@@ -201,6 +201,7 @@ def stats_files(
     min_tail: int = ...,
     bins_per_decade: int = ...,
     seed: int = ...,
+    include_spanning: bool = ...,
 ) -> List[Path]: ...
 def fit_power_law(
     samples: Sequence[float],

@@ -1201,7 +1201,7 @@ fn power_law_options(
 /// their paths (`precursors.stats` reads them into arrays).
 #[pyfunction]
 #[pyo3(signature = (dir, *, bootstrap=200, goodness=200, confidence=0.95, min_tail=10,
-                    bins_per_decade=5, seed=0))]
+                    bins_per_decade=5, seed=0, include_spanning=false))]
 #[allow(clippy::too_many_arguments)]
 fn stats_files(
     py: Python<'_>,
@@ -1212,12 +1212,14 @@ fn stats_files(
     min_tail: usize,
     bins_per_decade: usize,
     seed: u64,
+    include_spanning: bool,
 ) -> PyResult<Vec<PathBuf>> {
     let options = precursors::sweep::StatsOptions::default()
         .fit(power_law_options(
             bootstrap, goodness, confidence, min_tail, seed,
         ))
-        .bins_per_decade(bins_per_decade);
+        .bins_per_decade(bins_per_decade)
+        .include_spanning(include_spanning);
     let summary = py
         .detach(|| precursors::sweep::statistics(&dir, &options))
         .or_raise()?;

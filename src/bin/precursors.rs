@@ -152,6 +152,10 @@ enum Command {
         /// Seed of the bootstrap and of the synthetic data sets.
         #[arg(long, default_value_t = 0)]
         seed: u64,
+        /// Pool the spanning avalanche and those after it too (left out by default;
+        /// docs/statistics.md).
+        #[arg(long)]
+        include_spanning: bool,
     },
     /// Draws the figures of a run (precursor_length, contact_area, contact_map, stick_slip
     /// under a driving spring, the statistics) or of a sweep (merged first; ensemble
@@ -482,6 +486,7 @@ fn main() -> ExitCode {
             min_tail,
             bins_per_decade,
             seed,
+            include_spanning,
         } => stats(
             &dir,
             &StatsOptions::default()
@@ -493,7 +498,8 @@ fn main() -> ExitCode {
                         .min_tail(min_tail as usize)
                         .seed(seed),
                 )
-                .bins_per_decade(bins_per_decade as usize),
+                .bins_per_decade(bins_per_decade as usize)
+                .include_spanning(include_spanning),
         ),
         Command::Plot {
             dir,

@@ -22,7 +22,8 @@ pub(crate) const FRONTS_TABLE: &str = "fronts.csv";
 /// The header of `per_avalanche.csv`.
 pub(crate) const AVALANCHE_HEADER: &str = "avalanche,start_event,end_event,ruptures,\
      broken_area_m2,force_before_N,force_after_N,force_drop_N,drive_displacement_before_m,\
-     drive_displacement_after_m,energy_J,attaches,detaches,flash_ruptures,global_slip";
+     drive_displacement_after_m,energy_J,attaches,detaches,flash_ruptures,global_slip,\
+     ruptures_without_flash,contacts_before,contacts_after,spanning,after_spanning";
 /// The header of `fronts.csv`.
 pub(crate) const FRONTS_HEADER: &str =
     "event,force_N,force_over_mu_FN,precursor_over_Lx,damage_front_m,damage_front_over_Lx";
@@ -42,7 +43,7 @@ pub(crate) struct RunDerived {
 pub(crate) fn derive(grid: &Grid, events: &[Event]) -> Result<RunDerived> {
     let zero_shear = DamageFront::zero_shear_states(grid, events)?;
     let mut front = DamageFront::new(grid, &zero_shear)?;
-    let mut avalanches = Avalanches::new(grid);
+    let mut avalanches = Avalanches::with_zero_shear(grid, &zero_shear)?;
     let mut out = RunDerived {
         avalanches: Vec::new(),
         fronts: Vec::new(),
@@ -94,7 +95,7 @@ fn avalanche_text(avalanches: &[Avalanche]) -> String {
     for (k, a) in avalanches.iter().enumerate() {
         let _ = writeln!(
             text,
-            "{},{},{},{},{:.12e},{:.12e},{:.12e},{:.12e},{},{},{:.12e},{},{},{},{}",
+            "{},{},{},{},{:.12e},{:.12e},{:.12e},{:.12e},{},{},{:.12e},{},{},{},{},{},{},{},{},{}",
             k + 1,
             a.start_event,
             a.end_event,
@@ -110,9 +111,19 @@ fn avalanche_text(avalanches: &[Avalanche]) -> String {
             a.detaches,
             a.flash_ruptures,
             u8::from(a.global_slip),
+            a.ruptures - a.flash_ruptures,
+            count(a.contacts_before),
+            count(a.contacts_after),
+            u8::from(a.spanning),
+            u8::from(a.after_spanning),
         );
     }
     text
+}
+
+/// A count known only to a recorder told the zero-shear contacts (always, here).
+fn count(n: Option<usize>) -> String {
+    n.map(|n| n.to_string()).unwrap_or_default()
 }
 
 /// The text of `fronts.csv`: `curve`'s stable states (their loads and `ℓ/Lx` as written

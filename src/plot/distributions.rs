@@ -62,7 +62,8 @@ pub(super) fn draw_statistics(
     for point in order.iter().map(|&k| &points[k]).filter(|_| pooled) {
         let (mut s, mut d) = (Vec::new(), Vec::new());
         point.for_each_record(|run_dir, record| {
-            let [ruptures, drop, ..] = samples(record, run_dir)?;
+            // The samples `stats` pools by default (the spanning avalanche left out).
+            let [ruptures, drop, ..] = samples(record, run_dir, false)?;
             s.extend(ruptures);
             d.extend(drop.into_iter().filter(|x| *x > 0.0));
             Ok(())

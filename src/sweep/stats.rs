@@ -24,6 +24,10 @@ pub struct StatsOptions {
     pub fit: PowerLawOptions,
     /// Bins per decade of the log-binned distributions (default 5).
     pub bins_per_decade: usize,
+    /// Whether the samples include the spanning avalanche and the regime after it
+    /// ([`crate::Avalanche::spanning`]; default `false`: left out, with the stable states
+    /// from the spanning avalanche's on for the front leaps).
+    pub include_spanning: bool,
 }
 
 impl Default for StatsOptions {
@@ -31,6 +35,7 @@ impl Default for StatsOptions {
         Self {
             fit: PowerLawOptions::default(),
             bins_per_decade: 5,
+            include_spanning: false,
         }
     }
 }
@@ -45,6 +50,12 @@ impl StatsOptions {
     /// Bins per decade of the distributions.
     pub fn bins_per_decade(mut self, bins: usize) -> Self {
         self.bins_per_decade = bins;
+        self
+    }
+
+    /// Whether to pool the spanning avalanche and those after it too.
+    pub fn include_spanning(mut self, include: bool) -> Self {
+        self.include_spanning = include;
         self
     }
 }
@@ -70,29 +81,31 @@ pub(crate) const OBSERVABLES: [(&str, Support, &str); 7] = [
     (
         "avalanche_ruptures",
         Support::Discrete,
-        "ruptures of each avalanche before global slip",
+        "ruptures of each avalanche before the spanning one",
     ),
     (
         "force_drop_N",
         Support::Continuous,
-        "drop of the shear force over each avalanche before global slip (N): a driving \
-         spring's stress drops; none under force control",
+        "drop of the shear force over each avalanche before the spanning one (N): a \
+         driving spring's stress drops; none under force control",
     ),
     (
         "energy_J",
         Support::Continuous,
-        "elastic energy ½ k_x u_x² ΔA of the springs broken in each avalanche before global \
-         slip, summed (J)",
+        "stored elastic energy ½ k_x u_x² ΔA of the springs broken in each avalanche before \
+         the spanning one, summed (J)",
     ),
     (
         "precursor_leap_cells",
         Support::Discrete,
-        "each advance of ℓ from one stable state to the next, in cells Δx",
+        "each advance of the running maximum of ℓ from one stable state to the next, before \
+         the spanning avalanche, in cells Δx",
     ),
     (
         "damage_front_leap_cells",
         Support::Discrete,
-        "each advance of the damage front from one stable state to the next, in cells Δx",
+        "each advance of the running maximum of the damage front from one stable state to \
+         the next, before the spanning avalanche, in cells Δx",
     ),
     (
         "load_between_precursor_leaps",
@@ -106,17 +119,28 @@ pub(crate) const OBSERVABLES: [(&str, Support, &str); 7] = [
     ),
 ];
 
-/// The samples of each of [`OBSERVABLES`] in one complete run.
+/// The samples of each of [`OBSERVABLES`] in one complete run: from the avalanches before
+/// the spanning one and the stable states before its end, or (`include_spanning`) from
+/// every avalanche but global slip and every stable state. Front leaps are the advances of
+/// the running maximum of `ℓ` and of `x_D`: a front that recedes and regains ground makes
+/// no leap.
 ///
 /// # Errors
 /// [`Error::CorruptTable`] when its events are not the whole run of its grid.
-pub(crate) fn samples(record: &RunRecord, dir: &Path) -> Result<[Vec<f64>; 7]> {
+pub(crate) fn samples(
+    record: &RunRecord,
+    dir: &Path,
+    include_spanning: bool,
+) -> Result<[Vec<f64>; 7]> {
     let derived = derive(&record.grid, &record.events).map_err(|e| Error::CorruptTable {
         path: Some(dir.join(crate::output::TABLES[0])),
         reason: format!("not the whole run of its scene: {e}"),
     })?;
     let mut out: [Vec<f64>; 7] = Default::default();
-    for a in derived.avalanches.iter().filter(|a| !a.global_slip) {
+    let kept = |a: &&crate::avalanche::Avalanche| {
+        !a.global_slip && (include_spanning || !(a.spanning || a.after_spanning))
+    };
+    for a in derived.avalanches.iter().filter(kept) {
         out[0].push(a.ruptures as f64);
         out[1].push(a.force_drop());
         out[2].push(a.energy);
@@ -133,10 +157,21 @@ pub(crate) fn samples(record: &RunRecord, dir: &Path) -> Result<[Vec<f64>; 7]> {
         .iter()
         .map(|x| (x / record.grid.dx()).round())
         .collect();
+    // The stable states before the one that ends the spanning avalanche.
+    let states = match derived.avalanches.iter().find(|a| a.spanning) {
+        Some(spanning) if !include_spanning => record
+            .curve
+            .iter()
+            .take_while(|c| c.event < spanning.end_event)
+            .count(),
+        _ => record.curve.len(),
+    };
     for (k, cells) in [(3, &ell), (4, &front)] {
         let mut last_leap: Option<f64> = None;
-        for s in 1..cells.len().min(loads.len()) {
-            let step = cells[s] - cells[s - 1];
+        let mut reached = cells.first().copied().unwrap_or(0.0);
+        for s in 1..cells.len().min(loads.len()).min(states) {
+            let step = cells[s] - reached;
+            reached = reached.max(cells[s]);
             if step > 0.0 {
                 out[k].push(step);
                 if let Some(at) = last_leap {
@@ -301,7 +336,7 @@ pub fn statistics(dir: &Path, options: &StatsOptions) -> Result<StatsSummary, Sw
             .collect();
         let mut pooled: [Vec<f64>; 7] = Default::default();
         point.for_each_record(|run_dir, record| {
-            for (all, s) in pooled.iter_mut().zip(samples(record, run_dir)?) {
+            for (all, s) in pooled.iter_mut().zip(samples(record, run_dir, options.include_spanning)?) {
                 all.extend(s);
             }
             Ok(())
