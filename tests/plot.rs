@@ -639,7 +639,7 @@ fn figures_take_the_size_asked_for_within_limits() {
     }
     for size in [(199, 560), (800, 16385)] {
         let error = precursors::plot::draw_with_size(&dir, &[Format::Png], size).unwrap_err();
-        assert!(matches!(error, PlotError::Figure { .. }));
+        assert!(matches!(error, PlotError::InvalidSize { .. }), "{error:?}");
         assert!(error.to_string().contains("[200, 16384]"), "{error}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
@@ -1264,6 +1264,18 @@ mod cli {
             stderr(&o)
         );
         assert!(!dir.join("stick_slip.png").exists());
+        // Each value in range, their PNG too large (16384 at 1200 dpi: 131072 pixels
+        // wide): a bad command line too, not a figure that failed (code 3, issue 53).
+        let o = precursors(&[
+            "plot", path(&dir), "--figure", "stick_slip", "--dpi", "1200", "--width", "16384",
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains("131072 x 4480 pixels") && stderr(&o).contains("16384"),
+            "{}",
+            stderr(&o)
+        );
+        assert!(!dir.join("stick_slip.png").exists());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
@@ -1551,7 +1563,7 @@ fn a_png_has_the_pixels_of_its_resolution() {
         );
     }
     let e = draw_with_options(&dir, &options.clone().size(8000, 5600).dpi(600)).unwrap_err();
-    assert!(matches!(e, PlotError::Figure { .. }), "{e:?}");
+    assert!(matches!(e, PlotError::InvalidSize { .. }), "{e:?}");
     assert!(e.to_string().contains("32000 x 22400 pixels"), "{e}");
     // An SVG does not depend on the resolution.
     let svg = options.clone().formats(&[Format::Svg]);

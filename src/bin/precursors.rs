@@ -422,10 +422,11 @@ impl From<PlotError> for Failure {
             PlotError::Core(e) => core_code(e),
             PlotError::Sweep(e) => sweep_code(e),
             // --figure naming no figure, or one the directory cannot give; --dpi out of
-            // range.
+            // range, or a --width, --height and --dpi whose PNG is too large.
             PlotError::UnknownFigure { .. }
             | PlotError::FigureUnavailable { .. }
-            | PlotError::InvalidDpi { .. } => 2,
+            | PlotError::InvalidDpi { .. }
+            | PlotError::InvalidSize { .. } => 2,
             // A figure that cannot be drawn (a directory neither a run's nor a sweep's).
             _ => 3,
         };

@@ -71,6 +71,25 @@ pub enum PlotError {
         /// The highest resolution allowed (dots per inch).
         high: u32,
     },
+    /// A figure size ([`crate::plot::DrawOptions::size`], `precursors plot --width
+    /// --height`) with a side outside 200 to `largest` (in 1/150 inch), or one that at
+    /// [`crate::plot::DrawOptions::dpi`] makes a PNG of more than `largest` pixels along a
+    /// side: found before any figure is drawn.
+    #[error(
+        "a figure of {} x {} at {dpi} dpi ({} x {} pixels as a PNG): each side must lie in \
+         [200, {largest}], and a PNG's pixels, size · dpi/150, at most {largest} along a side",
+        size.0, size.1, pixels.0, pixels.1
+    )]
+    InvalidSize {
+        /// The size given (width, height in 1/150 inch).
+        size: (u32, u32),
+        /// The resolution given (dots per inch).
+        dpi: u32,
+        /// The PNG's pixels at that resolution (width, height).
+        pixels: (u32, u32),
+        /// The largest side allowed (pixels, and 1/150 inch).
+        largest: u32,
+    },
     /// A figure name ([`crate::plot::DrawOptions::figures`], `precursors plot --figure`)
     /// that is not one of the figures `plot` draws; the message lists them.
     #[error(

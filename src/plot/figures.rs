@@ -158,7 +158,7 @@ pub fn draw(dir: &Path, formats: &[Format]) -> Result<Drawn, PlotError> {
 /// ```
 ///
 /// # Errors
-/// As [`draw`]; [`PlotError::Figure`] also for a side below 200 or above 16384 pixels.
+/// As [`draw`]; [`PlotError::InvalidSize`] also for a side below 200 or above 16384 pixels.
 pub fn draw_with_size(
     dir: &Path,
     formats: &[Format],
@@ -283,8 +283,8 @@ impl DrawOptions {
 /// ```
 ///
 /// # Errors
-/// As [`draw`]; [`PlotError::Figure`] also for a side below 200 or above 16384, or a PNG
-/// of more than 16384 pixels along a side at the resolution; [`PlotError::InvalidDpi`]
+/// As [`draw`]; [`PlotError::InvalidSize`] for a side below 200 or above 16384, or a
+/// PNG of more than 16384 pixels along a side at the resolution; [`PlotError::InvalidDpi`]
 /// for a resolution outside 50 to 1200 dpi; [`PlotError::UnknownFigure`] for a name in [`DrawOptions::figures`] that is no figure;
 /// [`PlotError::FigureUnavailable`] for a named figure the directory cannot give (a
 /// run's figure of a sweep, `archard` of a run or of a sweep without the axis
@@ -293,31 +293,17 @@ impl DrawOptions {
 /// drawn, but for a spring's force that never drops and a contact map without rows.
 pub fn draw_with_options(dir: &Path, options: &DrawOptions) -> Result<Drawn, PlotError> {
     let size = options.size;
-    let (width, height) = size;
-    if !(200..=super::LARGEST_SIDE).contains(&width)
-        || !(200..=super::LARGEST_SIDE).contains(&height)
-    {
-        return Err(PlotError::Figure {
-            path: None,
-            reason: format!(
-                "a figure of {width} x {height}: each side must lie in [200, {}]",
-                super::LARGEST_SIDE
-            ),
-        });
-    }
     super::check_dpi(options.dpi)?;
     let pixels = super::png_pixels(size, options.dpi);
-    if options.formats.contains(&Format::Png) && pixels.0.max(pixels.1) > super::LARGEST_SIDE {
-        return Err(PlotError::Figure {
-            path: None,
-            reason: format!(
-                "a figure of {width} x {height} at {} dpi is a PNG of {} x {} pixels: at most \
-                 {} along a side",
-                options.dpi,
-                pixels.0,
-                pixels.1,
-                super::LARGEST_SIDE
-            ),
+    let sides = 200..=super::LARGEST_SIDE;
+    let png_fits = !options.formats.contains(&Format::Png)
+        || pixels.0.max(pixels.1) <= super::LARGEST_SIDE;
+    if !sides.contains(&size.0) || !sides.contains(&size.1) || !png_fits {
+        return Err(PlotError::InvalidSize {
+            size,
+            dpi: options.dpi,
+            pixels,
+            largest: super::LARGEST_SIDE,
         });
     }
     let canvas = Canvas {
