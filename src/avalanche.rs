@@ -556,7 +556,9 @@ mod tests {
         // Without the zero-shear contacts nothing is known, and nothing flagged.
         let mut blind = Avalanches::new(&g);
         let out: Vec<Avalanche> = events.iter().filter_map(|e| blind.observe(e)).collect();
-        assert!(out.iter().all(|a| a.contacts_before.is_none() && !a.spanning));
+        assert!(out
+            .iter()
+            .all(|a| a.contacts_before.is_none() && !a.spanning));
         assert!(Avalanches::with_zero_shear(&g, &all[..7]).is_err());
     }
 

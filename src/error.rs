@@ -278,6 +278,29 @@ pub enum Error {
         #[source]
         source: Box<Error>,
     },
+    /// A scene with a block length of 1 m or more under a mean normal pressure
+    /// `F_N/(Lx Ly)` below `1e-6 E` ([`crate::SceneBuilder::check`], `build`): most likely
+    /// lengths typed in millimetres (`"lx": 140` for 140 mm makes a 140 m block, and the
+    /// calibration's 3.5 kN a pressure of a few pascals, with almost no site in contact).
+    /// A block meant so confirms it with [`crate::SceneBuilder::confirm_metres`] (scene-file
+    /// key `"confirm_metres": true`).
+    #[error(
+        "the block is {} x {} x {} m ({} x {} x {} mm) under a mean normal pressure of {} Pa, \
+         {} of Young's modulus: lengths are in metres, did you mean {} x {} x {} mm? If the \
+         block is meant, confirm it with \"confirm_metres\": true (SceneBuilder::confirm_metres)",
+        Num(block.0), Num(block.1), Num(block.2),
+        Num(block.0 * 1e3), Num(block.1 * 1e3), Num(block.2 * 1e3),
+        Num(*pressure), Num(*pressure / *young_modulus),
+        Num(block.0), Num(block.1), Num(block.2)
+    )]
+    LikelyMillimetres {
+        /// The block's lengths `(Lx, Ly, Lz)` (m).
+        block: (f64, f64, f64),
+        /// The mean normal pressure `F_N/(Lx Ly)` (Pa).
+        pressure: f64,
+        /// Young's modulus `E` (Pa).
+        young_modulus: f64,
+    },
     /// An explicit thread count above one with the dense backend, which runs on one
     /// thread (its factor solve needs the whole attached set): `SolverOptions`, a scene's
     /// `solver` (`SceneBuilder::build`), `Driver::set_parallelism`,

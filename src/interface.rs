@@ -830,7 +830,13 @@ impl Interface {
     /// # Errors
     /// [`Error::NonFinite`] when the compliance overflows (as
     /// [`Interface::tangential_compliance_at`]).
-    pub(crate) fn rupture_energy(&self, index: usize, u_z: f64, phi: f64, cell: f64) -> Result<f64> {
+    pub(crate) fn rupture_energy(
+        &self,
+        index: usize,
+        u_z: f64,
+        phi: f64,
+        cell: f64,
+    ) -> Result<f64> {
         let compliance = self.tangential_compliance_at(index, u_z)?;
         Ok(0.5 * phi * phi * cell * compliance)
     }

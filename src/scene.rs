@@ -729,6 +729,7 @@ pub struct SceneBuilder {
     probes: ProbeSpec,
     max_cells: usize,
     run: RunOptions,
+    confirm_metres: bool,
 }
 
 impl PartialEq for SceneBuilder {
@@ -752,6 +753,7 @@ impl PartialEq for SceneBuilder {
             && self.probes == other.probes
             && self.max_cells == other.max_cells
             && self.run == other.run
+            && self.confirm_metres == other.confirm_metres
     }
 }
 
@@ -771,6 +773,7 @@ impl Default for SceneBuilder {
             probes: ProbeSpec::default(),
             max_cells: crate::green::DEFAULT_MAX_CELLS,
             run: RunOptions::default(),
+            confirm_metres: false,
         }
     }
 }
@@ -875,6 +878,24 @@ impl SceneBuilder {
     /// Raise it for a grid whose cost you accept; it does not change results.
     pub fn max_cells(mut self, max_cells: usize) -> Self {
         self.max_cells = max_cells;
+        self
+    }
+
+    /// Confirms a block of a metre or more under a mean normal pressure below `1e-6` of
+    /// Young's modulus (scene-file key `confirm_metres`; default `false`). Without it such
+    /// a scene is refused with [`Error::LikelyMillimetres`]: its numbers point to lengths
+    /// typed in millimetres. It does not change results.
+    ///
+    /// ```
+    /// use precursors::{Error, Scene};
+    /// // 140 x 7 x 75 "m" at the calibration's 3.5 kN: 3.6 Pa, millimetres most likely.
+    /// let mm = Scene::builder().block(140.0, 7.0, 75.0).cell_size(1.0, 1.0);
+    /// assert!(matches!(mm.clone().check(), Err(Error::LikelyMillimetres { .. })));
+    /// assert!(mm.confirm_metres(true).check().is_ok());
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    pub fn confirm_metres(mut self, confirm: bool) -> Self {
+        self.confirm_metres = confirm;
         self
     }
 

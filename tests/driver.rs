@@ -325,7 +325,12 @@ impl Case {
     }
 
     fn block(&self) -> Block {
-        Block::new(self.nx as f64 * self.cell, self.ny as f64 * self.cell, self.lz).unwrap()
+        Block::new(
+            self.nx as f64 * self.cell,
+            self.ny as f64 * self.cell,
+            self.lz,
+        )
+        .unwrap()
     }
 
     fn rod(&self) -> Lateral {
@@ -350,7 +355,11 @@ impl Case {
         let (e, nu) = self.material;
         let (c_x, c_z) = self.springs;
         Scene::builder()
-            .block(self.nx as f64 * self.cell, self.ny as f64 * self.cell, self.lz)
+            .block(
+                self.nx as f64 * self.cell,
+                self.ny as f64 * self.cell,
+                self.lz,
+            )
             .cells(self.nx, self.ny)
             .material(Material::new(e, nu, Material::default().friction_coefficient()).unwrap())
             .springs(SpringLaw::new(c_x, c_z).unwrap())
@@ -406,7 +415,9 @@ fn naive_protocol(case: &Case) -> Naive {
             // With no site attached (a rigid block on its one tallest spring, which just
             // broke) the bordered system is singular: restart from every spring left.
             if !(0..n).any(|i| attached[i]) {
-                (0..n).filter(|&i| !broken[i]).for_each(|i| attached[i] = true);
+                (0..n)
+                    .filter(|&i| !broken[i])
+                    .for_each(|i| attached[i] = true);
             }
             let set: Vec<usize> = (0..n).filter(|&i| attached[i]).collect();
             let d: Vec<f64> = set.iter().map(|&i| u0[i] / law.c_z()).collect();
@@ -642,7 +653,11 @@ fn extreme_cases_follow_the_naive_protocol() {
             case.nx * case.ny
         );
         assert!(load < 1e-8, "{}: loads differ by {load:e}", case.name);
-        assert!(energy < 1e-8, "{}: energies differ by {energy:e}", case.name);
+        assert!(
+            energy < 1e-8,
+            "{}: energies differ by {energy:e}",
+            case.name
+        );
     }
 }
 

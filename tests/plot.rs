@@ -666,7 +666,11 @@ fn statistics_figures_show_the_runs_fit_and_fronts() {
     let text = std::fs::read_to_string(dir.join("per_avalanche.csv")).unwrap();
     let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
     let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    let rows: Vec<Vec<&str>> = text.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
     // The avalanches before the spanning one (docs/statistics.md), as `stats` pools them.
     let span = rows
         .iter()
@@ -1267,7 +1271,14 @@ mod cli {
         // Each value in range, their PNG too large (16384 at 1200 dpi: 131072 pixels
         // wide): a bad command line too, not a figure that failed (code 3, issue 53).
         let o = precursors(&[
-            "plot", path(&dir), "--figure", "stick_slip", "--dpi", "1200", "--width", "16384",
+            "plot",
+            path(&dir),
+            "--figure",
+            "stick_slip",
+            "--dpi",
+            "1200",
+            "--width",
+            "16384",
         ]);
         assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
         assert!(

@@ -748,3 +748,68 @@ fn a_cuda_scene_without_a_gpu_says_what_is_missing() {
         assert!(message.contains("backend \"spectral\""), "{message}");
     }
 }
+
+/// A scene whose numbers point to millimetres typed as metres (issue 56: `"lx": 140` for
+/// 140 mm and the calibration's 3.5 kN, a 140 m block under 3.6 Pa, ran to global slip
+/// with 5 of 980 sites in contact) is refused, by cell size or count, from the builder, a
+/// scene file and the program, naming the likely mistake and the key that confirms it.
+#[test]
+fn a_block_in_millimetres_is_refused_unless_confirmed() {
+    use crate::common::program::{path, precursors, stderr};
+    for cells in [
+        r#"{"kind": "size", "dx": 1, "dy": 1}"#,
+        r#"{"kind": "count", "nx": 140, "ny": 7}"#,
+    ] {
+        let text = format!(r#"{{"block": {{"lx": 140, "ly": 7, "lz": 75}}, "cells": {cells}}}"#);
+        let builder = SceneBuilder::from_json_str(&text).unwrap();
+        let e = builder.clone().build().unwrap_err();
+        match &e {
+            Error::LikelyMillimetres {
+                block,
+                pressure,
+                young_modulus,
+            } => {
+                assert_eq!(*block, (140.0, 7.0, 75.0));
+                assert!((pressure - 3500.0 / 980.0).abs() < 1e-12, "{pressure}");
+                assert_eq!(*young_modulus, Material::default().young_modulus());
+            }
+            other => panic!("{other:?}"),
+        }
+        let message = e.to_string();
+        assert!(message.contains("140 x 7 x 75 mm"), "{message}");
+        assert!(message.contains("\"confirm_metres\": true"), "{message}");
+        // Confirmed, it is a scene (and the key round-trips through its file).
+        let confirmed = builder.confirm_metres(true);
+        confirmed.check().unwrap();
+        let again = SceneBuilder::from_json_str(&confirmed.to_json().unwrap()).unwrap();
+        assert_eq!(again, confirmed);
+    }
+    // The same pressure on a block under a metre, or a metre block pressed as the
+    // calibration's, is not a likely mistake.
+    Scene::builder()
+        .block(0.14, 0.007, 0.075)
+        .normal_load(3500.0 * 1e-6)
+        .check()
+        .unwrap();
+    Scene::builder()
+        .block(1.4, 0.07, 0.75)
+        .cell_size(0.01, 0.01)
+        .normal_load(3500.0 * 100.0)
+        .check()
+        .unwrap();
+    let dir = scratch("millimetres");
+    let file = dir.join("mm.json");
+    std::fs::write(
+        &file,
+        r#"{"block": {"lx": 140, "ly": 7, "lz": 75}, "cells": {"kind": "size", "dx": 1, "dy": 1}}"#,
+    )
+    .unwrap();
+    let o = precursors(&["run", path(&file), "--out", path(&dir.join("out"))]);
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("did you mean 140 x 7 x 75 mm"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!dir.join("out").join("events.csv").exists());
+}

@@ -58,7 +58,10 @@ fn a_spread_below_the_rounding_of_the_mean_gives_the_mean() {
         )
         .unwrap_or_else(|e| panic!("std_dev {sd:e}: {e}"));
         for h in heights.values() {
-            assert!((h - 2e-6).abs() <= 10.0 * sd + 1e-19, "std_dev {sd:e}: {h:e}");
+            assert!(
+                (h - 2e-6).abs() <= 10.0 * sd + 1e-19,
+                "std_dev {sd:e}: {h:e}"
+            );
         }
     }
 }

@@ -44,6 +44,7 @@ class Scene:
         probe_points: Optional[Sequence[Tuple[float, float, float]]] = ...,
         profile_loads: Optional[Sequence[float]] = ...,
         profile_planes: Optional[Sequence[float]] = ...,
+        confirm_metres: Optional[bool] = ...,
     ) -> None: ...
     @staticmethod
     def from_file(path: _Path) -> Scene: ...

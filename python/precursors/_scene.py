@@ -188,6 +188,7 @@ def scene_dict(
     probe_points: Optional[Sequence[Tuple[float, float, float]]] = None,
     profile_loads: Optional[Sequence[float]] = None,
     profile_planes: Optional[Sequence[float]] = None,
+    confirm_metres: Optional[bool] = None,
 ) -> Dict[str, Any]:
     """The scene-file dict of the keywords of ``precursors.Scene(...)``; a keyword left
     out is a key left out (the calibration scene's value)."""
@@ -320,4 +321,8 @@ def scene_dict(
                 "profile_planes", profile_planes or [], None, "a list of heights z (float, m)"
             ),
         }
+    if confirm_metres is not None:
+        if not isinstance(confirm_metres, bool):
+            raise TypeError(f"confirm_metres= takes True or False, not {confirm_metres!r}")
+        scene["confirm_metres"] = confirm_metres
     return scene

@@ -71,6 +71,7 @@ fn core_class(e: &precursors::Error) -> Class {
         | E::GridDoesNotDivide { .. }
         | E::GridTooLarge { .. }
         | E::LengthInMillimetres { .. }
+        | E::LikelyMillimetres { .. }
         | E::NonFinite { .. }
         | E::NonPositiveHeight { .. }
         | E::LengthMismatch { .. }
@@ -115,6 +116,7 @@ fn plot_class(e: &precursors::plot::PlotError) -> Class {
     match e {
         P::Core(e) => core_class(e),
         P::Sweep(e) => sweep_class(e),
+        P::InvalidSize { .. } | P::InvalidDpi { .. } => Class::Value,
         _ => Class::Base,
     }
 }
@@ -297,7 +299,9 @@ fn build(py: Python<'_>, builder: precursors::SceneBuilder) -> PyResult<Scene> {
 /// drive='rod' | 'top' | 'side' or a scene-file dict, rod=(height, half_width) (m);
 /// backend='auto' | 'dense' | 'spectral', threads (int, 'all', 'current');
 /// probe_planes=[z, ...], probe_points=[(x, y, z), ...] (m);
-/// profile_loads=[F/(μF_N), ...], profile_planes=[z, ...] (m).
+/// profile_loads=[F/(μF_N), ...], profile_planes=[z, ...] (m); confirm_metres=True for a
+/// block of a metre or more under a mean pressure below 1e-6 E (refused otherwise as
+/// millimetres typed as metres).
 #[pyclass(module = "precursors", frozen)]
 struct Scene {
     inner: precursors::Scene,
@@ -316,7 +320,7 @@ impl Scene {
                           young_modulus=None, poisson_ratio=None, friction_coefficient=None, \
                           c_x=None, c_z=None, drive=None, rod=None, backend=None, \
                           threads=None, probe_planes=None, probe_points=None, \
-                          profile_loads=None, profile_planes=None)"
+                          profile_loads=None, profile_planes=None, confirm_metres=None)"
     )]
     fn new(py: Python<'_>, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
         let dict = py

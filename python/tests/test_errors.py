@@ -32,6 +32,20 @@ def test_value_out_of_range_names_its_key():
     assert "block.lx" in str(error) and "valid range" in str(error)
 
 
+def test_a_block_in_millimetres_is_refused_unless_confirmed():
+    # 140 x 7 x 75 typed for millimetres: a 140 m block under 3.6 Pa (issue 56).
+    for keywords in ({"cell_size": (1, 1)}, {"cells": (140, 7)}):
+        with pytest.raises(PrecursorsValueError) as raised:
+            precursors.Scene(block=(140, 7, 75), **keywords)
+        assert raised.value.kind == "LikelyMillimetres"
+        message = str(raised.value)
+        assert "140 x 7 x 75 mm" in message and "confirm_metres" in message
+    scene = precursors.Scene(block=(140, 7, 75), cells=(140, 7), confirm_metres=True)
+    assert scene.to_dict()["confirm_metres"] is True
+    with pytest.raises(TypeError):
+        precursors.Scene(block=(140, 7, 75), cells=(140, 7), confirm_metres="yes")
+
+
 def test_negative_length():
     with pytest.raises(PrecursorsValueError) as raised:
         precursors.Scene(block=(-0.14, 0.007, 0.075))

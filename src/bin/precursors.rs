@@ -17,7 +17,7 @@ use precursors::output::RunTables;
 use precursors::plot::PlotError;
 use precursors::statistics::PowerLawOptions;
 use precursors::sweep::{StatsOptions, Sweep, SweepError, SweepOptions};
-use precursors::{Checkpoint, Driver, Error, GridCost, SceneBuilder};
+use precursors::{Checkpoint, Driver, Error, GridCost, SceneBuilder, SiteState};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -659,6 +659,12 @@ fn refuse_colliding_checkpoint(
     Ok(())
 }
 
+/// `x` with at most six decimals and no trailing zeros (`140`, `0.5`, `7.25`).
+fn digits(x: f64) -> String {
+    let text = format!("{x:.6}");
+    text.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 fn run(
     start: Start<'_>,
     out: &Path,
@@ -692,12 +698,23 @@ fn run(
         }
     };
     let grid = *scene.grid();
+    let block = grid.block();
+    // The lengths in mm beside metres and the mean pressure: a scene typed in the wrong
+    // unit shows at once (docs/scene-format.md).
     say!(
-        "{} x {} cells ({} backend), F_N = {} N",
+        "{} x {} cells ({} backend), block {} x {} x {} mm ({} x {} x {} m), F_N = {} N, \
+         mean pressure {:.4e} Pa",
         grid.nx(),
         grid.ny(),
         driver.backend(),
-        scene.normal_load()
+        digits(block.lx() * 1e3),
+        digits(block.ly() * 1e3),
+        digits(block.lz() * 1e3),
+        block.lx(),
+        block.ly(),
+        block.lz(),
+        scene.normal_load(),
+        scene.normal_load() / (block.lx() * block.ly())
     );
     let mu_fn = driver.friction_coefficient() * driver.normal_load();
     let first_event = driver.event_count();
@@ -720,8 +737,18 @@ fn run(
         std::num::NonZeroU64::new(every).ok_or_else(|| usage("--every must be >= 1".into()))?;
     let checkpoint = checkpoint.map(|path| (path, every));
     let fields_path = tables.fields_path().map(Path::to_path_buf);
+    // The sites in contact at zero shear, seen when the run starts from its first event.
+    let mut zero_shear = None;
     let [events_path, curve_path, map_path] =
         tables.run_to_slip(&mut driver, checkpoint, |_, driver| {
+            if driver.event_count() == 1 {
+                let attached = driver
+                    .site_states()
+                    .iter()
+                    .filter(|s| **s == SiteState::Attached)
+                    .count();
+                zero_shear = Some(attached);
+            }
             bar.show(false, |elapsed| line(driver, elapsed))
         })?;
     bar.show(true, |elapsed| line(&driver, elapsed));
@@ -734,6 +761,13 @@ fn run(
         curve_path.display(),
         map_path.display()
     );
+    if let Some(attached) = zero_shear {
+        let sites = grid.len();
+        say!(
+            "{attached} of {sites} sites ({:.1} %) were in contact at zero shear",
+            100.0 * attached as f64 / sites as f64
+        );
+    }
     if let Some(path) = fields_path {
         say!(
             "recorded the fields in {} (`precursors movie`)",

@@ -337,7 +337,10 @@ fn event_force(
             return Err(at(
                 line,
                 "force_N",
-                format!("{f:?} N is beyond the friction limit μF_N = {:?} N", b.mu_fn),
+                format!(
+                    "{f:?} N is beyond the friction limit μF_N = {:?} N",
+                    b.mu_fn
+                ),
             ));
         }
     }
@@ -362,7 +365,10 @@ pub(crate) fn curve_row(line: usize, row: &str, b: &Bounds) -> Row<CurveRow> {
         return Err(at(
             line,
             header[2],
-            format!("{load:?} is not force_N / μF_N = {force:?} / {:?} N", b.mu_fn),
+            format!(
+                "{load:?} is not force_N / μF_N = {force:?} / {:?} N",
+                b.mu_fn
+            ),
         ));
     }
     optional(line, &header, &c, 3)?;

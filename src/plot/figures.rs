@@ -296,8 +296,8 @@ pub fn draw_with_options(dir: &Path, options: &DrawOptions) -> Result<Drawn, Plo
     super::check_dpi(options.dpi)?;
     let pixels = super::png_pixels(size, options.dpi);
     let sides = 200..=super::LARGEST_SIDE;
-    let png_fits = !options.formats.contains(&Format::Png)
-        || pixels.0.max(pixels.1) <= super::LARGEST_SIDE;
+    let png_fits =
+        !options.formats.contains(&Format::Png) || pixels.0.max(pixels.1) <= super::LARGEST_SIDE;
     if !sides.contains(&size.0) || !sides.contains(&size.1) || !png_fits {
         return Err(PlotError::InvalidSize {
             size,

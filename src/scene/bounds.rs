@@ -378,6 +378,28 @@ pub(crate) fn run_options(
     )
 }
 
+/// The mean normal pressure `F_N/(Lx Ly)`, over Young's modulus, below which a block with
+/// a length of 1 m or more is taken for millimetres typed as metres: the calibration
+/// scene's is 1.2e-3, the same numbers in metres 1.2e-9; a real metre-sized block this
+/// lightly pressed confirms it with `confirm_metres`.
+pub(crate) const MILLIMETRE_PRESSURE: f64 = 1e-6;
+
+/// Refuses a scene whose numbers point to lengths in millimetres (docs/scene-format.md).
+fn millimetres(builder: &SceneBuilder) -> Result<()> {
+    let (lx, ly, lz) = builder.lengths;
+    let pressure = builder.normal_load / (lx * ly);
+    let young = builder.material.young_modulus();
+    if builder.confirm_metres || lx.max(ly).max(lz) < 1.0 || pressure >= MILLIMETRE_PRESSURE * young
+    {
+        return Ok(());
+    }
+    Err(Error::LikelyMillimetres {
+        block: (lx, ly, lz),
+        pressure,
+        young_modulus: young,
+    })
+}
+
 /// Everything but the geometry (after the builder's own checks of signs and finiteness).
 pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
     const HUGE: &str = "beyond it the model's products overflow or underflow f64";
@@ -406,6 +428,7 @@ pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
     within("springs.c_x", builder.law.c_x(), C_X, "N/m³", HUGE)?;
     within("springs.c_z", builder.law.c_z(), C_Z, "N/m²", HUGE)?;
     within("normal_load", builder.normal_load, NORMAL_LOAD, "N", HUGE)?;
+    millimetres(builder)?;
     heights(&builder.heights)?;
     drive(builder)?;
     let o = builder.solver;

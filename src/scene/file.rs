@@ -54,6 +54,10 @@ schema_struct! {
         /// Written only when profiles are recorded.
         #[cfg_attr(feature = "serde", serde(skip_serializing_if = "ProfilesSpec::is_off"))]
         [observer] profiles: ProfilesSpec,
+        /// Written only when true (a block of a metre or more meant so), so files of
+        /// other scenes stay as they were.
+        #[cfg_attr(feature = "serde", serde(skip_serializing_if = "is_false"))]
+        [observer] confirm_metres: bool,
     }
 }
 
@@ -91,6 +95,11 @@ impl ProfilesSpec {
     fn is_off(&self) -> bool {
         self.loads.is_empty() && self.planes.is_empty()
     }
+}
+
+#[cfg(feature = "serde")]
+fn is_false(value: &bool) -> bool {
+    !*value
 }
 
 #[cfg(feature = "serde")]
@@ -540,6 +549,7 @@ impl From<&SceneBuilder> for SceneFile {
             probes,
             max_cells,
             run,
+            confirm_metres,
         } = b;
         SceneFile {
             block: BlockSpec {
@@ -581,6 +591,7 @@ impl From<&SceneBuilder> for SceneFile {
                 loads: run.profile_loads().to_vec(),
                 planes: run.profile_planes().to_vec(),
             },
+            confirm_metres: *confirm_metres,
         }
     }
 }
@@ -686,6 +697,7 @@ impl SceneFile {
             max_cells,
             fields,
             profiles,
+            confirm_metres,
         } = self;
         let material = Material::new(
             material.young_modulus,
@@ -712,6 +724,7 @@ impl SceneFile {
             run: RunOptions::new()
                 .record_fields(fields.every, &fields.planes)
                 .record_profiles(&profiles.loads, &profiles.planes),
+            confirm_metres,
         })
     }
 }

@@ -162,6 +162,7 @@ macro_rules! schema_leaf {
 schema_leaf!(f64, |v| format!("{v:?}"));
 schema_leaf!(usize, |v| format!("{v}"));
 schema_leaf!(u64, |v| format!("{v}"));
+schema_leaf!(bool, |v| format!("{v}"));
 schema_leaf!(Vec<f64>, |v| format!("{v:?}"));
 schema_leaf!(Vec<[f64; 3]>, |v| format!("{v:?}"));
 schema_leaf!(std::path::PathBuf, |v| format!("{}", v.display()));

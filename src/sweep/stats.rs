@@ -336,7 +336,11 @@ pub fn statistics(dir: &Path, options: &StatsOptions) -> Result<StatsSummary, Sw
             .collect();
         let mut pooled: [Vec<f64>; 7] = Default::default();
         point.for_each_record(|run_dir, record| {
-            for (all, s) in pooled.iter_mut().zip(samples(record, run_dir, options.include_spanning)?) {
+            for (all, s) in
+                pooled
+                    .iter_mut()
+                    .zip(samples(record, run_dir, options.include_spanning)?)
+            {
                 all.extend(s);
             }
             Ok(())
