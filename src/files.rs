@@ -136,6 +136,7 @@ pub(crate) fn remove_if_exists(path: &Path, operation: &'static str) -> Result<(
 /// # Errors
 /// [`Error::NotARegularFile`] for a link or anything but a regular file there;
 /// [`Error::Io`] when `path` cannot be examined.
+#[cfg_attr(not(feature = "serde"), allow(dead_code))]
 pub(crate) fn is_file(path: &Path, operation: &'static str) -> Result<bool> {
     check_replaceable(path, operation)?;
     Ok(std::fs::symlink_metadata(path).is_ok())

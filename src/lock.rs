@@ -124,6 +124,8 @@ impl Drop for DirLock {
 /// A shared lock on a directory, a reader's (`plot`, `movie`, `stats`): writers
 /// ([`DirLock`]) are kept out while it is held, other readers are not. Released on drop;
 /// the lock file is never written.
+// Its readers (plot, sweep statistics) need feature `serde`.
+#[cfg_attr(not(feature = "serde"), allow(dead_code))]
 #[derive(Debug)]
 pub(crate) struct ReadLock {
     /// `None`: read without the lock ([`ReadLock::lock`]).
@@ -142,6 +144,7 @@ impl ReadLock {
     /// [`Error::DirectoryLocked`] naming the writer; [`Error::NotARegularFile`] for a
     /// lock file that is a symbolic link or not a regular file; [`Error::Io`] when it
     /// cannot be opened or locked.
+    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
     pub(crate) fn lock(dir: &Path) -> Result<ReadLock> {
         use std::io::ErrorKind;
         const OPENING: &str = "opening the lock file";
