@@ -14,9 +14,9 @@ import sys
 LAYERS = [
     ["format"],
     ["error"],
-    ["cost", "lock", "statistics"],
+    ["cost", "statistics"],
     ["files"],
-    ["geometry"],
+    ["geometry", "lock"],
     ["green", "surface"],
     ["interface"],
     ["solver"],

@@ -548,9 +548,11 @@ pub enum Error {
         reason: String,
     },
     /// A path named as an input or an output is not a regular file: a FIFO, a device, a
-    /// socket or a directory (an input), or also a symbolic link (an output, which would
-    /// be replaced, not written through). Refused before anything is read or written: a
-    /// FIFO would block, a device would be read without end or replaced by a file.
+    /// socket, a directory or a symbolic link. Refused before anything is read or
+    /// written: a FIFO would block, a device would be read without end or replaced by a
+    /// file, and a link is never followed (one in a run directory, such as its lock file,
+    /// would have the program write, empty or read a file elsewhere; as root, any file),
+    /// nor replaced.
     #[error("{operation} {}: it is {kind}, not a regular file", path.display())]
     NotARegularFile {
         /// What was being done (`"reading scene file"`, `"writing checkpoint"`, ...).
@@ -591,8 +593,10 @@ pub enum Error {
     },
     /// Another process holds the directory's lock (`RunTables::create`, `RunTables::resume`,
     /// a sweep's `execute` waiting 30 s for `sweep.json`): it is writing a run there (`run`,
-    /// `resume`, a sweep's run) or checking a sweep's `sweep.json`. The lock is the
-    /// operating system's and ends with that process, also when it is killed.
+    /// `resume`, a sweep's run), checking a sweep's `sweep.json`, or reading the directory
+    /// (`plot::draw_with_options`, `plot::Movie`, `sweep::statistics` take the lock
+    /// shared, and are refused so while a writer holds it). The lock is the operating
+    /// system's and ends with that process, also when it is killed.
     #[error(
         "{} is in use by another process ({holder}): wait until it ends or choose another \
          directory (the lock ends with that process, also if it is killed)",

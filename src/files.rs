@@ -5,8 +5,16 @@
 //! Why: a FIFO named as an input blocked `open` forever, `/dev/zero` reported a length of
 //! 0 and was read until memory ran out, and a rename over a character device named as an
 //! output replaced the device (run as root: `/dev/null`) with a regular file.
+//!
+//! No symbolic link is followed: every file is opened by [`open`] (`O_NOFOLLOW` on Unix),
+//! new files are created exclusively (`O_EXCL`), and a link where a file is read, written,
+//! replaced or removed is refused ([`Error::NotARegularFile`], naming the link). Why: a
+//! lock file `.precursors.lock` linked to a file outside its directory had the holder's
+//! line written into that file, then the file emptied (run as root: any file of the
+//! machine); a table linked elsewhere would have been truncated and written the same way.
 
 use crate::error::{Error, Result};
+use std::fs::{File, OpenOptions};
 use std::io::Read;
 use std::path::Path;
 
@@ -39,20 +47,49 @@ fn special(file_type: std::fs::FileType) -> Option<&'static str> {
     }
 }
 
-/// Opens `path` for reading as a regular file: never blocks (a FIFO is opened
-/// non-blocking on Unix, then refused), and refuses anything but a regular file (its
-/// target, for a symbolic link) with [`Error::NotARegularFile`].
-fn open_regular(path: &Path, operation: &'static str) -> Result<std::fs::File> {
-    let mut options = std::fs::OpenOptions::new();
-    options.read(true);
+/// Opens `path` as `options` say, the one open of every file the crate reads or writes:
+/// a symbolic link at `path` is not followed (`O_NOFOLLOW` on Unix; elsewhere a link
+/// found just before the open), the open never blocks (`O_NONBLOCK`: a FIFO), and
+/// anything but a regular file is refused with [`Error::NotARegularFile`] naming it (a
+/// link as `"a symbolic link"`). The directories above `path` are the caller's: only its
+/// last component is checked.
+///
+/// # Errors
+/// [`Error::NotARegularFile`]; [`Error::Io`] (with `operation`) when the open fails
+/// otherwise (of kind [`std::io::ErrorKind::NotFound`] for a missing file,
+/// [`std::io::ErrorKind::AlreadyExists`] for an existing one with `create_new`).
+pub(crate) fn open(
+    path: &Path,
+    options: &mut OpenOptions,
+    operation: &'static str,
+) -> Result<File> {
     #[cfg(unix)]
     {
         use std::os::unix::fs::OpenOptionsExt;
-        options.custom_flags(libc::O_NONBLOCK);
+        options.custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK);
     }
-    let file = options
-        .open(path)
-        .map_err(|e| Error::io(operation, path, e))?;
+    #[cfg(not(unix))]
+    if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) {
+        return Err(Error::NotARegularFile {
+            operation,
+            path: path.to_path_buf(),
+            kind: "a symbolic link",
+        });
+    }
+    let file = match options.open(path) {
+        Ok(file) => file,
+        // `create_new` on an existing path (a link included: `O_EXCL` follows none):
+        // the caller decides (another name for a temporary file).
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+            return Err(Error::io(operation, path, e))
+        }
+        Err(e) => {
+            // `O_NOFOLLOW` on a link fails with `ELOOP`, a FIFO opened to write without
+            // a reader with `ENXIO`: said as what the path is.
+            check_replaceable(path, operation)?;
+            return Err(Error::io(operation, path, e));
+        }
+    };
     let meta = file.metadata().map_err(|e| Error::io(operation, path, e))?;
     match special(meta.file_type()) {
         None => Ok(file),
@@ -62,6 +99,52 @@ fn open_regular(path: &Path, operation: &'static str) -> Result<std::fs::File> {
             kind,
         }),
     }
+}
+
+/// A new, empty file at `path` opened to write, replacing a regular file there: the old
+/// file is removed, then the new one created exclusively (`O_EXCL`), so that a link
+/// placed at `path` meanwhile is refused, never written through.
+///
+/// # Errors
+/// [`Error::NotARegularFile`] for anything but a regular file (or nothing) at `path`;
+/// [`Error::Io`] when it cannot be removed or created.
+pub(crate) fn create(path: &Path, operation: &'static str) -> Result<File> {
+    remove_if_exists(path, operation)?;
+    open(
+        path,
+        OpenOptions::new().write(true).create_new(true),
+        operation,
+    )
+}
+
+/// Removes the regular file `path` where it exists; anything else there (a link, a
+/// FIFO, a directory) is refused and stays.
+///
+/// # Errors
+/// [`Error::NotARegularFile`]; [`Error::Io`] when it cannot be removed.
+pub(crate) fn remove_if_exists(path: &Path, operation: &'static str) -> Result<()> {
+    check_replaceable(path, operation)?;
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(Error::io(operation, path, e)),
+        _ => Ok(()),
+    }
+}
+
+/// Whether the regular file `path` exists (a marker such as a sweep run's `done`),
+/// without following a link: `false` where nothing is there.
+///
+/// # Errors
+/// [`Error::NotARegularFile`] for a link or anything but a regular file there;
+/// [`Error::Io`] when `path` cannot be examined.
+#[cfg_attr(not(feature = "serde"), allow(dead_code))]
+pub(crate) fn is_file(path: &Path, operation: &'static str) -> Result<bool> {
+    check_replaceable(path, operation)?;
+    Ok(std::fs::symlink_metadata(path).is_ok())
+}
+
+/// Opens `path` for reading as a regular file ([`open`]).
+fn open_regular(path: &Path, operation: &'static str) -> Result<File> {
+    open(path, OpenOptions::new().read(true), operation)
 }
 
 /// The bytes of the regular file `path`, read up to the memory the machine can give its
@@ -129,9 +212,10 @@ pub(crate) fn read_text_if_exists(path: &Path, operation: &'static str) -> Resul
     }
 }
 
-/// Refuses an output `path` that exists and is not a regular file (a directory, a FIFO,
-/// a device, a socket, a symbolic link: [`Error::NotARegularFile`]); nothing there, or a
-/// regular file, may be replaced.
+/// Refuses a `path` that exists and is not a regular file (a directory, a FIFO, a device,
+/// a socket, a symbolic link: [`Error::NotARegularFile`]); nothing there, or a regular
+/// file, may be replaced. Called before a rename over `path`, which would replace a link
+/// rather than follow it, and so silently.
 ///
 /// # Errors
 /// [`Error::NotARegularFile`]; [`Error::Io`] when `path` cannot be examined.
@@ -184,14 +268,18 @@ pub(crate) fn write_atomically(path: &Path, bytes: &[u8], operation: &'static st
         tmp_name.push(name);
         tmp_name.push(format!(".tmp{}-{call}-{nanos}", std::process::id()));
         let tmp = dir.join(tmp_name);
-        match std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&tmp)
-        {
+        match open(
+            &tmp,
+            OpenOptions::new().write(true).create_new(true),
+            operation,
+        ) {
             Ok(file) => break (tmp, file),
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(io(path, e)),
+            Err(Error::Io { source, .. }) if source.kind() == std::io::ErrorKind::AlreadyExists => {
+                continue
+            }
+            // Named by the file written, as every other failure of the write.
+            Err(Error::Io { source, .. }) => return Err(io(path, source)),
+            Err(e) => return Err(e),
         }
     };
     if let Err(e) = file.write_all(bytes).and_then(|()| file.sync_all()) {
@@ -290,7 +378,7 @@ mod tests {
 
     #[cfg(unix)]
     #[test]
-    fn a_symbolic_link_is_not_replaced_and_a_missing_file_is_none() {
+    fn a_symbolic_link_is_neither_followed_nor_replaced_and_a_missing_file_is_none() {
         let dir = scratch("link");
         let target = dir.join("target");
         std::fs::write(&target, "kept").unwrap();
@@ -308,8 +396,36 @@ mod tests {
             "{e}"
         );
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "kept");
-        // A link to a regular file is read through.
-        assert_eq!(read_text(&link, "reading").unwrap(), "kept");
+        // Nor read through, nor created through, nor removed.
+        for e in [
+            read_text(&link, "reading").unwrap_err(),
+            create(&link, "creating").unwrap_err(),
+            open(&link, OpenOptions::new().append(true), "opening").unwrap_err(),
+            remove_if_exists(&link, "removing").unwrap_err(),
+        ] {
+            assert!(
+                matches!(
+                    e,
+                    Error::NotARegularFile {
+                        kind: "a symbolic link",
+                        ..
+                    }
+                ),
+                "{e}"
+            );
+        }
+        // A dangling link: nothing is created at its target.
+        let dangling = dir.join("dangling");
+        std::os::unix::fs::symlink(dir.join("nowhere"), &dangling).unwrap();
+        let e = open(
+            &dangling,
+            OpenOptions::new().read(true).write(true).create(true),
+            "opening",
+        )
+        .unwrap_err();
+        assert!(matches!(e, Error::NotARegularFile { .. }), "{e}");
+        assert!(!dir.join("nowhere").exists());
+        assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
         assert!(read_text_if_exists(&dir.join("none"), "reading")
             .unwrap()
             .is_none());

@@ -9,8 +9,14 @@
 //! it when it lets go. The file itself stays: removing it would let a process that opened
 //! it just before lock a file no longer in the directory while a third one locks a new
 //! file of the same name.
+//!
+//! Readers of a directory (`plot`, `movie`, `stats`) take the same lock shared
+//! ([`ReadLock`]): no writer takes the directory while one reads it, and a reader neither
+//! writes nor empties the file. The file is opened as every file of the crate
+//! ([`crate::files::open`]): a symbolic link there is refused, never followed.
 
 use crate::error::{Error, Result};
+use crate::files;
 use std::fs::{File, OpenOptions, TryLockError};
 use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
@@ -43,16 +49,26 @@ impl DirLock {
     pub(crate) fn try_lock(dir: &Path) -> Result<Attempt> {
         let path = dir.join(LOCK_FILE);
         // Not truncated on open: the holder's name is in it.
-        let mut file = OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create(true)
-            .truncate(false)
-            .open(&path)
-            .map_err(|e| Error::io("opening the lock file", &path, e))?;
+        let mut file = files::open(
+            &path,
+            OpenOptions::new()
+                .read(true)
+                .write(true)
+                .create(true)
+                .truncate(false),
+            "opening the lock file",
+        )?;
         match file.try_lock() {
             Ok(()) => {}
-            Err(TryLockError::WouldBlock) => return Ok(Attempt::Held(holder(&path))),
+            Err(TryLockError::WouldBlock) => {
+                // Readers only, if a shared lock is granted: their file holds no line (or
+                // a killed writer's, which is not the holder).
+                let who = match file.try_lock_shared() {
+                    Ok(()) => "a reader of the directory (plot, movie or stats)".to_string(),
+                    Err(_) => holder(&path),
+                };
+                return Ok(Attempt::Held(who));
+            }
             Err(TryLockError::Error(e)) => return Err(Error::io("locking", &path, e)),
         }
         let me = identity();
@@ -105,6 +121,62 @@ impl Drop for DirLock {
     }
 }
 
+/// A shared lock on a directory, a reader's (`plot`, `movie`, `stats`): writers
+/// ([`DirLock`]) are kept out while it is held, other readers are not. Released on drop;
+/// the lock file is never written.
+// Its readers (plot, sweep statistics) need feature `serde`.
+#[cfg_attr(not(feature = "serde"), allow(dead_code))]
+#[derive(Debug)]
+pub(crate) struct ReadLock {
+    /// `None`: read without the lock ([`ReadLock::lock`]).
+    _file: Option<File>,
+}
+
+impl ReadLock {
+    /// Takes the shared lock of `dir`, refusing at once when a writer holds it. The lock
+    /// file is created (empty) where it is missing; where it cannot be because the
+    /// directory is not writable (a read-only file system, no permission to write) or
+    /// does not exist, the directory is read without the lock: no writer has run there
+    /// since the file would have been made, on a read-only file system none can start,
+    /// and a missing directory is the reader's own error to report.
+    ///
+    /// # Errors
+    /// [`Error::DirectoryLocked`] naming the writer; [`Error::NotARegularFile`] for a
+    /// lock file that is a symbolic link or not a regular file; [`Error::Io`] when it
+    /// cannot be opened or locked.
+    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
+    pub(crate) fn lock(dir: &Path) -> Result<ReadLock> {
+        use std::io::ErrorKind;
+        const OPENING: &str = "opening the lock file";
+        let path = dir.join(LOCK_FILE);
+        let file = match files::open(&path, OpenOptions::new().read(true), OPENING) {
+            Err(Error::Io { source, .. }) if source.kind() == ErrorKind::NotFound => {
+                let mut create = OpenOptions::new();
+                create.read(true).write(true).create_new(true);
+                match files::open(&path, &mut create, OPENING) {
+                    Err(Error::Io { source, .. }) => match source.kind() {
+                        // Made by another process meanwhile.
+                        ErrorKind::AlreadyExists => {
+                            files::open(&path, OpenOptions::new().read(true), OPENING)
+                        }
+                        ErrorKind::NotFound
+                        | ErrorKind::PermissionDenied
+                        | ErrorKind::ReadOnlyFilesystem => return Ok(ReadLock { _file: None }),
+                        _ => Err(Error::io(OPENING, &path, source)),
+                    },
+                    other => other,
+                }
+            }
+            other => other,
+        }?;
+        match file.try_lock_shared() {
+            Ok(()) => Ok(ReadLock { _file: Some(file) }),
+            Err(TryLockError::WouldBlock) => Err(locked(dir, holder(&path))),
+            Err(TryLockError::Error(e)) => Err(Error::io("locking", &path, e)),
+        }
+    }
+}
+
 fn locked(dir: &Path, holder: String) -> Error {
     Error::DirectoryLocked {
         path: PathBuf::from(dir),
@@ -117,7 +189,7 @@ fn holder(path: &Path) -> String {
     // The first 4 kB: a holder writes one line; a file grown by something else is not read
     // whole.
     let mut text = String::new();
-    if let Ok(file) = File::open(path) {
+    if let Ok(file) = files::open(path, OpenOptions::new().read(true), "reading the lock file") {
         let _ = std::io::Read::read_to_string(&mut std::io::Read::take(file, 4096), &mut text);
     }
     let text = text.trim();
@@ -261,6 +333,66 @@ mod tests {
         drop(first);
         assert_eq!(std::fs::read(dir.join(LOCK_FILE)).unwrap(), b"");
         drop(DirLock::lock(&dir).unwrap());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn readers_share_the_lock_keep_writers_out_and_write_nothing() {
+        let dir = std::env::temp_dir().join(format!("precursors-lock-read-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join(LOCK_FILE);
+        let first = ReadLock::lock(&dir).unwrap();
+        let second = ReadLock::lock(&dir).unwrap();
+        assert_eq!(std::fs::read(&file).unwrap(), b"");
+        match DirLock::lock(&dir) {
+            Err(Error::DirectoryLocked { holder, .. }) => {
+                assert!(holder.starts_with("a reader"), "{holder}")
+            }
+            other => panic!("{other:?}"),
+        }
+        drop((first, second));
+        let writer = DirLock::lock(&dir).unwrap();
+        let line = std::fs::read(&file).unwrap();
+        match ReadLock::lock(&dir) {
+            Err(Error::DirectoryLocked { holder, .. }) => {
+                assert!(
+                    holder.starts_with(&format!("pid {}", std::process::id())),
+                    "{holder}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+        // The refused reader neither wrote nor emptied the holder's line.
+        assert_eq!(std::fs::read(&file).unwrap(), line);
+        drop(writer);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_lock_file_that_is_a_link_is_refused_and_its_target_kept() {
+        let dir = std::env::temp_dir().join(format!("precursors-lock-link-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let target = dir.join("target");
+        std::fs::write(&target, "kept").unwrap();
+        std::os::unix::fs::symlink(&target, dir.join(LOCK_FILE)).unwrap();
+        for e in [
+            DirLock::lock(&dir).unwrap_err(),
+            ReadLock::lock(&dir).unwrap_err(),
+        ] {
+            assert!(
+                matches!(
+                    e,
+                    Error::NotARegularFile {
+                        kind: "a symbolic link",
+                        ..
+                    }
+                ),
+                "{e}"
+            );
+            assert!(e.to_string().contains(LOCK_FILE), "{e}");
+        }
+        assert_eq!(std::fs::read(&target).unwrap(), b"kept");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -841,15 +841,13 @@ impl RunTables {
         // events.csv last: a crash between the renames leaves it .partial, so a resume
         // or a rerun still sees the run as not finished.
         if let Some(fields) = &self.fields {
-            fs::rename(&fields.partial, &fields.path)
-                .map_err(|e| Error::io("renaming table", &fields.path, e))?;
+            rename_table(&fields.partial, &fields.path)?;
         }
         if let Some(profiles) = &self.profiles {
             profiles.rename()?;
         }
         for t in [2, 1, 0] {
-            fs::rename(&self.partials[t], &self.paths[t])
-                .map_err(|e| Error::io("renaming table", &self.paths[t], e))?;
+            rename_table(&self.partials[t], &self.paths[t])?;
         }
         sync_dir(&self.dir).map_err(|e| Error::io("syncing directory", &self.dir, e))?;
         Ok(self.paths.clone())
@@ -974,29 +972,22 @@ fn remove_derived(dir: &Path) -> Result<()> {
         let entry = entry.map_err(|e| Error::io("reading directory", dir, e))?;
         let is_file = entry.file_type().is_ok_and(|t| !t.is_dir());
         if is_file && entry.file_name().to_str().is_some_and(layout::derived) {
-            match fs::remove_file(entry.path()) {
-                Err(e) if e.kind() != io::ErrorKind::NotFound => {
-                    return Err(Error::io(
-                        "removing the earlier run's figure",
-                        entry.path(),
-                        e,
-                    ))
-                }
-                _ => {}
-            }
+            crate::files::remove_if_exists(&entry.path(), "removing the earlier run's figure")?;
         }
     }
     Ok(())
 }
 
-/// Removes `path` where it exists.
+/// Removes the regular file `path` where it exists (a link there is refused).
 fn remove_if_exists(path: &Path) -> Result<()> {
-    match fs::remove_file(path) {
-        Err(e) if e.kind() != io::ErrorKind::NotFound => {
-            Err(Error::io("removing the earlier run's table", path, e))
-        }
-        _ => Ok(()),
-    }
+    crate::files::remove_if_exists(path, "removing the earlier run's table")
+}
+
+/// Renames a table from `partial` to its name `path`, refusing a link or any other
+/// file that is not a regular one at `path` (a rename would replace it silently).
+pub(crate) fn rename_table(partial: &Path, path: &Path) -> Result<()> {
+    check_replaceable(path, "renaming table")?;
+    fs::rename(partial, path).map_err(|e| Error::io("renaming table", path, e))
 }
 
 /// Removes `fields.csv` and `fields.csv.partial` from `dir` (where they exist).
@@ -1019,11 +1010,10 @@ fn remove_recordings(dir: &Path) -> Result<()> {
     remove_profiles(dir)
 }
 
-/// A new table at `path` holding its header.
+/// A new table at `path` holding its header (an old one there replaced; a link or a FIFO
+/// refused, never written through).
 fn new_table(path: &Path, header: &str) -> Result<File> {
-    // A FIFO there would block the open, a link would be written through.
-    check_replaceable(path, "creating table")?;
-    let mut file = File::create(path).map_err(|e| Error::io("creating table", path, e))?;
+    let mut file = crate::files::create(path, "creating table")?;
     writeln!(file, "{header}").map_err(|e| Error::io("writing table", path, e))?;
     Ok(file)
 }
@@ -1031,10 +1021,7 @@ fn new_table(path: &Path, header: &str) -> Result<File> {
 /// The table at `path` rewritten (atomically) as `text`, opened to append.
 fn append_to(path: &Path, text: &str) -> Result<File> {
     write_atomically(path, text.as_bytes(), "writing table")?;
-    OpenOptions::new()
-        .append(true)
-        .open(path)
-        .map_err(|e| Error::io("opening table", path, e))
+    crate::files::open(path, OpenOptions::new().append(true), "opening table")
 }
 
 /// The text of a table of a run under way (`partial`), else of a finished run (`path`),

@@ -718,7 +718,7 @@ impl Sweep {
             events: 0,
             seconds: 0.0,
         };
-        if dir.join(DONE).is_file() {
+        if crate::files::is_file(&dir.join(DONE), "examining the run directory")? {
             return Ok(report(true, false));
         }
         std::fs::create_dir_all(&dir)
@@ -728,7 +728,7 @@ impl Sweep {
             Attempt::Held(_) => return Ok(report(false, true)),
         };
         // Complete by a process that held the lock since the first look.
-        if dir.join(DONE).is_file() {
+        if crate::files::is_file(&dir.join(DONE), "examining the run directory")? {
             return Ok(report(true, false));
         }
         empty_but_lock(&dir)?;
@@ -945,7 +945,8 @@ impl Sweep {
     }
 }
 
-/// Removes everything in `dir` but its lock file (whose lock this process holds).
+/// Removes everything in `dir` but its lock file (whose lock this process holds); a
+/// symbolic link or a special file there is refused and stays.
 fn empty_but_lock(dir: &Path) -> Result<()> {
     let entries =
         std::fs::read_dir(dir).map_err(|e| Error::io("emptying the cut run directory", dir, e))?;
@@ -955,11 +956,12 @@ fn empty_but_lock(dir: &Path) -> Result<()> {
             continue;
         }
         let path = entry.path();
-        let removed = match entry.file_type() {
-            Ok(t) if t.is_dir() => std::fs::remove_dir_all(&path),
-            _ => std::fs::remove_file(&path),
-        };
-        removed.map_err(|e| Error::io("removing from the cut run directory", &path, e))?;
+        match entry.file_type() {
+            Ok(t) if t.is_dir() => std::fs::remove_dir_all(&path)
+                .map_err(|e| Error::io("removing from the cut run directory", &path, e))?,
+            // A link is no file of a run: refused, as everywhere in a run directory.
+            _ => crate::files::remove_if_exists(&path, "removing from the cut run directory")?,
+        }
     }
     Ok(())
 }

@@ -452,3 +452,506 @@ fn special_files_as_inputs_and_outputs_get_an_answer_and_stay() {
     assert!(failures.is_empty(), "{failures:#?}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Copies the files and directories under `from` into a new directory `to`.
+#[cfg(unix)]
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).unwrap();
+        }
+    }
+}
+
+/// One command against a symbolic link at one path of its directories: the link's target
+/// (a file outside the directory) must keep its bytes, the command must be refused with
+/// code 4 (a path that is not a regular file: docs/cli.md) and its message must name the
+/// link. `make` builds the case's directory (a copy) and returns the arguments.
+#[cfg(unix)]
+struct LinkCase<'a> {
+    /// The directory the case's copies go into.
+    dir: &'a Path,
+    failures: Vec<String>,
+    cases: usize,
+}
+
+#[cfg(unix)]
+impl LinkCase<'_> {
+    /// Runs `args` (made by `make` from the case's copy of `pristine`) with `name` (a path
+    /// relative to the copy) replaced by a link to a file outside it.
+    fn check(&mut self, pristine: &Path, name: &str, make: impl FnOnce(&Path) -> Vec<String>) {
+        self.cases += 1;
+        let case = self.dir.join(format!("case{}", self.cases));
+        let copy = case.join("dir");
+        copy_dir(pristine, &copy);
+        let target = case.join("outside");
+        let bytes = format!("the file outside, case {} ({name})\n", self.cases).into_bytes();
+        std::fs::write(&target, &bytes).unwrap();
+        let link = copy.join(name);
+        let _ = std::fs::remove_file(&link);
+        std::fs::create_dir_all(link.parent().unwrap()).unwrap();
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        let args = make(&copy);
+        let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+        let what = format!("{} with {name} a link", argv.join(" "));
+        let Some(o) = bounded(&argv) else {
+            self.failures.push(format!("{what}: hung"));
+            return;
+        };
+        let text = stderr(&o);
+        if std::fs::read(&target).unwrap() != bytes {
+            self.failures
+                .push(format!("{what}: the link's target was changed ({text})"));
+        }
+        if !std::fs::symlink_metadata(&link).is_ok_and(|m| m.is_symlink()) {
+            self.failures.push(format!("{what}: the link was replaced"));
+        }
+        if o.status.code() != Some(4) || !text.contains(path(&link)) {
+            self.failures
+                .push(format!("{what}: code {:?}, {text}", o.status.code()));
+        }
+        std::fs::remove_dir_all(&case).unwrap();
+    }
+}
+
+/// Issue 53: a symbolic link at any path of a run directory, a sweep directory, or of the
+/// figures and PNG frames, is never followed out of its directory, nor replaced: every
+/// reader and writer of that path refuses it (code 4) naming it, and the file it points to
+/// keeps its bytes. (Before: `run` wrote its holder line into the target of a linked
+/// `.precursors.lock`, then emptied it, with code 0; readers read tables through links.)
+#[cfg(unix)]
+#[test]
+fn a_symbolic_link_at_any_path_of_a_directory_is_refused_and_its_target_kept() {
+    let dir = scratch("links");
+    let (scene, run, ck) = finished_run(&dir);
+    let sweep_file = dir.join("sweep-in.json");
+    std::fs::write(&sweep_file, SWEEP).unwrap();
+    let sweep = dir.join("sweep");
+    for args in [
+        vec![
+            "sweep",
+            path(&sweep_file),
+            "--out",
+            path(&sweep),
+            "-q",
+            "--jobs",
+            "1",
+        ],
+        vec!["plot", path(&sweep)],
+        vec!["stats", path(&sweep), "--bootstrap", "5", "--goodness", "5"],
+    ] {
+        let o = precursors(&args);
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
+    }
+    let mut cases = LinkCase {
+        dir: &dir.join("cases"),
+        failures: Vec::new(),
+        cases: 0,
+    };
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let tables = ["events.csv", "curve.csv", "contact_map.csv", "fields.csv"];
+    let partials = tables.map(|t| format!("{t}.partial"));
+    // `run` writes (or removes) every file of a run directory.
+    let mut names: Vec<String> = [
+        ".precursors.lock",
+        "scene.json",
+        "per_avalanche.csv",
+        "fronts.csv",
+        "power_laws.csv",
+        "distributions.csv",
+        "precursor_length.png",
+        "contact_map.svg",
+        "contact_area.gif",
+    ]
+    .iter()
+    .chain(&tables)
+    .map(|n| n.to_string())
+    .chain(partials.iter().cloned())
+    .collect();
+    names.sort();
+    for name in &names {
+        cases.check(&run, name, |d| {
+            vec!["run".into(), s(&scene), "--out".into(), s(d), "-q".into()]
+        });
+    }
+    // `resume` reads the tables (a `.partial` first) and the scene record, and writes
+    // the tables and the derived ones; its checkpoint is read and written over.
+    for name in names.iter().filter(|n| {
+        !n.ends_with(".png")
+            && !n.ends_with(".svg")
+            && !n.ends_with(".gif")
+            && !["power_laws.csv", "distributions.csv"].contains(&n.as_str())
+    }) {
+        cases.check(&run, name, |d| {
+            let ck2 = d.join("ck-copy.json");
+            std::fs::copy(&ck, &ck2).unwrap();
+            vec!["resume".into(), s(&ck2), "--out".into(), s(d), "-q".into()]
+        });
+    }
+    cases.check(&run, "ck-link.json", |d| {
+        vec![
+            "resume".into(),
+            s(&d.join("ck-link.json")),
+            "--out".into(),
+            s(d),
+            "-q".into(),
+        ]
+    });
+    cases.check(&run, "ck-link.json", |d| {
+        vec![
+            "run".into(),
+            s(&scene),
+            "--out".into(),
+            s(d),
+            "--checkpoint".into(),
+            s(&d.join("ck-link.json")),
+            "-q".into(),
+        ]
+    });
+    // The readers: each path they read or write.
+    let reads: [(&[&str], &[&str]); 3] = [
+        (
+            &["plot", "--format", "both"],
+            &[
+                ".precursors.lock",
+                "scene.json",
+                "events.csv",
+                "curve.csv",
+                "contact_map.csv",
+                "precursor_length.png",
+                "contact_area.svg",
+                "contact_map.png",
+                "fronts.svg",
+            ],
+        ),
+        (
+            &["stats", "--bootstrap", "5", "--goodness", "5"],
+            &[
+                ".precursors.lock",
+                "scene.json",
+                "events.csv",
+                "curve.csv",
+                "power_laws.csv",
+                "distributions.csv",
+            ],
+        ),
+        (
+            &[
+                "movie",
+                "-q",
+                "--max-frames",
+                "3",
+                "--width",
+                "300",
+                "--height",
+                "200",
+            ],
+            &[
+                ".precursors.lock",
+                "scene.json",
+                "fields.csv",
+                "contact_area.gif",
+                "coulomb_stress.gif",
+            ],
+        ),
+    ];
+    for (command, names) in reads {
+        for name in names {
+            cases.check(&run, name, |d| {
+                let mut args = vec![command[0].to_string(), s(d)];
+                args.extend(command[1..].iter().map(|a| a.to_string()));
+                args
+            });
+        }
+    }
+    // The PNG frames of a movie, in a directory of the run's copy.
+    for name in [
+        "frames/contact_area_0000.png",
+        "frames/contact_area_0002.png",
+    ] {
+        cases.check(&run, name, |d| {
+            vec![
+                "movie".into(),
+                s(d),
+                "-q".into(),
+                "--field".into(),
+                "contact-area".into(),
+                "--max-frames".into(),
+                "3".into(),
+                "--width".into(),
+                "300".into(),
+                "--height".into(),
+                "200".into(),
+                "--png-frames".into(),
+                s(&d.join("frames")),
+            ]
+        });
+    }
+    // A sweep directory: its lock and copy of the sweep for `sweep`, `plot` and `stats`,
+    // the merged tables for `merge` and `plot`, a run's marker and tables for all.
+    let one = "p0000-r0001";
+    let sweep_cases: [(&[&str], &[&str]); 4] = [
+        (
+            &["sweep", "SWEEP", "-q", "--jobs", "1"],
+            &[".precursors.lock", "sweep.json", "p0000-r0001/done"],
+        ),
+        (
+            &["merge"],
+            &[
+                "sweep.json",
+                "curves.csv",
+                "slip.csv",
+                "avalanches.csv",
+                "runs.csv",
+                "p0000-r0001/done",
+                "p0000-r0001/curve.csv",
+                "p0000-r0001/events.csv",
+                "p0000-r0001/scene.json",
+            ],
+        ),
+        (
+            &["plot"],
+            &[
+                ".precursors.lock",
+                "sweep.json",
+                "curves.csv",
+                "precursor_length.png",
+                "avalanche_sizes.png",
+                "p0000-r0001/done",
+                "p0000-r0001/curve.csv",
+            ],
+        ),
+        (
+            &["stats", "--bootstrap", "5", "--goodness", "5"],
+            &[
+                ".precursors.lock",
+                "sweep.json",
+                "power_laws.csv",
+                "distributions.csv",
+                "p0000-r0001/done",
+                "p0000-r0001/events.csv",
+            ],
+        ),
+    ];
+    for (command, names) in sweep_cases {
+        for name in names {
+            cases.check(&sweep, name, |d| match command[0] {
+                "sweep" => {
+                    let mut args = vec!["sweep".into(), s(&sweep_file), "--out".into(), s(d)];
+                    args.extend(command[2..].iter().map(|a| a.to_string()));
+                    args
+                }
+                _ => {
+                    let mut args = vec![command[0].to_string(), s(d)];
+                    args.extend(command[1..].iter().map(|a| a.to_string()));
+                    args
+                }
+            });
+        }
+    }
+    // A cut run of the sweep (no marker): `sweep` runs it again, and refuses a link at
+    // its lock, its scene record or a table rather than remove it or write through it.
+    let cut = dir.join("cut");
+    copy_dir(&sweep, &cut);
+    std::fs::remove_file(cut.join(one).join("done")).unwrap();
+    std::fs::remove_file(cut.join(one).join("meta.json")).unwrap();
+    for name in [
+        ".precursors.lock",
+        "scene.json",
+        "events.csv",
+        "curve.csv.partial",
+    ] {
+        cases.check(&cut, &format!("{one}/{name}"), |d| {
+            vec![
+                "sweep".into(),
+                s(&sweep_file),
+                "--out".into(),
+                s(d),
+                "-q".into(),
+                "--jobs".into(),
+                "1".into(),
+            ]
+        });
+    }
+    assert!(cases.cases > 60, "{} cases", cases.cases);
+    assert!(cases.failures.is_empty(), "{:#?}", cases.failures);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Holds `dir`'s lock as a writer (`run`, `sweep`) does, with its line in the file.
+#[cfg(unix)]
+fn hold_lock(dir: &Path, line: &str) -> std::fs::File {
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(true)
+        .open(dir.join(".precursors.lock"))
+        .unwrap();
+    file.try_lock().unwrap();
+    std::fs::write(dir.join(".precursors.lock"), line).unwrap();
+    file
+}
+
+/// The readers `plot`, `movie` and `stats` take the directory's lock shared: refused
+/// (code 4, naming the holder) while a run or a sweep writes it, with nothing written
+/// and the holder's line kept; they neither write nor empty the lock file, and two of
+/// them read one directory at once.
+#[cfg(unix)]
+#[test]
+fn readers_are_refused_while_a_writer_holds_the_directory_and_leave_its_lock_alone() {
+    let dir = scratch("readlock");
+    let (_, run, _) = finished_run(&dir);
+    let sweep_file = dir.join("sweep-in.json");
+    std::fs::write(&sweep_file, SWEEP).unwrap();
+    let sweep = dir.join("sweep");
+    let o = precursors(&["sweep", path(&sweep_file), "--out", path(&sweep), "-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let line = "pid 4242 on host elsewhere, since 2026-01-01T00:00:00Z: precursors run";
+    let readers = |d: &Path| -> Vec<Vec<String>> {
+        let d = path(d).to_string();
+        let mut all = vec![
+            vec!["plot".into(), d.clone()],
+            vec![
+                "stats".into(),
+                d.clone(),
+                "--bootstrap".into(),
+                "5".into(),
+                "--goodness".into(),
+                "5".into(),
+            ],
+        ];
+        if !d.ends_with("sweep") {
+            all.push(vec![
+                "movie".into(),
+                d,
+                "-q".into(),
+                "--max-frames".into(),
+                "2".into(),
+                "--width".into(),
+                "300".into(),
+                "--height".into(),
+                "200".into(),
+            ]);
+        }
+        all
+    };
+    for d in [&run, &sweep] {
+        let held = hold_lock(d, line);
+        let before = contents(&dir);
+        for args in readers(d) {
+            let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+            let o = bounded(&argv).expect("no hang");
+            let text = stderr(&o);
+            assert_eq!(o.status.code(), Some(4), "{argv:?}: {text}");
+            assert!(
+                text.contains("pid 4242 on host elsewhere"),
+                "{argv:?}: {text}"
+            );
+            assert!(contents(&dir) == before, "{argv:?} wrote: {text}");
+        }
+        drop(held);
+        // Unlocked, a stale line (a writer killed before it emptied the file) stays as
+        // it is: a reader writes nothing into the lock file.
+        std::fs::write(d.join(".precursors.lock"), "stale").unwrap();
+        for args in readers(d) {
+            let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+            let o = precursors(&argv);
+            assert_eq!(o.status.code(), Some(0), "{argv:?}: {}", stderr(&o));
+            assert_eq!(std::fs::read(d.join(".precursors.lock")).unwrap(), b"stale");
+        }
+    }
+    // Two readers at once: one holding the shared lock does not refuse another ...
+    std::fs::write(run.join(".precursors.lock"), "a killed writer's line").unwrap();
+    let reader = std::fs::File::open(run.join(".precursors.lock")).unwrap();
+    reader.try_lock_shared().unwrap();
+    let o = precursors(&["plot", path(&run), "--figure", "precursor_length"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    // ... and keeps a writer out.
+    let scene = dir.join("scene-in.json");
+    let o = precursors(&["run", path(&scene), "--out", path(&run), "-q"]);
+    assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
+    assert!(stderr(&o).contains("a reader"), "{}", stderr(&o));
+    drop(reader);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A run directory holding a stray `sweep.json` is neither a run's nor a sweep's: `plot`,
+/// `stats` and `merge` refuse it (code 3, naming both) and write nothing. (Before: `plot`
+/// drew it as a sweep over the run's figures and ended with code 5.)
+#[test]
+fn a_run_directory_with_a_stray_sweep_json_is_refused_by_its_readers() {
+    let dir = scratch("stray");
+    let (_, run, _) = finished_run(&dir);
+    std::fs::write(run.join("sweep.json"), SWEEP).unwrap();
+    let before = contents(&dir);
+    for args in [
+        vec!["plot", path(&run)],
+        vec!["stats", path(&run), "--bootstrap", "5", "--goodness", "5"],
+        vec!["merge", path(&run)],
+    ] {
+        let o = bounded(&args).expect("no hang");
+        let text = stderr(&o);
+        assert_eq!(o.status.code(), Some(3), "{args:?}: {text}");
+        assert!(
+            text.contains("sweep.json") && text.contains("run's files"),
+            "{args:?}: {text}"
+        );
+        assert!(contents(&dir) == before, "{args:?} wrote: {text}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `--png-frames DIR` owns the frames of its name there: the frames of an older, longer
+/// movie that the new one does not overwrite are removed (an encoder reading
+/// `contact_area_%04d.png` would show them after the new movie's), the program says so,
+/// and files of other names stay.
+#[test]
+fn png_frames_of_an_older_longer_movie_are_removed_and_said() {
+    let dir = scratch("frames");
+    let (_, run, _) = finished_run(&dir);
+    let frames = dir.join("frames");
+    let movie = |n: &str| {
+        precursors(&[
+            "movie",
+            path(&run),
+            "--field",
+            "contact-area",
+            "--max-frames",
+            n,
+            "--width",
+            "300",
+            "--height",
+            "200",
+            "--png-frames",
+            path(&frames),
+        ])
+    };
+    let o = movie("5");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    std::fs::write(frames.join("notes.txt"), "mine").unwrap();
+    std::fs::write(frames.join("contact_area_0001.txt"), "mine").unwrap();
+    std::fs::write(frames.join("coulomb_stress_0004.png"), "another movie's").unwrap();
+    let o = movie("2");
+    let text = stderr(&o);
+    assert_eq!(o.status.code(), Some(0), "{text}");
+    let left: Vec<String> = contents(&frames).into_iter().map(|(n, _)| n).collect();
+    assert_eq!(
+        left,
+        [
+            "contact_area_0000.png",
+            "contact_area_0001.png",
+            "contact_area_0001.txt",
+            "coulomb_stress_0004.png",
+            "notes.txt"
+        ],
+        "{text}"
+    );
+    assert!(text.contains("removed 3 PNG frames"), "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1057,29 +1057,45 @@ fn movie(
         });
         bar.finish();
         match outcome {
-            Ok(report) => say!(
-                "wrote {} ({:.1} MB): {} frames of {} recorded states (one in {} and the \
+            Ok(report) => {
+                say!(
+                    "wrote {} ({:.1} MB): {} frames of {} recorded states (one in {} and the \
                  last), colour scale {:.4} to {:.4} {}{}",
-                path.display(),
-                std::fs::metadata(&path).map_or(0.0, |m| m.len() as f64 / 1e6),
-                report.frames,
-                report.states,
-                report.stride,
-                report.colour_range.0,
-                report.colour_range.1,
-                if kind == MovieKind::ContactArea {
-                    "mm²"
-                } else {
-                    "MPa"
-                },
-                options
-                    .png_frames
-                    .as_ref()
-                    .map_or_else(String::new, |d| format!(
-                        "; its frames as PNGs in {}",
-                        d.display()
-                    ))
-            ),
+                    path.display(),
+                    std::fs::metadata(&path).map_or(0.0, |m| m.len() as f64 / 1e6),
+                    report.frames,
+                    report.states,
+                    report.stride,
+                    report.colour_range.0,
+                    report.colour_range.1,
+                    if kind == MovieKind::ContactArea {
+                        "mm²"
+                    } else {
+                        "MPa"
+                    },
+                    options
+                        .png_frames
+                        .as_ref()
+                        .map_or_else(String::new, |d| format!(
+                            "; its frames as PNGs in {}",
+                            d.display()
+                        ))
+                );
+                // The frames' directory is the movie's: an older movie's frames beyond
+                // these would be encoded after them.
+                if let (Some(first), Some(last)) = (
+                    report.stale_frames_removed.first(),
+                    report.stale_frames_removed.last(),
+                ) {
+                    say!(
+                        "removed {} PNG frames of an older movie that these did not \
+                         overwrite ({} to {})",
+                        report.stale_frames_removed.len(),
+                        first.display(),
+                        last.display()
+                    );
+                }
+            }
             // `all`: the Coulomb stress movie of a run that recorded no planes is skipped.
             Err(precursors::plot::PlotError::NoFields { reason, .. })
                 if field == MovieArg::All && kind == MovieKind::CoulombStress =>

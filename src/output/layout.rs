@@ -194,6 +194,33 @@ pub(crate) fn check_not_a_sweeps(dir: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Whether `dir` is a sweep's directory (it holds `sweep.json`) rather than a run's, for
+/// the readers that take either (`plot`, `stats`, `merge`). A run directory with a stray
+/// `sweep.json` (a copy, a mistake) is neither: read as a sweep's, its figures would be
+/// drawn over the run's from runs it does not hold.
+///
+/// # Errors
+/// [`Error::RunDirectory`] for a directory that holds both `sweep.json` and a run's files
+/// ([`holds_a_run`]); [`Error::NotARegularFile`] for a `sweep.json` that is a link or not
+/// a regular file; [`Error::Io`] when `dir` cannot be examined.
+#[cfg(feature = "serde")]
+pub(crate) fn is_sweep(dir: &Path) -> Result<bool> {
+    if !crate::files::is_file(&dir.join(SWEEP), "examining the directory")? {
+        return Ok(false);
+    }
+    match holds_a_run(dir)? {
+        None => Ok(true),
+        Some(name) => Err(Error::RunDirectory {
+            path: dir.to_path_buf(),
+            reason: format!(
+                "it holds both a sweep's {SWEEP} and a run's files ({name}): it is neither a \
+                 run's directory nor a sweep's, and read as either its figures, statistics \
+                 or merged tables would be another's; remove the file that does not belong"
+            ),
+        }),
+    }
+}
+
 /// Whether `dir` holds a run's files (its scene record, a table, `NAME.partial`): a
 /// sweep is not written there.
 ///

@@ -301,8 +301,7 @@ impl ProfilesTable {
 
     /// Renames the table to its name.
     pub(super) fn rename(&self) -> Result<()> {
-        std::fs::rename(&self.partial, &self.path)
-            .map_err(|e| Error::io("renaming table", &self.path, e))
+        super::rename_table(&self.partial, &self.path)
     }
 }
 

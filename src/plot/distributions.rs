@@ -12,7 +12,6 @@ use crate::output::derived::derive;
 use crate::output::layout::{DROPS_FIGURE, FRONTS_FIGURE, SIZES_FIGURE};
 use crate::statistics::{fit_power_law, log_binned, PowerLawOptions, Support};
 use crate::sweep::stats::{points, samples};
-use crate::sweep::SWEEP_FILE;
 use std::path::{Path, PathBuf};
 
 /// What [`draw_statistics`] drew, and what it left out and why.
@@ -49,7 +48,7 @@ pub(super) fn draw_statistics(
     selection: &Selection,
 ) -> Result<Statistics, PlotError> {
     let mut drawn = Statistics::default();
-    let run = !dir.join(SWEEP_FILE).is_file();
+    let run = !crate::output::layout::is_sweep(dir)?;
     let pooled = selection.wants(SIZES_FIGURE) || selection.wants(DROPS_FIGURE);
     let fronts_wanted = run && selection.wants(FRONTS_FIGURE);
     if !pooled && !fronts_wanted {

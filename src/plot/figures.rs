@@ -117,8 +117,12 @@ pub struct Drawn {
 /// read (`NotFound` when missing), a table that cannot be read or a figure that
 /// cannot be written (each figure is written atomically: none is left half written),
 /// [`Error::CorruptTable`] for a damaged table, [`Error::NonFiniteCell`] for a `NaN`, an
-/// infinity or an empty cell where a number belongs (with the file, line and column); in
-/// [`PlotError::Sweep`]: a sweep's errors as [`crate::sweep::merge`].
+/// infinity or an empty cell where a number belongs (with the file, line and column),
+/// [`Error::DirectoryLocked`] while a run or a sweep writes the directory (its lock is
+/// taken shared, as a reader's), [`Error::RunDirectory`] for a run directory holding a
+/// `sweep.json`, [`Error::NotARegularFile`] for a symbolic link where a table is read or
+/// a figure written; in [`PlotError::Sweep`]: a sweep's errors as
+/// [`crate::sweep::merge`].
 ///
 /// [`Drawn`]'s example draws a run's figures as SVG; here as PNG:
 ///
@@ -326,7 +330,9 @@ pub fn draw_with_options(dir: &Path, options: &DrawOptions) -> Result<Drawn, Plo
     let extensions: Vec<&str> = formats.iter().map(|f| f.extension()).collect();
     // A directory that does not exist or cannot be read is a file error, not a figure's.
     std::fs::read_dir(dir).map_err(|e| Error::io("reading the run or sweep directory", dir, e))?;
-    let sweep = dir.join(SWEEP_FILE).is_file();
+    let sweep = crate::output::layout::is_sweep(dir)?;
+    // A reader: no run or sweep writes the directory while its figures are drawn.
+    let _lock = crate::lock::ReadLock::lock(dir)?;
     if !sweep && !dir.join("curve.csv").is_file() {
         return Err(
             if dir

@@ -72,6 +72,10 @@ pub struct MovieReport {
     pub events: Vec<usize>,
     /// The colour scale of every frame (mm² for the contact area, MPa for `τ_C`).
     pub colour_range: (f64, f64),
+    /// The PNG frames of an older movie of the same name that this one did not overwrite,
+    /// removed from the frames' directory ([`Movie::png_frames`]); empty without PNG
+    /// frames.
+    pub stale_frames_removed: Vec<PathBuf>,
 }
 
 /// One recorded stable state.
@@ -233,8 +237,13 @@ impl Movie {
     /// `dir` (made if missing), numbered from 0 in the order shown, for an encoder of the
     /// user's choice: `STEM_0000.png`, `STEM_0001.png`, … (`STEM` the GIF's file stem, as
     /// many digits as the last number needs, at least 4; e.g. `ffmpeg -framerate 10 -i
-    /// contact_area_%04d.png movie.mp4`). A movie stopped by [`Movie::save_until`] leaves
-    /// the frames written so far.
+    /// contact_area_%04d.png movie.mp4`). The directory is the movie's: once every frame
+    /// is written, the frames `STEM_<number>.png` of an older movie of the same name that
+    /// these did not overwrite (a longer one's last frames, which the encoder would show
+    /// after these) are removed and listed in [`MovieReport::stale_frames_removed`]; files
+    /// of other names stay. A movie stopped by [`Movie::save_until`] leaves the frames
+    /// written so far, and removes none. A frame's name that is a symbolic link is
+    /// refused, never written through.
     ///
     /// ```
     /// use precursors::output::RunTables;
@@ -346,6 +355,8 @@ impl Movie {
         mut progress: impl FnMut(usize, usize) -> ControlFlow<()>,
     ) -> Result<Option<MovieReport>> {
         let path = path.as_ref();
+        // A reader of the run directory: no run writes it while the movie is drawn.
+        let _lock = crate::lock::ReadLock::lock(&self.dir)?;
         let is_gif = path
             .extension()
             .and_then(|e| e.to_str())
@@ -382,9 +393,16 @@ impl Movie {
                 return Ok(None);
             }
         }
+        let stale_frames_removed = match &frames_dir {
+            Some(dir) => remove_stale_frames(dir, &stem, report.frames, digits)?,
+            None => Vec::new(),
+        };
         let bytes = gif.finish()?;
         crate::files::write_atomically(path, &bytes, "writing movie")?;
-        Ok(Some(report))
+        Ok(Some(MovieReport {
+            stale_frames_removed,
+            ..report
+        }))
     }
 
     /// The directory of the PNG frames, made if missing (`None`: no PNG frames).
@@ -411,6 +429,7 @@ impl Movie {
     /// # Errors
     /// As [`Movie::save_with_progress`]; [`PlotError::Figure`] for a frame past the last.
     pub fn save_frame(&self, frame: usize, path: impl AsRef<Path>) -> Result<MovieReport> {
+        let _lock = crate::lock::ReadLock::lock(&self.dir)?;
         let (recording, report) = self.plan()?;
         let Some(state) = self.frames(&recording, &report).nth(frame) else {
             return Err(self.refuse(&format!(
@@ -455,6 +474,7 @@ impl Movie {
             stride,
             events: indices.iter().map(|&i| recording.states[i].event).collect(),
             colour_range: range,
+            stale_frames_removed: Vec::new(),
         };
         Ok((recording, report))
     }
@@ -576,6 +596,45 @@ fn percentile_98(mut values: Vec<f64>) -> f64 {
 /// Frames of `n` states drawn every `stride`-th, the last added.
 fn frame_count(n: usize, stride: usize) -> usize {
     frame_indices(n, stride).len()
+}
+
+/// Removes from `dir` the PNG frames `STEM_<number>.png` (at least 4 digits) that this
+/// movie (`frames` frames of `digits` digits) did not write: an older, longer movie's
+/// last frames, which an encoder reading `STEM_%04d.png` would show after this movie's.
+/// Files of other names stay. Returns the frames removed, in order.
+///
+/// # Errors
+/// [`Error::Io`] when `dir` cannot be read or a frame removed;
+/// [`Error::NotARegularFile`] for a frame's name that is a link or not a regular file.
+fn remove_stale_frames(
+    dir: &Path,
+    stem: &str,
+    frames: usize,
+    digits: usize,
+) -> Result<Vec<PathBuf>> {
+    const READING: &str = "reading the directory of the movie's PNG frames";
+    let mut removed = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(|e| Error::io(READING, dir, e))? {
+        let entry = entry.map_err(|e| Error::io(READING, dir, e))?;
+        let name = entry.file_name();
+        let Some(number) = name
+            .to_str()
+            .and_then(|n| n.strip_prefix(stem))
+            .and_then(|n| n.strip_prefix('_'))
+            .and_then(|n| n.strip_suffix(".png"))
+        else {
+            continue;
+        };
+        let a_frame = number.len() >= 4 && number.bytes().all(|b| b.is_ascii_digit());
+        let written = number.len() == digits && number.parse::<usize>().is_ok_and(|k| k < frames);
+        if a_frame && !written {
+            let path = entry.path();
+            crate::files::remove_if_exists(&path, "removing a frame of an older movie")?;
+            removed.push(path);
+        }
+    }
+    removed.sort();
+    Ok(removed)
 }
 
 fn frame_indices(n: usize, stride: usize) -> Vec<usize> {

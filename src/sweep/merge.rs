@@ -311,7 +311,7 @@ pub(crate) fn ensemble_curves(dir: &Path, grid: &[f64]) -> Result<Vec<EnsembleCu
         let mut data = Vec::new();
         for run in &runs {
             let run_dir = dir.join(&run.dir_name);
-            if run_dir.join(DONE).is_file() {
+            if crate::files::is_file(&run_dir.join(DONE), "examining the run directory")? {
                 data.push(read_run(&run_dir, run)?);
             }
         }
@@ -404,7 +404,7 @@ pub fn merge(dir: &Path) -> Result<MergeSummary, SweepError> {
 /// [`SweepError::Directory`] when `dir` holds no `sweep.json`; its errors as a sweep file.
 pub(super) fn read_sweep(dir: &Path) -> Result<Sweep, SweepError> {
     let sweep_path = dir.join(SWEEP_FILE);
-    if !sweep_path.is_file() {
+    if !crate::output::layout::is_sweep(dir)? {
         return Err(SweepError::Directory {
             path: dir.to_path_buf(),
             reason: format!("no {SWEEP_FILE}: not the output directory of a sweep"),
@@ -453,7 +453,7 @@ impl Tables {
         for run in runs {
             let run_dir = dir.join(&run.dir_name);
             let (point, realization, seed) = (run.point, run.realization, run.seed);
-            if !run_dir.join(DONE).is_file() {
+            if !crate::files::is_file(&run_dir.join(DONE), "examining the run directory")? {
                 let _ = writeln!(
                     self.runs,
                     "{},{point},{realization},{seed},{values},,",

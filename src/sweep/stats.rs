@@ -224,7 +224,7 @@ impl Point {
 /// [`SweepError::Directory`] for a directory that is neither a run's nor a sweep's; a
 /// sweep file's errors.
 pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Vec<Point>, usize), SweepError> {
-    if !dir.join(SWEEP_FILE).is_file() {
+    if !crate::output::layout::is_sweep(dir)? {
         if !dir.join(crate::output::RUN_SCENE).is_file() {
             return Err(SweepError::Directory {
                 path: dir.to_path_buf(),
@@ -250,7 +250,7 @@ pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Vec<Point>, usize), Swe
         let mut complete = Vec::new();
         for run in &runs {
             let run_dir = dir.join(&run.dir_name);
-            if run_dir.join(DONE).is_file() {
+            if crate::files::is_file(&run_dir.join(DONE), "examining the run directory")? {
                 complete.push((run_dir, Some((*run).clone())));
             } else {
                 missing += 1;
@@ -309,7 +309,10 @@ pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Vec<Point>, usize), Swe
 /// # Errors
 /// [`SweepError::Directory`] for a directory that is neither a run's nor a sweep's;
 /// as [`super::merge`] for the runs' tables; in [`SweepError::Core`]:
-/// [`Error::InvalidParameter`]/[`Error::InvalidCount`] for bad options.
+/// [`Error::InvalidParameter`]/[`Error::InvalidCount`] for bad options,
+/// [`Error::DirectoryLocked`] while a run or a sweep writes the directory (its lock is
+/// taken shared, as a reader's), [`Error::RunDirectory`] for a run directory holding a
+/// `sweep.json`.
 pub fn statistics(dir: &Path, options: &StatsOptions) -> Result<StatsSummary, SweepError> {
     if options.bins_per_decade == 0 {
         return Err(Error::InvalidCount {
@@ -319,6 +322,8 @@ pub fn statistics(dir: &Path, options: &StatsOptions) -> Result<StatsSummary, Sw
         }
         .into());
     }
+    // A reader: no run or sweep writes the directory while its statistics are derived.
+    let _lock = crate::lock::ReadLock::lock(dir)?;
     let (keys, points, missing) = points(dir)?;
     let key_header: String = keys.iter().map(|k| format!("{},", cell(k))).collect();
     let mut fits = format!(
