@@ -955,3 +955,115 @@ fn png_frames_of_an_older_longer_movie_are_removed_and_said() {
     assert!(text.contains("removed 3 PNG frames"), "{text}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// docs/tables.md documents every column of every table a run, a sweep, `merge` and
+/// `stats` write, under the file's own name (issue 56): the tables of a spring-driven run
+/// recording fields and profiles, of a two-point sweep, merged, and `stats` of both are
+/// written here, and each header is checked against the page both ways (`<k>` in the
+/// page stands for the column indices, `<axis>` for the sweep's axis keys).
+#[test]
+fn every_column_is_documented() {
+    use precursors::output::RunTables;
+    use precursors::sweep::{merge, statistics, StatsOptions, Sweep, SweepOptions};
+    use precursors::SceneBuilder;
+    let base = r#"{"block": {"lx": 0.012, "ly": 0.002, "lz": 0.01},
+        "cells": {"kind": "count", "nx": 12, "ny": 2}, "normal_load": 50.0,
+        "drive": {"kind": "spring", "stiffness": 4e6, "lateral": {"kind": "side"}}"#;
+    let dir = scratch("columns");
+    let run = dir.join("run");
+    std::fs::create_dir_all(&run).unwrap();
+    let scene = SceneBuilder::from_json_str(&format!(
+        r#"{base}, "fields": {{"every": 1, "planes": [0.002]}},
+            "profiles": {{"loads": [0.5], "planes": [0.002]}}}}"#
+    ))
+    .unwrap()
+    .build()
+    .unwrap();
+    let mut driver = scene.driver().unwrap();
+    RunTables::create(&run, &driver)
+        .unwrap()
+        .run_to_slip(&mut driver, None, |_, _| {})
+        .unwrap();
+    let sweep_dir = dir.join("sweep");
+    let sweep = Sweep::from_json_str(&format!(
+        r#"{{"base": {base}}}, "axes": [{{"key": "normal_load", "values": [50.0, 60.0]}}],
+            "realizations": 2}}"#
+    ))
+    .unwrap();
+    sweep
+        .execute(&sweep_dir, &SweepOptions::new(), |_| {})
+        .unwrap();
+    merge(&sweep_dir).unwrap();
+    let options = StatsOptions::default().fit(
+        precursors::statistics::PowerLawOptions::default()
+            .bootstrap(2)
+            .goodness_samples(2)
+            .min_tail(2),
+    );
+    statistics(&run, &options).unwrap();
+    statistics(&sweep_dir, &options).unwrap();
+
+    // The page's tables: `### `NAME`` then rows whose first cell is `column`.
+    let page = std::fs::read_to_string("docs/tables.md").unwrap();
+    let mut documented: Vec<(String, Vec<String>)> = Vec::new();
+    for line in page.lines() {
+        if let Some(name) = line.strip_prefix("### `").and_then(|l| l.strip_suffix('`')) {
+            documented.push((name.to_string(), Vec::new()));
+        } else if let (Some(row), Some((_, columns))) =
+            (line.strip_prefix("| `"), documented.last_mut())
+        {
+            columns.push(row.split('`').next().unwrap().to_string());
+        }
+    }
+    let matches = |pattern: &str, column: &str| match pattern.split_once("<k>") {
+        Some((head, "")) => column
+            .strip_prefix(head)
+            .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit())),
+        _ => pattern == "<axis>" && column == "normal_load" || pattern == column,
+    };
+    let mut checked = 0;
+    for (table, columns) in &documented {
+        let mut found = false;
+        for directory in [&run, &sweep_dir] {
+            let Ok(text) = std::fs::read_to_string(directory.join(table)) else {
+                continue;
+            };
+            found = true;
+            let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+            for column in &header {
+                assert!(
+                    columns.iter().any(|p| matches(p, column)),
+                    "{table}: column {column} is not in docs/tables.md"
+                );
+            }
+            for pattern in columns {
+                // `<axis>` has no column in a run directory's tables.
+                let axis_in_run = pattern == "<axis>" && directory == &run;
+                assert!(
+                    axis_in_run || header.iter().any(|c| matches(pattern, c)),
+                    "{table}: docs/tables.md's {pattern} is not in {}",
+                    directory.display()
+                );
+            }
+            checked += 1;
+        }
+        assert!(
+            found,
+            "docs/tables.md documents {table}, which no directory holds"
+        );
+    }
+    // Every CSV table written is on the page.
+    for directory in [&run, &sweep_dir] {
+        for entry in std::fs::read_dir(directory).unwrap() {
+            let name = entry.unwrap().file_name().into_string().unwrap();
+            if name.ends_with(".csv") {
+                assert!(
+                    documented.iter().any(|(t, _)| *t == name),
+                    "{name} is not in docs/tables.md"
+                );
+            }
+        }
+    }
+    assert_eq!(checked, 15);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1168,6 +1168,7 @@ mod tests {
             assert!(left_out.contains(&"solver.threads"), "{left_out:?}");
             assert!(left_out.iter().all(|k| *k == "solver.threads"
                 || *k == "max_cells"
+                || *k == "confirm_metres"
                 || k.starts_with("probes.")
                 || k.starts_with("fields.")
                 || k.starts_with("profiles.")));
@@ -1185,6 +1186,7 @@ mod tests {
                     .unwrap(),
             )
             .max_cells(10)
+            .confirm_metres(true)
             .probes(ProbeSpec::default().with_plane(1e-3))
             .run_options(
                 RunOptions::new()
