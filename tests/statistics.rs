@@ -304,6 +304,34 @@ fn stats_pool_each_points_realizations() {
     }
     let fits = table(&dir.join("power_laws.csv"));
     let bins = table(&dir.join("distributions.csv"));
+    // 1.x's columns first and unchanged, the alternatives after them; each fitted row has
+    // its tests (p-values in [0, 1]) and the verdict the summary printed.
+    let header = std::fs::read_to_string(dir.join("power_laws.csv")).unwrap();
+    let header = header.lines().next().unwrap();
+    assert!(header.starts_with(
+        "point,normal_load,observable,support,samples,tail,x_min,alpha,alpha_std_error,\
+         alpha_low,alpha_high,x_min_low,x_min_high,ks_distance,p_value,confidence,cutoff_alpha,"
+    ));
+    assert!(
+        header.ends_with(",lr_cutoff_vs_lognormal_p,verdict"),
+        "{header}"
+    );
+    let fitted: Vec<_> = fits.iter().filter(|r| !r["alpha"].is_empty()).collect();
+    assert_eq!(summary.verdicts.len(), fitted.len());
+    for (row, verdict) in fitted.iter().zip(&summary.verdicts) {
+        for test in [
+            "lr_exponential",
+            "lr_lognormal",
+            "lr_cutoff",
+            "lr_cutoff_vs_lognormal",
+        ] {
+            let p = num(row, &format!("{test}_p"));
+            assert!((0.0..=1.0).contains(&p), "{test}: {row:?}");
+        }
+        assert!(num(row, "lr_cutoff") <= 0.0);
+        assert!(verdict.ends_with(&row["verdict"]), "{verdict} vs {row:?}");
+        assert!(row["verdict"].contains("cut-off law"));
+    }
     for point in 0..2 {
         let of = |observable: &str| {
             fits.iter()
