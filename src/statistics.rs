@@ -558,7 +558,9 @@ fn fit_with(
 ///
 /// # Errors
 ///
-/// Those of [`fit_power_law`].
+/// Those of [`fit_power_law`], and [`Error::InvalidParameter`] (`"samples"`) when the
+/// tail spans more than f64's range (`x/x_min` overflows for its largest sample, e.g.
+/// samples from 1e-300 to 1e300).
 pub fn compare_alternatives(
     samples: &[f64],
     support: Support,
@@ -567,11 +569,21 @@ pub fn compare_alternatives(
     let mut boot: (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
     let (power_law, xs, best) = fit_with(samples, support, options, |resample, fit| {
         let tail = alternatives::Tail::new(resample, fit, support);
-        let (alpha, lambda) = alternatives::cutoff_only(&tail);
-        boot.0.push(alpha);
-        boot.1.push(1.0 / lambda);
+        if tail.is_finite() {
+            let (alpha, lambda) = alternatives::cutoff_only(&tail);
+            boot.0.push(alpha);
+            boot.1.push(1.0 / lambda);
+        }
     })?;
     let tail = alternatives::Tail::new(&xs, &best, support);
+    if !tail.is_finite() {
+        return Err(Error::InvalidParameter {
+            name: "samples",
+            value: xs[xs.len() - 1],
+            reason: "the tail spans more than f64's range (x / x_min overflows): the \
+                     alternatives' likelihoods cannot be evaluated",
+        });
+    }
     let c = alternatives::compare(&tail);
     let (alpha, lambda, cutoff_ll) = c.cutoff;
     let cutoff = 1.0 / lambda;
@@ -1942,6 +1954,74 @@ mod tests {
                     .all(|v| v.is_finite())));
             }
         }
+    }
+
+    #[test]
+    fn alternatives_of_extreme_samples_are_never_nan() {
+        let options = PowerLawOptions::default()
+            .bootstrap(5)
+            .goodness_samples(0)
+            .min_tail(2);
+        let big = 9_007_199_254_740_000.0;
+        let counts = [
+            vec![big, big, big + 1.0, big + 2.0, big + 900.0],
+            vec![1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 2.0],
+            vec![1.0, 1e3, 1e6, 1e9, 1e12, 1e15],
+        ];
+        let reals = [
+            vec![1e-3, 1e-3, 2e-3, 1.0],
+            vec![1e-100, 1e-50, 1.0, 1e50, 1e100],
+        ];
+        let cases = counts.iter().map(|x| (x, Support::Discrete)).chain(
+            counts
+                .iter()
+                .chain(&reals)
+                .map(|x| (x, Support::Continuous)),
+        );
+        for (xs, support) in cases {
+            let c = compare_alternatives(xs, support, &options).unwrap();
+            let k = &c.cutoff;
+            let values = [
+                c.power_law_log_likelihood,
+                k.alpha,
+                k.lambda,
+                k.cutoff,
+                k.alpha_low,
+                k.alpha_high,
+                k.cutoff_low,
+                k.cutoff_high,
+                k.log_likelihood,
+                c.exponential.lambda,
+                c.exponential.log_likelihood,
+                c.lognormal.mu,
+                c.lognormal.sigma,
+                c.lognormal.log_likelihood,
+            ];
+            assert!(values.iter().all(|v| !v.is_nan()), "{xs:?}: {c:?}");
+            for lr in [
+                &c.vs_exponential,
+                &c.vs_lognormal,
+                &c.vs_cutoff,
+                &c.cutoff_vs_lognormal,
+            ] {
+                assert!(
+                    !lr.log_ratio.is_nan() && !lr.normalized.is_nan(),
+                    "{xs:?}: {lr:?}"
+                );
+                assert!((0.0..=1.0).contains(&lr.p_value), "{xs:?}: {lr:?}");
+            }
+            assert!(!c.verdict().contains("NaN"));
+        }
+        // Beyond f64's range (x_min 1e-300 under 1e300): a typed error, not a NaN.
+        let wide = [1e-300, 1e-300, 1e300, 1e300];
+        let e = compare_alternatives(&wide, Support::Continuous, &options).unwrap_err();
+        assert!(matches!(
+            e,
+            Error::InvalidParameter {
+                name: "samples",
+                ..
+            }
+        ));
     }
 
     #[test]

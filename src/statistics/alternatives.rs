@@ -38,7 +38,7 @@ impl Tail {
         }
         let (mut sy, mut sy2, mut st) = (0.0, 0.0, 0.0);
         for &(x, c) in &values {
-            let y = (x / x_min).ln();
+            let y = ln_ratio(x, x_min);
             let c = c as f64;
             sy += c * y;
             sy2 += c * y * y;
@@ -55,6 +55,22 @@ impl Tail {
             mean_t1: st / nf,
             alpha: fit.alpha,
         }
+    }
+
+    /// Whether the means the likelihoods need are finite (`x / x_min` can overflow for
+    /// samples spanning more than f64's range).
+    pub(super) fn is_finite(&self) -> bool {
+        self.mean_y.is_finite() && self.mean_y2.is_finite() && self.mean_t1.is_finite()
+    }
+}
+
+/// `ln(x / x_min)`, also where the quotient overflows.
+fn ln_ratio(x: f64, x_min: f64) -> f64 {
+    let r = x / x_min;
+    if r.is_finite() {
+        r.ln()
+    } else {
+        x.ln() - x_min.ln()
     }
 }
 
@@ -136,7 +152,7 @@ fn nelder_mead(
         if s[0].1 <= best.1 {
             best = s[0];
         }
-        if restart > 0 && !(improved > F_TOL) {
+        if restart > 0 && (improved.is_nan() || improved <= F_TOL) {
             break;
         }
     }
@@ -533,6 +549,15 @@ fn ratio(a: &[f64], b: &[f64], counts: &[usize], nested: bool) -> LikelihoodRati
     } else {
         r.signum() * f64::INFINITY
     };
+    if !r.is_finite() {
+        // A law that gives some sample no likelihood at all: the other wins outright.
+        return LikelihoodRatio {
+            log_ratio: r,
+            normalized: r,
+            p_value: if r.is_nan() { 1.0 } else { 0.0 },
+            nested,
+        };
+    }
     let p_value = if nested {
         chi2_one_survival_of_twice(r)
     } else if r == 0.0 {

@@ -12,8 +12,16 @@ use crate::output::check::RunRecord;
 use crate::output::derived::derive;
 use crate::output::layout::{DISTRIBUTIONS, POWER_LAWS};
 use crate::statistics::{
-    compare_alternatives, log_binned, Comparison, LikelihoodRatio, PowerLawOptions, Support,
+    compare_alternatives, fit_power_law, log_binned, Comparison, LikelihoodRatio, PowerLawFit,
+    PowerLawOptions, Support,
 };
+
+/// A row's fit: with its alternatives, or the power law alone where they cannot be
+/// evaluated.
+enum Fit {
+    Compared(Box<Comparison>),
+    PowerLaw(PowerLawFit),
+}
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -326,10 +334,15 @@ pub fn statistics(dir: &Path, options: &StatsOptions) -> Result<StatsSummary, Sw
         for ((name, support, _), x) in OBSERVABLES.iter().zip(&pooled) {
             let positive = x.iter().filter(|v| **v > 0.0).count();
             let fit = if positive >= options.fit.min_tail {
-                Some(compare_alternatives(x, *support, &options.fit)?)
+                match compare_alternatives(x, *support, &options.fit) {
+                    Ok(c) => Some(Fit::Compared(Box::new(c))),
+                    // Samples spanning more than f64's range have a power law but no
+                    // alternatives: the power law alone, its errors as before.
+                    Err(_) => Some(Fit::PowerLaw(fit_power_law(x, *support, &options.fit)?)),
+                }
             } else {
                 // Checked all the same: bad options are an error whatever the samples.
-                match compare_alternatives(x, *support, &options.fit) {
+                match fit_power_law(x, *support, &options.fit) {
                     Err(Error::TooFewSamples { .. }) | Ok(_) => None,
                     Err(e) => return Err(e.into()),
                 }
@@ -344,7 +357,7 @@ pub fn statistics(dir: &Path, options: &StatsOptions) -> Result<StatsSummary, Sw
                 fit_cells(fit.as_ref(), options.fit.confidence),
                 alternative_cells(fit.as_ref())
             );
-            if let Some(c) = &fit {
+            if let Some(Fit::Compared(c)) = &fit {
                 verdicts.push(format!("point {index}, {name}: {}", c.verdict()));
             }
             if positive > 0 {
@@ -383,8 +396,8 @@ const ALTERNATIVES_HEADER: &str = "cutoff_alpha,cutoff_alpha_low,cutoff_alpha_hi
     lr_cutoff_vs_lognormal_p,verdict";
 
 /// The cells of the alternatives and their tests (all empty without a fit).
-fn alternative_cells(fit: Option<&Comparison>) -> String {
-    let Some(c) = fit else {
+fn alternative_cells(fit: Option<&Fit>) -> String {
+    let Some(Fit::Compared(c)) = fit else {
         return ",".repeat(ALTERNATIVES_HEADER.matches(',').count());
     };
     let k = &c.cutoff;
@@ -416,8 +429,11 @@ fn alternative_cells(fit: Option<&Comparison>) -> String {
 }
 
 /// The cells of a fit from `tail` on (empty without one).
-fn fit_cells(fit: Option<&Comparison>, confidence: f64) -> String {
-    let Some(f) = fit.map(|c| &c.power_law) else {
+fn fit_cells(fit: Option<&Fit>, confidence: f64) -> String {
+    let Some(f) = fit.map(|f| match f {
+        Fit::Compared(c) => &c.power_law,
+        Fit::PowerLaw(p) => p,
+    }) else {
         return ",,,,,,,,,,".to_string();
     };
     format!(
