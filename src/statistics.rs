@@ -7,6 +7,11 @@
 //!   of both, and the goodness-of-fit p-value of Clauset et al. section 4.1. Samples are
 //!   [`Support::Discrete`] (integer counts: the ruptures of an avalanche) or
 //!   [`Support::Continuous`] (reals: a force drop in N, a stress drop in Pa).
+//! * [`compare_alternatives`]: the same fit, and on its tail `x ≥ x_min` the
+//!   alternatives of Clauset et al. section 5 fitted by maximum likelihood (the
+//!   exponential, the log-normal and the power law with exponential cut-off, with a
+//!   bootstrap interval of the cut-off law), the likelihood-ratio tests between them
+//!   ([`LikelihoodRatio`]) and a verdict in words ([`Comparison::verdict`]).
 //! * [`log_binned`]: a histogram with logarithmically spaced bins, as density estimates
 //!   `P(x)` for log-log plots.
 //!
@@ -30,6 +35,11 @@
 use crate::error::{Error, Result};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
+
+mod alternatives;
+mod special;
+
+pub use alternatives::LikelihoodRatio;
 
 /// Whether samples are integers (counts: the ruptures of an avalanche) or reals (a force
 /// drop in N, a stress drop in Pa).
@@ -204,6 +214,139 @@ impl PowerLawFit {
     }
 }
 
+/// The power law with exponential cut-off `p(x) ∝ x^(-α) e^(-λx)`, `x ≥ x_min`, fitted by
+/// maximum likelihood on the power law's tail ([`compare_alternatives`]).
+#[non_exhaustive]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct CutoffFit {
+    /// Exponent `α` (dimensionless, searched in `[0, 20]`; `α = 0` is the exponential).
+    pub alpha: f64,
+    /// Rate `λ` of the cut-off (inverse unit of the samples, ≥ 0). 0 when the pure power
+    /// law (`λ = 0`, the boundary) is at least as likely as any cut-off.
+    pub lambda: f64,
+    /// The cut-off scale `1/λ` (samples' unit); `+∞` when `λ = 0`.
+    pub cutoff: f64,
+    /// Lower end of the percentile bootstrap interval of `α` at the options'
+    /// `confidence`, from the power law's resamples (each refits `x_min`, then the cut-off
+    /// law on its own tail). Equal to `alpha` when `bootstrap` is 0.
+    pub alpha_low: f64,
+    /// Upper end of the bootstrap interval of `α`.
+    pub alpha_high: f64,
+    /// Lower end of the bootstrap interval of the cut-off scale `1/λ` (samples' unit).
+    pub cutoff_low: f64,
+    /// Upper end of the bootstrap interval of `1/λ` (samples' unit; `+∞` when a
+    /// resample's `λ` is 0 that far up).
+    pub cutoff_high: f64,
+    /// Log-likelihood of the tail under the fitted law (natural log; for reals, of the
+    /// density in the samples' inverse unit).
+    pub log_likelihood: f64,
+}
+
+/// The exponential `p(x) = λ e^(-λ(x - x_min))` (integers: `P(k) = (1 - e^(-λ))
+/// e^(-λ(k - x_min))`) fitted by maximum likelihood on the power law's tail
+/// ([`compare_alternatives`]).
+#[non_exhaustive]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct ExponentialFit {
+    /// Rate `λ` (inverse unit of the samples).
+    pub lambda: f64,
+    /// Log-likelihood of the tail (natural log).
+    pub log_likelihood: f64,
+}
+
+/// The log-normal fitted by maximum likelihood on the power law's tail
+/// ([`compare_alternatives`]): for reals the density `φ((ln x - μ)/σ) / (x σ)`
+/// normalised over `x ≥ x_min`; for integers the continuous law's mass in `[k - 1/2, k +
+/// 1/2)` normalised over `x ≥ x_min - 1/2` (the rounding discretisation).
+#[non_exhaustive]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct LognormalFit {
+    /// `μ`, the mean of `ln x` before truncation (`x` in the samples' unit; may lie far
+    /// below `ln x_min`); `-∞` in the limit `σ = ∞`.
+    pub mu: f64,
+    /// `σ`, the standard deviation of `ln x` before truncation (dimensionless, > 0). As
+    /// `σ → ∞` with `(ln x_min - μ)/σ²` fixed the law tends to a power law (for integers,
+    /// its rounding); that limit is part of the fit: `σ = ∞` where it is the most likely.
+    pub sigma: f64,
+    /// Log-likelihood of the tail (natural log).
+    pub log_likelihood: f64,
+}
+
+/// The power law and its alternatives on one tail ([`compare_alternatives`]).
+#[non_exhaustive]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Comparison {
+    /// The power-law fit, the same as [`fit_power_law`]'s for the same arguments.
+    pub power_law: PowerLawFit,
+    /// Log-likelihood of the tail under the power law (natural log).
+    pub power_law_log_likelihood: f64,
+    /// The power law with exponential cut-off.
+    pub cutoff: CutoffFit,
+    /// The exponential.
+    pub exponential: ExponentialFit,
+    /// The log-normal.
+    pub lognormal: LognormalFit,
+    /// Power law against exponential (non-nested, Vuong); `R > 0` favours the power law.
+    pub vs_exponential: LikelihoodRatio,
+    /// Power law against log-normal (non-nested, Vuong).
+    pub vs_lognormal: LikelihoodRatio,
+    /// Power law against the cut-off law (nested, Wilks); `R ≤ 0`.
+    pub vs_cutoff: LikelihoodRatio,
+    /// Cut-off law against log-normal (non-nested, Vuong); `R > 0` favours the cut-off law.
+    pub cutoff_vs_lognormal: LikelihoodRatio,
+}
+
+/// A likelihood ratio's sign means something only below this p-value (Clauset et al.).
+pub const LR_SIGNIFICANCE: f64 = 0.1;
+
+impl Comparison {
+    /// The tests in words, `; `-separated: the goodness-of-fit test of the pure power law
+    /// (`rejected` at `p ≤ 0.1`, section 4.1), then each likelihood-ratio test in the
+    /// order power law against exponential, log-normal and cut-off law, and cut-off law
+    /// against log-normal: `A preferred over B (p = …)` when `p <` [`LR_SIGNIFICANCE`],
+    /// else `A and B not distinguished (p = …)`. p-values to two decimals.
+    ///
+    /// ```
+    /// use precursors::statistics::{compare_alternatives, PowerLawOptions, Support};
+    /// // Exponential samples (mean 1): the power law loses to the exponential.
+    /// let xs: Vec<f64> = (1..=400).map(|i| -(1.0 - (i as f64 - 0.5) / 400.0).ln()).collect();
+    /// let options = PowerLawOptions::default().bootstrap(0).goodness_samples(0).min_tail(200);
+    /// let c = compare_alternatives(&xs, Support::Continuous, &options)?;
+    /// assert!(c.vs_exponential.log_ratio < 0.0 && c.vs_exponential.p_value < 0.1);
+    /// assert!(c.verdict().contains("exponential preferred over power law"), "{}", c.verdict());
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    pub fn verdict(&self) -> String {
+        let mut parts = Vec::new();
+        if let Some(p) = self.power_law.p_value {
+            let word = if p <= 0.1 { "rejected" } else { "not rejected" };
+            parts.push(format!(
+                "pure power law {word} by its goodness test (p = {p:.2})"
+            ));
+        }
+        for (a, b, lr) in [
+            ("power law", "exponential", &self.vs_exponential),
+            ("power law", "log-normal", &self.vs_lognormal),
+            ("power law", "cut-off law", &self.vs_cutoff),
+            ("cut-off law", "log-normal", &self.cutoff_vs_lognormal),
+        ] {
+            let p = lr.p_value;
+            parts.push(if p < LR_SIGNIFICANCE && lr.log_ratio > 0.0 {
+                format!("{a} preferred over {b} (p = {p:.2})")
+            } else if p < LR_SIGNIFICANCE && lr.log_ratio < 0.0 {
+                format!("{b} preferred over {a} (p = {p:.2})")
+            } else {
+                format!("{a} and {b} not distinguished (p = {p:.2})")
+            });
+        }
+        parts.join("; ")
+    }
+}
+
 /// One bin of a log-binned histogram ([`log_binned`]). Values are in the samples' unit.
 #[non_exhaustive]
 #[derive(Debug, Clone, PartialEq)]
@@ -303,6 +446,17 @@ pub fn fit_power_law(
     support: Support,
     options: &PowerLawOptions,
 ) -> Result<PowerLawFit> {
+    Ok(fit_with(samples, support, options, |_, _| {})?.0)
+}
+
+/// [`fit_power_law`], calling `on_resample` with each bootstrap resample (sorted) and its
+/// fit; also returns the sorted positive samples and the fit at `x_min`.
+fn fit_with(
+    samples: &[f64],
+    support: Support,
+    options: &PowerLawOptions,
+    on_resample: impl FnMut(&[f64], &TailFit),
+) -> Result<(PowerLawFit, Vec<f64>, TailFit)> {
     check_fit_options(options)?;
     let min_tail = options.min_tail;
     let xs = positive_sorted(samples, support)?;
@@ -324,7 +478,7 @@ pub fn fit_power_law(
     let alpha_std_error = alpha_std_error(&best, support);
     // Without a bootstrap (or no resample fitted), the intervals are the estimate alone.
     let ((alpha_low, alpha_high), (x_min_low, x_min_high)) = (options.bootstrap > 0)
-        .then(|| bootstrap_intervals(&xs, support, options, &mut scratch))
+        .then(|| bootstrap_intervals(&xs, support, options, &mut scratch, on_resample))
         .flatten()
         .unwrap_or(((best.alpha, best.alpha), (best.x_min, best.x_min)));
     let p_value = (options.goodness_samples > 0).then(|| {
@@ -339,7 +493,7 @@ pub fn fit_power_law(
             &mut scratch,
         )
     });
-    Ok(PowerLawFit {
+    let fit = PowerLawFit {
         support,
         samples: n,
         tail: best.tail,
@@ -352,6 +506,117 @@ pub fn fit_power_law(
         x_min_high,
         ks_distance: best.ks,
         p_value,
+    };
+    Ok((fit, xs, best))
+}
+
+/// [`fit_power_law`], and on its tail `x ≥ x_min` the alternatives of Clauset, Shalizi
+/// and Newman (section 5) fitted by maximum likelihood and tested against it.
+///
+/// * **The alternatives**, on the same tail (`n` samples): the exponential (closed form),
+///   the log-normal ([`LognormalFit`]) and the power law with exponential cut-off
+///   `p(x) ∝ x^(-α) e^(-λx)` ([`CutoffFit`]; reals normalised by
+///   `∫_{x_min}^∞ x^(-α) e^(-λx) dx = λ^(α-1) Γ(1-α, λ x_min) = x_min^(1-α) E_α(λ x_min)`,
+///   the generalized exponential integral by series, upward recurrence and a continued
+///   fraction to about 1e-14; integers by the sum over `k ≥ x_min`, 2000 terms or until
+///   they fall below 1e-18 of it, then an Euler–Maclaurin tail). The log-normal and the
+///   cut-off law are maximised by Nelder–Mead over two parameters (`(β, ln γ)` with the
+///   log-normal written `∝ e^(-β y - γ y²)` in `y = ln(x/x_min)`; `(α, ln λ x_min)`), each
+///   likelihood concave in its natural parameters, from two starts, restarted until a
+///   restart gains at most 1e-13 in log-likelihood per sample (points to 1e-9).
+/// * **The tests**: `R = Σ [ln p₁(x_i) - ln p₂(x_i)]` over the tail. Non-nested pairs
+///   (power law against exponential, against log-normal; cut-off law against
+///   log-normal): Vuong's statistic `R / √(n σ²)` (`σ²` the variance of the terms, over
+///   `n`) and the two-sided p-value `erfc(|R| / √(2 n σ²))` (Clauset et al. eq. 5.7).
+///   Nested (power law inside the cut-off law, `λ = 0`): Wilks' theorem,
+///   `p = P(χ²₁ ≥ 2|R|) = erfc(√|R|)`, as Clauset et al. and the `powerlaw` package do
+///   (the boundary `λ = 0` makes this conservative: the exact limit is half of it).
+/// * **The cut-off law's interval**: each bootstrap resample of the power law (same
+///   streams, so the power law's fields equal [`fit_power_law`]'s bit for bit) refits the
+///   cut-off law on its own tail; the percentile interval at `confidence` of `α` and of
+///   `1/λ`.
+///
+/// Single-threaded and seeded: the same samples (in any order), support and options give
+/// the same comparison bit for bit. Cost: [`fit_power_law`]'s plus `1 + bootstrap` fits
+/// of the cut-off law (an optimisation over the tail's means, independent of its size for
+/// reals; for integers each likelihood sums up to 2000 terms).
+///
+/// ```
+/// use precursors::statistics::{compare_alternatives, PowerLawOptions, Support};
+/// // Force drops (N) from a power law (α = 2.5 above 1 mN), by inversion of quantiles.
+/// let drops: Vec<f64> = (0..500)
+///     .map(|i| 1e-3 * (1.0 - (i as f64 + 0.5) / 500.0).powf(-1.0 / 1.5))
+///     .collect();
+/// let options = PowerLawOptions::default().bootstrap(20).goodness_samples(0);
+/// let c = compare_alternatives(&drops, Support::Continuous, &options)?;
+/// assert!((c.power_law.alpha - 2.5).abs() < 0.2);
+/// assert!(c.vs_cutoff.p_value > 0.1);        // no cut-off needed
+/// assert!(c.vs_exponential.log_ratio > 0.0 && c.vs_exponential.p_value < 0.1);
+/// assert!(c.cutoff.alpha_low <= c.cutoff.alpha && c.cutoff.alpha <= c.cutoff.alpha_high);
+/// # Ok::<(), precursors::Error>(())
+/// ```
+///
+/// # Errors
+///
+/// Those of [`fit_power_law`], and [`Error::InvalidParameter`] (`"samples"`) when the
+/// tail spans more than f64's range (`x/x_min` overflows for its largest sample, e.g.
+/// samples from 1e-300 to 1e300).
+pub fn compare_alternatives(
+    samples: &[f64],
+    support: Support,
+    options: &PowerLawOptions,
+) -> Result<Comparison> {
+    let mut boot: (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
+    let (power_law, xs, best) = fit_with(samples, support, options, |resample, fit| {
+        let tail = alternatives::Tail::new(resample, fit, support);
+        if tail.is_finite() {
+            let (alpha, lambda) = alternatives::cutoff_only(&tail);
+            boot.0.push(alpha);
+            boot.1.push(1.0 / lambda);
+        }
+    })?;
+    let tail = alternatives::Tail::new(&xs, &best, support);
+    if !tail.is_finite() {
+        return Err(Error::InvalidParameter {
+            name: "samples",
+            value: xs[xs.len() - 1],
+            reason: "the tail spans more than f64's range (x / x_min overflows): the \
+                     alternatives' likelihoods cannot be evaluated",
+        });
+    }
+    let c = alternatives::compare(&tail);
+    let (alpha, lambda, cutoff_ll) = c.cutoff;
+    let cutoff = 1.0 / lambda;
+    let (alpha_low, alpha_high) =
+        percentile_interval(&mut boot.0, options.confidence).unwrap_or((alpha, alpha));
+    let (cutoff_low, cutoff_high) =
+        percentile_interval(&mut boot.1, options.confidence).unwrap_or((cutoff, cutoff));
+    Ok(Comparison {
+        power_law,
+        power_law_log_likelihood: c.power_law_ll,
+        cutoff: CutoffFit {
+            alpha,
+            lambda,
+            cutoff,
+            alpha_low,
+            alpha_high,
+            cutoff_low,
+            cutoff_high,
+            log_likelihood: cutoff_ll,
+        },
+        exponential: ExponentialFit {
+            lambda: c.exponential.0,
+            log_likelihood: c.exponential.1,
+        },
+        lognormal: LognormalFit {
+            mu: c.lognormal.0,
+            sigma: c.lognormal.1,
+            log_likelihood: c.lognormal.2,
+        },
+        vs_exponential: c.vs_exponential,
+        vs_lognormal: c.vs_lognormal,
+        vs_cutoff: c.vs_cutoff,
+        cutoff_vs_lognormal: c.cutoff_vs_lognormal,
     })
 }
 
@@ -404,6 +669,7 @@ fn bootstrap_intervals(
     support: Support,
     options: &PowerLawOptions,
     scratch: &mut Scratch,
+    mut on_resample: impl FnMut(&[f64], &TailFit),
 ) -> Option<((f64, f64), (f64, f64))> {
     let n = xs.len();
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(options.seed);
@@ -423,6 +689,7 @@ fn bootstrap_intervals(
         if let Some(fit) = fit_sorted(&resample, support, options.min_tail, scratch) {
             alphas.push(fit.alpha);
             x_mins.push(fit.x_min);
+            on_resample(&resample, &fit);
         }
     }
     Some((
@@ -600,6 +867,9 @@ struct TailFit {
 struct Scratch {
     /// `ln x` of each sorted sample.
     logs: Vec<f64>,
+    /// `Σ_{j ≥ i} ln x_j` for each `i` (and 0 at `n`), as an unevaluated sum `hi + lo`
+    /// (compensated: as exact as the logarithms), so that a candidate's `α` costs O(1).
+    suffix: Vec<(f64, f64)>,
     /// Start index of each run of equal sorted samples, then the number of samples.
     groups: Vec<usize>,
     /// `ζ(α, q)` for consecutive integers `q` (see [`zeta_ladder`]).
@@ -620,6 +890,13 @@ fn fit_sorted(xs: &[f64], support: Support, min_tail: usize, s: &mut Scratch) ->
     let n = xs.len();
     s.logs.clear();
     s.logs.extend(xs.iter().map(|x| x.ln()));
+    s.suffix.clear();
+    s.suffix.resize(n + 1, (0.0, 0.0));
+    for i in (0..n).rev() {
+        let (hi, lo) = s.suffix[i + 1];
+        let (sum, err) = two_sum(hi, s.logs[i]);
+        s.suffix[i] = (sum, lo + err);
+    }
     s.groups.clear();
     for (i, x) in xs.iter().enumerate() {
         if i == 0 || xs[i - 1] != *x {
@@ -629,6 +906,7 @@ fn fit_sorted(xs: &[f64], support: Support, min_tail: usize, s: &mut Scratch) ->
     s.groups.push(n);
     let Scratch {
         logs,
+        suffix,
         groups,
         ladder,
         ..
@@ -650,8 +928,8 @@ fn fit_sorted(xs: &[f64], support: Support, min_tail: usize, s: &mut Scratch) ->
         last_tail = Some(tail);
         let bound = best.map_or(f64::INFINITY, |b| b.ks);
         let candidate = match support {
-            Support::Continuous => continuous_candidate(logs, groups, g, bound),
-            Support::Discrete => discrete_candidate(xs, logs, groups, g, bound, ladder),
+            Support::Continuous => continuous_candidate(logs, suffix, groups, g, bound),
+            Support::Discrete => discrete_candidate(xs, suffix, groups, g, bound, ladder),
         };
         // Strictly smaller only: on ties the smaller x_min, tried first, stays.
         if let Some((alpha, ks)) = candidate {
@@ -671,6 +949,7 @@ fn fit_sorted(xs: &[f64], support: Support, min_tail: usize, s: &mut Scratch) ->
 /// `bound` (the candidate cannot win; the rest of its distance is not computed).
 fn continuous_candidate(
     logs: &[f64],
+    suffix: &[(f64, f64)],
     groups: &[usize],
     g: usize,
     bound: f64,
@@ -679,9 +958,14 @@ fn continuous_candidate(
     let n = logs.len();
     let tail = (n - start) as f64;
     let ln_min = logs[start];
-    // Σ ln(x / x_min) term by term rather than from prefix sums, which would cancel for
-    // a narrow tail far from the smallest sample.
-    let sum: f64 = logs[start..].iter().map(|l| l - ln_min).sum();
+    // Σ ln(x / x_min) = Σ ln x - tail · ln x_min from the compensated suffix sum and an
+    // exact product (fma): the difference of a narrow tail far from 1 cancels, but both
+    // terms carry their rounding errors along, so the result is as accurate as a sum
+    // of the differences term by term.
+    let (hi, lo) = suffix[start];
+    let product = tail * ln_min;
+    let product_err = tail.mul_add(ln_min, -product);
+    let sum = (hi - product) + (lo - product_err);
     let alpha = 1.0 + tail / sum;
     if !alpha.is_finite() {
         return None; // distinct values of equal logarithms (adjacent floats near 1e300)
@@ -705,7 +989,7 @@ fn continuous_candidate(
 /// `bound`.
 fn discrete_candidate(
     xs: &[f64],
-    logs: &[f64],
+    suffix: &[(f64, f64)],
     groups: &[usize],
     g: usize,
     bound: f64,
@@ -715,10 +999,7 @@ fn discrete_candidate(
     let n = xs.len();
     let tail = (n - start) as f64;
     let x_min = xs[start];
-    let sum: f64 = groups[g..]
-        .windows(2)
-        .map(|w| (w[1] - w[0]) as f64 * logs[w[0]])
-        .sum();
+    let sum = suffix[start].0 + suffix[start].1;
     let alpha = discrete_mle(x_min, sum / tail);
     zeta_ladder(alpha, x_min, ladder);
     let top = x_min + (ladder.len() - 1) as f64;
@@ -751,6 +1032,13 @@ fn discrete_candidate(
         }
     }
     Some((alpha, ks))
+}
+
+/// `(a + b, its rounding error)` exactly (Knuth's two-sum).
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let bb = s - a;
+    (s, (a - (s - bb)) + (b - bb))
 }
 
 /// The largest discrete exponent searched.
@@ -1666,6 +1954,74 @@ mod tests {
                     .all(|v| v.is_finite())));
             }
         }
+    }
+
+    #[test]
+    fn alternatives_of_extreme_samples_are_never_nan() {
+        let options = PowerLawOptions::default()
+            .bootstrap(5)
+            .goodness_samples(0)
+            .min_tail(2);
+        let big = 9_007_199_254_740_000.0;
+        let counts = [
+            vec![big, big, big + 1.0, big + 2.0, big + 900.0],
+            vec![1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 2.0],
+            vec![1.0, 1e3, 1e6, 1e9, 1e12, 1e15],
+        ];
+        let reals = [
+            vec![1e-3, 1e-3, 2e-3, 1.0],
+            vec![1e-100, 1e-50, 1.0, 1e50, 1e100],
+        ];
+        let cases = counts.iter().map(|x| (x, Support::Discrete)).chain(
+            counts
+                .iter()
+                .chain(&reals)
+                .map(|x| (x, Support::Continuous)),
+        );
+        for (xs, support) in cases {
+            let c = compare_alternatives(xs, support, &options).unwrap();
+            let k = &c.cutoff;
+            let values = [
+                c.power_law_log_likelihood,
+                k.alpha,
+                k.lambda,
+                k.cutoff,
+                k.alpha_low,
+                k.alpha_high,
+                k.cutoff_low,
+                k.cutoff_high,
+                k.log_likelihood,
+                c.exponential.lambda,
+                c.exponential.log_likelihood,
+                c.lognormal.mu,
+                c.lognormal.sigma,
+                c.lognormal.log_likelihood,
+            ];
+            assert!(values.iter().all(|v| !v.is_nan()), "{xs:?}: {c:?}");
+            for lr in [
+                &c.vs_exponential,
+                &c.vs_lognormal,
+                &c.vs_cutoff,
+                &c.cutoff_vs_lognormal,
+            ] {
+                assert!(
+                    !lr.log_ratio.is_nan() && !lr.normalized.is_nan(),
+                    "{xs:?}: {lr:?}"
+                );
+                assert!((0.0..=1.0).contains(&lr.p_value), "{xs:?}: {lr:?}");
+            }
+            assert!(!c.verdict().contains("NaN"));
+        }
+        // Beyond f64's range (x_min 1e-300 under 1e300): a typed error, not a NaN.
+        let wide = [1e-300, 1e-300, 1e300, 1e300];
+        let e = compare_alternatives(&wide, Support::Continuous, &options).unwrap_err();
+        assert!(matches!(
+            e,
+            Error::InvalidParameter {
+                name: "samples",
+                ..
+            }
+        ));
     }
 
     #[test]

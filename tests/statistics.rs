@@ -346,6 +346,34 @@ fn stats_pool_each_points_realizations() {
     }
     let fits = table(&dir.join("power_laws.csv"));
     let bins = table(&dir.join("distributions.csv"));
+    // 1.x's columns first and unchanged, the alternatives after them; each fitted row has
+    // its tests (p-values in [0, 1]) and the verdict the summary printed.
+    let header = std::fs::read_to_string(dir.join("power_laws.csv")).unwrap();
+    let header = header.lines().next().unwrap();
+    assert!(header.starts_with(
+        "point,normal_load,observable,support,samples,tail,x_min,alpha,alpha_std_error,\
+         alpha_low,alpha_high,x_min_low,x_min_high,ks_distance,p_value,confidence,cutoff_alpha,"
+    ));
+    assert!(
+        header.ends_with(",lr_cutoff_vs_lognormal_p,verdict"),
+        "{header}"
+    );
+    let fitted: Vec<_> = fits.iter().filter(|r| !r["alpha"].is_empty()).collect();
+    assert_eq!(summary.verdicts.len(), fitted.len());
+    for (row, verdict) in fitted.iter().zip(&summary.verdicts) {
+        for test in [
+            "lr_exponential",
+            "lr_lognormal",
+            "lr_cutoff",
+            "lr_cutoff_vs_lognormal",
+        ] {
+            let p = num(row, &format!("{test}_p"));
+            assert!((0.0..=1.0).contains(&p), "{test}: {row:?}");
+        }
+        assert!(num(row, "lr_cutoff") <= 0.0);
+        assert!(verdict.ends_with(&row["verdict"]), "{verdict} vs {row:?}");
+        assert!(row["verdict"].contains("cut-off law"));
+    }
     for point in 0..2 {
         let of = |observable: &str| {
             fits.iter()
@@ -504,5 +532,222 @@ fn the_study_files_are_the_documented_study() {
             docs.contains(name),
             "docs/statistics.md does not name {name}"
         );
+    }
+}
+
+/// The fixture of tests/data/statistics/make_lr_fixtures.py: each case's samples and the
+/// values scipy computed on them.
+fn lr_fixture() -> Vec<(String, Vec<f64>, HashMap<String, f64>)> {
+    let dir = Path::new("tests/data/statistics");
+    let mut cases: Vec<(String, Vec<f64>, HashMap<String, f64>)> = Vec::new();
+    let text = std::fs::read_to_string(dir.join("lr_samples.csv")).unwrap();
+    for line in text.lines().skip(1) {
+        let (case, value) = line.split_once(',').unwrap();
+        if cases.last().is_none_or(|c| c.0 != case) {
+            cases.push((case.to_string(), Vec::new(), HashMap::new()));
+        }
+        cases.last_mut().unwrap().1.push(value.parse().unwrap());
+    }
+    let text = std::fs::read_to_string(dir.join("lr_expected.csv")).unwrap();
+    for line in text.lines().skip(1) {
+        let mut cells = line.split(',');
+        let (case, quantity, value) = (
+            cells.next().unwrap(),
+            cells.next().unwrap(),
+            cells.next().unwrap(),
+        );
+        let entry = cases.iter_mut().find(|c| c.0 == case).unwrap();
+        entry.2.insert(quantity.to_string(), value.parse().unwrap());
+    }
+    assert_eq!(cases.len(), 8);
+    cases
+}
+
+/// Every law fitted on the whole sample (`min_tail` = its size, so `x_min` is its smallest
+/// value), against scipy's fits of the same samples (make_lr_fixtures.py: its own
+/// likelihoods, normalised by quadrature or direct sums, maximised by L-BFGS-B and
+/// Nelder-Mead). Tolerances: both sides maximise to about 1e-12 in log-likelihood per
+/// sample and normalise to about 1e-12 relative, so log-likelihoods and `R` (sums over 1000
+/// samples, of order 1e3) agree to 1e-6 absolute; fitted parameters sit where the
+/// likelihood is flat (an error `δ` in a parameter costs `δ²` in likelihood), so they agree
+/// to 1e-4 relative (the discrete power law's `α`, from scipy's bounded scalar search, to
+/// 1e-7: it stops at about 1e-8); Vuong's statistic divides `R` by its spread, both of first
+/// order in those errors when `R` is near 0, so 1e-4 relative; p-values, which follow, 1e-4
+/// relative or 1e-12 absolute.
+#[test]
+fn alternatives_agree_with_an_independent_scipy_fit() {
+    use precursors::statistics::{compare_alternatives, PowerLawOptions, Support};
+    let mut failures = Vec::new();
+    for (case, samples, expected) in lr_fixture() {
+        let support = if case.starts_with("discrete") {
+            Support::Discrete
+        } else {
+            Support::Continuous
+        };
+        let options = PowerLawOptions::default()
+            .bootstrap(0)
+            .goodness_samples(0)
+            .min_tail(samples.len());
+        let c = compare_alternatives(&samples, support, &options).unwrap();
+        let mut check = |quantity: &str, got: f64, abs: f64, rel: f64| {
+            let want = expected[quantity];
+            let ok = if want.is_infinite() {
+                got == want
+            } else {
+                (got - want).abs() <= abs + rel * want.abs()
+            };
+            if !ok {
+                failures.push(format!("{case} {quantity}: {got} vs scipy {want}"));
+            }
+        };
+        check("x_min", c.power_law.x_min, 0.0, 0.0);
+        check("power_law_alpha", c.power_law.alpha, 0.0, 1e-7);
+        check("power_law_ll", c.power_law_log_likelihood, 1e-6, 0.0);
+        check("exponential_lambda", c.exponential.lambda, 0.0, 1e-6);
+        check("exponential_ll", c.exponential.log_likelihood, 1e-6, 0.0);
+        check("lognormal_ll", c.lognormal.log_likelihood, 1e-6, 0.0);
+        check("lognormal_mu", c.lognormal.mu, 1e-4, 1e-4);
+        check("lognormal_sigma", c.lognormal.sigma, 0.0, 1e-4);
+        check("cutoff_ll", c.cutoff.log_likelihood, 1e-6, 0.0);
+        check("cutoff_alpha", c.cutoff.alpha, 1e-4, 1e-4);
+        check("cutoff_lambda", c.cutoff.lambda, 1e-10, 1e-4);
+        for (name, lr) in [
+            ("vs_exponential", &c.vs_exponential),
+            ("vs_lognormal", &c.vs_lognormal),
+            ("vs_cutoff", &c.vs_cutoff),
+            ("cutoff_vs_lognormal", &c.cutoff_vs_lognormal),
+        ] {
+            check(&format!("{name}_R"), lr.log_ratio, 1e-6, 0.0);
+            check(&format!("{name}_normalized"), lr.normalized, 1e-6, 1e-4);
+            check(&format!("{name}_p"), lr.p_value, 1e-12, 1e-4);
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Samples of `p(x) ∝ x^(-α) e^(-λx)` above `x_min` (reals), or the same law on the
+/// integers (`discrete`), by rejection from a power law (rand_distr's Pareto and Zeta:
+/// samplers independent of the crate).
+fn cutoff_samples(alpha: f64, lambda: f64, n: usize, discrete: bool, seed: u64) -> Vec<f64> {
+    use rand::{RngExt, SeedableRng};
+    use rand_distr::{Distribution, Pareto, Zeta};
+    let mut r = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(seed);
+    let pareto = Pareto::new(1.0, alpha - 1.0).unwrap();
+    let zeta = Zeta::new(alpha).unwrap();
+    let mut out = Vec::with_capacity(n);
+    while out.len() < n {
+        let x: f64 = if discrete {
+            zeta.sample(&mut r)
+        } else {
+            pareto.sample(&mut r)
+        };
+        if r.random::<f64>() < (-lambda * (x - 1.0)).exp() {
+            out.push(x);
+        }
+    }
+    out
+}
+
+/// Tests that can fail: each law's samples are preferred to the wrong laws, over ten
+/// sample sets each (the tail fixed at the whole sample). A test of level 0.1 rejects a
+/// true pure power law in about 1 set of 10; the bounds allow 3.
+#[test]
+fn likelihood_ratios_prefer_the_law_the_samples_come_from() {
+    use precursors::statistics::{compare_alternatives, PowerLawOptions, Support};
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Exp};
+    let n = 2000;
+    let options = PowerLawOptions::default()
+        .bootstrap(0)
+        .goodness_samples(0)
+        .min_tail(n);
+    let (mut cut_found, mut pure_kept, mut exp_found) = ([0; 2], [0; 2], [0; 2]);
+    for seed in 0..10 {
+        for (i, support) in [Support::Continuous, Support::Discrete]
+            .into_iter()
+            .enumerate()
+        {
+            let discrete = support == Support::Discrete;
+            // A cut-off law (α 1.5, 1/λ 100 or 50): the cut-off law wins, over the
+            // pure law (Wilks) and over the log-normal is not required (Clauset et al.
+            // find the two often indistinguishable).
+            let xs = cutoff_samples(1.5, if discrete { 0.02 } else { 0.01 }, n, discrete, seed);
+            let c = compare_alternatives(&xs, support, &options).unwrap();
+            assert!(c.vs_cutoff.log_ratio <= 0.0 && c.vs_cutoff.nested);
+            if c.vs_cutoff.p_value < 0.1 {
+                cut_found[i] += 1;
+                assert!(
+                    c.verdict().contains("cut-off law preferred over power law"),
+                    "{}",
+                    c.verdict()
+                );
+                assert!((c.cutoff.alpha - 1.5).abs() < 0.3, "{:?}", c.cutoff);
+            }
+            // A pure power law (α 2.5 and 2.2): the cut-off is not needed.
+            let xs = cutoff_samples(
+                if discrete { 2.2 } else { 2.5 },
+                0.0,
+                n,
+                discrete,
+                100 + seed,
+            );
+            let c = compare_alternatives(&xs, support, &options).unwrap();
+            pure_kept[i] += usize::from(c.vs_cutoff.p_value >= 0.1);
+            assert!(c.vs_exponential.log_ratio > 0.0 && c.vs_exponential.p_value < 0.1);
+            // Exponential samples (rate 1 above 1; geometric above 1 for integers).
+            let exp = Exp::new(if discrete { 0.3f64 } else { 1.0 }).unwrap();
+            let mut r = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(200 + seed);
+            let xs: Vec<f64> = (0..n)
+                .map(|_| {
+                    let e = exp.sample(&mut r);
+                    if discrete {
+                        1.0 + e.floor()
+                    } else {
+                        1.0 + e
+                    }
+                })
+                .collect();
+            let c = compare_alternatives(&xs, support, &options).unwrap();
+            exp_found[i] +=
+                usize::from(c.vs_exponential.log_ratio < 0.0 && c.vs_exponential.p_value < 0.1);
+        }
+    }
+    assert_eq!(cut_found, [10, 10], "cut-off found");
+    assert!(
+        pure_kept.iter().all(|&k| k >= 7),
+        "pure laws kept: {pure_kept:?}"
+    );
+    assert_eq!(exp_found, [10, 10], "exponentials found");
+}
+
+/// The comparison's power law is `fit_power_law`'s bit for bit (the bootstrap shares its
+/// streams), the cut-off law's bootstrap interval holds its estimate, and the result does
+/// not depend on the samples' order.
+#[test]
+fn the_comparison_extends_the_power_law_fit_reproducibly() {
+    use precursors::statistics::{compare_alternatives, fit_power_law, PowerLawOptions, Support};
+    let options = PowerLawOptions::default()
+        .bootstrap(30)
+        .goodness_samples(10)
+        .seed(9);
+    for (support, discrete) in [(Support::Continuous, false), (Support::Discrete, true)] {
+        let mut xs = cutoff_samples(1.5, 0.02, 1500, discrete, 31);
+        let c = compare_alternatives(&xs, support, &options).unwrap();
+        let fit = fit_power_law(&xs, support, &options).unwrap();
+        assert_eq!(format!("{:?}", c.power_law), format!("{fit:?}"));
+        let cut = &c.cutoff;
+        assert!(
+            cut.alpha_low <= cut.alpha && cut.alpha <= cut.alpha_high,
+            "{cut:?}"
+        );
+        assert!(
+            cut.cutoff_low <= cut.cutoff && cut.cutoff <= cut.cutoff_high,
+            "{cut:?}"
+        );
+        assert!(cut.lambda > 0.0 && (cut.cutoff * cut.lambda - 1.0).abs() < 1e-15);
+        xs.reverse();
+        xs.swap(3, 700);
+        let again = compare_alternatives(&xs, support, &options).unwrap();
+        assert_eq!(format!("{again:?}"), format!("{c:?}"));
     }
 }

@@ -1124,6 +1124,9 @@ fn incomplete(summary: &precursors::sweep::MergeSummary, dir: &Path) -> Failure 
 
 fn stats(dir: &Path, options: &StatsOptions) -> Result<(), Failure> {
     let summary = precursors::sweep::statistics(dir, options)?;
+    for verdict in &summary.verdicts {
+        say!("{verdict}");
+    }
     for file in &summary.files {
         say!("wrote {}", file.display());
     }

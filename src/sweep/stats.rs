@@ -11,7 +11,17 @@ use crate::files::write_atomically;
 use crate::output::check::RunRecord;
 use crate::output::derived::derive;
 use crate::output::layout::{DISTRIBUTIONS, POWER_LAWS};
-use crate::statistics::{fit_power_law, log_binned, PowerLawFit, PowerLawOptions, Support};
+use crate::statistics::{
+    compare_alternatives, fit_power_law, log_binned, Comparison, LikelihoodRatio, PowerLawFit,
+    PowerLawOptions, Support,
+};
+
+/// A row's fit: with its alternatives, or the power law alone where they cannot be
+/// evaluated.
+enum Fit {
+    Compared(Box<Comparison>),
+    PowerLaw(PowerLawFit),
+}
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -72,6 +82,9 @@ pub struct StatsSummary {
     pub runs_missing: usize,
     /// The files written: `power_laws.csv`, `distributions.csv`.
     pub files: Vec<PathBuf>,
+    /// Each fit's verdict (`Comparison::verdict`), as `point <index>, <observable>:
+    /// <verdict>`, in the order of `power_laws.csv`'s rows; none for an empty fit.
+    pub verdicts: Vec<String>,
 }
 
 /// The observables [`statistics`] pools and fits, in the order of its tables: the name
@@ -273,12 +286,21 @@ pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Vec<Point>, usize), Swe
 /// `load_between_precursor_leaps` and `load_between_front_leaps` (the increase of
 /// `F/(μF_N)` between two advances); and writes into `dir`:
 ///
-/// * `power_laws.csv`: per point and observable, the maximum-likelihood power-law fit
-///   ([`fit_power_law`]: `x_min` by the Kolmogorov-Smirnov distance, the exponent with
-///   its bootstrap interval, the goodness-of-fit p-value), header `point,<axis
+/// * `power_laws.csv`: per point and observable, the maximum-likelihood power-law fit and
+///   its alternatives ([`compare_alternatives`]: `x_min` by the Kolmogorov-Smirnov
+///   distance, the exponent with its bootstrap interval, the goodness-of-fit p-value; on
+///   the same tail the cut-off law with its interval, the exponential, the log-normal and
+///   the likelihood-ratio tests), header `point,<axis
 ///   keys>,observable,support,samples,tail,x_min,alpha,alpha_std_error,alpha_low,
-///   alpha_high,x_min_low,x_min_high,ks_distance,p_value,confidence`; the fit's cells are
-///   empty where the samples are too few (fewer than `min_tail` positive ones);
+///   alpha_high,x_min_low,x_min_high,ks_distance,p_value,confidence,cutoff_alpha,
+///   cutoff_alpha_low,cutoff_alpha_high,cutoff_scale,cutoff_scale_low,cutoff_scale_high,
+///   exponential_lambda,lognormal_mu,lognormal_sigma,lr_exponential,
+///   lr_exponential_normalized,lr_exponential_p,lr_lognormal,lr_lognormal_normalized,
+///   lr_lognormal_p,lr_cutoff,lr_cutoff_normalized,lr_cutoff_p,lr_cutoff_vs_lognormal,
+///   lr_cutoff_vs_lognormal_normalized,lr_cutoff_vs_lognormal_p,verdict` (docs/statistics.md
+///   defines them; an infinite value, such as the cut-off scale `1/λ` at `λ = 0`, is an
+///   empty cell); the fit's cells are empty where the samples are too few (fewer than
+///   `min_tail` positive ones);
 /// * `distributions.csv`: per point and observable, the log-binned density
 ///   ([`log_binned`]), header `point,<axis keys>,observable,bin_low,bin_high,
 ///   bin_center,count,density`.
@@ -328,8 +350,10 @@ pub fn statistics(dir: &Path, options: &StatsOptions) -> Result<StatsSummary, Sw
     let key_header: String = keys.iter().map(|k| format!("{},", cell(k))).collect();
     let mut fits = format!(
         "point,{key_header}observable,support,samples,tail,x_min,alpha,alpha_std_error,\
-         alpha_low,alpha_high,x_min_low,x_min_high,ks_distance,p_value,confidence\n"
+         alpha_low,alpha_high,x_min_low,x_min_high,ks_distance,p_value,confidence,\
+         {ALTERNATIVES_HEADER}\n"
     );
+    let mut verdicts = Vec::new();
     let mut bins =
         format!("point,{key_header}observable,bin_low,bin_high,bin_center,count,density\n");
     let mut runs = 0;
@@ -354,7 +378,12 @@ pub fn statistics(dir: &Path, options: &StatsOptions) -> Result<StatsSummary, Sw
         for ((name, support, _), x) in OBSERVABLES.iter().zip(&pooled) {
             let positive = x.iter().filter(|v| **v > 0.0).count();
             let fit = if positive >= options.fit.min_tail {
-                Some(fit_power_law(x, *support, &options.fit)?)
+                match compare_alternatives(x, *support, &options.fit) {
+                    Ok(c) => Some(Fit::Compared(Box::new(c))),
+                    // Samples spanning more than f64's range have a power law but no
+                    // alternatives: the power law alone, its errors as before.
+                    Err(_) => Some(Fit::PowerLaw(fit_power_law(x, *support, &options.fit)?)),
+                }
             } else {
                 // Checked all the same: bad options are an error whatever the samples.
                 match fit_power_law(x, *support, &options.fit) {
@@ -368,9 +397,13 @@ pub fn statistics(dir: &Path, options: &StatsOptions) -> Result<StatsSummary, Sw
             };
             let _ = writeln!(
                 fits,
-                "{index},{values}{name},{support_name},{positive},{}",
-                fit_cells(fit.as_ref(), options.fit.confidence)
+                "{index},{values}{name},{support_name},{positive},{},{}",
+                fit_cells(fit.as_ref(), options.fit.confidence),
+                alternative_cells(fit.as_ref())
             );
+            if let Some(Fit::Compared(c)) = &fit {
+                verdicts.push(format!("point {index}, {name}: {}", c.verdict()));
+            }
             if positive > 0 {
                 for b in log_binned(x, *support, options.bins_per_decade)? {
                     let _ = writeln!(
@@ -394,12 +427,57 @@ pub fn statistics(dir: &Path, options: &StatsOptions) -> Result<StatsSummary, Sw
         runs,
         runs_missing: missing,
         files,
+        verdicts,
     })
 }
 
+/// The header of the alternatives' cells ([`alternative_cells`]).
+const ALTERNATIVES_HEADER: &str = "cutoff_alpha,cutoff_alpha_low,cutoff_alpha_high,\
+    cutoff_scale,cutoff_scale_low,cutoff_scale_high,exponential_lambda,lognormal_mu,\
+    lognormal_sigma,lr_exponential,lr_exponential_normalized,lr_exponential_p,\
+    lr_lognormal,lr_lognormal_normalized,lr_lognormal_p,lr_cutoff,lr_cutoff_normalized,\
+    lr_cutoff_p,lr_cutoff_vs_lognormal,lr_cutoff_vs_lognormal_normalized,\
+    lr_cutoff_vs_lognormal_p,verdict";
+
+/// The cells of the alternatives and their tests (all empty without a fit).
+fn alternative_cells(fit: Option<&Fit>) -> String {
+    let Some(Fit::Compared(c)) = fit else {
+        return ",".repeat(ALTERNATIVES_HEADER.matches(',').count());
+    };
+    let k = &c.cutoff;
+    let mut cells: Vec<String> = [
+        k.alpha,
+        k.alpha_low,
+        k.alpha_high,
+        k.cutoff,
+        k.cutoff_low,
+        k.cutoff_high,
+        c.exponential.lambda,
+        c.lognormal.mu,
+        c.lognormal.sigma,
+    ]
+    .into_iter()
+    .map(num)
+    .collect();
+    let tests: [&LikelihoodRatio; 4] = [
+        &c.vs_exponential,
+        &c.vs_lognormal,
+        &c.vs_cutoff,
+        &c.cutoff_vs_lognormal,
+    ];
+    for t in tests {
+        cells.extend([num(t.log_ratio), num(t.normalized), num(t.p_value)]);
+    }
+    cells.push(cell(&c.verdict()));
+    cells.join(",")
+}
+
 /// The cells of a fit from `tail` on (empty without one).
-fn fit_cells(fit: Option<&PowerLawFit>, confidence: f64) -> String {
-    let Some(f) = fit else {
+fn fit_cells(fit: Option<&Fit>, confidence: f64) -> String {
+    let Some(f) = fit.map(|f| match f {
+        Fit::Compared(c) => &c.power_law,
+        Fit::PowerLaw(p) => p,
+    }) else {
         return ",,,,,,,,,,".to_string();
     };
     format!(
