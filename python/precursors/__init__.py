@@ -6,10 +6,11 @@ events, the state between events as ``(Ny, Nx)`` float64 arrays (row ``iy``, col
 ``ix``), stress probes, checkpoints, runs, sweeps, merges and figures. Units are SI.
 """
 
-from pathlib import Path
-from typing import Any, Dict, Union
+# Imported under private names: `dir(precursors)` lists the package's own names only.
+from pathlib import Path as _Path
+from typing import Any as _Any, Dict as _Dict, Union as _Union
 
-import numpy as np
+import numpy as _np
 
 from ._errors import (
     CudaUnavailableError,
@@ -69,12 +70,12 @@ __all__ = [
 ]
 
 
-def read_tables(directory: Union[str, Path]) -> Dict[str, Dict[str, np.ndarray]]:
+def read_tables(directory: _Union[str, _Path]) -> _Dict[str, _Dict[str, _np.ndarray]]:
     """The tables of a run directory (``events``, ``curve``, ``contact_map``, those a
     finished run derives from them, ``per_avalanche`` and ``fronts``, and ``profiles``
     when the run records them; those that are complete) as dicts of columns (see
     ``read_table``)."""
-    directory = Path(directory)
+    directory = _Path(directory)
     return {
         name: read_table(directory / f"{name}.csv")
         for name in ("events", "curve", "contact_map", "per_avalanche", "fronts", "profiles")
@@ -82,7 +83,7 @@ def read_tables(directory: Union[str, Path]) -> Dict[str, Dict[str, np.ndarray]]
     }
 
 
-def stats(directory: Union[str, Path], **options: Any) -> Dict[str, Dict[str, np.ndarray]]:
+def stats(directory: _Union[str, _Path], **options: _Any) -> _Dict[str, _Dict[str, _np.ndarray]]:
     """The statistics of a run or sweep directory (as ``precursors stats``: avalanche
     sizes, force drops, energies and front leaps pooled per point, their power-law fits
     and log-binned distributions, written as ``power_laws.csv`` and ``distributions.csv``
@@ -90,11 +91,11 @@ def stats(directory: Union[str, Path], **options: Any) -> Dict[str, Dict[str, np
     ``bootstrap``, ``goodness``, ``confidence``, ``min_tail``, ``bins_per_decade``,
     ``seed``, ``include_spanning`` (pool the spanning avalanche and those after it too;
     docs/statistics.md)."""
-    return {Path(p).stem: read_table(p) for p in _stats_files(directory, **options)}
+    return {_Path(p).stem: read_table(p) for p in _stats_files(directory, **options)}
 
 
-def merge(directory: Union[str, Path]) -> Dict[str, Dict[str, np.ndarray]]:
+def merge(directory: _Union[str, _Path]) -> _Dict[str, _Dict[str, _np.ndarray]]:
     """Merges the runs of a sweep directory (as ``precursors merge``: the ensemble
     statistics as CSV files in it) and returns the merged tables, by file name without
     ``.csv``, as dicts of columns."""
-    return {Path(p).stem: read_table(p) for p in _merge_files(directory)}
+    return {_Path(p).stem: read_table(p) for p in _merge_files(directory)}
