@@ -1067,3 +1067,123 @@ fn every_column_is_documented() {
     assert_eq!(checked, 15);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Sends `signal` to the program once `file` holds more than `lines` lines, and returns
+/// its output.
+#[cfg(unix)]
+fn signalled(args: &[&str], file: &Path, lines: usize, signal: &str) -> Output {
+    let child = command(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while std::fs::read_to_string(file).map_or(0, |t| t.lines().count()) <= lines {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "{} not written",
+            file.display()
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let status = std::process::Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    child.wait_with_output().unwrap()
+}
+
+/// Ctrl-C (SIGINT) or SIGTERM stops `run` at its next event with one line saying what was
+/// kept and the exact command that continues (issue 56: it exited 130 saying nothing):
+/// with `--checkpoint` a checkpoint at that event, and the command given resumes to the
+/// uninterrupted run's tables byte for byte; without, it says the run cannot continue.
+/// `sweep` stops its runs and says how to go on. Exit code 128 + the signal.
+#[cfg(unix)]
+#[test]
+fn a_signal_stops_with_what_was_kept_and_how_to_continue() {
+    let dir = scratch("signals");
+    let scene = "examples/scenes/calibration.json";
+    let whole = dir.join("whole");
+    let o = precursors(&["run", scene, "--out", path(&whole), "-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+
+    let out = dir.join("stopped");
+    let checkpoint = dir.join("cp.json");
+    let o = signalled(
+        &[
+            "run",
+            scene,
+            "--out",
+            path(&out),
+            "--checkpoint",
+            path(&checkpoint),
+            "-q",
+        ],
+        &out.join("events.csv.partial"),
+        50,
+        "-INT",
+    );
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    let text = stderr(&o);
+    let errors: Vec<&str> = text.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(errors.len(), 1, "{text}");
+    assert!(errors[0].starts_with("error: stopped by SIGINT"), "{text}");
+    let again = format!(
+        "precursors resume {} --out {}",
+        path(&checkpoint),
+        path(&out)
+    );
+    assert!(text.contains(&again), "{text}");
+    assert!(!out.join("events.csv").exists());
+    // The command it gives continues the run to the uninterrupted run's tables.
+    let o = precursors(&["resume", path(&checkpoint), "--out", path(&out), "-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    for table in ["events.csv", "curve.csv", "contact_map.csv"] {
+        assert_eq!(
+            std::fs::read(out.join(table)).unwrap(),
+            std::fs::read(whole.join(table)).unwrap(),
+            "{table}"
+        );
+    }
+
+    let bare = dir.join("bare");
+    let o = signalled(
+        &["run", scene, "--out", path(&bare), "-q"],
+        &bare.join("events.csv.partial"),
+        50,
+        "-TERM",
+    );
+    assert_eq!(o.status.code(), Some(143), "{}", stderr(&o));
+    let text = stderr(&o);
+    assert!(text.contains("stopped by SIGTERM"), "{text}");
+    assert!(text.contains("cannot continue"), "{text}");
+
+    let sweep = dir.join("sweep.json");
+    std::fs::write(
+        &sweep,
+        r#"{"axes": [{"key": "normal_load", "values": [3000.0, 3500.0]}], "realizations": 2}"#,
+    )
+    .unwrap();
+    let out = dir.join("sweep");
+    let o = signalled(
+        &[
+            "sweep",
+            path(&sweep),
+            "--out",
+            path(&out),
+            "--jobs",
+            "1",
+            "-q",
+        ],
+        &out.join("p0000-r0000").join("events.csv.partial"),
+        50,
+        "-INT",
+    );
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    let text = stderr(&o);
+    let again = format!("precursors sweep {} --out {}", path(&sweep), path(&out));
+    assert!(text.contains(&again), "{text}");
+    assert!(!out.join("p0000-r0000").join("done").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -33,6 +33,65 @@ macro_rules! say {
     }};
 }
 
+/// Raised by SIGINT or SIGTERM ([`catch_stop_signals`]): the run, sweep or movie under
+/// way stops at its next event, run or frame and says what it kept; the signal's number.
+static STOP: std::sync::atomic::AtomicI32 = std::sync::atomic::AtomicI32::new(0);
+
+/// Catches the first SIGINT (Ctrl-C) and SIGTERM; a second one ends the process at once
+/// (the handler restores the default action).
+#[cfg(unix)]
+fn catch_stop_signals() {
+    extern "C" fn raise(signal: libc::c_int) {
+        STOP.store(signal, std::sync::atomic::Ordering::SeqCst);
+        // SAFETY: signal(2) is async-signal-safe.
+        unsafe { libc::signal(signal, libc::SIG_DFL) };
+    }
+    for signal in [libc::SIGINT, libc::SIGTERM] {
+        // SAFETY: the handler only stores to an atomic and calls signal(2), both
+        // async-signal-safe.
+        unsafe { libc::signal(signal, raise as *const () as libc::sighandler_t) };
+    }
+}
+
+#[cfg(not(unix))]
+fn catch_stop_signals() {}
+
+/// The signal [`catch_stop_signals`] caught, if any.
+fn stopped() -> Option<i32> {
+    match STOP.load(std::sync::atomic::Ordering::SeqCst) {
+        0 => None,
+        signal => Some(signal),
+    }
+}
+
+/// A run, sweep or movie stopped by a signal: what it kept and how to go on (one line),
+/// exit code `128 + signal` as a shell reports a process the signal ended.
+#[derive(Debug)]
+struct Interrupted {
+    signal: i32,
+    what: String,
+}
+
+impl std::fmt::Display for Interrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let name = match self.signal {
+            2 => "SIGINT".to_string(),
+            15 => "SIGTERM".to_string(),
+            n => format!("signal {n}"),
+        };
+        write!(f, "stopped by {name}: {}", self.what)
+    }
+}
+
+impl std::error::Error for Interrupted {}
+
+fn interrupted(signal: i32, what: String) -> Failure {
+    Failure {
+        error: Box::new(Interrupted { signal, what }),
+        code: u8::try_from(128 + signal).unwrap_or(130),
+    }
+}
+
 const EXIT_CODES: &str = "\
 Exit codes:
   0  success: every table and figure written is complete
@@ -53,7 +112,9 @@ Exit codes:
      of the others written)
   6  run, resume, info, sweep: the scene asks for backend \"cuda\" and it cannot run here
      (no feature cuda in this build, no NVIDIA driver or GPU, a CUDA library missing:
-     docs/gpu.md)";
+     docs/gpu.md)
+  130, 143  run, resume, sweep, movie: stopped by SIGINT (Ctrl-C) or SIGTERM; the last
+     line says what was kept and the command that continues";
 
 /// Quasi-static friction precursors: runs scene files and sweeps (docs/cli.md).
 #[derive(Debug, Parser)]
@@ -739,20 +800,53 @@ fn run(
     let fields_path = tables.fields_path().map(Path::to_path_buf);
     // The sites in contact at zero shear, seen when the run starts from its first event.
     let mut zero_shear = None;
-    let [events_path, curve_path, map_path] =
-        tables.run_to_slip(&mut driver, checkpoint, |_, driver| {
-            if driver.event_count() == 1 {
-                let attached = driver
-                    .site_states()
-                    .iter()
-                    .filter(|s| **s == SiteState::Attached)
-                    .count();
-                zero_shear = Some(attached);
+    let mut tables = tables;
+    catch_stop_signals();
+    let signal = tables.run_until(&mut driver, checkpoint, |event, driver| {
+        if driver.event_count() == 1 {
+            let attached = driver
+                .site_states()
+                .iter()
+                .filter(|s| **s == SiteState::Attached)
+                .count();
+            zero_shear = Some(attached);
+        }
+        bar.show(false, |elapsed| line(driver, elapsed));
+        // At the next stable state: the tables continue from a checkpoint taken there.
+        match (stopped(), event) {
+            (Some(signal), precursors::Event::Stable { .. }) => {
+                std::ops::ControlFlow::Break(signal)
             }
-            bar.show(false, |elapsed| line(driver, elapsed))
-        })?;
-    bar.show(true, |elapsed| line(&driver, elapsed));
+            _ => std::ops::ControlFlow::Continue(()),
+        }
+    })?;
     bar.finish();
+    if let Some(signal) = signal {
+        let at = driver.event_count();
+        let what = match checkpoint {
+            Some((path, _)) => {
+                // The checkpoint at this stable state, so that nothing done is lost.
+                driver.checkpoint().write_to(path)?;
+                format!(
+                    "kept the tables in {} as *.partial and the checkpoint {} at event {at}; \
+                     continue with: precursors resume {} --out {}",
+                    out.display(),
+                    path.display(),
+                    path.display(),
+                    out.display()
+                )
+            }
+            None => format!(
+                "kept the tables in {} as *.partial up to event {at}, but without \
+                 --checkpoint the run cannot continue: run it again (with --checkpoint FILE \
+                 to be able to stop and resume)",
+                out.display()
+            ),
+        };
+        return Err(interrupted(signal, what));
+    }
+    bar.show(true, |elapsed| line(&driver, elapsed));
+    let [events_path, curve_path, map_path] = tables.finish()?;
     say!(
         "global slip after {} events at F/(μF_N) = {:.6}; wrote {}, {} and {}",
         driver.event_count(),
@@ -937,24 +1031,64 @@ fn run_sweep(
     let options = SweepOptions::new()
         .with_jobs(jobs)?
         .with_shard(shard.0, shard.1)?;
-    let summary = sweep.execute(out, &options, |report| {
-        let d = done.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1;
-        let here = usize::from(!report.skipped && !report.held_elsewhere);
-        let r = ran.fetch_add(here, std::sync::atomic::Ordering::SeqCst) + here;
-        if let Ok(mut bar) = bar.lock() {
-            bar.show(d == share, |elapsed| {
-                let rate = r as f64 / elapsed.max(1e-9);
-                format!(
-                    "{d}/{share} runs ({} skipped)  {:.2} runs/min  {elapsed:.0} s, ETA {}",
-                    d - r,
-                    60.0 * rate,
-                    eta((share - d) as f64 / rate)
-                )
-            });
-        }
+    catch_stop_signals();
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    let finished = std::sync::atomic::AtomicBool::new(false);
+    let summary = std::thread::scope(|scope| {
+        // Raises the sweep's flag when a signal comes: its runs stop at their next event.
+        scope.spawn(|| {
+            while !finished.load(std::sync::atomic::Ordering::SeqCst) {
+                if stopped().is_some() {
+                    stop.store(true, std::sync::atomic::Ordering::SeqCst);
+                    return;
+                }
+                std::thread::sleep(Duration::from_millis(20));
+            }
+        });
+        let summary = sweep.execute_until(
+            out,
+            &options,
+            |report| {
+                let d = done.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1;
+                let here = usize::from(!report.skipped && !report.held_elsewhere);
+                let r = ran.fetch_add(here, std::sync::atomic::Ordering::SeqCst) + here;
+                if let Ok(mut bar) = bar.lock() {
+                    bar.show(d == share, |elapsed| {
+                        let rate = r as f64 / elapsed.max(1e-9);
+                        format!(
+                            "{d}/{share} runs ({} skipped)  {:.2} runs/min  {elapsed:.0} s, ETA {}",
+                            d - r,
+                            60.0 * rate,
+                            eta((share - d) as f64 / rate)
+                        )
+                    });
+                }
+            },
+            &stop,
+        );
+        finished.store(true, std::sync::atomic::Ordering::SeqCst);
+        summary
     })?;
     if let Ok(bar) = bar.lock() {
         bar.finish();
+    }
+    if let Some(signal) = stopped() {
+        return Err(interrupted(
+            signal,
+            format!(
+                "{} runs of this shard complete in {} (marked done), the others stopped or \
+                 not started; continue with: precursors sweep {} --out {}{} (complete runs \
+                 are skipped)",
+                summary.completed + summary.skipped,
+                out.display(),
+                path.display(),
+                out.display(),
+                match shard {
+                    (0, 1) => String::new(),
+                    (k, n) => format!(" --shard {k}/{n}"),
+                }
+            ),
+        ));
     }
     let held = match summary.held_elsewhere {
         0 => String::new(),
@@ -1046,7 +1180,8 @@ fn movie(
             movie = movie.png_frames(frames);
         }
         let mut bar = Progress::new(progress);
-        let outcome = movie.save_with_progress(&path, |drawn, frames| {
+        catch_stop_signals();
+        let outcome = movie.save_until(&path, |drawn, frames| {
             bar.show(drawn == frames, |elapsed| {
                 let left = elapsed / drawn as f64 * (frames - drawn) as f64;
                 format!(
@@ -1054,8 +1189,28 @@ fn movie(
                     eta(left)
                 )
             });
+            match stopped() {
+                Some(_) => std::ops::ControlFlow::Break(()),
+                None => std::ops::ControlFlow::Continue(()),
+            }
         });
         bar.finish();
+        if let (Some(signal), Ok(None)) = (stopped(), &outcome) {
+            return Err(interrupted(
+                signal,
+                format!(
+                    "{} was not written (the movies before it were); run the command again \
+                     to draw it",
+                    path.display()
+                ),
+            ));
+        }
+        let outcome = outcome.and_then(|report| {
+            report.ok_or_else(|| precursors::plot::PlotError::Figure {
+                path: Some(path.clone()),
+                reason: "the movie was stopped".into(),
+            })
+        });
         match outcome {
             Ok(report) => {
                 say!(
