@@ -152,13 +152,7 @@ impl Avalanches {
     /// # Errors
     /// [`Error::LengthMismatch`] when `zero_shear` does not hold one state per site.
     pub fn with_zero_shear(grid: &Grid, zero_shear: &[SiteState]) -> Result<Self> {
-        if zero_shear.len() != grid.len() {
-            return Err(Error::LengthMismatch {
-                name: "zero_shear",
-                expected: grid.len(),
-                found: zero_shear.len(),
-            });
-        }
+        check_zero_shear(grid, zero_shear)?;
         let mut out = Self::new(grid);
         out.contacts = Some(
             zero_shear
@@ -251,6 +245,19 @@ impl Avalanches {
     }
 }
 
+/// Refuses zero-shear states that are not one per site of `grid`.
+fn check_zero_shear(grid: &Grid, zero_shear: &[SiteState]) -> Result<()> {
+    if zero_shear.len() == grid.len() {
+        Ok(())
+    } else {
+        Err(Error::LengthMismatch {
+            name: "zero_shear",
+            expected: grid.len(),
+            found: zero_shear.len(),
+        })
+    }
+}
+
 /// The damage front: the extent `x_D` (m), from the trailing edge `x = 0`, of the run of
 /// columns that have lost at least half of their contacts at zero shear (docs/statistics.md),
 /// beside the paper's precursor length `ℓ`, the run of columns whose real contact area is
@@ -303,13 +310,7 @@ impl DamageFront {
     /// # Errors
     /// [`Error::LengthMismatch`] when `zero_shear` does not hold one state per site.
     pub fn new(grid: &Grid, zero_shear: &[SiteState]) -> Result<Self> {
-        if zero_shear.len() != grid.len() {
-            return Err(Error::LengthMismatch {
-                name: "zero_shear",
-                expected: grid.len(),
-                found: zero_shear.len(),
-            });
-        }
+        check_zero_shear(grid, zero_shear)?;
         let nx = grid.nx();
         let attached: Vec<bool> = zero_shear
             .iter()

@@ -92,24 +92,30 @@ fn finished_run(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
     (scene, run, ck)
 }
 
-/// The names of every file a run directory and a sweep directory (and its run
-/// directories) can hold.
-fn every_name(dir: &Path, run: &Path) -> Vec<String> {
+/// A sweep of [`SWEEP`] run to its end in `dir/sweep` (its file `dir/sweep-in.json`).
+fn finished_sweep(dir: &Path) -> PathBuf {
     let sweep_file = dir.join("sweep-in.json");
     std::fs::write(&sweep_file, SWEEP).unwrap();
     let sweep = dir.join("sweep");
-    for args in [
-        vec![
-            "sweep",
-            path(&sweep_file),
-            "--out",
-            path(&sweep),
-            "-q",
-            "--jobs",
-            "1",
-        ],
-        vec!["plot", path(&sweep), "--format", "both"],
-    ] {
+    let args = [
+        "sweep",
+        path(&sweep_file),
+        "--out",
+        path(&sweep),
+        "-q",
+        "--jobs",
+        "1",
+    ];
+    let o = precursors(&args);
+    assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
+    sweep
+}
+
+/// The names of every file a run directory and a sweep directory (and its run
+/// directories) can hold.
+fn every_name(dir: &Path, run: &Path) -> Vec<String> {
+    let sweep = finished_sweep(dir);
+    for args in [vec!["plot", path(&sweep), "--format", "both"]] {
         let o = precursors(&args);
         assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
     }
@@ -529,19 +535,9 @@ impl LinkCase<'_> {
 fn a_symbolic_link_at_any_path_of_a_directory_is_refused_and_its_target_kept() {
     let dir = scratch("links");
     let (scene, run, ck) = finished_run(&dir);
+    let sweep = finished_sweep(&dir);
     let sweep_file = dir.join("sweep-in.json");
-    std::fs::write(&sweep_file, SWEEP).unwrap();
-    let sweep = dir.join("sweep");
     for args in [
-        vec![
-            "sweep",
-            path(&sweep_file),
-            "--out",
-            path(&sweep),
-            "-q",
-            "--jobs",
-            "1",
-        ],
         vec!["plot", path(&sweep)],
         vec!["stats", path(&sweep), "--bootstrap", "5", "--goodness", "5"],
     ] {
