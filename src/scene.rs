@@ -176,6 +176,37 @@ pub enum Drive {
     },
 }
 
+/// Shortcuts for the drives a scene file names by `kind` (`"rod"`, `"top"`, `"side"`), under
+/// force control.
+///
+/// ```
+/// use precursors::{Drive, ForceLoad, Lateral, Scene};
+/// // The paper's default drive, as the scene file writes {"kind": "rod"}.
+/// assert_eq!(Drive::rod(6e-3, 2e-3), Drive::default());
+/// assert_eq!(Drive::top(), Drive::Force(ForceLoad::Top));
+/// assert_eq!(Drive::side(), Drive::Force(ForceLoad::Lateral(Lateral::Side)));
+/// assert!(Scene::builder().drive(Drive::rod(4e-3, 1e-3)).build()?.has_lateral_table());
+/// # Ok::<(), precursors::Error>(())
+/// ```
+impl Drive {
+    /// The rod on the trailing face at `height` (m) above the interface, pressing a band of
+    /// `half_width` (m) on each side of it, under force control (scene file
+    /// `{"kind": "rod", "height": h, "half_width": w}`).
+    pub fn rod(height: f64, half_width: f64) -> Drive {
+        Drive::Force(ForceLoad::Lateral(Lateral::Rod { height, half_width }))
+    }
+
+    /// A uniform shear on the top face, under force control (`{"kind": "top"}`).
+    pub fn top() -> Drive {
+        Drive::Force(ForceLoad::Top)
+    }
+
+    /// A uniform load on the whole trailing face, under force control (`{"kind": "side"}`).
+    pub fn side() -> Drive {
+        Drive::Force(ForceLoad::Lateral(Lateral::Side))
+    }
+}
+
 impl Default for Drive {
     /// The paper's rod at `h = 6 mm`, `Δh = 2 mm`, under force control.
     fn default() -> Self {
