@@ -64,6 +64,12 @@ impl StatsOptions {
     }
 
     /// Whether to pool the spanning avalanche and those after it too.
+    ///
+    /// ```
+    /// use precursors::sweep::StatsOptions;
+    /// assert!(!StatsOptions::default().include_spanning);
+    /// assert!(StatsOptions::default().include_spanning(true).include_spanning);
+    /// ```
     pub fn include_spanning(mut self, include: bool) -> Self {
         self.include_spanning = include;
         self
