@@ -278,6 +278,29 @@ pub enum Error {
         #[source]
         source: Box<Error>,
     },
+    /// The tables a run would record beside its three (`fields.csv`, `profiles.csv`) are
+    /// estimated above the run's limit ([`crate::RunOptions::max_output_bytes`], scene-file
+    /// key `max_output_bytes`, default 10 GB; [`crate::RunOptions::cost`]): refused before
+    /// anything is planned or written.
+    #[error(
+        "the recorded tables would take up to {} (fields.csv {}, profiles.csv {}; every \
+         site breaks at most once, so a run has at most N + 1 stable states), above the \
+         limit of {}: record less (the keys fields.every, fields.planes, profiles.loads, \
+         profiles.planes) or raise max_output_bytes (RunOptions::max_output_bytes) if that \
+         is intended",
+        format_bytes(fields_bytes + profiles_bytes),
+        format_bytes(*fields_bytes),
+        format_bytes(*profiles_bytes),
+        format_bytes(*limit)
+    )]
+    OutputTooLarge {
+        /// The most bytes of `fields.csv` (B).
+        fields_bytes: f64,
+        /// The most bytes of `profiles.csv` (B).
+        profiles_bytes: f64,
+        /// The limit (B).
+        limit: f64,
+    },
     /// A scene with a block length of 1 m or more under a mean normal pressure
     /// `F_N/(Lx Ly)` below `1e-6 E` ([`crate::SceneBuilder::check`], `build`): most likely
     /// lengths typed in millimetres (`"lx": 140` for 140 mm makes a 140 m block, and the

@@ -138,7 +138,7 @@ pub use interface::{
 pub use probe::{
     CellStress, PlaneStress, PointStress, ProbeInput, ProbeSpec, Profile, StressProbe, Stresses,
 };
-pub use recording::RunOptions;
+pub use recording::{ObserverCost, RunOptions};
 pub use scene::{Drive, ForceLoad, HeightSource, Lateral, Scene, SceneBuilder};
 pub use surface::SurfaceSpectrum;
 

@@ -2,6 +2,7 @@
 //! observers, never part of the physics. They change neither the events nor the scene's
 //! identity.
 
+use crate::geometry::Grid;
 use crate::probe::ProbeSpec;
 
 /// What a run records beside `events.csv`, `curve.csv` and `contact_map.csv`: the fields
@@ -27,7 +28,7 @@ use crate::probe::ProbeSpec;
 /// assert_eq!(options.probe_spec(), None); // the scene's probes
 /// assert_eq!(options.thread_count(), 0); // the scene's thread count
 /// ```
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(
     feature = "serde",
     derive(serde::Serialize, serde::Deserialize),
@@ -41,6 +42,64 @@ pub struct RunOptions {
     pub(crate) probes: Option<ProbeSpec>,
     /// The solver's thread count (0: the scene's).
     pub(crate) threads: usize,
+    /// The most bytes `fields.csv` and `profiles.csv` may take, estimated before the run.
+    pub(crate) max_output_bytes: f64,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        Self {
+            fields: FieldRecording::default(),
+            profiles: ProfileRecording::default(),
+            probes: None,
+            threads: 0,
+            max_output_bytes: RunOptions::DEFAULT_MAX_OUTPUT_BYTES,
+        }
+    }
+}
+
+/// The most bytes of a row's leading columns (event, load, field, height) in
+/// `fields.csv` and `profiles.csv`.
+const ROW_PREFIX_BYTES: f64 = 96.0;
+/// The most bytes of a value written with 13 significant digits (`-1.234567890123e-100,`).
+const VALUE_BYTES: f64 = 21.0;
+/// Memory a planned plane or point keeps, per cell (B), measured with
+/// `examples/observer_cost.rs` (docs/performance.md, "Observer costs").
+const KERNEL_BYTES_PER_CELL: f64 = 24.0;
+/// Time to plan a plane (s, one thread): a part per plane and one per cell, measured
+/// likewise.
+const PLAN_SECONDS: f64 = 1e-3;
+const PLAN_SECONDS_PER_CELL: f64 = 1.5e-6;
+/// Time to plan a point, per cell (s, one thread), measured likewise.
+const POINT_SECONDS_PER_CELL: f64 = 3e-6;
+/// Time to evaluate one plane in one stable state, per cell (s, one thread), measured
+/// likewise.
+const EVALUATION_SECONDS_PER_CELL: f64 = 2e-7;
+
+/// What recording a run's observers costs ([`RunOptions::cost`]): estimates, for one
+/// thread of a release build; `precursors info` prints them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct ObserverCost {
+    /// The most bytes `fields.csv` takes (B).
+    pub fields_bytes: f64,
+    /// The bytes `profiles.csv` takes (B, at most: a load the run never reaches has no
+    /// rows).
+    pub profiles_bytes: f64,
+    /// Memory the planned planes and points keep (B).
+    pub memory_bytes: f64,
+    /// Time to plan every plane and point (s).
+    pub plan_seconds: f64,
+    /// The most time to evaluate the recorded planes over the run (s).
+    pub record_seconds: f64,
+}
+
+impl ObserverCost {
+    /// The bytes of `fields.csv` and `profiles.csv` together (B): what
+    /// [`RunOptions::max_output_bytes`] bounds.
+    pub fn output_bytes(&self) -> f64 {
+        self.fields_bytes + self.profiles_bytes
+    }
 }
 
 /// What a run records of its fields ([`RunOptions::record_fields`]): every `every`-th
@@ -60,6 +119,10 @@ pub(crate) struct ProfileRecording {
 }
 
 impl RunOptions {
+    /// The default limit on the bytes of `fields.csv` and `profiles.csv` together, as
+    /// [`ObserverCost::output_bytes`] estimates them before a run: 10 GB.
+    pub const DEFAULT_MAX_OUTPUT_BYTES: f64 = 1e10;
+
     /// Records nothing beyond the three tables (the default).
     pub fn new() -> Self {
         Self::default()
@@ -98,6 +161,90 @@ impl RunOptions {
             planes: planes.to_vec(),
         };
         self
+    }
+
+    /// The most bytes (B) the recorded tables `fields.csv` and `profiles.csv` may take
+    /// together (default [`RunOptions::DEFAULT_MAX_OUTPUT_BYTES`], 10 GB; scene-file key
+    /// `max_output_bytes`). A run whose estimate ([`RunOptions::cost`]) is above it is
+    /// refused before it starts, with [`crate::Error::OutputTooLarge`]; raise it for a
+    /// recording whose size you accept. It does not change results.
+    ///
+    /// ```
+    /// use precursors::{Error, RunOptions, Scene};
+    /// // Profiles at 1000 loads on 1000 planes of the calibration block: about 10 GB.
+    /// let loads: Vec<f64> = (0..1000).map(|k| k as f64 / 1000.0).collect();
+    /// let planes: Vec<f64> = (0..1000).map(|k| 0.010 + 0.060 * k as f64 / 1000.0).collect();
+    /// let options = RunOptions::new().record_profiles(&loads, &planes);
+    /// let scene = Scene::builder().run_options(options.clone());
+    /// assert!(matches!(scene.check(), Err(Error::OutputTooLarge { .. })));
+    /// let raised = Scene::builder().run_options(options.max_output_bytes(1e11));
+    /// assert!(raised.check().is_ok());
+    /// ```
+    pub fn max_output_bytes(mut self, bytes: f64) -> Self {
+        self.max_output_bytes = bytes;
+        self
+    }
+
+    /// The limit given with [`RunOptions::max_output_bytes`] (B).
+    pub fn output_limit(&self) -> f64 {
+        self.max_output_bytes
+    }
+
+    /// What recording these options costs on `grid`, with `probes` the probes the run's
+    /// driver starts with (its scene's, or [`RunOptions::probes`]): the bytes of
+    /// `fields.csv` and `profiles.csv`, the memory and planning time of every plane and
+    /// point, and the time to evaluate the recorded planes over the run. Estimates for
+    /// one thread of a release build, fitted to `examples/observer_cost.rs`
+    /// (docs/performance.md, "Observer costs"); the table sizes are upper bounds: every
+    /// site breaks at most once, so a run has at most `N + 1` stable states.
+    ///
+    /// ```
+    /// use precursors::{Grid, Block, ProbeSpec, RunOptions};
+    /// let grid = Grid::new(Block::new(0.140, 0.007, 0.075)?, 140, 7)?;
+    /// let options = RunOptions::new().record_profiles(&[0.5], &[0.0, 0.01]);
+    /// let cost = options.cost(&grid, &ProbeSpec::default());
+    /// // 3 interface rows and 4 rows per plane, 140 values each: about 30 kB.
+    /// assert!(cost.profiles_bytes > 11.0 * 140.0 * 17.0 && cost.profiles_bytes < 40e3);
+    /// assert_eq!(cost.fields_bytes, 0.0);
+    /// assert_eq!(cost.output_bytes(), cost.profiles_bytes);
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    pub fn cost(&self, grid: &Grid, probes: &ProbeSpec) -> ObserverCost {
+        let n = grid.len() as f64;
+        let row = ROW_PREFIX_BYTES + VALUE_BYTES * grid.nx() as f64;
+        let fields = &self.fields;
+        let profiles = &self.profiles;
+        // Every site breaks once and every avalanche breaks one at least.
+        let states = if fields.every == 0 {
+            0.0
+        } else {
+            (grid.len() + 1).div_ceil(fields.every) as f64
+        };
+        let field_planes = if fields.every == 0 {
+            0
+        } else {
+            fields.planes.len()
+        };
+        let loads = profiles.loads.len() as f64;
+        let profile_planes = if profiles.loads.is_empty() {
+            0
+        } else {
+            profiles.planes.len()
+        };
+        let probes = self.probes.as_ref().unwrap_or(probes);
+        let planes = (field_planes + profile_planes + probes.planes().len()) as f64;
+        let points = probes.points().len() as f64; // Profiles evaluate their planes in every stable state until the last load is
+                                                   // passed (which state is in effect at a load shows only at the next one).
+        let profile_states = if profile_planes == 0 { 0.0 } else { n + 1.0 };
+        let evaluations = states * field_planes as f64 + profile_states * profile_planes as f64;
+        ObserverCost {
+            fields_bytes: states * (grid.ny() + field_planes) as f64 * row,
+            profiles_bytes: loads * (3 + 4 * profile_planes) as f64 * row,
+            memory_bytes: (planes + points) * KERNEL_BYTES_PER_CELL * n,
+            plan_seconds: planes * (PLAN_SECONDS + PLAN_SECONDS_PER_CELL * n)
+                + points * POINT_SECONDS_PER_CELL * n,
+            record_seconds: evaluations * EVALUATION_SECONDS_PER_CELL * n,
+        }
     }
 
     /// The stress probes (planes and points) a driver of the run starts with, in place of
@@ -166,6 +313,21 @@ struct RunOptionsFields {
     probes: Option<ProbeSpec>,
     #[serde(skip_serializing_if = "is_zero")]
     threads: usize,
+    /// Written only when it is not the default.
+    #[serde(skip_serializing_if = "is_default_limit", default = "default_limit")]
+    max_output_bytes: f64,
+}
+
+/// Whether an output limit is the default.
+#[cfg(feature = "serde")]
+fn is_default_limit(bytes: &f64) -> bool {
+    *bytes == RunOptions::DEFAULT_MAX_OUTPUT_BYTES
+}
+
+/// The default output limit.
+#[cfg(feature = "serde")]
+fn default_limit() -> f64 {
+    RunOptions::DEFAULT_MAX_OUTPUT_BYTES
 }
 
 /// Whether a thread count is the default (the scene's).
@@ -206,6 +368,7 @@ impl From<RunOptions> for RunOptionsFields {
             },
             probes: o.probes,
             threads: o.threads,
+            max_output_bytes: o.max_output_bytes,
         }
     }
 }
@@ -216,7 +379,8 @@ impl From<RunOptionsFields> for RunOptions {
         let options = RunOptions::new()
             .record_fields(f.fields.every, &f.fields.planes)
             .record_profiles(&f.profiles.loads, &f.profiles.planes)
-            .threads(f.threads);
+            .threads(f.threads)
+            .max_output_bytes(f.max_output_bytes);
         match f.probes {
             Some(probes) => options.probes(probes),
             None => options,

@@ -990,6 +990,28 @@ impl SceneBuilder {
         self
     }
 
+    /// What the scene's observers cost on its grid ([`RunOptions::cost`]): the tables
+    /// its run options record, and every plane and point it plans (the run options'
+    /// and, where the run options give their own probes, the scene's too). `precursors
+    /// info` prints it; a run is refused above [`RunOptions::max_output_bytes`].
+    ///
+    /// ```
+    /// use precursors::{RunOptions, Scene};
+    /// let builder = Scene::builder() // the calibration block, 140 x 7 cells
+    ///     .run_options(RunOptions::new().record_fields(10, &[0.01]));
+    /// let cost = builder.observer_cost()?;
+    /// // At most 99 recorded states of 7 area rows and 1 plane row, 140 values each.
+    /// assert!(cost.fields_bytes > 99.0 * 8.0 * 140.0 * 17.0);
+    /// assert!(cost.fields_bytes < 99.0 * 8.0 * (140.0 * 21.0 + 100.0));
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// Those of [`SceneBuilder::grid`].
+    pub fn observer_cost(&self) -> Result<crate::recording::ObserverCost> {
+        Ok(bounds::observer_cost(self, &self.grid()?))
+    }
+
     /// The probes a scene built from this builder starts its drivers with: the run
     /// options' where given, else those of [`SceneBuilder::probes`].
     pub(crate) fn effective_probes(&self) -> &ProbeSpec {

@@ -24,6 +24,8 @@ mod matrix;
 mod messages;
 #[cfg(feature = "plot")]
 mod movie;
+#[cfg(feature = "cli")]
+mod observers;
 mod operator;
 #[cfg(feature = "cli")]
 mod outputs;

@@ -413,6 +413,41 @@ fn a_run_directory_gets_its_five_figures() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+#[test]
+fn a_run_whose_zero_shear_area_is_zero_is_refused_not_drawn_empty() {
+    // An edited curve.csv: A_R(0) = 0 divided every A_R/A_R(0), and the area figure was
+    // drawn empty with exit 0 (issue 53). A stable state carries F_N on its contacts, so
+    // the table check refuses it, naming the cell.
+    let scene = scene();
+    let dir = scratch("zero_area");
+    let mut driver = scene.driver().unwrap();
+    let mut tables = RunTables::create(&dir, &driver).unwrap();
+    while let Some(event) = driver.step().unwrap() {
+        tables.record(&driver, &event).unwrap();
+    }
+    tables.finish().unwrap();
+    let curve = std::fs::read_to_string(dir.join("curve.csv")).unwrap();
+    for (column, value) in [(4, "0.000000000000e0"), (8, "0")] {
+        let edited: String = curve
+            .lines()
+            .enumerate()
+            .map(|(k, line)| {
+                let mut cells: Vec<&str> = line.split(',').collect();
+                if k == 1 {
+                    cells[column] = value;
+                }
+                cells.join(",") + "\n"
+            })
+            .collect();
+        std::fs::write(dir.join("curve.csv"), edited).unwrap();
+        let refused = draw(&dir, &[Format::Png]).unwrap_err();
+        let text = refused.to_string();
+        assert!(text.contains("line 2") && text.contains("F_N"), "{text}");
+        assert!(!dir.join("contact_area.png").exists());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// The `<text>` elements of an SVG: (attributes, content).
 fn svg_texts(path: &Path) -> Vec<(String, String)> {
     let svg = std::fs::read_to_string(path).unwrap();

@@ -45,6 +45,7 @@ class Scene:
         profile_loads: Optional[Sequence[float]] = ...,
         profile_planes: Optional[Sequence[float]] = ...,
         confirm_metres: Optional[bool] = ...,
+        max_output_bytes: Optional[float] = ...,
     ) -> None: ...
     @staticmethod
     def from_file(path: _Path) -> Scene: ...

@@ -189,6 +189,7 @@ def scene_dict(
     profile_loads: Optional[Sequence[float]] = None,
     profile_planes: Optional[Sequence[float]] = None,
     confirm_metres: Optional[bool] = None,
+    max_output_bytes: Optional[float] = None,
 ) -> Dict[str, Any]:
     """The scene-file dict of the keywords of ``precursors.Scene(...)``; a keyword left
     out is a key left out (the calibration scene's value)."""
@@ -325,4 +326,6 @@ def scene_dict(
         if not isinstance(confirm_metres, bool):
             raise TypeError(f"confirm_metres= takes True or False, not {confirm_metres!r}")
         scene["confirm_metres"] = confirm_metres
+    if max_output_bytes is not None:
+        scene["max_output_bytes"] = _number("max_output_bytes", max_output_bytes)
     return scene

@@ -72,6 +72,7 @@ fn core_class(e: &precursors::Error) -> Class {
         | E::GridTooLarge { .. }
         | E::LengthInMillimetres { .. }
         | E::LikelyMillimetres { .. }
+        | E::OutputTooLarge { .. }
         | E::NonFinite { .. }
         | E::NonPositiveHeight { .. }
         | E::LengthMismatch { .. }
@@ -301,7 +302,8 @@ fn build(py: Python<'_>, builder: precursors::SceneBuilder) -> PyResult<Scene> {
 /// probe_planes=[z, ...], probe_points=[(x, y, z), ...] (m);
 /// profile_loads=[F/(μF_N), ...], profile_planes=[z, ...] (m); confirm_metres=True for a
 /// block of a metre or more under a mean pressure below 1e-6 E (refused otherwise as
-/// millimetres typed as metres).
+/// millimetres typed as metres); max_output_bytes (B, default 1e10) bounds the estimated
+/// size of the recorded profiles (refused above it, before the run).
 #[pyclass(module = "precursors", frozen)]
 struct Scene {
     inner: precursors::Scene,
@@ -320,7 +322,8 @@ impl Scene {
                           young_modulus=None, poisson_ratio=None, friction_coefficient=None, \
                           c_x=None, c_z=None, drive=None, rod=None, backend=None, \
                           threads=None, probe_planes=None, probe_points=None, \
-                          profile_loads=None, profile_planes=None, confirm_metres=None)"
+                          profile_loads=None, profile_planes=None, confirm_metres=None, \
+                          max_output_bytes=None)"
     )]
     fn new(py: Python<'_>, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
         let dict = py

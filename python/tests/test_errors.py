@@ -249,3 +249,18 @@ def test_an_unknown_backend_lists_cuda():
     with pytest.raises(PrecursorsValueError) as raised:
         precursors.Scene(backend="gpu")
     assert "'cuda'" in str(raised.value)
+
+
+def test_a_recording_above_its_output_limit_is_refused_unless_raised():
+    # Profiles at 1000 loads on 1000 planes of the calibration block: about 10 GB of
+    # profiles.csv, above the default limit of 1e10 B (issue 53).
+    loads = [k / 1000 for k in range(1000)]
+    planes = [0.01 + 0.06 * k / 1000 for k in range(1000)]
+    with pytest.raises(PrecursorsValueError) as raised:
+        precursors.Scene(profile_loads=loads, profile_planes=planes)
+    assert raised.value.kind == "OutputTooLarge"
+    assert "max_output_bytes" in str(raised.value)
+    scene = precursors.Scene(profile_loads=loads, profile_planes=planes, max_output_bytes=1e11)
+    assert scene.to_dict()["max_output_bytes"] == 1e11
+    with pytest.raises(TypeError):
+        precursors.Scene(max_output_bytes="10 GB")

@@ -17,7 +17,9 @@ use precursors::output::RunTables;
 use precursors::plot::PlotError;
 use precursors::statistics::PowerLawOptions;
 use precursors::sweep::{StatsOptions, Sweep, SweepError, SweepOptions};
-use precursors::{Checkpoint, Driver, Error, GridCost, SceneBuilder, SiteState};
+use precursors::{
+    Checkpoint, Driver, Error, GridCost, ProbeSpec, RunOptions, SceneBuilder, SiteState,
+};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -883,8 +885,18 @@ fn info(path: &Path) -> Result<(), Failure> {
     let grid = builder.check()?;
     let n = grid.len();
     if n < INFO_BUILDS_BELOW {
-        builder.build()?;
+        // Without its probes and recording, which `check` has checked: their planning
+        // (milliseconds a plane) is estimated below, not done.
+        builder
+            .clone()
+            .probes(ProbeSpec::default())
+            .run_options(RunOptions::new())
+            .build()?;
     }
+    let observers = builder.observer_cost()?;
+    let limit = file["max_output_bytes"]
+        .as_f64()
+        .unwrap_or(RunOptions::DEFAULT_MAX_OUTPUT_BYTES);
     let cost = GridCost::of(grid.nx(), grid.ny());
     let backend = file["solver"]["backend"].as_str().unwrap_or("auto");
     if backend == "cuda" {
@@ -916,6 +928,10 @@ fn info(path: &Path) -> Result<(), Failure> {
          run        ~{} to global slip (rough: 0.84 s·(N/980)^1.9 up to N = 1e4, then \
          growing as N^2.1; fitted to the calibration scene, N = 1e4 and 1e5; the events \
          depend on the scene)\n\
+         output     ~{} at most beside the three tables (fields.csv {}, profiles.csv {}; \
+         limit {}, key max_output_bytes)\n\
+         observers  ~{} to plan, ~{} at most to record, ~{} of memory (estimates, one \
+         thread; docs/performance.md, \"Observer costs\")\n\
          gpu        {}\n",
         path.display(),
         metres(block.lx()),
@@ -930,6 +946,13 @@ fn info(path: &Path) -> Result<(), Failure> {
         format_seconds(cost.plan_seconds),
         format_seconds(cost.solve_seconds),
         format_seconds(run),
+        format_bytes(observers.output_bytes()),
+        format_bytes(observers.fields_bytes),
+        format_bytes(observers.profiles_bytes),
+        format_bytes(limit),
+        format_seconds(observers.plan_seconds),
+        format_seconds(observers.record_seconds),
+        format_bytes(observers.memory_bytes),
         gpu(),
     );
     print_out(&text)

@@ -373,8 +373,15 @@ pub(crate) fn curve_row(line: usize, row: &str, b: &Bounds) -> Row<CurveRow> {
     }
     optional(line, &header, &c, 3)?;
     let area = number(line, &header, &c, 4)?;
-    if area < 0.0 {
-        return Err(at(line, header[4], format!("{area:?} m² is negative")));
+    // A stable state carries F_N > 0 on its attached sites, each with an area growing
+    // with its force: its real contact area is positive (and `A_R(0)` divides the area
+    // figures).
+    if area <= 0.0 {
+        return Err(at(
+            line,
+            header[4],
+            format!("{area:?} m² is not positive: a stable state carries F_N on its contacts"),
+        ));
     }
     let length = number(line, &header, &c, 5)?;
     let ratio = number(line, &header, &c, 6)?;
@@ -394,6 +401,13 @@ pub(crate) fn curve_row(line: usize, row: &str, b: &Bounds) -> Row<CurveRow> {
     let broken = count(line, &header, &c, 7)?;
     let attached = count(line, &header, &c, 8)?;
     let sites = b.nx * b.ny;
+    if attached == 0 {
+        return Err(at(
+            line,
+            "attached",
+            "no site is attached: a stable state carries F_N on its contacts",
+        ));
+    }
     if broken + attached > sites {
         return Err(at(
             line,

@@ -370,12 +370,50 @@ pub(crate) fn run_options(
             "no stable state carries a load beyond the friction limit μF_N",
         )?;
     }
+    // `profiles.csv` writes a load with 13 significant digits, and readers find a load's
+    // rows by that text.
+    for pair in options.profile_loads().windows(2) {
+        if format!("{:.12e}", pair[0]) == format!("{:.12e}", pair[1]) {
+            return Err(Error::InvalidParameter {
+                name: "profiles.loads",
+                value: pair[1],
+                reason: "it equals another load to the 13 significant digits profiles.csv \
+                         writes, so the table could not tell their rows apart: give it once",
+            });
+        }
+    }
     count_within(
         "profiles.loads",
         options.profile_loads().len(),
         (0, MAX_PROBES),
         "each load is a row group of the table",
-    )
+    )?;
+    output(options, grid, &ProbeSpec::default())
+}
+
+/// The most bytes a recording may be allowed (`max_output_bytes`): a petabyte.
+pub(crate) const MAX_OUTPUT_BYTES: f64 = 1e15;
+
+/// The recorded tables' estimated size against the run's limit (`max_output_bytes`),
+/// before anything is planned or written.
+fn output(options: &crate::recording::RunOptions, grid: &Grid, probes: &ProbeSpec) -> Result<()> {
+    let limit = options.output_limit();
+    within(
+        "max_output_bytes",
+        limit,
+        (0.0, MAX_OUTPUT_BYTES),
+        "B",
+        "the limit on the recorded tables' estimated size (fields.csv and profiles.csv)",
+    )?;
+    let cost = options.cost(grid, probes);
+    if cost.output_bytes() > limit {
+        return Err(Error::OutputTooLarge {
+            fields_bytes: cost.fields_bytes,
+            profiles_bytes: cost.profiles_bytes,
+            limit,
+        });
+    }
+    Ok(())
 }
 
 /// The mean normal pressure `F_N/(Lx Ly)`, over Young's modulus, below which a block with
@@ -677,13 +715,25 @@ fn drive(builder: &SceneBuilder) -> Result<()> {
     }
 }
 
+/// What a scene's observers cost on `grid` (`SceneBuilder::observer_cost`): its run
+/// options' recording and planes, and its own probes, which the scene plans even where
+/// the run options give its drivers others.
+pub(super) fn observer_cost(builder: &SceneBuilder, grid: &Grid) -> crate::recording::ObserverCost {
+    let mut cost = builder.run.cost(grid, &builder.probes);
+    if builder.run.probe_spec().is_some() {
+        let own = crate::recording::RunOptions::new().cost(grid, &builder.probes);
+        cost.memory_bytes += own.memory_bytes;
+        cost.plan_seconds += own.plan_seconds;
+    }
+    cost
+}
+
 /// Bytes of a built scene and its driver on `grid` with these probes and heights
 /// ([`crate::GridCost`] plus what it leaves out).
 pub(super) fn memory_bytes(builder: &SceneBuilder, grid: &Grid) -> f64 {
     let n = grid.len() as f64;
     let cost = crate::cost::GridCost::of(grid.nx(), grid.ny()).memory_bytes;
-    // Each probe keeps a kernel of N values and returns a field of N values.
-    let probes = (builder.probes.planes().len() + builder.probes.points().len()) as f64 * 16.0 * n;
+    let probes = observer_cost(builder, grid).memory_bytes;
     // Given heights are copied into the interface.
     let heights = match &builder.heights {
         HeightSource::Values(v) => 8.0 * v.len() as f64,

@@ -58,6 +58,9 @@ schema_struct! {
         /// other scenes stay as they were.
         #[cfg_attr(feature = "serde", serde(skip_serializing_if = "is_false"))]
         [observer] confirm_metres: bool,
+        /// Written only when it is not the default.
+        #[cfg_attr(feature = "serde", serde(skip_serializing_if = "is_default_max_output_bytes"))]
+        [observer] max_output_bytes: f64,
     }
 }
 
@@ -100,6 +103,11 @@ impl ProfilesSpec {
 #[cfg(feature = "serde")]
 fn is_false(value: &bool) -> bool {
     !*value
+}
+
+#[cfg(feature = "serde")]
+fn is_default_max_output_bytes(bytes: &f64) -> bool {
+    *bytes == RunOptions::DEFAULT_MAX_OUTPUT_BYTES
 }
 
 #[cfg(feature = "serde")]
@@ -592,6 +600,7 @@ impl From<&SceneBuilder> for SceneFile {
                 planes: run.profile_planes().to_vec(),
             },
             confirm_metres: *confirm_metres,
+            max_output_bytes: run.output_limit(),
         }
     }
 }
@@ -698,6 +707,7 @@ impl SceneFile {
             fields,
             profiles,
             confirm_metres,
+            max_output_bytes,
         } = self;
         let material = Material::new(
             material.young_modulus,
@@ -723,7 +733,8 @@ impl SceneFile {
             max_cells,
             run: RunOptions::new()
                 .record_fields(fields.every, &fields.planes)
-                .record_profiles(&profiles.loads, &profiles.planes),
+                .record_profiles(&profiles.loads, &profiles.planes)
+                .max_output_bytes(max_output_bytes),
             confirm_metres,
         })
     }
@@ -1169,6 +1180,7 @@ mod tests {
             assert!(left_out.iter().all(|k| *k == "solver.threads"
                 || *k == "max_cells"
                 || *k == "confirm_metres"
+                || *k == "max_output_bytes"
                 || k.starts_with("probes.")
                 || k.starts_with("fields.")
                 || k.starts_with("profiles.")));
