@@ -79,6 +79,12 @@ pub struct Avalanche {
     /// Whether it comes after the run's spanning avalanche (the few sites left carry the
     /// whole normal load: a regime of its own, which statistics leave out by default).
     pub after_spanning: bool,
+    /// Its extent along `x` (m): from the trailing edge of the lowest column it broke a
+    /// spring in to the leading edge of the highest, `(ix_max - ix_min + 1)·Δx`.
+    pub extent: f64,
+    /// Its centroid along `x` by ruptures (m): the mean of its broken cells' centres,
+    /// `Δx·(⟨ix⟩ + ½)`. Not slip-weighted: the events carry no slip (docs/statistics.md).
+    pub centroid: f64,
 }
 
 impl Avalanche {
@@ -94,6 +100,10 @@ impl Avalanche {
 #[derive(Debug, Clone)]
 pub struct Avalanches {
     cell_area: f64,
+    dx: f64,
+    /// The lowest and highest column broken in the current avalanche, and the sum of the
+    /// broken columns.
+    columns: (usize, usize, usize),
     /// Events observed.
     events: usize,
     current: Option<Avalanche>,
@@ -110,6 +120,8 @@ impl Avalanches {
     pub fn new(grid: &Grid) -> Self {
         Self {
             cell_area: grid.cell_area(),
+            dx: grid.dx(),
+            columns: (usize::MAX, 0, 0),
             events: 0,
             current: None,
             attached: Vec::new(),
@@ -170,6 +182,7 @@ impl Avalanches {
         match *event {
             Event::LoadRaised { load } => {
                 self.attached.clear();
+                self.columns = (usize::MAX, 0, 0);
                 self.current = Some(Avalanche {
                     start_event: self.events,
                     end_event: self.events,
@@ -186,12 +199,17 @@ impl Avalanches {
                     contacts_after: self.contacts,
                     spanning: false,
                     after_spanning: false,
+                    extent: 0.0,
+                    centroid: 0.0,
                 });
                 None
             }
             Event::Rupture { site, load, energy } => {
                 self.count(-1);
                 if let Some(a) = &mut self.current {
+                    let (low, high, sum) = &mut self.columns;
+                    (*low, *high, *sum) =
+                        ((*low).min(site.ix), (*high).max(site.ix), *sum + site.ix);
                     a.ruptures += 1;
                     a.broken_area += self.cell_area;
                     a.energy += energy;
@@ -228,6 +246,11 @@ impl Avalanches {
         a.load_after = load;
         a.global_slip = global_slip;
         a.contacts_after = self.contacts;
+        let (low, high, sum) = self.columns;
+        if a.ruptures > 0 {
+            a.extent = (high - low + 1) as f64 * self.dx;
+            a.centroid = (sum as f64 / a.ruptures as f64 + 0.5) * self.dx;
+        }
         if self.spanned {
             a.after_spanning = true;
         } else if let (Some(before), Some(after)) = (a.contacts_before, a.contacts_after) {

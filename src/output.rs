@@ -47,7 +47,7 @@
 //!   start_event,end_event,ruptures,broken_area_m2,force_before_N,force_after_N,
 //!   force_drop_N,drive_displacement_before_m,drive_displacement_after_m,energy_J,
 //!   attaches,detaches,flash_ruptures,global_slip,ruptures_without_flash,contacts_before,
-//!   contacts_after,spanning,after_spanning`), and the damage front beside `ℓ` at
+//!   contacts_after,spanning,after_spanning,extent_m,centroid_m`), and the damage front beside `ℓ` at
 //!   every stable state ([`crate::DamageFront`]: `event,force_N,force_over_mu_FN,
 //!   precursor_over_Lx,damage_front_m,damage_front_over_Lx`); docs/statistics.md.
 //!

@@ -61,6 +61,8 @@ struct Read {
     before: String,
     after: String,
     contacts: (usize, usize),
+    /// The columns `ix` of its ruptures.
+    columns: Vec<usize>,
 }
 
 /// The index of the spanning avalanche as docs/statistics.md defines it: the first that
@@ -103,6 +105,7 @@ fn read_avalanches(events: &[HashMap<String, String>]) -> Vec<Read> {
                     before: e["force_N"].clone(),
                     after: String::new(),
                     contacts: (contacts, contacts),
+                    columns: Vec::new(),
                 };
                 open = Some((read, Vec::new()));
             }
@@ -110,6 +113,7 @@ fn read_avalanches(events: &[HashMap<String, String>]) -> Vec<Read> {
                 let (a, attached) = open.as_mut().unwrap();
                 a.ruptures += 1;
                 a.flash += usize::from(attached.contains(&site));
+                a.columns.push(site.0.parse().unwrap());
             }
             "attach" => {
                 let (a, attached) = open.as_mut().unwrap();
@@ -151,7 +155,17 @@ fn the_calibration_runs_avalanches_and_damage_front() {
                 row["contacts_before"].parse().unwrap(),
                 row["contacts_after"].parse().unwrap(),
             ),
+            columns: e.columns.clone(),
         };
+        // Extent and centroid from the ruptures' columns in events.csv (1 mm cells), to
+        // the 13 significant digits of the table.
+        let low = *e.columns.iter().min().unwrap() as f64;
+        let high = *e.columns.iter().max().unwrap() as f64;
+        let mean = e.columns.iter().sum::<usize>() as f64 / e.columns.len() as f64;
+        let extent = (high - low + 1.0) * 1e-3;
+        let centroid = (mean + 0.5) * 1e-3;
+        assert!((num(row, "extent_m") - extent).abs() < 1e-12 * extent);
+        assert!((num(row, "centroid_m") - centroid).abs() < 1e-12 * centroid);
         assert_eq!(&got, e, "avalanche {}", k + 1);
         let span = spanning(&expected);
         assert_eq!(row["spanning"], if k == span { "1" } else { "0" });

@@ -23,7 +23,8 @@ pub(crate) const FRONTS_TABLE: &str = "fronts.csv";
 pub(crate) const AVALANCHE_HEADER: &str = "avalanche,start_event,end_event,ruptures,\
      broken_area_m2,force_before_N,force_after_N,force_drop_N,drive_displacement_before_m,\
      drive_displacement_after_m,energy_J,attaches,detaches,flash_ruptures,global_slip,\
-     ruptures_without_flash,contacts_before,contacts_after,spanning,after_spanning";
+     ruptures_without_flash,contacts_before,contacts_after,spanning,after_spanning,extent_m,\
+     centroid_m";
 /// The header of `fronts.csv`.
 pub(crate) const FRONTS_HEADER: &str =
     "event,force_N,force_over_mu_FN,precursor_over_Lx,damage_front_m,damage_front_over_Lx";
@@ -95,7 +96,8 @@ fn avalanche_text(avalanches: &[Avalanche]) -> String {
     for (k, a) in avalanches.iter().enumerate() {
         let _ = writeln!(
             text,
-            "{},{},{},{},{:.12e},{:.12e},{:.12e},{:.12e},{},{},{:.12e},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{:.12e},{:.12e},{:.12e},{:.12e},{},{},{:.12e},{},{},{},{},{},{},{},{},{},\
+             {:.12e},{:.12e}",
             k + 1,
             a.start_event,
             a.end_event,
@@ -116,6 +118,8 @@ fn avalanche_text(avalanches: &[Avalanche]) -> String {
             count(a.contacts_after),
             u8::from(a.spanning),
             u8::from(a.after_spanning),
+            a.extent,
+            a.centroid,
         );
     }
     text
