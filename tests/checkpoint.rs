@@ -728,12 +728,12 @@ pub(crate) mod json {
         assert!(reason.contains("EOF"), "{reason}");
         // Another layout version, newer or older (older ones carry no digest): refused,
         // saying which.
-        for (version, words) in [(4, "layout version 4"), (2, "layout version 2")] {
-            let other = text.replacen("\"format\":3", &format!("\"format\":{version}"), 1);
+        for (version, words) in [(5, "layout version 5"), (2, "layout version 2")] {
+            let other = text.replacen("\"format\":4", &format!("\"format\":{version}"), 1);
             assert_ne!(other, text);
             let reason = refused(&other);
             assert!(
-                reason.contains(words) && reason.contains("reads version 3"),
+                reason.contains(words) && reason.contains("reads versions 3 to 4"),
                 "{reason}"
             );
         }
