@@ -723,7 +723,7 @@ impl RunTables {
     ///
     /// # Errors
     /// [`Error::Io`] when a table cannot be written or synced.
-    pub fn checkpoint(&mut self, driver: &Driver) -> Result<crate::Checkpoint> {
+    pub fn checkpoint(&mut self, driver: &Driver) -> Result<crate::driver::Checkpoint> {
         self.flush()?;
         let mut tables: Vec<TableDigest> = [&self.events, &self.curve, &self.map]
             .iter()
@@ -1147,11 +1147,12 @@ fn check_recorded_observers(dir: &Path, options: &RunOptions) -> Result<()> {
     {
         let path = dir.join(RUN_SCENE);
         if let Some(text) = read_text_if_exists(&path, "reading the scene record")? {
-            let recorded = crate::scene::SceneBuilder::from_json_str(&text)
-                .map_err(|e| Error::RunDirectory {
+            let recorded = crate::scene::SceneBuilder::from_json_str(&text).map_err(|e| {
+                Error::RunDirectory {
                     path: path.clone(),
                     reason: format!("not a scene file ({})", crate::error::Chain(&e)),
-                })?;
+                }
+            })?;
             let run = recorded.current_run();
             let differs = if run.fields_every() != options.fields_every()
                 || run.field_planes() != options.field_planes()

@@ -967,7 +967,11 @@ mod kept {
             let y = if x == 0.0 { 1e-9 } else { 1.5 * x };
             return Some(match cell.split_once('.') {
                 Some((_, decimals)) if !cell.contains('e') => {
-                    format!("{:.*}", decimals.len(), x + 10f64.powi(-(decimals.len() as i32)))
+                    format!(
+                        "{:.*}",
+                        decimals.len(),
+                        x + 10f64.powi(-(decimals.len() as i32))
+                    )
                 }
                 _ => format!("{y:.12e}"),
             });
@@ -1006,7 +1010,11 @@ mod kept {
             for (column, key) in header.iter().enumerate() {
                 let cell = |l: usize| lines[l].split(',').nth(column).unwrap();
                 // The middle kept row with a value in the column.
-                let rows: Vec<usize> = kept.iter().copied().filter(|&l| !cell(l).is_empty()).collect();
+                let rows: Vec<usize> = kept
+                    .iter()
+                    .copied()
+                    .filter(|&l| !cell(l).is_empty())
+                    .collect();
                 let Some(&line) = rows.get(rows.len() / 2) else {
                     continue; // never written before the checkpoint (no cell to edit)
                 };
@@ -1025,7 +1033,11 @@ mod kept {
                 match resume(&work) {
                     Err(Error::CorruptTable { path, reason }) => {
                         let path = path.unwrap();
-                        assert!(path.ends_with(&name), "{case}: {} ({reason})", path.display());
+                        assert!(
+                            path.ends_with(&name),
+                            "{case}: {} ({reason})",
+                            path.display()
+                        );
                     }
                     Err(Error::InvalidCheckpoint { .. }) => {}
                     other => panic!("{case}: not refused: {:?}", other.map(|_| ())),
@@ -1112,7 +1124,10 @@ mod kept {
         for (case, forged) in [
             ("a broken site set back to attached", attach_all(&text)),
             ("the normal tractions scaled", scaled(&text, "normal", 1.01)),
-            ("the shear tractions scaled", scaled(&text, "response", 1.01)),
+            (
+                "the shear tractions scaled",
+                scaled(&text, "response", 1.01),
+            ),
             (
                 "the load raised past the weakest site",
                 replace_value(&text, "control", &format!("{:?}", control * 1.5)),
@@ -1133,7 +1148,9 @@ mod kept {
             assert!(files(&dir) == before, "{case}: the directory changed");
         }
         // As written, it resumes.
-        let driver = scene().resume(&Checkpoint::from_json_str(&text).unwrap()).unwrap();
+        let driver = scene()
+            .resume(&Checkpoint::from_json_str(&text).unwrap())
+            .unwrap();
         output::RunTables::resume(&dir, &driver).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
     }
@@ -1174,7 +1191,9 @@ mod kept {
         let before = files(&work);
         let driver = scene.resume(&old).unwrap();
         match output::RunTables::resume_with(&work, &driver, &bare) {
-            Err(Error::RunDirectory { reason, .. }) => assert!(reason.contains("fields.csv"), "{reason}"),
+            Err(Error::RunDirectory { reason, .. }) => {
+                assert!(reason.contains("fields.csv"), "{reason}")
+            }
             other => panic!("not refused: {:?}", other.map(|_| ())),
         }
         assert!(files(&work) == before, "the directory changed");
@@ -1187,7 +1206,9 @@ mod kept {
         let before = files(&work);
         let driver = scene.resume(&old).unwrap();
         match output::RunTables::resume(&work, &driver) {
-            Err(Error::RunDirectory { reason, .. }) => assert!(reason.contains("profiles"), "{reason}"),
+            Err(Error::RunDirectory { reason, .. }) => {
+                assert!(reason.contains("profiles"), "{reason}")
+            }
             other => panic!("not refused: {:?}", other.map(|_| ())),
         }
         assert!(files(&work) == before, "the directory changed");

@@ -148,7 +148,9 @@ impl TableDigest {
             digest.update(row.as_bytes());
             digest.update(b"\n");
             let n = k as u64 + 1;
-            if n.is_multiple_of(MARK_ROWS) && self.marks.get(k / MARK_ROWS as usize) != Some(&digest.hash) {
+            if n.is_multiple_of(MARK_ROWS)
+                && self.marks.get(k / MARK_ROWS as usize) != Some(&digest.hash)
+            {
                 return Some(RowDifference::Rows {
                     first: n + 1 - MARK_ROWS,
                     last: n,
@@ -165,9 +167,7 @@ impl TableDigest {
                 last: self.rows,
             });
         }
-        (kept > self.rows).then_some(RowDifference::Extra {
-            covered: self.rows,
-        })
+        (kept > self.rows).then_some(RowDifference::Extra { covered: self.rows })
     }
 
     /// Whether its marks are those of its row count (a checkpoint that holds others was
@@ -822,9 +822,9 @@ impl Equilibrium<'_> {
             .map(|i| self.displacement[i] - self.applied[i] - self.product[i])
             .collect();
         let mean = offset.iter().sum::<f64>() / n as f64;
-        let size = max(&|i| {
-            self.product[i].abs() + self.applied[i].abs() + self.displacement[i].abs()
-        }) + mean.abs();
+        let size =
+            max(&|i| self.product[i].abs() + self.applied[i].abs() + self.displacement[i].abs())
+                + mean.abs();
         let spread = max(&|i| (offset[i] - mean).abs());
         if spread > tolerance * size {
             return Some(format!(
@@ -838,9 +838,8 @@ impl Equilibrium<'_> {
                 self.traction[i]
             ));
         }
-        let spring = |i: usize| {
-            self.displacement[i] + self.compliance[i] * self.traction[i] - self.rest[i]
-        };
+        let spring =
+            |i: usize| self.displacement[i] + self.compliance[i] * self.traction[i] - self.rest[i];
         let size = max(&|i| match attached[i] {
             true => {
                 self.product[i].abs()

@@ -570,7 +570,9 @@ pub(super) fn check_site_states(
         };
         if let Some(expected) = expected.filter(|e| e != state) {
             let since = match events {
-                Some((_, line)) => format!("line {line} of {} leaves it {expected:?}", path.display()),
+                Some((_, line)) => {
+                    format!("line {line} of {} leaves it {expected:?}", path.display())
+                }
                 None => format!("no rupture of it is in {}", path.display()),
             };
             return Err(Error::InvalidCheckpoint {
@@ -636,9 +638,9 @@ pub(super) fn check_covered(covered: &[TableDigest], kept: &[(&str, &Path, &str)
                  was taken",
                 digest.rows()
             ),
-            Some(RowDifference::Extra { covered }) => format!(
-                "it keeps rows beyond the {covered} the checkpoint covers, up to its event"
-            ),
+            Some(RowDifference::Extra { covered }) => {
+                format!("it keeps rows beyond the {covered} the checkpoint covers, up to its event")
+            }
         };
         return Err(corrupt(reason));
     }
