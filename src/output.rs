@@ -493,15 +493,23 @@ impl RunTables {
     /// reached by then, and with `options` recording them, `fields.csv` and
     /// `profiles.csv` what they record up to then. The `.partial` tables are then
     /// rewritten (atomically) with the rows up to the checkpoint's event; complete tables
-    /// of a finished run stay until [`RunTables::finish`] replaces them.
+    /// of a finished run stay until [`RunTables::finish`] replaces them. Where the
+    /// checkpoint records the digests of the rows it covers ([`RunTables::checkpoint`]),
+    /// the kept rows must be those, every table it covers continued; its site states must
+    /// be those the kept events leave; and `options` must record what the directory
+    /// recorded (its `fields.csv`, `profiles.csv` and `scene.json`): a resume continues
+    /// every recorded table or none.
     ///
     /// # Errors
     /// [`Error::OutOfRange`] for options the scene cannot record;
     /// [`Error::RunDirectory`] for a missing directory or (feature `serde`) one without
     /// its scene record; [`Error::CheckpointSceneMismatch`], naming the first differing
     /// key, when the recorded scene is another; [`Error::CorruptTable`], naming the file
-    /// and line, for a table that is damaged, too short or inconsistent with the others;
-    /// [`Error::InvalidCheckpoint`] for a checkpoint inside an avalanche;
+    /// and line, for a table that is damaged, too short or inconsistent with the others,
+    /// or whose kept rows differ from those the checkpoint covers;
+    /// [`Error::InvalidCheckpoint`] for a checkpoint inside an avalanche, one whose site
+    /// states are not those of the kept events, or one covering other tables;
+    /// [`Error::RunDirectory`] for other observers than the directory recorded;
     /// [`Error::DirectoryLocked`]; [`Error::Io`].
     pub fn resume_with(dir: &Path, driver: &Driver, options: &RunOptions) -> Result<Self> {
         check_options(driver, options)?;
@@ -784,8 +792,9 @@ impl RunTables {
     /// event [recorded](RunTables::record), then `observe` called with it and the driver
     /// in the state right after it; with `checkpoint = Some((path, every))`, at every
     /// `every`-th stable state recorded by this writer, the tables
-    /// [flushed](RunTables::flush) and a checkpoint written over `path`
-    /// ([`crate::Checkpoint::write_to`]), so a resume finds every row up to it.
+    /// [flushed](RunTables::flush) and a checkpoint covering their rows
+    /// ([`RunTables::checkpoint`]) written over `path` ([`crate::Checkpoint::write_to`]),
+    /// so a resume finds every row up to it, and refuses one edited since.
     ///
     /// Returns `Ok(None)` at global slip (then [`RunTables::finish`] the tables), or
     /// `Ok(Some(value))` as soon as `observe` returns `ControlFlow::Break(value)`: the rows

@@ -241,7 +241,12 @@ fn value_of(scene: &SceneBuilder, key: &str) -> String {
 /// after it was taken ([`Error::CheckpointSceneMismatch`]). Its JSON form also ends with
 /// a digest of its whole content (FNV-1a, 64 bits: it detects edits and damage, it is no
 /// signature), checked when it is read: an edited count, site state or number, or a
-/// damaged file, is refused with the reason.
+/// damaged file, is refused with the reason. [`Scene::resume`] also checks its state
+/// against the protocol and the physics (both equilibria hold, one residual evaluation
+/// each; a stable state holds its load). Taken by
+/// [`crate::output::RunTables::checkpoint`], it records the digests of the table rows it
+/// covers, which [`crate::output::RunTables::resume`] checks the kept rows against
+/// (layout version 4; version 3 checkpoints, without them, still resume).
 ///
 /// ```
 /// use precursors::{Event, Scene};
