@@ -51,6 +51,7 @@ mod observables;
 #[cfg(feature = "serde")]
 pub(crate) use checkpoint::scene_mismatch;
 pub use checkpoint::Checkpoint;
+pub(crate) use checkpoint::{RowDifference, RowDigest, TableDigest};
 pub use observables::SlipProfile;
 
 /// A site of the interface grid.
@@ -344,6 +345,9 @@ pub struct Driver {
     /// Whether the failure was returned to the caller, by [`Driver::step`] or the
     /// iterator: from then on the iterator ends.
     failure_returned: bool,
+    /// The digests of the table rows covered by the checkpoint this driver was resumed
+    /// from, with its event (`RunTables::resume` checks the kept rows against them).
+    kept_tables: Option<(usize, Vec<checkpoint::TableDigest>)>,
 }
 
 /// Where a [`Driver`]'s run stands ([`Driver::state`]): running, at global slip, or
@@ -502,6 +506,7 @@ impl Scene {
             stats: SolveStats::default(),
             failure: None,
             failure_returned: false,
+            kept_tables: None,
         })
     }
 }
@@ -885,6 +890,16 @@ impl Driver {
     /// Events returned so far.
     pub fn event_count(&self) -> usize {
         self.events
+    }
+
+    /// The digests of the table rows covered by the checkpoint this driver was resumed
+    /// from, while it stands at that checkpoint's event; `None` otherwise, or when the
+    /// checkpoint holds none (layout version 3, or taken by [`Driver::checkpoint`]).
+    pub(crate) fn kept_tables(&self) -> Option<&[TableDigest]> {
+        match &self.kept_tables {
+            Some((k, tables)) if *k == self.events => Some(tables),
+            _ => None,
+        }
     }
 
     /// The grid.

@@ -83,7 +83,7 @@ pub(crate) mod layout;
 pub(crate) mod profiles;
 mod resume;
 
-use crate::driver::{Driver, Event};
+use crate::driver::{Driver, Event, RowDigest, TableDigest};
 use crate::error::{Error, Result};
 use crate::files::{check_replaceable, read_text_if_exists, sync_dir, write_atomically};
 use crate::interface::SiteState;
@@ -231,9 +231,9 @@ pub fn check_output_path(dir: &Path, path: &Path) -> Result<()> {
 /// ```
 #[derive(Debug)]
 pub struct RunTables {
-    events: BufWriter<File>,
-    curve: BufWriter<File>,
-    map: BufWriter<File>,
+    events: TableFile,
+    curve: TableFile,
+    map: TableFile,
     dir: PathBuf,
     /// The tables' names (after [`RunTables::finish`]).
     paths: [PathBuf; 3],
@@ -260,7 +260,7 @@ pub struct RunTables {
 /// `fields.csv` of a run that records fields ([`crate::RunOptions::record_fields`]).
 #[derive(Debug)]
 struct FieldsTable {
-    file: BufWriter<File>,
+    file: TableFile,
     /// The table's name (after [`RunTables::finish`]) and the file written until then.
     path: PathBuf,
     partial: PathBuf,
@@ -290,7 +290,7 @@ impl FieldsTable {
         driver: &Driver,
         options: &RunOptions,
         dir: &Path,
-        file: impl FnOnce(&Path) -> Result<File>,
+        file: impl FnOnce(&Path) -> Result<TableFile>,
         stable: usize,
     ) -> Result<Option<Self>> {
         let every = options.fields_every();
@@ -301,7 +301,7 @@ impl FieldsTable {
         let probe = profiles::planes_probe(driver, &planes)?;
         let (path, partial) = Self::paths(dir);
         Ok(Some(Self {
-            file: BufWriter::new(file(&partial)?),
+            file: file(&partial)?,
             path,
             partial,
             every,
@@ -434,7 +434,7 @@ impl RunTables {
             "recording the scene",
         )?;
         let nx = driver.grid().nx();
-        let open = |t: usize, header: &str| new_table(&partials[t], header).map(BufWriter::new);
+        let open = |t: usize, header: &str| new_table(&partials[t], header);
         let events = open(0, EVENTS_HEADER)?;
         let curve = open(1, CURVE_HEADER)?;
         let map = open(2, &contact_map_header(nx))?;
@@ -493,15 +493,23 @@ impl RunTables {
     /// reached by then, and with `options` recording them, `fields.csv` and
     /// `profiles.csv` what they record up to then. The `.partial` tables are then
     /// rewritten (atomically) with the rows up to the checkpoint's event; complete tables
-    /// of a finished run stay until [`RunTables::finish`] replaces them.
+    /// of a finished run stay until [`RunTables::finish`] replaces them. Where the
+    /// checkpoint records the digests of the rows it covers ([`RunTables::checkpoint`]),
+    /// the kept rows must be those, every table it covers continued; its site states must
+    /// be those the kept events leave; and `options` must record what the directory
+    /// recorded (its `fields.csv`, `profiles.csv` and `scene.json`): a resume continues
+    /// every recorded table or none.
     ///
     /// # Errors
     /// [`Error::OutOfRange`] for options the scene cannot record;
     /// [`Error::RunDirectory`] for a missing directory or (feature `serde`) one without
     /// its scene record; [`Error::CheckpointSceneMismatch`], naming the first differing
     /// key, when the recorded scene is another; [`Error::CorruptTable`], naming the file
-    /// and line, for a table that is damaged, too short or inconsistent with the others;
-    /// [`Error::InvalidCheckpoint`] for a checkpoint inside an avalanche;
+    /// and line, for a table that is damaged, too short or inconsistent with the others,
+    /// or whose kept rows differ from those the checkpoint covers;
+    /// [`Error::InvalidCheckpoint`] for a checkpoint inside an avalanche, one whose site
+    /// states are not those of the kept events, or one covering other tables;
+    /// [`Error::RunDirectory`] for other observers than the directory recorded;
     /// [`Error::DirectoryLocked`]; [`Error::Io`].
     pub fn resume_with(dir: &Path, driver: &Driver, options: &RunOptions) -> Result<Self> {
         check_options(driver, options)?;
@@ -523,10 +531,14 @@ impl RunTables {
         for t in 0..3 {
             (old[t], read[t]) = read_old(&partials[t], &paths[t])?;
         }
+        let covered = driver.kept_tables();
+        let map_rows = covered
+            .and_then(|tables| tables.iter().find(|t| t.table() == TABLES[2]))
+            .map(TableDigest::rows);
         let plan = continuation(
             [old[0].as_deref(), old[1].as_deref(), old[2].as_deref()],
             &read,
-            k,
+            (k, map_rows),
             &check::Bounds::of(driver),
             driver.force(),
         )?;
@@ -539,9 +551,23 @@ impl RunTables {
             None
         };
         let kept = Recordings::kept(dir, driver, options, &plan)?;
+        if let Some(covered) = covered {
+            let mut tables: Vec<(&str, &Path, &str)> = (0..3)
+                .map(|t| (TABLES[t], read[t].as_path(), plan.texts[t].as_str()))
+                .collect();
+            if let Some((text, path)) = &kept.fields {
+                tables.push((FIELDS_FILE, path, text));
+            }
+            if let Some((text, path, _)) = &kept.profiles {
+                tables.push((layout::PROFILES_TABLE, path, text));
+            }
+            resume::check_covered(covered, &tables)?;
+        }
+        resume::check_site_states(&plan.site_events, driver.site_states(), &read[0])?;
+        check_recorded_observers(dir, options)?;
         // Checked: now the directory is written.
         remove_stale_temporaries(dir)?;
-        let continued = |t: usize| append_to(&partials[t], &plan.texts[t]).map(BufWriter::new);
+        let continued = |t: usize| append_to(&partials[t], &plan.texts[t]);
         let (events, curve, map) = (continued(0)?, continued(1)?, continued(2)?);
         let (fields, profiles) = kept.continue_in(dir, driver, options, plan.stable.len())?;
         Ok(Self {
@@ -681,21 +707,44 @@ impl RunTables {
             (&mut self.map, &self.partials[2]),
         ] {
             table
-                .flush()
-                .and_then(|()| table.get_ref().sync_data())
+                .sync()
                 .map_err(|e| Error::io("writing table", path, e))?;
         }
         if let Some(fields) = &mut self.fields {
             fields
                 .file
-                .flush()
-                .and_then(|()| fields.file.get_ref().sync_data())
+                .sync()
                 .map_err(|e| Error::io("writing table", &fields.partial, e))?;
         }
         if let Some(profiles) = &mut self.profiles {
             profiles.flush()?;
         }
         Ok(())
+    }
+
+    /// A checkpoint of `driver` that covers the rows written so far: the tables are
+    /// [flushed](RunTables::flush) to disk, and the checkpoint records the digest of each
+    /// table's rows (`events.csv`, `curve.csv`, `contact_map.csv`, and `fields.csv` and
+    /// `profiles.csv` where recorded), so that [`RunTables::resume`] refuses kept rows
+    /// edited after it was taken. [`RunTables::run_until`] takes its checkpoints so; take
+    /// one at a stable state to resume the tables from it.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when a table cannot be written or synced.
+    pub fn checkpoint(&mut self, driver: &Driver) -> Result<crate::driver::Checkpoint> {
+        self.flush()?;
+        let mut tables: Vec<TableDigest> = [&self.events, &self.curve, &self.map]
+            .iter()
+            .zip(TABLES)
+            .map(|(table, name)| table.digest(name))
+            .collect();
+        if let Some(fields) = &self.fields {
+            tables.push(fields.file.digest(FIELDS_FILE));
+        }
+        if let Some(profiles) = &self.profiles {
+            tables.push(profiles.digest());
+        }
+        Ok(driver.checkpoint().with_tables(tables))
     }
 
     /// Runs `driver` to global slip writing its tables (feature `serde`), as
@@ -743,8 +792,9 @@ impl RunTables {
     /// event [recorded](RunTables::record), then `observe` called with it and the driver
     /// in the state right after it; with `checkpoint = Some((path, every))`, at every
     /// `every`-th stable state recorded by this writer, the tables
-    /// [flushed](RunTables::flush) and a checkpoint written over `path`
-    /// ([`crate::Checkpoint::write_to`]), so a resume finds every row up to it.
+    /// [flushed](RunTables::flush) and a checkpoint covering their rows
+    /// ([`RunTables::checkpoint`]) written over `path` ([`crate::Checkpoint::write_to`]),
+    /// so a resume finds every row up to it, and refuses one edited since.
     ///
     /// Returns `Ok(None)` at global slip (then [`RunTables::finish`] the tables), or
     /// `Ok(Some(value))` as soon as `observe` returns `ControlFlow::Break(value)`: the rows
@@ -794,8 +844,7 @@ impl RunTables {
             self.record(driver, &event)?;
             if let (Event::Stable { .. }, Some((path, every))) = (&event, checkpoint) {
                 if (self.stable_states() as u64).is_multiple_of(every.get()) {
-                    self.flush()?;
-                    driver.checkpoint().write_to(path)?;
+                    self.checkpoint(driver)?.write_to(path)?;
                 }
             }
             if let ControlFlow::Break(value) = observe(&event, driver) {
@@ -857,10 +906,10 @@ impl RunTables {
 /// What a resumed run keeps of what it recorded beside its tables, checked and cut back
 /// to the checkpoint (`None` where the options record nothing of the kind).
 struct Recordings {
-    /// `fields.csv`'s text.
-    fields: Option<String>,
-    /// `profiles.csv`'s text and the rule where it stands.
-    profiles: Option<(String, profiles::Levels)>,
+    /// `fields.csv`'s text, and the path it was read from.
+    fields: Option<(String, PathBuf)>,
+    /// `profiles.csv`'s text, the path it was read from, and the rule where it stands.
+    profiles: Option<(String, PathBuf, profiles::Levels)>,
 }
 
 impl Recordings {
@@ -876,13 +925,14 @@ impl Recordings {
         let fields = if options.fields_every() > 0 {
             let (path, partial) = FieldsTable::paths(dir);
             let (old, read) = read_old(&partial, &path)?;
-            Some(fields_continuation(
+            let text = fields_continuation(
                 old.as_deref(),
                 &read,
                 &plan.stable,
                 (options.fields_every(), options.field_planes()),
                 (nx, driver.grid().ny()),
-            )?)
+            )?;
+            Some((text, read))
         } else {
             None
         };
@@ -904,14 +954,9 @@ impl Recordings {
                     .find(|s| s.0 == event)
                     .map(|s| format!("{:.12e}", s.1))
             };
-            Some(profiles::continuation(
-                old.as_deref(),
-                &read,
-                options,
-                nx,
-                &states,
-                load_text,
-            )?)
+            let (text, rule) =
+                profiles::continuation(old.as_deref(), &read, options, nx, &states, load_text)?;
+            Some((text, read, rule))
         };
         Ok(Self { fields, profiles })
     }
@@ -926,23 +971,19 @@ impl Recordings {
         options: &RunOptions,
         stable: usize,
     ) -> Result<(Option<FieldsTable>, Option<ProfilesTable>)> {
+        // A recording the options do not ask for was refused (`check_recorded_observers`):
+        // none is there to remove.
         let fields = match self.fields {
-            Some(text) => {
+            Some((text, _)) => {
                 FieldsTable::new(driver, options, dir, |path| append_to(path, &text), stable)?
             }
-            None => {
-                remove_fields(dir)?;
-                None
-            }
+            None => None,
         };
         let profiles = match self.profiles {
-            Some((text, rule)) => {
+            Some((text, _, rule)) => {
                 ProfilesTable::new(driver, options, dir, |path| append_to(path, &text), rule)?
             }
-            None => {
-                remove_profiles(dir)?;
-                None
-            }
+            None => None,
         };
         Ok((fields, profiles))
     }
@@ -1010,18 +1051,59 @@ fn remove_recordings(dir: &Path) -> Result<()> {
     remove_profiles(dir)
 }
 
-/// A new table at `path` holding its header (an old one there replaced; a link or a FIFO
-/// refused, never written through).
-fn new_table(path: &Path, header: &str) -> Result<File> {
-    let mut file = crate::files::create(path, "creating table")?;
-    writeln!(file, "{header}").map_err(|e| Error::io("writing table", path, e))?;
-    Ok(file)
+/// A table being written: its buffered file and the running digest of its rows, which a
+/// checkpoint records ([`RunTables::checkpoint`]) and a resume checks the kept rows against.
+#[derive(Debug)]
+pub(crate) struct TableFile {
+    file: BufWriter<File>,
+    digest: RowDigest,
 }
 
-/// The table at `path` rewritten (atomically) as `text`, opened to append.
-fn append_to(path: &Path, text: &str) -> Result<File> {
+impl TableFile {
+    /// Writes the rows so far to disk (flushed and synced).
+    pub(crate) fn sync(&mut self) -> io::Result<()> {
+        self.file.flush()?;
+        self.file.get_ref().sync_data()
+    }
+
+    /// What a checkpoint records of the rows so far of the table `name`.
+    pub(crate) fn digest(&self, name: &str) -> TableDigest {
+        self.digest.table(name)
+    }
+}
+
+impl Write for TableFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        let n = self.file.write(buf)?;
+        self.digest.update(&buf[..n]);
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.file.flush()
+    }
+}
+
+/// A new table at `path` holding its header (an old one there replaced; a link or a FIFO
+/// refused, never written through).
+fn new_table(path: &Path, header: &str) -> Result<TableFile> {
+    let mut file = crate::files::create(path, "creating table")?;
+    writeln!(file, "{header}").map_err(|e| Error::io("writing table", path, e))?;
+    Ok(TableFile {
+        file: BufWriter::new(file),
+        digest: RowDigest::new(),
+    })
+}
+
+/// The table at `path` rewritten (atomically) as `text` (its header and the rows kept),
+/// opened to append.
+fn append_to(path: &Path, text: &str) -> Result<TableFile> {
     write_atomically(path, text.as_bytes(), "writing table")?;
-    crate::files::open(path, OpenOptions::new().append(true), "opening table")
+    let file = crate::files::open(path, OpenOptions::new().append(true), "opening table")?;
+    Ok(TableFile {
+        file: BufWriter::new(file),
+        digest: RowDigest::of_rows(text.lines().skip(1)),
+    })
 }
 
 /// The text of a table of a run under way (`partial`), else of a finished run (`path`),
@@ -1039,6 +1121,69 @@ fn read_old(partial: &Path, path: &Path) -> Result<(Option<String>, PathBuf)> {
 fn check_options(driver: &Driver, options: &RunOptions) -> Result<()> {
     let probes = options.probe_spec().unwrap_or(driver.scene().probes());
     crate::scene::check_run_options(options, driver.grid(), probes.tolerance())
+}
+
+/// Refuses, before anything is written, a resume into `dir` that would not continue
+/// every table recorded there with `options`: `fields.csv` or `profiles.csv` (or their
+/// `.partial`) that `options` do not record, or (feature `serde`) a `scene.json` whose
+/// observers (keys `fields`, `profiles`) differ from `options`' (it must describe the
+/// tables present, and a resume does not rewrite it).
+fn check_recorded_observers(dir: &Path, options: &RunOptions) -> Result<()> {
+    let refuse = |reason: String| {
+        Err(Error::RunDirectory {
+            path: dir.to_path_buf(),
+            reason,
+        })
+    };
+    for (name, recorded) in [
+        (FIELDS_FILE, options.fields_every() > 0),
+        (layout::PROFILES_TABLE, !options.profile_loads().is_empty()),
+    ] {
+        let partial = format!("{name}{PARTIAL}");
+        let found = [name, partial.as_str()]
+            .into_iter()
+            .find(|n| !recorded && fs::symlink_metadata(dir.join(n)).is_ok())
+            .map(String::from);
+        if let Some(found) = found {
+            return refuse(format!(
+                "it holds {found}, which this resume would not continue (it records no {name}): \
+                 resume with the observers the run was recorded with (its scene.json), or run \
+                 the scene again into another directory"
+            ));
+        }
+    }
+    #[cfg(feature = "serde")]
+    {
+        let path = dir.join(RUN_SCENE);
+        if let Some(text) = read_text_if_exists(&path, "reading the scene record")? {
+            let recorded = crate::scene::SceneBuilder::from_json_str(&text).map_err(|e| {
+                Error::RunDirectory {
+                    path: path.clone(),
+                    reason: format!("not a scene file ({})", crate::error::Chain(&e)),
+                }
+            })?;
+            let run = recorded.current_run();
+            let differs = if run.fields_every() != options.fields_every()
+                || run.field_planes() != options.field_planes()
+            {
+                Some("fields")
+            } else if run.profile_loads() != options.profile_loads()
+                || run.profile_planes() != options.profile_planes()
+            {
+                Some("profiles")
+            } else {
+                None
+            };
+            if let Some(key) = differs {
+                return refuse(format!(
+                    "its {RUN_SCENE} records other `{key}` than this resume records: the \
+                     tables would not be the ones it describes; resume with the observers \
+                     it records, or run the scene again into another directory"
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Refuses a directory whose recorded scene is not `driver`'s, or that records none.

@@ -518,7 +518,7 @@ pub(crate) mod json {
     }
 
     /// `text` with the JSON array (or value) after `"key":` replaced by `value`.
-    fn replace_value(text: &str, key: &str, value: &str) -> String {
+    pub(crate) fn replace_value(text: &str, key: &str, value: &str) -> String {
         let at = text.find(&format!("\"{key}\":")).expect(key) + key.len() + 3;
         let rest = &text[at..];
         let end = match rest.chars().next() {
@@ -728,12 +728,12 @@ pub(crate) mod json {
         assert!(reason.contains("EOF"), "{reason}");
         // Another layout version, newer or older (older ones carry no digest): refused,
         // saying which.
-        for (version, words) in [(4, "layout version 4"), (2, "layout version 2")] {
-            let other = text.replacen("\"format\":3", &format!("\"format\":{version}"), 1);
+        for (version, words) in [(5, "layout version 5"), (2, "layout version 2")] {
+            let other = text.replacen("\"format\":4", &format!("\"format\":{version}"), 1);
             assert_ne!(other, text);
             let reason = refused(&other);
             assert!(
-                reason.contains(words) && reason.contains("reads version 3"),
+                reason.contains(words) && reason.contains("reads versions 3 to 4"),
                 "{reason}"
             );
         }
@@ -884,4 +884,339 @@ fn two_level_solves_repeat_across_threads_and_resume() {
         per_solve < 20.0,
         "{per_solve} CG iterations per normal solve"
     );
+}
+
+/// What a resume keeps (issue 53): every kept row is the one the checkpoint covers, the
+/// checkpoint's state is the one its events and equilibria give, and the observers it
+/// continues are those the run recorded; anything else is refused before the directory
+/// is touched.
+#[cfg(feature = "serde")]
+mod kept {
+    use super::json::{replace_value, resigned};
+    use super::*;
+    use crate::common::{killed_after_checkpoint, scratch};
+    use std::path::Path;
+
+    /// The tables a run recording fields and profiles keeps on resume.
+    const TABLES: [&str; 5] = [
+        "events.csv",
+        "curve.csv",
+        "contact_map.csv",
+        "fields.csv",
+        "profiles.csv",
+    ];
+
+    fn options() -> RunOptions {
+        RunOptions::new()
+            .record_fields(2, &[0.002])
+            .record_profiles(&[0.05, 0.1, 0.2], &[0.002])
+    }
+
+    fn scene() -> Scene {
+        Scene::builder()
+            .block(0.020, 0.004, 0.020)
+            .normal_load(200.0)
+            .seed(1)
+            .run_options(options())
+            .build()
+            .unwrap()
+    }
+
+    /// Every file of `dir` with its bytes.
+    fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+        let mut out: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| {
+                let path = e.unwrap().path();
+                let name = path.file_name().unwrap().to_string_lossy().to_string();
+                (name, std::fs::read(&path).unwrap())
+            })
+            .collect();
+        out.sort();
+        out
+    }
+
+    fn copy(from: &Path, to: &Path) {
+        let _ = std::fs::remove_dir_all(to);
+        std::fs::create_dir_all(to).unwrap();
+        for entry in std::fs::read_dir(from).unwrap() {
+            let entry = entry.unwrap();
+            std::fs::copy(entry.path(), to.join(entry.file_name())).unwrap();
+        }
+    }
+
+    /// A run of `scene()` into a new directory, killed 30 events past a checkpoint at
+    /// its 12th stable state; the checkpoint as JSON.
+    fn cut_run(name: &str) -> (std::path::PathBuf, String) {
+        let dir = scratch(name);
+        let checkpoint = killed_after_checkpoint(&scene(), &dir, 12, 30);
+        (dir, checkpoint.to_json().unwrap())
+    }
+
+    /// A finite edit of a cell, in its own format: an integer plus one, a number times
+    /// 1.5 (or a small number for a zero), a word swapped for `other` (another value of
+    /// its column); `None` for an empty cell.
+    fn edited(cell: &str, other: Option<&str>) -> Option<String> {
+        if cell.is_empty() {
+            return None;
+        }
+        if let Ok(i) = cell.parse::<i64>() {
+            return Some((i + 1).to_string());
+        }
+        if let Ok(x) = cell.parse::<f64>() {
+            let y = if x == 0.0 { 1e-9 } else { 1.5 * x };
+            return Some(match cell.split_once('.') {
+                Some((_, decimals)) if !cell.contains('e') => {
+                    format!(
+                        "{:.*}",
+                        decimals.len(),
+                        x + 10f64.powi(-(decimals.len() as i32))
+                    )
+                }
+                _ => format!("{y:.12e}"),
+            });
+        }
+        other.map(String::from)
+    }
+
+    /// Each table kept on resume, each of its columns: a finite edit of one kept row
+    /// (before the checkpoint's event) is refused with a typed error naming the table,
+    /// and the directory is left as it was. Reference: the untouched copy resumes.
+    #[test]
+    fn every_kept_table_refuses_a_finite_edit_of_each_column() {
+        let (base, text) = cut_run("edits");
+        let checkpoint = Checkpoint::from_json_str(&text).unwrap();
+        let k = checkpoint.event_count();
+        let work = base.with_extension("work");
+        let resume = |dir: &Path| {
+            let driver = scene().resume(&checkpoint).unwrap();
+            output::RunTables::resume(dir, &driver).map(|_| ())
+        };
+        let mut edits = 0;
+        for table in TABLES {
+            let name = format!("{table}.partial");
+            let original = std::fs::read_to_string(base.join(&name)).unwrap();
+            let lines: Vec<&str> = original.lines().collect();
+            let header: Vec<&str> = lines[0].split(',').collect();
+            // The event each row records (profiles.csv: its second column).
+            let event_column = usize::from(table == "profiles.csv");
+            let kept: Vec<usize> = (1..lines.len())
+                .filter(|&l| {
+                    let event = lines[l].split(',').nth(event_column).unwrap();
+                    event.parse::<usize>().is_ok_and(|e| e < k)
+                })
+                .collect();
+            assert!(kept.len() >= 2, "{table}: {} kept rows", kept.len());
+            for (column, key) in header.iter().enumerate() {
+                let cell = |l: usize| lines[l].split(',').nth(column).unwrap();
+                // The middle kept row with a value in the column.
+                let rows: Vec<usize> = kept
+                    .iter()
+                    .copied()
+                    .filter(|&l| !cell(l).is_empty())
+                    .collect();
+                let Some(&line) = rows.get(rows.len() / 2) else {
+                    continue; // never written before the checkpoint (no cell to edit)
+                };
+                let other = kept.iter().map(|&l| cell(l)).find(|c| *c != cell(line));
+                let Some(value) = edited(cell(line), other) else {
+                    continue;
+                };
+                let mut cells: Vec<String> = lines[line].split(',').map(String::from).collect();
+                cells[column] = value;
+                let mut forged: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+                forged[line] = cells.join(",");
+                copy(&base, &work);
+                std::fs::write(work.join(&name), forged.join("\n") + "\n").unwrap();
+                let before = files(&work);
+                let case = format!("{table} line {} column {key}", line + 1);
+                match resume(&work) {
+                    Err(Error::CorruptTable { path, reason }) => {
+                        let path = path.unwrap();
+                        assert!(
+                            path.ends_with(&name),
+                            "{case}: {} ({reason})",
+                            path.display()
+                        );
+                    }
+                    Err(Error::InvalidCheckpoint { .. }) => {}
+                    other => panic!("{case}: not refused: {:?}", other.map(|_| ())),
+                }
+                assert!(files(&work) == before, "{case}: the directory changed");
+                edits += 1;
+            }
+        }
+        assert!(edits > 40, "{edits} edits");
+        // An edit the row checks cannot see is named by its line: a rupture's energy.
+        let events = std::fs::read_to_string(base.join("events.csv.partial")).unwrap();
+        let (line, row) = events
+            .lines()
+            .enumerate()
+            .find(|(_, l)| l.contains(",rupture,"))
+            .unwrap();
+        let mut cells: Vec<String> = row.split(',').map(String::from).collect();
+        cells[6] = edited(&cells[6], None).unwrap();
+        copy(&base, &work);
+        std::fs::write(
+            work.join("events.csv.partial"),
+            events.replacen(row, &cells.join(","), 1),
+        )
+        .unwrap();
+        match resume(&work) {
+            Err(Error::CorruptTable { reason, .. }) => assert!(
+                reason.contains(&format!("line {}", line + 1)) || reason.contains("lines "),
+                "{reason}"
+            ),
+            other => panic!("not refused: {:?}", other.map(|_| ())),
+        }
+        // The untouched copy resumes.
+        copy(&base, &work);
+        resume(&work).unwrap();
+        std::fs::remove_dir_all(&base).unwrap();
+        std::fs::remove_dir_all(&work).unwrap();
+    }
+
+    /// Checkpoints forged with a recomputed digest, consistent in their own keys, but not
+    /// with the physics or the events before them: refused with typed errors, the tables
+    /// untouched. Reference: the model's equations (docs/model.md), not the check's code.
+    #[test]
+    fn forged_states_tractions_and_loads_are_refused() {
+        let (dir, text) = cut_run("forged");
+        let before = files(&dir);
+        // The first broken site, set back to attached (in the states and the normal
+        // equilibrium's states alike).
+        let states_at = text.find("\"states\":[").unwrap();
+        let broken = states_at + text[states_at..].find("\"Broken\"").unwrap();
+        let index = text[states_at + 10..broken].matches('"').count() / 2;
+        let attach_all = |t: &str| {
+            let mut out = String::new();
+            let mut rest = t;
+            let mut seen = 0;
+            while let Some(at) = rest.find("\"states\":[") {
+                let (head, tail) = rest.split_at(at + 10);
+                out.push_str(head);
+                let end = tail.find(']').unwrap();
+                let mut states: Vec<&str> = tail[..end].split(',').collect();
+                states[index] = "\"Attached\"";
+                out.push_str(&states.join(","));
+                rest = &tail[end..];
+                seen += 1;
+            }
+            out.push_str(rest);
+            assert_eq!(seen, 2, "the states and the normal equilibrium's");
+            out
+        };
+        let scaled = |t: &str, key: &str, factor: f64| {
+            let pattern = format!("\"{key}\":{{\"traction\":[");
+            let at = t.find(&pattern).unwrap() + pattern.len();
+            let end = at + t[at..].find(']').unwrap();
+            let values: Vec<String> = t[at..end]
+                .split(',')
+                .map(|v| format!("{:?}", v.parse::<f64>().unwrap() * factor))
+                .collect();
+            format!("{}{}{}", &t[..at], values.join(","), &t[end..])
+        };
+        let control: f64 = {
+            let at = text.find("\"control\":").unwrap() + 10;
+            let end = at + text[at..].find(',').unwrap();
+            text[at..end].parse().unwrap()
+        };
+        for (case, forged) in [
+            ("a broken site set back to attached", attach_all(&text)),
+            ("the normal tractions scaled", scaled(&text, "normal", 1.01)),
+            (
+                "the shear tractions scaled",
+                scaled(&text, "response", 1.01),
+            ),
+            (
+                "the load raised past the weakest site",
+                replace_value(&text, "control", &format!("{:?}", control * 1.5)),
+            ),
+        ] {
+            assert_ne!(forged, text, "{case}: nothing forged");
+            let checkpoint = Checkpoint::from_json_str(&resigned(&forged))
+                .unwrap_or_else(|e| panic!("{case}: does not parse: {e}"));
+            let refused = match scene().resume(&checkpoint) {
+                Err(e) => Err(e),
+                Ok(driver) => output::RunTables::resume(&dir, &driver).map(|_| ()),
+            };
+            match refused {
+                Err(Error::InvalidCheckpoint { reason }) => assert!(!reason.is_empty()),
+                Err(Error::CorruptTable { reason, .. }) => assert!(!reason.is_empty()),
+                other => panic!("{case}: not refused: {:?}", other.map(|_| ())),
+            }
+            assert!(files(&dir) == before, "{case}: the directory changed");
+        }
+        // As written, it resumes.
+        let driver = scene()
+            .resume(&Checkpoint::from_json_str(&text).unwrap())
+            .unwrap();
+        output::RunTables::resume(&dir, &driver).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A resume whose observers differ from those the directory recorded (its tables or
+    /// its scene.json) is refused before anything is touched: no recorded table is
+    /// removed, scene.json keeps describing the tables present.
+    #[test]
+    fn resume_across_other_observers_is_refused_and_removes_nothing() {
+        let (base, text) = cut_run("observers");
+        let checkpoint = Checkpoint::from_json_str(&text).unwrap();
+        let work = base.with_extension("work");
+        // The checkpoint's scene without observers, resumed into the directory that
+        // recorded fields and profiles: the checkpoint, and the tables, say otherwise.
+        let bare = RunOptions::new();
+        let scene = scene();
+        for (case, options) in [
+            ("no observers", bare.clone()),
+            ("fields only", bare.clone().record_fields(2, &[0.002])),
+        ] {
+            copy(&base, &work);
+            let before = files(&work);
+            let driver = scene.resume(&checkpoint).unwrap();
+            match output::RunTables::resume_with(&work, &driver, &options) {
+                Err(Error::InvalidCheckpoint { .. } | Error::RunDirectory { .. }) => {}
+                other => panic!("{case}: not refused: {:?}", other.map(|_| ())),
+            }
+            assert!(files(&work) == before, "{case}: the directory changed");
+        }
+        // The same without the checkpoint's table digests (a 1.x checkpoint): the
+        // recorded tables and scene.json still refuse it.
+        let old = text.replacen("\"format\":4", "\"format\":3", 1);
+        let tables = old.find(",\"tables\":").unwrap();
+        let end = old.rfind(",\"digest\":").unwrap();
+        let old = resigned(&format!("{}{}", &old[..tables], &old[end..]));
+        let old = Checkpoint::from_json_str(&old).unwrap();
+        copy(&base, &work);
+        let before = files(&work);
+        let driver = scene.resume(&old).unwrap();
+        match output::RunTables::resume_with(&work, &driver, &bare) {
+            Err(Error::RunDirectory { reason, .. }) => {
+                assert!(reason.contains("fields.csv"), "{reason}")
+            }
+            other => panic!("not refused: {:?}", other.map(|_| ())),
+        }
+        assert!(files(&work) == before, "the directory changed");
+        // scene.json's observers edited: refused, with the checkpoint's own options too.
+        copy(&base, &work);
+        let record = std::fs::read_to_string(work.join("scene.json")).unwrap();
+        let edited = record.replacen("0.05", "0.06", 1);
+        assert_ne!(edited, record);
+        std::fs::write(work.join("scene.json"), edited).unwrap();
+        let before = files(&work);
+        let driver = scene.resume(&old).unwrap();
+        match output::RunTables::resume(&work, &driver) {
+            Err(Error::RunDirectory { reason, .. }) => {
+                assert!(reason.contains("profiles"), "{reason}")
+            }
+            other => panic!("not refused: {:?}", other.map(|_| ())),
+        }
+        assert!(files(&work) == before, "the directory changed");
+        // The 1.x checkpoint resumes the untouched directory, with today's checks.
+        copy(&base, &work);
+        let driver = scene.resume(&old).unwrap();
+        output::RunTables::resume(&work, &driver).unwrap();
+        std::fs::remove_dir_all(&base).unwrap();
+        std::fs::remove_dir_all(&work).unwrap();
+    }
 }

@@ -828,7 +828,7 @@ fn run(
         let what = match checkpoint {
             Some((path, _)) => {
                 // The checkpoint at this stable state, so that nothing done is lost.
-                driver.checkpoint().write_to(path)?;
+                tables.checkpoint(&driver)?.write_to(path)?;
                 format!(
                     "kept the tables in {} as *.partial and the checkpoint {} at event {at}; \
                      continue with: precursors resume {} --out {}",

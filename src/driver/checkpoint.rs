@@ -17,18 +17,169 @@ use crate::solver::{NormalEquilibrium, SolverState, TangentialResponse};
 
 /// Version of the checkpoint layout; a checkpoint of another version is refused.
 /// Version 2: the scene digest; the dense backend's one factor. Version 3: the JSON form
-/// ends with a digest of its whole content; unknown keys are refused.
-const FORMAT: u32 = 3;
+/// ends with a digest of its whole content; unknown keys are refused. Version 4: the
+/// digests of the table rows it covers (`tables`).
+const FORMAT: u32 = 4;
+
+/// The oldest layout still read: version 3 (1.x) has no table digests, and its tables are
+/// checked as before them (row by row and against each other).
+const OLDEST_FORMAT: u32 = 3;
+
+/// Rows between two marks of a table's digest: an edit is located to within this many
+/// rows (the marks of a table of `r` rows add about `r / 3` bytes to a checkpoint).
+const MARK_ROWS: u64 = 64;
 
 /// The last key of a checkpoint's JSON form: its digest ([`Checkpoint::to_json`]).
 #[cfg(feature = "serde")]
 const DIGEST_KEY: &str = ",\"digest\":\"";
 
-/// FNV-1a (64 bits) of a text: a digest that is the same on every platform and build.
-fn fnv1a(text: &str) -> u64 {
-    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+/// FNV-1a's (64 bits) starting value.
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+
+/// FNV-1a (64 bits) of `hash` followed by `bytes`: a digest that is the same on every
+/// platform and build.
+fn fnv1a_extend(hash: u64, bytes: &[u8]) -> u64 {
+    bytes.iter().fold(hash, |h, &b| {
         (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
     })
+}
+
+/// FNV-1a (64 bits) of a text.
+fn fnv1a(text: &str) -> u64 {
+    fnv1a_extend(FNV_OFFSET, text.as_bytes())
+}
+
+/// The running digest of a table's rows as they are written (its header excluded):
+/// FNV-1a of their bytes, newlines included, with its value after every [`MARK_ROWS`]-th
+/// row kept. A checkpoint records it ([`TableDigest`]).
+#[derive(Debug, Clone)]
+pub(crate) struct RowDigest {
+    rows: u64,
+    hash: u64,
+    marks: Vec<u64>,
+}
+
+impl RowDigest {
+    /// The digest of no rows.
+    pub(crate) fn new() -> Self {
+        Self {
+            rows: 0,
+            hash: FNV_OFFSET,
+            marks: Vec::new(),
+        }
+    }
+
+    /// The digest of `rows` (each without its newline).
+    pub(crate) fn of_rows<'a>(rows: impl IntoIterator<Item = &'a str>) -> Self {
+        let mut digest = Self::new();
+        for row in rows {
+            digest.update(row.as_bytes());
+            digest.update(b"\n");
+        }
+        digest
+    }
+
+    /// Adds bytes written to the table.
+    pub(crate) fn update(&mut self, bytes: &[u8]) {
+        // Row by row: the marks fall after each MARK_ROWS-th newline.
+        for line in bytes.split_inclusive(|&b| b == b'\n') {
+            self.hash = fnv1a_extend(self.hash, line);
+            if line.ends_with(b"\n") {
+                self.rows += 1;
+                if self.rows.is_multiple_of(MARK_ROWS) {
+                    self.marks.push(self.hash);
+                }
+            }
+        }
+    }
+
+    /// What a checkpoint records of the rows so far of the table `name`.
+    pub(crate) fn table(&self, name: &str) -> TableDigest {
+        TableDigest {
+            table: name.to_string(),
+            rows: self.rows,
+            marks: self.marks.clone(),
+            digest: self.hash,
+        }
+    }
+}
+
+/// What a checkpoint records of a table of its run ([`RowDigest`]): the rows it covers
+/// (after the header) and their digest, with the digest after every [`MARK_ROWS`]-th row
+/// so that an edit is located.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub(crate) struct TableDigest {
+    table: String,
+    rows: u64,
+    marks: Vec<u64>,
+    digest: u64,
+}
+
+/// Where kept rows differ from those a checkpoint covers ([`TableDigest::difference`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum RowDifference {
+    /// The first differing row is one of the rows `first..=last` (numbered from 1 after
+    /// the header).
+    Rows { first: u64, last: u64 },
+    /// Only `kept` rows are kept, the checkpoint covers more.
+    Missing { kept: u64 },
+    /// More rows are kept than the checkpoint covers.
+    Extra { covered: u64 },
+}
+
+impl TableDigest {
+    /// The table's name (`events.csv`).
+    pub(crate) fn table(&self) -> &str {
+        &self.table
+    }
+
+    /// Rows covered (after the header).
+    pub(crate) fn rows(&self) -> u64 {
+        self.rows
+    }
+
+    /// Where `rows` (each without its newline) differ from the rows digested, `None` when
+    /// they are the same.
+    pub(crate) fn difference(&self, rows: &[&str]) -> Option<RowDifference> {
+        let mut digest = RowDigest::new();
+        for (k, row) in rows.iter().enumerate().take(self.rows as usize) {
+            digest.update(row.as_bytes());
+            digest.update(b"\n");
+            let n = k as u64 + 1;
+            if n.is_multiple_of(MARK_ROWS)
+                && self.marks.get(k / MARK_ROWS as usize) != Some(&digest.hash)
+            {
+                return Some(RowDifference::Rows {
+                    first: n + 1 - MARK_ROWS,
+                    last: n,
+                });
+            }
+        }
+        let kept = rows.len() as u64;
+        if kept < self.rows {
+            return Some(RowDifference::Missing { kept });
+        }
+        if digest.hash != self.digest {
+            return Some(RowDifference::Rows {
+                first: self.rows - self.rows % MARK_ROWS + 1,
+                last: self.rows,
+            });
+        }
+        (kept > self.rows).then_some(RowDifference::Extra { covered: self.rows })
+    }
+
+    /// Whether its marks are those of its row count (a checkpoint that holds others was
+    /// not written by this crate).
+    fn consistent(&self) -> bool {
+        let last = if self.rows.is_multiple_of(MARK_ROWS) {
+            self.marks.last().copied().unwrap_or(FNV_OFFSET)
+        } else {
+            self.digest
+        };
+        self.marks.len() as u64 == self.rows / MARK_ROWS && last == self.digest
+    }
 }
 
 /// The digest of a scene: each key of its identity ([`file::identity`]) and a hash of
@@ -90,7 +241,12 @@ fn value_of(scene: &SceneBuilder, key: &str) -> String {
 /// after it was taken ([`Error::CheckpointSceneMismatch`]). Its JSON form also ends with
 /// a digest of its whole content (FNV-1a, 64 bits: it detects edits and damage, it is no
 /// signature), checked when it is read: an edited count, site state or number, or a
-/// damaged file, is refused with the reason.
+/// damaged file, is refused with the reason. [`Scene::resume`] also checks its state
+/// against the protocol and the physics (both equilibria hold, one residual evaluation
+/// each; a stable state holds its load). Taken by
+/// [`crate::output::RunTables::checkpoint`], it records the digests of the table rows it
+/// covers, which [`crate::output::RunTables::resume`] checks the kept rows against
+/// (layout version 4; version 3 checkpoints, without them, still resume).
 ///
 /// ```
 /// use precursors::{Event, Scene};
@@ -122,6 +278,10 @@ pub struct Checkpoint {
     avalanche_ruptures: usize,
     events: usize,
     solver: SolverState,
+    /// The digests of the table rows it covers, when taken by
+    /// [`crate::output::RunTables::checkpoint`] (none in layout version 3).
+    #[cfg_attr(feature = "serde", serde(default))]
+    tables: Option<Vec<TableDigest>>,
 }
 
 impl Checkpoint {
@@ -133,6 +293,12 @@ impl Checkpoint {
     /// Events the driver had returned when the checkpoint was taken.
     pub fn event_count(&self) -> usize {
         self.events
+    }
+
+    /// The checkpoint with the digests of the rows of its run's tables (`RunTables`).
+    pub(crate) fn with_tables(mut self, tables: Vec<TableDigest>) -> Self {
+        self.tables = Some(tables);
+        self
     }
 
     /// The checkpoint as compact JSON (feature `serde`), ending with the key `digest`:
@@ -231,11 +397,12 @@ fn verified(text: &str) -> std::result::Result<Checkpoint, Refusal> {
     let version: Version = serde_json::from_str(text).map_err(|e| reason(e.to_string()))?;
     match version.format {
         None => return Err(reason("it has no `format` key".into())),
-        Some(v) if v != FORMAT => {
+        Some(v) if !(OLDEST_FORMAT..=FORMAT).contains(&v) => {
             return Err(reason(format!(
-                "layout version {v}, this build reads version {FORMAT} (version 3 added a \
-                 digest of the whole content): resume it with the precursors version that \
-                 wrote it, or start the run again"
+                "layout version {v}, this build reads versions {OLDEST_FORMAT} to {FORMAT} \
+                 (version 3 added a digest of the whole content, version 4 the digests of \
+                 the table rows): resume it with the precursors version that wrote it, or \
+                 start the run again"
             )))
         }
         Some(_) => {}
@@ -287,6 +454,7 @@ impl Driver {
             avalanche_ruptures: self.avalanche_ruptures,
             events: self.events,
             solver: self.solver.state(),
+            tables: None,
         }
     }
 }
@@ -342,11 +510,32 @@ impl Scene {
         driver.phase = checkpoint.phase;
         driver.avalanche_ruptures = checkpoint.avalanche_ruptures;
         driver.events = checkpoint.events;
+        driver.kept_tables = checkpoint
+            .tables
+            .clone()
+            .map(|tables| (checkpoint.events, tables));
         if checkpoint.phase == Phase::Failed {
             // A checkpoint does not hold the failure's message (layout version 3).
             driver.failure = Some("it was resumed from the checkpoint of a failed driver".into());
         }
         driver.refresh_shear();
+        // A stable state holds its load: no attached site breaks under it (the test the
+        // protocol's avalanche step makes, on the same values). A load raised by an edit
+        // would otherwise break sites at a load the run never reached.
+        if checkpoint.phase == Phase::Stable {
+            let force = driver.force();
+            if let Some(i) = (0..driver.breaking.len()).find(|&i| {
+                driver.interface.states()[i] == SiteState::Attached && driver.breaking[i] <= force
+            }) {
+                return Err(Error::InvalidCheckpoint {
+                    reason: format!(
+                        "it is a stable state at F = {force:e} N, but site {i} breaks at {:e} N: \
+                         its load or state was edited",
+                        driver.breaking[i]
+                    ),
+                });
+            }
+        }
         Ok(driver)
     }
 
@@ -354,11 +543,25 @@ impl Scene {
     /// one ([`Scene::resume`]'s first checks).
     fn check_checkpoint_scene(&self, checkpoint: &Checkpoint) -> Result<()> {
         let bad = |reason: String| Err(Error::InvalidCheckpoint { reason });
-        if checkpoint.format != FORMAT {
+        if !(OLDEST_FORMAT..=FORMAT).contains(&checkpoint.format) {
             return bad(format!(
-                "layout version {} (this build reads version {FORMAT})",
+                "layout version {} (this build reads versions {OLDEST_FORMAT} to {FORMAT})",
                 checkpoint.format
             ));
+        }
+        if let Some(tables) = &checkpoint.tables {
+            if checkpoint.format < FORMAT {
+                return bad(format!(
+                    "layout version {} holds no table digests, this one does",
+                    checkpoint.format
+                ));
+            }
+            if let Some(t) = tables.iter().find(|t| !t.consistent()) {
+                return bad(format!(
+                    "the digest of {} does not fit its {} rows",
+                    t.table, t.rows
+                ));
+            }
         }
         if let Some(key) = first_difference(&checkpoint.scene_digest, &digest(&checkpoint.scene)) {
             return Err(Error::CheckpointSceneMismatch {
@@ -437,6 +640,7 @@ impl Scene {
             ));
         }
         self.check_checkpoint_protocol(checkpoint, started)?;
+        self.check_checkpoint_equilibria(checkpoint)?;
         if !checkpoint.control.is_finite() {
             return bad(format!("the load {} is not finite", checkpoint.control));
         }
@@ -446,6 +650,94 @@ impl Scene {
             }
         }
         Ok(started)
+    }
+
+    /// The checkpoint's equilibria against the physics they solve, once each (one product
+    /// with the influence operator per equilibrium): the site states are those of its
+    /// normal equilibrium; the displacements are those of the tractions (`u = U + e +
+    /// (ΔA/M) Ĝ φ`, up to a constant); on attached sites the springs hold
+    /// (`u_z + φ_z/k_z = u0`, `u_x + φ_x/k_x = 0`) to the solver's tolerance, normwise as
+    /// the solver measures it; off them no traction; the tractions carry the loads
+    /// (`ΔA Σ φ_z = F_N`, `ΔA Σ φ_x = -1 N` per newton). A checkpoint forged with a
+    /// recomputed digest (tractions scaled, a site's state changed) fails one of them.
+    fn check_checkpoint_equilibria(&self, checkpoint: &Checkpoint) -> Result<()> {
+        let (Some(normal), Some(response)) = (&checkpoint.normal, &checkpoint.response) else {
+            return Ok(());
+        };
+        // Done or failed: the last rupture or solve left the equilibria behind the states.
+        if !matches!(checkpoint.phase, Phase::Stable | Phase::Avalanche { .. }) {
+            return Ok(());
+        }
+        let states = &checkpoint.states;
+        if !normal.states.is_empty() && normal.states != *states {
+            let i = (0..states.len())
+                .find(|&i| normal.states.get(i) != Some(&states[i]))
+                .unwrap_or(0);
+            return Err(Error::InvalidCheckpoint {
+                reason: format!(
+                    "site {i} is {:?}, its normal equilibrium has it {:?}: the site states were \
+                     edited",
+                    states[i],
+                    normal.states.get(i)
+                ),
+            });
+        }
+        let n = states.len();
+        let cell = self.grid().cell_area();
+        let scale = cell / self.material().modulus();
+        let product = |f: &[f64]| -> Result<Vec<f64>> {
+            let mut out = vec![0.0; n];
+            self.plan().apply(f, &mut out)?;
+            out.iter_mut().for_each(|x| *x *= scale);
+            Ok(out)
+        };
+        let attached: Vec<bool> = states.iter().map(|s| *s == SiteState::Attached).collect();
+        let interface = self.interface();
+        let normal_compliance = interface.normal_compliance();
+        let tangential_compliance = (0..n)
+            .map(|i| match attached[i] {
+                true => interface.tangential_compliance_at(i, normal.displacement[i]),
+                false => Ok(0.0),
+            })
+            .collect::<Result<Vec<f64>>>()?;
+        let zero = vec![0.0; n];
+        let unit_load = self.unit_load_displacement();
+        let tolerance = RESIDUAL_FACTOR * self.solver_options().tolerance();
+        let checks = [
+            Equilibrium {
+                name: "normal",
+                traction: &normal.traction,
+                displacement: &normal.displacement,
+                product: product(&normal.traction)?,
+                applied: &zero,
+                compliance: &normal_compliance,
+                rest: interface.heights(),
+                total: self.normal_load(),
+            },
+            Equilibrium {
+                name: "tangential",
+                traction: &response.traction,
+                displacement: &response.displacement,
+                product: product(&response.traction)?,
+                applied: &unit_load,
+                compliance: &tangential_compliance,
+                rest: &zero,
+                total: -1.0,
+            },
+        ];
+        for check in checks {
+            if let Some(reason) = check.violation(&attached, cell, tolerance) {
+                return Err(Error::InvalidCheckpoint {
+                    reason: format!(
+                        "its {} equilibrium does not hold: {reason} (the tolerance {tolerance:e} \
+                         is {RESIDUAL_FACTOR} times the solver's): its tractions, displacements \
+                         or site states were edited",
+                        check.name
+                    ),
+                });
+            }
+        }
+        Ok(())
     }
 
     /// The protocol's own state in a checkpoint ([`Scene::check_checkpoint_state`]).
@@ -498,5 +790,83 @@ impl Scene {
             ));
         }
         Ok(())
+    }
+}
+
+/// How far above the solver's tolerance a checkpoint's equilibria may be off
+/// ([`Scene::check_checkpoint_equilibria`]): the solver measures its backward error with
+/// `‖A‖ ‖φ‖`, this check with the smaller `‖A φ‖`, and its product is another
+/// implementation of the operator's (rounding apart).
+const RESIDUAL_FACTOR: f64 = 1e4;
+
+/// An equilibrium of a checkpoint, as [`Scene::check_checkpoint_equilibria`] checks it.
+struct Equilibrium<'a> {
+    name: &'static str,
+    traction: &'a [f64],
+    displacement: &'a [f64],
+    /// `(ΔA/M) Ĝ φ`.
+    product: Vec<f64>,
+    /// The displacement the load causes without the tractions (`e`; zero for the normal).
+    applied: &'a [f64],
+    /// The springs' compliance `1/k` on attached sites.
+    compliance: &'a [f64],
+    /// The displacement at which an attached spring carries no traction (`u0`; zero for
+    /// the shear).
+    rest: &'a [f64],
+    /// The load the tractions carry (N).
+    total: f64,
+}
+
+impl Equilibrium<'_> {
+    /// The first way it fails to hold to `tolerance` (normwise), if any.
+    fn violation(&self, attached: &[bool], cell: f64, tolerance: f64) -> Option<String> {
+        let n = self.traction.len();
+        let max = |f: &dyn Fn(usize) -> f64| (0..n).map(f).fold(0.0_f64, f64::max);
+        // u - e - Cφ is the constant U wherever the displacement is the tractions'.
+        let offset: Vec<f64> = (0..n)
+            .map(|i| self.displacement[i] - self.applied[i] - self.product[i])
+            .collect();
+        let mean = offset.iter().sum::<f64>() / n as f64;
+        let size =
+            max(&|i| self.product[i].abs() + self.applied[i].abs() + self.displacement[i].abs())
+                + mean.abs();
+        let spread = max(&|i| (offset[i] - mean).abs());
+        if spread > tolerance * size {
+            return Some(format!(
+                "the displacements are not those of the tractions (off by {spread:e} m against \
+                 a scale of {size:e} m)"
+            ));
+        }
+        if let Some(i) = (0..n).find(|&i| !attached[i] && self.traction[i] != 0.0) {
+            return Some(format!(
+                "site {i}, not attached, carries the traction {:e} Pa",
+                self.traction[i]
+            ));
+        }
+        let spring =
+            |i: usize| self.displacement[i] + self.compliance[i] * self.traction[i] - self.rest[i];
+        let size = max(&|i| match attached[i] {
+            true => {
+                self.product[i].abs()
+                    + self.applied[i].abs()
+                    + (self.compliance[i] * self.traction[i]).abs()
+                    + self.rest[i].abs()
+            }
+            false => 0.0,
+        }) + mean.abs();
+        if let Some(i) = (0..n).find(|&i| attached[i] && spring(i).abs() > tolerance * size) {
+            return Some(format!(
+                "the spring of site {i} is off by {:e} m against a scale of {size:e} m",
+                spring(i)
+            ));
+        }
+        let carried = cell * self.traction.iter().sum::<f64>();
+        if (carried - self.total).abs() > tolerance * self.total.abs() {
+            return Some(format!(
+                "the tractions carry {carried:e} N, the load is {:e} N",
+                self.total
+            ));
+        }
+        None
     }
 }

@@ -19,8 +19,7 @@ use crate::driver::Driver;
 use crate::error::{Error, Result};
 use crate::probe::{ProbeSpec, StressProbe};
 use crate::recording::RunOptions;
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -163,7 +162,7 @@ struct State {
 /// `profiles.csv` of a run that records profiles.
 #[derive(Debug)]
 pub(super) struct ProfilesTable {
-    file: BufWriter<File>,
+    file: super::TableFile,
     path: PathBuf,
     partial: PathBuf,
     rule: Levels,
@@ -192,7 +191,7 @@ impl ProfilesTable {
         driver: &Driver,
         options: &RunOptions,
         dir: &Path,
-        file: impl FnOnce(&Path) -> Result<File>,
+        file: impl FnOnce(&Path) -> Result<super::TableFile>,
         rule: Levels,
     ) -> Result<Option<Self>> {
         let loads = options.profile_loads();
@@ -204,7 +203,7 @@ impl ProfilesTable {
         let (path, partial) = Self::paths(dir);
         let resumed = rule.started;
         let mut table = Self {
-            file: BufWriter::new(file(&partial)?),
+            file: file(&partial)?,
             path,
             partial,
             level_texts: loads.iter().map(|&l| written(l).0).collect(),
@@ -294,9 +293,13 @@ impl ProfilesTable {
     /// Flushes and syncs the table.
     pub(super) fn flush(&mut self) -> Result<()> {
         self.file
-            .flush()
-            .and_then(|()| self.file.get_ref().sync_data())
+            .sync()
             .map_err(|e| Error::io("writing table", &self.partial, e))
+    }
+
+    /// What a checkpoint records of the rows written so far.
+    pub(super) fn digest(&self) -> crate::driver::TableDigest {
+        self.file.digest(PROFILES_TABLE)
     }
 
     /// Renames the table to its name.

@@ -7,7 +7,9 @@ use super::{
     check, contact_map_header, fields_header, first_level_at_or_above, level, CURVE_HEADER,
     EVENTS_HEADER, MAP_STEP,
 };
+use crate::driver::{Event, RowDifference, TableDigest};
 use crate::error::{Error, Result};
+use crate::interface::SiteState;
 use std::path::{Path, PathBuf};
 
 /// The complete rows of a table's text (line number, row), its header checked: a last
@@ -67,22 +69,32 @@ pub(super) struct Continuation {
     pub(super) stable: Vec<usize>,
     /// Their loads `F/(μF_N)` as `curve.csv` writes them.
     pub(super) loads: Vec<f64>,
+    /// The kept events that change a site's state (ruptures, detachments, attachments),
+    /// with their lines in `events.csv`.
+    pub(super) site_events: Vec<(usize, Event)>,
 }
 
 /// Checks the three tables (`old[t]`: the text of table `t` (`events.csv`, `curve.csv`, `contact_map.csv`)
 /// order, `None` when missing; `paths` for the messages) against each other and against
-/// the checkpoint's event `k` and load `force_at_k`, and cuts them back to it. Nothing is
-/// written.
+/// the checkpoint's event `k` and load `force_at_k`, and cuts them back to it: to the
+/// rows of the events up to `k`, and `contact_map.csv` to the `map_rows` rows the
+/// checkpoint covers where it records them (rows of the state at `k` written after it
+/// are written again). Nothing is written.
 pub(super) fn continuation(
     old: [Option<&str>; 3],
     paths: &[PathBuf; 3],
-    k: usize,
+    (k, map_rows): (usize, Option<u64>),
     bounds: &check::Bounds,
     force_at_k: f64,
 ) -> Result<Continuation> {
     let map_header = contact_map_header(bounds.nx);
     let headers = [EVENTS_HEADER, CURVE_HEADER, map_header.as_str()];
-    let cut = Cut { paths, k, bounds };
+    let cut = Cut {
+        paths,
+        k,
+        map_rows,
+        bounds,
+    };
     // Every table's header and rows first, so a damaged third table refuses the resume
     // before anything is cut.
     let mut rows: [Vec<(usize, &str)>; 3] = Default::default();
@@ -90,7 +102,7 @@ pub(super) fn continuation(
         rows[t] = complete_rows(old[t].unwrap_or(""), headers[t]).map_err(|r| cut.corrupt(t, r))?;
     }
     let [events, curve, map] = rows;
-    let (stable, forces) = cut.events(&events, old[0].is_none(), force_at_k)?;
+    let (stable, forces, site_events) = cut.events(&events, old[0].is_none(), force_at_k)?;
     let loads = cut.curve(&curve, &stable, &forces)?;
     let (kept_levels, next_level) = cut.map(&map, &map_header, &stable, &loads)?;
 
@@ -112,6 +124,7 @@ pub(super) fn continuation(
         in_effect: k > 0,
         stable,
         loads,
+        site_events,
     })
 }
 
@@ -119,6 +132,8 @@ pub(super) fn continuation(
 struct Cut<'a> {
     paths: &'a [PathBuf; 3],
     k: usize,
+    /// The rows of `contact_map.csv` the checkpoint covers, where it records them.
+    map_rows: Option<u64>,
     bounds: &'a check::Bounds,
 }
 
@@ -132,17 +147,20 @@ impl Cut<'_> {
 
     /// `events.csv`: rows 1, 2, 3, ... (one run's), up to at least `k`, each kept row
     /// checked, `k` a stable state at the checkpoint's load. Returns the events of the
-    /// stable states up to `k` and their `force_N` as written.
+    /// stable states up to `k`, their `force_N` as written, and the kept events that
+    /// change a site's state with their lines.
+    #[allow(clippy::type_complexity)]
     fn events(
         &self,
         events: &[(usize, &str)],
         missing: bool,
         force_at_k: f64,
-    ) -> Result<(Vec<usize>, Vec<String>)> {
+    ) -> Result<(Vec<usize>, Vec<String>, Vec<(usize, Event)>)> {
         let k = self.k;
         let mut last = 0;
         let mut stable = Vec::new();
         let mut stable_forces = Vec::new();
+        let mut site_events = Vec::new();
         let mut kind_at_k = "";
         for &(line, row) in events {
             let index = index_of(line, row).map_err(|r| self.corrupt(0, r))?;
@@ -173,6 +191,9 @@ impl Cut<'_> {
             if e.kind == "stable" {
                 stable.push(index);
                 stable_forces.push(e.force_text);
+            }
+            if let Event::Rupture { .. } | Event::Detach { .. } | Event::Attach { .. } = e.event {
+                site_events.push((line, e.event));
             }
             if index == k {
                 kind_at_k = e.kind;
@@ -216,7 +237,7 @@ impl Cut<'_> {
                 ));
             }
         }
-        Ok((stable, stable_forces))
+        Ok((stable, stable_forces, site_events))
     }
 
     /// `curve.csv`: one row per stable state of `events.csv` up to `k`, in order, at the
@@ -333,7 +354,7 @@ impl Cut<'_> {
             }
             previous = Some((level, event));
             // The first row past the checkpoint ends what is kept, once its level follows.
-            if event > self.k {
+            if event > self.k || self.map_rows == Some(kept_levels.len() as u64) {
                 break;
             }
             check::map_row(line, &map_cells, row).map_err(|b| b.at(&self.paths[2]))?;
@@ -501,6 +522,129 @@ pub(super) fn fields_continuation(
         text.push('\n');
     }
     Ok(text)
+}
+
+/// Refuses a resumed driver whose site states (`states`, from its checkpoint) are not
+/// those the kept events of `events.csv` (`site_events`, read from `path`) leave: every
+/// site a rupture broke is broken and none broke twice, no other site is broken, and a
+/// site's last detachment or attachment left it detached or attached. A checkpoint
+/// forged with a recomputed digest (a broken site set back to attached) would otherwise
+/// run on and break a site twice.
+pub(super) fn check_site_states(
+    site_events: &[(usize, Event)],
+    states: &[SiteState],
+    path: &Path,
+) -> Result<()> {
+    let mut left: Vec<Option<(SiteState, usize)>> = vec![None; states.len()];
+    for &(line, event) in site_events {
+        let (site, state) = match event {
+            Event::Rupture { site, .. } => (site, SiteState::Broken),
+            Event::Detach { site } => (site, SiteState::Detached),
+            Event::Attach { site } => (site, SiteState::Attached),
+            _ => continue,
+        };
+        let Some(slot) = left.get_mut(site.index) else {
+            continue; // beyond the grid: refused by the row check already
+        };
+        if let Some((SiteState::Broken, broke)) = *slot {
+            return Err(Error::CorruptTable {
+                path: Some(path.to_path_buf()),
+                reason: format!(
+                    "line {line}: a {} of site ({}, {}), which broke on line {broke}: a broken \
+                     site never changes again",
+                    event.kind(),
+                    site.ix,
+                    site.iy
+                ),
+            });
+        }
+        *slot = Some((state, line));
+    }
+    for (i, (state, events)) in states.iter().zip(&left).enumerate() {
+        let expected = match events {
+            Some((s, _)) => Some(*s),
+            // No event for the site: any state but broken (its contact at zero shear is
+            // the normal equilibrium's).
+            None if *state == SiteState::Broken => Some(SiteState::Attached),
+            None => None,
+        };
+        if let Some(expected) = expected.filter(|e| e != state) {
+            let since = match events {
+                Some((_, line)) => {
+                    format!("line {line} of {} leaves it {expected:?}", path.display())
+                }
+                None => format!("no rupture of it is in {}", path.display()),
+            };
+            return Err(Error::InvalidCheckpoint {
+                reason: format!(
+                    "site {i} is {state:?} in the checkpoint, but {since}: the checkpoint or \
+                     the table was edited"
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Refuses kept rows that are not those a checkpoint covers (`covered`: its table
+/// digests): `kept` names each table continued, the path it was read from and its kept
+/// text (header first). A table the checkpoint covers and the resume does not continue,
+/// or the reverse, is refused too (recorded with other observers).
+pub(super) fn check_covered(covered: &[TableDigest], kept: &[(&str, &Path, &str)]) -> Result<()> {
+    for digest in covered {
+        if !kept.iter().any(|(name, _, _)| *name == digest.table()) {
+            return Err(Error::InvalidCheckpoint {
+                reason: format!(
+                    "it covers {} rows of {}, a table this resume does not continue: the run \
+                     recorded other observers (scene keys `fields`, `profiles`) than it is \
+                     resumed with",
+                    digest.rows(),
+                    digest.table()
+                ),
+            });
+        }
+    }
+    for &(name, path, text) in kept {
+        let corrupt = |reason: String| Error::CorruptTable {
+            path: Some(path.to_path_buf()),
+            reason,
+        };
+        let Some(digest) = covered.iter().find(|d| d.table() == name) else {
+            return Err(corrupt(
+                "the checkpoint covers no rows of this table: it was recorded with other \
+                 observers (scene keys `fields`, `profiles`) than the run is resumed with"
+                    .into(),
+            ));
+        };
+        let rows: Vec<&str> = text.lines().skip(1).collect();
+        let line = |row: u64| row + 1; // the header is line 1
+        let reason = match digest.difference(&rows) {
+            None => continue,
+            Some(RowDifference::Rows { first, last }) if first == last => format!(
+                "line {}: the row differs from the one the checkpoint covers (its digest): \
+                 the table was edited after the checkpoint was taken",
+                line(first)
+            ),
+            Some(RowDifference::Rows { first, last }) => format!(
+                "lines {} to {}: a row among them differs from those the checkpoint covers \
+                 (its digests of the rows, one per {} rows): the table was edited after \
+                 the checkpoint was taken",
+                line(first),
+                line(last),
+                last + 1 - first
+            ),
+            Some(RowDifference::Missing { kept }) => format!(
+                "it keeps {kept} rows, the checkpoint covers {}: rows were removed after it \
+                 was taken",
+                digest.rows()
+            ),
+            Some(RowDifference::Extra { covered }) => {
+                format!("it keeps rows beyond the {covered} the checkpoint covers, up to its event")
+            }
+        };
+        return Err(corrupt(reason));
+    }
+    Ok(())
 }
 
 /// A map level as the table writes it.

@@ -226,8 +226,7 @@ pub fn killed_after_checkpoint(
         } else if matches!(event, precursors::Event::Stable { .. }) {
             states += 1;
             if states == stable {
-                tables.flush().unwrap();
-                checkpoint = Some(driver.checkpoint());
+                checkpoint = Some(tables.checkpoint(&driver).unwrap());
             }
         }
     }
