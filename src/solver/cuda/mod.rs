@@ -17,6 +17,7 @@
 mod coarse;
 mod device;
 mod fsai;
+mod kernels;
 mod libraries;
 mod memory;
 mod operator;
@@ -40,7 +41,8 @@ use coarse::DeviceCoarse;
 use cudarc::driver::CudaSlice;
 use device::{cuda_error, Gpu};
 use fsai::DeviceFsai;
-use operator::{Kernels, Transforms};
+use kernels::Kernels;
+use operator::Transforms;
 use phases::{DevicePhases, DevicePrecond};
 use vectors::SetVectors;
 
@@ -78,9 +80,12 @@ impl CudaCore {
     /// Opens the GPU, checks its free memory against the estimate, compiles the kernels
     /// and allocates everything the solves use.
     pub(crate) fn new(plan: &InfluencePlan, compliance: Compliance) -> Result<Self> {
-        let gpu = Gpu::open()?;
         let (nx, ny) = (plan.grid().nx(), plan.grid().ny());
         let n = nx * ny;
+        // The kernels index cells with an `int`: every cell, set position and offset
+        // below is then one too.
+        kernels::int("grid cells", n)?;
+        let gpu = Gpu::open()?;
         memory::check_fits(
             &gpu.info.to_string(),
             memory::device_bytes(nx, ny),
@@ -292,6 +297,7 @@ impl CudaCore {
     fn upload_problem(&mut self, problem: SetProblem<'_>, f: &[f64]) -> Result<()> {
         let m = problem.set.len();
         let n = self.plan.grid().len();
+        // Cells and positions are below N, which fits an `int` (`CudaCore::new`).
         let set: Vec<i32> = problem.set.iter().map(|&i| i as i32).collect();
         let mut pos = vec![-1i32; n];
         for (j, &i) in problem.set.iter().enumerate() {
