@@ -28,8 +28,9 @@ pub(super) fn coarse_bytes(count: usize) -> f64 {
 /// The aggregates whose column of `E` the last [`Aggregates::enter`] made stale: those
 /// whose sites or compliances changed, ascending.
 pub(super) fn stale_columns(aggregates: &Aggregates) -> Vec<usize> {
+    let layout = aggregates.layout();
     (0..aggregates.count())
-        .filter(|&a| aggregates.touched(a))
+        .filter(|&a| layout.touched[a])
         .collect()
 }
 
@@ -73,8 +74,8 @@ impl DeviceCoarse {
         Ok(DeviceCoarse {
             nx: int("grid cells along x", nx)?,
             ny: int("grid cells along y", ny)?,
-            block: int("cells per aggregate side", aggregates.block())?,
-            bx: int("aggregates along x", aggregates.blocks_x())?,
+            block: int("cells per aggregate side", aggregates.layout().block)?,
+            bx: int("aggregates along x", aggregates.layout().blocks_x)?,
             count: int("aggregates", count)?,
             aggregates,
             e: real(count * count)?,

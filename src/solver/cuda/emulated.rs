@@ -389,7 +389,8 @@ fn the_fsai_kernels_apply_the_hosts_factor_after_its_updates() {
         fsai.update(&entries, &first, &d_of(&first, n));
         // The first copy is the planes as they are: every cell's row.
         let all: (Vec<i32>, Vec<f64>) = {
-            let (stride, planes) = (fsai.stride(), fsai.planes());
+            let layout = fsai.layout();
+            let (stride, planes) = (layout.stride, layout.planes);
             let weights = (0..n)
                 .flat_map(|i| (0..stride).map(move |k| planes[k * n + i]))
                 .collect();
@@ -412,9 +413,9 @@ fn the_fsai_kernels_apply_the_hosts_factor_after_its_updates() {
         let mut host = vec![0.0; second.len()];
         fsai.apply(&r, &mut host);
         let device = |rounds: &[&(Vec<i32>, Vec<f64>)]| -> Vec<f64> {
-            let stride = fsai.stride();
+            let stride = fsai.layout().stride;
             let mut input = format!("fsai {nx} {ny} {stride}\n");
-            for o in fsai.offsets() {
+            for o in fsai.layout().offsets {
                 input += &format!("{o} ");
             }
             input += &format!("\nrounds {}\n", rounds.len());

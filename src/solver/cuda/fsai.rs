@@ -35,10 +35,10 @@ pub(super) fn fsai_bytes(n: usize, stride: usize) -> f64 {
 /// The rows the last update refreshed, as their cells and their `stride` weights each
 /// (zero weights for a row off the set).
 pub(super) fn rows_to_copy(fsai: &Fsai) -> (Vec<i32>, Vec<f64>) {
-    let stride = fsai.stride();
-    let planes = fsai.planes();
+    let layout = fsai.layout();
+    let (stride, planes) = (layout.stride, layout.planes);
     let n = planes.len() / stride;
-    let cells = fsai.refreshed();
+    let cells = layout.refreshed;
     let weights = cells
         .iter()
         .flat_map(|&i| (0..stride).map(move |k| planes[k * n + i]))
@@ -51,10 +51,11 @@ impl DeviceFsai {
     /// Zero planes for `fsai`'s pattern on a grid of `n` cells.
     pub(super) fn new(stream: &Arc<CudaStream>, fsai: &Fsai, n: usize) -> Result<Self> {
         // Offsets below N, which fits an `int` (`CudaCore::new`).
-        let offsets: Vec<i32> = fsai.offsets().iter().map(|&o| o as i32).collect();
+        let layout = fsai.layout();
+        let offsets: Vec<i32> = layout.offsets.iter().map(|&o| o as i32).collect();
         Ok(DeviceFsai {
-            stride: fsai.stride(),
-            planes: zeros(stream, fsai.stride() * n)?,
+            stride: layout.stride,
+            planes: zeros(stream, layout.stride * n)?,
             offsets: stream
                 .clone_htod(&offsets)
                 .map_err(|e| cuda_error("cuMemcpyHtoD", e))?,
@@ -75,7 +76,7 @@ impl DeviceFsai {
         if !self.synced {
             // Every row: the planes as they are (no lists, no scratch on the device).
             stream
-                .memcpy_htod(fsai.planes(), &mut self.planes)
+                .memcpy_htod(fsai.layout().planes, &mut self.planes)
                 .map_err(|e| cuda_error("cuMemcpyHtoD", e))?;
             self.synced = true;
             return Ok(());

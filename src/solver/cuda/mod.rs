@@ -33,7 +33,7 @@ use super::fsai::{Entries, Fsai};
 use super::parallel::Parallelism;
 use super::pcg::{max_abs, run_cg, Effort};
 use super::set::{SetProblem, SetSolve};
-use super::spectral::{Precond, FSAI_RADIUS};
+use super::spectral::{stale_mean, Precond, SpectralRule, FSAI_RADIUS};
 use super::system::Compliance;
 use crate::error::{Error, Result};
 use crate::green::InfluencePlan;
@@ -120,23 +120,6 @@ impl CudaCore {
         })
     }
 
-    /// The `d̄` of the spectral preconditioner's table, if one was built (checkpoints).
-    pub(crate) fn preconditioner_mean(&self) -> Option<f64> {
-        self.inverse.as_ref().map(|(d, _)| *d)
-    }
-
-    /// Rebuilds the spectral preconditioner's table for `d̄` (or drops it), as the host's
-    /// backend does: a restored solver preconditions as before.
-    pub(crate) fn restore_preconditioner(&mut self, mean: Option<f64>) -> Result<()> {
-        match mean {
-            Some(d) => self.build_inverse(d),
-            None => {
-                self.inverse = None;
-                Ok(())
-            }
-        }
-    }
-
     fn build_inverse(&mut self, mean_d: f64) -> Result<()> {
         let values = operator::table(&self.plan, self.compliance, |e| 1.0 / (e + mean_d));
         self.inverse = Some((mean_d, upload(&self.gpu, &values)?));
@@ -175,13 +158,7 @@ impl CudaCore {
             });
         }
         if precond == Precond::Spectral {
-            // The host's rule: rebuild when the mean compliance moved by more than 5 %.
-            let mean_d = problem.d.iter().sum::<f64>() / m.max(1) as f64;
-            let stale = match &self.inverse {
-                Some((old, _)) => (old - mean_d).abs() > 0.05 * mean_d.abs().max(f64::MIN_POSITIVE),
-                None => true,
-            };
-            if stale {
+            if let Some(mean_d) = stale_mean(self.preconditioner_mean(), problem.d) {
                 self.build_inverse(mean_d)?;
             }
         }
@@ -318,6 +295,41 @@ impl CudaCore {
             }
         }
         Ok(())
+    }
+}
+
+/// The spectral rule on the GPU: the host's preconditioner choices and `d̄`, so a
+/// checkpoint resumes across the two backends.
+impl SpectralRule for CudaCore {
+    fn solve(
+        &mut self,
+        problem: SetProblem<'_>,
+        precond: Precond,
+        f: Vec<f64>,
+        effort: Effort,
+    ) -> Result<SetSolve> {
+        CudaCore::solve(self, problem, precond, f, effort)
+    }
+    fn preconditioner_mean(&self) -> Option<f64> {
+        self.inverse.as_ref().map(|(d, _)| *d)
+    }
+    fn restore_preconditioner(&mut self, mean: Option<f64>) -> Result<()> {
+        match mean {
+            Some(d) => self.build_inverse(d),
+            None => {
+                self.inverse = None;
+                Ok(())
+            }
+        }
+    }
+    /// One: the device runs the whole set (the host's threads only build FSAI's table).
+    fn parts(&self) -> usize {
+        1
+    }
+    /// Not tracked on the device (the host's tests ask it of the host's backends).
+    #[cfg(test)]
+    fn built(&self) -> bool {
+        false
     }
 }
 
