@@ -743,7 +743,8 @@ pub enum Error {
     #[cfg(feature = "cuda")]
     #[error("CUDA call {call} failed: {}", Bounded(message))]
     Cuda {
-        /// The call (`cuMemcpyDtoH`, `cufftExecD2Z`, a kernel's name).
+        /// The call and the step it served (`cuMemcpyDtoH (reduction)`, `cufftExecD2Z
+        /// (rows)`, a kernel's name).
         call: &'static str,
         /// What the driver or library reported.
         message: String,

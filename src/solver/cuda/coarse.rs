@@ -120,7 +120,7 @@ impl DeviceCoarse {
         }
         stream
             .memcpy_htod(&counts, &mut self.c)
-            .map_err(|e| cuda_error("cuMemcpyHtoD", e))?;
+            .map_err(|e| cuda_error("cuMemcpyHtoD (aggregate site counts)", e))?;
         for a in stale_columns(&self.aggregates) {
             if let Some(cfg) = over("sites in the set", m)? {
                 let (m32, a32) = (int("sites in the set", m)?, int("aggregates", a)?);
@@ -148,7 +148,7 @@ impl DeviceCoarse {
         unsafe { kernels.coarse_fix_empty(stream, each, &mut self.e, &self.c, self.count) }?;
         stream
             .memcpy_dtod(&self.e, &mut self.lower)
-            .map_err(|e| cuda_error("cuMemcpyDtoD", e))?;
+            .map_err(|e| cuda_error("cuMemcpyDtoD (coarse matrix to its factor)", e))?;
         unsafe { kernels.coarse_factor(stream, one, &mut self.lower, self.count, &mut self.info) }?;
         unsafe { kernels.coarse_invert(stream, each, &self.lower, self.count, &mut self.inverse) }?;
         unsafe {
@@ -165,10 +165,10 @@ impl DeviceCoarse {
         let mut info = [0.0f64; 2];
         stream
             .memcpy_dtoh(&self.info, info.as_mut_slice())
-            .map_err(|e| cuda_error("cuMemcpyDtoH", e))?;
+            .map_err(|e| cuda_error("cuMemcpyDtoH (coarse validity)", e))?;
         stream
             .synchronize()
-            .map_err(|e| cuda_error("cuStreamSynchronize", e))?;
+            .map_err(|e| cuda_error("cuStreamSynchronize (coarse upkeep)", e))?;
         self.valid = info[0] == 1.0;
         Ok(())
     }

@@ -58,7 +58,7 @@ impl DeviceFsai {
             planes: zeros(stream, layout.stride * n)?,
             offsets: stream
                 .clone_htod(&offsets)
-                .map_err(|e| cuda_error("cuMemcpyHtoD", e))?,
+                .map_err(|e| cuda_error("cuMemcpyHtoD (FSAI offsets)", e))?,
             y: zeros(stream, n)?,
             synced: false,
         })
@@ -77,7 +77,7 @@ impl DeviceFsai {
             // Every row: the planes as they are (no lists, no scratch on the device).
             stream
                 .memcpy_htod(fsai.layout().planes, &mut self.planes)
-                .map_err(|e| cuda_error("cuMemcpyHtoD", e))?;
+                .map_err(|e| cuda_error("cuMemcpyHtoD (FSAI planes)", e))?;
             self.synced = true;
             return Ok(());
         }
@@ -87,7 +87,7 @@ impl DeviceFsai {
             self.synced = true;
             return Ok(());
         };
-        let copy = |e| cuda_error("cuMemcpyHtoD", e);
+        let copy = |e| cuda_error("cuMemcpyHtoD (FSAI rows)", e);
         let cells_d = stream.clone_htod(&cells).map_err(copy)?;
         let weights_d = stream.clone_htod(&weights).map_err(copy)?;
         let (count, stride, n) = (

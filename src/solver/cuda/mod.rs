@@ -192,12 +192,8 @@ impl CudaCore {
             },
             m,
             norm: self.compliance.norm + problem.d.iter().fold(0.0f64, |a, x| a.max(*x)),
-            error: None,
         };
-        let outcome = run_cg(&mut phases, m, max_abs(problem.b), problem.total, effort);
-        if let Some(e) = phases.error {
-            return Err(e);
-        }
+        let outcome = run_cg(&mut phases, m, max_abs(problem.b), problem.total, effort)?;
         // The displacements' product `C_s f` on every cell, of the returned `f`.
         let v = &self.vectors;
         self.transforms
@@ -208,14 +204,14 @@ impl CudaCore {
         if m > 0 {
             stream
                 .memcpy_dtoh(&v.f.slice(0..m), f.as_mut_slice())
-                .map_err(|e| cuda_error("cuMemcpyDtoH", e))?;
+                .map_err(|e| cuda_error("cuMemcpyDtoH (tractions)", e))?;
         }
         stream
             .memcpy_dtoh(&self.grid, grid_product.as_mut_slice())
-            .map_err(|e| cuda_error("cuMemcpyDtoH", e))?;
+            .map_err(|e| cuda_error("cuMemcpyDtoH (grid product)", e))?;
         stream
             .synchronize()
-            .map_err(|e| cuda_error("cuStreamSynchronize", e))?;
+            .map_err(|e| cuda_error("cuStreamSynchronize (solve results)", e))?;
         Ok(SetSolve {
             f,
             outcome,
@@ -282,7 +278,7 @@ impl CudaCore {
         }
         let stream = &self.gpu.stream;
         let v = &mut self.vectors;
-        let copy = |e| cuda_error("cuMemcpyHtoD", e);
+        let copy = |e| cuda_error("cuMemcpyHtoD (set problem)", e);
         stream.memcpy_htod(&pos, &mut v.pos).map_err(copy)?;
         if m > 0 {
             stream
@@ -346,5 +342,5 @@ impl Drop for CudaCore {
 fn upload(gpu: &Gpu, values: &[f64]) -> Result<CudaSlice<f64>> {
     gpu.stream
         .clone_htod(values)
-        .map_err(|e| cuda_error("cuMemcpyHtoD", e))
+        .map_err(|e| cuda_error("cuMemcpyHtoD (DCT table)", e))
 }

@@ -8,7 +8,7 @@ use super::fsai::DeviceFsai;
 use super::kernels::{blocks, int, over, Kernels, THREADS};
 use super::operator::Transforms;
 use super::vectors::{SetVectors, REDUCTION_BLOCKS};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::solver::pcg::{Main, Phase, PhaseRunner, Pre};
 use cudarc::driver::{CudaSlice, CudaStream};
 use std::sync::Arc;
@@ -37,9 +37,6 @@ pub(super) struct DevicePhases<'a> {
     pub(super) norm: f64,
     /// The coarse space, when it applies (A-DEF2: pcg.rs).
     pub(super) coarse: Option<&'a mut DeviceCoarse>,
-    /// The first failed CUDA call: later phases do nothing and return NaN, which stops
-    /// the CG; the solve returns this error.
-    pub(super) error: Option<Error>,
 }
 
 /// Which vectors a product reads and writes.
@@ -53,8 +50,10 @@ enum Product {
     Coarse,
 }
 
-impl DevicePhases<'_> {
-    fn try_run(&mut self, phase: Phase) -> Result<[f64; 3]> {
+impl PhaseRunner for DevicePhases<'_> {
+    /// The phase's kernels, FFTs and copies; the first that fails stops the CG with its
+    /// error (`Error::Cuda` naming the call).
+    fn run(&mut self, phase: Phase) -> Result<[f64; 3]> {
         self.pre(phase.pre)?;
         self.prolong(phase.pre)?;
         match phase.main {
@@ -91,6 +90,27 @@ impl DevicePhases<'_> {
         }
     }
 
+    fn product_stages(&self) -> usize {
+        1
+    }
+    fn precondition_stages(&self) -> usize {
+        1
+    }
+    fn norm_bound(&self) -> f64 {
+        self.norm
+    }
+    fn has_coarse(&self) -> bool {
+        self.coarse.as_ref().is_some_and(|c| c.valid())
+    }
+    fn coarse_solve(&mut self) -> Result<()> {
+        match self.coarse.as_deref_mut() {
+            Some(coarse) => coarse.solve(self.stream, self.kernels),
+            None => Ok(()),
+        }
+    }
+}
+
+impl DevicePhases<'_> {
     /// `Zᵀ (r - t)` (`with_t`) or `Zᵀ r`, for the next coarse solve (asked only when the
     /// coarse space applies).
     fn restrict(&mut self, with_t: bool) -> Result<()> {
@@ -299,10 +319,10 @@ impl DevicePhases<'_> {
         let mut out = [0.0f64; 3];
         self.stream
             .memcpy_dtoh(scalars, out.as_mut_slice())
-            .map_err(|e| cuda_error("cuMemcpyDtoH", e))?;
+            .map_err(|e| cuda_error("cuMemcpyDtoH (reduction)", e))?;
         self.stream
             .synchronize()
-            .map_err(|e| cuda_error("cuStreamSynchronize", e))?;
+            .map_err(|e| cuda_error("cuStreamSynchronize (reduction)", e))?;
         Ok(out)
     }
 }
@@ -315,41 +335,4 @@ enum Vector {
     Z,
     P,
     Q,
-}
-
-impl PhaseRunner for DevicePhases<'_> {
-    fn run(&mut self, phase: Phase) -> [f64; 3] {
-        if self.error.is_some() {
-            return [f64::NAN; 3];
-        }
-        match self.try_run(phase) {
-            Ok(values) => values,
-            Err(e) => {
-                self.error = Some(e);
-                [f64::NAN; 3]
-            }
-        }
-    }
-    fn product_stages(&self) -> usize {
-        1
-    }
-    fn precondition_stages(&self) -> usize {
-        1
-    }
-    fn norm_bound(&self) -> f64 {
-        self.norm
-    }
-    fn has_coarse(&self) -> bool {
-        self.coarse.as_ref().is_some_and(|c| c.valid())
-    }
-    fn coarse_solve(&mut self) {
-        if self.error.is_some() {
-            return;
-        }
-        if let Some(coarse) = self.coarse.as_deref_mut() {
-            if let Err(e) = coarse.solve(self.stream, self.kernels) {
-                self.error = Some(e);
-            }
-        }
-    }
 }
