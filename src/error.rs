@@ -743,13 +743,31 @@ pub enum Error {
         /// Bytes free on the device.
         free_bytes: f64,
     },
+    /// A size the CUDA backend's kernels or launches hold in a 32-bit integer (a grid's
+    /// cells, a set's sites, a launch's blocks) exceeds it: refused before the launch
+    /// rather than wrapped (`EquilibriumSolverBuilder::build` with
+    /// [`crate::solver::Backend::Cuda`], a solve).
+    #[cfg(feature = "cuda")]
+    #[error(
+        "the CUDA backend cannot take {what} = {value}: its kernels hold it in a 32-bit \
+         integer (at most {limit}); use backend \"spectral\""
+    )]
+    DeviceLimit {
+        /// Which size.
+        what: &'static str,
+        /// Its value.
+        value: u64,
+        /// The largest value accepted.
+        limit: u64,
+    },
     /// A CUDA call failed during a solve (a launch, a copy, an FFT): the device, its
     /// driver or its memory failed after the backend was set up. The solver's state is
     /// the one before the failing solve.
     #[cfg(feature = "cuda")]
     #[error("CUDA call {call} failed: {}", Bounded(message))]
     Cuda {
-        /// The call (`cuMemcpyDtoH`, `cufftExecD2Z`, a kernel's name).
+        /// The call and the step it served (`cuMemcpyDtoH (reduction)`, `cufftExecD2Z
+        /// (rows)`, a kernel's name).
         call: &'static str,
         /// What the driver or library reported.
         message: String,

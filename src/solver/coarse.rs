@@ -87,15 +87,20 @@ impl Aggregates {
     }
 
     /// Cells per block side.
-    #[cfg(any(test, feature = "cuda"))]
+    #[cfg(test)]
     pub(crate) fn block(&self) -> usize {
         self.block
     }
 
-    /// Blocks along x.
+    /// The blocks and which ones the last [`Aggregates::enter`] changed, as a device
+    /// reads them (`layout.rs`).
     #[cfg(feature = "cuda")]
-    pub(crate) fn blocks_x(&self) -> usize {
-        self.bx
+    pub(crate) fn layout(&self) -> super::layout::AggregateLayout<'_> {
+        super::layout::AggregateLayout {
+            block: self.block,
+            blocks_x: self.bx,
+            touched: &self.touched,
+        }
     }
 
     /// The block of a site.
@@ -117,13 +122,6 @@ impl Aggregates {
     /// Whether the last [`Aggregates::enter`] changed block `a`'s sites.
     fn moved(&self, a: usize) -> bool {
         self.moved[a]
-    }
-
-    /// Whether the last [`Aggregates::enter`] changed block `a`'s sites or their
-    /// compliances.
-    #[cfg(feature = "cuda")]
-    pub(crate) fn touched(&self, a: usize) -> bool {
-        self.touched[a]
     }
 
     /// Makes `set` (ascending sites) with compliances `d` the current one; returns the
@@ -214,8 +212,9 @@ impl Coarse {
         self.unknowns.len()
     }
 
-    /// The coarse solution per block of the last [`Coarse::solve`].
-    #[cfg(test)]
+    /// The coarse solution per block of the last [`Coarse::solve`] (the CUDA backend's
+    /// tests' reference).
+    #[cfg(all(test, feature = "cuda"))]
     pub(crate) fn solution(&self) -> Vec<f64> {
         read(&self.solution).clone()
     }

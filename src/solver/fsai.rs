@@ -379,30 +379,16 @@ impl Fsai {
         slots.push(slot);
     }
 
-    /// The pattern slots of a row: the weight planes per cell (the CUDA backend's copy).
+    /// The planes and the rows the last update wrote, as a device copies them
+    /// (`layout.rs`).
     #[cfg(feature = "cuda")]
-    pub(crate) fn stride(&self) -> usize {
-        self.stride
-    }
-
-    /// Per slot, how many cells back its neighbour lies (`i - offset`; the last is 0).
-    #[cfg(feature = "cuda")]
-    pub(crate) fn offsets(&self) -> &[usize] {
-        &self.offsets
-    }
-
-    /// The weight planes, `stride` planes of one value per cell (slot `k` of cell `i` at
-    /// `k N + i`).
-    #[cfg(feature = "cuda")]
-    pub(crate) fn planes(&self) -> &[f64] {
-        &self.planes
-    }
-
-    /// The cells whose weights the last [`Fsai::update`] wrote: every other cell kept
-    /// its weights, so a copy of the planes is brought up to date by these alone.
-    #[cfg(feature = "cuda")]
-    pub(crate) fn refreshed(&self) -> &[usize] {
-        &self.dirty
+    pub(crate) fn layout(&self) -> super::layout::FsaiLayout<'_> {
+        super::layout::FsaiLayout {
+            stride: self.stride,
+            offsets: &self.offsets,
+            planes: &self.planes,
+            refreshed: &self.dirty,
+        }
     }
 
     /// Cells `G` reaches back (and `Gᵀ` forward): the largest slot offset.

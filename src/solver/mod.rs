@@ -27,7 +27,9 @@
 //! `tangential.rs` (the two equilibria), `pcg.rs` (the one projected CG), `system.rs` (the
 //! set system: staged product and preconditioners), `spectral.rs` and `dense.rs` (the
 //! backends), `fsai.rs` (the sparse approximate inverse), `coarse.rs` (the coarse space of
-//! the two-level preconditioner on large grids), `parallel.rs` (threads).
+//! the two-level preconditioner on large grids), `parallel.rs` (threads); with the feature
+//! `cuda`, `cuda/` (the spectral rule on a GPU, behind `spectral::SpectralRule`) and
+//! `layout.rs` (what it reads of the host's preconditioners).
 
 mod active_set;
 mod coarse;
@@ -35,6 +37,8 @@ mod coarse;
 mod cuda;
 mod dense;
 mod fsai;
+#[cfg(feature = "cuda")]
+mod layout;
 mod options;
 mod parallel;
 mod pcg;
@@ -57,7 +61,7 @@ use crate::interface::{Interface, Material};
 use dense::{DenseCore, FactorState};
 use pcg::Effort;
 use set::{SetProblem, SetSolve};
-use spectral::{Precond, SpectralCore};
+use spectral::{Precond, SpectralCore, SpectralRule};
 use system::Compliance;
 
 /// Backward error of the linear solves while a cold attached set is explored.
@@ -79,9 +83,9 @@ pub(crate) struct SolverState {
 
 enum Core {
     Dense(Box<DenseCore>),
-    Spectral(Box<SpectralCore>),
-    #[cfg(feature = "cuda")]
-    Cuda(Box<cuda::CudaCore>),
+    /// The spectral backend's rule on the host's threads or on a GPU (`SpectralRule`:
+    /// the one seam between the solver and a machine).
+    Spectral(Box<dyn SpectralRule>),
 }
 
 /// Builder of an [`EquilibriumSolver`].
@@ -192,7 +196,9 @@ impl EquilibriumSolverBuilder {
 /// The CUDA backend's core on the plan's grid.
 #[cfg(feature = "cuda")]
 fn cuda_core(plan: &InfluencePlan, compliance: Compliance) -> Result<Core> {
-    Ok(Core::Cuda(Box::new(cuda::CudaCore::new(plan, compliance)?)))
+    Ok(Core::Spectral(Box::new(cuda::CudaCore::new(
+        plan, compliance,
+    )?)))
 }
 
 /// Without the feature `cuda` there is no CUDA backend to build.
@@ -314,8 +320,6 @@ impl EquilibriumSolver {
         let parts = match &self.core {
             Core::Dense(_) => 1,
             Core::Spectral(s) => s.parts(),
-            #[cfg(feature = "cuda")]
-            Core::Cuda(_) => 1,
         };
         self.options.parallelism().threads().min(parts).max(1)
     }
@@ -336,8 +340,6 @@ impl EquilibriumSolver {
         match &self.core {
             Core::Spectral(core) => core.built(),
             Core::Dense(core) => core.spectral.built(),
-            #[cfg(feature = "cuda")]
-            Core::Cuda(_) => false,
         }
     }
 
@@ -345,8 +347,6 @@ impl EquilibriumSolver {
         let (preconditioner_mean, factor) = match &self.core {
             Core::Dense(d) => (d.spectral.preconditioner_mean(), Some(d.normal.state())),
             Core::Spectral(s) => (s.preconditioner_mean(), None),
-            #[cfg(feature = "cuda")]
-            Core::Cuda(c) => (c.preconditioner_mean(), None),
         };
         SolverState {
             backend: self.backend,
@@ -406,9 +406,9 @@ impl EquilibriumSolver {
                 core.spectral
                     .restore_preconditioner(state.preconditioner_mean);
             }
-            (Core::Spectral(core), None) => core.restore_preconditioner(state.preconditioner_mean),
-            #[cfg(feature = "cuda")]
-            (Core::Cuda(core), None) => core.restore_preconditioner(state.preconditioner_mean)?,
+            (Core::Spectral(core), None) => {
+                core.restore_preconditioner(state.preconditioner_mean)?
+            }
             _ => return bad("the dense factor does not match the backend".into()),
         }
         self.warm_normal = state.warm_normal;
@@ -481,15 +481,6 @@ impl EquilibriumSolver {
             )?,
             Core::Dense(core) => core.solve(problem, warm, effort)?,
             Core::Spectral(core) => {
-                let precond = if cold {
-                    Precond::Spectral
-                } else {
-                    spectral::warm_precond(tangential, self.grid.len())
-                };
-                core.solve(problem, precond, warm, effort)?
-            }
-            #[cfg(feature = "cuda")]
-            Core::Cuda(core) => {
                 let precond = if cold {
                     Precond::Spectral
                 } else {

@@ -136,7 +136,7 @@ pub(crate) fn projected_pcg<S: SetSystem>(
     let outcome = with_crew(effort.parallelism, parts, &work, |crew| {
         let phases = HostPhases { crew, sys };
         run_cg(phases, n, norm_b, total, effort)
-    })?;
+    })??;
     for (k, v) in work.vectors.iter().enumerate() {
         f[sys.range(k)].copy_from_slice(&lock(v).f);
     }
@@ -358,12 +358,13 @@ impl<S: SetSystem> Tasks for Work<'_, S> {
 
 /// What runs the CG's phases: on the host the crew over the system's parts
 /// ([`HostPhases`]), on a device its kernels. The CG's scalar logic ([`run_cg`]) is the
-/// same for both.
+/// same for both. A failed phase (a device's launch, copy, FFT or synchronisation) stops
+/// the CG with its error; the host's phases do not fail.
 pub(crate) trait PhaseRunner {
     /// Runs `phase`; returns slots 1-3 combined over the parts: for [`Main::Measure`]
     /// `[max |r|, max |f|, rᵀz]`, otherwise `[the main work's value, the stage's carry
     /// for the next stage, 0]`.
-    fn run(&mut self, phase: Phase) -> [f64; 3];
+    fn run(&mut self, phase: Phase) -> Result<[f64; 3]>;
     /// Stages of the product `y = A x`.
     fn product_stages(&self) -> usize;
     /// Stages of the preconditioner `z = M⁻¹ r`.
@@ -373,11 +374,11 @@ pub(crate) trait PhaseRunner {
     /// Whether a coarse space corrects the preconditioner (A-DEF2).
     fn has_coarse(&self) -> bool;
     /// The coarse solve of the last restriction.
-    fn coarse_solve(&mut self);
+    fn coarse_solve(&mut self) -> Result<()>;
 }
 
 impl<R: PhaseRunner + ?Sized> PhaseRunner for &mut R {
-    fn run(&mut self, phase: Phase) -> [f64; 3] {
+    fn run(&mut self, phase: Phase) -> Result<[f64; 3]> {
         (**self).run(phase)
     }
     fn product_stages(&self) -> usize {
@@ -392,7 +393,7 @@ impl<R: PhaseRunner + ?Sized> PhaseRunner for &mut R {
     fn has_coarse(&self) -> bool {
         (**self).has_coarse()
     }
-    fn coarse_solve(&mut self) {
+    fn coarse_solve(&mut self) -> Result<()> {
         (**self).coarse_solve()
     }
 }
@@ -405,12 +406,12 @@ struct HostPhases<'c, 'a, S: SetSystem> {
 }
 
 impl<S: SetSystem> PhaseRunner for HostPhases<'_, '_, S> {
-    fn run(&mut self, phase: Phase) -> [f64; 3] {
+    fn run(&mut self, phase: Phase) -> Result<[f64; 3]> {
         let p = self.crew.run(phase);
-        match phase.main {
+        Ok(match phase.main {
             Main::Measure => [p.max(1), p.max(2), p.sum(3)],
             _ => [p.sum(1), p.sum(0), 0.0],
-        }
+        })
     }
     fn product_stages(&self) -> usize {
         self.sys.product_stages()
@@ -424,20 +425,24 @@ impl<S: SetSystem> PhaseRunner for HostPhases<'_, '_, S> {
     fn has_coarse(&self) -> bool {
         self.sys.has_coarse()
     }
-    fn coarse_solve(&mut self) {
-        self.sys.coarse_solve()
+    fn coarse_solve(&mut self) -> Result<()> {
+        self.sys.coarse_solve();
+        Ok(())
     }
 }
 
 /// The projected CG on `runner`'s vectors (`n` values, `‖b‖∞ = norm_b`, `1ᵀ f = total`
 /// kept): the one CG of every backend.
+///
+/// # Errors
+/// The first failed phase's error (none on the host): the CG stops there.
 pub(crate) fn run_cg<R: PhaseRunner>(
     runner: R,
     n: usize,
     norm_b: f64,
     total: f64,
     effort: Effort,
-) -> PcgOutcome {
+) -> Result<PcgOutcome> {
     Leader {
         norm_a: runner.norm_bound(),
         runner,
@@ -471,32 +476,33 @@ struct Leader<R: PhaseRunner> {
 impl<R: PhaseRunner> Leader<R> {
     /// Runs `main` with the pending updates; returns slots 1-3 combined (sums, or maxima
     /// for `Measure`'s first two).
-    fn phase(&mut self, main: Main) -> [f64; 3] {
+    fn phase(&mut self, main: Main) -> Result<[f64; 3]> {
         let pre = std::mem::take(&mut self.pending);
         self.runner.run(Phase { pre, main })
     }
 
     /// Runs the stages of a product or a preconditioner (`make(stage, carry)`), the
     /// pending updates with the first; returns the last stage's slot 1.
-    fn staged(&mut self, stages: usize, make: impl Fn(usize, f64) -> Main) -> f64 {
+    fn staged(&mut self, stages: usize, make: impl Fn(usize, f64) -> Main) -> Result<f64> {
         let mut carry = 0.0;
         let mut last = 0.0;
         for stage in 0..stages {
-            let [value, passed, _] = self.phase(make(stage, carry));
+            let [value, passed, _] = self.phase(make(stage, carry))?;
             carry = passed;
             last = value;
         }
-        last
+        Ok(last)
     }
 
     /// `f += (total - Σf)/n` (applied with the next phase).
-    fn fix_sum(&mut self) {
-        let [s, _, _] = self.phase(Main::SumF);
+    fn fix_sum(&mut self) -> Result<()> {
+        let [s, _, _] = self.phase(Main::SumF)?;
         self.pending.shift_f = Some((self.total - s) / self.n);
+        Ok(())
     }
 
     /// `r = A f + U - b`.
-    fn residual(&mut self) {
+    fn residual(&mut self) -> Result<()> {
         let offset = self.offset;
         self.staged(self.runner.product_stages(), |stage, carry| {
             Main::Residual {
@@ -504,7 +510,8 @@ impl<R: PhaseRunner> Leader<R> {
                 carry,
                 offset,
             }
-        });
+        })?;
+        Ok(())
     }
 
     /// `z = P M⁻¹ r`, the multiplier folded into `U` and `r` (applied with the next
@@ -515,41 +522,42 @@ impl<R: PhaseRunner> Leader<R> {
     /// `z ← z + Z E⁻¹ Zᵀ (r - A z)`, one more operator product. Why not the additive
     /// `z + Q r`: the smooth modes of an order −1 operator are its *large* eigenvalues,
     /// which an additive term enlarges instead of removing (docs/performance.md).
-    fn project(&mut self) {
-        let sz = self.precondition();
+    fn project(&mut self) -> Result<()> {
+        let sz = self.precondition()?;
         let u = -sz / self.s1;
         self.pending.project = Some(u);
         self.offset += u;
         if self.runner.has_coarse() {
             self.staged(self.runner.product_stages(), |stage, carry| {
                 Main::CoarseProduct { stage, carry }
-            });
-            self.runner.coarse_solve();
+            })?;
+            self.runner.coarse_solve()?;
             self.pending.coarse_z = true;
         }
+        Ok(())
     }
 
     /// The coarse start `f ← f - Z E⁻¹ Zᵀ r` (A-DEF2 needs a residual with `Zᵀ r = 0`).
-    fn coarse_start(&mut self) {
-        self.residual();
-        self.phase(Main::Restrict);
-        self.runner.coarse_solve();
+    fn coarse_start(&mut self) -> Result<()> {
+        self.residual()?;
+        self.phase(Main::Restrict)?;
+        self.runner.coarse_solve()?;
         self.pending.coarse_f = true;
-        self.fix_sum();
+        self.fix_sum()
     }
 
     /// `z = M⁻¹ r`; returns `Σ z`.
-    fn precondition(&mut self) -> f64 {
+    fn precondition(&mut self) -> Result<f64> {
         self.staged(self.runner.precondition_stages(), |stage, carry| {
             Main::Precondition { stage, carry }
         })
     }
 
     /// The backward error and `rᵀ z` (after the pending projection).
-    fn measure(&mut self) -> (f64, f64) {
-        let [r, f, rz] = self.phase(Main::Measure);
+    fn measure(&mut self) -> Result<(f64, f64)> {
+        let [r, f, rz] = self.phase(Main::Measure)?;
         let den = self.norm_a * f + self.norm_b + self.offset.abs();
-        (if den > 0.0 { r / den } else { 0.0 }, rz)
+        Ok((if den > 0.0 { r / den } else { 0.0 }, rz))
     }
 
     fn outcome(&self, iterations: usize, residual: f64) -> PcgOutcome {
@@ -561,22 +569,22 @@ impl<R: PhaseRunner> Leader<R> {
         }
     }
 
-    fn solve(mut self) -> PcgOutcome {
+    fn solve(mut self) -> Result<PcgOutcome> {
         let tol = self.effort.tolerance;
-        self.fix_sum();
+        self.fix_sum()?;
         if self.runner.has_coarse() {
-            self.coarse_start();
+            self.coarse_start()?;
         }
         // w = M⁻¹ 1.
         self.pending.fill_r_one = true;
-        self.s1 = self.precondition();
+        self.s1 = self.precondition()?;
         self.pending.w_from_z = true;
-        self.residual();
-        self.project();
-        let (mut residual, mut rz) = self.measure();
+        self.residual()?;
+        self.project()?;
+        let (mut residual, mut rz) = self.measure()?;
         let mut iterations = 0;
         if residual <= tol {
-            return self.outcome(iterations, residual);
+            return Ok(self.outcome(iterations, residual));
         }
         self.pending.direction = Some(None);
         // The best iterate so far (CG residuals are not monotone).
@@ -587,7 +595,7 @@ impl<R: PhaseRunner> Leader<R> {
             iterations += 1;
             let pq = self.staged(self.runner.product_stages(), |stage, carry| {
                 Main::Direction { stage, carry }
-            });
+            })?;
             if !(pq > 0.0 && rz.is_finite()) {
                 break; // no curvature left: rounding has taken over
             }
@@ -595,13 +603,13 @@ impl<R: PhaseRunner> Leader<R> {
             if iterations % 64 == 0 {
                 // Refresh the recurrence against drift.
                 self.pending.step = Some((alpha, false));
-                self.fix_sum();
-                self.residual();
+                self.fix_sum()?;
+                self.residual()?;
             } else {
                 self.pending.step = Some((alpha, true));
             }
-            self.project();
-            let (r_now, rz_new) = self.measure();
+            self.project()?;
+            let (r_now, rz_new) = self.measure()?;
             residual = r_now;
             if residual < best.0 {
                 best = (residual, self.offset);
@@ -609,10 +617,10 @@ impl<R: PhaseRunner> Leader<R> {
             }
             if residual <= tol {
                 // Confirm with the true residual; rounding in the recurrence can flatter it.
-                self.fix_sum();
-                self.residual();
-                self.project();
-                let (r_true, rz_true) = self.measure();
+                self.fix_sum()?;
+                self.residual()?;
+                self.project()?;
+                let (r_true, rz_true) = self.measure()?;
                 residual = r_true;
                 if residual < best.0 {
                     best = (residual, self.offset);
@@ -635,19 +643,19 @@ impl<R: PhaseRunner> Leader<R> {
                 self.pending.restore_best = true;
                 self.offset = best.1;
             }
-            self.fix_sum();
-            self.residual();
-            self.project();
-            residual = self.measure().0;
+            self.fix_sum()?;
+            self.residual()?;
+            self.project()?;
+            residual = self.measure()?.0;
         }
         // The last phase's updates touched only r, z (or nothing the caller reads).
         if self.pending.shift_f.is_some()
             || self.pending.step.is_some()
             || self.pending.restore_best
         {
-            self.phase(Main::Nothing);
+            self.phase(Main::Nothing)?;
         }
-        self.outcome(iterations, residual)
+        Ok(self.outcome(iterations, residual))
     }
 }
 
@@ -713,4 +721,100 @@ pub(crate) fn max_abs(a: &[f64]) -> f64 {
         }
     }
     combine(lanes, f64::max).max(tail)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::Error;
+
+    /// A runner whose `fail_at`-th call (phases and coarse solves counted together)
+    /// fails, as a device's failed launch or copy does; the others return values a
+    /// solve could see. It counts the calls made after the failure.
+    struct Failing {
+        calls: usize,
+        fail_at: usize,
+        after: usize,
+        coarse: bool,
+    }
+
+    impl Failing {
+        fn step(&mut self) -> Result<()> {
+            self.calls += 1;
+            if self.calls > self.fail_at {
+                self.after += 1;
+            }
+            if self.calls == self.fail_at {
+                return Err(Error::InvalidParameter {
+                    name: "planted failure",
+                    value: self.calls as f64,
+                    reason: "injected by the test",
+                });
+            }
+            Ok(())
+        }
+    }
+
+    impl PhaseRunner for Failing {
+        fn run(&mut self, phase: Phase) -> Result<[f64; 3]> {
+            self.step()?;
+            Ok(match phase.main {
+                Main::Measure => [1.0, 1.0, 1.0],
+                _ => [1.0, 0.0, 0.0],
+            })
+        }
+        fn product_stages(&self) -> usize {
+            1
+        }
+        fn precondition_stages(&self) -> usize {
+            1
+        }
+        fn norm_bound(&self) -> f64 {
+            1.0
+        }
+        fn has_coarse(&self) -> bool {
+            self.coarse
+        }
+        fn coarse_solve(&mut self) -> Result<()> {
+            self.step()
+        }
+    }
+
+    /// Every phase and coarse solve, wherever the CG is, stops it with its own error:
+    /// nothing runs after it and no outcome (NaN or other) comes back. Without a
+    /// failure the same runner runs to its iteration limit (the reference count).
+    #[test]
+    fn a_failed_phase_stops_the_cg_with_its_error() {
+        let effort = Effort {
+            tolerance: 1e-300,
+            max_iterations: 5,
+            parallelism: Parallelism::Sequential,
+        };
+        for coarse in [false, true] {
+            let mut clean = Failing {
+                calls: 0,
+                fail_at: usize::MAX,
+                after: 0,
+                coarse,
+            };
+            let outcome = run_cg(&mut clean, 4, 1.0, 0.0, effort).unwrap();
+            assert_eq!(outcome.iterations, 5);
+            let total = clean.calls;
+            assert!(total > 20, "{total} calls");
+            for fail_at in 1..=total {
+                let mut runner = Failing {
+                    calls: 0,
+                    fail_at,
+                    after: 0,
+                    coarse,
+                };
+                let e = run_cg(&mut runner, 4, 1.0, 0.0, effort).unwrap_err();
+                assert!(
+                    matches!(e, Error::InvalidParameter { value, .. } if value == fail_at as f64),
+                    "{e:?}"
+                );
+                assert_eq!(runner.after, 0, "call {fail_at} of {total}: calls after it");
+            }
+        }
+    }
 }

@@ -41,6 +41,71 @@ pub(crate) fn warm_precond(tangential: bool, cells: usize) -> Precond {
     }
 }
 
+/// The mean compliance `d̄` to rebuild the spectral preconditioner's table for, when the
+/// table built for `built` (`None`: none yet) is stale for the set's compliances `d`:
+/// when `d̄` moved by more than 5 %. The one rule of both machines (`SpectralCore`,
+/// `cuda::CudaCore`): the table is a function of `d̄` alone, so the same `d̄` gives the
+/// same preconditioner on either.
+pub(crate) fn stale_mean(built: Option<f64>, d: &[f64]) -> Option<f64> {
+    let mean_d = d.iter().sum::<f64>() / d.len().max(1) as f64;
+    let stale = match built {
+        Some(old) => (old - mean_d).abs() > 0.05 * mean_d.abs().max(f64::MIN_POSITIVE),
+        None => true,
+    };
+    stale.then_some(mean_d)
+}
+
+/// The spectral backend's rule (its preconditioner choices, their state kept between
+/// solves, the set solve) as one machine runs it: [`SpectralCore`] on the host's
+/// threads, `cuda::CudaCore` on a GPU. The solver holds either behind this one seam
+/// (`Core::Spectral`), so `solver/mod.rs` has no code of its own per machine.
+pub(crate) trait SpectralRule: Send + Sync {
+    /// Solves `problem` with `precond`; `f` holds the warm start.
+    fn solve(
+        &mut self,
+        problem: SetProblem<'_>,
+        precond: Precond,
+        f: Vec<f64>,
+        effort: Effort,
+    ) -> Result<SetSolve>;
+    /// The `d̄` of the spectral preconditioner's table, if one was built (checkpoints).
+    fn preconditioner_mean(&self) -> Option<f64>;
+    /// Rebuilds the spectral preconditioner's table for `d̄` (or drops it): a restored
+    /// solver preconditions as before.
+    fn restore_preconditioner(&mut self, mean: Option<f64>) -> Result<()>;
+    /// The parts of the grid a solve runs over (the threads it may use).
+    fn parts(&self) -> usize;
+    /// Whether a preconditioner is built (they are built on first use only).
+    #[cfg(test)]
+    fn built(&self) -> bool;
+}
+
+impl SpectralRule for SpectralCore {
+    fn solve(
+        &mut self,
+        problem: SetProblem<'_>,
+        precond: Precond,
+        f: Vec<f64>,
+        effort: Effort,
+    ) -> Result<SetSolve> {
+        SpectralCore::solve(self, problem, precond, f, effort)
+    }
+    fn preconditioner_mean(&self) -> Option<f64> {
+        SpectralCore::preconditioner_mean(self)
+    }
+    fn restore_preconditioner(&mut self, mean: Option<f64>) -> Result<()> {
+        SpectralCore::restore_preconditioner(self, mean);
+        Ok(())
+    }
+    fn parts(&self) -> usize {
+        SpectralCore::parts(self)
+    }
+    #[cfg(test)]
+    fn built(&self) -> bool {
+        SpectralCore::built(self)
+    }
+}
+
 /// Preconditioner of a spectral solve.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Precond {
@@ -126,12 +191,12 @@ impl SpectralCore {
         self.inverse = Some((staging, mean_d, table));
     }
 
-    /// The `d̄` of the spectral preconditioner's table, if one was built (checkpoints).
     /// The parts of the grid a solve runs over.
     pub(crate) fn parts(&self) -> usize {
         self.staging.partition().parts()
     }
 
+    /// The `d̄` of the spectral preconditioner's table, if one was built (checkpoints).
     pub(crate) fn preconditioner_mean(&self) -> Option<f64> {
         self.inverse.as_ref().map(|(_, d, _)| *d)
     }
@@ -186,14 +251,7 @@ impl SpectralCore {
                 }
             }
             Precond::Spectral => {
-                let mean_d = d.iter().sum::<f64>() / d.len().max(1) as f64;
-                let stale = match &self.inverse {
-                    Some((_, old, _)) => {
-                        (old - mean_d).abs() > 0.05 * mean_d.abs().max(f64::MIN_POSITIVE)
-                    }
-                    None => true,
-                };
-                if stale {
+                if let Some(mean_d) = stale_mean(self.preconditioner_mean(), d) {
                     self.build_inverse(mean_d);
                 }
             }
@@ -264,5 +322,26 @@ impl SpectralCore {
             outcome,
             grid_product,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::stale_mean;
+
+    /// The 5 % rule at its edges: `|d̄ - built| > 0.05 |d̄|` (values by hand).
+    #[test]
+    fn the_table_is_stale_past_five_percent_of_the_mean() {
+        // No table yet: always built, for the mean of d.
+        assert_eq!(stale_mean(None, &[1.0, 3.0]), Some(2.0));
+        // d̄ = 1.04: |1 - 1.04| = 0.04 <= 0.052, kept.
+        assert_eq!(stale_mean(Some(1.0), &[1.0, 1.08]), None);
+        // d̄ = 1.06: 0.06 > 0.053, rebuilt for 1.06.
+        assert_eq!(stale_mean(Some(1.0), &[1.06, 1.06]), Some(1.06));
+        // Downward: d̄ = 0.9: 0.1 > 0.045.
+        assert_eq!(stale_mean(Some(1.0), &[0.9]), Some(0.9));
+        // An empty set has d̄ = 0: a table for 0 is kept, another one rebuilt.
+        assert_eq!(stale_mean(Some(0.0), &[]), None);
+        assert_eq!(stale_mean(Some(1e-300), &[]), Some(0.0));
     }
 }

@@ -12,11 +12,12 @@
 //! one to rounding, not bit for bit; docs/gpu.md).
 
 use super::device::{cuda_error, zeros};
-use super::operator::{over, Kernels, Transforms, THREADS};
+use super::kernels::{blocks, int, over, Kernels};
+use super::operator::Transforms;
 use super::vectors::SetVectors;
 use crate::error::Result;
 use crate::solver::coarse::Aggregates;
-use cudarc::driver::{CudaSlice, CudaStream, LaunchConfig, PushKernelArg};
+use cudarc::driver::{CudaSlice, CudaStream};
 use std::sync::Arc;
 
 /// The bytes of a [`DeviceCoarse`] with `count` aggregates.
@@ -27,8 +28,9 @@ pub(super) fn coarse_bytes(count: usize) -> f64 {
 /// The aggregates whose column of `E` the last [`Aggregates::enter`] made stale: those
 /// whose sites or compliances changed, ascending.
 pub(super) fn stale_columns(aggregates: &Aggregates) -> Vec<usize> {
+    let layout = aggregates.layout();
     (0..aggregates.count())
-        .filter(|&a| aggregates.touched(a))
+        .filter(|&a| layout.touched[a])
         .collect()
 }
 
@@ -70,11 +72,11 @@ impl DeviceCoarse {
         let count = aggregates.count();
         let real = |len: usize| zeros::<f64>(stream, len);
         Ok(DeviceCoarse {
-            nx: nx as i32,
-            ny: ny as i32,
-            block: aggregates.block() as i32,
-            bx: aggregates.blocks_x() as i32,
-            count: count as i32,
+            nx: int("grid cells along x", nx)?,
+            ny: int("grid cells along y", ny)?,
+            block: int("cells per aggregate side", aggregates.layout().block)?,
+            bx: int("aggregates along x", aggregates.layout().blocks_x)?,
+            count: int("aggregates", count)?,
             aggregates,
             e: real(count * count)?,
             lower: real(count * count)?,
@@ -118,25 +120,16 @@ impl DeviceCoarse {
         }
         stream
             .memcpy_htod(&counts, &mut self.c)
-            .map_err(|e| cuda_error("cuMemcpyHtoD", e))?;
+            .map_err(|e| cuda_error("cuMemcpyHtoD (aggregate site counts)", e))?;
         for a in stale_columns(&self.aggregates) {
-            if let Some(cfg) = over(m) {
-                let (m32, a32) = (m as i32, a as i32);
-                // SAFETY: the argument list matches kernels.cu's coarse_indicator; set and
-                // p hold at least m values.
+            if let Some(cfg) = over("sites in the set", m)? {
+                let (m32, a32) = (int("sites in the set", m)?, int("aggregates", a)?);
+                // SAFETY: set and p hold at least m values.
                 unsafe {
-                    stream
-                        .launch_builder(&kernels.coarse_indicator)
-                        .arg(&v.set)
-                        .arg(&m32)
-                        .arg(&self.nx)
-                        .arg(&self.block)
-                        .arg(&self.bx)
-                        .arg(&a32)
-                        .arg(&mut v.p)
-                        .launch(cfg)
-                }
-                .map_err(|e| cuda_error("coarse_indicator", e))?;
+                    kernels.coarse_indicator(
+                        stream, cfg, &v.set, m32, self.nx, self.block, self.bx, a32, &mut v.p,
+                    )
+                }?;
             }
             transforms.filter(stream, kernels, operator, &v.p, &v.pos)?;
             transforms.gather_set(stream, kernels, &v.set, &v.d, &v.p, &mut v.q, true, m)?;
@@ -148,63 +141,34 @@ impl DeviceCoarse {
     /// The empty aggregates fixed, then `E`'s factor, inverse and border; the validity
     /// read back.
     fn factor(&mut self, stream: &Arc<CudaStream>, kernels: &Kernels) -> Result<()> {
-        let one = LaunchConfig {
-            grid_dim: (1, 1, 1),
-            block_dim: (THREADS, 1, 1),
-            shared_mem_bytes: 0,
-        };
-        let each = over(self.count as usize).unwrap_or(one);
-        // SAFETY (this function's launches): the argument lists match kernels.cu's
-        // coarse_fix_empty, coarse_factor, coarse_invert and coarse_border; e, lower and
-        // inverse hold count² values, c and w count, info 2.
-        unsafe {
-            stream
-                .launch_builder(&kernels.coarse_fix_empty)
-                .arg(&mut self.e)
-                .arg(&self.c)
-                .arg(&self.count)
-                .launch(each)
-        }
-        .map_err(|e| cuda_error("coarse_fix_empty", e))?;
+        let one = blocks("one block", 1)?;
+        let each = over("aggregates", self.count as usize)?.unwrap_or(one);
+        // SAFETY (this function's launches): e, lower and inverse hold count² values, c
+        // and w count, info 2.
+        unsafe { kernels.coarse_fix_empty(stream, each, &mut self.e, &self.c, self.count) }?;
         stream
             .memcpy_dtod(&self.e, &mut self.lower)
-            .map_err(|e| cuda_error("cuMemcpyDtoD", e))?;
+            .map_err(|e| cuda_error("cuMemcpyDtoD (coarse matrix to its factor)", e))?;
+        unsafe { kernels.coarse_factor(stream, one, &mut self.lower, self.count, &mut self.info) }?;
+        unsafe { kernels.coarse_invert(stream, each, &self.lower, self.count, &mut self.inverse) }?;
         unsafe {
-            stream
-                .launch_builder(&kernels.coarse_factor)
-                .arg(&mut self.lower)
-                .arg(&self.count)
-                .arg(&mut self.info)
-                .launch(one)
-        }
-        .map_err(|e| cuda_error("coarse_factor", e))?;
-        unsafe {
-            stream
-                .launch_builder(&kernels.coarse_invert)
-                .arg(&self.lower)
-                .arg(&self.count)
-                .arg(&mut self.inverse)
-                .launch(each)
-        }
-        .map_err(|e| cuda_error("coarse_invert", e))?;
-        unsafe {
-            stream
-                .launch_builder(&kernels.coarse_border)
-                .arg(&self.inverse)
-                .arg(&self.c)
-                .arg(&self.count)
-                .arg(&mut self.w)
-                .arg(&mut self.info)
-                .launch(one)
-        }
-        .map_err(|e| cuda_error("coarse_border", e))?;
+            kernels.coarse_border(
+                stream,
+                one,
+                &self.inverse,
+                &self.c,
+                self.count,
+                &mut self.w,
+                &mut self.info,
+            )
+        }?;
         let mut info = [0.0f64; 2];
         stream
             .memcpy_dtoh(&self.info, info.as_mut_slice())
-            .map_err(|e| cuda_error("cuMemcpyDtoH", e))?;
+            .map_err(|e| cuda_error("cuMemcpyDtoH (coarse validity)", e))?;
         stream
             .synchronize()
-            .map_err(|e| cuda_error("cuStreamSynchronize", e))?;
+            .map_err(|e| cuda_error("cuStreamSynchronize (coarse upkeep)", e))?;
         self.valid = info[0] == 1.0;
         Ok(())
     }
@@ -219,61 +183,51 @@ impl DeviceCoarse {
         pos: &CudaSlice<i32>,
         into: Target,
     ) -> Result<()> {
-        let cfg = LaunchConfig {
-            grid_dim: (self.count as u32, 1, 1),
-            block_dim: (THREADS, 1, 1),
-            shared_mem_bytes: 0,
-        };
+        // One block per aggregate.
+        let cfg = blocks("aggregates", self.count as usize)?;
         let subtract = i32::from(t.is_some());
         let (out, column) = match into {
-            Target::Column(a) => (&mut self.e, a as i32),
+            Target::Column(a) => (&mut self.e, int("aggregates", a)?),
             Target::Rhs => (&mut self.g, -1),
         };
-        // SAFETY: the argument list matches kernels.cu's coarse_restrict; x and t hold a
-        // value per set site, pos one per cell, out count² values (a column) or count.
+        // SAFETY: x and t hold a value per set site, pos one per cell, out count² values
+        // (a column) or count.
         unsafe {
-            stream
-                .launch_builder(&kernels.coarse_restrict)
-                .arg(x)
-                .arg(t.unwrap_or(x))
-                .arg(&subtract)
-                .arg(pos)
-                .arg(&self.nx)
-                .arg(&self.ny)
-                .arg(&self.block)
-                .arg(&self.bx)
-                .arg(out)
-                .arg(&column)
-                .arg(&self.count)
-                .launch(cfg)
+            kernels.coarse_restrict(
+                stream,
+                cfg,
+                x,
+                t.unwrap_or(x),
+                subtract,
+                pos,
+                self.nx,
+                self.ny,
+                self.block,
+                self.bx,
+                out,
+                column,
+                self.count,
+            )
         }
-        .map(|_| ())
-        .map_err(|e| cuda_error("coarse_restrict", e))
     }
 
     /// The bordered coarse solve of the last restriction, left on the device.
     pub(super) fn solve(&mut self, stream: &Arc<CudaStream>, kernels: &Kernels) -> Result<()> {
-        let one = LaunchConfig {
-            grid_dim: (1, 1, 1),
-            block_dim: (THREADS, 1, 1),
-            shared_mem_bytes: 0,
-        };
-        // SAFETY: the argument list matches kernels.cu's coarse_solve; inverse holds
-        // count² values, g, c, w and solution count, info 2.
+        let one = blocks("one block", 1)?;
+        // SAFETY: inverse holds count² values, g, c, w and solution count, info 2.
         unsafe {
-            stream
-                .launch_builder(&kernels.coarse_solve)
-                .arg(&self.inverse)
-                .arg(&self.g)
-                .arg(&self.c)
-                .arg(&self.w)
-                .arg(&self.info)
-                .arg(&self.count)
-                .arg(&mut self.solution)
-                .launch(one)
+            kernels.coarse_solve(
+                stream,
+                one,
+                &self.inverse,
+                &self.g,
+                &self.c,
+                &self.w,
+                &self.info,
+                self.count,
+                &mut self.solution,
+            )
         }
-        .map(|_| ())
-        .map_err(|e| cuda_error("coarse_solve", e))
     }
 
     /// `x += sign Z y` on the `m` sites of `set`, `y` the last coarse solution.
@@ -286,26 +240,24 @@ impl DeviceCoarse {
         set: &CudaSlice<i32>,
         m: usize,
     ) -> Result<()> {
-        let Some(cfg) = over(m) else {
+        let Some(cfg) = over("sites in the set", m)? else {
             return Ok(());
         };
-        let m32 = m as i32;
-        // SAFETY: the argument list matches kernels.cu's coarse_prolong; x and set hold
-        // at least m values, solution count.
+        let m32 = int("sites in the set", m)?;
+        // SAFETY: x and set hold at least m values, solution count.
         unsafe {
-            stream
-                .launch_builder(&kernels.coarse_prolong)
-                .arg(x)
-                .arg(&self.solution)
-                .arg(&sign)
-                .arg(set)
-                .arg(&m32)
-                .arg(&self.nx)
-                .arg(&self.block)
-                .arg(&self.bx)
-                .launch(cfg)
+            kernels.coarse_prolong(
+                stream,
+                cfg,
+                x,
+                &self.solution,
+                sign,
+                set,
+                m32,
+                self.nx,
+                self.block,
+                self.bx,
+            )
         }
-        .map(|_| ())
-        .map_err(|e| cuda_error("coarse_prolong", e))
     }
 }

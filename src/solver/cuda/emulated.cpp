@@ -1,5 +1,5 @@
 // kernels.cu run on the host, for the tests of src/solver/cuda/emulated.rs: blocks run one
-// after the other, each of EMULATED_THREADS threads (below), and the batched FFTs are
+// after the other, each of THREADS threads (below), and the batched FFTs are
 // naive DFTs in long double. The launch
 // sequence is operator.rs's `Transforms::filter` and `gather_set`/`gather_grid`.
 //
@@ -12,13 +12,13 @@
 #include <string>
 #include <vector>
 
-// Threads per block: 1 (each block one thread, `__syncthreads` a no-op), or more, run as
-// real threads meeting at a barrier for `__syncthreads`, so that a missing or misplaced
-// barrier in a kernel shows.
-#ifndef EMULATED_THREADS
-#define EMULATED_THREADS 1
+// Threads per block, given as -DTHREADS as NVRTC is given it (emulated.rs: kernels.rs's
+// THREADS, and fewer): 1 (each block one thread, `__syncthreads` a no-op), or more, run
+// as real threads meeting at a barrier for `__syncthreads`, so that a missing or
+// misplaced barrier in a kernel shows.
+#ifndef THREADS
+#error "compile with -DTHREADS=..."
 #endif
-#define THREADS EMULATED_THREADS
 
 struct double2 {
     double x, y;
@@ -27,7 +27,7 @@ struct Dim {
     unsigned x, y, z;
 };
 static Dim blockIdx, blockDim, gridDim;
-#if EMULATED_THREADS > 1
+#if THREADS > 1
 #include <barrier>
 #include <thread>
 static thread_local Dim threadIdx;
@@ -60,7 +60,7 @@ static void launch(size_t blocks, F kernel) {
     gridDim = {(unsigned)blocks, 1, 1};
     for (size_t b = 0; b < blocks; b++) {
         blockIdx = {(unsigned)b, 0, 0};
-#if EMULATED_THREADS > 1
+#if THREADS > 1
         std::barrier<> barrier(THREADS);
         block_barrier = &barrier;
         std::vector<std::thread> threads;

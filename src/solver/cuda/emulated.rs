@@ -4,6 +4,7 @@
 //! compared with the dense `Ĝ` (`InfluencePlan::dense`, explicit cosine sums: independent
 //! of any DCT) and the reductions with plain sums.
 
+use super::kernels::{threads_define, THREADS};
 use super::operator::table;
 use crate::geometry::{Block, Grid};
 use crate::green::InfluencePlan;
@@ -11,19 +12,20 @@ use crate::solver::system::Compliance;
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
 
-/// Threads per block of the two emulators: one (the sequential reference), and four run
-/// as real threads meeting at a barrier for `__syncthreads` (a missing barrier or a race
-/// in a block's cooperation shows as a wrong or varying result).
-const EMULATED_THREADS: [usize; 2] = [1, 4];
+/// Threads per block of the emulators: one (the sequential reference), then four and the
+/// device's [`THREADS`] run as real threads meeting at a barrier for `__syncthreads` (a
+/// missing barrier or a race in a block's cooperation shows as a wrong or varying
+/// result; the device's count runs its trees at their full depth).
+const EMULATED_THREADS: [u32; 3] = [1, 4, THREADS];
 
 /// Compiles emulated.cpp with `threads` threads per block, once per version of its
 /// sources: the program sits beside the test binary (under `target/`), named by a hash of
 /// emulated.cpp and kernels.cu, so later test processes reuse it and nothing is left in
 /// the system's temporary directory. Written under a name of this process's, then
 /// renamed: two test processes never see half a program.
-fn program(threads: usize) -> PathBuf {
+fn program(threads: u32) -> PathBuf {
     use std::hash::{Hash, Hasher};
-    static PROGRAMS: std::sync::Mutex<Vec<(usize, PathBuf)>> = std::sync::Mutex::new(Vec::new());
+    static PROGRAMS: std::sync::Mutex<Vec<(u32, PathBuf)>> = std::sync::Mutex::new(Vec::new());
     let mut programs = PROGRAMS.lock().unwrap_or_else(|e| e.into_inner());
     if let Some((_, path)) = programs.iter().find(|(t, _)| *t == threads) {
         return path.clone();
@@ -50,7 +52,7 @@ fn program(threads: usize) -> PathBuf {
         ));
         let status = Command::new("c++")
             .args(["-O2", "-std=c++20", "-pthread"])
-            .arg(format!("-DEMULATED_THREADS={threads}"))
+            .arg(threads_define(threads))
             .arg("-o")
             .arg(&partial)
             .arg(here.join("emulated.cpp"))
@@ -103,7 +105,7 @@ fn emulate(input: &str) -> Vec<f64> {
 /// Runs the emulator of `threads` threads per block on `input`. A run that does not end
 /// within a minute is killed and fails the test: threads that disagree on a barrier
 /// (one leaves a loop the others stay in) wait for each other forever.
-fn emulate_with(threads: usize, input: &str) -> Vec<f64> {
+fn emulate_with(threads: u32, input: &str) -> Vec<f64> {
     use std::io::{Read, Write};
     use std::time::{Duration, Instant};
     let mut child = Command::new(program(threads))
@@ -387,7 +389,8 @@ fn the_fsai_kernels_apply_the_hosts_factor_after_its_updates() {
         fsai.update(&entries, &first, &d_of(&first, n));
         // The first copy is the planes as they are: every cell's row.
         let all: (Vec<i32>, Vec<f64>) = {
-            let (stride, planes) = (fsai.stride(), fsai.planes());
+            let layout = fsai.layout();
+            let (stride, planes) = (layout.stride, layout.planes);
             let weights = (0..n)
                 .flat_map(|i| (0..stride).map(move |k| planes[k * n + i]))
                 .collect();
@@ -410,9 +413,9 @@ fn the_fsai_kernels_apply_the_hosts_factor_after_its_updates() {
         let mut host = vec![0.0; second.len()];
         fsai.apply(&r, &mut host);
         let device = |rounds: &[&(Vec<i32>, Vec<f64>)]| -> Vec<f64> {
-            let stride = fsai.stride();
+            let stride = fsai.layout().stride;
             let mut input = format!("fsai {nx} {ny} {stride}\n");
-            for o in fsai.offsets() {
+            for o in fsai.layout().offsets {
                 input += &format!("{o} ");
             }
             input += &format!("\nrounds {}\n", rounds.len());

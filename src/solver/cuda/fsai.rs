@@ -7,10 +7,10 @@
 //! (`(4 + 8 stride)` bytes each), not the planes.
 
 use super::device::{cuda_error, zeros};
-use super::operator::{over, Kernels};
+use super::kernels::{int, over, Kernels};
 use crate::error::Result;
 use crate::solver::fsai::Fsai;
-use cudarc::driver::{CudaSlice, CudaStream, PushKernelArg};
+use cudarc::driver::{CudaSlice, CudaStream};
 use std::sync::Arc;
 
 /// The device's copy of a [`Fsai`] factor and the scratch of its product.
@@ -35,27 +35,30 @@ pub(super) fn fsai_bytes(n: usize, stride: usize) -> f64 {
 /// The rows the last update refreshed, as their cells and their `stride` weights each
 /// (zero weights for a row off the set).
 pub(super) fn rows_to_copy(fsai: &Fsai) -> (Vec<i32>, Vec<f64>) {
-    let stride = fsai.stride();
-    let planes = fsai.planes();
+    let layout = fsai.layout();
+    let (stride, planes) = (layout.stride, layout.planes);
     let n = planes.len() / stride;
-    let cells = fsai.refreshed();
+    let cells = layout.refreshed;
     let weights = cells
         .iter()
         .flat_map(|&i| (0..stride).map(move |k| planes[k * n + i]))
         .collect();
+    // Cells below N, which fits an `int` (`CudaCore::new`).
     (cells.iter().map(|&i| i as i32).collect(), weights)
 }
 
 impl DeviceFsai {
     /// Zero planes for `fsai`'s pattern on a grid of `n` cells.
     pub(super) fn new(stream: &Arc<CudaStream>, fsai: &Fsai, n: usize) -> Result<Self> {
-        let offsets: Vec<i32> = fsai.offsets().iter().map(|&o| o as i32).collect();
+        // Offsets below N, which fits an `int` (`CudaCore::new`).
+        let layout = fsai.layout();
+        let offsets: Vec<i32> = layout.offsets.iter().map(|&o| o as i32).collect();
         Ok(DeviceFsai {
-            stride: fsai.stride(),
-            planes: zeros(stream, fsai.stride() * n)?,
+            stride: layout.stride,
+            planes: zeros(stream, layout.stride * n)?,
             offsets: stream
                 .clone_htod(&offsets)
-                .map_err(|e| cuda_error("cuMemcpyHtoD", e))?,
+                .map_err(|e| cuda_error("cuMemcpyHtoD (FSAI offsets)", e))?,
             y: zeros(stream, n)?,
             synced: false,
         })
@@ -73,40 +76,39 @@ impl DeviceFsai {
         if !self.synced {
             // Every row: the planes as they are (no lists, no scratch on the device).
             stream
-                .memcpy_htod(fsai.planes(), &mut self.planes)
-                .map_err(|e| cuda_error("cuMemcpyHtoD", e))?;
+                .memcpy_htod(fsai.layout().planes, &mut self.planes)
+                .map_err(|e| cuda_error("cuMemcpyHtoD (FSAI planes)", e))?;
             self.synced = true;
             return Ok(());
         }
         self.synced = false;
         let (cells, weights) = rows_to_copy(fsai);
-        let Some(cfg) = over(weights.len()) else {
+        let Some(cfg) = over("FSAI weights to copy", weights.len())? else {
             self.synced = true;
             return Ok(());
         };
-        let copy = |e| cuda_error("cuMemcpyHtoD", e);
+        let copy = |e| cuda_error("cuMemcpyHtoD (FSAI rows)", e);
         let cells_d = stream.clone_htod(&cells).map_err(copy)?;
         let weights_d = stream.clone_htod(&weights).map_err(copy)?;
         let (count, stride, n) = (
-            cells.len() as i32,
-            self.stride as i32,
-            (self.planes.len() / self.stride) as i32,
+            int("FSAI rows to copy", cells.len())?,
+            int("FSAI pattern slots", self.stride)?,
+            int("grid cells", self.planes.len() / self.stride)?,
         );
-        // SAFETY: the argument list matches kernels.cu's fsai_scatter; `cells` holds
-        // `count` cells of the grid, `weights` `count * stride` values, the planes
-        // `stride * n`.
+        // SAFETY: `cells` holds `count` cells of the grid, `weights` `count * stride`
+        // values, the planes `stride * n`.
         unsafe {
-            stream
-                .launch_builder(&kernels.fsai_scatter)
-                .arg(&cells_d)
-                .arg(&weights_d)
-                .arg(&count)
-                .arg(&mut self.planes)
-                .arg(&stride)
-                .arg(&n)
-                .launch(cfg)
-        }
-        .map_err(|e| cuda_error("fsai_scatter", e))?;
+            kernels.fsai_scatter(
+                stream,
+                cfg,
+                &cells_d,
+                &weights_d,
+                count,
+                &mut self.planes,
+                stride,
+                n,
+            )
+        }?;
         self.synced = true;
         Ok(())
     }
@@ -123,47 +125,46 @@ impl DeviceFsai {
         z: &mut CudaSlice<f64>,
         m: usize,
     ) -> Result<()> {
-        let Some(cfg) = over(m) else {
+        let Some(cfg) = over("sites in the set", m)? else {
             return Ok(());
         };
         let (stride, m32, n) = (
-            self.stride as i32,
-            m as i32,
-            (self.planes.len() / self.stride) as i32,
+            int("FSAI pattern slots", self.stride)?,
+            int("sites in the set", m)?,
+            int("grid cells", self.planes.len() / self.stride)?,
         );
-        // SAFETY: the argument lists match kernels.cu's fsai_g and fsai_gt; set, r, y and z
-        // hold at least m values, pos and every plane n, offsets `stride`.
+        // SAFETY: set, r, y and z hold at least m values, pos and every plane n, offsets
+        // `stride`.
         unsafe {
-            stream
-                .launch_builder(&kernels.fsai_g)
-                .arg(&self.planes)
-                .arg(&self.offsets)
-                .arg(&stride)
-                .arg(set)
-                .arg(pos)
-                .arg(r)
-                .arg(&mut self.y)
-                .arg(&m32)
-                .arg(&n)
-                .launch(cfg)
-        }
-        .map_err(|e| cuda_error("fsai_g", e))?;
+            kernels.fsai_g(
+                stream,
+                cfg,
+                &self.planes,
+                &self.offsets,
+                stride,
+                set,
+                pos,
+                r,
+                &mut self.y,
+                m32,
+                n,
+            )
+        }?;
         // SAFETY: as above.
         unsafe {
-            stream
-                .launch_builder(&kernels.fsai_gt)
-                .arg(&self.planes)
-                .arg(&self.offsets)
-                .arg(&stride)
-                .arg(set)
-                .arg(pos)
-                .arg(&self.y)
-                .arg(z)
-                .arg(&m32)
-                .arg(&n)
-                .launch(cfg)
+            kernels.fsai_gt(
+                stream,
+                cfg,
+                &self.planes,
+                &self.offsets,
+                stride,
+                set,
+                pos,
+                &self.y,
+                z,
+                m32,
+                n,
+            )
         }
-        .map(|_| ())
-        .map_err(|e| cuda_error("fsai_gt", e))
     }
 }

@@ -16,8 +16,11 @@
 // Reductions run in a fixed order (fixed block count, grid-stride loops, a tree in shared
 // memory, one block for the final pass), so a run repeats bit for bit on the same GPU.
 
+// Threads per block: kernels.rs's THREADS, given by the compiler's -DTHREADS (NVRTC's and
+// the emulator's alike), so that the block size of the launches and of the trees below is
+// one value.
 #ifndef THREADS
-#define THREADS 256
+#error "THREADS (threads per block) comes from kernels.rs: compile with -DTHREADS=..."
 #endif
 
 // The position of source index n in Makhoul's order v (v[m] = x[perm(m)]).

@@ -17,6 +17,7 @@
 mod coarse;
 mod device;
 mod fsai;
+mod kernels;
 mod libraries;
 mod memory;
 mod operator;
@@ -32,7 +33,7 @@ use super::fsai::{Entries, Fsai};
 use super::parallel::Parallelism;
 use super::pcg::{max_abs, run_cg, Effort};
 use super::set::{SetProblem, SetSolve};
-use super::spectral::{Precond, FSAI_RADIUS};
+use super::spectral::{stale_mean, Precond, SpectralRule, FSAI_RADIUS};
 use super::system::Compliance;
 use crate::error::{Error, Result};
 use crate::green::InfluencePlan;
@@ -40,7 +41,8 @@ use coarse::DeviceCoarse;
 use cudarc::driver::CudaSlice;
 use device::{cuda_error, Gpu};
 use fsai::DeviceFsai;
-use operator::{Kernels, Transforms};
+use kernels::Kernels;
+use operator::Transforms;
 use phases::{DevicePhases, DevicePrecond};
 use vectors::SetVectors;
 
@@ -78,9 +80,12 @@ impl CudaCore {
     /// Opens the GPU, checks its free memory against the estimate, compiles the kernels
     /// and allocates everything the solves use.
     pub(crate) fn new(plan: &InfluencePlan, compliance: Compliance) -> Result<Self> {
-        let gpu = Gpu::open()?;
         let (nx, ny) = (plan.grid().nx(), plan.grid().ny());
         let n = nx * ny;
+        // The kernels index cells with an `int`: every cell, set position and offset
+        // below is then one too.
+        kernels::int("grid cells", n)?;
+        let gpu = Gpu::open()?;
         memory::check_fits(
             &gpu.info.to_string(),
             memory::device_bytes(nx, ny),
@@ -113,23 +118,6 @@ impl CudaCore {
             coarse: None,
             grid,
         })
-    }
-
-    /// The `d̄` of the spectral preconditioner's table, if one was built (checkpoints).
-    pub(crate) fn preconditioner_mean(&self) -> Option<f64> {
-        self.inverse.as_ref().map(|(d, _)| *d)
-    }
-
-    /// Rebuilds the spectral preconditioner's table for `d̄` (or drops it), as the host's
-    /// backend does: a restored solver preconditions as before.
-    pub(crate) fn restore_preconditioner(&mut self, mean: Option<f64>) -> Result<()> {
-        match mean {
-            Some(d) => self.build_inverse(d),
-            None => {
-                self.inverse = None;
-                Ok(())
-            }
-        }
     }
 
     fn build_inverse(&mut self, mean_d: f64) -> Result<()> {
@@ -170,13 +158,7 @@ impl CudaCore {
             });
         }
         if precond == Precond::Spectral {
-            // The host's rule: rebuild when the mean compliance moved by more than 5 %.
-            let mean_d = problem.d.iter().sum::<f64>() / m.max(1) as f64;
-            let stale = match &self.inverse {
-                Some((old, _)) => (old - mean_d).abs() > 0.05 * mean_d.abs().max(f64::MIN_POSITIVE),
-                None => true,
-            };
-            if stale {
+            if let Some(mean_d) = stale_mean(self.preconditioner_mean(), problem.d) {
                 self.build_inverse(mean_d)?;
             }
         }
@@ -210,12 +192,8 @@ impl CudaCore {
             },
             m,
             norm: self.compliance.norm + problem.d.iter().fold(0.0f64, |a, x| a.max(*x)),
-            error: None,
         };
-        let outcome = run_cg(&mut phases, m, max_abs(problem.b), problem.total, effort);
-        if let Some(e) = phases.error {
-            return Err(e);
-        }
+        let outcome = run_cg(&mut phases, m, max_abs(problem.b), problem.total, effort)?;
         // The displacements' product `C_s f` on every cell, of the returned `f`.
         let v = &self.vectors;
         self.transforms
@@ -226,14 +204,14 @@ impl CudaCore {
         if m > 0 {
             stream
                 .memcpy_dtoh(&v.f.slice(0..m), f.as_mut_slice())
-                .map_err(|e| cuda_error("cuMemcpyDtoH", e))?;
+                .map_err(|e| cuda_error("cuMemcpyDtoH (tractions)", e))?;
         }
         stream
             .memcpy_dtoh(&self.grid, grid_product.as_mut_slice())
-            .map_err(|e| cuda_error("cuMemcpyDtoH", e))?;
+            .map_err(|e| cuda_error("cuMemcpyDtoH (grid product)", e))?;
         stream
             .synchronize()
-            .map_err(|e| cuda_error("cuStreamSynchronize", e))?;
+            .map_err(|e| cuda_error("cuStreamSynchronize (solve results)", e))?;
         Ok(SetSolve {
             f,
             outcome,
@@ -292,6 +270,7 @@ impl CudaCore {
     fn upload_problem(&mut self, problem: SetProblem<'_>, f: &[f64]) -> Result<()> {
         let m = problem.set.len();
         let n = self.plan.grid().len();
+        // Cells and positions are below N, which fits an `int` (`CudaCore::new`).
         let set: Vec<i32> = problem.set.iter().map(|&i| i as i32).collect();
         let mut pos = vec![-1i32; n];
         for (j, &i) in problem.set.iter().enumerate() {
@@ -299,7 +278,7 @@ impl CudaCore {
         }
         let stream = &self.gpu.stream;
         let v = &mut self.vectors;
-        let copy = |e| cuda_error("cuMemcpyHtoD", e);
+        let copy = |e| cuda_error("cuMemcpyHtoD (set problem)", e);
         stream.memcpy_htod(&pos, &mut v.pos).map_err(copy)?;
         if m > 0 {
             stream
@@ -312,6 +291,41 @@ impl CudaCore {
             }
         }
         Ok(())
+    }
+}
+
+/// The spectral rule on the GPU: the host's preconditioner choices and `d̄`, so a
+/// checkpoint resumes across the two backends.
+impl SpectralRule for CudaCore {
+    fn solve(
+        &mut self,
+        problem: SetProblem<'_>,
+        precond: Precond,
+        f: Vec<f64>,
+        effort: Effort,
+    ) -> Result<SetSolve> {
+        CudaCore::solve(self, problem, precond, f, effort)
+    }
+    fn preconditioner_mean(&self) -> Option<f64> {
+        self.inverse.as_ref().map(|(d, _)| *d)
+    }
+    fn restore_preconditioner(&mut self, mean: Option<f64>) -> Result<()> {
+        match mean {
+            Some(d) => self.build_inverse(d),
+            None => {
+                self.inverse = None;
+                Ok(())
+            }
+        }
+    }
+    /// One: the device runs the whole set (the host's threads only build FSAI's table).
+    fn parts(&self) -> usize {
+        1
+    }
+    /// Not tracked on the device (the host's tests ask it of the host's backends).
+    #[cfg(test)]
+    fn built(&self) -> bool {
+        false
     }
 }
 
@@ -328,5 +342,5 @@ impl Drop for CudaCore {
 fn upload(gpu: &Gpu, values: &[f64]) -> Result<CudaSlice<f64>> {
     gpu.stream
         .clone_htod(values)
-        .map_err(|e| cuda_error("cuMemcpyHtoD", e))
+        .map_err(|e| cuda_error("cuMemcpyHtoD (DCT table)", e))
 }

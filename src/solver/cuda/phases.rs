@@ -5,11 +5,12 @@
 use super::coarse::{DeviceCoarse, Target};
 use super::device::cuda_error;
 use super::fsai::DeviceFsai;
-use super::operator::{over, Kernels, Transforms, THREADS};
+use super::kernels::{blocks, int, over, Kernels, THREADS};
+use super::operator::Transforms;
 use super::vectors::{SetVectors, REDUCTION_BLOCKS};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::solver::pcg::{Main, Phase, PhaseRunner, Pre};
-use cudarc::driver::{CudaSlice, CudaStream, LaunchConfig, PushKernelArg};
+use cudarc::driver::{CudaSlice, CudaStream};
 use std::sync::Arc;
 
 /// The preconditioner of a device solve.
@@ -36,9 +37,6 @@ pub(super) struct DevicePhases<'a> {
     pub(super) norm: f64,
     /// The coarse space, when it applies (A-DEF2: pcg.rs).
     pub(super) coarse: Option<&'a mut DeviceCoarse>,
-    /// The first failed CUDA call: later phases do nothing and return NaN, which stops
-    /// the CG; the solve returns this error.
-    pub(super) error: Option<Error>,
 }
 
 /// Which vectors a product reads and writes.
@@ -52,8 +50,10 @@ enum Product {
     Coarse,
 }
 
-impl DevicePhases<'_> {
-    fn try_run(&mut self, phase: Phase) -> Result<[f64; 3]> {
+impl PhaseRunner for DevicePhases<'_> {
+    /// The phase's kernels, FFTs and copies; the first that fails stops the CG with its
+    /// error (`Error::Cuda` naming the call).
+    fn run(&mut self, phase: Phase) -> Result<[f64; 3]> {
         self.pre(phase.pre)?;
         self.prolong(phase.pre)?;
         match phase.main {
@@ -90,6 +90,27 @@ impl DevicePhases<'_> {
         }
     }
 
+    fn product_stages(&self) -> usize {
+        1
+    }
+    fn precondition_stages(&self) -> usize {
+        1
+    }
+    fn norm_bound(&self) -> f64 {
+        self.norm
+    }
+    fn has_coarse(&self) -> bool {
+        self.coarse.as_ref().is_some_and(|c| c.valid())
+    }
+    fn coarse_solve(&mut self) -> Result<()> {
+        match self.coarse.as_deref_mut() {
+            Some(coarse) => coarse.solve(self.stream, self.kernels),
+            None => Ok(()),
+        }
+    }
+}
+
+impl DevicePhases<'_> {
     /// `Zᵀ (r - t)` (`with_t`) or `Zᵀ r`, for the next coarse solve (asked only when the
     /// coarse space applies).
     fn restrict(&mut self, with_t: bool) -> Result<()> {
@@ -156,33 +177,34 @@ impl DevicePhases<'_> {
         if pre.fill_r_one {
             flags |= 512;
         }
-        let Some(cfg) = over(self.m).filter(|_| flags != 0) else {
+        if flags == 0 {
+            return Ok(());
+        }
+        let Some(cfg) = over("sites in the set", self.m)? else {
             return Ok(());
         };
-        let m = self.m as i32;
+        let m = int("sites in the set", self.m)?;
         let v = &mut *self.v;
-        // SAFETY: the argument list matches kernels.cu's pre_updates; every vector holds
-        // at least m values.
+        // SAFETY: every vector holds at least m values.
         unsafe {
-            self.stream
-                .launch_builder(&self.kernels.pre_updates)
-                .arg(&mut v.f)
-                .arg(&mut v.r)
-                .arg(&mut v.z)
-                .arg(&mut v.p)
-                .arg(&v.q)
-                .arg(&mut v.w)
-                .arg(&mut v.best)
-                .arg(&flags)
-                .arg(&shift)
-                .arg(&alpha)
-                .arg(&u)
-                .arg(&beta)
-                .arg(&m)
-                .launch(cfg)
+            self.kernels.pre_updates(
+                self.stream,
+                cfg,
+                &mut v.f,
+                &mut v.r,
+                &mut v.z,
+                &mut v.p,
+                &v.q,
+                &mut v.w,
+                &mut v.best,
+                flags,
+                shift,
+                alpha,
+                u,
+                beta,
+                m,
+            )
         }
-        .map(|_| ())
-        .map_err(|e| cuda_error("pre_updates", e))
     }
 
     /// `q = A p` or `r = A f` (`A = C_SS + diag(d)`).
@@ -201,23 +223,16 @@ impl DevicePhases<'_> {
 
     /// `r += offset - b`.
     fn residual_tail(&mut self, offset: f64) -> Result<()> {
-        let Some(cfg) = over(self.m) else {
+        let Some(cfg) = over("sites in the set", self.m)? else {
             return Ok(());
         };
-        let m = self.m as i32;
+        let m = int("sites in the set", self.m)?;
         let v = &mut *self.v;
-        // SAFETY: the argument list matches kernels.cu; r and b hold at least m values.
+        // SAFETY: r and b hold at least m values.
         unsafe {
-            self.stream
-                .launch_builder(&self.kernels.residual_tail)
-                .arg(&mut v.r)
-                .arg(&v.b)
-                .arg(&offset)
-                .arg(&m)
-                .launch(cfg)
+            self.kernels
+                .residual_tail(self.stream, cfg, &mut v.r, &v.b, offset, m)
         }
-        .map(|_| ())
-        .map_err(|e| cuda_error("residual_tail", e))
     }
 
     /// `z = M⁻¹ r`.
@@ -225,23 +240,15 @@ impl DevicePhases<'_> {
         let v = &mut *self.v;
         match &mut self.precond {
             DevicePrecond::Jacobi { diag_c } => {
-                let Some(cfg) = over(self.m) else {
+                let Some(cfg) = over("sites in the set", self.m)? else {
                     return Ok(());
                 };
-                let m = self.m as i32;
-                // SAFETY: the argument list matches kernels.cu; r, d, z hold m values.
+                let m = int("sites in the set", self.m)?;
+                // SAFETY: r, d, z hold at least m values.
                 unsafe {
-                    self.stream
-                        .launch_builder(&self.kernels.jacobi)
-                        .arg(&v.r)
-                        .arg(&v.d)
-                        .arg(&*diag_c)
-                        .arg(&mut v.z)
-                        .arg(&m)
-                        .launch(cfg)
+                    self.kernels
+                        .jacobi(self.stream, cfg, &v.r, &v.d, *diag_c, &mut v.z, m)
                 }
-                .map(|_| ())
-                .map_err(|e| cuda_error("jacobi", e))
             }
             DevicePrecond::Spectral { table } => {
                 self.transforms
@@ -272,51 +279,50 @@ impl DevicePhases<'_> {
     /// A reduction in a fixed order (kernels.cu's modes: 0 `Σ a`, 1 `aᵀ b`, 2
     /// `[max |a|, max |b|, aᵀ c]`), its three values copied to the host.
     fn reduce(&mut self, mode: i32, a: Vector, b: Vector, c: Vector) -> Result<[f64; 3]> {
-        let blocks = self.m.div_ceil(THREADS as usize).clamp(1, REDUCTION_BLOCKS);
-        let (m, blocks32) = (self.m as i32, blocks as i32);
-        let v = &mut *self.v;
-        let first = LaunchConfig {
-            grid_dim: (blocks as u32, 1, 1),
-            block_dim: (THREADS, 1, 1),
-            shared_mem_bytes: 0,
+        let count = self.m.div_ceil(THREADS as usize).clamp(1, REDUCTION_BLOCKS);
+        let (m, count32) = (
+            int("sites in the set", self.m)?,
+            int("reduction blocks", count)?,
+        );
+        let (first, last) = (blocks("reduction blocks", count)?, blocks("one block", 1)?);
+        let SetVectors {
+            f,
+            r,
+            z,
+            p,
+            q,
+            partials,
+            scalars,
+            ..
+        } = &mut *self.v;
+        let (f, r, z, p, q) = (&*f, &*r, &*z, &*p, &*q);
+        let of = move |which: Vector| -> &CudaSlice<f64> {
+            match which {
+                Vector::F => f,
+                Vector::R => r,
+                Vector::Z => z,
+                Vector::P => p,
+                Vector::Q => q,
+            }
         };
-        let last = LaunchConfig {
-            grid_dim: (1, 1, 1),
-            ..first
-        };
-        let (a, b, c) = (a.of(v), b.of(v), c.of(v));
-        // SAFETY: the argument lists match kernels.cu; a, b, c hold at least m values,
-        // `partials` 3 per block, `scalars` 3.
+        let (a, b, c) = (of(a), of(b), of(c));
+        // SAFETY: a, b, c hold at least m values, `partials` 3 per block, `scalars` 3.
         unsafe {
-            self.stream
-                .launch_builder(&self.kernels.reduce_partial)
-                .arg(&mode)
-                .arg(a)
-                .arg(b)
-                .arg(c)
-                .arg(&m)
-                .arg(&v.partials)
-                .launch(first)
-        }
-        .map_err(|e| cuda_error("reduce_partial", e))?;
+            self.kernels
+                .reduce_partial(self.stream, first, mode, a, b, c, m, partials)
+        }?;
         // SAFETY: as above.
         unsafe {
-            self.stream
-                .launch_builder(&self.kernels.reduce_final)
-                .arg(&mode)
-                .arg(&v.partials)
-                .arg(&blocks32)
-                .arg(&v.scalars)
-                .launch(last)
-        }
-        .map_err(|e| cuda_error("reduce_final", e))?;
+            self.kernels
+                .reduce_final(self.stream, last, mode, partials, count32, scalars)
+        }?;
         let mut out = [0.0f64; 3];
         self.stream
-            .memcpy_dtoh(&v.scalars, out.as_mut_slice())
-            .map_err(|e| cuda_error("cuMemcpyDtoH", e))?;
+            .memcpy_dtoh(scalars, out.as_mut_slice())
+            .map_err(|e| cuda_error("cuMemcpyDtoH (reduction)", e))?;
         self.stream
             .synchronize()
-            .map_err(|e| cuda_error("cuStreamSynchronize", e))?;
+            .map_err(|e| cuda_error("cuStreamSynchronize (reduction)", e))?;
         Ok(out)
     }
 }
@@ -329,53 +335,4 @@ enum Vector {
     Z,
     P,
     Q,
-}
-
-impl Vector {
-    fn of(self, v: &SetVectors) -> &CudaSlice<f64> {
-        match self {
-            Vector::F => &v.f,
-            Vector::R => &v.r,
-            Vector::Z => &v.z,
-            Vector::P => &v.p,
-            Vector::Q => &v.q,
-        }
-    }
-}
-
-impl PhaseRunner for DevicePhases<'_> {
-    fn run(&mut self, phase: Phase) -> [f64; 3] {
-        if self.error.is_some() {
-            return [f64::NAN; 3];
-        }
-        match self.try_run(phase) {
-            Ok(values) => values,
-            Err(e) => {
-                self.error = Some(e);
-                [f64::NAN; 3]
-            }
-        }
-    }
-    fn product_stages(&self) -> usize {
-        1
-    }
-    fn precondition_stages(&self) -> usize {
-        1
-    }
-    fn norm_bound(&self) -> f64 {
-        self.norm
-    }
-    fn has_coarse(&self) -> bool {
-        self.coarse.as_ref().is_some_and(|c| c.valid())
-    }
-    fn coarse_solve(&mut self) {
-        if self.error.is_some() {
-            return;
-        }
-        if let Some(coarse) = self.coarse.as_deref_mut() {
-            if let Err(e) = coarse.solve(self.stream, self.kernels) {
-                self.error = Some(e);
-            }
-        }
-    }
 }

@@ -1,0 +1,570 @@
+//! The kernels of kernels.cu as Rust sees them: each one's parameter list declared once
+//! ([`kernels!`] below), from which come both its typed launch function
+//! (`Kernels::scatter_rows(..)`, the bindings' argument list written by the macro, not by
+//! hand) and the declaration a test checks against kernels.cu's `extern "C"` signature
+//! (names, count, types). Also: the threads per block ([`THREADS`], passed to NVRTC and
+//! to the emulator's C++ compiler as `-DTHREADS`), the launch shapes with their sizes
+//! checked against the 32-bit integers the kernels and the driver take, and NVRTC.
+//!
+//! What a typed launch does not check: that the buffers hold the values the kernel reads
+//! and writes. That stays each caller's `unsafe` obligation.
+
+use super::device::{cuda_error, guarded, Gpu};
+use crate::error::{Error, Result};
+use cudarc::cufft::sys::double2;
+use cudarc::driver::{CudaFunction, CudaSlice, CudaStream, LaunchConfig, PushKernelArg};
+use cudarc::nvrtc::{compile_ptx_with_opts, CompileOptions, Ptx};
+use std::sync::OnceLock;
+
+/// The kernels' source (NVRTC compiles it when a solver is built; it has no `THREADS` of
+/// its own).
+pub(super) const SOURCE: &str = include_str!("kernels.cu");
+
+/// Threads per block: every launch's block size and kernels.cu's `THREADS` (its shared
+/// memory trees and grid-stride loops), one value for both.
+pub(super) const THREADS: u32 = 256;
+
+/// The compiler option that gives kernels.cu its `THREADS` (NVRTC's and the emulator's
+/// `c++` alike).
+pub(super) fn threads_define(threads: u32) -> String {
+    format!("-DTHREADS={threads}")
+}
+
+/// `value` as the kernels' `int`, else [`Error::DeviceLimit`] naming `what`.
+pub(super) fn int(what: &'static str, value: usize) -> Result<i32> {
+    i32::try_from(value).map_err(|_| Error::DeviceLimit {
+        what,
+        value: value as u64,
+        limit: i32::MAX as u64,
+    })
+}
+
+/// `blocks` blocks of [`THREADS`] threads (a grid's x dimension is a `u32`).
+pub(super) fn blocks(what: &'static str, blocks: usize) -> Result<LaunchConfig> {
+    let grid = u32::try_from(blocks).map_err(|_| Error::DeviceLimit {
+        what,
+        value: blocks as u64,
+        limit: u32::MAX as u64,
+    })?;
+    Ok(LaunchConfig {
+        grid_dim: (grid, 1, 1),
+        block_dim: (THREADS, 1, 1),
+        shared_mem_bytes: 0,
+    })
+}
+
+/// One thread per element of `n`, `None` for none (a launch of no blocks is an error).
+/// The kernels index the elements with an `int`, so `n` must fit one.
+pub(super) fn over(what: &'static str, n: usize) -> Result<Option<LaunchConfig>> {
+    if n == 0 {
+        return Ok(None);
+    }
+    int(what, n)?;
+    blocks(what, n.div_ceil(THREADS as usize)).map(Some)
+}
+
+/// How a kernel parameter is passed.
+#[cfg(test)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Pass {
+    /// `const T*`: a buffer the kernel reads.
+    In,
+    /// `T*`: a buffer the kernel writes (and may read).
+    Out,
+    /// `T`: a value.
+    Val,
+}
+
+/// An element or value type shared with kernels.cu, and its C name there.
+#[cfg(test)]
+pub(super) trait Scalar {
+    /// The C type.
+    const C: &'static str;
+}
+
+#[cfg(test)]
+impl Scalar for f64 {
+    const C: &'static str = "double";
+}
+#[cfg(test)]
+impl Scalar for i32 {
+    const C: &'static str = "int";
+}
+#[cfg(test)]
+impl Scalar for u32 {
+    const C: &'static str = "unsigned";
+}
+#[cfg(test)]
+impl Scalar for i64 {
+    const C: &'static str = "long long";
+}
+#[cfg(test)]
+impl Scalar for double2 {
+    const C: &'static str = "double2";
+}
+
+/// One parameter of a kernel as declared on the Rust side.
+#[cfg(test)]
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Param {
+    pub(super) name: &'static str,
+    pub(super) pass: Pass,
+    /// The C name of its type ([`Scalar::C`]).
+    pub(super) scalar: &'static str,
+}
+
+#[cfg(test)]
+impl Param {
+    /// The C type this parameter must have in kernels.cu.
+    pub(super) fn c_type(&self) -> String {
+        match self.pass {
+            Pass::In => format!("const {}*", self.scalar),
+            Pass::Out => format!("{}*", self.scalar),
+            Pass::Val => self.scalar.to_string(),
+        }
+    }
+}
+
+/// One kernel as declared on the Rust side.
+#[cfg(test)]
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Declaration {
+    pub(super) name: &'static str,
+    pub(super) params: &'static [Param],
+}
+
+/// The Rust type of a launch argument.
+macro_rules! arg_type {
+    (In, $t:ty) => { &CudaSlice<$t> };
+    (Out, $t:ty) => { &mut CudaSlice<$t> };
+    (Val, $t:ty) => { $t };
+}
+
+/// Pushes a launch argument (the bindings take buffers by reference, values by a
+/// reference to a live copy).
+macro_rules! push_arg {
+    ($builder:ident, In, $v:ident) => {
+        $builder.arg($v)
+    };
+    ($builder:ident, Out, $v:ident) => {
+        $builder.arg($v)
+    };
+    ($builder:ident, Val, $v:ident) => {
+        $builder.arg(&$v)
+    };
+}
+
+/// Declares the kernels: each one's parameters as `name: Pass<type>`, in kernels.cu's
+/// order. Generates [`DECLARATIONS`], the [`Kernels`] that loads them and one typed,
+/// `unsafe` launch function per kernel.
+macro_rules! kernels {
+    ($( $name:ident ( $( $p:ident : $pass:ident < $t:ty > ),* $(,)? ); )*) => {
+        /// Every kernel of kernels.cu, as the launch functions pass their arguments (the
+        /// tests' check against its signatures).
+        #[cfg(test)]
+        pub(super) const DECLARATIONS: &[Declaration] = &[$(
+            Declaration {
+                name: stringify!($name),
+                params: &[$( Param {
+                    name: stringify!($p),
+                    pass: Pass::$pass,
+                    scalar: <$t as Scalar>::C,
+                } ),*],
+            }
+        ),*];
+
+        /// The compiled kernels, one typed launch function each.
+        pub(super) struct Kernels {
+            $( $name: CudaFunction, )*
+        }
+
+        impl Kernels {
+            /// Loads every declared kernel from `module`.
+            fn load(
+                module: &std::sync::Arc<cudarc::driver::CudaModule>,
+                unavailable: impl Fn(String) -> Error,
+            ) -> Result<Self> {
+                Ok(Kernels {$(
+                    $name: module.load_function(stringify!($name)).map_err(|e| {
+                        unavailable(format!(
+                            "kernel {} is missing from the module: {e}",
+                            stringify!($name)
+                        ))
+                    })?,
+                )*})
+            }
+
+            $(
+                #[doc = concat!("Launches kernels.cu's `", stringify!($name), "` on `stream`.")]
+                ///
+                /// # Safety
+                /// Every buffer holds the values the kernel reads or writes under `cfg`
+                /// (kernels.cu says which). The argument types are the declaration's.
+                #[allow(clippy::too_many_arguments)]
+                pub(super) unsafe fn $name(
+                    &self,
+                    stream: &CudaStream,
+                    cfg: LaunchConfig,
+                    $( $p: arg_type!($pass, $t), )*
+                ) -> Result<()> {
+                    let mut builder = stream.launch_builder(&self.$name);
+                    $( push_arg!(builder, $pass, $p); )*
+                    // SAFETY: the argument list is the declaration's, which the tests
+                    // check against kernels.cu; the buffers' sizes are the caller's.
+                    unsafe { builder.launch(cfg) }
+                        .map(|_| ())
+                        .map_err(|e| cuda_error(stringify!($name), e))
+                }
+            )*
+        }
+    };
+}
+
+kernels! {
+    scatter_rows(x: In<f64>, pos: In<i32>, v: Out<f64>, nx: Val<i32>, ny: Val<i32>);
+    rows_to_columns(spec: In<double2>, u: Out<f64>, nx: Val<i32>, ny: Val<i32>);
+    filter_columns(
+        spec: In<double2>, table: In<f64>, out: Out<double2>, nx: Val<i32>, ny: Val<i32>,
+    );
+    columns_to_rows(w: In<f64>, out: Out<double2>, nx: Val<i32>, ny: Val<i32>);
+    gather_set(
+        s: In<f64>, set: In<i32>, d: In<f64>, x: In<f64>, y: Out<f64>, with_d: Val<i32>,
+        m: Val<i32>, nx: Val<i32>,
+    );
+    gather_grid(s: In<f64>, out: Out<f64>, nx: Val<i32>, ny: Val<i32>);
+    residual_tail(r: Out<f64>, b: In<f64>, offset: Val<f64>, m: Val<i32>);
+    jacobi(r: In<f64>, d: In<f64>, diag_c: Val<f64>, z: Out<f64>, m: Val<i32>);
+    pre_updates(
+        f: Out<f64>, r: Out<f64>, z: Out<f64>, p: Out<f64>, q: In<f64>, w: Out<f64>,
+        best: Out<f64>, flags: Val<i32>, shift: Val<f64>, alpha: Val<f64>, u: Val<f64>,
+        beta: Val<f64>, m: Val<i32>,
+    );
+    reduce_partial(
+        mode: Val<i32>, a: In<f64>, b: In<f64>, c: In<f64>, m: Val<i32>, partials: Out<f64>,
+    );
+    reduce_final(mode: Val<i32>, partials: In<f64>, blocks: Val<i32>, out: Out<f64>);
+    fsai_scatter(
+        cells: In<i32>, weights: In<f64>, count: Val<i32>, planes: Out<f64>, stride: Val<i32>,
+        n: Val<i32>,
+    );
+    fsai_g(
+        planes: In<f64>, offsets: In<i32>, stride: Val<i32>, set: In<i32>, pos: In<i32>,
+        r: In<f64>, y: Out<f64>, m: Val<i32>, n: Val<i32>,
+    );
+    fsai_gt(
+        planes: In<f64>, offsets: In<i32>, stride: Val<i32>, set: In<i32>, pos: In<i32>,
+        y: In<f64>, z: Out<f64>, m: Val<i32>, n: Val<i32>,
+    );
+    coarse_indicator(
+        set: In<i32>, m: Val<i32>, nx: Val<i32>, block: Val<i32>, bx: Val<i32>, a: Val<i32>,
+        x: Out<f64>,
+    );
+    coarse_restrict(
+        v: In<f64>, t: In<f64>, subtract: Val<i32>, pos: In<i32>, nx: Val<i32>, ny: Val<i32>,
+        block: Val<i32>, bx: Val<i32>, out: Out<f64>, column: Val<i32>, count: Val<i32>,
+    );
+    coarse_fix_empty(e: Out<f64>, c: In<f64>, count: Val<i32>);
+    coarse_factor(l: Out<f64>, k: Val<i32>, info: Out<f64>);
+    coarse_invert(l: In<f64>, k: Val<i32>, inv: Out<f64>);
+    coarse_border(inv: In<f64>, c: In<f64>, k: Val<i32>, w: Out<f64>, info: Out<f64>);
+    coarse_solve(
+        inv: In<f64>, g: In<f64>, c: In<f64>, w: In<f64>, info: In<f64>, k: Val<i32>,
+        sol: Out<f64>,
+    );
+    coarse_prolong(
+        x: Out<f64>, sol: In<f64>, sign: Val<f64>, set: In<i32>, m: Val<i32>, nx: Val<i32>,
+        block: Val<i32>, bx: Val<i32>,
+    );
+}
+
+impl Kernels {
+    /// Compiles kernels.cu (once per process) and loads its functions on `gpu`.
+    pub(super) fn compile(gpu: &Gpu) -> Result<Self> {
+        let unavailable = |reason: String| Error::CudaUnavailable {
+            reason,
+            hint: "report it with the output of `precursors info` (docs/gpu.md); use backend \
+                   \"spectral\" meanwhile"
+                .into(),
+        };
+        // Compiled once per process (NVRTC takes about 250 ms; the backend uses device 0
+        // only, so one compute capability), loaded per solver.
+        static IMAGE: OnceLock<((u32, u32), std::result::Result<Ptx, String>)> = OnceLock::new();
+        let capability = gpu.info.compute_capability;
+        let (compiled_for, image) = IMAGE.get_or_init(|| (capability, compile(capability)));
+        let ptx = if *compiled_for == capability {
+            image.clone()
+        } else {
+            compile(capability)
+        }
+        .map_err(unavailable)?;
+        let module = guarded("loading the kernels", || {
+            gpu.ctx
+                .load_module(ptx)
+                .map_err(|e| format!("the driver does not load the compiled kernels: {e}"))
+        })
+        .map_err(unavailable)?;
+        Kernels::load(&module, unavailable)
+    }
+}
+
+/// kernels.cu compiled for the GPU's architecture (`sm_XY`, a binary the driver loads as
+/// it is), else as PTX for the driver to compile. Why a binary first: PTX carries the
+/// ISA version of the NVRTC that wrote it, which a driver older than that NVRTC refuses
+/// (`CUDA_ERROR_UNSUPPORTED_PTX_VERSION`); a binary of the same major version loads.
+fn compile((major, minor): (u32, u32)) -> std::result::Result<Ptx, String> {
+    guarded("compiling the kernels (NVRTC)", || {
+        let binary = compile_binary(major, minor);
+        binary.map(Ptx::from_binary).or_else(|binary_error| {
+            let options = CompileOptions {
+                name: Some("precursors_kernels.cu".into()),
+                options: vec![threads_define(THREADS)],
+                ..Default::default()
+            };
+            compile_ptx_with_opts(SOURCE, options).map_err(|e| {
+                format!(
+                    "the kernels do not compile with NVRTC (for sm_{major}{minor}: \
+                     {binary_error}; as PTX: {e:?})"
+                )
+            })
+        })
+    })
+}
+
+/// kernels.cu as a binary for `sm_{major}{minor}` (NVRTC's `nvrtcGetCUBIN`, which the
+/// bindings' safe API does not wrap).
+fn compile_binary(major: u32, minor: u32) -> std::result::Result<Vec<u8>, String> {
+    use cudarc::nvrtc::{result, sys};
+    use std::ffi::{CStr, CString};
+    let source = CString::new(SOURCE).map_err(|e| e.to_string())?;
+    let name = CString::new("precursors_kernels.cu").map_err(|e| e.to_string())?;
+    let program = result::create_program(&source, Some(&name)).map_err(|e| e.to_string())?;
+    let options = [
+        format!("--gpu-architecture=sm_{major}{minor}"),
+        threads_define(THREADS),
+    ];
+    // SAFETY: `program` is a live NVRTC program until destroyed below; the log and the
+    // binary are read into buffers of the sizes NVRTC reports.
+    let outcome = unsafe {
+        match result::compile_program(program, &options) {
+            Err(e) => {
+                let log = result::get_program_log(program)
+                    .map(|log| CStr::from_ptr(log.as_ptr()).to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                Err(format!("{e:?}: {log}"))
+            }
+            Ok(()) => {
+                let mut size = 0usize;
+                sys::nvrtcGetCUBINSize(program, &mut size)
+                    .result()
+                    .and_then(|()| {
+                        let mut binary = vec![0u8; size];
+                        sys::nvrtcGetCUBIN(program, binary.as_mut_ptr().cast())
+                            .result()
+                            .map(|()| binary)
+                    })
+                    .map_err(|e| format!("{e:?}"))
+            }
+        }
+    };
+    // SAFETY: destroyed once, after its last use.
+    let _ = unsafe { result::destroy_program(program) };
+    outcome
+}
+
+/// The `extern "C"` kernels of a CUDA source: each one's name and its parameters as
+/// `(C type, name)`, the type's spacing normalised (`const double*`). Comments are not
+/// parsed: kernels.cu keeps none inside a signature.
+#[cfg(test)]
+pub(super) fn signatures(source: &str) -> Vec<(String, Vec<(String, String)>)> {
+    const START: &str = "extern \"C\" __global__ void ";
+    let mut out = Vec::new();
+    let mut rest = source;
+    while let Some(at) = rest.find(START) {
+        rest = &rest[at + START.len()..];
+        let open = rest.find('(').expect("a kernel's parameter list");
+        let close = rest.find(')').expect("a kernel's parameter list closed");
+        let name = rest[..open].trim().to_string();
+        let params = rest[open + 1..close]
+            .split(',')
+            .filter(|p| !p.trim().is_empty())
+            .map(|p| {
+                let spaced = p.replace('*', " * ");
+                let mut tokens: Vec<&str> = spaced.split_whitespace().collect();
+                let name = tokens.pop().unwrap_or_default().to_string();
+                let c_type = tokens.join(" ").replace(" *", "*");
+                (c_type, name)
+            })
+            .collect();
+        out.push((name, params));
+        rest = &rest[close..];
+    }
+    out
+}
+
+/// Every declaration against `source`'s signatures, and every kernel of `source`
+/// declared: the first difference, if any.
+#[cfg(test)]
+pub(super) fn check_declarations(
+    source: &str,
+    declarations: &[Declaration],
+) -> std::result::Result<(), String> {
+    let found = signatures(source);
+    for (name, _) in &found {
+        if !declarations.iter().any(|d| d.name == name) {
+            return Err(format!(
+                "kernel {name} of kernels.cu has no Rust declaration"
+            ));
+        }
+    }
+    for d in declarations {
+        let Some((_, params)) = found.iter().find(|(name, _)| name == d.name) else {
+            return Err(format!("{} is declared but not in kernels.cu", d.name));
+        };
+        if params.len() != d.params.len() {
+            return Err(format!(
+                "{}: {} parameters in kernels.cu, {} declared",
+                d.name,
+                params.len(),
+                d.params.len()
+            ));
+        }
+        for (k, ((c_type, c_name), p)) in params.iter().zip(d.params).enumerate() {
+            if *c_type != p.c_type() || c_name != p.name {
+                return Err(format!(
+                    "{} parameter {k}: `{c_type} {c_name}` in kernels.cu, `{} {}` declared",
+                    d.name,
+                    p.c_type(),
+                    p.name
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_kernel_is_declared_as_kernels_cu_signs_it() {
+        assert_eq!(signatures(SOURCE).len(), DECLARATIONS.len());
+        assert_eq!(DECLARATIONS.len(), 22);
+        check_declarations(SOURCE, DECLARATIONS).unwrap();
+    }
+
+    /// Planted differences, one of each kind, each caught.
+    #[test]
+    fn a_planted_mismatch_fails_the_check() {
+        let plant = |from: &str, to: &str| {
+            assert!(SOURCE.contains(from), "{from}");
+            let planted = SOURCE.replacen(from, to, 1);
+            check_declarations(&planted, DECLARATIONS).unwrap_err()
+        };
+        // A size as a 64-bit integer.
+        let e = plant(
+            "scatter_rows(const double* x, const int* pos, double* v, int nx, int ny)",
+            "scatter_rows(const double* x, const int* pos, double* v, long long nx, int ny)",
+        );
+        assert!(e.contains("scatter_rows parameter 3"), "{e}");
+        // A written buffer made const, a const one written.
+        let e = plant("jacobi(const double* r", "jacobi(double* r");
+        assert!(e.contains("jacobi parameter 0"), "{e}");
+        let e = plant("residual_tail(double* r", "residual_tail(const double* r");
+        assert!(e.contains("residual_tail parameter 0"), "{e}");
+        // double for double2, unsigned for int.
+        let e = plant(
+            "rows_to_columns(const double2* spec",
+            "rows_to_columns(const double* spec",
+        );
+        assert!(e.contains("rows_to_columns parameter 0"), "{e}");
+        let e = plant(
+            "coarse_factor(double* l, int k",
+            "coarse_factor(double* l, unsigned k",
+        );
+        assert!(e.contains("coarse_factor parameter 1"), "{e}");
+        // A value for a pointer.
+        let e = plant("double offset, int m", "double* offset, int m");
+        assert!(e.contains("residual_tail parameter 2"), "{e}");
+        // Two parameters swapped (same types: only the names tell).
+        let e = plant(
+            "columns_to_rows(const double* w, double2* out, int nx, int ny)",
+            "columns_to_rows(const double* w, double2* out, int ny, int nx)",
+        );
+        assert!(e.contains("columns_to_rows parameter 2"), "{e}");
+        // One parameter more, one kernel renamed, one kernel added.
+        let e = plant(
+            "int with_d, int m, int nx)",
+            "int with_d, int m, int nx, int ny)",
+        );
+        assert!(
+            e.contains("gather_set: 9 parameters in kernels.cu, 8 declared"),
+            "{e}"
+        );
+        let e = plant("void fsai_gt(", "void fsai_g_transposed(");
+        assert!(e.contains("fsai_g_transposed"), "{e}");
+        let e = check_declarations(
+            &format!("{SOURCE}\nextern \"C\" __global__ void extra(int m) {{}}\n"),
+            DECLARATIONS,
+        )
+        .unwrap_err();
+        assert!(
+            e.contains("kernel extra of kernels.cu has no Rust declaration"),
+            "{e}"
+        );
+        // A declaration with a parameter of the wrong type, against the true source.
+        let mut wrong = DECLARATIONS.to_vec();
+        let params: &'static [Param] = Box::leak(
+            wrong[0]
+                .params
+                .iter()
+                .map(|p| Param {
+                    scalar: if p.name == "ny" { u32::C } else { p.scalar },
+                    ..*p
+                })
+                .collect(),
+        );
+        wrong[0].params = params;
+        let e = check_declarations(SOURCE, &wrong).unwrap_err();
+        assert!(
+            e.contains("`int ny` in kernels.cu, `unsigned ny` declared"),
+            "{e}"
+        );
+    }
+
+    /// kernels.cu has no block size of its own: without the define it does not compile
+    /// (the guard), so the Rust constant is the only one.
+    #[test]
+    fn threads_come_from_the_rust_constant_only() {
+        assert!(SOURCE.contains("#ifndef THREADS\n#error"));
+        assert!(!SOURCE.contains("#define THREADS"));
+        assert_eq!(threads_define(THREADS), "-DTHREADS=256");
+    }
+
+    #[test]
+    fn sizes_past_the_kernels_integers_are_errors() {
+        assert_eq!(int("m", 7).unwrap(), 7);
+        let limit = i32::MAX as usize;
+        assert_eq!(int("m", limit).unwrap(), i32::MAX);
+        let e = int("sites in the set", limit + 1).unwrap_err();
+        assert!(
+            matches!(e, Error::DeviceLimit { what: "sites in the set", value, limit }
+                if value == 1 << 31 && limit == (1 << 31) - 1),
+            "{e:?}"
+        );
+        assert!(over("m", 0).unwrap().is_none());
+        let one = over("m", 1).unwrap().unwrap();
+        assert_eq!((one.grid_dim, one.block_dim), ((1, 1, 1), (THREADS, 1, 1)));
+        let last = over("m", limit).unwrap().unwrap();
+        assert_eq!(last.grid_dim.0, (limit as u32).div_ceil(THREADS));
+        assert!(matches!(
+            over("m", limit + 1),
+            Err(Error::DeviceLimit { .. })
+        ));
+        assert_eq!(blocks("b", u32::MAX as usize).unwrap().grid_dim.0, u32::MAX);
+        assert!(matches!(
+            blocks("b", u32::MAX as usize + 1),
+            Err(Error::DeviceLimit { what: "b", .. })
+        ));
+    }
+}
