@@ -753,6 +753,7 @@ fn a_cuda_scene_without_a_gpu_says_what_is_missing() {
 /// 140 mm and the calibration's 3.5 kN, a 140 m block under 3.6 Pa, ran to global slip
 /// with 5 of 980 sites in contact) is refused, by cell size or count, from the builder, a
 /// scene file and the program, naming the likely mistake and the key that confirms it.
+#[cfg(feature = "cli")]
 #[test]
 fn a_block_in_millimetres_is_refused_unless_confirmed() {
     use crate::common::program::{path, precursors, stderr};
