@@ -75,7 +75,7 @@ fn run() -> report::Outcome {
         let mut out = std::io::BufWriter::new(std::fs::File::create(&csv)?);
         writeln!(
             out,
-            "force_over_mu_fn,precursor_over_lx,real_contact_area_m2,ruptures,\
+            "force_over_mu_FN,precursor_over_Lx,real_contact_area_m2,ruptures,\
              area_exceeds_nominal"
         )?;
         for (f, l, a, r, x) in &rows {
