@@ -544,8 +544,10 @@ fn fit_with<R: Send>(
 ///   cut-off law on its own tail; the percentile interval at `confidence` of `α` and of
 ///   `1/λ`.
 ///
-/// Single-threaded and seeded: the same samples (in any order), support and options give
-/// the same comparison bit for bit. Cost: [`fit_power_law`]'s plus `1 + bootstrap` fits
+/// Seeded, one random stream per bootstrap resample and per synthetic set, made on the
+/// threads of the current rayon pool (`ThreadPool::install` chooses them): the same
+/// samples (in any order), support and options give the same comparison bit for bit,
+/// on any number of threads ([`fit_power_law`] alike). Cost: [`fit_power_law`]'s plus `1 + bootstrap` fits
 /// of the cut-off law (an optimisation over the tail's means, independent of its size for
 /// reals; for integers each likelihood sums up to 2000 terms).
 ///
@@ -1589,7 +1591,6 @@ fn goodness_of_fit(
         Support::Discrete => Some(DiscreteLaw::new(fit.alpha, fit.x_min)),
         Support::Continuous => None,
     };
-    let exponent = -1.0 / (fit.alpha - 1.0);
     let sets = options.goodness_samples;
     let exceed = replicas(sets, progress, |i, s| {
         let mut rng = replica_rng(options.seed, GOODNESS_STREAM, i);
@@ -1612,42 +1613,56 @@ fn goodness_of_fit(
                 set.push(runs.values[g], runs.logs[g], c);
             }
         }
-        // Sorted uniforms: with E_0..E_m exponential and T_k = Σ_{i ≥ k} E_i, the
-        // T_k / T_0 (k = 1..m) fall as the order statistics of m uniforms on (0, 1).
-        // Summed from the top, the small ones keep their relative precision.
-        s.spacings.clear();
-        s.spacings
-            .extend((0..=m).map(|_| rng.sample::<f64, _>(rand_distr::Exp1)));
-        for k in (0..m).rev() {
-            s.spacings[k] += s.spacings[k + 1];
-        }
-        let total = s.spacings[0];
-        let mut last = fit.x_min;
-        let mut step = 0;
-        for &t in &s.spacings[1..] {
-            // A survival probability u in (0, 1), falling: the draws rise.
-            let u = t / total;
-            let x = match &law {
-                Some(law) => law.draw_from(u, &mut step),
-                None => {
-                    let x = fit.x_min * (exponent * u.ln()).exp();
-                    if x.is_finite() {
-                        x
-                    } else {
-                        f64::MAX
-                    }
-                }
-            };
-            // Rounding must not unsort the draws.
-            last = last.max(x);
-            set.push(last, last.ln(), 1);
-        }
+        sorted_draws(m, fit, law.as_ref(), &mut rng, &mut s.spacings, &mut set);
         // One value only: a point mass, fitted perfectly in the limit α → ∞ (D = 0).
         let ks = fit_runs(&set, support, min_tail, s).map_or(0.0, |f| f.ks);
         s.synthetic = set;
         ks >= fit.ks
     });
     exceed.iter().filter(|&&e| e).count() as f64 / sets as f64
+}
+
+/// Appends to `set` (whose values are all below `fit.x_min`) `m` draws of the fitted
+/// law above `fit.x_min` (`law` for counts, the continuous law without), in ascending
+/// order: with `E_0..E_m` exponential and `T_k = Σ_{i ≥ k} E_i`, the `T_k / T_0`
+/// (`k = 1..m`) fall as the order statistics of `m` uniforms on (0, 1), and the law's
+/// inverse survival function turns them into rising draws. Summed from the top, the
+/// small ones keep their relative precision.
+fn sorted_draws(
+    m: usize,
+    fit: &TailFit,
+    law: Option<&DiscreteLaw>,
+    rng: &mut Xoshiro256PlusPlus,
+    spacings: &mut Vec<f64>,
+    set: &mut Runs,
+) {
+    spacings.clear();
+    spacings.extend((0..=m).map(|_| rng.sample::<f64, _>(rand_distr::Exp1)));
+    for k in (0..m).rev() {
+        spacings[k] += spacings[k + 1];
+    }
+    let total = spacings[0];
+    let exponent = -1.0 / (fit.alpha - 1.0);
+    let mut last = fit.x_min;
+    let mut step = 0;
+    for &t in &spacings[1..] {
+        // A survival probability u in (0, 1), falling: the draws rise.
+        let u = t / total;
+        let x = match law {
+            Some(law) => law.draw_from(u, &mut step),
+            None => {
+                let x = fit.x_min * (exponent * u.ln()).exp();
+                if x.is_finite() {
+                    x
+                } else {
+                    f64::MAX
+                }
+            }
+        };
+        // Rounding must not unsort the draws.
+        last = last.max(x);
+        set.push(last, last.ln(), 1);
+    }
 }
 
 /// The percentile interval `(1 ∓ confidence) / 2` of `values` (sorted in place): the
@@ -2299,6 +2314,166 @@ mod tests {
                 ..
             }
         ));
+    }
+
+    /// The search as it was before runs, blocks and probes (issue 54 item 5): every
+    /// candidate of the 1 % grid with `α` from a compensated sum of `ln x` sample by
+    /// sample and `D` from a plain pass over all its runs, no early stop. The reference
+    /// of [`the_fast_search_equals_the_plain_scan`].
+    fn plain_search(xs: &[f64], support: Support, min_tail: usize) -> (f64, f64, f64) {
+        let n = xs.len();
+        let mut suffix = vec![(0.0, 0.0); n + 1];
+        for i in (0..n).rev() {
+            let (hi, lo) = suffix[i + 1];
+            let (sum, err) = two_sum(hi, xs[i].ln());
+            suffix[i] = (sum, lo + err);
+        }
+        let mut starts: Vec<usize> = (0..n).filter(|&i| i == 0 || xs[i - 1] != xs[i]).collect();
+        starts.push(n);
+        let (mut best, mut last) = ((f64::NAN, f64::NAN, f64::INFINITY), None::<usize>);
+        for g in 0..starts.len() - 2 {
+            let (start, tail) = (starts[g], n - starts[g]);
+            if tail < min_tail {
+                break;
+            }
+            if last.is_some_and(|l| tail * 100 > l * 99) {
+                continue;
+            }
+            last = Some(tail);
+            let (t, x_min) = (tail as f64, xs[start]);
+            let (alpha, cdf): (f64, Box<dyn Fn(f64) -> f64>) = match support {
+                Support::Continuous => {
+                    let (hi, lo) = suffix[start];
+                    let product = t * x_min.ln();
+                    let sum = (hi - product) + (lo - t.mul_add(x_min.ln(), -product));
+                    let alpha = 1.0 + t / sum;
+                    (
+                        alpha,
+                        Box::new(move |x: f64| -((1.0 - alpha) * (x.ln() - x_min.ln())).exp_m1()),
+                    )
+                }
+                _ => {
+                    let alpha = discrete_mle(x_min, (suffix[start].0 + suffix[start].1) / t);
+                    let norm = hurwitz_zeta(alpha, x_min);
+                    (alpha, Box::new(move |x: f64| 1.0 - hurwitz_zeta(alpha, x + 1.0) / norm))
+                }
+            };
+            let mut d = 0.0f64;
+            for w in starts[g..].windows(2) {
+                let (below, at) = ((w[0] - start) as f64 / t, (w[1] - start) as f64 / t);
+                let x = xs[w[0]];
+                match support {
+                    Support::Continuous => {
+                        let p = cdf(x);
+                        d = d.max((below - p).abs()).max((at - p).abs());
+                    }
+                    _ => {
+                        d = d.max((at - cdf(x)).abs());
+                        if w[1] < n && xs[w[1]] > x + 1.0 {
+                            d = d.max((at - cdf(xs[w[1]] - 1.0)).abs());
+                        }
+                    }
+                }
+            }
+            if d < best.2 {
+                best = (x_min, alpha, d);
+            }
+        }
+        best
+    }
+
+    #[test]
+    fn the_fast_search_equals_the_plain_scan() {
+        // 30 000 samples: tails of many thousand runs, so the blocked passes and the
+        // probes are used; reals rounded to 4 digits in part, so runs of equal samples
+        // occur in both supports.
+        for seed in 0..3 {
+            let mut reals: Vec<f64> = pareto(2.4, 1.0, 24_000, 40 + seed);
+            reals.extend((0..6_000).map(|i| 0.5 + (i as f64 * 0.618_034).fract() * 0.5));
+            for x in reals.iter_mut().step_by(3) {
+                *x = (*x * 1e4).round() / 1e4;
+            }
+            let mut counts = zeta_samples(2.1, 30_000, 50 + seed);
+            for (support, xs) in [(Support::Continuous, &mut reals), (Support::Discrete, &mut counts)] {
+                xs.sort_unstable_by(f64::total_cmp);
+                let (x_min, alpha, d) = plain_search(xs, support, 10);
+                let fit = fit_runs(&Runs::from_sorted(xs), support, 10, &mut Scratch::default())
+                    .unwrap();
+                assert_eq!(fit.x_min, x_min, "{support:?} {seed}");
+                // Counts of equal samples enter the sums as products (exact by fma)
+                // rather than one by one: equal within rounding.
+                assert!(close(fit.alpha, alpha, 1e-13), "{} vs {alpha}", fit.alpha);
+                assert!((fit.ks - d).abs() < 1e-13, "{} vs {d}", fit.ks);
+            }
+        }
+    }
+
+    #[test]
+    fn results_do_not_depend_on_the_threads() {
+        let options = PowerLawOptions::default().bootstrap(12).goodness_samples(12).seed(9);
+        let xs = pareto(2.5, 1.0, 3000, 60);
+        let ks = zeta_samples(2.3, 3000, 61);
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                (
+                    compare_alternatives(&xs, Support::Continuous, &options).unwrap(),
+                    compare_alternatives(&ks, Support::Discrete, &options).unwrap(),
+                )
+            })
+        };
+        let one = run(1);
+        for threads in [2, 3] {
+            // Debug prints the shortest round-tripping decimal: equal text, equal bits.
+            assert_eq!(format!("{:?}", run(threads)), format!("{one:?}"));
+        }
+    }
+
+    #[test]
+    fn sorted_draws_follow_the_law() {
+        // Discrete: the walk up the table draws what the bisection draws, for falling u.
+        let law = DiscreteLaw::new(2.2, 3.0);
+        let mut us: Vec<f64> = (1..5000).map(|i| (i as f64 / 5000.0).powi(3)).collect();
+        us.reverse();
+        let mut step = 0;
+        for &u in &us {
+            assert_eq!(law.draw_from(u, &mut step), law.draw(u), "u = {u}");
+        }
+        // Both: sorted, above x_min; the pooled continuous draws of five sets pass a
+        // Kolmogorov–Smirnov test against the law (critical value at 1e-3: 1.95/√n).
+        let fit = |x_min: f64| TailFit {
+            x_min,
+            alpha: 2.5,
+            tail: 0,
+            ks: 0.0,
+            start: 0,
+            run: 0,
+        };
+        let mut pooled = Vec::new();
+        for seed in 0..5 {
+            let mut r = rng(seed);
+            let mut spacings = Vec::new();
+            for (law, x_min) in [(None, 1.0), (Some(DiscreteLaw::new(2.5, 2.0)), 2.0)] {
+                let mut set = Runs::default();
+                sorted_draws(4000, &fit(x_min), law.as_ref(), &mut r, &mut spacings, &mut set);
+                assert_eq!(set.samples(), 4000);
+                assert!(set.values.windows(2).all(|w| w[0] < w[1]) && set.values[0] >= x_min);
+                if law.is_none() {
+                    pooled.extend(set.values.iter().copied());
+                }
+            }
+        }
+        pooled.sort_unstable_by(f64::total_cmp);
+        let n = pooled.len() as f64;
+        let d = pooled
+            .iter()
+            .enumerate()
+            .map(|(i, x)| {
+                let p = 1.0 - x.powf(-1.5);
+                (i as f64 / n - p).abs().max(((i + 1) as f64 / n - p).abs())
+            })
+            .fold(0.0, f64::max);
+        assert!(d < 1.95 / n.sqrt(), "D = {d}");
     }
 
     #[test]
