@@ -484,14 +484,13 @@ fn fit_with<R: Send>(
     };
     drop(xs);
     let mut scratch = Scratch::default();
-    let best = fit_runs(&data.runs, support, min_tail, &mut scratch).ok_or(
-        Error::InvalidParameter {
+    let best =
+        fit_runs(&data.runs, support, min_tail, &mut scratch).ok_or(Error::InvalidParameter {
             name: "samples",
             value: data.runs.values[0],
             reason: "all positive samples are equal (or their logarithms are): a power law \
                      needs two distinct values",
-        },
-    )?;
+        })?;
     drop(scratch);
     progress();
     let alpha_std_error = alpha_std_error(&best, support);
@@ -601,7 +600,8 @@ pub(crate) fn compare_alternatives_with(
                 (alpha, 1.0 / lambda)
             })
         })?;
-    let (mut boot_alpha, mut boot_cutoff): (Vec<f64>, Vec<f64>) = boot.into_iter().flatten().unzip();
+    let (mut boot_alpha, mut boot_cutoff): (Vec<f64>, Vec<f64>) =
+        boot.into_iter().flatten().unzip();
     let tail = alternatives::Tail::new(&data.runs, &best, support);
     if !tail.is_finite() {
         return Err(Error::InvalidParameter {
@@ -1191,7 +1191,10 @@ fn continuous_candidate(
     }
     let block = ((runs as f64).sqrt() / 16.0) as usize;
     ends.clear();
-    for j in (g..groups).step_by(block).chain(std::iter::once(groups - 1)) {
+    for j in (g..groups)
+        .step_by(block)
+        .chain(std::iter::once(groups - 1))
+    {
         let p = model(j);
         ends.push((j, p));
         if take(j, p, &mut ks, &mut at) {
@@ -1598,8 +1601,7 @@ fn goodness_of_fit(
             n
         } else {
             // 0 < p_tail < 1 here: a valid binomial.
-            rand_distr::Binomial::new(n as u64, p_tail)
-                .map_or(n, |b| rng.sample(b) as usize)
+            rand_distr::Binomial::new(n as u64, p_tail).map_or(n, |b| rng.sample(b) as usize)
         };
         let mut set = std::mem::take(&mut s.synthetic);
         set.clear();
@@ -2355,7 +2357,10 @@ mod tests {
                 _ => {
                     let alpha = discrete_mle(x_min, (suffix[start].0 + suffix[start].1) / t);
                     let norm = hurwitz_zeta(alpha, x_min);
-                    (alpha, Box::new(move |x: f64| 1.0 - hurwitz_zeta(alpha, x + 1.0) / norm))
+                    (
+                        alpha,
+                        Box::new(move |x: f64| 1.0 - hurwitz_zeta(alpha, x + 1.0) / norm),
+                    )
                 }
             };
             let mut d = 0.0f64;
@@ -2394,11 +2399,14 @@ mod tests {
                 *x = (*x * 1e4).round() / 1e4;
             }
             let mut counts = zeta_samples(2.1, 30_000, 50 + seed);
-            for (support, xs) in [(Support::Continuous, &mut reals), (Support::Discrete, &mut counts)] {
+            for (support, xs) in [
+                (Support::Continuous, &mut reals),
+                (Support::Discrete, &mut counts),
+            ] {
                 xs.sort_unstable_by(f64::total_cmp);
                 let (x_min, alpha, d) = plain_search(xs, support, 10);
-                let fit = fit_runs(&Runs::from_sorted(xs), support, 10, &mut Scratch::default())
-                    .unwrap();
+                let fit =
+                    fit_runs(&Runs::from_sorted(xs), support, 10, &mut Scratch::default()).unwrap();
                 assert_eq!(fit.x_min, x_min, "{support:?} {seed}");
                 // Counts of equal samples enter the sums as products (exact by fma)
                 // rather than one by one: equal within rounding.
@@ -2410,11 +2418,17 @@ mod tests {
 
     #[test]
     fn results_do_not_depend_on_the_threads() {
-        let options = PowerLawOptions::default().bootstrap(12).goodness_samples(12).seed(9);
+        let options = PowerLawOptions::default()
+            .bootstrap(12)
+            .goodness_samples(12)
+            .seed(9);
         let xs = pareto(2.5, 1.0, 3000, 60);
         let ks = zeta_samples(2.3, 3000, 61);
         let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
             pool.install(|| {
                 (
                     compare_alternatives(&xs, Support::Continuous, &options).unwrap(),
@@ -2455,7 +2469,14 @@ mod tests {
             let mut spacings = Vec::new();
             for (law, x_min) in [(None, 1.0), (Some(DiscreteLaw::new(2.5, 2.0)), 2.0)] {
                 let mut set = Runs::default();
-                sorted_draws(4000, &fit(x_min), law.as_ref(), &mut r, &mut spacings, &mut set);
+                sorted_draws(
+                    4000,
+                    &fit(x_min),
+                    law.as_ref(),
+                    &mut r,
+                    &mut spacings,
+                    &mut set,
+                );
                 assert_eq!(set.samples(), 4000);
                 assert!(set.values.windows(2).all(|w| w[0] < w[1]) && set.values[0] >= x_min);
                 if law.is_none() {

@@ -12,8 +12,8 @@ use crate::output::check::RunRecord;
 use crate::output::derived::derive;
 use crate::output::layout::{DISTRIBUTIONS, POWER_LAWS};
 use crate::statistics::{
-    compare_alternatives_with, fit_power_law, log_binned, whole_fits, Comparison,
-    LikelihoodRatio, PowerLawFit, PowerLawOptions, Support,
+    compare_alternatives_with, fit_power_law, log_binned, whole_fits, Comparison, LikelihoodRatio,
+    PowerLawFit, PowerLawOptions, Support,
 };
 
 /// A row's fit: with its alternatives, or the power law alone where they cannot be
@@ -311,7 +311,7 @@ pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Vec<Point>, usize), Swe
 /// `F/(μF_N)` between two advances); and writes into `dir`:
 ///
 /// * `power_laws.csv`: per point and observable, the maximum-likelihood power-law fit and
-///   its alternatives ([`compare_alternatives`]: `x_min` by the Kolmogorov-Smirnov
+///   its alternatives ([`compare_alternatives`](crate::statistics::compare_alternatives): `x_min` by the Kolmogorov-Smirnov
 ///   distance, the exponent with its bootstrap interval, the goodness-of-fit p-value; on
 ///   the same tail the cut-off law with its interval, the exponential, the log-normal and
 ///   the likelihood-ratio tests), header `point,<axis
