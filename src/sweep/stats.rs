@@ -311,8 +311,9 @@ pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Vec<Point>, usize), Swe
 /// `F/(μF_N)` between two advances); and writes into `dir`:
 ///
 /// * `power_laws.csv`: per point and observable, the maximum-likelihood power-law fit and
-///   its alternatives ([`compare_alternatives`](crate::statistics::compare_alternatives): `x_min` by the Kolmogorov-Smirnov
-///   distance, the exponent with its bootstrap interval, the goodness-of-fit p-value; on
+///   its alternatives
+///   ([`compare_alternatives`](crate::statistics::compare_alternatives): `x_min` by the
+///   Kolmogorov-Smirnov distance, the exponent with its bootstrap interval, the goodness-of-fit p-value; on
 ///   the same tail the cut-off law with its interval, the exponential, the log-normal and
 ///   the likelihood-ratio tests), header `point,<axis
 ///   keys>,observable,support,samples,tail,x_min,alpha,alpha_std_error,alpha_low,
