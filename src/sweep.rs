@@ -33,7 +33,7 @@ pub(crate) use merge::GRID_LOADS;
 #[cfg(feature = "plot")]
 pub(crate) use merge::{ensemble_curves, EnsembleCurves, MEDIAN_BAND_RUNS};
 pub use merge::{mean_band, merge, Band, MergeSummary};
-pub use stats::{statistics, StatsOptions, StatsSummary};
+pub use stats::{statistics, statistics_with_progress, StatsOptions, StatsProgress, StatsSummary};
 
 /// The results of this module: its errors are [`SweepError`]s.
 type Result<T, E = SweepError> = std::result::Result<T, E>;

@@ -564,6 +564,7 @@ fn main() -> ExitCode {
                 )
                 .bins_per_decade(bins_per_decade as usize)
                 .include_spanning(include_spanning),
+            progress,
         ),
         Command::Plot {
             dir,
@@ -1300,8 +1301,34 @@ fn incomplete(summary: &precursors::sweep::MergeSummary, dir: &Path) -> Failure 
     }
 }
 
-fn stats(dir: &Path, options: &StatsOptions) -> Result<(), Failure> {
-    let summary = precursors::sweep::statistics(dir, options)?;
+fn stats(dir: &Path, options: &StatsOptions, progress: bool) -> Result<(), Failure> {
+    let bar = std::sync::Mutex::new(Progress::new(progress));
+    let summary = precursors::sweep::statistics_with_progress(dir, options, |p| {
+        let Ok(mut bar) = bar.lock() else { return };
+        // Only a `stats` that lasts: a short one prints its lines alone.
+        if bar.started.elapsed() < Duration::from_secs(1) {
+            return;
+        }
+        let last = p.fits_done == p.fits && p.point + 1 == p.points;
+        bar.show(last, |elapsed| {
+            let filled = (20 * p.fits_done).checked_div(p.fits).unwrap_or(20);
+            format!(
+                "stats: point {}/{} [{}{}] {}/{} fits ({}), {:.0} s",
+                p.point + 1,
+                p.points,
+                "#".repeat(filled),
+                " ".repeat(20 - filled),
+                p.fits_done,
+                p.fits,
+                p.observable,
+                elapsed
+            )
+        });
+    });
+    if let Ok(bar) = bar.lock() {
+        bar.finish();
+    }
+    let summary = summary?;
     for verdict in &summary.verdicts {
         say!("{verdict}");
     }

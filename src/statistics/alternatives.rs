@@ -4,9 +4,9 @@
 //! between them.
 
 use super::special::{chi2_one_survival_of_twice, ln_erfcx, ln_expint, normal_two_sided};
-use super::{hurwitz_zeta, Support, TailFit, ALPHA_MAX};
+use super::{hurwitz_zeta, Runs, Support, TailFit, ALPHA_MAX};
 
-/// The tail `x ≥ x_min` of sorted samples as its distinct values and their counts, with
+/// The tail `x ≥ x_min` of samples as its distinct values and their counts, with
 /// the means the continuous likelihoods need (`t = x / x_min`, `y = ln t`).
 pub(super) struct Tail {
     pub support: Support,
@@ -25,17 +25,12 @@ pub(super) struct Tail {
 }
 
 impl Tail {
-    pub(super) fn new(xs: &[f64], fit: &TailFit, support: Support) -> Self {
-        let tail = &xs[fit.start..];
+    pub(super) fn new(runs: &Runs, fit: &TailFit, support: Support) -> Self {
         let x_min = fit.x_min;
-        let n = tail.len();
-        let mut values: Vec<(f64, usize)> = Vec::new();
-        for &x in tail {
-            match values.last_mut() {
-                Some((v, c)) if *v == x => *c += 1,
-                _ => values.push((x, 1)),
-            }
-        }
+        let n = runs.samples() - fit.start;
+        let values: Vec<(f64, usize)> = (fit.run..runs.len())
+            .map(|g| (runs.values[g], runs.starts[g + 1] - runs.starts[g]))
+            .collect();
         let (mut sy, mut sy2, mut st) = (0.0, 0.0, 0.0);
         for &(x, c) in &values {
             let y = ln_ratio(x, x_min);

@@ -12,8 +12,8 @@ use crate::output::check::RunRecord;
 use crate::output::derived::derive;
 use crate::output::layout::{DISTRIBUTIONS, POWER_LAWS};
 use crate::statistics::{
-    compare_alternatives, fit_power_law, log_binned, Comparison, LikelihoodRatio, PowerLawFit,
-    PowerLawOptions, Support,
+    compare_alternatives_with, fit_power_law, log_binned, whole_fits, Comparison, LikelihoodRatio,
+    PowerLawFit, PowerLawOptions, Support,
 };
 
 /// A row's fit: with its alternatives, or the power law alone where they cannot be
@@ -91,6 +91,24 @@ pub struct StatsSummary {
     /// Each fit's verdict (`Comparison::verdict`), as `point <index>, <observable>:
     /// <verdict>`, in the order of `power_laws.csv`'s rows; none for an empty fit.
     pub verdicts: Vec<String>,
+}
+
+/// Where [`statistics_with_progress`] stands, after each whole fit (the `x_min` search on
+/// the pooled samples, each bootstrap resample, each synthetic set).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct StatsProgress {
+    /// The parameter point being fitted (from 0).
+    pub point: usize,
+    /// Parameter points in all.
+    pub points: usize,
+    /// The observable being fitted (`power_laws.csv`'s `observable`).
+    pub observable: &'static str,
+    /// Whole fits done at this point, over its observables.
+    pub fits_done: usize,
+    /// Whole fits at this point: `1 + bootstrap + goodness_samples` per observable with
+    /// enough samples.
+    pub fits: usize,
 }
 
 /// The observables [`statistics`] pools and fits, in the order of its tables: the name
@@ -293,8 +311,9 @@ pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Vec<Point>, usize), Swe
 /// `F/(μF_N)` between two advances); and writes into `dir`:
 ///
 /// * `power_laws.csv`: per point and observable, the maximum-likelihood power-law fit and
-///   its alternatives ([`compare_alternatives`]: `x_min` by the Kolmogorov-Smirnov
-///   distance, the exponent with its bootstrap interval, the goodness-of-fit p-value; on
+///   its alternatives
+///   ([`compare_alternatives`](crate::statistics::compare_alternatives): `x_min` by the
+///   Kolmogorov-Smirnov distance, the exponent with its bootstrap interval, the goodness-of-fit p-value; on
 ///   the same tail the cut-off law with its interval, the exponential, the log-normal and
 ///   the likelihood-ratio tests), header `point,<axis
 ///   keys>,observable,support,samples,tail,x_min,alpha,alpha_std_error,alpha_low,
@@ -342,6 +361,32 @@ pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Vec<Point>, usize), Swe
 /// taken shared, as a reader's), [`Error::RunDirectory`] for a run directory holding a
 /// `sweep.json`.
 pub fn statistics(dir: &Path, options: &StatsOptions) -> Result<StatsSummary, SweepError> {
+    statistics_with_progress(dir, options, |_| {})
+}
+
+/// [`statistics`], calling `progress` after each whole fit (from the threads that make
+/// them: the bootstrap resamples and synthetic sets of a fit run on the current rayon
+/// pool; the tables do not depend on its threads).
+///
+/// ```
+/// use precursors::sweep::{statistics_with_progress, StatsOptions};
+/// let dir = std::env::temp_dir().join("precursors-no-such-directory");
+/// let seen = std::sync::atomic::AtomicUsize::new(0);
+/// let options = StatsOptions::default();
+/// assert!(statistics_with_progress(&dir, &options, |p| {
+///     seen.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+///     assert!(p.fits_done <= p.fits);
+/// })
+/// .is_err());
+/// ```
+///
+/// # Errors
+/// Those of [`statistics`].
+pub fn statistics_with_progress(
+    dir: &Path,
+    options: &StatsOptions,
+    progress: impl Fn(&StatsProgress) + Sync,
+) -> Result<StatsSummary, SweepError> {
     if options.bins_per_decade == 0 {
         return Err(Error::InvalidCount {
             name: "bins_per_decade",
@@ -381,10 +426,23 @@ pub fn statistics(dir: &Path, options: &StatsOptions) -> Result<StatsSummary, Sw
             Ok(())
         })?;
         runs += point.runs();
+        let enough = |x: &Vec<f64>| x.iter().filter(|v| **v > 0.0).count() >= options.fit.min_tail;
+        let total = pooled.iter().filter(|x| enough(x)).count() * whole_fits(&options.fit);
+        let done = std::sync::atomic::AtomicUsize::new(0);
         for ((name, support, _), x) in OBSERVABLES.iter().zip(&pooled) {
             let positive = x.iter().filter(|v| **v > 0.0).count();
+            let step = || {
+                let fits_done = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                progress(&StatsProgress {
+                    point: index,
+                    points: points.len(),
+                    observable: name,
+                    fits_done: fits_done.min(total),
+                    fits: total,
+                });
+            };
             let fit = if positive >= options.fit.min_tail {
-                match compare_alternatives(x, *support, &options.fit) {
+                match compare_alternatives_with(x, *support, &options.fit, &step) {
                     Ok(c) => Some(Fit::Compared(Box::new(c))),
                     // Samples spanning more than f64's range have a power law but no
                     // alternatives: the power law alone, its errors as before.
