@@ -8,23 +8,18 @@
 //! 100 and the default limit, `1e6` cells: 10000 x 10000 is refused at once with the
 //! estimates); the peak memory is read from `/proc/self/status` (Linux; `n/a` elsewhere).
 
+#[path = "support/memory.rs"]
+mod memory;
 #[path = "support/report.rs"]
 mod report;
 
+use memory::peak_memory;
 use precursors::{GridCost, Scene};
 use std::process::ExitCode;
 use std::time::Instant;
 
 fn main() -> ExitCode {
     report::report(run())
-}
-
-/// Peak resident memory of the process (bytes), from `/proc/self/status`'s `VmHWM`.
-fn peak_memory() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024.0)
 }
 
 fn run() -> report::Outcome {

@@ -10,23 +10,18 @@
 //! 140 x 7 and 100 planes, evenly between `0.1 Lz` and `0.9 Lz`); the peak memory is read
 //! from `/proc/self/status` (Linux; `n/a` elsewhere).
 
+#[path = "support/memory.rs"]
+mod memory;
 #[path = "support/report.rs"]
 mod report;
 
+use memory::peak_memory;
 use precursors::{Event, Point, ProbeSpec, Scene};
 use std::process::ExitCode;
 use std::time::Instant;
 
 fn main() -> ExitCode {
     report::report(run())
-}
-
-/// Peak resident memory of the process (bytes), from `/proc/self/status`'s `VmHWM`.
-fn peak_memory() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024.0)
 }
 
 fn run() -> report::Outcome {

@@ -580,6 +580,7 @@ pub fn compare_alternatives(
 
 /// The whole fits [`compare_alternatives`] makes (and reports to its `progress`): the
 /// search on the data, each bootstrap resample and each synthetic set.
+#[cfg(feature = "serde")] // the sweep's statistics count them for their progress
 pub(crate) fn whole_fits(options: &PowerLawOptions) -> usize {
     1 + options.bootstrap + options.goodness_samples
 }

@@ -79,11 +79,9 @@ fn size(file: &Path) -> f64 {
 fn the_recorded_tables_stay_within_their_estimate() {
     let dir = scratch("within");
     let scene_file = dir.join("scene.json");
-    let extra = format!(
-        r#", "fields": {{ "every": 1, "planes": [0.002, 0.005] }},
-        "profiles": {{ "loads": [0.1, 0.3, 0.5, 0.7], "planes": [0.0, 0.002, 0.005] }}"#
-    );
-    std::fs::write(&scene_file, base(&extra)).unwrap();
+    let extra = r#", "fields": { "every": 1, "planes": [0.002, 0.005] },
+        "profiles": { "loads": [0.1, 0.3, 0.5, 0.7], "planes": [0.0, 0.002, 0.005] }"#;
+    std::fs::write(&scene_file, base(extra)).unwrap();
     let builder = precursors::SceneBuilder::from_json_file(&scene_file).unwrap();
     let cost = builder.observer_cost().unwrap();
     let out = dir.join("run");

@@ -439,8 +439,34 @@ mod cli {
         ]);
         assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
         let fits = table(&run_dir.join("power_laws.csv"));
-        assert_eq!(fits.len(), 7);
+        assert_eq!(fits.len(), 12);
         assert_eq!(fits[0]["observable"], "avalanche_ruptures");
+        // The observables appended in 1.2, against the run's avalanches read from
+        // events.csv (`read_avalanches`): before the spanning one, its flash ruptures out,
+        // its extent in cells, its size in the load window of its starting load.
+        let events = table(&run_dir.join("events.csv"));
+        let avalanches = read_avalanches(&events);
+        let kept = &avalanches[..spanning(&avalanches)];
+        let samples = |name: &str| {
+            let row = fits.iter().find(|r| r["observable"] == name).unwrap();
+            num(row, "samples") as usize
+        };
+        assert_eq!(samples("avalanche_ruptures_without_flash"), kept.len());
+        assert!(kept.iter().all(|a| a.ruptures > a.flash));
+        assert_eq!(samples("avalanche_extent_cells"), kept.len());
+        // F/(μF_N) with μ = 0.5, F_N = 3.5 kN.
+        let load = |a: &Read| a.before.parse::<f64>().unwrap() / (0.5 * 3500.0);
+        let windows = [
+            kept.iter().filter(|a| load(a) < 0.5).count(),
+            kept.iter()
+                .filter(|a| (0.5..0.8).contains(&load(a)))
+                .count(),
+            kept.iter().filter(|a| load(a) >= 0.8).count(),
+        ];
+        assert!(windows.iter().all(|&n| n > 0), "{windows:?}");
+        assert_eq!(samples("avalanche_ruptures_load_below_0.5"), windows[0]);
+        assert_eq!(samples("avalanche_ruptures_load_0.5_to_0.8"), windows[1]);
+        assert_eq!(samples("avalanche_ruptures_load_from_0.8"), windows[2]);
         // The rod drive does not drop its force: no samples, no fit.
         assert_eq!(fits[1]["samples"], "0");
         assert_eq!(fits[1]["alpha"], "");

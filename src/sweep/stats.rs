@@ -114,7 +114,7 @@ pub struct StatsProgress {
 /// The observables [`statistics`] pools and fits, in the order of its tables: the name
 /// (the `observable` column), whether the samples are counts, and what they are
 /// (docs/statistics.md has the list).
-pub(crate) const OBSERVABLES: [(&str, Support, &str); 7] = [
+pub(crate) const OBSERVABLES: [(&str, Support, &str); 12] = [
     (
         "avalanche_ruptures",
         Support::Discrete,
@@ -154,7 +154,38 @@ pub(crate) const OBSERVABLES: [(&str, Support, &str); 7] = [
         Support::Continuous,
         "the increase of F/(μF_N) between two advances of the damage front",
     ),
+    (
+        "avalanche_ruptures_without_flash",
+        Support::Discrete,
+        "ruptures of each avalanche before the spanning one, its flash ruptures left out \
+         (docs/model.md section 5)",
+    ),
+    (
+        "avalanche_extent_cells",
+        Support::Discrete,
+        "extent along x of each avalanche before the spanning one, in cells Δx",
+    ),
+    (
+        "avalanche_ruptures_load_below_0.5",
+        Support::Discrete,
+        "ruptures of each avalanche before the spanning one that starts below F/(μF_N) = 0.5",
+    ),
+    (
+        "avalanche_ruptures_load_0.5_to_0.8",
+        Support::Discrete,
+        "ruptures of each avalanche before the spanning one that starts at F/(μF_N) from 0.5 \
+         to below 0.8",
+    ),
+    (
+        "avalanche_ruptures_load_from_0.8",
+        Support::Discrete,
+        "ruptures of each avalanche before the spanning one that starts at F/(μF_N) 0.8 or \
+         above",
+    ),
 ];
+
+/// The samples of every observable of one run, in the order of [`OBSERVABLES`].
+type Samples = [Vec<f64>; OBSERVABLES.len()];
 
 /// The samples of each of [`OBSERVABLES`] in one complete run: from the avalanches before
 /// the spanning one and the stable states before its end, or (`include_spanning`) from
@@ -164,23 +195,33 @@ pub(crate) const OBSERVABLES: [(&str, Support, &str); 7] = [
 ///
 /// # Errors
 /// [`Error::CorruptTable`] when its events are not the whole run of its grid.
-pub(crate) fn samples(
-    record: &RunRecord,
-    dir: &Path,
-    include_spanning: bool,
-) -> Result<[Vec<f64>; 7]> {
+pub(crate) fn samples(record: &RunRecord, dir: &Path, include_spanning: bool) -> Result<Samples> {
     let derived = derive(&record.grid, &record.events).map_err(|e| Error::CorruptTable {
         path: Some(dir.join(crate::output::TABLES[0])),
         reason: format!("not the whole run of its scene: {e}"),
     })?;
-    let mut out: [Vec<f64>; 7] = Default::default();
+    let mut out: Samples = Default::default();
     let kept = |a: &&crate::avalanche::Avalanche| {
         !a.global_slip && (include_spanning || !(a.spanning || a.after_spanning))
     };
+    let dx = record.grid.dx();
     for a in derived.avalanches.iter().filter(kept) {
         out[0].push(a.ruptures as f64);
         out[1].push(a.force_drop());
         out[2].push(a.energy);
+        out[7].push((a.ruptures - a.flash_ruptures) as f64);
+        out[8].push((a.extent / dx).round());
+        // The load windows of issue 54: the mean size grows as the load nears μF_N, so
+        // sizes pooled over the whole run mix regimes.
+        let load = a.load_before.force / record.bounds.mu_fn;
+        let window = if load < 0.5 {
+            9
+        } else if load < 0.8 {
+            10
+        } else {
+            11
+        };
+        out[window].push(a.ruptures as f64);
     }
     let nx = record.bounds.nx as f64;
     let loads: Vec<f64> = record.curve.iter().map(|c| c.load).collect();
@@ -414,7 +455,7 @@ pub fn statistics_with_progress(
             .iter()
             .map(|(_, v)| format!("{},", cell(v)))
             .collect();
-        let mut pooled: [Vec<f64>; 7] = Default::default();
+        let mut pooled: Samples = Default::default();
         point.for_each_record(|run_dir, record| {
             for (all, s) in
                 pooled
