@@ -197,16 +197,50 @@ fn holder(path: &Path) -> String {
         // It locked the file and has not written its name yet (microseconds).
         return "a process that has not written its name yet".into();
     }
-    shorten(text, 400)
+    let mut who = shorten(text, 400);
+    if let Some(pid) = dead_holder(text) {
+        who.push_str(&format!(
+            "; pid {pid} is no longer running on this host, yet the lock is held: by a \
+             process it started, which inherited the lock (`fuser {}` names it), or, on a \
+             network file system, by the server for a client that died (it lets go when the \
+             client's lease ends)",
+            path.display()
+        ));
+    }
+    who
+}
+
+/// The pid of a holder line (`pid P on host H, ...`) written on this host by a process
+/// that is no longer running (Linux: no `/proc/P`); `None` when it runs, when another
+/// host wrote it, or when this cannot be told.
+fn dead_holder(line: &str) -> Option<u32> {
+    let rest = line.strip_prefix("pid ")?;
+    let digits = rest
+        .find(|c: char| !c.is_ascii_digit())
+        .unwrap_or(rest.len());
+    let pid: u32 = rest[..digits].parse().ok()?;
+    let written_on = rest[digits..]
+        .strip_prefix(" on host ")
+        .map(|h| h.split(',').next().unwrap_or(""));
+    if written_on.is_some() && written_on != host().as_deref() {
+        return None;
+    }
+    let proc = Path::new("/proc");
+    (proc.join("self").exists() && !proc.join(pid.to_string()).exists()).then_some(pid)
+}
+
+/// This machine's host name, as the holder line gives it.
+fn host() -> Option<String> {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .map(|h| h.trim().to_string())
+        .filter(|h| !h.is_empty())
 }
 
 /// Who this process is: `pid P on host H, since T: COMMAND`.
 fn identity() -> String {
-    let host = std::fs::read_to_string("/proc/sys/kernel/hostname")
-        .ok()
-        .or_else(|| std::env::var("HOSTNAME").ok())
-        .map(|h| h.trim().to_string())
-        .filter(|h| !h.is_empty());
+    let host = host();
     let command: Vec<String> = std::env::args_os()
         .map(|a| a.to_string_lossy().into_owned())
         .collect();
@@ -333,6 +367,42 @@ mod tests {
         drop(first);
         assert_eq!(std::fs::read(dir.join(LOCK_FILE)).unwrap(), b"");
         drop(DirLock::lock(&dir).unwrap());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_holder_that_no_longer_runs_is_named_so_with_what_to_do() {
+        let dir = std::env::temp_dir().join(format!("precursors-dead-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(LOCK_FILE);
+        // A lock held by a handle whose line names a pid above Linux's largest (2^22).
+        let mut held = std::fs::File::create(&path).unwrap();
+        held.lock().unwrap();
+        let host = host().map(|h| format!(" on host {h}")).unwrap_or_default();
+        write!(
+            held,
+            "pid 4999999{host}, since 2026-11-29T00:00:00Z: precursors run"
+        )
+        .unwrap();
+        match DirLock::lock(&dir) {
+            Err(Error::DirectoryLocked { holder, .. }) => {
+                assert!(holder.starts_with("pid 4999999"), "{holder}");
+                if Path::new("/proc/self").exists() {
+                    assert!(holder.contains("no longer running") && holder.contains("fuser"));
+                }
+            }
+            other => panic!("{other:?}"),
+        }
+        // A running holder (this process), and one on another host, are not called dead.
+        assert_eq!(
+            dead_holder(&format!("pid {}{host}, since", std::process::id())),
+            None
+        );
+        assert_eq!(
+            dead_holder("pid 4999999 on host elsewhere.invalid, since"),
+            None
+        );
+        drop(held);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

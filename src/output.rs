@@ -726,7 +726,7 @@ impl RunTables {
     /// [flushed](RunTables::flush) to disk, and the checkpoint records the digest of each
     /// table's rows (`events.csv`, `curve.csv`, `contact_map.csv`, and `fields.csv` and
     /// `profiles.csv` where recorded), so that [`RunTables::resume`] refuses kept rows
-    /// edited after it was taken. [`RunTables::run_until`] takes its checkpoints so; take
+    /// edited after it was taken. `RunTables::run_until` (feature `serde`) takes its checkpoints so; take
     /// one at a stable state to resume the tables from it.
     ///
     /// # Errors
