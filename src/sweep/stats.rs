@@ -262,6 +262,16 @@ pub(crate) fn samples(record: &RunRecord, dir: &Path, include_spanning: bool) ->
     Ok(out)
 }
 
+/// Whether the positive samples are all one value (one avalanche extent on a narrow
+/// grid, say): no power law fits them, and the observable is reported without a fit, as
+/// one with too few samples.
+fn all_equal(x: &[f64]) -> bool {
+    let mut positive = x.iter().filter(|v| **v > 0.0);
+    positive
+        .next()
+        .is_some_and(|first| positive.all(|v| v == first))
+}
+
 /// A parameter point of a run or sweep directory: its axes' values (none for a run
 /// directory) and its complete runs, read one at a time ([`Point::for_each_record`]) so
 /// that a sweep of many runs never holds more than one run's events.
@@ -467,7 +477,9 @@ pub fn statistics_with_progress(
             Ok(())
         })?;
         runs += point.runs();
-        let enough = |x: &Vec<f64>| x.iter().filter(|v| **v > 0.0).count() >= options.fit.min_tail;
+        let enough = |x: &Vec<f64>| {
+            x.iter().filter(|v| **v > 0.0).count() >= options.fit.min_tail && !all_equal(x)
+        };
         let total = pooled.iter().filter(|x| enough(x)).count() * whole_fits(&options.fit);
         let done = std::sync::atomic::AtomicUsize::new(0);
         for ((name, support, _), x) in OBSERVABLES.iter().zip(&pooled) {
@@ -482,7 +494,7 @@ pub fn statistics_with_progress(
                     fits: total,
                 });
             };
-            let fit = if positive >= options.fit.min_tail {
+            let fit = if positive >= options.fit.min_tail && !all_equal(x) {
                 match compare_alternatives_with(x, *support, &options.fit, &step) {
                     Ok(c) => Some(Fit::Compared(Box::new(c))),
                     // Samples spanning more than f64's range have a power law but no
@@ -493,6 +505,9 @@ pub fn statistics_with_progress(
                 // Checked all the same: bad options are an error whatever the samples.
                 match fit_power_law(x, *support, &options.fit) {
                     Err(Error::TooFewSamples { .. }) | Ok(_) => None,
+                    Err(Error::InvalidParameter {
+                        name: "samples", ..
+                    }) if all_equal(x) => None,
                     Err(e) => return Err(e.into()),
                 }
             };
