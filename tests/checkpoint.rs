@@ -894,7 +894,7 @@ fn two_level_solves_repeat_across_threads_and_resume() {
 mod kept {
     use super::json::{replace_value, resigned};
     use super::*;
-    use crate::common::{killed_after_checkpoint, scratch};
+    use crate::common::{copy_dir, killed_after_checkpoint, scratch};
     use std::path::Path;
 
     /// The tables a run recording fields and profiles keeps on resume.
@@ -934,15 +934,6 @@ mod kept {
             .collect();
         out.sort();
         out
-    }
-
-    fn copy(from: &Path, to: &Path) {
-        let _ = std::fs::remove_dir_all(to);
-        std::fs::create_dir_all(to).unwrap();
-        for entry in std::fs::read_dir(from).unwrap() {
-            let entry = entry.unwrap();
-            std::fs::copy(entry.path(), to.join(entry.file_name())).unwrap();
-        }
     }
 
     /// A run of `scene()` into a new directory, killed 30 events past a checkpoint at
@@ -1026,7 +1017,7 @@ mod kept {
                 cells[column] = value;
                 let mut forged: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
                 forged[line] = cells.join(",");
-                copy(&base, &work);
+                copy_dir(&base, &work);
                 std::fs::write(work.join(&name), forged.join("\n") + "\n").unwrap();
                 let before = files(&work);
                 let case = format!("{table} line {} column {key}", line + 1);
@@ -1056,7 +1047,7 @@ mod kept {
             .unwrap();
         let mut cells: Vec<String> = row.split(',').map(String::from).collect();
         cells[6] = edited(&cells[6], None).unwrap();
-        copy(&base, &work);
+        copy_dir(&base, &work);
         std::fs::write(
             work.join("events.csv.partial"),
             events.replacen(row, &cells.join(","), 1),
@@ -1070,7 +1061,7 @@ mod kept {
             other => panic!("not refused: {:?}", other.map(|_| ())),
         }
         // The untouched copy resumes.
-        copy(&base, &work);
+        copy_dir(&base, &work);
         resume(&work).unwrap();
         std::fs::remove_dir_all(&base).unwrap();
         std::fs::remove_dir_all(&work).unwrap();
@@ -1171,7 +1162,7 @@ mod kept {
             ("no observers", bare.clone()),
             ("fields only", bare.clone().record_fields(2, &[0.002])),
         ] {
-            copy(&base, &work);
+            copy_dir(&base, &work);
             let before = files(&work);
             let driver = scene.resume(&checkpoint).unwrap();
             match output::RunTables::resume_with(&work, &driver, &options) {
@@ -1187,7 +1178,7 @@ mod kept {
         let end = old.rfind(",\"digest\":").unwrap();
         let old = resigned(&format!("{}{}", &old[..tables], &old[end..]));
         let old = Checkpoint::from_json_str(&old).unwrap();
-        copy(&base, &work);
+        copy_dir(&base, &work);
         let before = files(&work);
         let driver = scene.resume(&old).unwrap();
         match output::RunTables::resume_with(&work, &driver, &bare) {
@@ -1198,7 +1189,7 @@ mod kept {
         }
         assert!(files(&work) == before, "the directory changed");
         // scene.json's observers edited: refused, with the checkpoint's own options too.
-        copy(&base, &work);
+        copy_dir(&base, &work);
         let record = std::fs::read_to_string(work.join("scene.json")).unwrap();
         let edited = record.replacen("0.05", "0.06", 1);
         assert_ne!(edited, record);
@@ -1213,7 +1204,7 @@ mod kept {
         }
         assert!(files(&work) == before, "the directory changed");
         // The 1.x checkpoint resumes the untouched directory, with today's checks.
-        copy(&base, &work);
+        copy_dir(&base, &work);
         let driver = scene.resume(&old).unwrap();
         output::RunTables::resume(&work, &driver).unwrap();
         std::fs::remove_dir_all(&base).unwrap();

@@ -7,7 +7,7 @@
 //! point's `scene.json`, run directories swapped, `sweep.json` edited.
 
 use crate::common::program::{contents, path, precursors, stderr};
-use crate::common::scratch;
+use crate::common::{copy_dir, scratch};
 use std::path::{Path, PathBuf};
 
 /// Two loads, two realizations of a tiny scene (30 x 5 cells) recording its fields.
@@ -21,19 +21,6 @@ const SWEEP: &str = r#"{ "base": { "block": { "lx": 0.03, "ly": 0.005, "lz": 0.0
 
 /// The run directory damaged in every case.
 const RUN: &str = "p0000-r0000";
-
-fn copy(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for entry in std::fs::read_dir(from).unwrap() {
-        let entry = entry.unwrap();
-        let target = to.join(entry.file_name());
-        if entry.file_type().unwrap().is_dir() {
-            copy(&entry.path(), &target);
-        } else {
-            std::fs::copy(entry.path(), target).unwrap();
-        }
-    }
-}
 
 /// The lines of a table (header first).
 fn lines(file: &Path) -> Vec<String> {
@@ -418,7 +405,7 @@ fn merge_stats_plot_and_movie_refuse_every_damaged_table_with_its_name() {
     let root = sweep.parent().unwrap().to_path_buf();
     // The undamaged copy is read (the checks refuse nothing a run writes).
     let whole = root.join("whole");
-    copy(&sweep, &whole);
+    copy_dir(&sweep, &whole);
     for args in [
         vec!["merge", path(&whole)],
         vec!["plot", path(&whole)],
@@ -449,7 +436,7 @@ fn merge_stats_plot_and_movie_refuse_every_damaged_table_with_its_name() {
     let mut failures = Vec::new();
     for (k, (case, damage, names)) in damages().into_iter().enumerate() {
         let d = root.join(format!("case-{k}"));
-        copy(&sweep, &d);
+        copy_dir(&sweep, &d);
         damage(&d);
         let run = d.join(RUN);
         refused(case, &["merge", path(&d)], names, &d, &mut failures);
@@ -481,7 +468,7 @@ fn merge_stats_plot_and_movie_refuse_every_damaged_table_with_its_name() {
     }
     for (k, (case, damage)) in field_damages().into_iter().enumerate() {
         let d = root.join(format!("fields-{k}"));
-        copy(&sweep, &d);
+        copy_dir(&sweep, &d);
         damage(&d);
         let run = d.join(RUN);
         refused(
@@ -528,7 +515,7 @@ fn resume_refuses_damaged_rows_before_its_checkpoint_and_writes_nothing() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     // The undamaged directory resumes.
     let whole = dir.join("whole");
-    copy(&run, &whole);
+    copy_dir(&run, &whole);
     let o = precursors(&["resume", path(&ck), "--out", path(&whole), "-q"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let cases: Vec<(&str, Damage, &str)> = vec![
@@ -574,7 +561,7 @@ fn resume_refuses_damaged_rows_before_its_checkpoint_and_writes_nothing() {
     let mut failures = Vec::new();
     for (k, (case, damage, names)) in cases.into_iter().enumerate() {
         let d = dir.join(format!("case-{k}"));
-        copy(&run, &d);
+        copy_dir(&run, &d);
         damage(&d);
         refused(
             case,

@@ -8,7 +8,7 @@
 //! directory's bytes before and after a refusal.
 
 use crate::common::program::{command, contents, path, precursors, stderr};
-use crate::common::scratch;
+use crate::common::{copy_dir, scratch};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 use std::time::{Duration, Instant};
@@ -455,21 +455,6 @@ fn special_files_as_inputs_and_outputs_get_an_answer_and_stay() {
     assert_eq!(std::fs::read(&ck).unwrap(), kept);
     assert!(failures.is_empty(), "{failures:#?}");
     std::fs::remove_dir_all(&dir).unwrap();
-}
-
-/// Copies the files and directories under `from` into a new directory `to`.
-#[cfg(unix)]
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for entry in std::fs::read_dir(from).unwrap() {
-        let entry = entry.unwrap();
-        let target = to.join(entry.file_name());
-        if entry.file_type().unwrap().is_dir() {
-            copy_dir(&entry.path(), &target);
-        } else {
-            std::fs::copy(entry.path(), &target).unwrap();
-        }
-    }
 }
 
 /// One command against a symbolic link at one path of its directories: the link's target

@@ -341,16 +341,6 @@ mod cli {
         (out, text)
     }
 
-    /// A copy of the run directory `from` at `to`.
-    fn copy(from: &Path, to: &Path) {
-        let _ = std::fs::remove_dir_all(to);
-        std::fs::create_dir_all(to).unwrap();
-        for entry in std::fs::read_dir(from).unwrap() {
-            let entry = entry.unwrap();
-            std::fs::copy(entry.path(), to.join(entry.file_name())).unwrap();
-        }
-    }
-
     /// `text` without its lines `from..to` (1-based, the header is line 1).
     fn without_lines(text: &str, from: usize, to: usize) -> String {
         text.split_inclusive('\n')
@@ -488,7 +478,7 @@ mod cli {
         ];
         let work = dir.join("work");
         for (case, edit, words) in cases {
-            copy(&base, &work);
+            crate::common::copy_dir(&base, &work);
             edit(&work);
             let before = files(&work, &[]);
             let cp = work.join("cp.json");
@@ -503,7 +493,7 @@ mod cli {
         }
         // The same resume on the untouched copy continues the finished run (from its
         // complete tables) and ends with the same tables.
-        copy(&base, &work);
+        crate::common::copy_dir(&base, &work);
         let cp = work.join("cp.json");
         let o = precursors(&["resume", path(&cp), "--out", path(&work)]);
         assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));

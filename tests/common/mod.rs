@@ -9,6 +9,23 @@ pub mod program;
 /// not the system's temporary directory), emptied if a run before left it. `module` is
 /// the calling test file's name (`sweep` for tests/sweep.rs): the pid keeps two test
 /// processes apart, `module` and `name` the tests of one process.
+/// A copy of the directory `from` at `to`, its subdirectories included; whatever was at
+/// `to` is removed first.
+#[allow(dead_code)] // not every feature set has a test that copies a directory
+pub fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
+    let _ = std::fs::remove_dir_all(to);
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), target).unwrap();
+        }
+    }
+}
+
 #[allow(dead_code)] // not every feature set has a test that writes files
 #[track_caller]
 pub fn scratch(name: &str) -> std::path::PathBuf {
