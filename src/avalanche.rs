@@ -420,6 +420,54 @@ impl DamageFront {
             .count();
         run as f64 * self.dx
     }
+
+    /// The damage front at another threshold (m): the first columns that have each lost
+    /// at least the share `lost` of their contacts at zero shear, `n(ix) ≤ (1 - lost)
+    /// n₀(ix)`. [`DamageFront::position`] is `lost = 0.5`; docs/statistics.md shows how
+    /// the front moves with the threshold.
+    ///
+    /// ```
+    /// use precursors::{DamageFront, Event, Scene};
+    /// let scene = Scene::builder().block(0.012, 0.002, 0.010).cells(12, 2).normal_load(50.0).build()?;
+    /// let mut driver = scene.driver()?;
+    /// driver.step()?;
+    /// let mut front = DamageFront::new(driver.grid(), driver.site_states())?;
+    /// while let Some(event) = driver.step()? {
+    ///     front.observe(&event);
+    ///     if let Event::Stable { .. } = event {
+    ///         // A stricter threshold is never ahead of a looser one.
+    ///         assert!(front.position_at(0.75)? <= front.position_at(0.25)?);
+    ///         assert_eq!(front.position_at(0.5)?, front.position());
+    ///     }
+    /// }
+    /// assert!(front.position_at(1.5).is_err());
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `lost` unless `0 < lost ≤ 1`.
+    pub fn position_at(&self, lost: f64) -> Result<f64> {
+        if !(lost > 0.0 && lost <= 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "lost",
+                value: lost,
+                reason: "the share of a column's contacts lost is above 0 and at most 1",
+            });
+        }
+        Ok(self.front_lost(lost))
+    }
+
+    /// [`DamageFront::position_at`] for a share `lost` the caller has checked.
+    pub(crate) fn front_lost(&self, lost: f64) -> f64 {
+        let kept = 1.0 - lost;
+        let run = self
+            .now
+            .iter()
+            .zip(&self.initial)
+            .take_while(|(n, n0)| **n as f64 <= kept * **n0 as f64)
+            .count();
+        run as f64 * self.dx
+    }
 }
 
 #[cfg(test)]

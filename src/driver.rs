@@ -52,7 +52,7 @@ mod observables;
 pub(crate) use checkpoint::scene_mismatch;
 pub use checkpoint::Checkpoint;
 pub(crate) use checkpoint::{RowDifference, RowDigest, TableDigest};
-pub use observables::SlipProfile;
+pub use observables::{SlipPerNewton, SlipProfile};
 
 /// A site of the interface grid.
 ///

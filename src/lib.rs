@@ -129,7 +129,9 @@ pub mod sweep;
 
 pub use avalanche::{Avalanche, Avalanches, DamageFront};
 pub use cost::GridCost;
-pub use driver::{Checkpoint, Driver, Event, Load, RunState, Site, SlipProfile, SolveStats};
+pub use driver::{
+    Checkpoint, Driver, Event, Load, RunState, Site, SlipPerNewton, SlipProfile, SolveStats,
+};
 pub use error::{Error, Result};
 pub use geometry::{Block, Grid, Point};
 pub use interface::{

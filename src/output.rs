@@ -6,7 +6,9 @@
 //!   column does not apply);
 //! * `curve.csv`, one row per stable state ([`CURVE_HEADER`]): `event,force_N,
 //!   force_over_mu_FN,drive_displacement_m,real_contact_area_m2,precursor_length_m,
-//!   precursor_over_Lx,broken,attached,area_exceeds_nominal`;
+//!   precursor_over_Lx,broken,attached,area_exceeds_nominal,potency_m3_per_N,
+//!   potency_moment_m4_per_N,load_compliance_m_per_N`, the last three the slip per newton
+//!   of load ([`crate::SlipPerNewton`], 17 significant digits);
 //! * `contact_map.csv` (header `event,force_over_mu_FN`, then `area_m2_ix0`, `area_m2_ix1`, ...): the map over x and F of the paper's
 //!   Fig. 2b inset, one row per load level `F/(μF_N)` = 0, 0.005, 0.01, ...
 //!   (`0.005`) from the first stable state up to global slip: the real
@@ -47,7 +49,8 @@
 //!   start_event,end_event,ruptures,broken_area_m2,force_before_N,force_after_N,
 //!   force_drop_N,drive_displacement_before_m,drive_displacement_after_m,energy_J,
 //!   attaches,detaches,flash_ruptures,global_slip,ruptures_without_flash,contacts_before,
-//!   contacts_after,spanning,after_spanning,extent_m,centroid_m`), and the damage front beside `ℓ` at
+//!   contacts_after,spanning,after_spanning,extent_m,centroid_m,potency_m3,slip_centroid_m,
+//!   released_energy_J`), and the damage front beside `ℓ` at
 //!   every stable state ([`crate::DamageFront`]: `event,force_N,force_over_mu_FN,
 //!   precursor_over_Lx,damage_front_m,damage_front_over_Lx`); docs/statistics.md.
 //!
@@ -101,10 +104,26 @@ use std::path::{Path, PathBuf};
 /// The header of `events.csv`.
 pub const EVENTS_HEADER: &str =
     "index,kind,ix,iy,force_N,drive_displacement_m,energy_J,ruptures,area_exceeds_nominal";
-/// The header of `curve.csv`.
+/// The header of `curve.csv`. Its last three columns (the slip per newton of load,
+/// [`crate::SlipPerNewton`]) came in 1.2: a run begun by 1.1 and resumed keeps them empty
+/// on its earlier rows, and a 1.1 table (without them) is still read.
 pub const CURVE_HEADER: &str = "event,force_N,force_over_mu_FN,drive_displacement_m,\
                                 real_contact_area_m2,precursor_length_m,precursor_over_Lx,\
-                                broken,attached,area_exceeds_nominal";
+                                broken,attached,area_exceeds_nominal,potency_m3_per_N,\
+                                potency_moment_m4_per_N,load_compliance_m_per_N";
+
+/// Columns of `curve.csv` as 1.1 wrote it (the first of [`CURVE_HEADER`]'s).
+pub(crate) const CURVE_COLUMNS_1_1: usize = 10;
+
+/// The header of `curve.csv` as 1.1 wrote it: [`CURVE_HEADER`]'s first
+/// [`CURVE_COLUMNS_1_1`] columns.
+pub(crate) fn curve_header_1_1() -> &'static str {
+    let end = CURVE_HEADER
+        .match_indices(',')
+        .nth(CURVE_COLUMNS_1_1 - 1)
+        .map_or(CURVE_HEADER.len(), |(i, _)| i);
+    &CURVE_HEADER[..end]
+}
 
 /// The spacing in `F/(μF_N)` of the rows of `contact_map.csv`.
 pub(crate) const MAP_STEP: f64 = 0.005;
@@ -567,7 +586,7 @@ impl RunTables {
         check_recorded_observers(dir, options)?;
         // Checked: now the directory is written.
         remove_stale_temporaries(dir)?;
-        let continued = |t: usize| append_to(&partials[t], &plan.texts[t]);
+        let continued = |t: usize| append_to(&partials[t], &plan.written(t));
         let (events, curve, map) = (continued(0)?, continued(1)?, continued(2)?);
         let (fields, profiles) = kept.continue_in(dir, driver, options, plan.stable.len())?;
         Ok(Self {
@@ -624,9 +643,12 @@ impl RunTables {
             let mu_fn = driver.friction_coefficient() * driver.normal_load();
             let (broken, attached) = counts(driver.site_states());
             let ell = driver.precursor_length()?;
+            let slip = driver.slip_per_newton()?;
+            // The slip columns at 17 digits (exact): avalanches take their differences.
             writeln!(
                 self.curve,
-                "{index},{:.12e},{:.12e},{},{:.12e},{:.12e},{:.12e},{broken},{attached},{}",
+                "{index},{:.12e},{:.12e},{},{:.12e},{:.12e},{:.12e},{broken},{attached},{},\
+                 {:.16e},{:.16e},{:.16e}",
                 load.force,
                 load.force / mu_fn,
                 optional(load.drive_displacement),
@@ -634,6 +656,9 @@ impl RunTables {
                 ell,
                 ell / driver.grid().block().lx(),
                 u8::from(exceeds),
+                slip.potency,
+                slip.potency_moment,
+                slip.load_compliance,
             )
             .map_err(|e| Error::io("writing table", &self.partials[1], e))?;
             let x = load.force / mu_fn;

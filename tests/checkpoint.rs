@@ -1146,6 +1146,100 @@ mod kept {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    /// A run begun by 1.1 resumes: `curve.csv` without the slip columns 1.2 added, under a
+    /// checkpoint of layout 3 (no table digests). The resumed tables carry 1.2's header,
+    /// the kept rows with empty slip cells and the others as an uninterrupted run writes
+    /// them (reference: the run from the start in another directory); per_avalanche.csv
+    /// has slip where both of an avalanche's states have it, and the rest of every table
+    /// equals the uninterrupted run's.
+    #[test]
+    fn a_run_begun_by_1_1_resumes_with_empty_slip_cells_on_its_kept_rows() {
+        let (work, text) = cut_run("from-1-1");
+        let whole = scratch("from-1-1-whole");
+        let mut driver = scene().driver().unwrap();
+        output::RunTables::create(&whole, &driver)
+            .unwrap()
+            .run_to_slip(&mut driver, None, |_, _| {})
+            .unwrap();
+        // As 1.1 left it: ten columns in curve.csv, no digests in the checkpoint.
+        let partial = work.join("curve.csv.partial");
+        let curve = std::fs::read_to_string(&partial).unwrap();
+        let old: String = curve
+            .lines()
+            .map(|l| l.split(',').take(10).collect::<Vec<_>>().join(",") + "\n")
+            .collect();
+        assert!(
+            old.starts_with("event,force_N,")
+                && old
+                    .lines()
+                    .next()
+                    .unwrap()
+                    .ends_with("area_exceeds_nominal")
+        );
+        std::fs::write(&partial, old).unwrap();
+        let text = text.replacen("\"format\":4", "\"format\":3", 1);
+        let tables = text.find(",\"tables\":").unwrap();
+        let end = text.rfind(",\"digest\":").unwrap();
+        let text = resigned(&format!("{}{}", &text[..tables], &text[end..]));
+        let checkpoint = Checkpoint::from_json_str(&text).unwrap();
+        let kept = checkpoint.event_count();
+        let mut driver = scene().resume(&checkpoint).unwrap();
+        output::RunTables::resume(&work, &driver)
+            .unwrap()
+            .run_to_slip(&mut driver, None, |_, _| {})
+            .unwrap();
+        let read = |dir: &Path, name: &str| std::fs::read_to_string(dir.join(name)).unwrap();
+        let (resumed, reference) = (read(&work, "curve.csv"), read(&whole, "curve.csv"));
+        assert_eq!(resumed.lines().count(), reference.lines().count());
+        let mut empty = 0;
+        for (a, b) in resumed.lines().zip(reference.lines()) {
+            let event: usize = b.split(',').next().unwrap().parse().unwrap_or(0);
+            if event > 0 && event <= kept {
+                let cells: Vec<&str> = b.split(',').collect();
+                assert_eq!(a, format!("{},,,", cells[..10].join(",")));
+                empty += 1;
+            } else {
+                assert_eq!(a, b);
+            }
+        }
+        assert!(empty >= 12, "{empty} kept rows");
+        for name in [
+            "events.csv",
+            "contact_map.csv",
+            "fields.csv",
+            "profiles.csv",
+            "fronts.csv",
+        ] {
+            assert_eq!(read(&work, name), read(&whole, name), "{name}");
+        }
+        // per_avalanche.csv: the three slip columns empty where the state before an
+        // avalanche is a kept row.
+        let (resumed, reference) = (
+            read(&work, "per_avalanche.csv"),
+            read(&whole, "per_avalanche.csv"),
+        );
+        let mut filled = 0;
+        for (a, b) in resumed.lines().zip(reference.lines()).skip(1) {
+            let (a, b): (Vec<&str>, Vec<&str>) = (a.split(',').collect(), b.split(',').collect());
+            let n = b.len();
+            assert_eq!(a[..n - 3], b[..n - 3]);
+            let start: usize = b[1].parse().unwrap();
+            // The state before the avalanche that starts after the checkpoint's is kept.
+            if start <= kept + 1 {
+                assert_eq!(a[n - 3..], ["", "", ""], "avalanche {}", b[0]);
+            } else {
+                assert_eq!(a[n - 3..], b[n - 3..], "avalanche {}", b[0]);
+                filled += usize::from(!b[n - 3].is_empty());
+            }
+        }
+        assert!(
+            filled > 3,
+            "{filled} avalanches with slip after the checkpoint"
+        );
+        std::fs::remove_dir_all(&work).unwrap();
+        std::fs::remove_dir_all(&whole).unwrap();
+    }
+
     /// A resume whose observers differ from those the directory recorded (its tables or
     /// its scene.json) is refused before anything is touched: no recorded table is
     /// removed, scene.json keeps describing the tables present.

@@ -67,7 +67,8 @@ const EVENTS_HEADER: &str =
     "index,kind,ix,iy,force_N,drive_displacement_m,energy_J,ruptures,area_exceeds_nominal";
 const CURVE_HEADER: &str = "event,force_N,force_over_mu_FN,drive_displacement_m,\
                             real_contact_area_m2,precursor_length_m,precursor_over_Lx,broken,\
-                            attached,area_exceeds_nominal";
+                            attached,area_exceeds_nominal,potency_m3_per_N,\
+                            potency_moment_m4_per_N,load_compliance_m_per_N";
 
 use crate::common::program::SLURM_VARS;
 
@@ -733,6 +734,13 @@ fn check_run_tables(dir: &Path, f: &Facts) -> Result<(), String> {
                     nx * ny
                 ));
             }
+        }
+        for (k, name) in [
+            (10, "potency_m3_per_N"),
+            (11, "potency_moment_m4_per_N"),
+            (12, "load_compliance_m_per_N"),
+        ] {
+            finite(&row[k], &format!("{at} {name}"))?;
         }
         if row[9] != state.exceeds {
             return Err(format!(

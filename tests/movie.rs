@@ -238,7 +238,7 @@ fn handwritten_on(name: &str, planes: &[f64]) -> (PathBuf, Vec<usize>) {
         ));
         let ell = 0.1 * (s + 1) as f64;
         curve_csv.push_str(&format!(
-            "{event},{force},{x:.12e},,1e-6,{:.12e},{ell:.12e},{s},30,0\n",
+            "{event},{force},{x:.12e},,1e-6,{:.12e},{ell:.12e},{s},30,0,1e-9,1e-12,1e-9\n",
             ell * 0.010
         ));
     }

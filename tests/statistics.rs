@@ -192,6 +192,61 @@ fn the_calibration_runs_avalanches_and_damage_front() {
     let fronts = table(&dir.join("fronts.csv"));
     let curve = table(&dir.join("curve.csv"));
     assert_eq!(fronts.len(), curve.len());
+    // The fronts at a quarter and three quarters of the contacts lost, read here from
+    // events.csv: a site's first event says whether it was in contact at zero shear, then
+    // ruptures and detachments take it out, attachments bring it back (140 x 7 sites).
+    let (nx, ny) = (140usize, 7usize);
+    let site = |e: &HashMap<String, String>| -> usize {
+        e["iy"].parse::<usize>().unwrap() * nx + e["ix"].parse::<usize>().unwrap()
+    };
+    let mut first: Vec<Option<bool>> = vec![None; nx * ny];
+    for e in &events {
+        if matches!(e["kind"].as_str(), "rupture" | "detach" | "attach") {
+            let slot = &mut first[site(e)];
+            slot.get_or_insert(e["kind"] != "attach");
+        }
+    }
+    let mut attached: Vec<bool> = first.iter().map(|f| f.unwrap()).collect();
+    let initial: Vec<usize> = (0..nx)
+        .map(|ix| (0..ny).filter(|iy| attached[iy * nx + ix]).count())
+        .collect();
+    let mut by_state = Vec::new();
+    for e in &events {
+        match e["kind"].as_str() {
+            "rupture" | "detach" => attached[site(e)] = false,
+            "attach" => attached[site(e)] = true,
+            "stable" => {
+                let front = |lost: f64| {
+                    let run = (0..nx)
+                        .take_while(|&ix| {
+                            let n = (0..ny).filter(|iy| attached[iy * nx + ix]).count();
+                            n as f64 <= (1.0 - lost) * initial[ix] as f64
+                        })
+                        .count();
+                    run as f64 * 1e-3
+                };
+                by_state.push([front(0.25), front(0.75)]);
+            }
+            _ => {}
+        }
+    }
+    assert_eq!(by_state.len(), fronts.len());
+    let mut apart = 0;
+    for (f, [quarter, three_quarters]) in fronts.iter().zip(&by_state) {
+        assert!(
+            (num(f, "damage_front_quarter_m") - quarter).abs() < 1e-12,
+            "{f:?}"
+        );
+        assert!((num(f, "damage_front_three_quarters_m") - three_quarters).abs() < 1e-12);
+        assert!(
+            three_quarters <= &num(f, "damage_front_m") && &num(f, "damage_front_m") <= quarter
+        );
+        apart += usize::from(quarter > three_quarters);
+    }
+    assert!(
+        apart > fronts.len() / 2,
+        "the thresholds differ at {apart} states"
+    );
     for (f, c) in fronts.iter().zip(&curve) {
         assert_eq!(f["event"], c["event"]);
         assert_eq!(f["precursor_over_Lx"], c["precursor_over_Lx"]);
@@ -789,5 +844,127 @@ fn the_comparison_extends_the_power_law_fit_reproducibly() {
         xs.swap(3, 700);
         let again = compare_alternatives(&xs, support, &options).unwrap();
         assert_eq!(format!("{again:?}"), format!("{c:?}"));
+    }
+}
+
+/// `per_avalanche.csv`'s potency and slip centroid against the driver's own shear
+/// displacements, read here at each avalanche's `load_raised` (the state before it at its
+/// starting load) and at its `stable` state, summed by this test; the released energy
+/// against two independent facts: under a top load (`e = 0`) it is `½ F Δ⟨u_x⟩` with the
+/// driver's `mean_shear_displacement`, and an avalanche with ruptures only releases at
+/// least the stored energy of its broken springs (cutting a spring dissipates what it
+/// held, the relaxation at a fixed load only lowers the potential). Under a driving
+/// spring the energy is not given.
+#[test]
+fn potency_slip_centroid_and_released_energy_follow_the_slip() {
+    use precursors::{Drive, Lateral};
+    let base = || {
+        Scene::builder()
+            .block(0.024, 0.004, 0.012)
+            .cells(24, 4)
+            .normal_load(60.0)
+            .seed(3)
+    };
+    let spring = Drive::Spring {
+        stiffness: 4e6,
+        lateral: Lateral::Side,
+    };
+    for (name, drive) in [
+        ("rod", Drive::default()),
+        ("top", Drive::top()),
+        ("spring", spring),
+    ] {
+        let scene = base().drive(drive).build().unwrap();
+        let dir = scratch(&format!("slip-{name}"));
+        let mut driver = scene.driver().unwrap();
+        let tables = RunTables::create(&dir, &driver).unwrap();
+        // Per avalanche: (Σu, Σxu, ⟨u_x⟩) at its load_raised and at its stable state.
+        let area = driver.grid().cell_area();
+        let (nx, dx) = (driver.grid().nx(), driver.grid().dx());
+        let mut at_raise = Vec::new();
+        let mut at_stable = Vec::new();
+        tables
+            .run_to_slip(&mut driver, None, |event, driver| {
+                let snapshot = || {
+                    let u = driver.shear_displacement().unwrap();
+                    let sum: f64 = u.iter().sum::<f64>() * area;
+                    let moment: f64 = u
+                        .iter()
+                        .enumerate()
+                        .map(|(i, u)| ((i % nx) as f64 + 0.5) * dx * u)
+                        .sum::<f64>()
+                        * area;
+                    (sum, moment, driver.mean_shear_displacement().unwrap())
+                };
+                match event {
+                    Event::LoadRaised { .. } => at_raise.push(snapshot()),
+                    Event::Stable { .. } if !at_raise.is_empty() => at_stable.push(snapshot()),
+                    _ => {}
+                }
+            })
+            .unwrap();
+        let rows = table(&dir.join("per_avalanche.csv"));
+        assert_eq!(rows.len(), at_raise.len(), "{name}");
+        assert!(rows.len() > 5, "{name}: {} avalanches", rows.len());
+        let mut checked_energy = 0;
+        for (k, row) in rows.iter().enumerate() {
+            let last = row["global_slip"] == "1";
+            if last {
+                for key in ["potency_m3", "slip_centroid_m", "released_energy_J"] {
+                    assert_eq!(row[key], "", "{name}: the global slip has no {key}");
+                }
+                continue;
+            }
+            let (p0, m0, u0) = at_raise[k];
+            let (p1, m1, u1) = at_stable[k];
+            let potency = num(row, "potency_m3");
+            let expected = p1 - p0;
+            let scale = p1.abs().max(p0.abs());
+            assert!(
+                (potency - expected).abs() <= 1e-8 * scale,
+                "{name} avalanche {}: potency {potency:e}, the driver's {expected:e}",
+                k + 1
+            );
+            if expected > 1e-6 * scale {
+                let centroid = num(row, "slip_centroid_m");
+                let by_slip = (m1 - m0) / expected;
+                assert!(
+                    (centroid - by_slip).abs() <= 1e-5 * 0.024,
+                    "{name} avalanche {}: slip centroid {centroid}, the driver's {by_slip}",
+                    k + 1
+                );
+                assert!((0.0..=0.024).contains(&centroid), "{name}: {centroid}");
+            }
+            if name == "spring" {
+                assert_eq!(row["released_energy_J"], "", "{name}: no exact balance");
+                continue;
+            }
+            let released = num(row, "released_energy_J");
+            let force = num(row, "force_before_N");
+            if name == "top" {
+                let expected = 0.5 * force * (u1 - u0);
+                assert!(
+                    (released - expected).abs() <= 1e-8 * (0.5 * force * u1.abs()),
+                    "{name} avalanche {}: released {released:e}, ½FΔ⟨u⟩ {expected:e}",
+                    k + 1
+                );
+            }
+            if row["attaches"] == "0" && row["detaches"] == "0" {
+                let stored = num(row, "energy_J");
+                assert!(
+                    released >= stored * (1.0 - 1e-6),
+                    "{name} avalanche {}: released {released:e} J below the stored {stored:e} J",
+                    k + 1
+                );
+                checked_energy += 1;
+            }
+        }
+        if name != "spring" {
+            assert!(
+                checked_energy > 3,
+                "{name}: {checked_energy} avalanches checked"
+            );
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -28,6 +28,29 @@ pub struct SlipProfile {
     pub normal_traction: Vec<f64>,
 }
 
+/// The interface's slip per newton of shear load at the current attached set
+/// ([`Driver::slip_per_newton`]): the tangential equilibrium is linear in the load `F` at
+/// a fixed set, so the state at any load of the set is `F` times these. Differences between
+/// two stable states give an avalanche's potency, its slip-weighted centroid and the energy
+/// it releases (`per_avalanche.csv`, docs/statistics.md).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct SlipPerNewton {
+    /// `ΔA Σ_i u_x,i`, the potency of the bottom face per newton of load (m³/N), every
+    /// cell counted (in contact or not).
+    pub potency: f64,
+    /// `ΔA Σ_i x_i u_x,i`, its first moment along `x` per newton (m⁴/N), `x_i` the cell
+    /// centre from the trailing edge.
+    pub potency_moment: f64,
+    /// The displacement work-conjugate to the shear load, per newton (m/N), less the
+    /// load's own compliance (a constant of the scene): `U + ΔA Σ_i φ_x,i e_i`, with `U`
+    /// the block's offset, `φ_x` the interface tractions and `e` the load's displacement
+    /// of the bottom face, both per newton (Betti's reciprocity). At a fixed load `F` the
+    /// elastic energy is `½ F² (c + c₀)` (Clapeyron), so an avalanche at constant `F` from
+    /// compliance `c_before` to `c_after` releases `½ F² (c_after - c_before)`.
+    pub load_compliance: f64,
+}
+
 impl Driver {
     /// The spring force `K_S (U_S - ⟨u_x⟩)` (N) under displacement control, `None` under
     /// force control.
@@ -91,6 +114,59 @@ impl Driver {
     /// after it.
     pub fn mean_shear_displacement(&self) -> Result<f64> {
         Ok(self.force() * self.response()?.offset_per_newton)
+    }
+
+    /// The interface's slip per newton of shear load at the current attached set
+    /// ([`SlipPerNewton`]): the potency `ΔA Σ u_x`, its first moment along `x` and the
+    /// load's work-conjugate compliance.
+    ///
+    /// ```
+    /// use precursors::{Event, Scene};
+    /// let scene = Scene::builder()
+    ///     .block(0.020, 0.004, 0.010)
+    ///     .cells(20, 4)
+    ///     .normal_load(80.0)
+    ///     .seed(0)
+    ///     .build()?;
+    /// let mut driver = scene.driver()?;
+    /// while let Some(event) = driver.step()? {
+    ///     if let Event::Stable { load, .. } = event {
+    ///         if load.force > 0.0 {
+    ///             // ΔA Σ u_x at this state is F times the potency per newton (m³).
+    ///             let slip = driver.slip_per_newton()?;
+    ///             let sum: f64 = driver.shear_displacement()?.iter().sum();
+    ///             let potency = sum * driver.grid().cell_area();
+    ///             assert!((load.force * slip.potency - potency).abs() <= 1e-9 * potency.abs());
+    ///             break;
+    ///         }
+    ///     }
+    /// }
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::NotSolved`] before the first event ([`Driver::event_count`] 0), never
+    /// after it.
+    pub fn slip_per_newton(&self) -> Result<SlipPerNewton> {
+        let response = self.response()?;
+        let grid = self.grid();
+        let (nx, dx, area) = (grid.nx(), grid.dx(), grid.cell_area());
+        let (mut potency, mut moment, mut reciprocal) = (0.0, 0.0, 0.0);
+        for (i, (&u, (&g, &e))) in response
+            .displacement
+            .iter()
+            .zip(response.traction.iter().zip(&self.unit_load))
+            .enumerate()
+        {
+            potency += u;
+            moment += ((i % nx) as f64 + 0.5) * dx * u;
+            reciprocal += g * e;
+        }
+        Ok(SlipPerNewton {
+            potency: potency * area,
+            potency_moment: moment * area,
+            load_compliance: response.offset_per_newton + reciprocal * area,
+        })
     }
 
     /// The interface's profiles along `x`, averaged over `y` (one value per column `ix`,

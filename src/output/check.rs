@@ -9,7 +9,7 @@
 
 #[cfg(feature = "serde")]
 use super::{contact_map_header, first_level_at_or_above, level, TABLES};
-use super::{CURVE_HEADER, EVENTS_HEADER, MAP_STEP};
+use super::{curve_header_1_1, CURVE_COLUMNS_1_1, CURVE_HEADER, EVENTS_HEADER, MAP_STEP};
 use crate::driver::{Event, Load, Site};
 use crate::error::Error;
 #[cfg(feature = "serde")]
@@ -134,6 +134,9 @@ pub(crate) struct CurveRow {
     pub precursor_over_lx: f64,
     /// The real contact area (m²).
     pub area: f64,
+    /// The slip per newton of load (`potency_m3_per_N`, `potency_moment_m4_per_N`,
+    /// `load_compliance_m_per_N`); `None` on a row written by 1.1.
+    pub slip: Option<[f64; 3]>,
 }
 
 /// A row of `contact_map.csv`, checked.
@@ -347,9 +350,10 @@ fn event_force(
     Ok(force)
 }
 
-/// Checks a row of `curve.csv` (line `line`).
-pub(crate) fn curve_row(line: usize, row: &str, b: &Bounds) -> Row<CurveRow> {
-    let header: Vec<&str> = CURVE_HEADER.split(',').collect();
+/// Checks a row of `curve.csv` (line `line`) under `header`: [`CURVE_HEADER`], or the header 1.1 wrote (without the slip columns,
+/// [`curve_header_of`]).
+pub(crate) fn curve_row(line: usize, row: &str, b: &Bounds, header: &str) -> Row<CurveRow> {
+    let header: Vec<&str> = header.split(',').collect();
     let c = cells(line, &header, row)?;
     let event = count(line, &header, &c, 0)?;
     let force = number(line, &header, &c, 1)?;
@@ -416,6 +420,26 @@ pub(crate) fn curve_row(line: usize, row: &str, b: &Bounds) -> Row<CurveRow> {
         ));
     }
     flag(line, &header, &c, 9)?;
+    let slip = if c.len() == CURVE_COLUMNS_1_1 {
+        None
+    } else {
+        let k = CURVE_COLUMNS_1_1;
+        match [k, k + 1, k + 2].map(|k| optional(line, &header, &c, k)) {
+            [Ok(None), Ok(None), Ok(None)] => None,
+            [Ok(Some(p)), Ok(Some(m)), Ok(Some(c))] => Some([p, m, c]),
+            [p, m, c] => {
+                p?;
+                m?;
+                c?;
+                return Err(at(
+                    line,
+                    header[k],
+                    "the three slip columns are either all empty (a row kept from a run 1.1 \
+                     began) or all numbers",
+                ));
+            }
+        }
+    };
     Ok(CurveRow {
         event,
         force_text: c[1].to_string(),
@@ -424,7 +448,19 @@ pub(crate) fn curve_row(line: usize, row: &str, b: &Bounds) -> Row<CurveRow> {
         precursor_text: c[6].to_string(),
         precursor_over_lx: ratio,
         area,
+        slip,
     })
+}
+
+/// The header of a `curve.csv` text: [`CURVE_HEADER`], or the one 1.1 wrote (without the
+/// slip columns) when the text starts with it.
+pub(crate) fn curve_header_of(text: &str) -> &'static str {
+    let first = text.split_inclusive('\n').next().unwrap_or("");
+    if first.trim_end_matches(['\n', '\r']) == curve_header_1_1() {
+        curve_header_1_1()
+    } else {
+        CURVE_HEADER
+    }
 }
 
 /// Checks a row of `contact_map.csv` (line `line`; its header has `b.nx` area columns).
@@ -539,8 +575,9 @@ pub(crate) fn whole_events(text: &str, bounds: &Bounds) -> Row<WholeEvents> {
 /// same `force_N`.
 pub(crate) fn whole_curve(text: &str, stable: &[EventRow], bounds: &Bounds) -> Row<Vec<CurveRow>> {
     let mut curve = Vec::with_capacity(stable.len());
-    for (line, row) in rows(text, CURVE_HEADER)? {
-        let c = curve_row(line, row, bounds)?;
+    let header = curve_header_of(text);
+    for (line, row) in rows(text, header)? {
+        let c = curve_row(line, row, bounds, header)?;
         let Some(s) = stable.get(curve.len()) else {
             return Err(Bad::Reason(format!(
                 "line {line}: event {}: events.csv has {} stable states, this table more",
@@ -829,12 +866,12 @@ mod tests {
             mu_fn: 10.0,
         };
         let rows = [
-            "2,1e308,1e308,,1e-6,0,0,0,8,0",
-            "2,1.0,0.1,,-1e308,0,0,0,8,0",
-            "2,1e300,0.1,,1e-6,0,0,0,8,0",
+            "2,1e308,1e308,,1e-6,0,0,0,8,0,,,",
+            "2,1.0,0.1,,-1e308,0,0,0,8,0,,,",
+            "2,1e300,0.1,,1e-6,0,0,0,8,0,,,",
         ];
         for row in rows {
-            let message = match curve_row(2, row, &b) {
+            let message = match curve_row(2, row, &b, CURVE_HEADER) {
                 Err(Bad::Reason(m)) => m,
                 other => panic!("{row}: {other:?}"),
             };

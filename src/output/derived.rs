@@ -24,10 +24,15 @@ pub(crate) const AVALANCHE_HEADER: &str = "avalanche,start_event,end_event,ruptu
      broken_area_m2,force_before_N,force_after_N,force_drop_N,drive_displacement_before_m,\
      drive_displacement_after_m,energy_J,attaches,detaches,flash_ruptures,global_slip,\
      ruptures_without_flash,contacts_before,contacts_after,spanning,after_spanning,extent_m,\
-     centroid_m";
+     centroid_m,potency_m3,slip_centroid_m,released_energy_J";
 /// The header of `fronts.csv`.
 pub(crate) const FRONTS_HEADER: &str =
-    "event,force_N,force_over_mu_FN,precursor_over_Lx,damage_front_m,damage_front_over_Lx";
+    "event,force_N,force_over_mu_FN,precursor_over_Lx,damage_front_m,damage_front_over_Lx,\
+     damage_front_quarter_m,damage_front_three_quarters_m";
+
+/// The other thresholds of `fronts.csv`: the share of a column's contacts lost
+/// ([`DamageFront::position_at`]), beside the half of [`DamageFront::position`].
+const FRONT_THRESHOLDS: [f64; 2] = [0.25, 0.75];
 
 /// What a whole run's events give: its avalanches, and the damage front (m) at each
 /// stable state (in order, the zero-shear state first).
@@ -35,6 +40,8 @@ pub(crate) const FRONTS_HEADER: &str =
 pub(crate) struct RunDerived {
     pub avalanches: Vec<Avalanche>,
     pub fronts: Vec<f64>,
+    /// The damage front (m) at each stable state at [`FRONT_THRESHOLDS`].
+    pub fronts_at: Vec<[f64; 2]>,
 }
 
 /// The avalanches and damage fronts of the whole run `events` on `grid`.
@@ -48,12 +55,15 @@ pub(crate) fn derive(grid: &Grid, events: &[Event]) -> Result<RunDerived> {
     let mut out = RunDerived {
         avalanches: Vec::new(),
         fronts: Vec::new(),
+        fronts_at: Vec::new(),
     };
     for event in events {
         front.observe(event);
         out.avalanches.extend(avalanches.observe(event));
         if let Event::Stable { .. } = event {
             out.fronts.push(front.position());
+            out.fronts_at
+                .push(FRONT_THRESHOLDS.map(|lost| front.front_lost(lost)));
         }
     }
     Ok(out)
@@ -80,24 +90,75 @@ pub(crate) fn write(
     })?;
     write_atomically(
         &dir.join(AVALANCHE_TABLE),
-        avalanche_text(&derived.avalanches).as_bytes(),
+        avalanche_text(&derived.avalanches, &curve).as_bytes(),
         "writing table",
     )?;
     write_atomically(
         &dir.join(FRONTS_TABLE),
-        fronts_text(&curve, &derived.fronts, bounds.lx).as_bytes(),
+        fronts_text(&curve, &derived, bounds.lx).as_bytes(),
         "writing table",
     )
 }
 
-/// The text of `per_avalanche.csv`.
-fn avalanche_text(avalanches: &[Avalanche]) -> String {
+/// What an avalanche slipped, from the slip per newton of load (`curve.csv`) of the
+/// stable state before it and of the one it ends in (docs/statistics.md).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Slip {
+    /// `Σ Δu_x ΔA` over the interface (m³).
+    potency: Option<f64>,
+    /// `Σ x Δu_x ΔA / Σ Δu_x ΔA` (m), where the potency is positive.
+    centroid: Option<f64>,
+    /// The work of the load less the change of the elastic energy (J), under force
+    /// control: `½ F² (c_after - c_before)`.
+    released: Option<f64>,
+}
+
+impl Slip {
+    /// The slip of `a` from the rows of the stable states before and after it: `None`
+    /// where the after state is global slip (no stable state) or a row holds no slip
+    /// (kept from a run 1.1 began). The state before holds at the avalanche's starting
+    /// load (the set is the same, the equilibrium linear in the load).
+    fn of(a: &Avalanche, before: Option<&CurveRow>, after: Option<&CurveRow>) -> Slip {
+        let (Some([p0, m0, c0]), Some([p1, m1, c1])) =
+            (before.and_then(|r| r.slip), after.and_then(|r| r.slip))
+        else {
+            return Slip::default();
+        };
+        let (f0, f1) = (a.load_before.force, a.load_after.force);
+        // At one force (force control) the difference is taken first: no rounding of
+        // two large products.
+        let change = |x0: f64, x1: f64| {
+            if f0 == f1 {
+                f0 * (x1 - x0)
+            } else {
+                f1 * x1 - f0 * x0
+            }
+        };
+        let potency = change(p0, p1);
+        let moment = change(m0, m1);
+        Slip {
+            potency: Some(potency),
+            centroid: (potency > 0.0).then(|| moment / potency),
+            // A driving spring is not the work-conjugate of the lateral load it exerts
+            // (the paper ties it to ⟨u_x⟩): no exact balance (docs/statistics.md).
+            released: (a.load_before.drive_displacement.is_none() && f0 == f1)
+                .then(|| 0.5 * f0 * f0 * (c1 - c0)),
+        }
+    }
+}
+
+/// The text of `per_avalanche.csv`, each avalanche's slip from `curve`'s rows.
+fn avalanche_text(avalanches: &[Avalanche], curve: &[CurveRow]) -> String {
     let mut text = format!("{AVALANCHE_HEADER}\n");
     for (k, a) in avalanches.iter().enumerate() {
+        let next = curve.partition_point(|c| c.event < a.start_event);
+        let before = next.checked_sub(1).and_then(|i| curve.get(i));
+        let after = curve.get(next).filter(|c| c.event == a.end_event);
+        let slip = Slip::of(a, before, after);
         let _ = writeln!(
             text,
             "{},{},{},{},{:.12e},{:.12e},{:.12e},{:.12e},{},{},{:.12e},{},{},{},{},{},{},{},{},{},\
-             {:.12e},{:.12e}",
+             {:.12e},{:.12e},{},{},{}",
             k + 1,
             a.start_event,
             a.end_event,
@@ -120,6 +181,9 @@ fn avalanche_text(avalanches: &[Avalanche]) -> String {
             u8::from(a.after_spanning),
             a.extent,
             a.centroid,
+            optional(slip.potency),
+            optional(slip.centroid),
+            optional(slip.released),
         );
     }
     text
@@ -131,13 +195,15 @@ fn count(n: Option<usize>) -> String {
 }
 
 /// The text of `fronts.csv`: `curve`'s stable states (their loads and `ℓ/Lx` as written
-/// there) with the damage front of each.
-fn fronts_text(curve: &[CurveRow], fronts: &[f64], lx: f64) -> String {
+/// there) with the damage fronts of each.
+fn fronts_text(curve: &[CurveRow], derived: &RunDerived, lx: f64) -> String {
     let mut text = format!("{FRONTS_HEADER}\n");
-    for (c, front) in curve.iter().zip(fronts) {
+    for ((c, front), [quarter, three_quarters]) in
+        curve.iter().zip(&derived.fronts).zip(&derived.fronts_at)
+    {
         let _ = writeln!(
             text,
-            "{},{},{},{},{front:.12e},{:.12e}",
+            "{},{},{},{},{front:.12e},{:.12e},{quarter:.12e},{three_quarters:.12e}",
             c.event,
             c.force_text,
             c.load_text,

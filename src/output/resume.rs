@@ -4,8 +4,8 @@
 //! finished table's. Nothing here writes.
 
 use super::{
-    check, contact_map_header, fields_header, first_level_at_or_above, level, CURVE_HEADER,
-    EVENTS_HEADER, MAP_STEP,
+    check, contact_map_header, fields_header, first_level_at_or_above, level, CURVE_COLUMNS_1_1,
+    CURVE_HEADER, EVENTS_HEADER, MAP_STEP,
 };
 use crate::driver::{Event, RowDifference, TableDigest};
 use crate::error::{Error, Result};
@@ -74,6 +74,27 @@ pub(super) struct Continuation {
     pub(super) site_events: Vec<(usize, Event)>,
 }
 
+impl Continuation {
+    /// The text table `t` is continued from: the kept text, with `curve.csv`'s rows of a
+    /// run 1.1 began brought to [`CURVE_HEADER`] (their slip columns empty: the states
+    /// are gone). The kept texts ([`Continuation::texts`]) are what checkpoints' digests
+    /// cover.
+    pub(super) fn written(&self, t: usize) -> std::borrow::Cow<'_, str> {
+        let text = &self.texts[t];
+        if t != 1 || check::curve_header_of(text) == CURVE_HEADER {
+            return text.into();
+        }
+        let empty = ",".repeat(CURVE_HEADER.split(',').count() - CURVE_COLUMNS_1_1);
+        let mut out = format!("{CURVE_HEADER}\n");
+        for row in text.lines().skip(1) {
+            out.push_str(row);
+            out.push_str(&empty);
+            out.push('\n');
+        }
+        out.into()
+    }
+}
+
 /// Checks the three tables (`old[t]`: the text of table `t` (`events.csv`, `curve.csv`, `contact_map.csv`)
 /// order, `None` when missing; `paths` for the messages) against each other and against
 /// the checkpoint's event `k` and load `force_at_k`, and cuts them back to it: to the
@@ -88,12 +109,16 @@ pub(super) fn continuation(
     force_at_k: f64,
 ) -> Result<Continuation> {
     let map_header = contact_map_header(bounds.nx);
-    let headers = [EVENTS_HEADER, CURVE_HEADER, map_header.as_str()];
+    // A run begun by 1.1 wrote `curve.csv` without the slip columns: it is continued
+    // with them, empty on the kept rows (`Continuation::written`).
+    let curve_header = old[1].map_or(CURVE_HEADER, check::curve_header_of);
+    let headers = [EVENTS_HEADER, curve_header, map_header.as_str()];
     let cut = Cut {
         paths,
         k,
         map_rows,
         bounds,
+        curve_header,
     };
     // Every table's header and rows first, so a damaged third table refuses the resume
     // before anything is cut.
@@ -117,7 +142,7 @@ pub(super) fn continuation(
     Ok(Continuation {
         texts: [
             text(EVENTS_HEADER, &events, k),
-            text(CURVE_HEADER, &curve, loads.len()),
+            text(curve_header, &curve, loads.len()),
             text(&map_header, &map, kept_levels),
         ],
         next_level,
@@ -135,6 +160,8 @@ struct Cut<'a> {
     /// The rows of `contact_map.csv` the checkpoint covers, where it records them.
     map_rows: Option<u64>,
     bounds: &'a check::Bounds,
+    /// The header `curve.csv` was written with.
+    curve_header: &'a str,
 }
 
 impl Cut<'_> {
@@ -281,7 +308,8 @@ impl Cut<'_> {
                     ))
                 }
             }
-            let c = check::curve_row(line, row, self.bounds).map_err(|b| b.at(&self.paths[1]))?;
+            let c = check::curve_row(line, row, self.bounds, self.curve_header)
+                .map_err(|b| b.at(&self.paths[1]))?;
             let force = &stable_forces[loads.len()];
             if &c.force_text != force {
                 return Err(self.corrupt(
