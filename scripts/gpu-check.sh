@@ -10,13 +10,18 @@
 # the CUDA backend with the CPU's spectral backend (scripts/compare-events.py: the same
 # events by kind and site, loads and A_R within 1e-9 relative):
 #   1. the five scenes of scripts/identity/, each run as backend "cuda" and "spectral";
-#   2. N = 1e4 (200 x 50), the first 2000 ruptures; N = 1e5 (1000 x 100, 1 MPa), the
+#   2. the per-phase times at N = 1e4, 1e5, 1e6 (examples/gpu_timings, carried beside
+#      the program: cargo build --release --features cuda --example gpu_timings);
+#   3. N = 1e4 (200 x 50), the first 2000 ruptures; N = 1e5 (1000 x 100, 1 MPa), the
 #      first 1000 (runs stopped by a time limit: the ruptures both reached are compared);
-#   3. a checkpoint of a GPU run resumed on the CPU, and the reverse;
-# with each run's wall time and peak memory (/usr/bin/time), then one summary table.
-# The CPU runs go in the background while the GPU runs, so the whole takes about 5
-# minutes on an H200 host (16 cores). With --dry-run, or when `precursors info` finds no
-# usable GPU, it checks its inputs, skips every GPU step, says so and exits 0.
+#   4. a checkpoint of a GPU run resumed on the CPU, and the reverse;
+# with each run's wall time and peak memory (/usr/bin/time), then one summary table and
+# the per-phase table (scripts/phase-table.py). The CPU runs go in the background while
+# the GPU runs. Every run has a time limit, cut to what is left of a budget of 450 s
+# (GPU_CHECK_BUDGET) and skipped when under 10 s of it is left, so the whole ends within
+# 8 minutes whatever the GPU does; the steps go in the order above. With --dry-run, or
+# when `precursors info` finds no usable GPU, it checks its inputs, skips every GPU step,
+# says so and exits 0.
 # Exit status: 0 all compared runs the same (or the GPU steps skipped), 1 a difference or
 # a failed run, 2 bad arguments or inputs.
 set -uo pipefail
@@ -29,16 +34,24 @@ if [ $# -eq 3 ]; then [ "$3" = "--dry-run" ] && dry=1 || usage; fi
 program="$bin_dir/precursors"
 
 # Time limits (s) of the runs stopped early, and the ruptures compared.
-N4_LIMIT=${GPU_CHECK_N4_LIMIT:-90}
-N5_LIMIT=${GPU_CHECK_N5_LIMIT:-200}
+N4_LIMIT=${GPU_CHECK_N4_LIMIT:-60}
+N5_LIMIT=${GPU_CHECK_N5_LIMIT:-120}
 N4_RUPTURES=2000
 N5_RUPTURES=1000
+# The whole check's budget (s): each run's limit is cut to what is left of it.
+BUDGET=${GPU_CHECK_BUDGET:-450}
+[[ "$BUDGET" =~ ^[0-9]+$ && "$N4_LIMIT" =~ ^[0-9]+$ && "$N5_LIMIT" =~ ^[0-9]+$ ]] ||
+    { echo "gpu-check: GPU_CHECK_BUDGET, GPU_CHECK_N4_LIMIT and GPU_CHECK_N5_LIMIT are whole seconds" >&2; exit 2; }
 
 # --- inputs -------------------------------------------------------------------------
 fail_input() { echo "gpu-check: $*" >&2; exit 2; }
 [ -x "$program" ] || fail_input "$program is not an executable (build it with cargo build --release --features cli,cuda)"
 command -v python3 >/dev/null || fail_input "python3 is needed (the scene edits and scripts/compare-events.py)"
 [ -f "$here/compare-events.py" ] || fail_input "$here/compare-events.py is missing"
+[ -f "$here/phase-table.py" ] || fail_input "$here/phase-table.py is missing"
+timings="$bin_dir/gpu_timings"
+[ -x "$timings" ] || timings="$bin_dir/examples/gpu_timings"
+[ -x "$timings" ] || timings=""
 scenes=("$here"/identity/*.json)
 [ -f "${scenes[0]}" ] || fail_input "no scenes in $here/identity/"
 case "$(uname -m)" in x86_64) ;; *) fail_input "this machine is $(uname -m); the binaries are x86-64" ;; esac
@@ -50,7 +63,7 @@ if [ -x /usr/bin/time ]; then timer=(/usr/bin/time -f "%e %M"); fi
 echo "== precursors info (the GPU and its libraries)"
 info_scene="$out/info-scene.json"
 cp "${scenes[0]}" "$info_scene"
-"$program" info "$info_scene" >"$out/info.txt" 2>&1
+timeout -k 5 60 "$program" info "$info_scene" >"$out/info.txt" 2>&1
 gpu_line=$(grep '^gpu ' "$out/info.txt" || echo "gpu        (no gpu line: $(head -c 300 "$out/info.txt"))")
 echo "$gpu_line"
 echo "LD_LIBRARY_PATH=${LD_LIBRARY_PATH:-}"
@@ -62,7 +75,8 @@ elif [[ "$gpu_line" == *"none usable"* || "$gpu_line" == *"no CUDA backend"* || 
     skip="no usable GPU (the gpu line above says why)"
 fi
 if [ -n "$skip" ]; then
-    echo "== inputs checked: $program, python3, compare-events.py, ${#scenes[@]} identity scenes"
+    echo "== inputs checked: $program, python3, compare-events.py, phase-table.py, ${#scenes[@]} identity scenes"
+    echo "== gpu_timings: ${timings:-none beside the program (the per-phase table will be skipped)}"
     echo "== every GPU step skipped: $skip"
     exit 0
 fi
@@ -106,18 +120,27 @@ open(dest, "w", encoding="utf-8").write(body[:-1] + key + f"{h:016x}" + '"}')
 EOF
 }
 
+# within LIMIT: LIMIT cut to what is left of the budget (less 5 s for the summary), or
+# 0 when under 10 s is left (the run is then skipped).
+within() {
+    local left=$((BUDGET - SECONDS - 5))
+    if [ $left -lt 10 ]; then echo 0; elif [ "$1" -lt $left ]; then echo "$1"; else echo $left; fi
+}
+
 # timed NAME LIMIT CMD...: runs CMD (its stderr and time in $out/NAME.log), stopped after
-# LIMIT seconds (0: none) by SIGINT to its process group: /usr/bin/time ignores it and
-# still reports the program's peak memory. Sets $secs and $rc (124: stopped at the limit).
+# LIMIT seconds, cut to the budget (within), by SIGINT to its process group:
+# /usr/bin/time ignores it and still reports the program's peak memory. Sets $secs and
+# $rc (124: stopped at the limit; 125: not run, the budget spent).
 timed() {
-    local name=$1 limit=$2
+    local name=$1 limit
+    limit=$(within "$2")
     shift 2
     local start=$SECONDS
-    if [ "$limit" -gt 0 ]; then
-        timeout -k 10 -s INT "$limit" "${timer[@]}" "$@" >"$out/$name.stdout" 2>"$out/$name.log"
-    else
-        "${timer[@]}" "$@" >"$out/$name.stdout" 2>"$out/$name.log"
+    if [ "$limit" -eq 0 ]; then
+        rc=125 secs="not run (budget spent)"
+        return
     fi
+    timeout -k 10 -s INT "$limit" "${timer[@]}" "$@" >"$out/$name.stdout" 2>"$out/$name.log"
     rc=$?
     secs=$((SECONDS - start))
     if [ ${#timer[@]} -gt 0 ]; then
@@ -174,6 +197,10 @@ for backend in cuda spectral; do
 done
 
 # --- the CPU runs, in the background --------------------------------------------------
+# Limits (s) of the runs that go to the end: an identity scene, a checkpoint's run, and
+# the timings at each size (the first equilibrium, EVENTS events, then PHASE_EVENTS with
+# the per-phase timing on).
+SCENE_LIMIT=60
 echo "== CPU runs (spectral) started in the background"
 cpu_run() {  # cpu_run NAME LIMIT
     local name=$1 limit=$2
@@ -182,20 +209,20 @@ cpu_run() {  # cpu_run NAME LIMIT
     echo "$rc|$secs" >"$out/runs/$name.cpu.done"
 }
 for scene in "${scenes[@]}"; do
-    cpu_run "$(basename "$scene" .json)" 0 &
+    cpu_run "$(basename "$scene" .json)" "$BUDGET" &
 done
 cpu_run n1e4 "$N4_LIMIT" &
 cpu_run n1e5 "$N5_LIMIT" &
 
 # --- the GPU runs, one at a time -------------------------------------------------------
-gpu_run() {  # gpu_run NAME LIMIT: sets gpu_time
-    local name=$1 limit=$2
+gpu_run() {  # gpu_run NAME LIMIT STOPPED_OK: sets gpu_time, gpu_rc
+    local name=$1 limit=$2 stopped_ok=$3
     rm -rf "$out/runs/$name.gpu"
     timed "$name.gpu" "$limit" "$program" run "$out/scenes/$name.cuda.json" --out "$out/runs/$name.gpu" -q
     gpu_time=$secs
     gpu_rc=$rc
     # A run stopped by its time limit (124) is expected for N = 1e4 and 1e5.
-    if [ "$gpu_rc" -ne 0 ] && { [ "$limit" -eq 0 ] || [ "$gpu_rc" -ne 124 ]; }; then
+    if [ "$gpu_rc" -ne 0 ] && [ "$gpu_rc" -ne 125 ] && { [ "$stopped_ok" -eq 0 ] || [ "$gpu_rc" -ne 124 ]; }; then
         echo "   $name on the GPU failed (exit $gpu_rc): $(grep -v '^[0-9.]* [0-9]*$' "$out/$name.gpu.log" | tail -3)"
     fi
 }
@@ -203,23 +230,50 @@ cpu_result() {  # cpu_result NAME: waits for the CPU run, sets cpu_time and cpu_
     while [ ! -f "$out/runs/$1.cpu.done" ]; do sleep 1; done
     IFS='|' read -r cpu_rc cpu_time <"$out/runs/$1.cpu.done"
 }
+# not_run STEP GPU_RC CPU_RC GPU_TIME CPU_TIME: a row for a step not compared.
+not_run() {
+    local result=FAILED
+    [ "$2" -eq 125 ] || [ "$3" -eq 125 ] && result=SKIPPED
+    row "$1" $result "exit $2, $4" "exit $3, $5"
+    status=1
+}
 
 echo "== 1. the identity scenes, cuda against spectral"
 for scene in "${scenes[@]}"; do
     name=$(basename "$scene" .json)
-    gpu_run "$name" 0
+    gpu_run "$name" $SCENE_LIMIT 0
     cpu_result "$name"
     if [ "$gpu_rc" -ne 0 ] || [ "$cpu_rc" -ne 0 ]; then
-        row "$name" FAILED "exit $gpu_rc, $gpu_time" "exit $cpu_rc, $cpu_time"; status=1
+        not_run "$name" "$gpu_rc" "$cpu_rc" "$gpu_time" "$cpu_time"
     else
         compare_dirs "$name" "$out/runs/$name.gpu" "$out/runs/$name.cpu" "$gpu_time" "$cpu_time"
     fi
 done
 
-echo "== 2. N = 1e4 (first $N4_RUPTURES ruptures) and N = 1e5 (first $N5_RUPTURES)"
+# The per-phase times (examples/gpu_timings with PHASE_EVENTS): N = 1e4, 1e5, 1e6.
+echo "== 2. per-phase times (examples/gpu_timings)"
+phase_outputs=()
+if [ -n "$timings" ]; then
+    # NAME NX NY EVENTS PHASE_EVENTS LIMIT
+    for spec in "t1e4 200 50 500 200 30" "t1e5 1000 100 100 50 45" "t1e6 2000 500 20 10 90"; do
+        read -r name nx ny events phase_events limit <<<"$spec"
+        timed "$name.cuda" "$limit" "$timings" cuda "$nx" "$ny" "$events" "$phase_events"
+        line=$(grep '^backend' "$out/$name.cuda.stdout" 2>/dev/null || echo "exit $rc: see $out/$name.cuda.log")
+        echo "   $line ($secs)"
+        phase_outputs+=("$out/$name.cuda.stdout")
+        result=measured
+        case $rc in 0) ;; 125) result=SKIPPED ;; *) result="exit $rc" ;; esac
+        row "timing $name (N = $((nx * ny)))" "$result" "$secs" "-"
+    done
+else
+    echo "   no gpu_timings beside $program: skipped"
+    row "per-phase times" SKIPPED "-" "no gpu_timings binary"
+fi
+
+echo "== 3. N = 1e4 (first $N4_RUPTURES ruptures) and N = 1e5 (first $N5_RUPTURES)"
 for size in n1e4 n1e5; do
     if [ $size = n1e4 ]; then limit=$N4_LIMIT k=$N4_RUPTURES; else limit=$N5_LIMIT k=$N5_RUPTURES; fi
-    gpu_run $size "$limit"
+    gpu_run $size "$limit" 1
     cpu_result $size
     ok=1
     for r in "$gpu_rc" "$cpu_rc"; do [ "$r" -eq 0 ] || [ "$r" -eq 124 ] || ok=0; done
@@ -227,11 +281,11 @@ for size in n1e4 n1e5; do
         compare_dirs "$size, first $k ruptures" "$out/runs/$size.gpu" "$out/runs/$size.cpu" \
             "$gpu_time" "$cpu_time" --ruptures "$k"
     else
-        row "$size" FAILED "exit $gpu_rc, $gpu_time" "exit $cpu_rc, $cpu_time"; status=1
+        not_run "$size" "$gpu_rc" "$cpu_rc" "$gpu_time" "$cpu_time"
     fi
 done
 
-echo "== 3. checkpoints across devices (top_64x32_spectral)"
+echo "== 4. checkpoints across devices (top_64x32_spectral)"
 cross="top_64x32_spectral"
 reference="$out/runs/$cross.cpu"
 if [ -f "$reference/curve.csv" ]; then
@@ -241,17 +295,17 @@ if [ -f "$reference/curve.csv" ]; then
         if [ $way = gpu-to-cpu ]; then first=cuda then=spectral; else first=spectral then=cuda; fi
         dir="$out/runs/$cross.$way"
         rm -rf "$dir" "$dir.resumed"
-        timed "$cross.$way.first" 0 "$program" run "$out/scenes/$cross.$first.json" --out "$dir" \
+        timed "$cross.$way.first" $SCENE_LIMIT "$program" run "$out/scenes/$cross.$first.json" --out "$dir" \
             -q --checkpoint "$dir.ck.json" --every "$every"
         first_time=$secs first_rc=$rc
         resumed_rc=1 resumed_time="-"
         if [ "$first_rc" -eq 0 ] && swap_backend "$dir.ck.json" "$dir.ck2.json" "$first" "$then"; then
             cp -r "$dir" "$dir.resumed"
-            timed "$cross.$way.resume" 0 "$program" resume "$dir.ck2.json" --out "$dir.resumed" -q
+            timed "$cross.$way.resume" $SCENE_LIMIT "$program" resume "$dir.ck2.json" --out "$dir.resumed" -q
             resumed_time=$secs resumed_rc=$rc
         fi
         if [ "$first_rc" -ne 0 ] || [ "$resumed_rc" -ne 0 ]; then
-            row "checkpoint $way" FAILED "exit $first_rc/$resumed_rc" "see $cross.$way.*.log"; status=1
+            not_run "checkpoint $way" "$first_rc" "$resumed_rc" "$first_time" "$resumed_time"
         else
             # GPU and CPU columns: the run that wrote the checkpoint and the resumed one.
             if [ $way = gpu-to-cpu ]; then g=$first_time c=$resumed_time; else g=$resumed_time c=$first_time; fi
@@ -263,34 +317,17 @@ else
 fi
 wait
 
-# Item 6's timings: a CG iteration and an event at N = 1e4 ... 1e7 (examples/gpu_timings,
-# built by `cargo build --release --features cuda --example gpu_timings`; carried beside
-# the program or in BIN_DIR/examples/).
-timings="$bin_dir/gpu_timings"
-[ -x "$timings" ] || timings="$bin_dir/examples/gpu_timings"
-echo "== 4. timings (examples/gpu_timings)"
-if [ -x "$timings" ]; then
-    # NAME NX NY EVENTS LIMIT BACKEND
-    for spec in "t1e4 200 50 1000 20 cuda" "t1e5 1000 100 1000 30 cuda" \
-        "t1e6 2000 500 10000 90 cuda" "t1e7 10000 1000 20 45 cuda" \
-        "t1e4 200 50 1000 20 spectral" "t1e5 1000 100 200 30 spectral"; do
-        read -r name nx ny events limit backend <<<"$spec"
-        timed "$name.$backend" "$limit" "$timings" "$backend" "$nx" "$ny" "$events"
-        line=$(grep '^backend' "$out/$name.$backend.stdout" || echo "exit $rc: see $out/$name.$backend.log")
-        echo "$line ($secs)"
-        row "timing $name $backend" "$([ "$rc" -eq 0 ] && echo measured || echo "exit $rc")" \
-            "$([ "$backend" = cuda ] && echo "$secs" || echo -)" "$([ "$backend" = spectral ] && echo "$secs" || echo -)"
-    done
-else
-    echo "   no gpu_timings beside $program: skipped"
-    row "timings" SKIPPED "-" "no gpu_timings binary"
-fi
-
 echo
 echo "== summary (times: wall seconds, peak resident memory of the process)"
 printf '%-34s | %-9s | %-20s | %-20s\n' "check" "result" "GPU (cuda)" "CPU (spectral)"
 printf '%s\n' "-----------------------------------+-----------+----------------------+---------------------"
 printf '%s\n' "${rows[@]}"
+if [ ${#phase_outputs[@]} -gt 0 ]; then
+    echo
+    echo "== per-phase times of the CUDA backend (the timed events of gpu_timings; a"
+    echo "   synchronisation of the stream around each part; ms per CG iteration, share of the solves)"
+    python3 "$here/phase-table.py" "${phase_outputs[@]}" | tee "$out/phases.txt"
+fi
 echo "$gpu_line"
-echo "outputs and logs: $out"
+echo "the check took $SECONDS s (budget $BUDGET s); outputs and logs: $out"
 exit $status

@@ -48,7 +48,7 @@ mod system;
 mod tangential;
 
 #[cfg(feature = "cuda")]
-pub use cuda::{cuda_device, CudaDevice};
+pub use cuda::{cuda_device, record_cuda_phase_times, CudaDevice, CudaPhaseTimes};
 pub use options::{
     Backend, NormalEquilibrium, SolveReport, SolverOptions, TangentialResponse, AUTO_DENSE_LIMIT,
 };

@@ -140,12 +140,21 @@ impl Gpu {
 }
 
 /// Runs `f`, a panic inside the bindings (a library without a symbol they expect) turned
-/// into a reason naming `what`.
+/// into a reason naming `what`, with nothing printed: the panic's message goes into the
+/// reason, and the panic hook stays quiet for it (see [`quiet_panics`]).
+///
+/// Under `panic = "abort"` (a profile setting of the program that links the crate) no
+/// panic can be caught: the hook prints the bindings' message (`Missing symbol cuInit:
+/// ...`) and the process aborts (SIGABRT) instead of returning `CudaUnavailable`. Only a
+/// library that the search of `libraries.rs` found and opened but that lacks a function
+/// the bindings call (older than CUDA 12) can panic here; a missing library is an error
+/// of that search, before the bindings are called, under either setting.
 pub(crate) fn guarded<T>(
     what: &str,
     f: impl FnOnce() -> std::result::Result<T, String>,
 ) -> std::result::Result<T, String> {
-    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
+    let caught = quiet_panics(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)));
+    match caught {
         Ok(result) => result,
         Err(payload) => {
             let message = payload
@@ -158,6 +167,35 @@ pub(crate) fn guarded<T>(
             ))
         }
     }
+}
+
+thread_local! {
+    /// Whether this thread is inside [`quiet_panics`].
+    static QUIET: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs `f` with the panic hook silent for panics of this thread (they are caught and
+/// reported by [`guarded`]). The hook is the process's: on first use it is wrapped once,
+/// and the wrapper hands every other panic (other threads, or this one outside `f`) to
+/// the hook it replaced. Under `panic = "abort"` the hook is left alone: a panic there
+/// ends the process, and its message is then all that says why.
+fn quiet_panics<T>(f: impl FnOnce() -> T) -> T {
+    if cfg!(not(panic = "unwind")) {
+        return f();
+    }
+    static WRAPPED: std::sync::Once = std::sync::Once::new();
+    WRAPPED.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !QUIET.with(|q| q.get()) {
+                previous(info);
+            }
+        }));
+    });
+    let outer = QUIET.with(|q| q.replace(true));
+    let result = f();
+    QUIET.with(|q| q.set(outer));
+    result
 }
 
 /// `len` zeros on the device (every buffer of the backend is allocated through here).
@@ -175,5 +213,107 @@ pub(crate) fn cuda_error(call: &'static str, e: impl std::fmt::Display) -> Error
     Error::Cuda {
         call,
         message: e.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::process::Command;
+
+    /// Libraries that open but lack the driver's functions (a driver older than the
+    /// bindings): the bindings panic inside (`Missing symbol cuInit`), the backend answers
+    /// `CudaUnavailable` with that message, and nothing else is printed. Run in a process
+    /// of its own (this test binary again, with fake libraries first in
+    /// `LD_LIBRARY_PATH`): the bindings keep the library they open for the process. The
+    /// panic hook writes to the real stderr there (`--nocapture`), so without the quiet
+    /// hook the child's stderr has "panicked at".
+    #[test]
+    fn a_library_without_the_bindings_functions_is_unavailable_without_panic_text() {
+        const CHILD: &str = "PRECURSORS_TEST_FAKE_CUDA_CHILD";
+        if std::env::var_os(CHILD).is_some() {
+            match cuda_device() {
+                Err(e) => println!("RESULT {e}"),
+                Ok(gpu) => println!("RESULT a GPU: {gpu}"),
+            }
+            return;
+        }
+        let dir = std::env::temp_dir().join(format!("precursors-fake-cuda-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        // The driver's library answers its version (CUDA 13) and nothing else; cuFFT and
+        // NVRTC are empty. Each has its SONAME, as the real ones do.
+        let sources = [
+            (
+                "libcuda.so.1",
+                "int cuDriverGetVersion(int* v) { *v = 13000; return 0; }\n",
+            ),
+            ("libcufft.so.12", "int precursors_fake_cufft;\n"),
+            ("libnvrtc.so.13", "int precursors_fake_nvrtc;\n"),
+        ];
+        for (name, source) in sources {
+            let c = dir.join(format!("{name}.c"));
+            std::fs::write(&c, source).unwrap();
+            let status = Command::new("cc")
+                .args(["-shared", "-fPIC", &format!("-Wl,-soname,{name}"), "-o"])
+                .arg(dir.join(name))
+                .arg(&c)
+                .status()
+                .expect("a C compiler `cc` (the emulator's tests need `c++` too)");
+            assert!(status.success(), "cc failed on {name}");
+        }
+        let name = "solver::cuda::device::tests::\
+                    a_library_without_the_bindings_functions_is_unavailable_without_panic_text";
+        let child = Command::new(std::env::current_exe().unwrap())
+            .args(["--exact", name, "--nocapture", "--test-threads=1"])
+            .env(CHILD, "1")
+            .env("LD_LIBRARY_PATH", &dir)
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&child.stdout);
+        let stderr = String::from_utf8_lossy(&child.stderr);
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert!(child.status.success(), "{stdout}\n{stderr}");
+        // The child's line follows libtest's `test NAME ... ` on the same line.
+        let result = stdout
+            .split_once("RESULT ")
+            .and_then(|(_, r)| r.lines().next())
+            .unwrap_or_else(|| panic!("no result line: {stdout}\n{stderr}"));
+        assert!(
+            result.starts_with("the CUDA backend is unavailable: cuInit and the device's context failed inside the CUDA bindings (Missing symbol cuInit"),
+            "{result}"
+        );
+        assert!(
+            !stderr.contains("panicked"),
+            "panic text printed:\n{stderr}"
+        );
+        assert!(
+            !stdout.contains("panicked"),
+            "panic text printed:\n{stdout}"
+        );
+    }
+
+    /// The hook is quiet only inside [`guarded`], nested ones included, and the error
+    /// carries the panic's message. (That other panics still reach the hook it replaced
+    /// is not tested: the harness captures what that hook prints.)
+    #[test]
+    fn the_quiet_hook_is_only_for_guarded_panics() {
+        let caught = guarded("a test", || -> std::result::Result<(), String> {
+            panic!("planted")
+        });
+        assert_eq!(
+            caught.unwrap_err(),
+            "a test failed inside the CUDA bindings (planted): a library may be too old"
+        );
+        assert!(!QUIET.with(|q| q.get()));
+        let nested = guarded("outer", || {
+            let inner = guarded("inner", || -> std::result::Result<(), String> {
+                panic!("x")
+            });
+            assert!(QUIET.with(|q| q.get()), "still quiet after an inner guard");
+            inner
+        });
+        assert!(nested.unwrap_err().starts_with("inner failed"));
+        assert!(!QUIET.with(|q| q.get()));
     }
 }

@@ -286,8 +286,9 @@ impl Kernels {
                    \"spectral\" meanwhile"
                 .into(),
         };
-        // Compiled once per process (NVRTC takes about 250 ms; the backend uses device 0
-        // only, so one compute capability), loaded per solver.
+        // Compiled once per process (NVRTC took 1-2 s for sm_90 on the 2-core build
+        // machine, scripts/nvrtc-check.py; the backend uses device 0 only, so one compute
+        // capability), loaded per solver.
         static IMAGE: OnceLock<((u32, u32), std::result::Result<Ptx, String>)> = OnceLock::new();
         let capability = gpu.info.compute_capability;
         let (compiled_for, image) = IMAGE.get_or_init(|| (capability, compile(capability)));

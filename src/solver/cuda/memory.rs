@@ -65,7 +65,8 @@ mod tests {
         assert_eq!(device_bytes(4, 3), expected);
     }
 
-    /// N = 1e7 fits an 80 GB GPU with room to spare (about 2.5 GB): memory O(N).
+    /// N = 1e7 fits an 80 GB GPU with room to spare (about 2.5 GB by this count, not
+    /// measured on a GPU): memory O(N).
     #[test]
     fn ten_million_cells_need_a_few_gigabytes() {
         let bytes = device_bytes(10_000, 1_000);

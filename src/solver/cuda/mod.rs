@@ -22,12 +22,14 @@ mod libraries;
 mod memory;
 mod operator;
 mod phases;
+mod timing;
 mod vectors;
 
 #[cfg(test)]
 mod emulated;
 
 pub use device::{cuda_device, CudaDevice};
+pub use timing::{record_cuda_phase_times, CudaPhaseTimes};
 
 use super::fsai::{Entries, Fsai};
 use super::parallel::Parallelism;
@@ -44,6 +46,7 @@ use fsai::DeviceFsai;
 use kernels::Kernels;
 use operator::Transforms;
 use phases::{DevicePhases, DevicePrecond};
+use timing::{timed, timed_solve, Part};
 use vectors::SetVectors;
 
 /// The device's state kept between solves: kernels, plans, buffers, the operator's table
@@ -131,6 +134,17 @@ impl CudaCore {
         &mut self,
         problem: SetProblem<'_>,
         precond: Precond,
+        f: Vec<f64>,
+        effort: Effort,
+    ) -> Result<SetSolve> {
+        timed_solve(|| self.solve_timed(problem, precond, f, effort))
+    }
+
+    /// [`CudaCore::solve`], its parts timed when [`timing`] records.
+    fn solve_timed(
+        &mut self,
+        problem: SetProblem<'_>,
+        precond: Precond,
         mut f: Vec<f64>,
         effort: Effort,
     ) -> Result<SetSolve> {
@@ -157,17 +171,21 @@ impl CudaCore {
                 found: m,
             });
         }
+        let stream = self.gpu.stream.clone();
+        let upkeep = Part::PreconditionerUpkeep;
         if precond == Precond::Spectral {
             if let Some(mean_d) = stale_mean(self.preconditioner_mean(), problem.d) {
-                self.build_inverse(mean_d)?;
+                timed(&stream, upkeep, || self.build_inverse(mean_d))?;
             }
         }
         if matches!(precond, Precond::Fsai | Precond::TwoLevel) {
-            self.prepare_fsai(problem, effort.parallelism)?;
+            timed(&stream, upkeep, || {
+                self.prepare_fsai(problem, effort.parallelism)
+            })?;
         }
-        self.upload_problem(problem, &f)?;
+        timed(&stream, Part::Copies, || self.upload_problem(problem, &f))?;
         if precond == Precond::TwoLevel {
-            self.prepare_coarse(problem)?;
+            timed(&stream, Part::CoarseUpkeep, || self.prepare_coarse(problem))?;
         }
         let stream = &self.gpu.stream;
         let device_precond = match (precond, &self.inverse, &mut self.fsai) {
@@ -196,22 +214,26 @@ impl CudaCore {
         let outcome = run_cg(&mut phases, m, max_abs(problem.b), problem.total, effort)?;
         // The displacements' product `C_s f` on every cell, of the returned `f`.
         let v = &self.vectors;
-        self.transforms
-            .filter(stream, &self.kernels, &self.operator, &v.f, &v.pos)?;
-        self.transforms
-            .gather_grid(stream, &self.kernels, &mut self.grid)?;
+        timed(stream, Part::Operator, || {
+            self.transforms
+                .filter(stream, &self.kernels, &self.operator, &v.f, &v.pos)?;
+            self.transforms
+                .gather_grid(stream, &self.kernels, &mut self.grid)
+        })?;
         let mut grid_product = vec![0.0; n];
-        if m > 0 {
+        timed(stream, Part::Copies, || {
+            if m > 0 {
+                stream
+                    .memcpy_dtoh(&v.f.slice(0..m), f.as_mut_slice())
+                    .map_err(|e| cuda_error("cuMemcpyDtoH (tractions)", e))?;
+            }
             stream
-                .memcpy_dtoh(&v.f.slice(0..m), f.as_mut_slice())
-                .map_err(|e| cuda_error("cuMemcpyDtoH (tractions)", e))?;
-        }
-        stream
-            .memcpy_dtoh(&self.grid, grid_product.as_mut_slice())
-            .map_err(|e| cuda_error("cuMemcpyDtoH (grid product)", e))?;
-        stream
-            .synchronize()
-            .map_err(|e| cuda_error("cuStreamSynchronize (solve results)", e))?;
+                .memcpy_dtoh(&self.grid, grid_product.as_mut_slice())
+                .map_err(|e| cuda_error("cuMemcpyDtoH (grid product)", e))?;
+            stream
+                .synchronize()
+                .map_err(|e| cuda_error("cuStreamSynchronize (solve results)", e))
+        })?;
         Ok(SetSolve {
             f,
             outcome,

@@ -7,6 +7,7 @@ use super::device::cuda_error;
 use super::fsai::DeviceFsai;
 use super::kernels::{blocks, int, over, Kernels, THREADS};
 use super::operator::Transforms;
+use super::timing::{timed, Part};
 use super::vectors::{SetVectors, REDUCTION_BLOCKS};
 use crate::error::Result;
 use crate::solver::pcg::{Main, Phase, PhaseRunner, Pre};
@@ -53,38 +54,49 @@ enum Product {
 impl PhaseRunner for DevicePhases<'_> {
     /// The phase's kernels, FFTs and copies; the first that fails stops the CG with its
     /// error (`Error::Cuda` naming the call).
+    /// Each part is timed when [`super::timing`] records (docs/gpu.md).
     fn run(&mut self, phase: Phase) -> Result<[f64; 3]> {
-        self.pre(phase.pre)?;
-        self.prolong(phase.pre)?;
+        let stream = self.stream;
+        timed(stream, Part::Updates, || self.pre(phase.pre))?;
+        timed(stream, Part::Preconditioner, || self.prolong(phase.pre))?;
+        let reductions = Part::Reductions;
         match phase.main {
             Main::Nothing => Ok([0.0; 3]),
             Main::SumF => {
-                let [s, _, _] = self.reduce(0, Vector::F, Vector::F, Vector::F)?;
+                let [s, _, _] = timed(stream, reductions, || {
+                    self.reduce(0, Vector::F, Vector::F, Vector::F)
+                })?;
                 Ok([s, 0.0, 0.0])
             }
             Main::Direction { .. } => {
-                self.product(Product::Direction)?;
-                let [pq, _, _] = self.reduce(1, Vector::P, Vector::Q, Vector::Q)?;
+                timed(stream, Part::Operator, || self.product(Product::Direction))?;
+                let [pq, _, _] = timed(stream, reductions, || {
+                    self.reduce(1, Vector::P, Vector::Q, Vector::Q)
+                })?;
                 Ok([pq, 0.0, 0.0])
             }
             Main::Residual { offset, .. } => {
-                self.product(Product::Residual)?;
-                self.residual_tail(offset)?;
+                timed(stream, Part::Operator, || self.product(Product::Residual))?;
+                timed(stream, Part::Updates, || self.residual_tail(offset))?;
                 Ok([0.0; 3])
             }
             Main::Precondition { .. } => {
-                self.precondition()?;
-                let [s, _, _] = self.reduce(0, Vector::Z, Vector::Z, Vector::Z)?;
+                timed(stream, Part::Preconditioner, || self.precondition())?;
+                let [s, _, _] = timed(stream, reductions, || {
+                    self.reduce(0, Vector::Z, Vector::Z, Vector::Z)
+                })?;
                 Ok([s, 0.0, 0.0])
             }
-            Main::Measure => self.reduce(2, Vector::R, Vector::F, Vector::Z),
+            Main::Measure => timed(stream, reductions, || {
+                self.reduce(2, Vector::R, Vector::F, Vector::Z)
+            }),
             Main::CoarseProduct { .. } => {
-                self.product(Product::Coarse)?;
-                self.restrict(true)?;
+                timed(stream, Part::Operator, || self.product(Product::Coarse))?;
+                timed(stream, Part::Preconditioner, || self.restrict(true))?;
                 Ok([0.0; 3])
             }
             Main::Restrict => {
-                self.restrict(false)?;
+                timed(stream, Part::Preconditioner, || self.restrict(false))?;
                 Ok([0.0; 3])
             }
         }
@@ -104,7 +116,9 @@ impl PhaseRunner for DevicePhases<'_> {
     }
     fn coarse_solve(&mut self) -> Result<()> {
         match self.coarse.as_deref_mut() {
-            Some(coarse) => coarse.solve(self.stream, self.kernels),
+            Some(coarse) => timed(self.stream, Part::Preconditioner, || {
+                coarse.solve(self.stream, self.kernels)
+            }),
             None => Ok(()),
         }
     }
