@@ -58,10 +58,10 @@ fn run() -> report::Outcome {
         let (force, plane, interface) = before.ok_or("no stable state before the precursor")?;
         loads.push(force / (mu * scene.normal_load()));
         let columns = [
-            plane.shear.iter().map(|v| v.abs()).collect::<Vec<_>>(),
-            plane.normal.iter().map(|v| v.abs()).collect(),
-            plane.coulomb_of_means.clone(),
-            interface.mean_coulomb.clone(),
+            plane.shear().iter().map(|v| v.abs()).collect::<Vec<_>>(),
+            plane.normal().iter().map(|v| v.abs()).collect(),
+            plane.coulomb_of_means().to_vec(),
+            interface.mean_coulomb().to_vec(),
         ];
         match &mut sums {
             None => sums = Some(columns),

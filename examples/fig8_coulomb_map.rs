@@ -45,7 +45,7 @@ fn run() -> report::Outcome {
         let s = d.stresses()?;
         Ok(s.planes
             .iter()
-            .flat_map(|p| p.profile().coulomb_of_means)
+            .flat_map(|p| p.profile().coulomb_of_means().to_vec())
             .collect())
     };
     let mut stages: Vec<(String, f64, f64, Vec<f64>)> = Vec::new();

@@ -47,8 +47,8 @@ fn run() -> report::Outcome {
             while next < levels.len() && load.force / mu_fn >= levels[next] {
                 let p = driver.stresses()?.planes[0].profile();
                 for ix in 0..nx {
-                    sigma[next][ix] += p.normal[ix].abs() / seeds.len() as f64;
-                    tau[next][ix] += p.shear[ix].abs() / seeds.len() as f64;
+                    sigma[next][ix] += p.normal()[ix].abs() / seeds.len() as f64;
+                    tau[next][ix] += p.shear()[ix].abs() / seeds.len() as f64;
                 }
                 next += 1;
             }

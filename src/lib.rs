@@ -69,7 +69,8 @@
 //!             let area = driver.real_contact_area()?;          // A_R (m²)
 //!             let ell = driver.precursor_length()?;             // ℓ (m)
 //!             let plane = &driver.stresses()?.planes[0];        // τ, σ, τ_C (Pa)
-//!             let tau_c = plane.profile().mean_coulomb;
+//!             let profile = plane.profile();                    // along x, y-averaged
+//!             let tau_c = profile.mean_coulomb();               // τ_C(x) (Pa)
 //!             assert!(area > 0.0 && (0.0..=lx).contains(&ell) && tau_c.len() == 30);
 //!             assert!(load.force <= mu_fn * (1.0 + 1e-9));      // F ≤ μF_N
 //!         }

@@ -352,7 +352,7 @@ impl FieldsTable {
         if let Some(probe) = &self.probe {
             let stresses = driver.stresses_at(std::slice::from_ref(&probe.0))?;
             for (k, (plane, &z)) in stresses.planes.iter().zip(&self.planes).enumerate() {
-                row(FIELD_COULOMB, k, z, &plane.profile().coulomb_of_means);
+                row(FIELD_COULOMB, k, z, plane.profile().coulomb_of_means());
             }
         }
         self.file

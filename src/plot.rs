@@ -1010,6 +1010,21 @@ impl Map {
     }
 
     /// The PNG's resolution in dots per inch (default 150), as [`Chart::dpi`].
+    ///
+    /// ```
+    /// use precursors::plot::{Map, PlotError};
+    /// let dir = std::env::temp_dir().join(format!("precursors-doc-map-dpi-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// let map = Map::new(4, 2, vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0])?.size(600, 450);
+    /// map.clone().dpi(300).save(dir.join("print.png"))?;
+    /// let png = std::fs::read(dir.join("print.png"))?;
+    /// let width = u32::from_be_bytes([png[16], png[17], png[18], png[19]]);
+    /// assert_eq!(width, 1200);                        // 600 · 300/150
+    /// let e = map.dpi(20).save(dir.join("coarse.png")).unwrap_err();
+    /// assert!(matches!(e, PlotError::InvalidDpi { dpi: 20, .. }));
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn dpi(mut self, dpi: u32) -> Self {
         self.dpi = dpi;
         self

@@ -330,7 +330,7 @@ impl<'a> ProbeInput<'a> {
 /// assert_eq!(plane.shear().len(), 20 * 4);
 /// let cell = plane.at(3, 1).unwrap();
 /// assert_eq!(cell.normal, plane.normal()[plane.index(3, 1).unwrap()]);
-/// assert_eq!(plane.profile().normal.len(), 20);
+/// assert_eq!(plane.profile().normal().len(), 20);
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
@@ -355,6 +355,9 @@ pub struct PlaneStress {
     coulomb: Vec<f64>,
     /// The `μ` of the Coulomb stresses (the driver's, or [`ProbeInput`]'s).
     friction_coefficient: f64,
+    /// Cell length along x `Δx` (m), for [`Profile::x`]; `None` only for a plane read
+    /// from a serde value written before 1.2.
+    dx: Option<f64>,
 }
 
 /// A [`PlaneStress`] as serde sees it (feature `serde`): its accessors' names, read back
@@ -370,6 +373,9 @@ struct PlaneStressFields {
     normal: Vec<f64>,
     coulomb: Vec<f64>,
     friction_coefficient: f64,
+    /// Added in 1.2: absent from values written before.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    dx: Option<f64>,
 }
 
 #[cfg(feature = "serde")]
@@ -383,6 +389,7 @@ impl From<PlaneStress> for PlaneStressFields {
             normal: p.normal,
             coulomb: p.coulomb,
             friction_coefficient: p.friction_coefficient,
+            dx: p.dx,
         }
     }
 }
@@ -419,13 +426,36 @@ impl TryFrom<PlaneStressFields> for PlaneStress {
             normal: f.normal,
             coulomb: f.coulomb,
             friction_coefficient: f.friction_coefficient,
+            dx: f
+                .dx
+                .map(|dx| crate::error::check_length("dx", dx))
+                .transpose()?,
         })
     }
 }
 
-/// Profiles along x, averaged over y (one value per column, Pa).
+/// Profiles along x, averaged over y: one value per column `ix` of the plane, at the
+/// column's centre `x` (m; [`Profile::x`]), stresses in Pa.
 ///
-/// The y-average of a plane: each column's mean of the plane's cells.
+/// The y-average of a plane: each column's mean of the plane's cells. Read it through
+/// methods, as [`PlaneStress`]: [`Profile::x`], [`Profile::shear`], [`Profile::normal`],
+/// [`Profile::coulomb_of_means`], [`Profile::mean_coulomb`] (the public fields of 1.0 are
+/// deprecated from 1.2).
+///
+/// The two Coulomb profiles average at different moments (`⟨·⟩_y` the mean over the
+/// column's `Ny` cells, `μ` the plane's [`PlaneStress::friction_coefficient`]):
+///
+/// ```text
+/// coulomb_of_means(x) = |⟨τ⟩_y| - μ|⟨σ⟩_y|       the Coulomb stress of the mean stresses
+/// mean_coulomb(x)     = ⟨|τ| - μ|σ|⟩_y           the mean of the cells' Coulomb stresses
+/// mean_coulomb - coulomb_of_means = (⟨|τ|⟩_y - |⟨τ⟩_y|) - μ(⟨|σ|⟩_y - |⟨σ⟩_y|)
+/// ```
+///
+/// They are equal in a column where `τ` keeps one sign and `σ` keeps one sign (both
+/// brackets are zero), and differ where one of them changes sign along y (its bracket is
+/// then `> 0`; `τ` raises `mean_coulomb`, `σ` lowers it). The paper's `τ_C(x, z_P)` on a plane above the interface is
+/// `coulomb_of_means`; its interface profile `τ_C(x)` (at `z = 0`) is `mean_coulomb`.
+/// `profiles.csv` writes them as the columns `coulomb_of_means_Pa` and `mean_coulomb_Pa`.
 ///
 /// ```
 /// use precursors::{Point, ProbeSpec, Scene};
@@ -439,25 +469,71 @@ impl TryFrom<PlaneStressFields> for PlaneStress {
 /// let stresses = driver.stresses()?;
 /// let plane = &stresses.planes[0];
 /// let profile = plane.profile();
-/// assert_eq!(profile.normal.len(), plane.nx());
+/// assert_eq!(profile.normal().len(), plane.nx());
+/// assert_eq!(profile.x()[3], 3.5e-3);           // 1 mm columns: centre of column 3 (m)
 /// let column_3: f64 = (0..plane.ny()).map(|iy| plane.at(3, iy).unwrap().normal).sum();
-/// assert!((profile.normal[3] - column_3 / plane.ny() as f64).abs() < 1e-9 * column_3.abs());
+/// assert!((profile.normal()[3] - column_3 / plane.ny() as f64).abs() < 1e-9 * column_3.abs());
 /// // Under a normal load only, no column is past the Coulomb threshold.
-/// assert!(profile.coulomb_of_means.iter().all(|&c| c < 0.0));
+/// assert!(profile.coulomb_of_means().iter().all(|&c| c < 0.0));
 /// # Ok::<(), precursors::Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct Profile {
-    /// `τ(x, z) = (1/Ly) ∫ τ dy` (Pa).
+    /// `⟨τ⟩_y(x, z) = (1/Ly) ∫ τ dy` (Pa).
+    #[deprecated(since = "1.2.0", note = "use the method `Profile::shear()`")]
     pub shear: Vec<f64>,
-    /// `σ(x, z) = (1/Ly) ∫ σ dy` (Pa).
+    /// `⟨σ⟩_y(x, z) = (1/Ly) ∫ σ dy` (Pa).
+    #[deprecated(since = "1.2.0", note = "use the method `Profile::normal()`")]
     pub normal: Vec<f64>,
-    /// `|τ(x,z)| - μ|σ(x,z)|` of the averages (Pa): the paper's `τ_C(x, z_P)`.
+    /// `|⟨τ⟩_y| - μ|⟨σ⟩_y|` (Pa): the paper's `τ_C(x, z_P)`.
+    #[deprecated(since = "1.2.0", note = "use the method `Profile::coulomb_of_means()`")]
     pub coulomb_of_means: Vec<f64>,
-    /// `(1/Ly) ∫ (|τ| - μ|σ|) dy` (Pa): the paper's interface `τ_C(x)`.
+    /// `⟨|τ| - μ|σ|⟩_y` (Pa): the paper's interface `τ_C(x)`.
+    #[deprecated(since = "1.2.0", note = "use the method `Profile::mean_coulomb()`")]
     pub mean_coulomb: Vec<f64>,
+    /// The columns' centres `(ix + 1/2)·Δx` (m); empty for a profile of a plane read from
+    /// a serde value written before 1.2, which did not record `Δx` (a field added later
+    /// has a default: docs/compatibility.md).
+    #[cfg_attr(feature = "serde", serde(default))]
+    x: Vec<f64>,
+}
+
+// The fields stay readable through 1.x; the crate itself reads them only here.
+#[allow(deprecated)]
+impl Profile {
+    /// The centre `x = (ix + 1/2)·Δx` of each column `ix` (m), from `x = 0` at the
+    /// trailing face: the abscissa of every other profile. Empty only for a profile of a
+    /// plane read from a serde value written before 1.2.
+    pub fn x(&self) -> &[f64] {
+        &self.x
+    }
+
+    /// `⟨τ⟩_y(x, z) = (1/Ly) ∫ τ dy` (Pa), the mean shear stress `σ_xz` of each column.
+    pub fn shear(&self) -> &[f64] {
+        &self.shear
+    }
+
+    /// `⟨σ⟩_y(x, z) = (1/Ly) ∫ σ dy` (Pa, negative in compression), the mean normal
+    /// stress `σ_zz` of each column.
+    pub fn normal(&self) -> &[f64] {
+        &self.normal
+    }
+
+    /// `|⟨τ⟩_y| - μ|⟨σ⟩_y|` (Pa): the Coulomb stress of the column's mean stresses, the
+    /// paper's `τ_C(x, z_P)` on a plane above the interface (see [`Profile`] for how it
+    /// differs from [`Profile::mean_coulomb`]).
+    pub fn coulomb_of_means(&self) -> &[f64] {
+        &self.coulomb_of_means
+    }
+
+    /// `⟨|τ| - μ|σ|⟩_y` (Pa): the mean of the column's cell Coulomb stresses
+    /// ([`PlaneStress::coulomb`]), the paper's interface profile `τ_C(x)` (see
+    /// [`Profile`] for how it differs from [`Profile::coulomb_of_means`]).
+    pub fn mean_coulomb(&self) -> &[f64] {
+        &self.mean_coulomb
+    }
 }
 
 /// The stresses of one cell of a plane (Pa, cell averages).
@@ -571,11 +647,17 @@ impl PlaneStress {
             .zip(&normal)
             .map(|(t, s)| t.abs() - friction_coefficient * s.abs())
             .collect();
+        // Δx is unknown only for a plane read from a serde value written before 1.2.
+        let x = self.dx.map_or_else(Vec::new, |dx| {
+            (0..nx).map(|ix| (ix as f64 + 0.5) * dx).collect()
+        });
+        #[allow(deprecated)] // the 1.0 fields, read through the methods
         Profile {
             mean_coulomb: mean(&self.coulomb),
             shear,
             normal,
             coulomb_of_means,
+            x,
         }
     }
 }
@@ -806,6 +888,7 @@ impl StressProbe {
                 normal,
                 coulomb,
                 friction_coefficient: mu,
+                dx: Some(self.grid.dx()),
             });
         }
         let dot = |k: &[f64], v: &[f64]| k.iter().zip(v).map(|(a, b)| a * b).sum::<f64>();
@@ -1016,6 +1099,46 @@ fn cell_indicator(grid: &Grid, point: Point) -> Vec<f64> {
 mod tests {
     use super::*;
     use crate::geometry::Block;
+
+    /// The two Coulomb profiles on a plane written by hand (`Nx = 3`, `Ny = 2`, `μ = 1/2`,
+    /// `Δx = 3 mm`), each value worked out on paper. Column 0: `τ` changes sign along y,
+    /// so `⟨|τ|⟩ = 2 > |⟨τ⟩| = 1` and `mean_coulomb` exceeds `coulomb_of_means` by 1 Pa.
+    /// Column 1: `σ` changes sign, `⟨|σ|⟩ = 4 > |⟨σ⟩| = 2`, and `mean_coulomb` falls short
+    /// by `μ·2 = 1` Pa. Column 2: one sign each, the two agree.
+    #[test]
+    fn the_two_coulomb_profiles_differ_where_a_stress_changes_sign_along_y() {
+        // Rows iy = 0 and iy = 1 of columns 0, 1, 2 (Pa).
+        let shear = vec![3.0, 2.0, 2.0, -1.0, 4.0, 4.0];
+        let normal = vec![-2.0, -6.0, -6.0, -2.0, 2.0, -2.0];
+        // |τ| - μ|σ| cell by cell: 3-1, 2-3, 2-3 / 1-1, 4-1, 4-1.
+        let coulomb = vec![2.0, -1.0, -1.0, 0.0, 3.0, 3.0];
+        let plane = PlaneStress {
+            z: 0.0,
+            nx: 3,
+            ny: 2,
+            shear,
+            normal,
+            coulomb,
+            friction_coefficient: 0.5,
+            dx: Some(3e-3),
+        };
+        let p = plane.profile();
+        assert_eq!(p.shear(), [1.0, 3.0, 3.0]);
+        assert_eq!(p.normal(), [-2.0, -2.0, -4.0]);
+        // |⟨τ⟩| - μ|⟨σ⟩|: 1 - 1, 3 - 1, 3 - 2.
+        assert_eq!(p.coulomb_of_means(), [0.0, 2.0, 1.0]);
+        // ⟨|τ| - μ|σ|⟩: (2 + 0)/2, (-1 + 3)/2, (-1 + 3)/2.
+        assert_eq!(p.mean_coulomb(), [1.0, 1.0, 1.0]);
+        // Column centres (ix + 1/2)·Δx (m).
+        let x = p.x();
+        assert_eq!(x.len(), 3);
+        for (got, want) in x.iter().zip([1.5e-3, 4.5e-3, 7.5e-3]) {
+            assert!((got - want).abs() <= 1e-15, "{got} vs {want}");
+        }
+        // Without Δx (a plane read from a serde value written before 1.2), no abscissa.
+        let old = PlaneStress { dx: None, ..plane };
+        assert!(old.profile().x().is_empty());
+    }
 
     /// The documented lowest point converges on grids of several shapes and tolerances,
     /// at the corner, the middle and an edge of the face (the bound is sufficient; below

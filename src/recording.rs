@@ -252,6 +252,21 @@ impl RunOptions {
     /// and checked by [`crate::Scene::driver_with`], read with
     /// [`crate::Driver::stresses`]. An empty `ProbeSpec` starts with none. Probes
     /// observe: the events do not depend on them.
+    ///
+    /// ```
+    /// use precursors::{ProbeSpec, RunOptions, Scene};
+    /// let scene = Scene::builder().block(0.020, 0.004, 0.010).normal_load(80.0).build()?;
+    /// // The scene has no probes; this run's driver starts with a plane at z = 2 mm.
+    /// let options = RunOptions::new().probes(ProbeSpec::default().with_plane(2e-3));
+    /// assert_eq!(options.probe_spec().map(|spec| spec.planes()), Some(&[2e-3][..]));
+    /// let mut driver = scene.driver_with(&options)?;
+    /// driver.step()?;                                   // the normal equilibrium
+    /// let plane = &driver.stresses()?.planes[0];
+    /// // Through the plane the block carries F_N: ∫ σ_zz dA = -80 N.
+    /// let force: f64 = plane.normal().iter().sum::<f64>() * scene.grid().cell_area();
+    /// assert!((plane.z(), (force + 80.0).abs() < 1e-6 * 80.0) == (2e-3, true));
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
     pub fn probes(mut self, probes: ProbeSpec) -> Self {
         self.probes = Some(probes);
         self

@@ -85,7 +85,7 @@ fn probe_types_are_named_from_the_crate_root() {
         .unwrap();
     assert_eq!(probe.evaluate(&input).unwrap().planes[0].shear(), phi);
     assert!(points.is_empty());
-    assert_eq!(profile.shear.len(), 12);
+    assert_eq!(profile.shear().len(), 12);
     assert_eq!(cell.shear, plane.shear()[0]);
 }
 
@@ -138,7 +138,7 @@ fn plane_cells_are_read_by_column_and_row() {
     let profile = plane.profile();
     for ix in 0..5 {
         let mean = (-shear[ix] - shear[5 + ix] - shear[10 + ix]) / 3.0;
-        assert!((profile.shear[ix] - mean).abs() <= 1e-12 * mean.abs().max(1.0));
+        assert!((profile.shear()[ix] - mean).abs() <= 1e-12 * mean.abs().max(1.0));
     }
 }
 
@@ -159,8 +159,8 @@ fn plane_stresses_carry_the_friction_coefficient() {
     assert_eq!(plane.friction_coefficient(), 0.7);
     let profile = plane.profile();
     for ix in 0..plane.nx() {
-        let expected = profile.shear[ix].abs() - 0.7 * profile.normal[ix].abs();
-        assert_eq!(profile.coulomb_of_means[ix], expected);
+        let expected = profile.shear()[ix].abs() - 0.7 * profile.normal()[ix].abs();
+        assert_eq!(profile.coulomb_of_means()[ix], expected);
     }
     let phi = vec![1.0; scene.grid().len()];
     let probe =

@@ -96,7 +96,7 @@ fn recording_fields_changes_no_table_and_records_the_drivers_fields() {
         for (k, plane) in driver.stresses().unwrap().planes.iter().enumerate() {
             let cells: Vec<String> = plane
                 .profile()
-                .coulomb_of_means
+                .coulomb_of_means()
                 .iter()
                 .map(|v| format!("{v:.12e}"))
                 .collect();

@@ -461,7 +461,13 @@ fn the_driver_reports_probes_only_when_requested() {
     let total: f64 = s.planes[1].shear().iter().sum::<f64>() * scene.grid().cell_area();
     assert!((total - d.force()).abs() < 1e-9 * d.force());
     let profile = s.planes[1].profile();
-    assert_eq!(profile.shear.len(), scene.grid().nx());
+    assert_eq!(profile.shear().len(), scene.grid().nx());
+    // The abscissa of the profile: the columns' centres (m), as the grid places them.
+    assert_eq!(profile.x().len(), scene.grid().nx());
+    for (ix, &x) in profile.x().iter().enumerate() {
+        let (centre, _) = scene.grid().centre(ix, 0).unwrap();
+        assert!((x - centre).abs() <= 1e-15, "column {ix}: {x} vs {centre}");
+    }
 }
 
 /// The probes of `RunOptions::probes` are the scene's probes, planned on the same plan:

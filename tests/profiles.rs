@@ -68,10 +68,10 @@ fn states(builder: SceneBuilder) -> (Vec<State>, f64) {
                         ("slip_m", 0.0, slip.slip),
                         ("shear_traction_Pa", 0.0, slip.shear_traction),
                         ("normal_traction_Pa", 0.0, slip.normal_traction),
-                        ("shear_Pa", PLANE, p.shear.clone()),
-                        ("normal_Pa", PLANE, p.normal.clone()),
-                        ("coulomb_of_means_Pa", PLANE, p.coulomb_of_means.clone()),
-                        ("mean_coulomb_Pa", PLANE, p.mean_coulomb.clone()),
+                        ("shear_Pa", PLANE, p.shear().to_vec()),
+                        ("normal_Pa", PLANE, p.normal().to_vec()),
+                        ("coulomb_of_means_Pa", PLANE, p.coulomb_of_means().to_vec()),
+                        ("mean_coulomb_Pa", PLANE, p.mean_coulomb().to_vec()),
                     ],
                 });
             }

@@ -339,6 +339,31 @@ fn a_plane_of_stresses_is_checked_when_read() {
     driver.step().unwrap();
     let plane = driver.stresses().unwrap().planes.remove(0);
     let mut json: serde_json::Value = serde_json::to_value(&plane).unwrap();
+    // A plane and a profile written before 1.2 (no `dx`, no `x`) read back; the profile
+    // then has no abscissa. A written `dx` is a length.
+    let profile = plane.profile();
+    assert_eq!(profile.x().len(), 10);
+    let mut old = json.clone();
+    old.as_object_mut()
+        .unwrap()
+        .remove("dx")
+        .expect("dx is written");
+    let old: precursors::PlaneStress = serde_json::from_value(old).unwrap();
+    assert_eq!(old.shear(), plane.shear());
+    assert!(old.profile().x().is_empty());
+    let mut old_profile = serde_json::to_value(&profile).unwrap();
+    old_profile
+        .as_object_mut()
+        .unwrap()
+        .remove("x")
+        .expect("x is written");
+    let old_profile: precursors::Profile = serde_json::from_value(old_profile).unwrap();
+    assert_eq!(old_profile.mean_coulomb(), profile.mean_coulomb());
+    assert!(old_profile.x().is_empty());
+    let mut bad = json.clone();
+    bad["dx"] = (-1.0).into();
+    let e = refused::<precursors::PlaneStress>(&bad.to_string());
+    names(&e, &["dx"]);
     json["nx"] = 0.into();
     let e = refused::<precursors::PlaneStress>(&json.to_string());
     names(&e, &["at least one cell along x"]);

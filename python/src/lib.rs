@@ -967,18 +967,20 @@ impl PlaneStress {
 
 #[pymethods]
 impl PlaneStress {
-    /// The y-averaged profiles along x (Pa), each `(Nx,)`: `shear`, `normal`,
-    /// `coulomb_of_means` (`|τ̄| - μ|σ̄|`, the paper's `τ_C(x, z)`) and `mean_coulomb`.
+    /// The y-averaged profiles along x, each `(Nx,)`: `x` (the columns' centres, m),
+    /// `shear`, `normal` (Pa), `coulomb_of_means` (`|⟨τ⟩_y| - μ|⟨σ⟩_y|`, the paper's
+    /// `τ_C(x, z)`, Pa) and `mean_coulomb` (`⟨|τ| - μ|σ|⟩_y`, Pa).
     fn profile<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
         let p = &self.profile;
-        d.set_item("shear", PyArray1::from_slice(py, &p.shear))?;
-        d.set_item("normal", PyArray1::from_slice(py, &p.normal))?;
+        d.set_item("x", PyArray1::from_slice(py, p.x()))?;
+        d.set_item("shear", PyArray1::from_slice(py, p.shear()))?;
+        d.set_item("normal", PyArray1::from_slice(py, p.normal()))?;
         d.set_item(
             "coulomb_of_means",
-            PyArray1::from_slice(py, &p.coulomb_of_means),
+            PyArray1::from_slice(py, p.coulomb_of_means()),
         )?;
-        d.set_item("mean_coulomb", PyArray1::from_slice(py, &p.mean_coulomb))?;
+        d.set_item("mean_coulomb", PyArray1::from_slice(py, p.mean_coulomb()))?;
         Ok(d)
     }
 

@@ -107,6 +107,8 @@ def test_stress_probes_on_planes_and_points(calibration):
     assert z0.shear.shape == z0.normal.shape == z0.coulomb.shape == driver.shape
     profile = z4.profile()
     assert profile["shear"].shape == (driver.shape[1],)
+    nx = driver.shape[1]
+    np.testing.assert_allclose(profile["x"], (np.arange(nx) + 0.5) * lx / nx, rtol=1e-12)
     np.testing.assert_allclose(profile["normal"], z4.normal.mean(axis=0), rtol=1e-12, atol=1e-9)
     (point,) = stresses["points"]
     assert point.point == (0.07, 0.0035, 0.004)

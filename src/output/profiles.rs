@@ -238,10 +238,10 @@ impl ProfilesTable {
             for (plane, &z) in stresses.planes.iter().zip(&self.planes) {
                 let p = plane.profile();
                 for (field, values) in PLANE_FIELDS.iter().zip([
-                    &p.shear,
-                    &p.normal,
-                    &p.coulomb_of_means,
-                    &p.mean_coulomb,
+                    p.shear(),
+                    p.normal(),
+                    p.coulomb_of_means(),
+                    p.mean_coulomb(),
                 ]) {
                     row(field, z, values);
                 }

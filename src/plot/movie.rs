@@ -177,6 +177,35 @@ impl Movie {
 
     /// Draws every `every`-th recorded state (and the last).
     ///
+    /// ```
+    /// use precursors::output::RunTables;
+    /// use precursors::plot::{Movie, MovieKind};
+    /// use precursors::{RunOptions, Scene};
+    /// let dir = std::env::temp_dir().join(format!("precursors-doc-every-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// let scene = Scene::builder()
+    ///     .block(0.010, 0.004, 0.010)
+    ///     .normal_load(100.0)
+    ///     .run_options(RunOptions::new().record_fields(1, &[]))   // every stable state
+    ///     .build()?;
+    /// let mut driver = scene.driver()?;
+    /// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
+    /// let all = Movie::new(&dir, MovieKind::ContactArea).size(480, 300).save(dir.join("all.gif"))?;
+    /// let third = Movie::new(&dir, MovieKind::ContactArea)
+    ///     .every(3)?
+    ///     .size(480, 300)
+    ///     .save(dir.join("third.gif"))?;
+    /// // The states 0, 3, 6, ... of the recording, and its last.
+    /// let mut expected: Vec<usize> = all.events.iter().step_by(3).copied().collect();
+    /// if expected.last() != all.events.last() {
+    ///     expected.extend(all.events.last());
+    /// }
+    /// assert_eq!((third.stride, &third.events), (3, &expected));
+    /// assert!(Movie::new(&dir, MovieKind::ContactArea).every(0).is_err());
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    ///
     /// # Errors
     /// [`PlotError::Figure`] for `every = 0`.
     pub fn every(mut self, every: usize) -> Result<Self> {
@@ -210,6 +239,32 @@ impl Movie {
 
     /// Seconds each frame is shown (default 0.1; GIF counts hundredths: from 0.01 to 655 s).
     ///
+    /// ```
+    /// use precursors::output::RunTables;
+    /// use precursors::plot::{Movie, MovieKind};
+    /// use precursors::{RunOptions, Scene};
+    /// let dir = std::env::temp_dir().join(format!("precursors-doc-duration-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// let scene = Scene::builder()
+    ///     .block(0.010, 0.004, 0.010)
+    ///     .normal_load(100.0)
+    ///     .run_options(RunOptions::new().record_fields(1, &[]))   // every stable state
+    ///     .build()?;
+    /// let mut driver = scene.driver()?;
+    /// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
+    /// Movie::new(&dir, MovieKind::ContactArea)
+    ///     .frame_duration(0.25)?
+    ///     .size(480, 300)
+    ///     .save(dir.join("slow.gif"))?;
+    /// // The GIF's first graphic control block: 21 F9 04, flags, the delay in hundredths.
+    /// let gif = std::fs::read(dir.join("slow.gif"))?;
+    /// let at = gif.windows(3).position(|w| w == [0x21, 0xF9, 0x04]).unwrap();
+    /// assert_eq!(u16::from_le_bytes([gif[at + 4], gif[at + 5]]), 25);
+    /// assert!(Movie::new(&dir, MovieKind::ContactArea).frame_duration(0.001).is_err());
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    ///
     /// # Errors
     /// [`PlotError::Figure`] outside that range (or not finite).
     pub fn frame_duration(mut self, seconds: f64) -> Result<Self> {
@@ -228,6 +283,31 @@ impl Movie {
     /// the movie; `τ_C`: symmetric about 0, to the 98th percentile of `|τ_C|`; both
     /// saturating beyond). Checked
     /// when the movie is drawn (finite, increasing).
+    ///
+    /// ```
+    /// use precursors::output::RunTables;
+    /// use precursors::plot::{Movie, MovieKind};
+    /// use precursors::{RunOptions, Scene};
+    /// let dir = std::env::temp_dir().join(format!("precursors-doc-range-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// let scene = Scene::builder()
+    ///     .block(0.010, 0.004, 0.010)
+    ///     .normal_load(100.0)
+    ///     .run_options(RunOptions::new().record_fields(1, &[]))   // every stable state
+    ///     .build()?;
+    /// let mut driver = scene.driver()?;
+    /// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
+    /// let report = Movie::new(&dir, MovieKind::ContactArea)
+    ///     .colour_range(0.0, 0.5)                         // mm² of contact per cell
+    ///     .size(480, 300)
+    ///     .save(dir.join("fixed.gif"))?;
+    /// assert_eq!(report.colour_range, (0.0, 0.5));
+    /// // Checked when drawn: a decreasing range is refused.
+    /// let reversed = Movie::new(&dir, MovieKind::ContactArea).colour_range(0.5, 0.0);
+    /// assert!(reversed.save(dir.join("reversed.gif")).is_err());
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn colour_range(mut self, low: f64, high: f64) -> Self {
         self.colour_range = Some((low, high));
         self
@@ -294,6 +374,30 @@ impl Movie {
 
     /// [`Movie::save`], calling `progress(drawn, frames)` after each frame drawn (a
     /// progress bar).
+    ///
+    /// ```
+    /// use precursors::output::RunTables;
+    /// use precursors::plot::{Movie, MovieKind};
+    /// use precursors::{RunOptions, Scene};
+    /// let dir = std::env::temp_dir().join(format!("precursors-doc-progress-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// let scene = Scene::builder()
+    ///     .block(0.010, 0.004, 0.010)
+    ///     .normal_load(100.0)
+    ///     .run_options(RunOptions::new().record_fields(1, &[]))   // every stable state
+    ///     .build()?;
+    /// let mut driver = scene.driver()?;
+    /// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
+    /// let mut calls = Vec::new();
+    /// let report = Movie::new(&dir, MovieKind::ContactArea)
+    ///     .size(480, 300)
+    ///     .save_with_progress(dir.join("s1.gif"), |drawn, frames| calls.push((drawn, frames)))?;
+    /// // Once per frame, counting up to the movie's frames.
+    /// let expected: Vec<(usize, usize)> = (1..=report.frames).map(|k| (k, report.frames)).collect();
+    /// assert_eq!(calls, expected);
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     ///
     /// # Errors
     /// [`PlotError::NoFields`] when the directory has no recorded fields (no
@@ -425,6 +529,29 @@ impl Movie {
 
     /// Draws frame `frame` (0-based, of the frames [`Movie::save`] draws) as a still PNG
     /// or SVG (chosen by the extension), e.g. to show a few frames in a document.
+    ///
+    /// ```
+    /// use precursors::output::RunTables;
+    /// use precursors::plot::{Movie, MovieKind};
+    /// use precursors::{RunOptions, Scene};
+    /// let dir = std::env::temp_dir().join(format!("precursors-doc-still-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// let scene = Scene::builder()
+    ///     .block(0.010, 0.004, 0.010)
+    ///     .normal_load(100.0)
+    ///     .run_options(RunOptions::new().record_fields(1, &[]))   // every stable state
+    ///     .build()?;
+    /// let mut driver = scene.driver()?;
+    /// RunTables::create(&dir, &driver)?.run_to_slip(&mut driver, None, |_, _| {})?;
+    /// let movie = Movie::new(&dir, MovieKind::ContactArea).size(480, 300);
+    /// let report = movie.save_frame(0, dir.join("first.png"))?;
+    /// assert!(std::fs::read(dir.join("first.png"))?.starts_with(b"\x89PNG"));
+    /// movie.save_frame(report.frames - 1, dir.join("last.svg"))?;   // the last frame, as SVG
+    /// assert!(std::fs::read_to_string(dir.join("last.svg"))?.contains("<svg"));
+    /// assert!(movie.save_frame(report.frames, dir.join("past.png")).is_err());
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     ///
     /// # Errors
     /// As [`Movie::save_with_progress`]; [`PlotError::Figure`] for a frame past the last.
