@@ -37,9 +37,14 @@ use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 
 mod alternatives;
+mod scaling;
 mod special;
 
 pub use alternatives::LikelihoodRatio;
+pub use scaling::{
+    binned_means, classes_excluded, fit_collapse, fit_scaling, BinnedMean, Collapse, ScalingFit,
+    UniversalityClass, UNIVERSALITY_CLASSES,
+};
 
 /// Whether samples are integers (counts: the ruptures of an avalanche) or reals (a force
 /// drop in N, a stress drop in Pa).

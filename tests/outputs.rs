@@ -981,6 +981,16 @@ fn every_column_is_documented() {
     );
     statistics(&run, &options).unwrap();
     statistics(&sweep_dir, &options).unwrap();
+    // A sweep over a block length: its statistics add the finite-size collapse.
+    let length_dir = dir.join("lengths");
+    Sweep::from_json_str(&format!(
+        r#"{{"base": {base}}}, "axes": [{{"key": "block.lx", "values": [0.012, 0.024]}}],
+            "realizations": 2}}"#
+    ))
+    .unwrap()
+    .execute(&length_dir, &SweepOptions::new(), |_| {})
+    .unwrap();
+    statistics(&length_dir, &options).unwrap();
 
     // The page's tables: `### `NAME`` then rows whose first cell is `column`.
     let page = std::fs::read_to_string("docs/tables.md").unwrap();
@@ -998,12 +1008,15 @@ fn every_column_is_documented() {
         Some((head, "")) => column
             .strip_prefix(head)
             .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit())),
-        _ => pattern == "<axis>" && column == "normal_load" || pattern == column,
+        _ => {
+            pattern == "<axis>" && ["normal_load", "block.lx"].contains(&column)
+                || pattern == column
+        }
     };
     let mut checked = 0;
     for (table, columns) in &documented {
         let mut found = false;
-        for directory in [&run, &sweep_dir] {
+        for directory in [&run, &sweep_dir, &length_dir] {
             let Ok(text) = std::fs::read_to_string(directory.join(table)) else {
                 continue;
             };
@@ -1032,7 +1045,7 @@ fn every_column_is_documented() {
         );
     }
     // Every CSV table written is on the page.
-    for directory in [&run, &sweep_dir] {
+    for directory in [&run, &sweep_dir, &length_dir] {
         for entry in std::fs::read_dir(directory).unwrap() {
             let name = entry.unwrap().file_name().into_string().unwrap();
             if name.ends_with(".csv") {
@@ -1043,7 +1056,7 @@ fn every_column_is_documented() {
             }
         }
     }
-    assert_eq!(checked, 15);
+    assert_eq!(checked, 24);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -416,18 +416,30 @@ fn stats_pool_each_points_realizations() {
     // The avalanches of each point's runs as this test reads their events.csv.
     let mut sizes: [Vec<usize>; 2] = Default::default();
     let mut drops: [usize; 2] = [0; 2];
+    // Per avalanche: 1 - F/(μF_N) at its start (μ = 0.5), its size with and without flash
+    // ruptures, its force drop.
+    let mut values: [Vec<[f64; 4]>; 2] = Default::default();
     for run in sweep.runs() {
         let events = table(&dir.join(run.dir_name()).join("events.csv"));
         let all = read_avalanches(&events);
+        let mu_fn = 0.5 * [100.0, 150.0][run.point()];
         // `stats` leaves out the spanning avalanche and those after it by default.
         for a in &all[..spanning(&all)] {
             sizes[run.point()].push(a.ruptures);
-            let drop = a.before.parse::<f64>().unwrap() - a.after.parse::<f64>().unwrap();
+            let before = a.before.parse::<f64>().unwrap();
+            let drop = before - a.after.parse::<f64>().unwrap();
             drops[run.point()] += usize::from(drop > 0.0);
+            values[run.point()].push([
+                1.0 - before / mu_fn,
+                a.ruptures as f64,
+                (a.ruptures - a.flash) as f64,
+                drop,
+            ]);
         }
     }
     let fits = table(&dir.join("power_laws.csv"));
     let bins = table(&dir.join("distributions.csv"));
+    let means = table(&dir.join("binned_means.csv"));
     // 1.x's columns first and unchanged, the alternatives after them; each fitted row has
     // its tests (p-values in [0, 1]) and the verdict the summary printed.
     let header = std::fs::read_to_string(dir.join("power_laws.csv")).unwrap();
@@ -437,7 +449,9 @@ fn stats_pool_each_points_realizations() {
          alpha_low,alpha_high,x_min_low,x_min_high,ks_distance,p_value,confidence,cutoff_alpha,"
     ));
     assert!(
-        header.ends_with(",lr_cutoff_vs_lognormal_p,verdict"),
+        header.ends_with(
+            ",lr_cutoff_vs_lognormal_p,verdict,classes_excluded,cutoff_classes_excluded"
+        ),
         "{header}"
     );
     let fitted: Vec<_> = fits.iter().filter(|r| !r["alpha"].is_empty()).collect();
@@ -482,7 +496,108 @@ fn stats_pool_each_points_realizations() {
                 .count();
             assert_eq!(num(b, "count") as usize, inside, "{b:?}");
         }
+        // Each fit names the classes its intervals exclude: those of 3/2, 5/2 and 1.28
+        // outside [low, high].
+        for r in fits.iter().filter(|r| r["point"] == point.to_string()) {
+            for (column, low, high) in [
+                ("classes_excluded", "alpha_low", "alpha_high"),
+                (
+                    "cutoff_classes_excluded",
+                    "cutoff_alpha_low",
+                    "cutoff_alpha_high",
+                ),
+            ] {
+                if r[low].is_empty() {
+                    assert_eq!(r[column], "", "{r:?}");
+                    continue;
+                }
+                let (low, high) = (num(r, low), num(r, high));
+                let mut expected = Vec::new();
+                for (name, tau) in [
+                    ("mean-field depinning 3/2", 1.5),
+                    ("fibre bundle near failure 3/2", 1.5),
+                    ("fibre bundle far from failure 5/2", 2.5),
+                    ("long-range elastic line 1.28", 1.28),
+                ] {
+                    if !(low..=high).contains(&tau) {
+                        expected.push(name);
+                    }
+                }
+                let expected = if expected.is_empty() {
+                    "none".to_string()
+                } else {
+                    expected.join("; ")
+                };
+                assert_eq!(r[column].trim_matches('"'), expected, "{r:?}");
+            }
+        }
+        // The mean size against 1 - F/(μF_N), and the mean drop against the size, in
+        // bins [10^(k/5), 10^((k+1)/5)): counts, means and the 95 % standard-error
+        // interval from the avalanches read here.
+        type Pick = fn(&[f64; 4]) -> (f64, f64);
+        let relations: [(&str, Pick); 3] = [
+            ("ruptures_against_load_gap", |v| (v[0], v[1])),
+            ("ruptures_without_flash_against_load_gap", |v| (v[0], v[2])),
+            ("force_drop_N_against_ruptures", |v| (v[1], v[3])),
+        ];
+        let scaling = table(&dir.join("scaling.csv"));
+        for (relation, pick) in relations {
+            let pairs: Vec<(f64, f64)> = values[point]
+                .iter()
+                .map(pick)
+                .filter(|(x, y)| *x > 0.0 && *y > 0.0)
+                .collect();
+            let rows: Vec<_> = means
+                .iter()
+                .filter(|r| r["point"] == point.to_string() && r["relation"] == relation)
+                .collect();
+            assert!(!rows.is_empty(), "{relation}");
+            let mut counted = 0;
+            for r in &rows {
+                let k = (5.0 * num(r, "x_low").log10()).round();
+                let (lo, hi) = (10f64.powf(k / 5.0), 10f64.powf((k + 1.0) / 5.0));
+                let ys: Vec<f64> = pairs
+                    .iter()
+                    .filter(|(x, _)| *x >= lo && *x < hi)
+                    .map(|p| p.1)
+                    .collect();
+                let n = ys.len() as f64;
+                let mean = ys.iter().sum::<f64>() / n;
+                assert_eq!(num(r, "count") as usize, ys.len(), "{r:?}");
+                assert!((num(r, "mean") - mean).abs() <= 1e-9 * mean, "{r:?}");
+                if ys.len() > 1 {
+                    let sd =
+                        (ys.iter().map(|y| (y - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+                    let half = 1.959_963_984_540_054 * sd / n.sqrt(); // scipy norm.ppf(0.975)
+                    assert!((num(r, "mean_high") - mean - half).abs() <= 1e-9 * mean.max(1.0));
+                    assert!((mean - num(r, "mean_low") - half).abs() <= 1e-9 * mean.max(1.0));
+                } else {
+                    assert_eq!(r["mean_high"], "");
+                }
+                counted += ys.len();
+            }
+            assert_eq!(counted, pairs.len(), "{relation}");
+            // The slope of ln y on ln x by least squares, computed here.
+            let row = scaling
+                .iter()
+                .find(|r| r["point"] == point.to_string() && r["relation"] == relation)
+                .unwrap();
+            assert_eq!(num(row, "pairs") as usize, pairs.len());
+            let n = pairs.len() as f64;
+            let mx = pairs.iter().map(|p| p.0.ln()).sum::<f64>() / n;
+            let my = pairs.iter().map(|p| p.1.ln()).sum::<f64>() / n;
+            let sxy: f64 = pairs
+                .iter()
+                .map(|p| (p.0.ln() - mx) * (p.1.ln() - my))
+                .sum();
+            let sxx: f64 = pairs.iter().map(|p| (p.0.ln() - mx).powi(2)).sum();
+            let slope = sxy / sxx;
+            assert!((num(row, "exponent") - slope).abs() <= 1e-9, "{row:?}");
+            assert!(num(row, "exponent_low") <= slope && slope <= num(row, "exponent_high"));
+        }
     }
+    // A sweep over a normal load has no collapse.
+    assert!(!dir.join("collapse.csv").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -640,6 +755,110 @@ fn the_study_files_are_the_documented_study() {
             docs.contains(name),
             "docs/statistics.md does not name {name}"
         );
+    }
+}
+
+#[test]
+fn stats_collapse_a_sweep_along_a_length() {
+    // A sweep over block.lx at fixed cells and pressure: collapse.csv holds the fit of
+    // `statistics::fit_collapse` to the sizes of each length's runs as this test reads
+    // them from events.csv (before the spanning avalanche), grouped by run.
+    use precursors::statistics::{fit_collapse, PowerLawOptions, Support};
+    use precursors::sweep::{statistics, StatsOptions, Sweep, SweepOptions};
+    let dir = scratch("lengths");
+    let sweep = Sweep::from_json_str(
+        r#"{
+        "base": { "block": { "lx": 0.02, "ly": 0.004, "lz": 0.01 },
+                  "cells": { "kind": "size", "dx": 0.001, "dy": 0.001 },
+                  "normal_load": 100.0,
+                  "drive": { "kind": "spring", "stiffness": 4e6, "lateral": { "kind": "side" } } },
+        "axes": [ { "keys": ["block.lx", "normal_load"],
+                    "values": [[0.02, 100.0], [0.04, 200.0], [0.08, 400.0]] } ],
+        "realizations": 4,
+        "seed": 9
+    }"#,
+    )
+    .unwrap();
+    sweep.execute(&dir, &SweepOptions::new(), |_| {}).unwrap();
+    let fit = PowerLawOptions::default()
+        .bootstrap(10)
+        .goodness_samples(0)
+        .min_tail(5);
+    let summary = statistics(&dir, &StatsOptions::default().fit(fit.clone())).unwrap();
+    assert!(summary.files.iter().any(|f| f.ends_with("collapse.csv")));
+    let rows = table(&dir.join("collapse.csv"));
+    assert_eq!(rows.len(), 2);
+    for (row, flash) in rows.iter().zip([false, true]) {
+        let mut sets: Vec<(f64, Vec<Vec<f64>>)> = [0.02, 0.04, 0.08]
+            .iter()
+            .map(|l| (*l, Vec::new()))
+            .collect();
+        for run in sweep.runs() {
+            let all = read_avalanches(&table(&dir.join(run.dir_name()).join("events.csv")));
+            let sizes = all[..spanning(&all)]
+                .iter()
+                .map(|a| (a.ruptures - if flash { a.flash } else { 0 }) as f64)
+                .collect();
+            sets[run.point()].1.push(sizes);
+        }
+        let c = fit_collapse(&sets, Support::Discrete, 5, &fit).unwrap();
+        assert_eq!(row["axis"], "block.lx");
+        assert_eq!(num(row, "lengths"), 3.0);
+        for (column, value) in [
+            ("tau", c.tau),
+            ("tau_low", c.tau_low),
+            ("tau_high", c.tau_high),
+            ("d", c.d),
+            ("d_low", c.d_low),
+            ("d_high", c.d_high),
+            ("spread", c.spread),
+        ] {
+            assert!(
+                (num(row, column) - value).abs() <= 1e-11 * value.abs().max(1.0),
+                "{column}: {row:?}"
+            );
+        }
+        assert_eq!(num(row, "overlaps") as usize, c.overlaps);
+        assert!(c.overlaps > 0);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_finite_size_study_files_are_the_documented_study() {
+    // Issue 54's study: Lx 35 to 560 mm at Ly = 7 mm, Ly 7 to 28 mm at Lx = 140 mm, 1 mm
+    // cells, the calibration block's load per area (3500 N on 140 x 7 mm), 50 realizations.
+    use precursors::sweep::Sweep;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/sweeps/finite_size");
+    for (name, lengths) in [
+        (
+            "lx.json",
+            vec![
+                (0.035, 0.007),
+                (0.07, 0.007),
+                (0.14, 0.007),
+                (0.28, 0.007),
+                (0.56, 0.007),
+            ],
+        ),
+        ("ly.json", vec![(0.14, 0.007), (0.14, 0.014), (0.14, 0.028)]),
+    ] {
+        let sweep = Sweep::from_json_file(dir.join(name)).unwrap();
+        assert_eq!(sweep.runs().len(), 50 * lengths.len(), "{name}");
+        for (point, (lx, ly)) in lengths.iter().enumerate() {
+            let run = sweep.runs().iter().find(|r| r.point() == point).unwrap();
+            let scene = run.scene();
+            let grid = scene.grid().unwrap();
+            let b = grid.block();
+            assert_eq!((b.lx(), b.ly()), (*lx, *ly), "{name}");
+            assert!((grid.dx() - 0.001).abs() < 1e-12 && (grid.dy() - 0.001).abs() < 1e-12);
+            let json: serde_json::Value = serde_json::from_str(&scene.to_json().unwrap()).unwrap();
+            let pressure = json["normal_load"].as_f64().unwrap() / (lx * ly);
+            assert!(
+                (pressure / (3500.0 / (0.14 * 0.007)) - 1.0).abs() < 1e-12,
+                "{name}"
+            );
+        }
     }
 }
 

@@ -188,8 +188,9 @@ enum Command {
         dir: PathBuf,
     },
     /// Fits the statistics of a run's or a sweep's avalanches, stress drops and front
-    /// leaps (pooled per point; docs/statistics.md) into DIR/power_laws.csv and
-    /// distributions.csv.
+    /// leaps (pooled per point; docs/statistics.md) into DIR/power_laws.csv,
+    /// distributions.csv, binned_means.csv, scaling.csv, and collapse.csv for a sweep over
+    /// a block length.
     Stats {
         /// A run's or a sweep's output directory.
         dir: PathBuf,
@@ -1331,6 +1332,9 @@ fn stats(dir: &Path, options: &StatsOptions, progress: bool) -> Result<(), Failu
     let summary = summary?;
     for verdict in &summary.verdicts {
         say!("{verdict}");
+    }
+    for line in summary.classes.iter().chain(&summary.scaling) {
+        say!("{line}");
     }
     for file in &summary.files {
         say!("wrote {}", file.display());

@@ -75,13 +75,23 @@ pub(crate) const DERIVED_TABLES: [&str; 2] = [AVALANCHE_TABLE, FRONTS_TABLE];
 pub(crate) const POWER_LAWS: &str = "power_laws.csv";
 /// The log-binned distributions `stats` writes.
 pub(crate) const DISTRIBUTIONS: &str = "distributions.csv";
+/// The binned means of one observable against another `stats` writes (the mean size
+/// against `1 - F/(μF_N)`, the mean drop against the size).
+pub(crate) const BINNED_MEANS: &str = "binned_means.csv";
+/// The power-law relations between observables `stats` fits (drop against size).
+pub(crate) const SCALING: &str = "scaling.csv";
+/// The finite-size data collapse `stats` writes for a sweep over a block length.
+pub(crate) const COLLAPSE: &str = "collapse.csv";
+/// The tables `stats` writes.
+pub(crate) const STATS_TABLES: [&str; 5] =
+    [POWER_LAWS, DISTRIBUTIONS, BINNED_MEANS, SCALING, COLLAPSE];
 
 /// Whether `name` is a derived table, a figure or a movie: derived or drawn from a run's
 /// tables, so stale once the tables are another run's.
 pub(crate) fn derived(name: &str) -> bool {
     MOVIES.contains(&name)
         || DERIVED_TABLES.contains(&name)
-        || [POWER_LAWS, DISTRIBUTIONS].contains(&name)
+        || STATS_TABLES.contains(&name)
         || name
             .rsplit_once('.')
             .is_some_and(|(stem, ext)| FIGURES.contains(&stem) && FIGURE_EXTENSIONS.contains(&ext))

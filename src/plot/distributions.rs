@@ -62,7 +62,7 @@ pub(super) fn draw_statistics(
         let (mut s, mut d) = (Vec::new(), Vec::new());
         point.for_each_record(|run_dir, record| {
             // The samples `stats` pools by default (the spanning avalanche left out).
-            let [ruptures, drop, ..] = samples(record, run_dir, false)?;
+            let [ruptures, drop, ..] = samples(record, run_dir, false)?.observables;
             s.extend(ruptures);
             d.extend(drop.into_iter().filter(|x| *x > 0.0));
             Ok(())

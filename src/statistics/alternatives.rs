@@ -74,7 +74,7 @@ fn ln_ratio(x: f64, x_min: f64) -> f64 {
 /// point with the initial steps until a restart improves by no more than `F_TOL`. A run
 /// stops when the simplex's values agree within `F_TOL` and its points within `X_TOL` in
 /// each coordinate, or after 2000 steps. NaN counts as `+∞`.
-fn nelder_mead(
+pub(super) fn nelder_mead(
     mut f: impl FnMut([f64; 2]) -> f64,
     start: [f64; 2],
     step: [f64; 2],

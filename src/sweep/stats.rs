@@ -10,10 +10,11 @@ use crate::error::{Error, Result};
 use crate::files::write_atomically;
 use crate::output::check::RunRecord;
 use crate::output::derived::derive;
-use crate::output::layout::{DISTRIBUTIONS, POWER_LAWS};
+use crate::output::layout::{BINNED_MEANS, COLLAPSE, DISTRIBUTIONS, POWER_LAWS, SCALING};
 use crate::statistics::{
-    compare_alternatives_with, fit_power_law, log_binned, whole_fits, Comparison, LikelihoodRatio,
-    PowerLawFit, PowerLawOptions, Support,
+    binned_means, classes_excluded, compare_alternatives_with, fit_collapse, fit_power_law,
+    fit_scaling, log_binned, whole_fits, Comparison, LikelihoodRatio, PowerLawFit, PowerLawOptions,
+    Support,
 };
 
 /// A row's fit: with its alternatives, or the power law alone where they cannot be
@@ -86,11 +87,18 @@ pub struct StatsSummary {
     pub runs: usize,
     /// Runs left out: not complete (no completion marker).
     pub runs_missing: usize,
-    /// The files written: `power_laws.csv`, `distributions.csv`.
+    /// The files written: `power_laws.csv`, `distributions.csv`, `binned_means.csv`,
+    /// `scaling.csv`, and `collapse.csv` for a sweep over a block length.
     pub files: Vec<PathBuf>,
     /// Each fit's verdict (`Comparison::verdict`), as `point <index>, <observable>:
     /// <verdict>`, in the order of `power_laws.csv`'s rows; none for an empty fit.
     pub verdicts: Vec<String>,
+    /// For each fit, the universality classes its exponents' intervals exclude
+    /// ([`crate::statistics::classes_excluded`]), as `point <index>, <observable>: α
+    /// [low, high] excludes …; cut-off α [low, high] excludes …`.
+    pub classes: Vec<String>,
+    /// The fitted relations (`scaling.csv`) and collapses (`collapse.csv`) in words.
+    pub scaling: Vec<String>,
 }
 
 /// Where [`statistics_with_progress`] stands, after each whole fit (the `x_min` search on
@@ -187,6 +195,69 @@ pub(crate) const OBSERVABLES: [(&str, Support, &str); 12] = [
 /// The samples of every observable of one run, in the order of [`OBSERVABLES`].
 type Samples = [Vec<f64>; OBSERVABLES.len()];
 
+/// The values of one avalanche that enter the relations between observables
+/// ([`RELATIONS`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct AvalancheValues {
+    /// `1 - F/(μF_N)` at its start (the load of its first rupture).
+    pub load_gap: f64,
+    /// Its ruptures.
+    pub ruptures: f64,
+    /// Its ruptures without the flash ones.
+    pub without_flash: f64,
+    /// Its force drop (N).
+    pub drop: f64,
+}
+
+/// A relation between two observables of the same avalanches: its name (the `relation`
+/// column of `binned_means.csv` and `scaling.csv`), `x` and `y` of an avalanche, and what
+/// it is (docs/statistics.md).
+pub(crate) type Relation = (
+    &'static str,
+    fn(&AvalancheValues) -> (f64, f64),
+    &'static str,
+);
+
+/// The relations [`statistics`] bins and fits, over the avalanches before the spanning one
+/// whose `x` and `y` are both positive.
+pub(crate) const RELATIONS: [Relation; 3] = [
+    (
+        "ruptures_against_load_gap",
+        |a| (a.load_gap, a.ruptures),
+        "the size against 1 - F/(μF_N) at the avalanche's start",
+    ),
+    (
+        "ruptures_without_flash_against_load_gap",
+        |a| (a.load_gap, a.without_flash),
+        "the size without flash ruptures against 1 - F/(μF_N) at the avalanche's start",
+    ),
+    (
+        "force_drop_N_against_ruptures",
+        |a| (a.ruptures, a.drop),
+        "the force drop (N) against the size, over the avalanches whose force drops",
+    ),
+];
+
+/// The `(x, y)` of a relation over avalanches, both positive.
+pub(crate) fn relation_pairs(
+    relation: &Relation,
+    avalanches: &[AvalancheValues],
+) -> (Vec<f64>, Vec<f64>) {
+    avalanches
+        .iter()
+        .map(relation.1)
+        .filter(|(x, y)| *x > 0.0 && *y > 0.0)
+        .unzip()
+}
+
+/// The samples of one run: of each observable, and the values of each avalanche kept.
+pub(crate) struct RunSamples {
+    /// The samples of each of [`OBSERVABLES`].
+    pub observables: Samples,
+    /// The avalanches kept, in order.
+    pub avalanches: Vec<AvalancheValues>,
+}
+
 /// The samples of each of [`OBSERVABLES`] in one complete run: from the avalanches before
 /// the spanning one and the stable states before its end, or (`include_spanning`) from
 /// every avalanche but global slip and every stable state. Front leaps are the advances of
@@ -195,12 +266,17 @@ type Samples = [Vec<f64>; OBSERVABLES.len()];
 ///
 /// # Errors
 /// [`Error::CorruptTable`] when its events are not the whole run of its grid.
-pub(crate) fn samples(record: &RunRecord, dir: &Path, include_spanning: bool) -> Result<Samples> {
+pub(crate) fn samples(
+    record: &RunRecord,
+    dir: &Path,
+    include_spanning: bool,
+) -> Result<RunSamples> {
     let derived = derive(&record.grid, &record.events).map_err(|e| Error::CorruptTable {
         path: Some(dir.join(crate::output::TABLES[0])),
         reason: format!("not the whole run of its scene: {e}"),
     })?;
     let mut out: Samples = Default::default();
+    let mut avalanches = Vec::new();
     let kept = |a: &&crate::avalanche::Avalanche| {
         !a.global_slip && (include_spanning || !(a.spanning || a.after_spanning))
     };
@@ -214,6 +290,12 @@ pub(crate) fn samples(record: &RunRecord, dir: &Path, include_spanning: bool) ->
         // The load windows of issue 54: the mean size grows as the load nears μF_N, so
         // sizes pooled over the whole run mix regimes.
         let load = a.load_before.force / record.bounds.mu_fn;
+        avalanches.push(AvalancheValues {
+            load_gap: 1.0 - load,
+            ruptures: a.ruptures as f64,
+            without_flash: (a.ruptures - a.flash_ruptures) as f64,
+            drop: a.force_drop(),
+        });
         let window = if load < 0.5 {
             9
         } else if load < 0.8 {
@@ -259,7 +341,10 @@ pub(crate) fn samples(record: &RunRecord, dir: &Path, include_spanning: bool) ->
             }
         }
     }
-    Ok(out)
+    Ok(RunSamples {
+        observables: out,
+        avalanches,
+    })
 }
 
 /// Whether the positive samples are all one value (one avalanche extent on a narrow
@@ -453,11 +538,25 @@ pub fn statistics_with_progress(
     let mut fits = format!(
         "point,{key_header}observable,support,samples,tail,x_min,alpha,alpha_std_error,\
          alpha_low,alpha_high,x_min_low,x_min_high,ks_distance,p_value,confidence,\
-         {ALTERNATIVES_HEADER}\n"
+         {ALTERNATIVES_HEADER},classes_excluded,cutoff_classes_excluded\n"
     );
     let mut verdicts = Vec::new();
+    let mut classes = Vec::new();
+    let mut scaling_lines = Vec::new();
     let mut bins =
         format!("point,{key_header}observable,bin_low,bin_high,bin_center,count,density\n");
+    let mut means = format!(
+        "point,{key_header}relation,x_low,x_high,x_center,x_mean,count,mean,mean_low,\
+         mean_high,confidence\n"
+    );
+    let mut scaling = format!(
+        "point,{key_header}relation,pairs,exponent,exponent_low,exponent_high,prefactor,\
+         confidence\n"
+    );
+    // A sweep over one block length (linked keys, a normal load at fixed pressure, may
+    // vary with it): each point's sizes per run, for the collapse.
+    let length_axis = length_axis(&keys, &points);
+    let mut sizes_by_length: Vec<(f64, [Vec<Vec<f64>>; 2])> = Vec::new();
     let mut runs = 0;
     for (index, point) in points.iter().enumerate() {
         let values: String = point
@@ -466,16 +565,25 @@ pub fn statistics_with_progress(
             .map(|(_, v)| format!("{},", cell(v)))
             .collect();
         let mut pooled: Samples = Default::default();
+        let mut avalanches = Vec::new();
+        let mut per_run: [Vec<Vec<f64>>; 2] = Default::default();
         point.for_each_record(|run_dir, record| {
-            for (all, s) in
-                pooled
-                    .iter_mut()
-                    .zip(samples(record, run_dir, options.include_spanning)?)
-            {
+            let run = samples(record, run_dir, options.include_spanning)?;
+            if length_axis.is_some() {
+                per_run[0].push(run.observables[0].clone());
+                per_run[1].push(run.observables[7].clone());
+            }
+            for (all, s) in pooled.iter_mut().zip(run.observables) {
                 all.extend(s);
             }
+            avalanches.extend(run.avalanches);
             Ok(())
         })?;
+        if let Some((_, k)) = &length_axis {
+            // The axis' value is a length in metres (the scene's unit).
+            let length = point.values[*k].1.parse::<f64>().unwrap_or(f64::NAN);
+            sizes_by_length.push((length, per_run));
+        }
         runs += point.runs();
         let enough = |x: &Vec<f64>| {
             x.iter().filter(|v| **v > 0.0).count() >= options.fit.min_tail && !all_equal(x)
@@ -515,14 +623,36 @@ pub fn statistics_with_progress(
                 Support::Discrete => "discrete",
                 _ => "continuous",
             };
+            let excluded = class_cells(fit.as_ref());
             let _ = writeln!(
                 fits,
-                "{index},{values}{name},{support_name},{positive},{},{}",
+                "{index},{values}{name},{support_name},{positive},{},{},{},{}",
                 fit_cells(fit.as_ref(), options.fit.confidence),
-                alternative_cells(fit.as_ref())
+                alternative_cells(fit.as_ref()),
+                cell(&excluded[0]),
+                cell(&excluded[1]),
             );
             if let Some(Fit::Compared(c)) = &fit {
                 verdicts.push(format!("point {index}, {name}: {}", c.verdict()));
+            }
+            if let Some(f) = &fit {
+                let pl = match f {
+                    Fit::Compared(c) => &c.power_law,
+                    Fit::PowerLaw(p) => p,
+                };
+                let mut line = format!(
+                    "point {index}, {name}: α = {:.2} [{:.2}, {:.2}] excludes {}",
+                    pl.alpha, pl.alpha_low, pl.alpha_high, excluded[0]
+                );
+                if let Fit::Compared(c) = f {
+                    let k = &c.cutoff;
+                    let _ = write!(
+                        line,
+                        "; cut-off α = {:.2} [{:.2}, {:.2}] excludes {}",
+                        k.alpha, k.alpha_low, k.alpha_high, excluded[1]
+                    );
+                }
+                classes.push(line);
             }
             if positive > 0 {
                 for b in log_binned(x, *support, options.bins_per_decade)? {
@@ -538,17 +668,167 @@ pub fn statistics_with_progress(
                 }
             }
         }
+        for relation in &RELATIONS {
+            let name = relation.0;
+            let (x, y) = relation_pairs(relation, &avalanches);
+            for b in binned_means(&x, &y, options.bins_per_decade, options.fit.confidence)? {
+                let _ = writeln!(
+                    means,
+                    "{index},{values}{name},{},{},{},{},{},{},{},{},{}",
+                    num(b.low),
+                    num(b.high),
+                    num(b.center),
+                    num(b.x_mean),
+                    b.count,
+                    num(b.mean),
+                    b.mean_low.map(num).unwrap_or_default(),
+                    b.mean_high.map(num).unwrap_or_default(),
+                    num(options.fit.confidence),
+                );
+            }
+            let fit = match fit_scaling(&x, &y, &options.fit) {
+                Ok(f) => Some(f),
+                Err(
+                    Error::TooFewSamples { .. }
+                    | Error::InvalidParameter {
+                        name: "samples", ..
+                    },
+                ) => None,
+                Err(e) => return Err(e.into()),
+            };
+            let cells = fit.as_ref().map_or_else(
+                || ",,,".to_string(),
+                |f| {
+                    scaling_lines.push(format!(
+                        "point {index}, {name}: exponent {:.2} [{:.2}, {:.2}] over {} avalanches",
+                        f.exponent, f.exponent_low, f.exponent_high, f.pairs
+                    ));
+                    format!(
+                        "{},{},{},{}",
+                        num(f.exponent),
+                        num(f.exponent_low),
+                        num(f.exponent_high),
+                        num(f.prefactor)
+                    )
+                },
+            );
+            let _ = writeln!(
+                scaling,
+                "{index},{values}{name},{},{cells},{}",
+                x.len(),
+                num(options.fit.confidence)
+            );
+        }
     }
-    let files = vec![dir.join(POWER_LAWS), dir.join(DISTRIBUTIONS)];
+    let mut files = vec![
+        dir.join(POWER_LAWS),
+        dir.join(DISTRIBUTIONS),
+        dir.join(BINNED_MEANS),
+        dir.join(SCALING),
+    ];
     write_atomically(&files[0], fits.as_bytes(), "writing table")?;
     write_atomically(&files[1], bins.as_bytes(), "writing table")?;
+    write_atomically(&files[2], means.as_bytes(), "writing table")?;
+    write_atomically(&files[3], scaling.as_bytes(), "writing table")?;
+    if let Some((axis, _)) = &length_axis {
+        let table = collapse_table(axis, &sizes_by_length, options, &mut scaling_lines)?;
+        files.push(dir.join(COLLAPSE));
+        write_atomically(&files[4], table.as_bytes(), "writing table")?;
+    }
     Ok(StatsSummary {
         points: points.len(),
         runs,
         runs_missing: missing,
         files,
         verdicts,
+        classes,
+        scaling: scaling_lines,
     })
+}
+
+/// The length axis of a sweep, and its place among the keys: the one key that is
+/// `block.lx` or `block.ly`, its value distinct at each of at least two points (so no other
+/// axis crosses it; linked keys may vary with it).
+fn length_axis(keys: &[String], points: &[Point]) -> Option<(String, usize)> {
+    let mut lengths = keys
+        .iter()
+        .enumerate()
+        .filter(|(_, k)| *k == "block.lx" || *k == "block.ly");
+    let (k, key) = lengths.next()?;
+    if lengths.next().is_some() || points.len() < 2 {
+        return None;
+    }
+    let mut values: Vec<&str> = points.iter().map(|p| p.values[k].1.as_str()).collect();
+    values.sort_unstable();
+    values.dedup();
+    (values.len() == points.len()).then(|| (key.clone(), k))
+}
+
+/// `collapse.csv`: for the sizes with and without flash ruptures, the finite-size
+/// collapse over the points of a sweep along `axis` (`block.lx` or `block.ly`), from each
+/// point's sizes per run; its line in words pushed onto `lines`.
+fn collapse_table(
+    axis: &str,
+    sets: &[(f64, [Vec<Vec<f64>>; 2])],
+    options: &StatsOptions,
+    lines: &mut Vec<String>,
+) -> Result<String> {
+    let mut table = "axis,observable,lengths,tau,tau_low,tau_high,d,d_low,d_high,spread,\
+                     overlaps,confidence\n"
+        .to_string();
+    for (k, name) in [(0, OBSERVABLES[0].0), (1, OBSERVABLES[7].0)] {
+        let by_length: Vec<(f64, Vec<Vec<f64>>)> =
+            sets.iter().map(|(l, s)| (*l, s[k].clone())).collect();
+        let cells = match fit_collapse(
+            &by_length,
+            Support::Discrete,
+            options.bins_per_decade,
+            &options.fit,
+        ) {
+            Ok(c) => {
+                lines.push(format!(
+                    "{name} against {axis}: τ = {:.2} [{:.2}, {:.2}], D = {:.2} [{:.2}, {:.2}] \
+                     (spread {:.2} over {} points)",
+                    c.tau, c.tau_low, c.tau_high, c.d, c.d_low, c.d_high, c.spread, c.overlaps
+                ));
+                [
+                    c.tau, c.tau_low, c.tau_high, c.d, c.d_low, c.d_high, c.spread,
+                ]
+                .map(num)
+                .join(",")
+                    + &format!(",{}", c.overlaps)
+            }
+            Err(Error::TooFewSamples { .. }) => ",,,,,,,".to_string(),
+            Err(e) => return Err(e),
+        };
+        let _ = writeln!(
+            table,
+            "{},{name},{},{cells},{}",
+            cell(axis),
+            sets.len(),
+            num(options.fit.confidence)
+        );
+    }
+    Ok(table)
+}
+
+/// The universality classes the intervals of the power law's `α` and of the cut-off
+/// law's exclude ([`classes_excluded`]): names `; `-separated, `none`, or empty without
+/// the fit.
+fn class_cells(fit: Option<&Fit>) -> [String; 2] {
+    let names = |low: f64, high: f64| match classes_excluded(low, high) {
+        Ok(c) if c.is_empty() => "none".to_string(),
+        Ok(c) => c.iter().map(|c| c.name).collect::<Vec<_>>().join("; "),
+        Err(_) => String::new(),
+    };
+    match fit {
+        None => [String::new(), String::new()],
+        Some(Fit::PowerLaw(p)) => [names(p.alpha_low, p.alpha_high), String::new()],
+        Some(Fit::Compared(c)) => [
+            names(c.power_law.alpha_low, c.power_law.alpha_high),
+            names(c.cutoff.alpha_low, c.cutoff.alpha_high),
+        ],
+    }
 }
 
 /// The header of the alternatives' cells ([`alternative_cells`]).
