@@ -622,7 +622,7 @@ mod cli {
         ]);
         assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
         let fits = table(&run_dir.join("power_laws.csv"));
-        assert_eq!(fits.len(), 12);
+        assert_eq!(fits.len(), 14);
         assert_eq!(fits[0]["observable"], "avalanche_ruptures");
         // The observables appended in 1.2, against the run's avalanches read from
         // events.csv (`read_avalanches`): before the spanning one, its flash ruptures out,
@@ -650,6 +650,23 @@ mod cli {
         assert_eq!(samples("avalanche_ruptures_load_below_0.5"), windows[0]);
         assert_eq!(samples("avalanche_ruptures_load_0.5_to_0.8"), windows[1]);
         assert_eq!(samples("avalanche_ruptures_load_from_0.8"), windows[2]);
+        // The potencies and released energies that are positive, of the avalanches
+        // per_avalanche.csv keeps (before the spanning one).
+        let rows = table(&run_dir.join("per_avalanche.csv"));
+        let kept_rows: Vec<_> = rows
+            .iter()
+            .filter(|r| {
+                r["spanning"] == "0" && r["after_spanning"] == "0" && r["global_slip"] == "0"
+            })
+            .collect();
+        assert_eq!(kept_rows.len(), kept.len());
+        let positive = |key: &str| kept_rows.iter().filter(|r| num(r, key) > 0.0).count();
+        assert!(positive("potency_m3") > kept.len() / 2);
+        assert_eq!(samples("avalanche_potency_m3"), positive("potency_m3"));
+        assert_eq!(
+            samples("avalanche_released_energy_J"),
+            positive("released_energy_J")
+        );
         // The rod drive does not drop its force: no samples, no fit.
         assert_eq!(fits[1]["samples"], "0");
         assert_eq!(fits[1]["alpha"], "");

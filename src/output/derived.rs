@@ -103,17 +103,26 @@ pub(crate) fn write(
 /// What an avalanche slipped, from the slip per newton of load (`curve.csv`) of the
 /// stable state before it and of the one it ends in (docs/statistics.md).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-struct Slip {
+pub(crate) struct Slip {
     /// `Σ Δu_x ΔA` over the interface (m³).
-    potency: Option<f64>,
+    pub potency: Option<f64>,
     /// `Σ x Δu_x ΔA / Σ Δu_x ΔA` (m), where the potency is positive.
-    centroid: Option<f64>,
+    pub centroid: Option<f64>,
     /// The work of the load less the change of the elastic energy (J), under force
     /// control: `½ F² (c_after - c_before)`.
-    released: Option<f64>,
+    pub released: Option<f64>,
 }
 
 impl Slip {
+    /// The slip of `a`, an avalanche of the run whose checked `curve.csv` rows are
+    /// `curve` (one per stable state, in order).
+    pub(crate) fn in_run(a: &Avalanche, curve: &[CurveRow]) -> Slip {
+        let next = curve.partition_point(|c| c.event < a.start_event);
+        let before = next.checked_sub(1).and_then(|i| curve.get(i));
+        let after = curve.get(next).filter(|c| c.event == a.end_event);
+        Slip::of(a, before, after)
+    }
+
     /// The slip of `a` from the rows of the stable states before and after it: `None`
     /// where the after state is global slip (no stable state) or a row holds no slip
     /// (kept from a run 1.1 began). The state before holds at the avalanche's starting
@@ -151,10 +160,7 @@ impl Slip {
 fn avalanche_text(avalanches: &[Avalanche], curve: &[CurveRow]) -> String {
     let mut text = format!("{AVALANCHE_HEADER}\n");
     for (k, a) in avalanches.iter().enumerate() {
-        let next = curve.partition_point(|c| c.event < a.start_event);
-        let before = next.checked_sub(1).and_then(|i| curve.get(i));
-        let after = curve.get(next).filter(|c| c.event == a.end_event);
-        let slip = Slip::of(a, before, after);
+        let slip = Slip::in_run(a, curve);
         let _ = writeln!(
             text,
             "{},{},{},{},{:.12e},{:.12e},{:.12e},{:.12e},{},{},{:.12e},{},{},{},{},{},{},{},{},{},\

@@ -9,7 +9,7 @@ use super::{SweepError, SweepRun, DONE, SWEEP_FILE};
 use crate::error::{Error, Result};
 use crate::files::write_atomically;
 use crate::output::check::RunRecord;
-use crate::output::derived::derive;
+use crate::output::derived::{derive, Slip};
 use crate::output::layout::{BINNED_MEANS, COLLAPSE, DISTRIBUTIONS, POWER_LAWS, SCALING};
 use crate::statistics::{
     binned_means, classes_excluded, compare_alternatives_with, fit_collapse, fit_power_law,
@@ -122,7 +122,7 @@ pub struct StatsProgress {
 /// The observables [`statistics`] pools and fits, in the order of its tables: the name
 /// (the `observable` column), whether the samples are counts, and what they are
 /// (docs/statistics.md has the list).
-pub(crate) const OBSERVABLES: [(&str, Support, &str); 12] = [
+pub(crate) const OBSERVABLES: [(&str, Support, &str); 14] = [
     (
         "avalanche_ruptures",
         Support::Discrete,
@@ -190,6 +190,17 @@ pub(crate) const OBSERVABLES: [(&str, Support, &str); 12] = [
         "ruptures of each avalanche before the spanning one that starts at F/(μF_N) 0.8 or \
          above",
     ),
+    (
+        "avalanche_potency_m3",
+        Support::Continuous,
+        "potency Σ Δu_x ΔA of each avalanche before the spanning one (m³), where positive",
+    ),
+    (
+        "avalanche_released_energy_J",
+        Support::Continuous,
+        "energy released by each avalanche before the spanning one (J): the work of the load \
+         less the change of the elastic energy, under force control; where positive",
+    ),
 ];
 
 /// The samples of every observable of one run, in the order of [`OBSERVABLES`].
@@ -207,6 +218,8 @@ pub(crate) struct AvalancheValues {
     pub without_flash: f64,
     /// Its force drop (N).
     pub drop: f64,
+    /// Its potency (m³; 0 where not known).
+    pub potency: f64,
 }
 
 /// A relation between two observables of the same avalanches: its name (the `relation`
@@ -220,7 +233,7 @@ pub(crate) type Relation = (
 
 /// The relations [`statistics`] bins and fits, over the avalanches before the spanning one
 /// whose `x` and `y` are both positive.
-pub(crate) const RELATIONS: [Relation; 3] = [
+pub(crate) const RELATIONS: [Relation; 4] = [
     (
         "ruptures_against_load_gap",
         |a| (a.load_gap, a.ruptures),
@@ -235,6 +248,12 @@ pub(crate) const RELATIONS: [Relation; 3] = [
         "force_drop_N_against_ruptures",
         |a| (a.ruptures, a.drop),
         "the force drop (N) against the size, over the avalanches whose force drops",
+    ),
+    (
+        "potency_m3_against_ruptures",
+        |a| (a.ruptures, a.potency),
+        "the potency (m³) against the size, over the avalanches whose potency is known and \
+         positive",
     ),
 ];
 
@@ -290,11 +309,16 @@ pub(crate) fn samples(
         // The load windows of issue 54: the mean size grows as the load nears μF_N, so
         // sizes pooled over the whole run mix regimes.
         let load = a.load_before.force / record.bounds.mu_fn;
+        let slip = Slip::in_run(a, &record.curve);
+        let positive = |x: Option<f64>| x.filter(|x| *x > 0.0);
+        out[12].extend(positive(slip.potency));
+        out[13].extend(positive(slip.released));
         avalanches.push(AvalancheValues {
             load_gap: 1.0 - load,
             ruptures: a.ruptures as f64,
             without_flash: (a.ruptures - a.flash_ruptures) as f64,
             drop: a.force_drop(),
+            potency: slip.potency.unwrap_or(0.0),
         });
         let window = if load < 0.5 {
             9
