@@ -1146,6 +1146,53 @@ mod kept {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    /// A checkpoint and the partial tables of its run as the 1.1 code wrote them
+    /// (`tests/data/checkpoints/paper-1.1`: a 12 x 2 run cut 7 events past a checkpoint at
+    /// its 7th stable state, written before the contact rule became one component, issue
+    /// 55). Resumed, the tables end byte for byte as those of the uninterrupted run today's
+    /// code records, derived tables included. The reference is that uninterrupted run.
+    /// Like every resume, this needs the same float results (same CPU features) as the
+    /// machine that wrote the fixture.
+    #[test]
+    fn a_1_1_checkpoint_resumes_its_tables_to_the_uninterrupted_run() {
+        let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/checkpoints");
+        let checkpoint = Checkpoint::read_from(data.join("paper-1.1.json")).unwrap();
+        let scene = checkpoint.scene().clone().build().unwrap();
+        // The fixture holds rows past the checkpoint, which the resume cuts away.
+        let events = std::fs::read_to_string(data.join("paper-1.1/events.csv.partial")).unwrap();
+        let last: usize = events
+            .lines()
+            .last()
+            .unwrap()
+            .split(',')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(last > checkpoint.event_count() && checkpoint.event_count() > 0);
+        let whole = scratch("fixture-whole");
+        let mut driver = scene.driver().unwrap();
+        output::RunTables::create(&whole, &driver)
+            .unwrap()
+            .run_to_slip(&mut driver, None, |_, _| {})
+            .unwrap();
+        let work = scratch("fixture-resumed");
+        copy_dir(&data.join("paper-1.1"), &work);
+        let mut driver = scene.resume(&checkpoint).unwrap();
+        output::RunTables::resume(&work, &driver)
+            .unwrap()
+            .run_to_slip(&mut driver, None, |_, _| {})
+            .unwrap();
+        let (resumed, reference) = (files(&work), files(&whole));
+        let names = |f: &[(String, Vec<u8>)]| f.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>();
+        assert_eq!(names(&resumed), names(&reference));
+        for ((name, a), (_, b)) in resumed.iter().zip(&reference) {
+            assert!(a == b, "{name} differs from the uninterrupted run's");
+        }
+        std::fs::remove_dir_all(&whole).unwrap();
+        std::fs::remove_dir_all(&work).unwrap();
+    }
+
     /// A resume whose observers differ from those the directory recorded (its tables or
     /// its scene.json) is refused before anything is touched: no recorded table is
     /// removed, scene.json keeps describing the tables present.
