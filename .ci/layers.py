@@ -19,6 +19,7 @@ LAYERS = [
     ["geometry", "lock"],
     ["green", "surface"],
     ["interface"],
+    ["contact"],
     ["solver"],
     ["probe"],
     ["recording"],

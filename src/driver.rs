@@ -37,9 +37,10 @@
 //! # Ok::<(), precursors::Error>(())
 //! ```
 
+use crate::contact::ContactRule;
 use crate::error::{Error, Result};
 use crate::geometry::Grid;
-use crate::interface::{Interface, Material, SiteState};
+use crate::interface::{Interface, Material};
 use crate::probe::StressProbe;
 use crate::scene::{Drive, Scene};
 use crate::solver::{EquilibriumSolver, NormalEquilibrium, TangentialResponse};
@@ -676,30 +677,15 @@ impl Driver {
             }
             Phase::Avalanche { forced } => {
                 let force = self.force();
-                let u_z = &self.normal()?.displacement;
-                let traction = &self.response()?.traction;
-                let grid = *self.grid();
-                let cell = grid.cell_area();
-                let mut best: Option<(usize, f64)> = None;
-                for i in 0..grid.len() {
-                    if self.interface.states()[i] != SiteState::Attached {
-                        continue;
-                    }
-                    if self.breaking[i] <= force || forced == Some(i) {
-                        let phi = force * traction[i];
-                        let key = self.interface.log_rupture_energy(i, u_z[i], phi, cell);
-                        if best.is_none_or(|(_, k)| key > k) {
-                            best = Some((i, key));
-                        }
-                    }
-                }
-                let best = match best {
-                    Some((i, _)) => {
-                        let phi = force * traction[i];
-                        Some((i, self.interface.rupture_energy(i, u_z[i], phi, cell)?))
-                    }
-                    None => None,
-                };
+                let best = self.contact_rule().next_rupture(
+                    &self.interface,
+                    &self.breaking,
+                    force,
+                    forced,
+                    &self.response()?.traction,
+                    &self.normal()?.displacement,
+                    self.grid().cell_area(),
+                )?;
                 match best {
                     None => {
                         self.pending.push_back(Event::Stable {
@@ -711,13 +697,13 @@ impl Driver {
                     Some((i, energy)) => {
                         let load = self.load();
                         self.pending.push_back(Event::Rupture {
-                            site: Site::new(&grid, i),
+                            site: Site::new(self.scene.grid(), i),
                             load,
                             energy,
                         });
                         self.avalanche_ruptures += 1;
                         self.interface.break_site(i)?;
-                        if self.interface.broken_count() == grid.len() {
+                        if self.contact_rule().global_slip(&self.interface) {
                             self.pending.push_back(Event::GlobalSlip { load });
                             self.phase = Phase::Done;
                             return Ok(());
@@ -746,18 +732,17 @@ impl Driver {
         self.stats.normal_active_set_iterations += normal.report.active_set_iterations;
         self.stats.normal_iterations += normal.report.linear_iterations;
         if self.normal.is_some() {
-            for (i, (old, new)) in before.iter().zip(self.interface.states()).enumerate() {
-                let site = Site::new(self.scene.grid(), i);
-                match (old, new) {
-                    (SiteState::Attached, SiteState::Detached) => {
-                        self.pending.push_back(Event::Detach { site })
-                    }
-                    (SiteState::Detached, SiteState::Attached) => {
-                        self.pending.push_back(Event::Attach { site })
-                    }
-                    _ => {}
-                }
-            }
+            let grid = self.scene.grid();
+            let pending = &mut self.pending;
+            self.scene
+                .contact_rule()
+                .changes(&before, self.interface.states(), |i, attached| {
+                    let site = Site::new(grid, i);
+                    pending.push_back(match attached {
+                        true => Event::Attach { site },
+                        false => Event::Detach { site },
+                    })
+                });
         }
         let clock = std::time::Instant::now();
         let response =
@@ -777,7 +762,8 @@ impl Driver {
                 });
             }
         }
-        self.breaking = self.interface.breaking_loads(
+        self.breaking = self.contact_rule().breaking_loads(
+            &self.interface,
             &normal.traction,
             &response.traction,
             self.friction_coefficient(),
@@ -789,19 +775,17 @@ impl Driver {
 
     /// The attached site with the smallest breaking load, and that load (N).
     fn weakest(&self) -> Result<(usize, f64)> {
-        let mut best: Option<(usize, f64)> = None;
-        for (i, &b) in self.breaking.iter().enumerate() {
-            if self.interface.states()[i] == SiteState::Attached
-                && b.is_finite()
-                && best.is_none_or(|(_, v)| b < v)
-            {
-                best = Some((i, b));
-            }
-        }
-        best.ok_or(Error::EmptyContact {
-            available: self.interface.attached_count(),
-            reason: "no attached site carries shear: the next threshold is undefined",
-        })
+        self.contact_rule()
+            .weakest(self.interface.states(), &self.breaking)
+            .ok_or(Error::EmptyContact {
+                available: self.interface.attached_count(),
+                reason: "no attached site carries shear: the next threshold is undefined",
+            })
+    }
+
+    /// The rule of the site transitions ([`crate::contact`]): the scene's.
+    pub(crate) fn contact_rule(&self) -> ContactRule {
+        self.scene.contact_rule()
     }
 
     fn normal(&self) -> Result<&NormalEquilibrium> {

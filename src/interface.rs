@@ -755,44 +755,7 @@ impl Interface {
         Ok(())
     }
 
-    /// The Coulomb rule: the shear load (N) at which each site reaches the threshold
-    /// `|φ_x| = μ φ_z`, `λ_i = μ φ_z,i / |φ_x,i(1)|` (paper Eq. lambda_Amonton_dscrt), from
-    /// the normal tractions (Pa) and the shear tractions per newton of load (Pa/N,
-    /// [`crate::solver::TangentialResponse::traction`]). `+∞` for sites that carry no shear
-    /// (detached, broken, or exactly unloaded).
-    ///
-    /// # Errors
-    /// [`Error::LengthMismatch`] for slices of the wrong length;
-    /// [`Error::InvalidParameter`] for a friction coefficient that is negative or not
-    /// finite.
-    pub fn breaking_loads(
-        &self,
-        normal_traction: &[f64],
-        shear_per_newton: &[f64],
-        friction_coefficient: f64,
-    ) -> Result<Vec<f64>> {
-        let n = self.states.len();
-        check_slice("normal_traction", normal_traction, n)?;
-        check_slice("shear_per_newton", shear_per_newton, n)?;
-        if !(friction_coefficient.is_finite() && friction_coefficient >= 0.0) {
-            return Err(Error::InvalidParameter {
-                name: "friction_coefficient",
-                value: friction_coefficient,
-                reason: "the friction coefficient must be finite and >= 0",
-            });
-        }
-        Ok(shear_per_newton
-            .iter()
-            .zip(normal_traction)
-            .map(|(g, f)| {
-                if *g == 0.0 {
-                    f64::INFINITY
-                } else {
-                    friction_coefficient * f / g.abs()
-                }
-            })
-            .collect())
-    }
+    // `breaking_loads`, the Coulomb rule, is defined with the contact rule (contact.rs).
 
     /// Normal stiffness per unit area `k_z = c_z / u0` (N/m³) of every site (the value
     /// while attached; a detached or broken site exerts no force).

@@ -105,6 +105,7 @@
 
 mod avalanche;
 pub mod calibration;
+mod contact;
 mod cost;
 mod driver;
 mod error;

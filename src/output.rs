@@ -582,7 +582,12 @@ impl RunTables {
             }
             resume::check_covered(covered, &tables)?;
         }
-        resume::check_site_states(&plan.site_events, driver.site_states(), &read[0])?;
+        resume::check_site_states(
+            driver.contact_rule(),
+            &plan.site_events,
+            driver.site_states(),
+            &read[0],
+        )?;
         check_recorded_observers(dir, options)?;
         // Checked: now the directory is written.
         remove_stale_temporaries(dir)?;

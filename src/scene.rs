@@ -21,6 +21,7 @@
 //! # Ok::<(), precursors::Error>(())
 //! ```
 
+use crate::contact::ContactRule;
 use crate::error::{check_tolerance, Error, Result};
 use crate::geometry::{Block, Grid};
 use crate::green::{InfluencePlan, Planner, RodLoad};
@@ -1391,6 +1392,12 @@ impl Scene {
     /// The default probes as planned at build (`None` when there are none).
     pub(crate) fn stress_probe(&self) -> Option<&StressProbe> {
         self.inner.probe.as_ref()
+    }
+
+    /// The rule of the site transitions ([`crate::contact`]): the paper's, the only one
+    /// so far (a scene key will choose).
+    pub(crate) fn contact_rule(&self) -> ContactRule {
+        ContactRule::Paper
     }
 
     /// The lateral load of the drive, if any (the probes' lateral stress term).

@@ -1146,12 +1146,64 @@ mod kept {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    /// Checks a directory resumed from a run begun by 1.1 (`work`: its `curve.csv` had no
+    /// slip columns up to the checkpoint's event `kept`) against the uninterrupted run
+    /// `whole`: the same files; `curve.csv` with 1.2's header, the kept rows with empty slip
+    /// cells and the others as the uninterrupted run writes them; `per_avalanche.csv` with
+    /// slip where both of an avalanche's states have it; every other file byte for byte.
+    fn assert_resumed_from_1_1(work: &Path, whole: &Path, kept: usize) {
+        let (resumed, reference) = (files(work), files(whole));
+        let names = |f: &[(String, Vec<u8>)]| f.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>();
+        assert_eq!(names(&resumed), names(&reference));
+        let (mut empty, mut filled) = (0, 0);
+        for ((name, a), (_, b)) in resumed.iter().zip(&reference) {
+            let (a, b) = (String::from_utf8_lossy(a), String::from_utf8_lossy(b));
+            match name.as_str() {
+                "curve.csv" => {
+                    assert_eq!(a.lines().count(), b.lines().count());
+                    for (a, b) in a.lines().zip(b.lines()) {
+                        let event: usize = b.split(',').next().unwrap().parse().unwrap_or(0);
+                        if event > 0 && event <= kept {
+                            let cells: Vec<&str> = b.split(',').collect();
+                            assert_eq!(a, format!("{},,,", cells[..10].join(",")));
+                            empty += 1;
+                        } else {
+                            assert_eq!(a, b);
+                        }
+                    }
+                }
+                "per_avalanche.csv" => {
+                    assert_eq!(a.lines().count(), b.lines().count());
+                    for (a, b) in a.lines().zip(b.lines()).skip(1) {
+                        let (a, b): (Vec<&str>, Vec<&str>) =
+                            (a.split(',').collect(), b.split(',').collect());
+                        let n = b.len();
+                        assert_eq!(a[..n - 3], b[..n - 3]);
+                        let start: usize = b[1].parse().unwrap();
+                        // The state before the avalanche that starts after the
+                        // checkpoint's is a kept row.
+                        if start <= kept + 1 {
+                            assert_eq!(a[n - 3..], ["", "", ""], "avalanche {}", b[0]);
+                        } else {
+                            assert_eq!(a[n - 3..], b[n - 3..], "avalanche {}", b[0]);
+                            filled += usize::from(!b[n - 3].is_empty());
+                        }
+                    }
+                }
+                _ => assert!(a == b, "{name} differs from the uninterrupted run's"),
+            }
+        }
+        assert!(empty >= 7, "{empty} kept rows");
+        assert!(
+            filled > 3,
+            "{filled} avalanches with slip after the checkpoint"
+        );
+    }
+
     /// A run begun by 1.1 resumes: `curve.csv` without the slip columns 1.2 added, under a
-    /// checkpoint of layout 3 (no table digests). The resumed tables carry 1.2's header,
-    /// the kept rows with empty slip cells and the others as an uninterrupted run writes
-    /// them (reference: the run from the start in another directory); per_avalanche.csv
-    /// has slip where both of an avalanche's states have it, and the rest of every table
-    /// equals the uninterrupted run's.
+    /// checkpoint of layout 3 (no table digests), made here from a run of today's code
+    /// (`assert_resumed_from_1_1` says what the resumed tables hold; reference: the run from
+    /// the start in another directory).
     #[test]
     fn a_run_begun_by_1_1_resumes_with_empty_slip_cells_on_its_kept_rows() {
         let (work, text) = cut_run("from-1-1");
@@ -1168,14 +1220,11 @@ mod kept {
             .lines()
             .map(|l| l.split(',').take(10).collect::<Vec<_>>().join(",") + "\n")
             .collect();
-        assert!(
-            old.starts_with("event,force_N,")
-                && old
-                    .lines()
-                    .next()
-                    .unwrap()
-                    .ends_with("area_exceeds_nominal")
-        );
+        assert!(old
+            .lines()
+            .next()
+            .unwrap()
+            .ends_with(",attached,area_exceeds_nominal"));
         std::fs::write(&partial, old).unwrap();
         let text = text.replacen("\"format\":4", "\"format\":3", 1);
         let tables = text.find(",\"tables\":").unwrap();
@@ -1188,56 +1237,52 @@ mod kept {
             .unwrap()
             .run_to_slip(&mut driver, None, |_, _| {})
             .unwrap();
-        let read = |dir: &Path, name: &str| std::fs::read_to_string(dir.join(name)).unwrap();
-        let (resumed, reference) = (read(&work, "curve.csv"), read(&whole, "curve.csv"));
-        assert_eq!(resumed.lines().count(), reference.lines().count());
-        let mut empty = 0;
-        for (a, b) in resumed.lines().zip(reference.lines()) {
-            let event: usize = b.split(',').next().unwrap().parse().unwrap_or(0);
-            if event > 0 && event <= kept {
-                let cells: Vec<&str> = b.split(',').collect();
-                assert_eq!(a, format!("{},,,", cells[..10].join(",")));
-                empty += 1;
-            } else {
-                assert_eq!(a, b);
-            }
-        }
-        assert!(empty >= 12, "{empty} kept rows");
-        for name in [
-            "events.csv",
-            "contact_map.csv",
-            "fields.csv",
-            "profiles.csv",
-            "fronts.csv",
-        ] {
-            assert_eq!(read(&work, name), read(&whole, name), "{name}");
-        }
-        // per_avalanche.csv: the three slip columns empty where the state before an
-        // avalanche is a kept row.
-        let (resumed, reference) = (
-            read(&work, "per_avalanche.csv"),
-            read(&whole, "per_avalanche.csv"),
-        );
-        let mut filled = 0;
-        for (a, b) in resumed.lines().zip(reference.lines()).skip(1) {
-            let (a, b): (Vec<&str>, Vec<&str>) = (a.split(',').collect(), b.split(',').collect());
-            let n = b.len();
-            assert_eq!(a[..n - 3], b[..n - 3]);
-            let start: usize = b[1].parse().unwrap();
-            // The state before the avalanche that starts after the checkpoint's is kept.
-            if start <= kept + 1 {
-                assert_eq!(a[n - 3..], ["", "", ""], "avalanche {}", b[0]);
-            } else {
-                assert_eq!(a[n - 3..], b[n - 3..], "avalanche {}", b[0]);
-                filled += usize::from(!b[n - 3].is_empty());
-            }
-        }
-        assert!(
-            filled > 3,
-            "{filled} avalanches with slip after the checkpoint"
-        );
+        assert_resumed_from_1_1(&work, &whole, kept);
         std::fs::remove_dir_all(&work).unwrap();
         std::fs::remove_dir_all(&whole).unwrap();
+    }
+
+    /// A checkpoint and the partial tables of its run as the 1.1 code wrote them
+    /// (`tests/data/checkpoints/paper-1.1`: a 12 x 2 run cut 7 events past a checkpoint at
+    /// its 7th stable state, written before the contact rule became one component, issue
+    /// 55, and before `curve.csv`'s slip columns). Resumed, the tables end as those of the
+    /// uninterrupted run today's code records, derived tables included, but for the slip
+    /// cells of the kept rows (`assert_resumed_from_1_1`). The reference is that
+    /// uninterrupted run. Like every resume, this needs the same float results (same CPU
+    /// features) as the machine that wrote the fixture.
+    #[test]
+    fn a_1_1_checkpoint_resumes_its_tables_to_the_uninterrupted_run() {
+        let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/checkpoints");
+        let checkpoint = Checkpoint::read_from(data.join("paper-1.1.json")).unwrap();
+        let scene = checkpoint.scene().clone().build().unwrap();
+        // The fixture holds rows past the checkpoint, which the resume cuts away.
+        let events = std::fs::read_to_string(data.join("paper-1.1/events.csv.partial")).unwrap();
+        let last: usize = events
+            .lines()
+            .last()
+            .unwrap()
+            .split(',')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(last > checkpoint.event_count() && checkpoint.event_count() > 0);
+        let whole = scratch("fixture-whole");
+        let mut driver = scene.driver().unwrap();
+        output::RunTables::create(&whole, &driver)
+            .unwrap()
+            .run_to_slip(&mut driver, None, |_, _| {})
+            .unwrap();
+        let work = scratch("fixture-resumed");
+        copy_dir(&data.join("paper-1.1"), &work);
+        let mut driver = scene.resume(&checkpoint).unwrap();
+        output::RunTables::resume(&work, &driver)
+            .unwrap()
+            .run_to_slip(&mut driver, None, |_, _| {})
+            .unwrap();
+        assert_resumed_from_1_1(&work, &whole, checkpoint.event_count());
+        std::fs::remove_dir_all(&whole).unwrap();
+        std::fs::remove_dir_all(&work).unwrap();
     }
 
     /// A resume whose observers differ from those the directory recorded (its tables or

@@ -210,3 +210,79 @@ fn capped_area_law_caps_each_site_at_its_cell() {
         Err(Error::NonFinite { index: 3, .. })
     ));
 }
+
+/// The Coulomb rule's breaking loads, bit for bit (issue 55: the rule moved into one
+/// component, whose paper rule must keep the 1.x events): `λ_i = (μ f_i) / |g_i|`,
+/// rounded in that order, `+∞` where `g_i` is zero (either sign), on random tractions
+/// over many decades, signs, subnormals and the extremes. Reference: IEEE 754's
+/// correctly rounded product and quotient in that order, written out here; the other
+/// order (`μ (f / |g|)`) gives other bits for some of the same inputs, so the check sees
+/// the order.
+#[test]
+fn breaking_loads_are_the_coulomb_quotient_bit_for_bit() {
+    let n = 4096;
+    let grid = grid(64, 64);
+    let interface = Interface::new(
+        grid,
+        Heights::from_values(&grid, vec![1e-6; n]).unwrap(),
+        SpringLaw::default(),
+    )
+    .unwrap();
+    // splitmix64: a fixed stream of bits, no dependency.
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut next = move || {
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    };
+    // A finite value of any sign and exponent, or one of the special values.
+    let mut value = |special: &[f64]| {
+        let bits = next();
+        match bits % 16 {
+            0 => special[(bits >> 8) as usize % special.len()],
+            _ => {
+                let exponent = ((bits >> 52) & 0x7ff) % 0x7ff; // all ones is inf or NaN
+                f64::from_bits((bits & (1 << 63)) | (exponent << 52) | (bits & ((1 << 52) - 1)))
+            }
+        }
+    };
+    let specials = [
+        0.0,
+        -0.0,
+        5e-324,
+        -5e-324,
+        f64::MIN_POSITIVE,
+        f64::MAX,
+        -f64::MAX,
+        1.0,
+    ];
+    let f: Vec<f64> = (0..n).map(|_| value(&specials)).collect();
+    let g: Vec<f64> = (0..n).map(|_| value(&specials)).collect();
+    let mut reordered = 0;
+    for mu in [0.5, 0.3, 0.0, 1.7e-3, 9.9e2] {
+        let loads = interface.breaking_loads(&f, &g, mu).unwrap();
+        for i in 0..n {
+            let expected = if g[i] == 0.0 {
+                f64::INFINITY
+            } else {
+                (mu * f[i]) / g[i].abs()
+            };
+            assert_eq!(
+                loads[i].to_bits(),
+                expected.to_bits(),
+                "site {i}: mu {mu:e}, f {:e}, g {:e}",
+                f[i],
+                g[i]
+            );
+            if g[i] != 0.0 && (mu * (f[i] / g[i].abs())).to_bits() != expected.to_bits() {
+                reordered += 1;
+            }
+        }
+    }
+    assert!(
+        reordered > 100,
+        "only {reordered} inputs tell the orders apart"
+    );
+}

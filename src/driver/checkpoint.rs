@@ -496,7 +496,8 @@ impl Scene {
         // λ is a function of the two equilibria: recomputed rather than stored (it holds
         // infinities, which JSON cannot).
         if let (Some(normal), Some(response)) = (&checkpoint.normal, &checkpoint.response) {
-            driver.breaking = driver.interface.breaking_loads(
+            driver.breaking = driver.contact_rule().breaking_loads(
+                &driver.interface,
                 &normal.traction,
                 &response.traction,
                 driver.friction_coefficient(),
@@ -524,9 +525,11 @@ impl Scene {
         // would otherwise break sites at a load the run never reached.
         if checkpoint.phase == Phase::Stable {
             let force = driver.force();
-            if let Some(i) = (0..driver.breaking.len()).find(|&i| {
-                driver.interface.states()[i] == SiteState::Attached && driver.breaking[i] <= force
-            }) {
+            if let Some(i) = driver.contact_rule().first_over_threshold(
+                driver.interface.states(),
+                &driver.breaking,
+                force,
+            ) {
                 return Err(Error::InvalidCheckpoint {
                     reason: format!(
                         "it is a stable state at F = {force:e} N, but site {i} breaks at {:e} N: \
@@ -778,14 +781,12 @@ impl Scene {
                 ));
             }
         }
-        let broken = checkpoint
-            .states
-            .iter()
-            .filter(|s| **s == SiteState::Broken)
-            .count();
-        if checkpoint.avalanche_ruptures > broken {
+        let bound = self
+            .contact_rule()
+            .avalanche_ruptures_bound(&checkpoint.states);
+        if checkpoint.avalanche_ruptures > bound {
             return bad(format!(
-                "{} ruptures in the avalanche under way, but {broken} broken sites",
+                "{} ruptures in the avalanche under way, but {bound} broken sites",
                 checkpoint.avalanche_ruptures
             ));
         }

@@ -7,6 +7,7 @@ use super::{
     check, contact_map_header, fields_header, first_level_at_or_above, level, CURVE_COLUMNS_1_1,
     CURVE_HEADER, EVENTS_HEADER, MAP_STEP,
 };
+use crate::contact::{ContactRule, Replay, SiteChange};
 use crate::driver::{Event, RowDifference, TableDigest};
 use crate::error::{Error, Result};
 use crate::interface::SiteState;
@@ -553,28 +554,27 @@ pub(super) fn fields_continuation(
 }
 
 /// Refuses a resumed driver whose site states (`states`, from its checkpoint) are not
-/// those the kept events of `events.csv` (`site_events`, read from `path`) leave: every
-/// site a rupture broke is broken and none broke twice, no other site is broken, and a
-/// site's last detachment or attachment left it detached or attached. A checkpoint
-/// forged with a recomputed digest (a broken site set back to attached) would otherwise
-/// run on and break a site twice.
+/// those the kept events of `events.csv` (`site_events`, read from `path`) leave under
+/// the run's contact rule (`rule`, [`Replay`]): under the paper's, every site a rupture
+/// broke is broken and none broke twice, no other site is broken, and a site's last
+/// detachment or attachment left it detached or attached. A checkpoint forged with a
+/// recomputed digest (a broken site set back to attached) would otherwise run on and
+/// break a site twice.
 pub(super) fn check_site_states(
+    rule: ContactRule,
     site_events: &[(usize, Event)],
     states: &[SiteState],
     path: &Path,
 ) -> Result<()> {
-    let mut left: Vec<Option<(SiteState, usize)>> = vec![None; states.len()];
+    let mut replay = Replay::new(rule, states.len());
     for &(line, event) in site_events {
-        let (site, state) = match event {
-            Event::Rupture { site, .. } => (site, SiteState::Broken),
-            Event::Detach { site } => (site, SiteState::Detached),
-            Event::Attach { site } => (site, SiteState::Attached),
+        let (site, change) = match event {
+            Event::Rupture { site, .. } => (site, SiteChange::Rupture),
+            Event::Detach { site } => (site, SiteChange::Detach),
+            Event::Attach { site } => (site, SiteChange::Attach),
             _ => continue,
         };
-        let Some(slot) = left.get_mut(site.index) else {
-            continue; // beyond the grid: refused by the row check already
-        };
-        if let Some((SiteState::Broken, broke)) = *slot {
+        if let Err(broke) = replay.apply(site.index, change, line) {
             return Err(Error::CorruptTable {
                 path: Some(path.to_path_buf()),
                 reason: format!(
@@ -586,19 +586,11 @@ pub(super) fn check_site_states(
                 ),
             });
         }
-        *slot = Some((state, line));
     }
-    for (i, (state, events)) in states.iter().zip(&left).enumerate() {
-        let expected = match events {
-            Some((s, _)) => Some(*s),
-            // No event for the site: any state but broken (its contact at zero shear is
-            // the normal equilibrium's).
-            None if *state == SiteState::Broken => Some(SiteState::Attached),
-            None => None,
-        };
-        if let Some(expected) = expected.filter(|e| e != state) {
-            let since = match events {
-                Some((_, line)) => {
+    for (i, state) in states.iter().enumerate() {
+        if let Some((expected, last)) = replay.mismatch(i, *state) {
+            let since = match last {
+                Some(line) => {
                     format!("line {line} of {} leaves it {expected:?}", path.display())
                 }
                 None => format!("no rupture of it is in {}", path.display()),

@@ -76,6 +76,13 @@ pub(crate) struct SolverState {
     backend: Backend,
     warm_normal: Vec<f64>,
     warm_tangential: Vec<f64>,
+    /// The anchors' tangential solve's warm start (`tangential.rs`): empty until one ran,
+    /// and then left out of a checkpoint's JSON, which stays the one 1.x writes.
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Vec::is_empty")
+    )]
+    warm_anchor: Vec<f64>,
     preconditioner_mean: Option<f64>,
     /// Dense backend: the normal factor.
     factor: Option<FactorState>,
@@ -189,6 +196,7 @@ impl EquilibriumSolverBuilder {
             core,
             warm_normal: Vec::new(),
             warm_tangential: Vec::new(),
+            warm_anchor: Vec::new(),
         })
     }
 }
@@ -249,6 +257,7 @@ pub struct EquilibriumSolver {
     core: Core,
     warm_normal: Vec<f64>,
     warm_tangential: Vec<f64>,
+    warm_anchor: Vec<f64>,
 }
 
 impl std::fmt::Debug for EquilibriumSolver {
@@ -328,6 +337,7 @@ impl EquilibriumSolver {
     pub fn reset(&mut self) {
         self.warm_normal.clear();
         self.warm_tangential.clear();
+        self.warm_anchor.clear();
         if let Core::Dense(d) = &mut self.core {
             d.normal.clear();
         }
@@ -352,6 +362,7 @@ impl EquilibriumSolver {
             backend: self.backend,
             warm_normal: self.warm_normal.clone(),
             warm_tangential: self.warm_tangential.clone(),
+            warm_anchor: self.warm_anchor.clone(),
             preconditioner_mean,
             factor,
         }
@@ -393,6 +404,17 @@ impl EquilibriumSolver {
                 ));
             }
         }
+        // The anchors' warm start: none until an anchored rule solved, then one per site.
+        let anchor = &state.warm_anchor;
+        if !(anchor.is_empty() || (solved && anchor.len() == n))
+            || !anchor.iter().all(|x| x.is_finite())
+        {
+            return bad(format!(
+                "the anchor warm start has {} values (expected none, or {n} finite ones \
+                 after the first solve)",
+                anchor.len()
+            ));
+        }
         if let Some(d) = state.preconditioner_mean {
             if !(d.is_finite() && d >= 0.0) {
                 return bad(format!(
@@ -413,6 +435,7 @@ impl EquilibriumSolver {
         }
         self.warm_normal = state.warm_normal;
         self.warm_tangential = state.warm_tangential;
+        self.warm_anchor = state.warm_anchor;
         Ok(())
     }
 

@@ -1,0 +1,161 @@
+//! Unit tests of the paper's contact rule, against values worked out by hand here.
+
+use super::*;
+use crate::geometry::{Block, Grid};
+use crate::interface::{Heights, SpringLaw};
+use SiteState::{Attached, Broken, Detached};
+
+/// Four 1 mm cells, heights 1 µm, every site attached.
+fn interface() -> Interface {
+    let grid = Grid::new(Block::new(0.004, 0.001, 0.005).unwrap(), 4, 1).unwrap();
+    let heights = Heights::from_values(&grid, vec![1e-6; 4]).unwrap();
+    Interface::new(grid, heights, SpringLaw::default()).unwrap()
+}
+
+/// The threshold: `μ f / |g|`, `+∞` at `g = ±0`, the same bits as the public
+/// `Interface::breaking_loads`; bad input refused with typed errors.
+#[test]
+fn breaking_loads_are_the_coulomb_rule() {
+    let interface = interface();
+    let (f, g) = ([1e3, 2e3, 0.0, 5.0], [10.0, -4.0, 3.0, -0.0]);
+    let loads = ContactRule::Paper
+        .breaking_loads(&interface, &f, &g, 0.5)
+        .unwrap();
+    // 0.5·1e3/10 = 50, 0.5·2e3/4 = 250, 0/3 = 0, and no shear: +∞.
+    assert_eq!(loads, vec![50.0, 250.0, 0.0, f64::INFINITY]);
+    let public = interface.breaking_loads(&f, &g, 0.5).unwrap();
+    assert!(loads
+        .iter()
+        .zip(&public)
+        .all(|(a, b)| a.to_bits() == b.to_bits()));
+    let rule = ContactRule::Paper;
+    assert!(matches!(
+        rule.breaking_loads(&interface, &f[..3], &g, 0.5),
+        Err(Error::LengthMismatch {
+            name: "normal_traction",
+            ..
+        })
+    ));
+    assert!(matches!(
+        rule.breaking_loads(&interface, &f, &[f64::NAN; 4], 0.5),
+        Err(Error::NonFinite {
+            name: "shear_per_newton",
+            ..
+        })
+    ));
+    for mu in [-0.1, f64::INFINITY, f64::NAN] {
+        assert!(matches!(
+            rule.breaking_loads(&interface, &f, &g, mu),
+            Err(Error::InvalidParameter {
+                name: "friction_coefficient",
+                ..
+            })
+        ));
+    }
+}
+
+/// The next threshold is the smallest finite load of an attached site; a site over it
+/// is one whose load is at or below the force; none when nothing is attached.
+#[test]
+fn weakest_and_over_threshold_look_at_attached_sites_only() {
+    let rule = ContactRule::Paper;
+    let states = [Attached, Detached, Attached, Broken];
+    let breaking = [7.0, 1.0, 3.0, 2.0];
+    assert_eq!(rule.weakest(&states, &breaking), Some((2, 3.0)));
+    assert_eq!(rule.weakest(&states, &[f64::INFINITY; 4]), None);
+    assert_eq!(
+        rule.weakest(&[Detached, Broken, Detached, Broken], &breaking),
+        None
+    );
+    // A tie keeps the first site.
+    assert_eq!(rule.weakest(&states, &[3.0, 1.0, 3.0, 2.0]), Some((0, 3.0)));
+    assert_eq!(rule.first_over_threshold(&states, &breaking, 2.9), None);
+    assert_eq!(rule.first_over_threshold(&states, &breaking, 3.0), Some(2));
+    assert_eq!(rule.first_over_threshold(&states, &breaking, 10.0), Some(0));
+}
+
+/// The next rupture is the site over threshold (or forced) of largest energy
+/// `½ φ² ΔA / k_x` with `k_x = c_x e^{-u_z/u0}`, worked out here; none once no site is
+/// over threshold.
+#[test]
+fn the_site_of_largest_energy_breaks_first() {
+    let mut interface = interface();
+    let rule = ContactRule::Paper;
+    let cell = 1e-6; // m²
+    let u_z = [0.0, 0.0, 1e-6, 0.0];
+    let traction = [1e6, 2e6, 1.5e6, 4e6]; // Pa/N
+    let breaking = [0.5, 0.5, 0.5, 5.0]; // N
+    let energy = |i: usize, force: f64| {
+        let phi = force * traction[i];
+        let k_x = SpringLaw::default().c_x() * (-u_z[i] / 1e-6_f64).exp();
+        0.5 * phi * phi * cell / k_x
+    };
+    // At F = 1 N sites 0-2 are over; site 2's compliance is e times larger, so 1.5² e =
+    // 6.1 beats 2² = 4: site 2. Site 3 carries the most but is under its threshold.
+    let (i, e) = rule
+        .next_rupture(&interface, &breaking, 1.0, None, &traction, &u_z, cell)
+        .unwrap()
+        .unwrap();
+    assert_eq!(i, 2);
+    assert!((e / energy(2, 1.0) - 1.0).abs() < 1e-12, "{e} J");
+    // Forced in, site 3 (16 against 6.1) breaks first.
+    let (i, _) = rule
+        .next_rupture(&interface, &breaking, 1.0, Some(3), &traction, &u_z, cell)
+        .unwrap()
+        .unwrap();
+    assert_eq!(i, 3);
+    // Broken and detached sites never break; under every threshold, none does.
+    interface
+        .set_states(&[Attached, Detached, Attached, Attached])
+        .unwrap();
+    interface.break_site(2).unwrap();
+    let next = rule.next_rupture(&interface, &breaking, 1.0, None, &traction, &u_z, cell);
+    assert_eq!(next.unwrap().map(|(i, _)| i), Some(0));
+    let next = rule.next_rupture(&interface, &breaking, 0.4, None, &traction, &u_z, cell);
+    assert_eq!(next.unwrap(), None);
+}
+
+/// Global slip is every site broken; the attach and detach events of an equilibrium are
+/// its changes into and out of the contact, in site order, and nothing else.
+#[test]
+fn global_slip_and_the_changes_of_an_equilibrium() {
+    let mut interface = interface();
+    let rule = ContactRule::Paper;
+    for i in 0..4 {
+        assert!(!rule.global_slip(&interface));
+        interface.break_site(i).unwrap();
+    }
+    assert!(rule.global_slip(&interface));
+    let before = [Attached, Detached, Attached, Broken, Detached];
+    let after = [Detached, Attached, Attached, Broken, Detached];
+    let mut seen = Vec::new();
+    rule.changes(&before, &after, |i, attached| seen.push((i, attached)));
+    assert_eq!(seen, vec![(0, false), (1, true)]);
+    assert_eq!(rule.avalanche_ruptures_bound(&before), 1);
+}
+
+/// The replay of a run's site events: under the paper's rule any change of a broken
+/// site is refused, naming the rupture's tag; the states the events leave are the only
+/// ones that fit, and a site no event touched may be anything but broken.
+#[test]
+fn a_broken_site_never_changes_again() {
+    let rule = ContactRule::Paper;
+    for change in [SiteChange::Rupture, SiteChange::Detach, SiteChange::Attach] {
+        let mut replay = Replay::new(rule, 3);
+        replay.apply(0, SiteChange::Detach, 10).unwrap();
+        replay.apply(0, SiteChange::Attach, 11).unwrap();
+        replay.apply(0, SiteChange::Rupture, 12).unwrap();
+        assert_eq!(replay.apply(0, change, 13), Err(12));
+    }
+    let mut replay = Replay::new(rule, 3);
+    replay.apply(0, SiteChange::Rupture, 5).unwrap();
+    replay.apply(1, SiteChange::Detach, 6).unwrap();
+    replay.apply(7, SiteChange::Rupture, 8).unwrap(); // beyond the grid: the row checks'
+    assert_eq!(replay.mismatch(0, Broken), None);
+    assert_eq!(replay.mismatch(0, Attached), Some((Broken, Some(5))));
+    assert_eq!(replay.mismatch(1, Detached), None);
+    assert_eq!(replay.mismatch(1, Attached), Some((Detached, Some(6))));
+    assert_eq!(replay.mismatch(2, Attached), None);
+    assert_eq!(replay.mismatch(2, Detached), None);
+    assert_eq!(replay.mismatch(2, Broken), Some((Attached, None)));
+}
