@@ -151,7 +151,7 @@ impl Slip {
             // A driving spring is not the work-conjugate of the lateral load it exerts
             // (the paper ties it to ⟨u_x⟩): no exact balance (docs/statistics.md).
             released: (a.load_before.drive_displacement.is_none() && f0 == f1)
-                .then(|| 0.5 * f0 * f0 * (c1 - c0)),
+                .then_some(0.5 * f0 * f0 * (c1 - c0)),
         }
     }
 }
