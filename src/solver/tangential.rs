@@ -9,6 +9,7 @@
 //! `Σ = 0`). The paper's springs are anchored at 0 and need only `g1`.
 
 use super::options::{SolveReport, TangentialResponse};
+use super::pcg::PcgOutcome;
 use super::set::{SetProblem, SetSolve};
 use super::{EquilibriumSolver, SolveKind};
 use crate::error::{check_slice, Error, Result};
@@ -81,16 +82,7 @@ impl EquilibriumSolver {
             traction,
             displacement,
             offset_per_newton: offset - self.compliance.scale * self.compliance.shift * sum,
-            report: SolveReport {
-                backend: self.backend,
-                active_set_iterations: 1,
-                linear_iterations: solved.outcome.iterations,
-                flips: 0,
-                residual: solved.outcome.residual,
-                force_balance_error: (sum * self.grid.cell_area() + 1.0).abs(),
-                complementarity: 0.0,
-                fallback: false,
-            },
+            report: self.set_report(&solved.outcome, (sum * self.grid.cell_area() + 1.0).abs()),
         })
     }
 
@@ -148,17 +140,22 @@ impl EquilibriumSolver {
             traction,
             displacement,
             offset: offset - self.compliance.scale * self.compliance.shift * sum,
-            report: SolveReport {
-                backend: self.backend,
-                active_set_iterations: 1,
-                linear_iterations: solved.outcome.iterations,
-                flips: 0,
-                residual: solved.outcome.residual,
-                force_balance_error: (sum * self.grid.cell_area()).abs(),
-                complementarity: 0.0,
-                fallback: false,
-            },
+            report: self.set_report(&solved.outcome, (sum * self.grid.cell_area()).abs()),
         })
+    }
+
+    /// The report of one linear set solve (no active-set iterations beyond the one set).
+    fn set_report(&self, outcome: &PcgOutcome, force_balance_error: f64) -> SolveReport {
+        SolveReport {
+            backend: self.backend,
+            active_set_iterations: 1,
+            linear_iterations: outcome.iterations,
+            flips: 0,
+            residual: outcome.residual,
+            force_balance_error,
+            complementarity: 0.0,
+            fallback: false,
+        }
     }
 
     /// The set solve both tangential solves share (on an interface the caller checked):
