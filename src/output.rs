@@ -519,6 +519,36 @@ impl RunTables {
     /// recorded (its `fields.csv`, `profiles.csv` and `scene.json`): a resume continues
     /// every recorded table or none.
     ///
+    /// ```
+    /// # #[cfg(feature = "serde")] {
+    /// use precursors::{output::RunTables, Event, RunOptions, Scene};
+    /// use std::ops::ControlFlow;
+    /// let dir = std::env::temp_dir().join(format!("precursors-doc-resume-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// let scene = Scene::builder().block(0.012, 0.002, 0.010).normal_load(50.0).seed(0).build()?;
+    /// // The stresses 2 mm above the interface at every stable state, beside the tables.
+    /// let options = RunOptions::new().record_fields(1, &[0.002]);
+    /// let mut driver = scene.driver_with(&options)?;
+    /// let mut tables = RunTables::create_with(&dir, &driver, &options)?;
+    /// // Stop at the fifth stable state and take a checkpoint there.
+    /// let mut stable = 0;
+    /// tables.run_until(&mut driver, None, |event, _| match event {
+    ///     Event::Stable { .. } if { stable += 1; stable == 5 } => ControlFlow::Break(()),
+    ///     _ => ControlFlow::Continue(()),
+    /// })?;
+    /// let checkpoint = tables.checkpoint(&driver)?;
+    /// drop(tables);
+    /// // Later, maybe in another process: the driver and the tables continued.
+    /// let mut resumed = scene.resume_with(&checkpoint, &options)?;
+    /// let tables = RunTables::resume_with(&dir, &resumed, &options)?;
+    /// assert!(tables.fields_path().unwrap().ends_with("fields.csv"));
+    /// tables.run_to_slip(&mut resumed, None, |_, _| {})?;
+    /// assert!(dir.join("fields.csv").is_file());
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # }
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    ///
     /// # Errors
     /// [`Error::OutOfRange`] for options the scene cannot record;
     /// [`Error::RunDirectory`] for a missing directory or (feature `serde`) one without
@@ -621,7 +651,8 @@ impl RunTables {
 
     /// The path of `fields.csv` (written as `fields.csv.partial` until
     /// [`RunTables::finish`]), `None` when the scene records no fields
-    /// ([`crate::SceneBuilder::record_fields`]).
+    /// ([`crate::SceneBuilder::record_fields`]); [`RunTables::resume_with`]'s example
+    /// reads it.
     pub fn fields_path(&self) -> Option<&Path> {
         self.fields.as_ref().map(|f| f.path.as_path())
     }

@@ -42,8 +42,8 @@ mod special;
 
 pub use alternatives::LikelihoodRatio;
 pub use scaling::{
-    binned_means, classes_excluded, fit_collapse, fit_scaling, BinnedMean, Collapse, ScalingFit,
-    UniversalityClass, UNIVERSALITY_CLASSES,
+    binned_means, classes_excluded, fit_collapse, fit_cutoff_scaling, fit_scaling, BinnedMean,
+    Collapse, CutoffScaling, ScalingFit, UniversalityClass, UNIVERSALITY_CLASSES,
 };
 
 /// Whether samples are integers (counts: the ruptures of an avalanche) or reals (a force
@@ -146,6 +146,16 @@ impl PowerLawOptions {
 
 /// The fit of `p(x) ∝ x^(-α)` for `x ≥ x_min` ([`fit_power_law`]). Values of `x` are in
 /// the samples' unit (N for force drops, a count for avalanche sizes).
+///
+/// ```
+/// use precursors::statistics::{fit_power_law, PowerLawOptions, Support};
+/// // Reals spread as x^-2.5 above 1: the quantiles (1 - u)^(-1/1.5).
+/// let x: Vec<f64> = (0..2000).map(|i| (1.0 - (i as f64 + 0.5) / 2000.0).powf(-1.0 / 1.5)).collect();
+/// let fit = fit_power_law(&x, Support::Continuous, &PowerLawOptions::default().bootstrap(0).goodness_samples(0))?;
+/// assert!(fit.tail <= fit.samples && fit.x_min >= 1.0);
+/// assert!((fit.alpha - 2.5).abs() < 0.1, "{}", fit.alpha);
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[non_exhaustive]
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -353,6 +363,15 @@ impl Comparison {
 }
 
 /// One bin of a log-binned histogram ([`log_binned`]). Values are in the samples' unit.
+///
+/// ```
+/// use precursors::statistics::{log_binned, Support};
+/// // Counts 1, 1, 2 and 10, one bin per decade: [1, 10) holds the integers 1 to 9.
+/// let bins = log_binned(&[1.0, 1.0, 2.0, 10.0], Support::Discrete, 1)?;
+/// assert_eq!((bins[0].low, bins[0].high, bins[0].count), (1.0, 10.0, 3));
+/// assert!((bins[0].density - 3.0 / 4.0 / 9.0).abs() < 1e-15); // a share per integer
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[non_exhaustive]
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]

@@ -775,7 +775,9 @@ fn stats_collapse_a_sweep_along_a_length() {
     // A sweep over block.lx at fixed cells and pressure: collapse.csv holds the fit of
     // `statistics::fit_collapse` to the sizes of each length's runs as this test reads
     // them from events.csv (before the spanning avalanche), grouped by run.
-    use precursors::statistics::{fit_collapse, PowerLawOptions, Support};
+    use precursors::statistics::{
+        compare_alternatives, fit_collapse, fit_cutoff_scaling, PowerLawOptions, Support,
+    };
     use precursors::sweep::{statistics, StatsOptions, Sweep, SweepOptions};
     let dir = scratch("lengths");
     let sweep = Sweep::from_json_str(
@@ -800,6 +802,7 @@ fn stats_collapse_a_sweep_along_a_length() {
     assert!(summary.files.iter().any(|f| f.ends_with("collapse.csv")));
     let rows = table(&dir.join("collapse.csv"));
     assert_eq!(rows.len(), 2);
+    let mut growths = 0;
     for (row, flash) in rows.iter().zip([false, true]) {
         let mut sets: Vec<(f64, Vec<Vec<f64>>)> = [0.02, 0.04, 0.08]
             .iter()
@@ -832,7 +835,38 @@ fn stats_collapse_a_sweep_along_a_length() {
         }
         assert_eq!(num(row, "overlaps") as usize, c.overlaps);
         assert!(c.overlaps > 0);
+        // The cut-off's growth: the cut-off law of each length's pooled sizes (as
+        // compare_alternatives fits it on this test's reading), through fit_cutoff_scaling.
+        let (lengths, fits): (Vec<f64>, Vec<_>) = sets
+            .iter()
+            .filter_map(|(l, runs)| {
+                let pooled: Vec<f64> = runs.concat();
+                compare_alternatives(&pooled, Support::Discrete, &fit)
+                    .ok()
+                    .map(|c| (*l, c.cutoff))
+            })
+            .unzip();
+        match fit_cutoff_scaling(&lengths, &fits, 0.95) {
+            Ok(g) => {
+                growths += 1;
+                assert_eq!(num(row, "cutoff_lengths") as usize, g.lengths);
+                for (column, value) in [
+                    ("cutoff_exponent", g.exponent),
+                    ("cutoff_exponent_low", g.exponent_low),
+                    ("cutoff_exponent_high", g.exponent_high),
+                    ("cutoff_prefactor", g.prefactor),
+                ] {
+                    assert!(
+                        (num(row, column) - value).abs() <= 1e-11 * value.abs().max(1.0),
+                        "{column}: {row:?}"
+                    );
+                }
+            }
+            Err(_) => assert_eq!(row["cutoff_exponent"], "", "{row:?}"),
+        }
     }
+    // At least one row fits the cut-off's growth, so the columns are checked.
+    assert!(growths > 0);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -563,6 +563,163 @@ pub fn fit_collapse(
     })
 }
 
+/// How the cut-off scale of the size distribution grows with the system's size
+/// ([`fit_cutoff_scaling`]): `s_c ≈ c L^β`.
+#[non_exhaustive]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct CutoffScaling {
+    /// The lengths fitted: those whose cut-off and interval are finite and positive.
+    pub lengths: usize,
+    /// The exponent `β` (dimensionless; `L` in metres): the weighted least-squares slope of
+    /// `ln s_c` on `ln L`. The collapse's `D` estimates the same exponent.
+    pub exponent: f64,
+    /// Lower end of its interval `β - z σ_β` at the confidence given (see
+    /// [`fit_cutoff_scaling`] for `σ_β`); equal to `exponent` with two lengths whose
+    /// intervals are degenerate.
+    pub exponent_low: f64,
+    /// Upper end `β + z σ_β`.
+    pub exponent_high: f64,
+    /// The prefactor `c` (the samples' unit over metres to the `β`).
+    pub prefactor: f64,
+    /// `χ²` per degree of freedom of the weighted fit (dimensionless; about 1 when the
+    /// lengths' intervals account for their scatter); `None` with two lengths.
+    pub chi2_per_dof: Option<f64>,
+}
+
+/// Fits `s_c ≈ c L^β` to the cut-off scales of one size observable at several system
+/// sizes `L` (m): `fits[k]` is the cut-off law fitted at `lengths[k]` (from
+/// [`compare_alternatives`](super::compare_alternatives)), with its percentile bootstrap
+/// interval `[cutoff_low, cutoff_high]` at level `confidence`.
+///
+/// Each interval is read as a normal error on `ln s_c`, `σ_k = (ln high - ln low)/(2z)`
+/// with `z` the normal quantile of `confidence` (1.96 at 0.95); `β` and `ln c` are the
+/// weighted least-squares line through `(ln L, ln s_c)` with weights `1/σ_k²`, and
+/// `σ_β = (Σ w (ln L - mean)²)^(-1/2)`, multiplied by `√(χ²/dof)` when that exceeds 1
+/// (the intervals then understate the scatter). Lengths whose cut-off or interval is not
+/// finite and positive (a pure power law as likely as any cut-off, `λ = 0`) are left out;
+/// a degenerate interval (`low = high`, no resamples) gives every length weight 1.
+///
+/// ```
+/// use precursors::statistics::{compare_alternatives, fit_cutoff_scaling, PowerLawOptions, Support};
+/// // Sizes spread as S^-1.5 e^(-S/s_c) with s_c = 2000 L^1.5: 37, 105, 296 ruptures.
+/// let draw = |s_c: f64| -> Vec<f64> {
+///     let (mut x, mut out) = (1.0f64, Vec::new());
+///     for i in 1..3000u32 {
+///         let u = ((i as f64) * 0.618034).fract();
+///         x = (1.0 - u).powf(-1.0 / 0.5); // Pareto with τ = 1.5
+///         if ((i as f64) * 0.414214).fract() < (-x / s_c).exp() { out.push(x.floor()); }
+///     }
+///     out
+/// };
+/// let options = PowerLawOptions::default().bootstrap(20).goodness_samples(0);
+/// let lengths = [0.07f64, 0.14, 0.28];
+/// let fits: Vec<_> = lengths.iter()
+///     .map(|&l| compare_alternatives(&draw(2000.0 * l * l.sqrt()), Support::Discrete, &options)
+///         .map(|c| c.cutoff))
+///     .collect::<Result<_, _>>()?;
+/// let s = fit_cutoff_scaling(&lengths, &fits, 0.95)?;
+/// assert!(s.lengths <= 3 && s.exponent_low <= s.exponent && s.exponent <= s.exponent_high);
+/// assert!((s.exponent - 1.5).abs() < 0.05, "{s:?}");
+/// # Ok::<(), precursors::Error>(())
+/// ```
+///
+/// # Errors
+/// [`Error::InvalidCount`] (`"fits"`) when `lengths` and `fits` differ in length;
+/// [`Error::InvalidParameter`] (`"length"`) for a length that is not finite and positive
+/// or that repeats, (`"confidence"`) for a level not strictly between 0 and 1;
+/// [`Error::TooFewSamples`] (`"cut-off scaling"`) for fewer than two lengths with a
+/// finite cut-off.
+pub fn fit_cutoff_scaling(
+    lengths: &[f64],
+    fits: &[super::CutoffFit],
+    confidence: f64,
+) -> Result<CutoffScaling> {
+    if lengths.len() != fits.len() {
+        return Err(Error::InvalidCount {
+            name: "fits",
+            value: fits.len() as u64,
+            reason: "one cut-off fit per length",
+        });
+    }
+    for (k, l) in lengths.iter().enumerate() {
+        if !(l.is_finite() && *l > 0.0) || lengths[..k].contains(l) {
+            return Err(Error::InvalidParameter {
+                name: "length",
+                value: *l,
+                reason: "the sizes of a cut-off scaling must be finite, positive and distinct",
+            });
+        }
+    }
+    if !(confidence > 0.0 && confidence < 1.0) {
+        return Err(Error::InvalidParameter {
+            name: "confidence",
+            value: confidence,
+            reason: "a confidence level lies strictly between 0 and 1",
+        });
+    }
+    let z = normal_quantile(confidence);
+    let usable = |v: f64| v.is_finite() && v > 0.0;
+    // (ln L, ln s_c, σ of ln s_c)
+    let points: Vec<(f64, f64, f64)> = lengths
+        .iter()
+        .zip(fits)
+        .filter(|(_, f)| usable(f.cutoff) && usable(f.cutoff_low) && usable(f.cutoff_high))
+        .map(|(l, f)| {
+            let sigma = (f.cutoff_high.ln() - f.cutoff_low.ln()) / (2.0 * z);
+            (l.ln(), f.cutoff.ln(), sigma)
+        })
+        .collect();
+    if points.len() < 2 {
+        return Err(Error::TooFewSamples {
+            what: "cut-off scaling",
+            count: points.len(),
+            needed: 2,
+        });
+    }
+    let degenerate = points.iter().any(|p| p.2 <= 0.0);
+    let w: Vec<f64> = points
+        .iter()
+        .map(|p| if degenerate { 1.0 } else { p.2.powi(-2) })
+        .collect();
+    let sw: f64 = w.iter().sum();
+    let mx = points.iter().zip(&w).map(|(p, w)| w * p.0).sum::<f64>() / sw;
+    let my = points.iter().zip(&w).map(|(p, w)| w * p.1).sum::<f64>() / sw;
+    let sxx: f64 = points
+        .iter()
+        .zip(&w)
+        .map(|(p, w)| w * (p.0 - mx).powi(2))
+        .sum();
+    let sxy: f64 = points
+        .iter()
+        .zip(&w)
+        .map(|(p, w)| w * (p.0 - mx) * (p.1 - my))
+        .sum();
+    let slope = sxy / sxx;
+    let intercept = my - slope * mx;
+    let dof = points.len() - 2;
+    let chi2: f64 = points
+        .iter()
+        .zip(&w)
+        .map(|(p, w)| w * (p.1 - intercept - slope * p.0).powi(2))
+        .sum();
+    let chi2_per_dof = (dof > 0).then(|| chi2 / dof as f64);
+    let half = if degenerate && dof == 0 {
+        0.0
+    } else {
+        let birge = chi2_per_dof.map_or(1.0, |c| if degenerate { c } else { c.max(1.0) });
+        z * (birge / sxx).sqrt()
+    };
+    Ok(CutoffScaling {
+        lengths: points.len(),
+        exponent: slope,
+        exponent_low: slope - half,
+        exponent_high: slope + half,
+        prefactor: intercept.exp(),
+        chi2_per_dof,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::{fit_power_law, PowerLawOptions};
@@ -773,6 +930,79 @@ mod tests {
         assert!(matches!(
             fit_collapse(&twice, Support::Continuous, 5, &options),
             Err(Error::InvalidParameter { name: "length", .. })
+        ));
+    }
+
+    /// A cut-off law fit with only the fields [`fit_cutoff_scaling`] reads set.
+    fn cutoff_fit(cutoff: f64, low: f64, high: f64) -> super::super::CutoffFit {
+        super::super::CutoffFit {
+            alpha: 1.5,
+            lambda: 1.0 / cutoff,
+            cutoff,
+            alpha_low: 1.5,
+            alpha_high: 1.5,
+            cutoff_low: low,
+            cutoff_high: high,
+            log_likelihood: 0.0,
+        }
+    }
+
+    #[test]
+    fn the_cutoff_scaling_is_the_weighted_line_through_the_lengths() {
+        // s_c = 3 (L/0.035)^1.2 e^noise with log-normal intervals of σ 0.3, 0.2, 0.25,
+        // 0.4. Reference: the normal equations solved by Cramer's rule in plain Python
+        // (statistics.NormalDist for z), not this module's centred sums.
+        let lengths = [0.035, 0.07, 0.14, 0.28];
+        let fits = [
+            cutoff_fit(3.315512754226943, 1.8415785166101493, 5.96913176619588),
+            cutoff_fit(5.932163019913744, 4.008415830124776, 8.7791685259702),
+            cutoff_fit(16.64592633642069, 10.197825648772747, 27.17117090846614),
+            cutoff_fit(44.431209478196706, 20.2865183527516, 97.31252753026651),
+        ];
+        let s = fit_cutoff_scaling(&lengths, &fits, 0.95).unwrap();
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-9 * b.abs().max(1.0);
+        assert_eq!(s.lengths, 4);
+        assert!(close(s.exponent, 1.2726834443774477), "{s:?}");
+        assert!(close(s.prefactor, 198.28070104165008), "{s:?}");
+        assert!(close(s.chi2_per_dof.unwrap(), 0.4192761156186608), "{s:?}");
+        // χ²/dof < 1: the intervals alone.
+        assert!(close(s.exponent_low, 0.8599238293658017), "{s:?}");
+        assert!(close(s.exponent_high, 1.685443059389094), "{s:?}");
+        // The same cut-offs with σ = 0.05 each: χ²/dof = 10.5 widens the interval.
+        let z: f64 = 1.959963984540054;
+        let tight: Vec<_> = fits
+            .iter()
+            .map(|f| {
+                cutoff_fit(
+                    f.cutoff,
+                    f.cutoff * (-0.05 * z).exp(),
+                    f.cutoff * (0.05 * z).exp(),
+                )
+            })
+            .collect();
+        let t = fit_cutoff_scaling(&lengths, &tight, 0.95).unwrap();
+        assert!(close(t.exponent, 1.2721347520444508), "{t:?}");
+        assert!((t.chi2_per_dof.unwrap() - 10.5).abs() < 1e-6, "{t:?}");
+        assert!((t.exponent_low - 1.0672534706549188).abs() < 1e-6, "{t:?}");
+        assert!((t.exponent_high - 1.4770160334339828).abs() < 1e-6, "{t:?}");
+        // A length without a cut-off (λ = 0) is left out; one left is too few.
+        let mut open = fits.clone();
+        open[1] = cutoff_fit(f64::INFINITY, 10.0, f64::INFINITY);
+        assert_eq!(
+            fit_cutoff_scaling(&lengths, &open, 0.95).unwrap().lengths,
+            3
+        );
+        assert!(matches!(
+            fit_cutoff_scaling(&lengths[..2], &open[..2], 0.95),
+            Err(Error::TooFewSamples { .. })
+        ));
+        assert!(matches!(
+            fit_cutoff_scaling(&[0.1, 0.1], &fits[..2], 0.95),
+            Err(Error::InvalidParameter { name: "length", .. })
+        ));
+        assert!(matches!(
+            fit_cutoff_scaling(&lengths, &fits[..3], 0.95),
+            Err(Error::InvalidCount { name: "fits", .. })
         ));
     }
 }

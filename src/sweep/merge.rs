@@ -76,6 +76,14 @@ fn t_quantile_975(df: usize) -> f64 {
 
 /// The mean of a sample and the two-sided 95 % Student-t band of the mean
 /// ([`mean_band`]), in the units of the sample.
+///
+/// ```
+/// use precursors::sweep::mean_band;
+/// let band = mean_band(&[2.0, 4.0]); // t(1) = 12.706, s/√n = 1
+/// assert_eq!(band.mean, 3.0);
+/// assert!((band.hi - band.mean - 12.706).abs() < 1e-3 && band.mean - band.lo == band.hi - band.mean);
+/// assert!(mean_band(&[2.0]).lo.is_nan()); // no band from one value
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct Band {

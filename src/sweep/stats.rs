@@ -12,9 +12,9 @@ use crate::output::check::RunRecord;
 use crate::output::derived::{derive, Slip};
 use crate::output::layout::{BINNED_MEANS, COLLAPSE, DISTRIBUTIONS, POWER_LAWS, SCALING};
 use crate::statistics::{
-    binned_means, classes_excluded, compare_alternatives_with, fit_collapse, fit_power_law,
-    fit_scaling, log_binned, whole_fits, Comparison, LikelihoodRatio, PowerLawFit, PowerLawOptions,
-    Support,
+    binned_means, classes_excluded, compare_alternatives_with, fit_collapse, fit_cutoff_scaling,
+    fit_power_law, fit_scaling, log_binned, whole_fits, Comparison, CutoffFit, LikelihoodRatio,
+    PowerLawFit, PowerLawOptions, Support,
 };
 
 /// A row's fit: with its alternatives, or the power law alone where they cannot be
@@ -59,6 +59,15 @@ impl StatsOptions {
     }
 
     /// Bins per decade of the distributions.
+    ///
+    /// ```
+    /// use precursors::sweep::{statistics, StatsOptions};
+    /// assert_eq!(StatsOptions::default().bins_per_decade(10).bins_per_decade, 10);
+    /// // Zero bins is refused by `statistics` before any directory is read.
+    /// let zero = StatsOptions::default().bins_per_decade(0);
+    /// let error = statistics(std::path::Path::new("."), &zero).unwrap_err();
+    /// assert!(error.to_string().contains("bins_per_decade"), "{error}");
+    /// ```
     pub fn bins_per_decade(mut self, bins: usize) -> Self {
         self.bins_per_decade = bins;
         self
@@ -77,7 +86,7 @@ impl StatsOptions {
     }
 }
 
-/// What [`statistics`] wrote.
+/// What [`statistics`] wrote (its example reads one: points, runs and the files).
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct StatsSummary {
@@ -581,6 +590,8 @@ pub fn statistics_with_progress(
     // vary with it): each point's sizes per run, for the collapse.
     let length_axis = length_axis(&keys, &points);
     let mut sizes_by_length: Vec<(f64, [Vec<Vec<f64>>; 2])> = Vec::new();
+    // Each length's cut-off law of the two size observables (None where not compared).
+    let mut cutoffs_by_length: Vec<[Option<CutoffFit>; 2]> = Vec::new();
     let mut runs = 0;
     for (index, point) in points.iter().enumerate() {
         let values: String = point
@@ -607,6 +618,7 @@ pub fn statistics_with_progress(
             // The axis' value is a length in metres (the scene's unit).
             let length = point.values[*k].1.parse::<f64>().unwrap_or(f64::NAN);
             sizes_by_length.push((length, per_run));
+            cutoffs_by_length.push([None, None]);
         }
         runs += point.runs();
         let enough = |x: &Vec<f64>| {
@@ -658,6 +670,12 @@ pub fn statistics_with_progress(
             );
             if let Some(Fit::Compared(c)) = &fit {
                 verdicts.push(format!("point {index}, {name}: {}", c.verdict()));
+                let slot = [0, 7].iter().position(|o| OBSERVABLES[*o].0 == *name);
+                if let (Some(k), Some(last)) = (slot, cutoffs_by_length.last_mut()) {
+                    if length_axis.is_some() {
+                        last[k] = Some(c.cutoff.clone());
+                    }
+                }
             }
             if let Some(f) = &fit {
                 let pl = match f {
@@ -755,7 +773,13 @@ pub fn statistics_with_progress(
     write_atomically(&files[2], means.as_bytes(), "writing table")?;
     write_atomically(&files[3], scaling.as_bytes(), "writing table")?;
     if let Some((axis, _)) = &length_axis {
-        let table = collapse_table(axis, &sizes_by_length, options, &mut scaling_lines)?;
+        let table = collapse_table(
+            axis,
+            &sizes_by_length,
+            &cutoffs_by_length,
+            options,
+            &mut scaling_lines,
+        )?;
         files.push(dir.join(COLLAPSE));
         write_atomically(&files[4], table.as_bytes(), "writing table")?;
     }
@@ -790,15 +814,18 @@ fn length_axis(keys: &[String], points: &[Point]) -> Option<(String, usize)> {
 
 /// `collapse.csv`: for the sizes with and without flash ruptures, the finite-size
 /// collapse over the points of a sweep along `axis` (`block.lx` or `block.ly`), from each
-/// point's sizes per run; its line in words pushed onto `lines`.
+/// point's sizes per run, and the growth of each point's cut-off scale with the length
+/// (`cutoffs`, per point); their lines in words pushed onto `lines`.
 fn collapse_table(
     axis: &str,
     sets: &[(f64, [Vec<Vec<f64>>; 2])],
+    cutoffs: &[[Option<CutoffFit>; 2]],
     options: &StatsOptions,
     lines: &mut Vec<String>,
 ) -> Result<String> {
     let mut table = "axis,observable,lengths,tau,tau_low,tau_high,d,d_low,d_high,spread,\
-                     overlaps,confidence\n"
+                     overlaps,cutoff_lengths,cutoff_exponent,cutoff_exponent_low,\
+                     cutoff_exponent_high,cutoff_prefactor,cutoff_chi2_per_dof,confidence\n"
         .to_string();
     for (k, name) in [(0, OBSERVABLES[0].0), (1, OBSERVABLES[7].0)] {
         let by_length: Vec<(f64, Vec<Vec<f64>>)> =
@@ -825,9 +852,34 @@ fn collapse_table(
             Err(Error::TooFewSamples { .. }) => ",,,,,,,".to_string(),
             Err(e) => return Err(e),
         };
+        // The lengths whose cut-off law was fitted, and those fits.
+        let (lengths, fits): (Vec<f64>, Vec<CutoffFit>) = sets
+            .iter()
+            .zip(cutoffs)
+            .filter_map(|((l, _), c)| c[k].clone().map(|c| (*l, c)))
+            .unzip();
+        let growth = match fit_cutoff_scaling(&lengths, &fits, options.fit.confidence) {
+            Ok(g) => {
+                lines.push(format!(
+                    "{name} cut-off against {axis}: s_c ∝ L^{:.2} [{:.2}, {:.2}] over {} lengths",
+                    g.exponent, g.exponent_low, g.exponent_high, g.lengths
+                ));
+                format!(
+                    "{},{},{},{},{},{}",
+                    g.lengths,
+                    num(g.exponent),
+                    num(g.exponent_low),
+                    num(g.exponent_high),
+                    num(g.prefactor),
+                    g.chi2_per_dof.map(num).unwrap_or_default()
+                )
+            }
+            Err(Error::TooFewSamples { count, .. }) => format!("{count},,,,,"),
+            Err(e) => return Err(e),
+        };
         let _ = writeln!(
             table,
-            "{},{name},{},{cells},{}",
+            "{},{name},{},{cells},{growth},{}",
             cell(axis),
             sets.len(),
             num(options.fit.confidence)
