@@ -551,7 +551,12 @@ fn estimate_table(studies: &[Study], estimates: &[Option<Estimate>]) -> String {
         out += &estimate_row(name, e.as_ref(), columns);
         out.push('\n');
     }
-    if !extrapolated {
+    if extrapolated {
+        out += &format!(
+            "\n(Not resolved: fewer than {:.0} % of the resamples resolved.)\n",
+            100.0 * RESOLVED_SHARE
+        );
+    } else {
         out += "\n(No order and no limit: a new surface on every grid, whose correlation length is the cell.)\n";
     }
     out
