@@ -26,9 +26,9 @@
 //!   (ℓ/Lx against `F/(μF_N)`, ensemble mean and 95 % band per cell size, `curves.csv`),
 //!   `convergence_SLUG_thresholds.png` (the threshold loads against `h` with their
 //!   intervals, and the Richardson limit at `h` = 0 where it is established with a
-//!   bounded interval) and `convergence_SLUG_avalanches.png` (the fraction of avalanches at least as
-//!   large as a slipped area, ruptures x cell area, pooled over the realizations,
-//!   log-log).
+//!   bounded interval) and `convergence_SLUG_avalanches.png` (the fraction of avalanches
+//!   at least as large as a slipped area, ruptures x cell area, pooled over the
+//!   realizations, log-log).
 //!
 //! Run: `cargo run --release --features plot --example convergence_figures -- OUTDIR
 //! [FIGDIR]`. Its arithmetic is unit-tested:
@@ -450,7 +450,9 @@ fn paired(studies: &[Study]) -> bool {
 /// so its grids share no limit.
 fn estimates(studies: &[Study]) -> Option<Vec<Option<Estimate>>> {
     let name = &studies[0].heights;
-    if studies.len() < 3 || !(studies[0].h() > studies[1].h() && studies[1].h() > studies[2].h()) {
+    let decreasing =
+        studies.len() >= 3 && studies[0].h() > studies[1].h() && studies[1].h() > studies[2].h();
+    if !decreasing {
         eprintln!("note: {name}: fewer than three cell sizes, no extrapolation");
         return None;
     }

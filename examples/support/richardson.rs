@@ -5,9 +5,9 @@
 //! `h = √(ΔxΔy)` (a cell that is refined by different ratios along x and y, as
 //! 2 x 1.75 mm → 1 mm, is refined by the ratio of the square roots of the cell areas), is
 //! modelled as `Q(h) = Q∞ + C hᵖ`. With the differences `D₁₂ = Q₁ − Q₂` and
-//! `D₂₃ = Q₂ − Q₃`, the order solves `D₁₂/D₂₃ = (h₁ᵖ − h₂ᵖ)/(h₂ᵖ − h₃ᵖ)`; for a constant
-//! ratio `r` that is `rᵖ = D₁₂/D₂₃`, otherwise it is solved by bisection (the right-hand
-//! side increases with `p`, from `ln(h₁/h₂)/ln(h₂/h₃)` at `p → 0`). Then
+//! `D₂₃ = Q₂ − Q₃`, the order solves `D₁₂/D₂₃ = (h₁ᵖ − h₂ᵖ)/(h₂ᵖ − h₃ᵖ)` (for a constant
+//! ratio `r`, `rᵖ = D₁₂/D₂₃`), found by bisection: the right-hand side increases with
+//! `p`, from `ln(h₁/h₂)/ln(h₂/h₃)` at `p → 0`. Then
 //! `Q∞ = Q₃ − D₂₃/((h₂/h₃)ᵖ − 1)`. The model holds only when a positive order fits: the
 //! differences have one sign and `D₁₂/D₂₃ > ln(h₁/h₂)/ln(h₂/h₃)` (`> 1` for a constant
 //! ratio); otherwise no order and no limit are read.
