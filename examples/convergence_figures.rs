@@ -10,21 +10,25 @@
 //!   contact area at zero shear per nominal area, the loads at which the precursor length
 //!   ℓ first reaches 5 mm and 20 mm and the damage front 5 mm, and ℓ/Lx at
 //!   `F/(μF_N)` = 0.75;
-//! * takes the three finest grids (cell sizes in a constant ratio) and prints per
-//!   observable the ensemble means, the differences between consecutive grids, the
-//!   observed order `p`, the Richardson limit `Q∞` and the error left on the finest grid,
-//!   each with a 95 % percentile-bootstrap interval over the realizations
-//!   (`support/richardson.rs`). The Gaussian surface with one seed is the same surface on
-//!   every grid, so its grids are *paired*: the realizations are resampled together and
-//!   the differences are taken between grids on the same realization. The white noise is
-//!   a new surface on every grid: its grids are resampled apart;
+//! * takes the three finest grids (by the representative cell size `h = √(ΔxΔy)`) and
+//!   prints per observable the ensemble means and the differences between consecutive
+//!   grids and, for a surface with a correlation length, the observed order `p`, the
+//!   Richardson limit `Q∞` and the error left on the finest grid, each with a 95 %
+//!   percentile-bootstrap interval over the realizations that counts the unresolved
+//!   resamples as unbounded (`support/richardson.rs`); below a resolved share of
+//!   [`RESOLVED_SHARE`] the order, limit and error read "not resolved". The Gaussian
+//!   surface with one seed is the same surface on every grid, so its grids are *paired*:
+//!   the realizations are resampled together and the differences are taken between grids
+//!   on the same realization. The white noise is a new surface on every grid, whose
+//!   correlation length is the cell: its grids are resampled apart and have no limit to
+//!   extrapolate to (docs/convergence.md), so no order or limit is printed;
 //! * draws into `FIGDIR` (default `docs/figures`) `convergence_SLUG_precursor_length.png`
 //!   (ℓ/Lx against `F/(μF_N)`, ensemble mean and 95 % band per cell size, `curves.csv`),
-//!   `convergence_SLUG_thresholds.png` (the threshold loads against the cell size with
-//!   their intervals, and the Richardson limit at zero cell size where the differences
-//!   shrink) and `convergence_SLUG_avalanches.png` (the fraction of avalanches at least as
-//!   large as a slipped area, ruptures x cell area, pooled over the realizations,
-//!   log-log).
+//!   `convergence_SLUG_thresholds.png` (the threshold loads against `h` with their
+//!   intervals, and the Richardson limit at `h` = 0 where it is established with a
+//!   bounded interval) and `convergence_SLUG_avalanches.png` (the fraction of avalanches
+//!   at least as large as a slipped area, ruptures x cell area, pooled over the
+//!   realizations, log-log).
 //!
 //! Run: `cargo run --release --features plot --example convergence_figures -- OUTDIR
 //! [FIGDIR]`. Its arithmetic is unit-tested:
@@ -37,7 +41,7 @@ mod richardson;
 
 use precursors::plot::{Chart, Colours, Corner, Style};
 use report::AtPath;
-use richardson::{estimate, Estimate, Interval};
+use richardson::{estimate, Estimate, Interval, RESOLVED_SHARE};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -209,6 +213,12 @@ struct Study {
 }
 
 impl Study {
+    /// The representative cell size `√(ΔxΔy)` (m): the one length of a cell refined by
+    /// different ratios along x and y (2 x 1.75 mm → 1 mm).
+    fn h(&self) -> f64 {
+        (self.dx * self.dy).sqrt()
+    }
+
     fn label(&self) -> String {
         if (self.dx - self.dy).abs() < 1e-12 {
             format!("{} mm", mm(self.dx))
@@ -411,12 +421,12 @@ fn run() -> report::Outcome {
         groups.entry(study.slug.clone()).or_default().push(study);
     }
     for studies in groups.values_mut() {
-        studies.sort_by(|a, b| b.dx.total_cmp(&a.dx));
+        studies.sort_by(|a, b| b.h().total_cmp(&a.h()));
         let finest: &[Study] = &studies[studies.len().saturating_sub(3)..];
         cost_table(studies);
         let estimates = estimates(finest);
         if let Some(estimates) = &estimates {
-            estimate_table(finest, estimates);
+            println!("{}", estimate_table(finest, estimates));
         }
         figures(studies, estimates.as_deref(), &args.figures)?;
     }
@@ -434,24 +444,21 @@ fn paired(studies: &[Study]) -> bool {
         })
 }
 
-/// The cell ratio of three grids if constant (within 1 %) along x.
-fn constant_ratio(studies: &[Study]) -> Option<f64> {
-    let (r1, r2) = (studies[0].dx / studies[1].dx, studies[1].dx / studies[2].dx);
-    ((r1 - r2).abs() < 0.01 * r1 && r1 > 1.0).then_some(r1)
-}
-
 /// The estimates of [`OBSERVABLES`] on the three grids; `None` (with a note) when the
-/// group has fewer than three or their ratio is not constant.
+/// group has fewer than three distinct cell sizes. Only a surface with a correlation
+/// length of its own is extrapolated: the white noise's correlation length is the cell,
+/// so its grids share no limit.
 fn estimates(studies: &[Study]) -> Option<Vec<Option<Estimate>>> {
     let name = &studies[0].heights;
-    if studies.len() < 3 {
+    let decreasing =
+        studies.len() >= 3 && studies[0].h() > studies[1].h() && studies[1].h() > studies[2].h();
+    if !decreasing {
         eprintln!("note: {name}: fewer than three cell sizes, no extrapolation");
         return None;
     }
-    let Some(r) = constant_ratio(studies) else {
-        eprintln!("note: {name}: the cell sizes are not in a constant ratio, no extrapolation");
-        return None;
-    };
+    let h = studies[0]
+        .xi
+        .map(|_| [studies[0].h(), studies[1].h(), studies[2].h()]);
     let paired = paired(studies);
     let realizations = studies
         .iter()
@@ -466,16 +473,23 @@ fn estimates(studies: &[Study]) -> Option<Vec<Option<Estimate>>> {
                         .map(|k| studies[g].observed.get(&k).map_or(f64::NAN, |o| o.1[q]))
                         .collect()
                 });
-                estimate(&observed, r, paired, RESAMPLES, BOOTSTRAP_SEED + q as u64)
+                estimate(&observed, h, paired, RESAMPLES, BOOTSTRAP_SEED + q as u64)
             })
             .collect(),
     )
 }
 
-/// A number with three significant figures.
+/// A number with three significant figures; an open interval's end is `±∞`.
 fn sig(x: f64) -> String {
-    if !x.is_finite() {
+    if x.is_nan() {
         return "—".into();
+    }
+    if x.is_infinite() {
+        return if x > 0.0 {
+            "∞".into()
+        } else {
+            "−∞".into()
+        };
     }
     if x == 0.0 || (1e-2..1e3).contains(&x.abs()) {
         let decimals = (2 - x.abs().log10().floor() as i32).clamp(0, 4) as usize;
@@ -508,43 +522,81 @@ fn cost_table(studies: &[Study]) {
     println!();
 }
 
-fn estimate_table(studies: &[Study], estimates: &[Option<Estimate>]) {
+fn estimate_table(studies: &[Study], estimates: &[Option<Estimate>]) -> String {
     let paired = if paired(studies) {
         "paired: differences on the same realization"
     } else {
         "unpaired: a new surface on every grid"
     };
     let labels: Vec<String> = studies.iter().map(Study::label).collect();
-    println!(
-        "### {}: cells {}, means and 95 % bootstrap intervals; {paired}\n",
+    let sizes: Vec<String> = studies.iter().map(|s| mm(s.h())).collect();
+    let extrapolated = studies[0].xi.is_some();
+    let mut out = format!(
+        "### {}: cells {} (h = √(ΔxΔy) = {} mm), means and 95 % bootstrap intervals; {paired}\n\n",
         studies[0].heights,
         labels.join(", "),
+        sizes.join(", "),
     );
-    println!(
-        "| observable | {} | {} | {} | Δ {}→{} | Δ {}→{} | order p | resolved | limit h → 0 | error at {} |",
-        labels[0], labels[1], labels[2], labels[0], labels[1], labels[1], labels[2], labels[2]
+    let mut header = format!(
+        "| observable | {} | {} | {} | Δ {}→{} | Δ {}→{} |",
+        labels[0], labels[1], labels[2], labels[0], labels[1], labels[1], labels[2]
     );
-    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
-    for (name, e) in OBSERVABLES.iter().zip(estimates) {
-        let Some(e) = e else {
-            println!("| {name} | fewer than two realizations reach it | | | | | | | | |");
-            continue;
-        };
-        println!(
-            "| {name} ({} runs) | {} | {} | {} | {} | {} | {} | {:.0} % | {} | {} |",
-            e.realizations[2],
-            interval(Some(e.means[0])),
-            interval(Some(e.means[1])),
-            interval(Some(e.means[2])),
-            interval(Some(e.differences[0])),
-            interval(Some(e.differences[1])),
-            interval(e.order),
-            100.0 * e.resolved,
-            interval(e.limit),
-            interval(e.finest_error),
+    if extrapolated {
+        header += &format!(
+            " order p | resolved | limit h → 0 | error at {} |",
+            labels[2]
         );
     }
-    println!();
+    let columns = header.matches('|').count() - 1;
+    out += &format!("{header}\n|{}\n", " --- |".repeat(columns));
+    for (name, e) in OBSERVABLES.iter().zip(estimates) {
+        out += &estimate_row(name, e.as_ref(), columns);
+        out.push('\n');
+    }
+    if extrapolated {
+        out += &format!(
+            "\n(Not resolved: fewer than {:.0} % of the resamples resolved.)\n",
+            100.0 * RESOLVED_SHARE
+        );
+    } else {
+        out += "\n(No order and no limit: a new surface on every grid, whose correlation length is the cell.)\n";
+    }
+    out
+}
+
+/// One observable's row of [`estimate_table`]: the extrapolation's cells where the
+/// estimate has one; "not resolved" below [`RESOLVED_SHARE`], "—" where the full sample
+/// gives no positive order.
+fn estimate_row(name: &str, e: Option<&Estimate>, columns: usize) -> String {
+    let Some(e) = e else {
+        return format!(
+            "| {name} | fewer than two realizations reach it |{}",
+            " |".repeat(columns - 2)
+        );
+    };
+    let mut row = format!(
+        "| {name} ({} runs) | {} | {} | {} | {} | {} |",
+        e.realizations[2],
+        interval(Some(e.means[0])),
+        interval(Some(e.means[1])),
+        interval(Some(e.means[2])),
+        interval(Some(e.differences[0])),
+        interval(Some(e.differences[1])),
+    );
+    if let Some(x) = &e.extrapolation {
+        let resolved = format!("{:.0} %", 100.0 * x.resolved);
+        if x.established() {
+            row += &format!(
+                " {} | {resolved} | {} | {} |",
+                interval(x.order),
+                interval(x.limit),
+                interval(x.finest_error)
+            );
+        } else {
+            row += &format!(" not resolved | {resolved} | not resolved | not resolved |");
+        }
+    }
+    row
 }
 
 /// The fraction of avalanches of at least each size, from `(size, count)` rows: the
@@ -619,37 +671,43 @@ fn figures(
     save(aval, &path("avalanches"))
 }
 
-/// The threshold loads against the cell size, with the Richardson limit at zero cell
-/// size where the full sample gives one.
+/// The threshold loads against `h = √(ΔxΔy)`, with the Richardson limit at `h` = 0
+/// where it is established with a bounded interval.
 fn thresholds(studies: &[Study], estimates: &[Option<Estimate>], path: &Path) -> report::Outcome {
     let mut chart = Chart::new(
         &format!(
             "Threshold loads, {} (h = 0: Richardson limit)",
             studies[0].heights
         ),
-        "cell size Δx (mm)",
+        "cell size h = √(ΔxΔy) (mm)",
         "F/(μF_N) (mean, 95 % interval)",
     )
-    .x_range(0.0, studies[0].dx * 1e3 * 1.05)
+    .x_range(0.0, studies[0].h() * 1e3 * 1.05)
     .legend(Corner::UpperRight);
     for q in 1..=3 {
         let Some(e) = &estimates[q] else { continue };
         let mut rows: Vec<(f64, f64, f64, f64)> = Vec::new();
-        if let Some(l) = e.limit {
+        if let Some(l) = e.extrapolation.as_ref().and_then(drawn_limit) {
             rows.push((0.0, l.value, l.lo, l.hi));
         }
         for (s, m) in studies.iter().rev().zip(e.means.iter().rev()) {
-            rows.push((s.dx * 1e3, m.value, m.lo, m.hi));
+            rows.push((s.h() * 1e3, m.value, m.lo, m.hi));
         }
         chart = chart.band(OBSERVABLES[q], &rows);
     }
     // A load cannot pass global slip: an interval above it is the extrapolation's, not
     // the model's.
-    let slip = [(0.0, 1.0), (studies[0].dx * 1e3 * 1.05, 1.0)];
+    let slip = [(0.0, 1.0), (studies[0].h() * 1e3 * 1.05, 1.0)];
     chart = chart
         .line("global slip", &slip)
         .style(Style::new().colour(120, 120, 120).dashed());
     save(chart, path)
+}
+
+/// The limit a figure draws: established, with a bounded interval.
+fn drawn_limit(x: &richardson::Extrapolation) -> Option<Interval> {
+    x.limit
+        .filter(|l| x.established() && l.lo.is_finite() && l.hi.is_finite())
 }
 
 fn save(chart: Chart, path: &Path) -> report::Outcome {
@@ -727,6 +785,125 @@ mod tests {
         // P(S ≥ 1) = 1, P(S ≥ 2) = 4/10, P(S ≥ 5) = 1/10.
         let rows = [(2.0, 3.0), (1.0, 6.0), (7.0, 0.0), (5.0, 1.0)];
         assert_eq!(at_least(&rows), vec![(1.0, 1.0), (2.0, 0.4), (5.0, 0.1)]);
+    }
+
+    /// A study of `runs` realizations whose every observable is `value(realization)`.
+    fn study(
+        xi: Option<f64>,
+        dx: f64,
+        dy: f64,
+        runs: usize,
+        value: impl Fn(usize) -> f64,
+    ) -> Study {
+        Study {
+            heights: "test".into(),
+            slug: "test".into(),
+            xi,
+            dx,
+            dy,
+            cells: 1,
+            runs_incomplete: 0,
+            core_seconds: 0.0,
+            loads: Vec::new(),
+            ell: Vec::new(),
+            avalanches: Vec::new(),
+            observed: (0..runs)
+                .map(|k| (k, (k.to_string(), [value(k); 5])))
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn the_order_uses_the_cell_area_not_the_ratio_along_x() {
+        // Grids of 2 x 1.75, 1 and 0.5 mm carrying Q = 0.1 + (h/1 mm)^1.5 with h = √(ΔxΔy)
+        // exactly (every realization alike): the table's order is 1.50 and the limit
+        // 0.100; with the ratio along x (2) it would read log₂(D₁₂/D₂₃) = 1.27 and a
+        // limit of −0.0044 (by hand: Q = 2.6589, 1.1, 0.4536).
+        let q = |dx: f64, dy: f64| 0.1 + (dx * dy * 1e6).sqrt().powf(1.5);
+        let studies: Vec<Study> = [(2e-3, 1.75e-3), (1e-3, 1e-3), (0.5e-3, 0.5e-3)]
+            .into_iter()
+            .map(|(dx, dy)| study(Some(8e-3), dx, dy, 4, |_| q(dx, dy)))
+            .collect();
+        assert!((studies[0].h() - 3.5e-6_f64.sqrt()).abs() < 1e-15);
+        let estimates = estimates(&studies).unwrap();
+        let x = estimates[1]
+            .as_ref()
+            .unwrap()
+            .extrapolation
+            .clone()
+            .unwrap();
+        let (p, limit) = (x.order.unwrap().value, x.limit.unwrap().value);
+        assert!(
+            (p - 1.5).abs() < 1e-9 && (limit - 0.1).abs() < 1e-9,
+            "{p} {limit}"
+        );
+        let table = estimate_table(&studies, &estimates);
+        assert!(table.contains("h = √(ΔxΔy) = 1.8708, 1, 0.5 mm"), "{table}");
+        assert!(
+            table.contains("| 1.50 [1.50, 1.50] | 100 % | 0.100 [0.100, 0.100] |"),
+            "{table}"
+        );
+    }
+
+    #[test]
+    fn the_white_noise_prints_no_order_and_no_limit() {
+        // The same exact power law on a white noise (no correlation length): the table
+        // has the means and differences and no order, limit or error columns.
+        let studies: Vec<Study> = [2e-3, 1e-3, 0.5e-3]
+            .into_iter()
+            .map(|dx| study(None, dx, dx, 4, |k| 1.0 + dx * 1e3 + 0.01 * k as f64))
+            .collect();
+        let estimates = estimates(&studies).unwrap();
+        assert!(estimates[0].as_ref().unwrap().extrapolation.is_none());
+        let table = estimate_table(&studies, &estimates);
+        assert!(
+            !table.contains("order p") && !table.contains("limit h → 0"),
+            "{table}"
+        );
+        let header = table
+            .lines()
+            .find(|l| l.starts_with("| observable"))
+            .unwrap();
+        let row = table.lines().find(|l| l.starts_with("| A_R(0)")).unwrap();
+        assert_eq!(header.matches('|').count(), 7, "{header}");
+        assert_eq!(row.matches('|').count(), 7, "{row}");
+    }
+
+    #[test]
+    fn an_unresolved_row_says_so() {
+        // Paired grids whose middle grid scatters by realization: the full sample's
+        // differences shrink (Q = 2, 1.02, 0.5 on average) but in part of the resamples
+        // they do not; below 95 % resolved the row reads "not resolved" in place of an
+        // order and a limit.
+        let scatter = [0.3, -0.2, 0.25, -0.35, 0.1, -0.05, 0.4, -0.3, 0.15, -0.25];
+        let studies: Vec<Study> = [(2e-3, 0.0), (1e-3, 1.0), (0.5e-3, 0.0)]
+            .into_iter()
+            .map(|(dx, w)| study(Some(8e-3), dx, dx, 10, |k| dx * 1e3 + w * 4.0 * scatter[k]))
+            .collect();
+        let estimates = estimates(&studies).unwrap();
+        let x = estimates[0]
+            .as_ref()
+            .unwrap()
+            .extrapolation
+            .clone()
+            .unwrap();
+        assert!(x.resolved < RESOLVED_SHARE, "{}", x.resolved);
+        let table = estimate_table(&studies, &estimates);
+        let row = table.lines().find(|l| l.starts_with("| A_R(0)")).unwrap();
+        assert!(row.ends_with("| not resolved | not resolved |"), "{row}");
+        assert_eq!(row.matches("not resolved").count(), 3, "{row}");
+    }
+
+    #[test]
+    fn open_ends_print_as_infinities() {
+        assert_eq!(sig(f64::INFINITY), "∞");
+        assert_eq!(sig(f64::NEG_INFINITY), "−∞");
+        let open = Interval {
+            value: 0.5,
+            lo: f64::NEG_INFINITY,
+            hi: 0.9,
+        };
+        assert_eq!(interval(Some(open)), "0.500 [−∞, 0.900]");
     }
 
     #[test]

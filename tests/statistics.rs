@@ -729,7 +729,8 @@ fn slip_profiles_balance_the_loads() {
 
 /// The study's files (docs/statistics.md): each expands to 50 runs on the calibration
 /// block with the drive, heights and grid its name says; the two cell sizes of the
-/// correlated surface share their seeds, so realization `r` is one surface at both.
+/// correlated surface share their seeds, so realization `r` is one surface at both, and
+/// both resolve it (cells of at most ξ/4).
 #[test]
 fn the_study_files_are_the_documented_study() {
     use precursors::sweep::Sweep;
@@ -738,7 +739,7 @@ fn the_study_files_are_the_documented_study() {
     for (name, drive, heights, nx) in [
         ("rod", "rod", "gaussian", 140),
         ("spring", "spring", "gaussian", 140),
-        ("surface_1mm", "rod", "gaussian_surface", 140),
+        ("surface_0.7mm", "rod", "gaussian_surface", 200),
         ("surface_0.5mm", "rod", "gaussian_surface", 280),
     ] {
         let path = dir.join(format!("{name}.json"));
@@ -753,6 +754,15 @@ fn the_study_files_are_the_documented_study() {
         assert_eq!(json["drive"]["kind"], drive, "{path:?}");
         assert_eq!(json["heights"]["kind"], heights, "{path:?}");
         assert_eq!(json["normal_load"], 3500.0, "{path:?}");
+        if let Some(xi) = json["heights"]["correlation_length"].as_f64() {
+            // docs/convergence.md's rule: a cell resolves the surface at ξ/4 or less.
+            assert!(
+                grid.dx() <= xi / 4.0 && grid.dy() <= xi / 4.0,
+                "{path:?}: cells {} x {} against ξ = {xi}",
+                grid.dx(),
+                grid.dy()
+            );
+        }
         seeds.push(sweep.runs().iter().map(|r| r.seed()).collect::<Vec<u64>>());
     }
     assert_eq!(seeds[2], seeds[3]);
@@ -760,7 +770,7 @@ fn the_study_files_are_the_documented_study() {
     for name in [
         "rod.json",
         "spring.json",
-        "surface_1mm.json",
+        "surface_0.7mm.json",
         "surface_0.5mm.json",
     ] {
         assert!(
