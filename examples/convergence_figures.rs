@@ -676,8 +676,14 @@ fn figures(
 fn thresholds(studies: &[Study], estimates: &[Option<Estimate>], path: &Path) -> report::Outcome {
     let mut chart = Chart::new(
         &format!(
-            "Threshold loads, {} (h = 0: Richardson limit)",
-            studies[0].heights
+            "Threshold loads, {}{}",
+            studies[0].heights,
+            // The white noise has no limit to draw (docs/convergence.md).
+            if studies[0].xi.is_some() {
+                " (h = 0: Richardson limit)"
+            } else {
+                ""
+            }
         ),
         "cell size h = √(ΔxΔy) (mm)",
         "F/(μF_N) (mean, 95 % interval)",
