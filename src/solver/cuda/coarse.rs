@@ -11,9 +11,9 @@
 //! last bits depend on the run's history (a resumed run agrees with the uninterrupted
 //! one to rounding, not bit for bit; docs/gpu.md).
 
-use super::kernels::{int, Launch};
+use super::kernels::Launch;
 use super::operator::Transforms;
-use super::seam::Device;
+use super::seam::{int, Device};
 use super::vectors::SetVectors;
 use crate::error::Result;
 use crate::solver::coarse::Aggregates;

@@ -5,7 +5,7 @@
 //! sums, the host's own FSAI factor, coarse space and spectral backend.
 
 use super::emulator::{Emulator, Step, VARIANTS};
-use super::kernels::THREADS;
+use super::kernels::{Kernel, THREADS};
 use super::phases::DevicePhases;
 use super::seam::Device;
 use super::CudaCore;
@@ -634,6 +634,7 @@ fn device_solves_are_the_spectral_backends() {
         parallelism: Parallelism::Sequential,
     };
     for threads in VARIANTS {
+        let mut launched = Vec::new();
         for precond in [
             Precond::Jacobi,
             Precond::Spectral,
@@ -667,7 +668,18 @@ fn device_solves_are_the_spectral_backends() {
                 assert!(offset <= 1e-9 * want.outcome.offset.abs(), "{precond:?}: U");
                 assert!(got.f.iter().all(|f| f.is_finite()));
             }
+            launched.extend(device.device.launched());
         }
+        // Every kernel of kernels.cu ran in these solves.
+        let missing: Vec<&str> = Kernel::ALL
+            .iter()
+            .filter(|k| !launched.contains(k))
+            .map(|k| k.name())
+            .collect();
+        assert!(
+            missing.is_empty(),
+            "{threads} threads: not launched: {missing:?}"
+        );
     }
 }
 
@@ -747,9 +759,7 @@ fn a_failed_device_step_is_an_error_naming_it() {
                 let named = match step {
                     Step::Launch => {
                         call.starts_with("cufftExec")
-                            || super::kernels::Kernel::ALL
-                                .iter()
-                                .any(|k| k.name() == *call)
+                            || Kernel::ALL.iter().any(|k| k.name() == *call)
                     }
                     Step::Copy => call.starts_with("cuMemcpy"),
                     Step::Synchronize => call.starts_with("cuStreamSynchronize"),

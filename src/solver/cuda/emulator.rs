@@ -19,7 +19,7 @@
 
 use super::device::cuda_error;
 use super::kernels::{threads_define, Kernel, SOURCE, THREADS};
-use super::seam::{check_copy, Arg, Device, Elem, FftKind};
+use super::seam::{check_copy, Arg, Device, Elem, FftKind, KernelId};
 use crate::error::Result;
 use cudarc::cufft::sys::double2;
 use cudarc::driver::LaunchConfig;
@@ -77,6 +77,8 @@ pub(super) struct HostPlan {
 #[derive(Debug, Default)]
 struct Faults {
     counts: [usize; 5],
+    /// Per kernel ([`Kernel`] as index), whether it was launched.
+    launched: Vec<bool>,
     /// Fail the step of this kind whose count (from zero) is this.
     fail: Option<(Step, usize)>,
 }
@@ -113,6 +115,16 @@ impl Emulator {
     /// emulator was made) fail, as a failed CUDA call: `Error::Cuda` naming the call.
     pub(super) fn fail(&self, step: Step, nth: usize) {
         self.faults().fail = Some((step, nth));
+    }
+
+    /// The kernels launched so far.
+    pub(super) fn launched(&self) -> Vec<Kernel> {
+        let faults = self.faults();
+        Kernel::ALL
+            .iter()
+            .copied()
+            .filter(|&k| faults.launched.get(k as usize) == Some(&true))
+            .collect()
     }
 
     /// Steps of kind `step` asked for so far.
@@ -204,12 +216,17 @@ impl Device for Emulator {
     }
     unsafe fn launch(
         &self,
-        kernel: Kernel,
+        kernel: KernelId,
         cfg: LaunchConfig,
         args: &mut [Arg<'_, Self>],
     ) -> Result<()> {
-        let name = kernel.name();
+        let name = kernel.name;
         self.step(Step::Launch, name)?;
+        {
+            let mut faults = self.faults();
+            faults.launched.resize(Kernel::ALL.len(), false);
+            faults.launched[kernel.index] = true;
+        }
         if cfg.block_dim != (self.threads, 1, 1)
             || (cfg.grid_dim.1, cfg.grid_dim.2) != (1, 1)
             || cfg.grid_dim.0 == 0
@@ -267,7 +284,7 @@ impl Device for Emulator {
                             // SAFETY: the arguments are the kernel's (the caller's), each
                             // slot alive until the scope ends.
                             let status =
-                                unsafe { block(w as i32, kernel as i32, grid, b, params.0) };
+                                unsafe { block(w as i32, kernel.index as i32, grid, b, params.0) };
                             if status != 0 {
                                 return status;
                             }
@@ -440,8 +457,8 @@ fn z2d(dims: &[usize], spectrum: &[double2], out: &mut [f64]) {
             let z = if k[last] < half_last {
                 spectrum[at_half(&k, dims, half_last)]
             } else {
-                for d in 0..rank {
-                    mirrored[d] = (dims[d] - k[d]) % dims[d];
+                for ((m, &kd), &n) in mirrored.iter_mut().zip(&k).zip(dims) {
+                    *m = (n - kd) % n;
                 }
                 let z = spectrum[at_half(&mirrored, dims, half_last)];
                 double2 { x: z.x, y: -z.y }
@@ -456,10 +473,10 @@ fn z2d(dims: &[usize], spectrum: &[double2], out: &mut [f64]) {
 /// The index of `k` in a half spectrum (last dimension `half_last` long).
 fn at_half(k: &[usize], dims: &[usize], half_last: usize) -> usize {
     let last = dims.len() - 1;
-    let mut index = 0;
-    for d in 0..last {
-        index = index * dims[d] + k[d];
-    }
+    let index = k[..last]
+        .iter()
+        .zip(&dims[..last])
+        .fold(0, |index, (&kd, &n)| index * n + kd);
     index * half_last + k[last]
 }
 
@@ -645,7 +662,7 @@ mod tests {
         let r = device.zeros::<f64>(4).unwrap();
         let mut z = device.zeros::<f64>(4).unwrap();
         let d = device.zeros::<f64>(4).unwrap();
-        let cfg = super::super::kernels::blocks(THREADS, "test", 1).unwrap();
+        let cfg = super::super::seam::blocks(THREADS, "test", 1).unwrap();
         use super::super::kernels::Launch;
         // SAFETY: every buffer holds 4 values.
         let e = unsafe { device.jacobi(cfg, &r, &d, 1.0, &mut z, 4) }.unwrap_err();

@@ -6,8 +6,8 @@
 //! each changed site), each a small dense solve, so per set solve only those rows cross
 //! (`(4 + 8 stride)` bytes each), not the planes.
 
-use super::kernels::{int, Launch};
-use super::seam::Device;
+use super::kernels::Launch;
+use super::seam::{int, Device};
 use crate::error::Result;
 use crate::solver::fsai::Fsai;
 

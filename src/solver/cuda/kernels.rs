@@ -1,16 +1,17 @@
 //! The kernels of kernels.cu as Rust sees them: each one's parameter list declared once
-//! ([`kernels!`] below), from which come both its typed launch function
-//! (`Kernels::scatter_rows(..)`, the bindings' argument list written by the macro, not by
-//! hand) and the declaration a test checks against kernels.cu's `extern "C"` signature
-//! (names, count, types). Also: the threads per block ([`THREADS`], passed to NVRTC and
-//! to the emulator's C++ compiler as `-DTHREADS`), the launch shapes with their sizes
-//! checked against the 32-bit integers the kernels and the driver take, and NVRTC.
+//! ([`kernels!`] below), from which come its [`Kernel`] name, its typed launch function
+//! on every [`Device`] (`device.scatter_rows(cfg, ..)`, [`Launch`]: the argument list
+//! written by the macro, not by hand) and the declaration a test checks against
+//! kernels.cu's `extern "C"` signature (names, count, types). Also: the threads per block
+//! ([`THREADS`], passed to NVRTC and to the emulator's C++ compiler as `-DTHREADS`), the
+//! launch shapes with their sizes checked against the 32-bit integers the kernels and the
+//! driver take, and NVRTC ([`Kernels`], the GPU's compiled functions).
 //!
 //! What a typed launch does not check: that the buffers hold the values the kernel reads
 //! and writes. That stays each caller's `unsafe` obligation.
 
 use super::device::{guarded, Gpu};
-use super::seam::{Device, Elem, Value};
+use super::seam::{Device, Elem, KernelId, Value};
 use crate::error::{Error, Result};
 use cudarc::cufft::sys::double2;
 use cudarc::driver::{CudaFunction, LaunchConfig};
@@ -29,41 +30,6 @@ pub(super) const THREADS: u32 = 256;
 /// `c++` alike).
 pub(super) fn threads_define(threads: u32) -> String {
     format!("-DTHREADS={threads}")
-}
-
-/// `value` as the kernels' `int`, else [`Error::DeviceLimit`] naming `what`.
-pub(super) fn int(what: &'static str, value: usize) -> Result<i32> {
-    i32::try_from(value).map_err(|_| Error::DeviceLimit {
-        what,
-        value: value as u64,
-        limit: i32::MAX as u64,
-    })
-}
-
-/// `blocks` blocks of `threads` threads (a grid's x dimension is a `u32`): the device's
-/// own count ([`Device::blocks`]), [`THREADS`] on a GPU.
-pub(super) fn blocks(threads: u32, what: &'static str, blocks: usize) -> Result<LaunchConfig> {
-    let grid = u32::try_from(blocks).map_err(|_| Error::DeviceLimit {
-        what,
-        value: blocks as u64,
-        limit: u32::MAX as u64,
-    })?;
-    Ok(LaunchConfig {
-        grid_dim: (grid, 1, 1),
-        block_dim: (threads, 1, 1),
-        shared_mem_bytes: 0,
-    })
-}
-
-/// One thread per element of `n` in blocks of `threads`, `None` for none (a launch of no
-/// blocks is an error). The kernels index the elements with an `int`, so `n` must fit
-/// one.
-pub(super) fn over(threads: u32, what: &'static str, n: usize) -> Result<Option<LaunchConfig>> {
-    if n == 0 {
-        return Ok(None);
-    }
-    int(what, n)?;
-    blocks(threads, what, n.div_ceil(threads as usize)).map(Some)
 }
 
 /// How a kernel parameter is passed.
@@ -192,6 +158,14 @@ macro_rules! kernels {
                     $( Kernel::$name => stringify!($name), )*
                 }
             }
+
+            /// As a device finds it.
+            pub(crate) fn id(self) -> KernelId {
+                KernelId {
+                    index: self as usize,
+                    name: self.name(),
+                }
+            }
         }
 
         /// The typed launches: one function per kernel, on any [`Device`].
@@ -211,7 +185,7 @@ macro_rules! kernels {
                     let mut args = [$( to_arg!(Self, $pass, $t, $p), )*];
                     // SAFETY: the argument list is the declaration's, which the tests
                     // check against kernels.cu; the buffers' sizes are the caller's.
-                    unsafe { self.launch(Kernel::$name, cfg, &mut args) }
+                    unsafe { self.launch(Kernel::$name.id(), cfg, &mut args) }
                 }
             )*
         }
@@ -284,8 +258,8 @@ pub(super) struct Kernels {
 
 impl Kernels {
     /// The loaded function of `kernel`.
-    pub(super) fn function(&self, kernel: Kernel) -> &CudaFunction {
-        &self.functions[kernel as usize]
+    pub(super) fn function(&self, kernel: KernelId) -> &CudaFunction {
+        &self.functions[kernel.index]
     }
 
     /// Compiles kernels.cu (once per process) and loads its functions on `gpu`.
@@ -561,37 +535,5 @@ mod tests {
         assert!(SOURCE.contains("#ifndef THREADS\n#error"));
         assert!(!SOURCE.contains("#define THREADS"));
         assert_eq!(threads_define(THREADS), "-DTHREADS=256");
-    }
-
-    #[test]
-    fn sizes_past_the_kernels_integers_are_errors() {
-        assert_eq!(int("m", 7).unwrap(), 7);
-        let limit = i32::MAX as usize;
-        assert_eq!(int("m", limit).unwrap(), i32::MAX);
-        let e = int("sites in the set", limit + 1).unwrap_err();
-        assert!(
-            matches!(e, Error::DeviceLimit { what: "sites in the set", value, limit }
-                if value == 1 << 31 && limit == (1 << 31) - 1),
-            "{e:?}"
-        );
-        assert!(over(THREADS, "m", 0).unwrap().is_none());
-        let one = over(THREADS, "m", 1).unwrap().unwrap();
-        assert_eq!((one.grid_dim, one.block_dim), ((1, 1, 1), (THREADS, 1, 1)));
-        let last = over(THREADS, "m", limit).unwrap().unwrap();
-        assert_eq!(last.grid_dim.0, (limit as u32).div_ceil(THREADS));
-        assert!(matches!(
-            over(THREADS, "m", limit + 1),
-            Err(Error::DeviceLimit { .. })
-        ));
-        let four = over(4, "m", 9).unwrap().unwrap();
-        assert_eq!((four.grid_dim, four.block_dim), ((3, 1, 1), (4, 1, 1)));
-        assert_eq!(
-            blocks(THREADS, "b", u32::MAX as usize).unwrap().grid_dim.0,
-            u32::MAX
-        );
-        assert!(matches!(
-            blocks(THREADS, "b", u32::MAX as usize + 1),
-            Err(Error::DeviceLimit { what: "b", .. })
-        ));
     }
 }

@@ -17,6 +17,7 @@
 mod coarse;
 mod device;
 mod fsai;
+mod gpu;
 mod kernels;
 mod libraries;
 mod memory;
@@ -43,8 +44,9 @@ use super::system::Compliance;
 use crate::error::{Error, Result};
 use crate::green::InfluencePlan;
 use coarse::DeviceCoarse;
-use device::{Cuda, Gpu};
+use device::Gpu;
 use fsai::DeviceFsai;
+use gpu::Cuda;
 use kernels::Kernels;
 use operator::Transforms;
 use phases::{DevicePhases, DevicePrecond};
@@ -89,7 +91,7 @@ impl CudaCore<Cuda> {
         let (nx, ny) = (plan.grid().nx(), plan.grid().ny());
         // The kernels index cells with an `int`: every cell, set position and offset
         // below is then one too.
-        kernels::int("grid cells", nx * ny)?;
+        seam::int("grid cells", nx * ny)?;
         let gpu = Gpu::open()?;
         memory::check_fits(
             &gpu.info.to_string(),
@@ -106,7 +108,7 @@ impl<D: Device> CudaCore<D> {
     fn on(device: D, plan: &InfluencePlan, compliance: Compliance) -> Result<Self> {
         let (nx, ny) = (plan.grid().nx(), plan.grid().ny());
         let n = nx * ny;
-        kernels::int("grid cells", n)?;
+        seam::int("grid cells", n)?;
         // cuFFT's symbols load with its first plan: a panic there is a library problem.
         let transforms = device::guarded("creating the cuFFT plans", || {
             Transforms::new(&device, nx, ny).map_err(|e| e.to_string())

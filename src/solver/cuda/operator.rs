@@ -2,8 +2,8 @@
 //! and a diagonal `W` (the operator's, the spectral preconditioner's). The algebra is in
 //! kernels.cu's header.
 
-use super::kernels::{int, Launch};
-use super::seam::{Device, FftKind};
+use super::kernels::Launch;
+use super::seam::{int, Device, FftKind};
 use crate::error::Result;
 use crate::green::InfluencePlan;
 use crate::solver::system::Compliance;

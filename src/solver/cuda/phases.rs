@@ -4,9 +4,9 @@
 
 use super::coarse::{DeviceCoarse, Target};
 use super::fsai::DeviceFsai;
-use super::kernels::{int, Launch};
+use super::kernels::Launch;
 use super::operator::Transforms;
-use super::seam::Device;
+use super::seam::{int, Device};
 use super::timing::{timed, Part};
 use super::vectors::{SetVectors, REDUCTION_BLOCKS};
 use crate::error::Result;

@@ -10,7 +10,6 @@
 //! step it served (`cuMemcpyDtoH (reduction)`, a kernel's name), and nothing after it
 //! runs.
 
-use super::kernels::{self, Kernel};
 use crate::error::{Error, Result};
 use cudarc::cufft::sys::double2;
 use cudarc::driver::{DeviceRepr, LaunchConfig, ValidAsZeroBits};
@@ -80,6 +79,15 @@ pub(crate) enum Arg<'a, D: Device + ?Sized> {
     F64(f64),
 }
 
+/// A kernel of kernels.cu as a device finds it (kernels.rs's `Kernel`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct KernelId {
+    /// Its index among kernels.rs's declarations.
+    pub(crate) index: usize,
+    /// Its name in kernels.cu.
+    pub(crate) name: &'static str,
+}
+
 /// cuFFT's real transforms (double precision), unnormalised both ways.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum FftKind {
@@ -125,7 +133,7 @@ pub(crate) trait Device: std::fmt::Debug + Send + Sync {
     /// holds the values the kernel reads or writes under `cfg`.
     unsafe fn launch(
         &self,
-        kernel: Kernel,
+        kernel: KernelId,
         cfg: LaunchConfig,
         args: &mut [Arg<'_, Self>],
     ) -> Result<()>;
@@ -164,11 +172,11 @@ pub(crate) trait Device: std::fmt::Debug + Send + Sync {
     }
     /// One thread per element of `n` in blocks of [`Device::threads`], `None` for none.
     fn over(&self, what: &'static str, n: usize) -> Result<Option<LaunchConfig>> {
-        kernels::over(self.threads(), what, n)
+        over(self.threads(), what, n)
     }
     /// `count` blocks of [`Device::threads`].
     fn blocks(&self, what: &'static str, count: usize) -> Result<LaunchConfig> {
-        kernels::blocks(self.threads(), what, count)
+        blocks(self.threads(), what, count)
     }
 }
 
@@ -182,4 +190,77 @@ pub(crate) fn check_copy(what: &'static str, from: usize, into: usize) -> Result
         });
     }
     Ok(())
+}
+
+/// `value` as the kernels' `int`, else [`Error::DeviceLimit`] naming `what`.
+pub(crate) fn int(what: &'static str, value: usize) -> Result<i32> {
+    i32::try_from(value).map_err(|_| Error::DeviceLimit {
+        what,
+        value: value as u64,
+        limit: i32::MAX as u64,
+    })
+}
+
+/// `blocks` blocks of `threads` threads (a grid's x dimension is a `u32`): the device's
+/// own count ([`Device::blocks`]), kernels.rs's `THREADS` on a GPU.
+pub(crate) fn blocks(threads: u32, what: &'static str, blocks: usize) -> Result<LaunchConfig> {
+    let grid = u32::try_from(blocks).map_err(|_| Error::DeviceLimit {
+        what,
+        value: blocks as u64,
+        limit: u32::MAX as u64,
+    })?;
+    Ok(LaunchConfig {
+        grid_dim: (grid, 1, 1),
+        block_dim: (threads, 1, 1),
+        shared_mem_bytes: 0,
+    })
+}
+
+/// One thread per element of `n` in blocks of `threads`, `None` for none (a launch of no
+/// blocks is an error). The kernels index the elements with an `int`, so `n` must fit
+/// one.
+pub(crate) fn over(threads: u32, what: &'static str, n: usize) -> Result<Option<LaunchConfig>> {
+    if n == 0 {
+        return Ok(None);
+    }
+    int(what, n)?;
+    blocks(threads, what, n.div_ceil(threads as usize)).map(Some)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::cuda::kernels::THREADS;
+
+    #[test]
+    fn sizes_past_the_kernels_integers_are_errors() {
+        assert_eq!(int("m", 7).unwrap(), 7);
+        let limit = i32::MAX as usize;
+        assert_eq!(int("m", limit).unwrap(), i32::MAX);
+        let e = int("sites in the set", limit + 1).unwrap_err();
+        assert!(
+            matches!(e, Error::DeviceLimit { what: "sites in the set", value, limit }
+                if value == 1 << 31 && limit == (1 << 31) - 1),
+            "{e:?}"
+        );
+        assert!(over(THREADS, "m", 0).unwrap().is_none());
+        let one = over(THREADS, "m", 1).unwrap().unwrap();
+        assert_eq!((one.grid_dim, one.block_dim), ((1, 1, 1), (THREADS, 1, 1)));
+        let last = over(THREADS, "m", limit).unwrap().unwrap();
+        assert_eq!(last.grid_dim.0, (limit as u32).div_ceil(THREADS));
+        assert!(matches!(
+            over(THREADS, "m", limit + 1),
+            Err(Error::DeviceLimit { .. })
+        ));
+        let four = over(4, "m", 9).unwrap().unwrap();
+        assert_eq!((four.grid_dim, four.block_dim), ((3, 1, 1), (4, 1, 1)));
+        assert_eq!(
+            blocks(THREADS, "b", u32::MAX as usize).unwrap().grid_dim.0,
+            u32::MAX
+        );
+        assert!(matches!(
+            blocks(THREADS, "b", u32::MAX as usize + 1),
+            Err(Error::DeviceLimit { what: "b", .. })
+        ));
+    }
 }
