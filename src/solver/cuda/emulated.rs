@@ -589,9 +589,12 @@ fn solver_compliance(plan: &InfluencePlan) -> Compliance {
     }
 }
 
+/// A set problem's values: the set, `d`, `b`, the total.
+type Problem = (Vec<usize>, Vec<f64>, Vec<f64>, f64);
+
 /// Two set problems of one grid: the second drops some sites, adds others and changes a
 /// compliance (FSAI's and the coarse space's updates).
-fn problems(n: usize, scale: f64) -> Vec<(Vec<usize>, Vec<f64>, Vec<f64>, f64)> {
+fn problems(n: usize, scale: f64) -> Vec<Problem> {
     let first: Vec<usize> = (0..n).filter(|&i| (i * 7919 + 5) % 10 < 7).collect();
     let mut second: Vec<usize> = first.iter().copied().filter(|&i| i % 11 != 3).collect();
     second.extend((0..n).filter(|i| !first.contains(i)).take(3));

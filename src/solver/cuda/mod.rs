@@ -5,6 +5,9 @@
 //! host. Per set solve the set, `d`, `b` and the warm start go up and the tractions and
 //! the displacements' grid product come back (a few `O(N)` copies).
 //!
+//! The launch code reaches the device through one seam (`seam.rs`'s `Device`): the GPU
+//! (`gpu.rs`) or, in the tests, the host emulator (`emulator.rs`), under the same code.
+//!
 //! Preconditioners: the host's choices. Cold solves take the restricted spectral inverse;
 //! warm normal solves FSAI (its rows built on the host, `fsai.rs`) with the coarse space
 //! of aggregates on large grids (`coarse.rs`, kept on the device); warm tangential solves
