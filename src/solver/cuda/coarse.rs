@@ -11,14 +11,12 @@
 //! last bits depend on the run's history (a resumed run agrees with the uninterrupted
 //! one to rounding, not bit for bit; docs/gpu.md).
 
-use super::device::{cuda_error, zeros};
-use super::kernels::{blocks, int, over, Kernels};
+use super::kernels::Launch;
 use super::operator::Transforms;
+use super::seam::{int, Device};
 use super::vectors::SetVectors;
 use crate::error::Result;
 use crate::solver::coarse::Aggregates;
-use cudarc::driver::{CudaSlice, CudaStream};
-use std::sync::Arc;
 
 /// The bytes of a [`DeviceCoarse`] with `count` aggregates.
 pub(super) fn coarse_bytes(count: usize) -> f64 {
@@ -35,7 +33,7 @@ pub(super) fn stale_columns(aggregates: &Aggregates) -> Vec<usize> {
 }
 
 /// The device's coarse space.
-pub(super) struct DeviceCoarse {
+pub(super) struct DeviceCoarse<D: Device> {
     aggregates: Aggregates,
     /// Kernel arguments: grid width and height, cells per block side, blocks along x,
     /// aggregates.
@@ -44,15 +42,15 @@ pub(super) struct DeviceCoarse {
     block: i32,
     bx: i32,
     count: i32,
-    e: CudaSlice<f64>,
-    lower: CudaSlice<f64>,
-    inverse: CudaSlice<f64>,
+    pub(super) e: D::Buffer<f64>,
+    lower: D::Buffer<f64>,
+    inverse: D::Buffer<f64>,
     /// Site counts per aggregate, `E⁻¹ c`, the restriction, the solution, `[valid, cᵀ w]`.
-    c: CudaSlice<f64>,
-    w: CudaSlice<f64>,
-    g: CudaSlice<f64>,
-    solution: CudaSlice<f64>,
-    info: CudaSlice<f64>,
+    c: D::Buffer<f64>,
+    w: D::Buffer<f64>,
+    g: D::Buffer<f64>,
+    pub(super) solution: D::Buffer<f64>,
+    pub(super) info: D::Buffer<f64>,
     /// Whether `E` was positive definite (the correction is skipped otherwise).
     valid: bool,
 }
@@ -65,12 +63,12 @@ pub(super) enum Target {
     Rhs,
 }
 
-impl DeviceCoarse {
+impl<D: Device> DeviceCoarse<D> {
     /// The aggregates of an `nx x ny` grid, nothing on the set yet.
-    pub(super) fn new(stream: &Arc<CudaStream>, nx: usize, ny: usize) -> Result<Self> {
+    pub(super) fn new(device: &D, nx: usize, ny: usize) -> Result<Self> {
         let aggregates = Aggregates::new(nx, ny);
         let count = aggregates.count();
-        let real = |len: usize| zeros::<f64>(stream, len);
+        let real = |len: usize| device.zeros::<f64>(len);
         Ok(DeviceCoarse {
             nx: int("grid cells along x", nx)?,
             ny: int("grid cells along y", ny)?,
@@ -102,11 +100,10 @@ impl DeviceCoarse {
     #[allow(clippy::too_many_arguments)]
     pub(super) fn update(
         &mut self,
-        stream: &Arc<CudaStream>,
-        kernels: &Kernels,
-        transforms: &mut Transforms,
-        operator: &CudaSlice<f64>,
-        v: &mut SetVectors,
+        device: &D,
+        transforms: &mut Transforms<D>,
+        operator: &D::Buffer<f64>,
+        v: &mut SetVectors<D>,
         set: &[usize],
         d: &[f64],
     ) -> Result<()> {
@@ -118,42 +115,43 @@ impl DeviceCoarse {
         for (a, c) in counts.iter_mut().enumerate() {
             *c = self.aggregates.members(a).len() as f64;
         }
-        stream
-            .memcpy_htod(&counts, &mut self.c)
-            .map_err(|e| cuda_error("cuMemcpyHtoD (aggregate site counts)", e))?;
+        device.htod("cuMemcpyHtoD (aggregate site counts)", &counts, &mut self.c)?;
         for a in stale_columns(&self.aggregates) {
-            if let Some(cfg) = over("sites in the set", m)? {
+            if let Some(cfg) = device.over("sites in the set", m)? {
                 let (m32, a32) = (int("sites in the set", m)?, int("aggregates", a)?);
                 // SAFETY: set and p hold at least m values.
                 unsafe {
-                    kernels.coarse_indicator(
-                        stream, cfg, &v.set, m32, self.nx, self.block, self.bx, a32, &mut v.p,
+                    device.coarse_indicator(
+                        cfg, &v.set, m32, self.nx, self.block, self.bx, a32, &mut v.p,
                     )
                 }?;
             }
-            transforms.filter(stream, kernels, operator, &v.p, &v.pos)?;
-            transforms.gather_set(stream, kernels, &v.set, &v.d, &v.p, &mut v.q, true, m)?;
-            self.restrict(stream, kernels, &v.q, None, &v.pos, Target::Column(a))?;
+            transforms.filter(device, operator, &v.p, &v.pos)?;
+            transforms.gather_set(device, &v.set, &v.d, &v.p, &mut v.q, true, m)?;
+            self.restrict(device, &v.q, None, &v.pos, Target::Column(a))?;
         }
-        self.factor(stream, kernels)
+        self.factor(device)
     }
 
     /// The empty aggregates fixed, then `E`'s factor, inverse and border; the validity
     /// read back.
-    fn factor(&mut self, stream: &Arc<CudaStream>, kernels: &Kernels) -> Result<()> {
-        let one = blocks("one block", 1)?;
-        let each = over("aggregates", self.count as usize)?.unwrap_or(one);
+    fn factor(&mut self, device: &D) -> Result<()> {
+        let one = device.blocks("one block", 1)?;
+        let each = device
+            .over("aggregates", self.count as usize)?
+            .unwrap_or(one);
         // SAFETY (this function's launches): e, lower and inverse hold count² values, c
         // and w count, info 2.
-        unsafe { kernels.coarse_fix_empty(stream, each, &mut self.e, &self.c, self.count) }?;
-        stream
-            .memcpy_dtod(&self.e, &mut self.lower)
-            .map_err(|e| cuda_error("cuMemcpyDtoD (coarse matrix to its factor)", e))?;
-        unsafe { kernels.coarse_factor(stream, one, &mut self.lower, self.count, &mut self.info) }?;
-        unsafe { kernels.coarse_invert(stream, each, &self.lower, self.count, &mut self.inverse) }?;
+        unsafe { device.coarse_fix_empty(each, &mut self.e, &self.c, self.count) }?;
+        device.dtod(
+            "cuMemcpyDtoD (coarse matrix to its factor)",
+            &self.e,
+            &mut self.lower,
+        )?;
+        unsafe { device.coarse_factor(one, &mut self.lower, self.count, &mut self.info) }?;
+        unsafe { device.coarse_invert(each, &self.lower, self.count, &mut self.inverse) }?;
         unsafe {
-            kernels.coarse_border(
-                stream,
+            device.coarse_border(
                 one,
                 &self.inverse,
                 &self.c,
@@ -163,12 +161,8 @@ impl DeviceCoarse {
             )
         }?;
         let mut info = [0.0f64; 2];
-        stream
-            .memcpy_dtoh(&self.info, info.as_mut_slice())
-            .map_err(|e| cuda_error("cuMemcpyDtoH (coarse validity)", e))?;
-        stream
-            .synchronize()
-            .map_err(|e| cuda_error("cuStreamSynchronize (coarse upkeep)", e))?;
+        device.dtoh("cuMemcpyDtoH (coarse validity)", &self.info, &mut info)?;
+        device.synchronize("cuStreamSynchronize (coarse upkeep)")?;
         self.valid = info[0] == 1.0;
         Ok(())
     }
@@ -176,15 +170,14 @@ impl DeviceCoarse {
     /// `Zᵀ (x - t)` (`t` given) or `Zᵀ x` into `into`.
     pub(super) fn restrict(
         &mut self,
-        stream: &Arc<CudaStream>,
-        kernels: &Kernels,
-        x: &CudaSlice<f64>,
-        t: Option<&CudaSlice<f64>>,
-        pos: &CudaSlice<i32>,
+        device: &D,
+        x: &D::Buffer<f64>,
+        t: Option<&D::Buffer<f64>>,
+        pos: &D::Buffer<i32>,
         into: Target,
     ) -> Result<()> {
         // One block per aggregate.
-        let cfg = blocks("aggregates", self.count as usize)?;
+        let cfg = device.blocks("aggregates", self.count as usize)?;
         let subtract = i32::from(t.is_some());
         let (out, column) = match into {
             Target::Column(a) => (&mut self.e, int("aggregates", a)?),
@@ -193,8 +186,7 @@ impl DeviceCoarse {
         // SAFETY: x and t hold a value per set site, pos one per cell, out count² values
         // (a column) or count.
         unsafe {
-            kernels.coarse_restrict(
-                stream,
+            device.coarse_restrict(
                 cfg,
                 x,
                 t.unwrap_or(x),
@@ -212,12 +204,11 @@ impl DeviceCoarse {
     }
 
     /// The bordered coarse solve of the last restriction, left on the device.
-    pub(super) fn solve(&mut self, stream: &Arc<CudaStream>, kernels: &Kernels) -> Result<()> {
-        let one = blocks("one block", 1)?;
+    pub(super) fn solve(&mut self, device: &D) -> Result<()> {
+        let one = device.blocks("one block", 1)?;
         // SAFETY: inverse holds count² values, g, c, w and solution count, info 2.
         unsafe {
-            kernels.coarse_solve(
-                stream,
+            device.coarse_solve(
                 one,
                 &self.inverse,
                 &self.g,
@@ -233,21 +224,19 @@ impl DeviceCoarse {
     /// `x += sign Z y` on the `m` sites of `set`, `y` the last coarse solution.
     pub(super) fn prolong(
         &self,
-        stream: &Arc<CudaStream>,
-        kernels: &Kernels,
-        x: &mut CudaSlice<f64>,
+        device: &D,
+        x: &mut D::Buffer<f64>,
         sign: f64,
-        set: &CudaSlice<i32>,
+        set: &D::Buffer<i32>,
         m: usize,
     ) -> Result<()> {
-        let Some(cfg) = over("sites in the set", m)? else {
+        let Some(cfg) = device.over("sites in the set", m)? else {
             return Ok(());
         };
         let m32 = int("sites in the set", m)?;
         // SAFETY: x and set hold at least m values, solution count.
         unsafe {
-            kernels.coarse_prolong(
-                stream,
+            device.coarse_prolong(
                 cfg,
                 x,
                 &self.solution,

@@ -198,16 +198,6 @@ fn quiet_panics<T>(f: impl FnOnce() -> T) -> T {
     result
 }
 
-/// `len` zeros on the device (every buffer of the backend is allocated through here).
-pub(crate) fn zeros<T: cudarc::driver::DeviceRepr + cudarc::driver::ValidAsZeroBits>(
-    stream: &Arc<CudaStream>,
-    len: usize,
-) -> Result<cudarc::driver::CudaSlice<T>> {
-    stream
-        .alloc_zeros::<T>(len)
-        .map_err(|e| cuda_error("cuMemAlloc", e))
-}
-
 /// A failed CUDA call during a solve.
 pub(crate) fn cuda_error(call: &'static str, e: impl std::fmt::Display) -> Error {
     Error::Cuda {

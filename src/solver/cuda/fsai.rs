@@ -6,22 +6,20 @@
 //! each changed site), each a small dense solve, so per set solve only those rows cross
 //! (`(4 + 8 stride)` bytes each), not the planes.
 
-use super::device::{cuda_error, zeros};
-use super::kernels::{int, over, Kernels};
+use super::kernels::Launch;
+use super::seam::{int, Device};
 use crate::error::Result;
 use crate::solver::fsai::Fsai;
-use cudarc::driver::{CudaSlice, CudaStream};
-use std::sync::Arc;
 
 /// The device's copy of a [`Fsai`] factor and the scratch of its product.
-pub(super) struct DeviceFsai {
+pub(super) struct DeviceFsai<D: Device> {
     stride: usize,
     /// `stride` planes of one weight per cell.
-    planes: CudaSlice<f64>,
+    planes: D::Buffer<f64>,
     /// Per slot, cells back to the neighbour.
-    offsets: CudaSlice<i32>,
+    offsets: D::Buffer<i32>,
     /// `G r` on the set.
-    pub(super) y: CudaSlice<f64>,
+    pub(super) y: D::Buffer<f64>,
     /// Whether the planes equal the host's after its last update. False until the first
     /// copy, and after a failed one: then every row is copied again.
     synced: bool,
@@ -47,19 +45,17 @@ pub(super) fn rows_to_copy(fsai: &Fsai) -> (Vec<i32>, Vec<f64>) {
     (cells.iter().map(|&i| i as i32).collect(), weights)
 }
 
-impl DeviceFsai {
+impl<D: Device> DeviceFsai<D> {
     /// Zero planes for `fsai`'s pattern on a grid of `n` cells.
-    pub(super) fn new(stream: &Arc<CudaStream>, fsai: &Fsai, n: usize) -> Result<Self> {
+    pub(super) fn new(device: &D, fsai: &Fsai, n: usize) -> Result<Self> {
         // Offsets below N, which fits an `int` (`CudaCore::new`).
         let layout = fsai.layout();
         let offsets: Vec<i32> = layout.offsets.iter().map(|&o| o as i32).collect();
         Ok(DeviceFsai {
             stride: layout.stride,
-            planes: zeros(stream, layout.stride * n)?,
-            offsets: stream
-                .clone_htod(&offsets)
-                .map_err(|e| cuda_error("cuMemcpyHtoD (FSAI offsets)", e))?,
-            y: zeros(stream, n)?,
+            planes: device.zeros(layout.stride * n)?,
+            offsets: device.upload("cuMemcpyHtoD (FSAI offsets)", &offsets)?,
+            y: device.zeros(n)?,
             synced: false,
         })
     }
@@ -67,39 +63,35 @@ impl DeviceFsai {
     /// Brings the planes up to date with `fsai` after its update: the refreshed rows
     /// through a scatter kernel, or the whole planes when the copy is not known to be
     /// current.
-    pub(super) fn sync(
-        &mut self,
-        stream: &Arc<CudaStream>,
-        kernels: &Kernels,
-        fsai: &Fsai,
-    ) -> Result<()> {
+    pub(super) fn sync(&mut self, device: &D, fsai: &Fsai) -> Result<()> {
         if !self.synced {
             // Every row: the planes as they are (no lists, no scratch on the device).
-            stream
-                .memcpy_htod(fsai.layout().planes, &mut self.planes)
-                .map_err(|e| cuda_error("cuMemcpyHtoD (FSAI planes)", e))?;
+            device.htod(
+                "cuMemcpyHtoD (FSAI planes)",
+                fsai.layout().planes,
+                &mut self.planes,
+            )?;
             self.synced = true;
             return Ok(());
         }
         self.synced = false;
         let (cells, weights) = rows_to_copy(fsai);
-        let Some(cfg) = over("FSAI weights to copy", weights.len())? else {
+        let Some(cfg) = device.over("FSAI weights to copy", weights.len())? else {
             self.synced = true;
             return Ok(());
         };
-        let copy = |e| cuda_error("cuMemcpyHtoD (FSAI rows)", e);
-        let cells_d = stream.clone_htod(&cells).map_err(copy)?;
-        let weights_d = stream.clone_htod(&weights).map_err(copy)?;
+        let copy = "cuMemcpyHtoD (FSAI rows)";
+        let cells_d = device.upload(copy, &cells)?;
+        let weights_d = device.upload(copy, &weights)?;
         let (count, stride, n) = (
             int("FSAI rows to copy", cells.len())?,
             int("FSAI pattern slots", self.stride)?,
-            int("grid cells", self.planes.len() / self.stride)?,
+            int("grid cells", D::len(&self.planes) / self.stride)?,
         );
         // SAFETY: `cells` holds `count` cells of the grid, `weights` `count * stride`
         // values, the planes `stride * n`.
         unsafe {
-            kernels.fsai_scatter(
-                stream,
+            device.fsai_scatter(
                 cfg,
                 &cells_d,
                 &weights_d,
@@ -117,27 +109,25 @@ impl DeviceFsai {
     #[allow(clippy::too_many_arguments)]
     pub(super) fn apply(
         &mut self,
-        stream: &Arc<CudaStream>,
-        kernels: &Kernels,
-        set: &CudaSlice<i32>,
-        pos: &CudaSlice<i32>,
-        r: &CudaSlice<f64>,
-        z: &mut CudaSlice<f64>,
+        device: &D,
+        set: &D::Buffer<i32>,
+        pos: &D::Buffer<i32>,
+        r: &D::Buffer<f64>,
+        z: &mut D::Buffer<f64>,
         m: usize,
     ) -> Result<()> {
-        let Some(cfg) = over("sites in the set", m)? else {
+        let Some(cfg) = device.over("sites in the set", m)? else {
             return Ok(());
         };
         let (stride, m32, n) = (
             int("FSAI pattern slots", self.stride)?,
             int("sites in the set", m)?,
-            int("grid cells", self.planes.len() / self.stride)?,
+            int("grid cells", D::len(&self.planes) / self.stride)?,
         );
         // SAFETY: set, r, y and z hold at least m values, pos and every plane n, offsets
         // `stride`.
         unsafe {
-            kernels.fsai_g(
-                stream,
+            device.fsai_g(
                 cfg,
                 &self.planes,
                 &self.offsets,
@@ -152,8 +142,7 @@ impl DeviceFsai {
         }?;
         // SAFETY: as above.
         unsafe {
-            kernels.fsai_gt(
-                stream,
+            device.fsai_gt(
                 cfg,
                 &self.planes,
                 &self.offsets,

@@ -1,18 +1,20 @@
 //! The kernels of kernels.cu as Rust sees them: each one's parameter list declared once
-//! ([`kernels!`] below), from which come both its typed launch function
-//! (`Kernels::scatter_rows(..)`, the bindings' argument list written by the macro, not by
-//! hand) and the declaration a test checks against kernels.cu's `extern "C"` signature
-//! (names, count, types). Also: the threads per block ([`THREADS`], passed to NVRTC and
-//! to the emulator's C++ compiler as `-DTHREADS`), the launch shapes with their sizes
-//! checked against the 32-bit integers the kernels and the driver take, and NVRTC.
+//! ([`kernels!`] below), from which come its [`Kernel`] name, its typed launch function
+//! on every [`Device`] (`device.scatter_rows(cfg, ..)`, [`Launch`]: the argument list
+//! written by the macro, not by hand) and the declaration a test checks against
+//! kernels.cu's `extern "C"` signature (names, count, types). Also: the threads per block
+//! ([`THREADS`], passed to NVRTC and to the emulator's C++ compiler as `-DTHREADS`), the
+//! launch shapes with their sizes checked against the 32-bit integers the kernels and the
+//! driver take, and NVRTC ([`Kernels`], the GPU's compiled functions).
 //!
 //! What a typed launch does not check: that the buffers hold the values the kernel reads
 //! and writes. That stays each caller's `unsafe` obligation.
 
-use super::device::{cuda_error, guarded, Gpu};
+use super::device::{guarded, Gpu};
+use super::seam::{Device, Elem, KernelId, Value};
 use crate::error::{Error, Result};
 use cudarc::cufft::sys::double2;
-use cudarc::driver::{CudaFunction, CudaSlice, CudaStream, LaunchConfig, PushKernelArg};
+use cudarc::driver::{CudaFunction, LaunchConfig};
 use cudarc::nvrtc::{compile_ptx_with_opts, CompileOptions, Ptx};
 use std::sync::OnceLock;
 
@@ -28,39 +30,6 @@ pub(super) const THREADS: u32 = 256;
 /// `c++` alike).
 pub(super) fn threads_define(threads: u32) -> String {
     format!("-DTHREADS={threads}")
-}
-
-/// `value` as the kernels' `int`, else [`Error::DeviceLimit`] naming `what`.
-pub(super) fn int(what: &'static str, value: usize) -> Result<i32> {
-    i32::try_from(value).map_err(|_| Error::DeviceLimit {
-        what,
-        value: value as u64,
-        limit: i32::MAX as u64,
-    })
-}
-
-/// `blocks` blocks of [`THREADS`] threads (a grid's x dimension is a `u32`).
-pub(super) fn blocks(what: &'static str, blocks: usize) -> Result<LaunchConfig> {
-    let grid = u32::try_from(blocks).map_err(|_| Error::DeviceLimit {
-        what,
-        value: blocks as u64,
-        limit: u32::MAX as u64,
-    })?;
-    Ok(LaunchConfig {
-        grid_dim: (grid, 1, 1),
-        block_dim: (THREADS, 1, 1),
-        shared_mem_bytes: 0,
-    })
-}
-
-/// One thread per element of `n`, `None` for none (a launch of no blocks is an error).
-/// The kernels index the elements with an `int`, so `n` must fit one.
-pub(super) fn over(what: &'static str, n: usize) -> Result<Option<LaunchConfig>> {
-    if n == 0 {
-        return Ok(None);
-    }
-    int(what, n)?;
-    blocks(what, n.div_ceil(THREADS as usize)).map(Some)
 }
 
 /// How a kernel parameter is passed.
@@ -133,30 +102,29 @@ pub(super) struct Declaration {
     pub(super) params: &'static [Param],
 }
 
-/// The Rust type of a launch argument.
+/// The Rust type of a launch argument on device `D`.
 macro_rules! arg_type {
-    (In, $t:ty) => { &CudaSlice<$t> };
-    (Out, $t:ty) => { &mut CudaSlice<$t> };
-    (Val, $t:ty) => { $t };
+    ($d:ident, In, $t:ty) => { &$d::Buffer<$t> };
+    ($d:ident, Out, $t:ty) => { &mut $d::Buffer<$t> };
+    ($d:ident, Val, $t:ty) => { $t };
 }
 
-/// Pushes a launch argument (the bindings take buffers by reference, values by a
-/// reference to a live copy).
-macro_rules! push_arg {
-    ($builder:ident, In, $v:ident) => {
-        $builder.arg($v)
+/// A launch argument as the seam's [`Arg`].
+macro_rules! to_arg {
+    ($d:ident, In, $t:ty, $v:ident) => {
+        <$t as Elem>::arg::<$d>($v)
     };
-    ($builder:ident, Out, $v:ident) => {
-        $builder.arg($v)
+    ($d:ident, Out, $t:ty, $v:ident) => {
+        <$t as Elem>::arg_mut::<$d>($v)
     };
-    ($builder:ident, Val, $v:ident) => {
-        $builder.arg(&$v)
+    ($d:ident, Val, $t:ty, $v:ident) => {
+        <$t as Value>::arg::<$d>($v)
     };
 }
 
 /// Declares the kernels: each one's parameters as `name: Pass<type>`, in kernels.cu's
-/// order. Generates [`DECLARATIONS`], the [`Kernels`] that loads them and one typed,
-/// `unsafe` launch function per kernel.
+/// order. Generates [`DECLARATIONS`], the [`Kernel`] names and one typed, `unsafe`
+/// launch function per kernel on every [`Device`] ([`Launch`]).
 macro_rules! kernels {
     ($( $name:ident ( $( $p:ident : $pass:ident < $t:ty > ),* $(,)? ); )*) => {
         /// Every kernel of kernels.cu, as the launch functions pass their arguments (the
@@ -173,50 +141,56 @@ macro_rules! kernels {
             }
         ),*];
 
-        /// The compiled kernels, one typed launch function each.
-        pub(super) struct Kernels {
-            $( $name: CudaFunction, )*
+        /// A kernel of kernels.cu, by its name there.
+        #[allow(non_camel_case_types)]
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        pub(crate) enum Kernel {
+            $( $name, )*
         }
 
-        impl Kernels {
-            /// Loads every declared kernel from `module`.
-            fn load(
-                module: &std::sync::Arc<cudarc::driver::CudaModule>,
-                unavailable: impl Fn(String) -> Error,
-            ) -> Result<Self> {
-                Ok(Kernels {$(
-                    $name: module.load_function(stringify!($name)).map_err(|e| {
-                        unavailable(format!(
-                            "kernel {} is missing from the module: {e}",
-                            stringify!($name)
-                        ))
-                    })?,
-                )*})
+        impl Kernel {
+            /// Every kernel, in declaration order (`kernel as usize` is its index).
+            pub(crate) const ALL: &[Kernel] = &[$( Kernel::$name, )*];
+
+            /// Its name in kernels.cu.
+            pub(crate) fn name(self) -> &'static str {
+                match self {
+                    $( Kernel::$name => stringify!($name), )*
+                }
             }
 
+            /// As a device finds it.
+            pub(crate) fn id(self) -> KernelId {
+                KernelId {
+                    index: self as usize,
+                    name: self.name(),
+                }
+            }
+        }
+
+        /// The typed launches: one function per kernel, on any [`Device`].
+        pub(super) trait Launch: Device {
             $(
-                #[doc = concat!("Launches kernels.cu's `", stringify!($name), "` on `stream`.")]
+                #[doc = concat!("Launches kernels.cu's `", stringify!($name), "`.")]
                 ///
                 /// # Safety
                 /// Every buffer holds the values the kernel reads or writes under `cfg`
                 /// (kernels.cu says which). The argument types are the declaration's.
                 #[allow(clippy::too_many_arguments)]
-                pub(super) unsafe fn $name(
+                unsafe fn $name(
                     &self,
-                    stream: &CudaStream,
                     cfg: LaunchConfig,
-                    $( $p: arg_type!($pass, $t), )*
+                    $( $p: arg_type!(Self, $pass, $t), )*
                 ) -> Result<()> {
-                    let mut builder = stream.launch_builder(&self.$name);
-                    $( push_arg!(builder, $pass, $p); )*
+                    let mut args = [$( to_arg!(Self, $pass, $t, $p), )*];
                     // SAFETY: the argument list is the declaration's, which the tests
                     // check against kernels.cu; the buffers' sizes are the caller's.
-                    unsafe { builder.launch(cfg) }
-                        .map(|_| ())
-                        .map_err(|e| cuda_error(stringify!($name), e))
+                    unsafe { self.launch(Kernel::$name.id(), cfg, &mut args) }
                 }
             )*
         }
+
+        impl<D: Device + ?Sized> Launch for D {}
     };
 }
 
@@ -277,7 +251,17 @@ kernels! {
     );
 }
 
+/// The kernels compiled and loaded on a GPU, one function per [`Kernel`] (by index).
+pub(super) struct Kernels {
+    functions: Vec<CudaFunction>,
+}
+
 impl Kernels {
+    /// The loaded function of `kernel`.
+    pub(super) fn function(&self, kernel: KernelId) -> &CudaFunction {
+        &self.functions[kernel.index]
+    }
+
     /// Compiles kernels.cu (once per process) and loads its functions on `gpu`.
     pub(super) fn compile(gpu: &Gpu) -> Result<Self> {
         let unavailable = |reason: String| Error::CudaUnavailable {
@@ -304,7 +288,18 @@ impl Kernels {
                 .map_err(|e| format!("the driver does not load the compiled kernels: {e}"))
         })
         .map_err(unavailable)?;
-        Kernels::load(&module, unavailable)
+        let functions = Kernel::ALL
+            .iter()
+            .map(|k| {
+                module.load_function(k.name()).map_err(|e| {
+                    unavailable(format!(
+                        "kernel {} is missing from the module: {e}",
+                        k.name()
+                    ))
+                })
+            })
+            .collect::<Result<_>>()?;
+        Ok(Kernels { functions })
     }
 }
 
@@ -540,32 +535,5 @@ mod tests {
         assert!(SOURCE.contains("#ifndef THREADS\n#error"));
         assert!(!SOURCE.contains("#define THREADS"));
         assert_eq!(threads_define(THREADS), "-DTHREADS=256");
-    }
-
-    #[test]
-    fn sizes_past_the_kernels_integers_are_errors() {
-        assert_eq!(int("m", 7).unwrap(), 7);
-        let limit = i32::MAX as usize;
-        assert_eq!(int("m", limit).unwrap(), i32::MAX);
-        let e = int("sites in the set", limit + 1).unwrap_err();
-        assert!(
-            matches!(e, Error::DeviceLimit { what: "sites in the set", value, limit }
-                if value == 1 << 31 && limit == (1 << 31) - 1),
-            "{e:?}"
-        );
-        assert!(over("m", 0).unwrap().is_none());
-        let one = over("m", 1).unwrap().unwrap();
-        assert_eq!((one.grid_dim, one.block_dim), ((1, 1, 1), (THREADS, 1, 1)));
-        let last = over("m", limit).unwrap().unwrap();
-        assert_eq!(last.grid_dim.0, (limit as u32).div_ceil(THREADS));
-        assert!(matches!(
-            over("m", limit + 1),
-            Err(Error::DeviceLimit { .. })
-        ));
-        assert_eq!(blocks("b", u32::MAX as usize).unwrap().grid_dim.0, u32::MAX);
-        assert!(matches!(
-            blocks("b", u32::MAX as usize + 1),
-            Err(Error::DeviceLimit { what: "b", .. })
-        ));
     }
 }

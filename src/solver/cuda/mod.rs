@@ -5,6 +5,9 @@
 //! host. Per set solve the set, `d`, `b` and the warm start go up and the tractions and
 //! the displacements' grid product come back (a few `O(N)` copies).
 //!
+//! The launch code reaches the device through one seam (`seam.rs`'s `Device`): the GPU
+//! (`gpu.rs`) or, in the tests, the host emulator (`emulator.rs`), under the same code.
+//!
 //! Preconditioners: the host's choices. Cold solves take the restricted spectral inverse;
 //! warm normal solves FSAI (its rows built on the host, `fsai.rs`) with the coarse space
 //! of aggregates on large grids (`coarse.rs`, kept on the device); warm tangential solves
@@ -17,16 +20,20 @@
 mod coarse;
 mod device;
 mod fsai;
+mod gpu;
 mod kernels;
 mod libraries;
 mod memory;
 mod operator;
 mod phases;
+mod seam;
 mod timing;
 mod vectors;
 
 #[cfg(test)]
 mod emulated;
+#[cfg(test)]
+mod emulator;
 
 pub use device::{cuda_device, CudaDevice};
 pub use timing::{record_cuda_phase_times, CudaPhaseTimes};
@@ -40,54 +47,54 @@ use super::system::Compliance;
 use crate::error::{Error, Result};
 use crate::green::InfluencePlan;
 use coarse::DeviceCoarse;
-use cudarc::driver::CudaSlice;
-use device::{cuda_error, Gpu};
+use device::Gpu;
 use fsai::DeviceFsai;
+use gpu::Cuda;
 use kernels::Kernels;
 use operator::Transforms;
 use phases::{DevicePhases, DevicePrecond};
-use timing::{timed, timed_solve, Part};
+use seam::Device;
+use timing::{timed, timed_mut, timed_solve, Part};
 use vectors::SetVectors;
 
-/// The device's state kept between solves: kernels, plans, buffers, the operator's table
-/// and the spectral preconditioner's with its `d̄`.
-pub(crate) struct CudaCore {
-    gpu: Gpu,
-    kernels: Kernels,
-    transforms: Transforms,
-    vectors: SetVectors,
+/// The device's state kept between solves: plans, buffers, the operator's table and the
+/// spectral preconditioner's with its `d̄`. On the GPU ([`Cuda`]), or in the tests on the
+/// host emulator (`emulator.rs`): the same code.
+pub(crate) struct CudaCore<D: Device = Cuda> {
+    device: D,
+    transforms: Transforms<D>,
+    vectors: SetVectors<D>,
     plan: InfluencePlan,
     compliance: Compliance,
     /// Mean diagonal of `C_s` (m/Pa), Jacobi's elastic part.
     diag_c: f64,
-    operator: CudaSlice<f64>,
-    inverse: Option<(f64, CudaSlice<f64>)>,
+    operator: D::Buffer<f64>,
+    inverse: Option<(f64, D::Buffer<f64>)>,
     /// FSAI: the exact local entries of `C_s` and the factor on the host (built on first
     /// use), its copy on the device.
-    fsai: Option<(Entries, Fsai, DeviceFsai)>,
+    fsai: Option<(Entries, Fsai, DeviceFsai<D>)>,
     /// The two-level preconditioner's coarse space (built on first use).
-    coarse: Option<DeviceCoarse>,
+    coarse: Option<DeviceCoarse<D>>,
     /// The grid product of the last solve (`C_s f` on every cell).
-    grid: CudaSlice<f64>,
+    grid: D::Buffer<f64>,
 }
 
-impl std::fmt::Debug for CudaCore {
+impl<D: Device> std::fmt::Debug for CudaCore<D> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("CudaCore")
-            .field("gpu", &self.gpu)
+            .field("device", &self.device)
             .finish_non_exhaustive()
     }
 }
 
-impl CudaCore {
+impl CudaCore<Cuda> {
     /// Opens the GPU, checks its free memory against the estimate, compiles the kernels
     /// and allocates everything the solves use.
     pub(crate) fn new(plan: &InfluencePlan, compliance: Compliance) -> Result<Self> {
         let (nx, ny) = (plan.grid().nx(), plan.grid().ny());
-        let n = nx * ny;
         // The kernels index cells with an `int`: every cell, set position and offset
         // below is then one too.
-        kernels::int("grid cells", n)?;
+        seam::int("grid cells", nx * ny)?;
         let gpu = Gpu::open()?;
         memory::check_fits(
             &gpu.info.to_string(),
@@ -95,22 +102,33 @@ impl CudaCore {
             gpu.free_bytes()?,
         )?;
         let kernels = Kernels::compile(&gpu)?;
-        let stream = &gpu.stream;
+        CudaCore::on(Cuda { gpu, kernels }, plan, compliance)
+    }
+}
+
+impl<D: Device> CudaCore<D> {
+    /// Everything the solves use allocated on `device`.
+    fn on(device: D, plan: &InfluencePlan, compliance: Compliance) -> Result<Self> {
+        let (nx, ny) = (plan.grid().nx(), plan.grid().ny());
+        let n = nx * ny;
+        seam::int("grid cells", n)?;
         // cuFFT's symbols load with its first plan: a panic there is a library problem.
         let transforms = device::guarded("creating the cuFFT plans", || {
-            Transforms::new(stream, nx, ny).map_err(|e| e.to_string())
+            Transforms::new(&device, nx, ny).map_err(|e| e.to_string())
         })
         .map_err(|reason| Error::CudaUnavailable {
             reason,
             hint: libraries::HINT.to_string(),
         })?;
-        let vectors = SetVectors::new(stream, n)?;
-        let operator = upload(&gpu, &operator::table(plan, compliance, |e| e))?;
-        let grid = device::zeros::<f64>(stream, n)?;
+        let vectors = SetVectors::new(&device, n)?;
+        let operator = device.upload(
+            "cuMemcpyHtoD (DCT table)",
+            &operator::table(plan, compliance, |e| e),
+        )?;
+        let grid = device.zeros::<f64>(n)?;
         Ok(CudaCore {
             diag_c: compliance.mean_diagonal(plan),
-            gpu,
-            kernels,
+            device,
             transforms,
             vectors,
             plan: plan.clone(),
@@ -125,7 +143,8 @@ impl CudaCore {
 
     fn build_inverse(&mut self, mean_d: f64) -> Result<()> {
         let values = operator::table(&self.plan, self.compliance, |e| 1.0 / (e + mean_d));
-        self.inverse = Some((mean_d, upload(&self.gpu, &values)?));
+        let table = self.device.upload("cuMemcpyHtoD (DCT table)", &values)?;
+        self.inverse = Some((mean_d, table));
         Ok(())
     }
 
@@ -171,35 +190,52 @@ impl CudaCore {
                 found: m,
             });
         }
-        let stream = self.gpu.stream.clone();
         let upkeep = Part::PreconditionerUpkeep;
         if precond == Precond::Spectral {
             if let Some(mean_d) = stale_mean(self.preconditioner_mean(), problem.d) {
-                timed(&stream, upkeep, || self.build_inverse(mean_d))?;
+                self.timed(upkeep, |core| core.build_inverse(mean_d))?;
             }
         }
         if matches!(precond, Precond::Fsai | Precond::TwoLevel) {
-            timed(&stream, upkeep, || {
-                self.prepare_fsai(problem, effort.parallelism)
+            self.timed(upkeep, |core| {
+                core.prepare_fsai(problem, effort.parallelism)
             })?;
         }
-        timed(&stream, Part::Copies, || self.upload_problem(problem, &f))?;
+        self.timed(Part::Copies, |core| core.upload_problem(problem, &f))?;
         if precond == Precond::TwoLevel {
-            timed(&stream, Part::CoarseUpkeep, || self.prepare_coarse(problem))?;
+            self.timed(Part::CoarseUpkeep, |core| core.prepare_coarse(problem))?;
         }
-        let stream = &self.gpu.stream;
+        let norm = self.compliance.norm + problem.d.iter().fold(0.0f64, |a, x| a.max(*x));
+        let mut phases = self.phases(precond, m, norm);
+        let outcome = run_cg(&mut phases, m, max_abs(problem.b), problem.total, effort)?;
+        // The displacements' product `C_s f` on every cell, of the returned `f`.
+        self.timed(Part::Operator, |core| core.grid_product())?;
+        let (device, v) = (&self.device, &self.vectors);
+        let mut grid_product = vec![0.0; n];
+        timed(device, Part::Copies, || {
+            device.dtoh("cuMemcpyDtoH (tractions)", &v.f, &mut f)?;
+            device.dtoh("cuMemcpyDtoH (grid product)", &self.grid, &mut grid_product)?;
+            device.synchronize("cuStreamSynchronize (solve results)")
+        })?;
+        Ok(SetSolve {
+            f,
+            outcome,
+            grid_product,
+        })
+    }
+
+    /// The phases of a solve of the `m` sites on the device with `precond` (its state
+    /// prepared); `norm` bounds `‖A‖₂`.
+    fn phases(&mut self, precond: Precond, m: usize, norm: f64) -> DevicePhases<'_, D> {
         let device_precond = match (precond, &self.inverse, &mut self.fsai) {
             (Precond::Spectral, Some((_, table)), _) => DevicePrecond::Spectral { table },
-            (Precond::Fsai | Precond::TwoLevel, _, Some((_, _, device))) => {
-                DevicePrecond::Fsai(device)
-            }
+            (Precond::Fsai | Precond::TwoLevel, _, Some((_, _, copy))) => DevicePrecond::Fsai(copy),
             _ => DevicePrecond::Jacobi {
                 diag_c: self.diag_c,
             },
         };
-        let mut phases = DevicePhases {
-            stream,
-            kernels: &self.kernels,
+        DevicePhases {
+            device: &self.device,
             transforms: &mut self.transforms,
             operator: &self.operator,
             v: &mut self.vectors,
@@ -209,73 +245,52 @@ impl CudaCore {
                 _ => None,
             },
             m,
-            norm: self.compliance.norm + problem.d.iter().fold(0.0f64, |a, x| a.max(*x)),
-        };
-        let outcome = run_cg(&mut phases, m, max_abs(problem.b), problem.total, effort)?;
-        // The displacements' product `C_s f` on every cell, of the returned `f`.
+            norm,
+        }
+    }
+
+    /// `C_s f` on every cell into `grid`, `f` the set vector on the device.
+    fn grid_product(&mut self) -> Result<()> {
         let v = &self.vectors;
-        timed(stream, Part::Operator, || {
-            self.transforms
-                .filter(stream, &self.kernels, &self.operator, &v.f, &v.pos)?;
-            self.transforms
-                .gather_grid(stream, &self.kernels, &mut self.grid)
-        })?;
-        let mut grid_product = vec![0.0; n];
-        timed(stream, Part::Copies, || {
-            if m > 0 {
-                stream
-                    .memcpy_dtoh(&v.f.slice(0..m), f.as_mut_slice())
-                    .map_err(|e| cuda_error("cuMemcpyDtoH (tractions)", e))?;
-            }
-            stream
-                .memcpy_dtoh(&self.grid, grid_product.as_mut_slice())
-                .map_err(|e| cuda_error("cuMemcpyDtoH (grid product)", e))?;
-            stream
-                .synchronize()
-                .map_err(|e| cuda_error("cuStreamSynchronize (solve results)", e))
-        })?;
-        Ok(SetSolve {
-            f,
-            outcome,
-            grid_product,
-        })
+        self.transforms
+            .filter(&self.device, &self.operator, &v.f, &v.pos)?;
+        self.transforms.gather_grid(&self.device, &mut self.grid)
     }
 
     /// The FSAI factor brought up to date for the problem's set and compliances on the
     /// host (the rows around changed sites), then its refreshed rows copied. Its table of
     /// exact entries is built on first use on `parallelism`'s threads.
     fn prepare_fsai(&mut self, problem: SetProblem<'_>, parallelism: Parallelism) -> Result<()> {
-        let stream = &self.gpu.stream;
-        let (entries, fsai, device) = match &mut self.fsai {
+        let device = &self.device;
+        let (entries, fsai, copy) = match &mut self.fsai {
             Some(built) => built,
             slot => {
                 let grid = self.plan.grid();
                 let Compliance { scale, shift, .. } = self.compliance;
                 let fsai = Fsai::new(grid.nx(), grid.len(), FSAI_RADIUS);
-                let device = DeviceFsai::new(stream, &fsai, grid.len())?;
+                let copy = DeviceFsai::new(device, &fsai, grid.len())?;
                 let entries = Entries::new(&self.plan, scale, shift, parallelism)?;
-                slot.insert((entries, fsai, device))
+                slot.insert((entries, fsai, copy))
             }
         };
         fsai.update(entries, problem.set, problem.d);
-        device.sync(stream, &self.kernels, fsai)
+        copy.sync(device, fsai)
     }
 
     /// The coarse space brought up to date for the problem's set and compliances (already
     /// on the device). After a failure its state is dropped: the next solve builds it
     /// anew rather than trust a half-updated `E`.
     fn prepare_coarse(&mut self, problem: SetProblem<'_>) -> Result<()> {
-        let stream = &self.gpu.stream;
+        let device = &self.device;
         let coarse = match &mut self.coarse {
             Some(built) => built,
             slot => {
                 let grid = self.plan.grid();
-                slot.insert(DeviceCoarse::new(stream, grid.nx(), grid.ny())?)
+                slot.insert(DeviceCoarse::new(device, grid.nx(), grid.ny())?)
             }
         };
         let updated = coarse.update(
-            stream,
-            &self.kernels,
+            device,
             &mut self.transforms,
             &self.operator,
             &mut self.vectors,
@@ -298,27 +313,28 @@ impl CudaCore {
         for (j, &i) in problem.set.iter().enumerate() {
             pos[i] = j as i32;
         }
-        let stream = &self.gpu.stream;
+        let device = &self.device;
         let v = &mut self.vectors;
-        let copy = |e| cuda_error("cuMemcpyHtoD (set problem)", e);
-        stream.memcpy_htod(&pos, &mut v.pos).map_err(copy)?;
+        let copy = "cuMemcpyHtoD (set problem)";
+        device.htod(copy, &pos, &mut v.pos)?;
         if m > 0 {
-            stream
-                .memcpy_htod(&set, &mut v.set.slice_mut(0..m))
-                .map_err(copy)?;
-            for (host, device) in [(problem.d, &mut v.d), (problem.b, &mut v.b), (f, &mut v.f)] {
-                stream
-                    .memcpy_htod(host, &mut device.slice_mut(0..m))
-                    .map_err(copy)?;
+            device.htod(copy, &set, &mut v.set)?;
+            for (host, on_device) in [(problem.d, &mut v.d), (problem.b, &mut v.b), (f, &mut v.f)] {
+                device.htod(copy, host, on_device)?;
             }
         }
         Ok(())
+    }
+
+    /// Runs `f` on this core, its time added to `part` when [`timing`] records.
+    fn timed<T>(&mut self, part: Part, f: impl FnOnce(&mut Self) -> Result<T>) -> Result<T> {
+        timed_mut(self, |core| timing::sync(&core.device), part, f)
     }
 }
 
 /// The spectral rule on the GPU: the host's preconditioner choices and `d̄`, so a
 /// checkpoint resumes across the two backends.
-impl SpectralRule for CudaCore {
+impl<D: Device> SpectralRule for CudaCore<D> {
     fn solve(
         &mut self,
         problem: SetProblem<'_>,
@@ -354,15 +370,8 @@ impl SpectralRule for CudaCore {
 /// The buffers free themselves on the context's stream, which is the calling thread's
 /// current context's: a solver dropped on another thread (Python's garbage collector)
 /// would leak them without this.
-impl Drop for CudaCore {
+impl<D: Device> Drop for CudaCore<D> {
     fn drop(&mut self) {
-        let _ = self.gpu.ctx.bind_to_thread();
+        self.device.bind_to_thread();
     }
-}
-
-/// A host table to the device.
-fn upload(gpu: &Gpu, values: &[f64]) -> Result<CudaSlice<f64>> {
-    gpu.stream
-        .clone_htod(values)
-        .map_err(|e| cuda_error("cuMemcpyHtoD (DCT table)", e))
 }

@@ -3,41 +3,38 @@
 //! the phase's three scalars cross to the host (one small copy per reduction).
 
 use super::coarse::{DeviceCoarse, Target};
-use super::device::cuda_error;
 use super::fsai::DeviceFsai;
-use super::kernels::{blocks, int, over, Kernels, THREADS};
+use super::kernels::Launch;
 use super::operator::Transforms;
+use super::seam::{int, Device};
 use super::timing::{timed, Part};
 use super::vectors::{SetVectors, REDUCTION_BLOCKS};
 use crate::error::Result;
 use crate::solver::pcg::{Main, Phase, PhaseRunner, Pre};
-use cudarc::driver::{CudaSlice, CudaStream};
-use std::sync::Arc;
 
 /// The preconditioner of a device solve.
-pub(super) enum DevicePrecond<'a> {
+pub(super) enum DevicePrecond<'a, D: Device> {
     /// `z = r / (diag_c + d)`.
     Jacobi { diag_c: f64 },
     /// `z = P_S (C_s + d̄ I)⁻¹ P_S r` through its DCT table.
-    Spectral { table: &'a CudaSlice<f64> },
+    Spectral { table: &'a D::Buffer<f64> },
     /// `z = Gᵀ G r`, the host's FSAI factor copied to the device.
-    Fsai(&'a mut DeviceFsai),
+    Fsai(&'a mut DeviceFsai<D>),
 }
 
 /// One set solve's phases on the device.
-pub(super) struct DevicePhases<'a> {
-    pub(super) stream: &'a Arc<CudaStream>,
-    pub(super) kernels: &'a Kernels,
-    pub(super) transforms: &'a mut Transforms,
-    pub(super) operator: &'a CudaSlice<f64>,
-    pub(super) v: &'a mut SetVectors,
-    pub(super) precond: DevicePrecond<'a>,
+pub(super) struct DevicePhases<'a, D: Device> {
+    pub(super) device: &'a D,
+    pub(super) transforms: &'a mut Transforms<D>,
+    pub(super) operator: &'a D::Buffer<f64>,
+    pub(super) v: &'a mut SetVectors<D>,
+    pub(super) precond: DevicePrecond<'a, D>,
     /// Sites in the set.
     pub(super) m: usize,
     /// `‖A‖₂` bound (m/Pa).
     pub(super) norm: f64,
     /// The coarse space, when it applies (A-DEF2: pcg.rs).
-    pub(super) coarse: Option<&'a mut DeviceCoarse>,
+    pub(super) coarse: Option<&'a mut DeviceCoarse<D>>,
 }
 
 /// Which vectors a product reads and writes.
@@ -51,52 +48,52 @@ enum Product {
     Coarse,
 }
 
-impl PhaseRunner for DevicePhases<'_> {
+impl<D: Device> PhaseRunner for DevicePhases<'_, D> {
     /// The phase's kernels, FFTs and copies; the first that fails stops the CG with its
     /// error (`Error::Cuda` naming the call).
     /// Each part is timed when [`super::timing`] records (docs/gpu.md).
     fn run(&mut self, phase: Phase) -> Result<[f64; 3]> {
-        let stream = self.stream;
-        timed(stream, Part::Updates, || self.pre(phase.pre))?;
-        timed(stream, Part::Preconditioner, || self.prolong(phase.pre))?;
+        let device = self.device;
+        timed(device, Part::Updates, || self.pre(phase.pre))?;
+        timed(device, Part::Preconditioner, || self.prolong(phase.pre))?;
         let reductions = Part::Reductions;
         match phase.main {
             Main::Nothing => Ok([0.0; 3]),
             Main::SumF => {
-                let [s, _, _] = timed(stream, reductions, || {
+                let [s, _, _] = timed(device, reductions, || {
                     self.reduce(0, Vector::F, Vector::F, Vector::F)
                 })?;
                 Ok([s, 0.0, 0.0])
             }
             Main::Direction { .. } => {
-                timed(stream, Part::Operator, || self.product(Product::Direction))?;
-                let [pq, _, _] = timed(stream, reductions, || {
+                timed(device, Part::Operator, || self.product(Product::Direction))?;
+                let [pq, _, _] = timed(device, reductions, || {
                     self.reduce(1, Vector::P, Vector::Q, Vector::Q)
                 })?;
                 Ok([pq, 0.0, 0.0])
             }
             Main::Residual { offset, .. } => {
-                timed(stream, Part::Operator, || self.product(Product::Residual))?;
-                timed(stream, Part::Updates, || self.residual_tail(offset))?;
+                timed(device, Part::Operator, || self.product(Product::Residual))?;
+                timed(device, Part::Updates, || self.residual_tail(offset))?;
                 Ok([0.0; 3])
             }
             Main::Precondition { .. } => {
-                timed(stream, Part::Preconditioner, || self.precondition())?;
-                let [s, _, _] = timed(stream, reductions, || {
+                timed(device, Part::Preconditioner, || self.precondition())?;
+                let [s, _, _] = timed(device, reductions, || {
                     self.reduce(0, Vector::Z, Vector::Z, Vector::Z)
                 })?;
                 Ok([s, 0.0, 0.0])
             }
-            Main::Measure => timed(stream, reductions, || {
+            Main::Measure => timed(device, reductions, || {
                 self.reduce(2, Vector::R, Vector::F, Vector::Z)
             }),
             Main::CoarseProduct { .. } => {
-                timed(stream, Part::Operator, || self.product(Product::Coarse))?;
-                timed(stream, Part::Preconditioner, || self.restrict(true))?;
+                timed(device, Part::Operator, || self.product(Product::Coarse))?;
+                timed(device, Part::Preconditioner, || self.restrict(true))?;
                 Ok([0.0; 3])
             }
             Main::Restrict => {
-                timed(stream, Part::Preconditioner, || self.restrict(false))?;
+                timed(device, Part::Preconditioner, || self.restrict(false))?;
                 Ok([0.0; 3])
             }
         }
@@ -116,15 +113,15 @@ impl PhaseRunner for DevicePhases<'_> {
     }
     fn coarse_solve(&mut self) -> Result<()> {
         match self.coarse.as_deref_mut() {
-            Some(coarse) => timed(self.stream, Part::Preconditioner, || {
-                coarse.solve(self.stream, self.kernels)
+            Some(coarse) => timed(self.device, Part::Preconditioner, || {
+                coarse.solve(self.device)
             }),
             None => Ok(()),
         }
     }
 }
 
-impl DevicePhases<'_> {
+impl<D: Device> DevicePhases<'_, D> {
     /// `Zᵀ (r - t)` (`with_t`) or `Zᵀ r`, for the next coarse solve (asked only when the
     /// coarse space applies).
     fn restrict(&mut self, with_t: bool) -> Result<()> {
@@ -133,7 +130,7 @@ impl DevicePhases<'_> {
         };
         let v = &*self.v;
         let t = with_t.then_some(&v.t);
-        coarse.restrict(self.stream, self.kernels, &v.r, t, &v.pos, Target::Rhs)
+        coarse.restrict(self.device, &v.r, t, &v.pos, Target::Rhs)
     }
 
     /// The prolongations a phase's updates ask for, after the others: `f -= Z y`,
@@ -144,10 +141,10 @@ impl DevicePhases<'_> {
         };
         let v = &mut *self.v;
         if pre.coarse_f {
-            coarse.prolong(self.stream, self.kernels, &mut v.f, -1.0, &v.set, self.m)?;
+            coarse.prolong(self.device, &mut v.f, -1.0, &v.set, self.m)?;
         }
         if pre.coarse_z {
-            coarse.prolong(self.stream, self.kernels, &mut v.z, 1.0, &v.set, self.m)?;
+            coarse.prolong(self.device, &mut v.z, 1.0, &v.set, self.m)?;
         }
         Ok(())
     }
@@ -194,15 +191,14 @@ impl DevicePhases<'_> {
         if flags == 0 {
             return Ok(());
         }
-        let Some(cfg) = over("sites in the set", self.m)? else {
+        let Some(cfg) = self.device.over("sites in the set", self.m)? else {
             return Ok(());
         };
         let m = int("sites in the set", self.m)?;
         let v = &mut *self.v;
         // SAFETY: every vector holds at least m values.
         unsafe {
-            self.kernels.pre_updates(
-                self.stream,
+            self.device.pre_updates(
                 cfg,
                 &mut v.f,
                 &mut v.r,
@@ -230,23 +226,20 @@ impl DevicePhases<'_> {
             Product::Coarse => (&v.z, &mut v.t),
         };
         self.transforms
-            .filter(self.stream, self.kernels, self.operator, x, &v.pos)?;
+            .filter(self.device, self.operator, x, &v.pos)?;
         self.transforms
-            .gather_set(self.stream, self.kernels, &v.set, &v.d, x, y, true, self.m)
+            .gather_set(self.device, &v.set, &v.d, x, y, true, self.m)
     }
 
     /// `r += offset - b`.
     fn residual_tail(&mut self, offset: f64) -> Result<()> {
-        let Some(cfg) = over("sites in the set", self.m)? else {
+        let Some(cfg) = self.device.over("sites in the set", self.m)? else {
             return Ok(());
         };
         let m = int("sites in the set", self.m)?;
         let v = &mut *self.v;
         // SAFETY: r and b hold at least m values.
-        unsafe {
-            self.kernels
-                .residual_tail(self.stream, cfg, &mut v.r, &v.b, offset, m)
-        }
+        unsafe { self.device.residual_tail(cfg, &mut v.r, &v.b, offset, m) }
     }
 
     /// `z = M⁻¹ r`.
@@ -254,51 +247,40 @@ impl DevicePhases<'_> {
         let v = &mut *self.v;
         match &mut self.precond {
             DevicePrecond::Jacobi { diag_c } => {
-                let Some(cfg) = over("sites in the set", self.m)? else {
+                let Some(cfg) = self.device.over("sites in the set", self.m)? else {
                     return Ok(());
                 };
                 let m = int("sites in the set", self.m)?;
                 // SAFETY: r, d, z hold at least m values.
-                unsafe {
-                    self.kernels
-                        .jacobi(self.stream, cfg, &v.r, &v.d, *diag_c, &mut v.z, m)
-                }
+                unsafe { self.device.jacobi(cfg, &v.r, &v.d, *diag_c, &mut v.z, m) }
             }
             DevicePrecond::Spectral { table } => {
+                self.transforms.filter(self.device, table, &v.r, &v.pos)?;
                 self.transforms
-                    .filter(self.stream, self.kernels, table, &v.r, &v.pos)?;
-                self.transforms.gather_set(
-                    self.stream,
-                    self.kernels,
-                    &v.set,
-                    &v.d,
-                    &v.r,
-                    &mut v.z,
-                    false,
-                    self.m,
-                )
+                    .gather_set(self.device, &v.set, &v.d, &v.r, &mut v.z, false, self.m)
             }
-            DevicePrecond::Fsai(fsai) => fsai.apply(
-                self.stream,
-                self.kernels,
-                &v.set,
-                &v.pos,
-                &v.r,
-                &mut v.z,
-                self.m,
-            ),
+            DevicePrecond::Fsai(fsai) => {
+                fsai.apply(self.device, &v.set, &v.pos, &v.r, &mut v.z, self.m)
+            }
         }
     }
 
     /// A reduction in a fixed order (kernels.cu's modes: 0 `Σ a`, 1 `aᵀ b`, 2
     /// `[max |a|, max |b|, aᵀ c]`), its three values copied to the host.
     fn reduce(&mut self, mode: i32, a: Vector, b: Vector, c: Vector) -> Result<[f64; 3]> {
-        let count = self.m.div_ceil(THREADS as usize).clamp(1, REDUCTION_BLOCKS);
+        let device = self.device;
+        let count = self
+            .m
+            .div_ceil(device.threads() as usize)
+            .clamp(1, REDUCTION_BLOCKS);
         let (m, count32) = (
             int("sites in the set", self.m)?,
             int("reduction blocks", count)?,
         );
-        let (first, last) = (blocks("reduction blocks", count)?, blocks("one block", 1)?);
+        let (first, last) = (
+            device.blocks("reduction blocks", count)?,
+            device.blocks("one block", 1)?,
+        );
         let SetVectors {
             f,
             r,
@@ -310,7 +292,7 @@ impl DevicePhases<'_> {
             ..
         } = &mut *self.v;
         let (f, r, z, p, q) = (&*f, &*r, &*z, &*p, &*q);
-        let of = move |which: Vector| -> &CudaSlice<f64> {
+        let of = move |which: Vector| -> &D::Buffer<f64> {
             match which {
                 Vector::F => f,
                 Vector::R => r,
@@ -321,22 +303,12 @@ impl DevicePhases<'_> {
         };
         let (a, b, c) = (of(a), of(b), of(c));
         // SAFETY: a, b, c hold at least m values, `partials` 3 per block, `scalars` 3.
-        unsafe {
-            self.kernels
-                .reduce_partial(self.stream, first, mode, a, b, c, m, partials)
-        }?;
+        unsafe { device.reduce_partial(first, mode, a, b, c, m, partials) }?;
         // SAFETY: as above.
-        unsafe {
-            self.kernels
-                .reduce_final(self.stream, last, mode, partials, count32, scalars)
-        }?;
+        unsafe { device.reduce_final(last, mode, partials, count32, scalars) }?;
         let mut out = [0.0f64; 3];
-        self.stream
-            .memcpy_dtoh(scalars, out.as_mut_slice())
-            .map_err(|e| cuda_error("cuMemcpyDtoH (reduction)", e))?;
-        self.stream
-            .synchronize()
-            .map_err(|e| cuda_error("cuStreamSynchronize (reduction)", e))?;
+        device.dtoh("cuMemcpyDtoH (reduction)", scalars, &mut out)?;
+        device.synchronize("cuStreamSynchronize (reduction)")?;
         Ok(out)
     }
 }

@@ -4,9 +4,8 @@
 //! so a part's launch overhead counts with it (the GPU's own time per kernel is for a
 //! profiler).
 
-use super::device::cuda_error;
+use super::seam::Device;
 use crate::error::Result;
-use cudarc::driver::CudaStream;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
@@ -104,27 +103,37 @@ fn add(part: Option<Part>, seconds: f64) {
     *slot += seconds;
 }
 
-fn sync(stream: &CudaStream) -> Result<()> {
-    stream
-        .synchronize()
-        .map_err(|e| cuda_error("cuStreamSynchronize (phase timing)", e))
+/// Waits for `device` (a timed part's start and end).
+pub(super) fn sync<D: Device>(device: &D) -> Result<()> {
+    device.synchronize("cuStreamSynchronize (phase timing)")
 }
 
 /// Runs `f`, its time added to `part` when recording (the stream drained before and
 /// after, so the part's work is all inside). Parts do not nest: each caller times the
 /// outermost call of its part only.
-pub(super) fn timed<T>(
-    stream: &CudaStream,
+pub(super) fn timed<D: Device, T>(
+    device: &D,
     part: Part,
     f: impl FnOnce() -> Result<T>,
 ) -> Result<T> {
+    timed_mut(&mut (), |_| sync(device), part, |_| f())
+}
+
+/// [`timed`] of `f` on `state`, which `wait` drains (the device is part of the state `f`
+/// changes).
+pub(super) fn timed_mut<S, T>(
+    state: &mut S,
+    wait: impl Fn(&S) -> Result<()>,
+    part: Part,
+    f: impl FnOnce(&mut S) -> Result<T>,
+) -> Result<T> {
     if !recording() {
-        return f();
+        return f(state);
     }
-    sync(stream)?;
+    wait(state)?;
     let start = Instant::now();
-    let out = f()?;
-    sync(stream)?;
+    let out = f(state)?;
+    wait(state)?;
     add(Some(part), start.elapsed().as_secs_f64());
     Ok(out)
 }
