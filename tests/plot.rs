@@ -1948,7 +1948,7 @@ fn the_fig7_scene_records_the_stresses_just_before_the_first_precursor() {
     for part in [
         "200x7x100mm",
         "FN=6.25kN",
-        "topandrodshear,n=1",
+        "topandrodath=6mmshear,n=1",
         "seed1",
         "200x7cellsof1mm",
         "zP=2mm",

@@ -58,7 +58,7 @@ pub(super) fn draw_statistics(
     let run = !crate::output::layout::is_sweep(dir)?;
     let pooled = selection.wants(SIZES_FIGURE) || selection.wants(DROPS_FIGURE);
     let fronts_wanted = run && selection.wants(FRONTS_FIGURE);
-    if !pooled && !selection.wants(FRONTS_FIGURE) {
+    if !pooled && !fronts_wanted {
         return Ok(drawn);
     }
     let (_, points, _) = points(dir)?;
@@ -121,17 +121,6 @@ pub(super) fn draw_statistics(
             canvas,
             (DROPS_FIGURE, title, drops_axes),
             (&drops, Support::Continuous, "force_drop_N"),
-            &mut drawn,
-        )?;
-    }
-    // A sweep: the fronts' medians and quartiles over each point's runs.
-    if !run && selection.wants(FRONTS_FIGURE) {
-        super::fronts::ensemble_fronts(
-            dir,
-            extensions,
-            canvas,
-            (title, label),
-            &points,
             &mut drawn,
         )?;
     }

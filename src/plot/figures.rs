@@ -18,6 +18,7 @@
 //! that the directory allows them.
 
 use super::distributions::draw_statistics;
+use super::fronts::ensemble_fronts;
 use super::paper::{draw_archard, draw_stick_slip};
 use super::profiles::draw_profiles;
 use super::relations::draw_relations;
@@ -28,7 +29,8 @@ use crate::error::{Error, Result};
 use crate::output::check::RunRecord;
 use crate::output::derived::derive;
 use crate::output::layout::{
-    ARCHARD_FIGURE, AREA_FIGURE, FIGURES, MAP_FIGURE, PRECURSOR_FIGURE, STICK_SLIP_FIGURE,
+    ARCHARD_FIGURE, AREA_FIGURE, FIGURES, FRONTS_FIGURE, MAP_FIGURE, PRECURSOR_FIGURE,
+    STICK_SLIP_FIGURE,
 };
 use crate::output::MAP_STEP;
 use crate::sweep::{merge, MergeSummary, MEDIAN_BAND_RUNS, SWEEP_FILE};
@@ -212,7 +214,9 @@ pub struct DrawOptions {
     /// The names of the figures to draw (`precursor_length`, `contact_area`,
     /// `contact_map`, `stick_slip`, `archard`, `fronts`, `avalanche_sizes`,
     /// `force_drops`, `slip_profiles`, `shear_profiles`, `normal_profiles`,
-    /// `coulomb_profiles`); empty (the default): every figure the directory allows.
+    /// `coulomb_profiles`, and from `precursors stats`' tables `drop_against_size`,
+    /// `potency_against_size`, `collapse`); empty (the default): every figure the
+    /// directory allows.
     pub figures: Vec<String>,
 }
 
@@ -371,6 +375,13 @@ pub fn draw_with_options(dir: &Path, options: &DrawOptions) -> Result<Drawn, Plo
     let statistics = draw_statistics(dir, &extensions, canvas, (&title, point_label), &selection)?;
     drawn.files.extend(statistics.files);
     drawn.notes.extend(statistics.notes);
+    if sweep && selection.wants(FRONTS_FIGURE) {
+        // The fronts' medians and quartiles over each point's runs.
+        let (_, points, _) = crate::sweep::stats::points(dir)?;
+        let fronts = ensemble_fronts(dir, &extensions, canvas, (&title, point_label), &points)?;
+        drawn.files.extend(fronts.files);
+        drawn.notes.extend(fronts.notes);
+    }
     let relations = draw_relations(dir, &extensions, canvas, (&title, point_label), &selection)?;
     drawn.files.extend(relations.files);
     drawn.notes.extend(relations.notes);

@@ -89,8 +89,8 @@ pub(super) fn ensemble_fronts(
     canvas: Canvas,
     (title, label): (&str, PointLabel),
     points: &[Point],
-    drawn: &mut Statistics,
-) -> Result<(), PlotError> {
+) -> Result<Statistics, PlotError> {
+    let mut drawn = Statistics::default();
     let (colours, order) = point_order(&points.iter().map(|p| &p.values[..]).collect::<Vec<_>>());
     let mut chart = canvas
         .chart(
@@ -146,7 +146,7 @@ pub(super) fn ensemble_fronts(
         drawn.notes.push(format!(
             "no {FRONTS_FIGURE} figure: the sweep has no complete run"
         ));
-        return Ok(());
+        return Ok(drawn);
     }
     chart = chart
         .note("ℓ: columns below their zero-shear area; x_D: columns with half their contacts lost");
@@ -155,7 +155,7 @@ pub(super) fn ensemble_fronts(
         chart.save(&path)?;
         drawn.files.push(path);
     }
-    Ok(())
+    Ok(drawn)
 }
 
 #[cfg(test)]
