@@ -130,6 +130,9 @@ pub(super) struct Test {
     pub p: f64,
 }
 
+/// The cut-off law's `α` with its interval and `1/λ` with its interval (`None`: infinite).
+pub(super) type CutoffFits = ((f64, f64, f64), [Option<f64>; 3]);
+
 /// A distribution's fits as a figure draws them: the power law and, where `stats` compared
 /// them, the cut-off law and the tests (`power_laws.csv`'s row, or
 /// [`crate::statistics::compare_alternatives`]'s result).
@@ -145,7 +148,7 @@ pub(super) struct Fits {
     /// The goodness-of-fit p-value (none when not computed).
     pub p: Option<f64>,
     /// The cut-off law: `α` and its interval, `1/λ` and its interval (`None`: infinite).
-    pub cutoff: Option<((f64, f64, f64), [Option<f64>; 3])>,
+    pub cutoff: Option<CutoffFits>,
     /// Power law against exponential, log-normal and cut-off law; cut-off law against
     /// log-normal.
     pub tests: Option<[Test; 4]>,

@@ -451,7 +451,9 @@ pub(crate) fn cutoff_density(
         alpha,
         mu: lambda * x_min,
     };
-    if x.is_nan() || x < x_min || !(x_min > 0.0) || !(lambda >= 0.0) {
+    // NaN anywhere fails a comparison: no law there.
+    let within = x >= x_min && x_min > 0.0 && lambda >= 0.0;
+    if !within {
         return 0.0;
     }
     let norm = match support {
