@@ -27,11 +27,14 @@
 mod distributions;
 mod error;
 mod figures;
+mod fronts;
 mod movie;
 mod paper;
 mod profiles;
+mod relations;
 mod scaled;
 mod selection;
+mod tables;
 
 pub use error::PlotError;
 pub use figures::{draw, draw_with_options, draw_with_size, DrawOptions, Drawn, Format};
@@ -402,6 +405,8 @@ struct Series {
     points: Vec<(f64, f64)>,
     /// `(x, lower, upper)`: a shaded band under the line.
     band: Vec<(f64, f64, f64)>,
+    /// `(x, lower, upper)`: a vertical error bar at each marker ([`Chart::error_bars`]).
+    errors: Vec<(f64, f64, f64)>,
     style: Style,
 }
 
@@ -585,6 +590,7 @@ impl Chart {
             kind,
             points,
             band: Vec::new(),
+            errors: Vec::new(),
             style: Style::default(),
         });
         self
@@ -615,6 +621,36 @@ impl Chart {
     /// Markers at `points`, no line.
     pub fn markers(self, label: &str, points: &[(f64, f64)]) -> Self {
         self.push(label, Kind::Markers, points.to_vec())
+    }
+
+    /// Markers at `(x, y)` with vertical error bars from `lower` to `upper`: `(x, y, lower,
+    /// upper)` (a density and its counting interval). Each bar is a line in the markers'
+    /// colour with a short cap at each end; a `lower` that is not finite, or not positive
+    /// on a logarithmic axis (the interval of a bin of one sample, `1 ± 1/√1`), runs the
+    /// bar down to the bottom of the chart, without a cap there.
+    ///
+    /// ```
+    /// use precursors::plot::Chart;
+    /// let dir = std::env::temp_dir().join(format!("precursors-doc-bars-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// let rows = [(1.0, 0.5, 0.4, 0.6), (10.0, 0.01, 0.0, 0.02)];
+    /// Chart::new("P(S)", "S", "P(S)").log_x().log_y().error_bars("counts", &rows)
+    ///     .save(dir.join("bars.svg"))?;
+    /// let svg = std::fs::read_to_string(dir.join("bars.svg"))?;
+    /// assert!(svg.contains("counts"));
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn error_bars(self, label: &str, rows: &[(f64, f64, f64, f64)]) -> Self {
+        let mut chart = self.push(
+            label,
+            Kind::Markers,
+            rows.iter().map(|r| (r.0, r.1)).collect(),
+        );
+        if let Some(s) = chart.series.last_mut() {
+            s.errors = rows.iter().map(|r| (r.0, r.2, r.3)).collect();
+        }
+        chart
     }
 
     /// A mean curve with its band: `(x, mean, lower, upper)`; the band is shaded in the
@@ -696,6 +732,9 @@ impl Chart {
                 s.band
                     .iter_mut()
                     .for_each(|b| *b = (lx(b.0), ly(b.1), ly(b.2)));
+                s.errors
+                    .iter_mut()
+                    .for_each(|b| *b = (lx(b.0), ly(b.1), ly(b.2)));
             }
             let (x, y) = drawn.ranges(path)?;
             return render(
@@ -734,6 +773,7 @@ impl Chart {
                 .iter()
                 .map(|p| p.1)
                 .chain(s.band.iter().flat_map(|b| [b.1, b.2]))
+                .chain(s.errors.iter().flat_map(|b| [b.1, b.2]))
         });
         let y = axis_range(path, "y", self.y_range, ys)?;
         Ok((x, y))
@@ -807,6 +847,7 @@ impl Draw for ChartDrawing<'_> {
                 chart
                     .draw_series(points.map(|p| Circle::new(*p, 3, colour.filled())))
                     .map_err(|e| e.to_string())?;
+                draw_error_bars(&mut chart, &s.errors, y.0, colour)?;
                 continue;
             }
             for run in finite_runs(&s.points, |p| [p.0, p.1]) {
@@ -831,6 +872,36 @@ impl Draw for ChartDrawing<'_> {
         )?;
         Ok(())
     }
+}
+
+/// The half width of an error bar's cap, in 1/150 inch.
+const CAP: i32 = 4;
+
+/// Vertical error bars `(x, lower, upper)` in the chart's drawn units: a line from
+/// `lower` (or `bottom` where `lower` is not finite) to `upper`, a cap at each finite end.
+fn draw_error_bars<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    errors: &[(f64, f64, f64)],
+    bottom: f64,
+    colour: RGBColor,
+) -> std::result::Result<(), String> {
+    let style = colour.stroke_width(1);
+    for &(x, lower, upper) in errors.iter().filter(|e| e.0.is_finite() && e.2.is_finite()) {
+        let low = if lower.is_finite() { lower } else { bottom };
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(x, low), (x, upper)],
+                style,
+            )))
+            .map_err(|e| e.to_string())?;
+        let ends = std::iter::once(upper).chain(lower.is_finite().then_some(lower));
+        chart
+            .draw_series(ends.map(|y| {
+                EmptyElement::at((x, y)) + PathElement::new(vec![(-CAP, 0), (CAP, 0)], style)
+            }))
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(())
 }
 
 /// A map of values on a regular grid of cells over `[x0, x1] x [y0, y1]`, with a colour

@@ -40,6 +40,7 @@ mod alternatives;
 mod scaling;
 mod special;
 
+pub(crate) use alternatives::cutoff_density;
 pub use alternatives::LikelihoodRatio;
 pub use scaling::{
     binned_means, classes_excluded, fit_collapse, fit_cutoff_scaling, fit_scaling, BinnedMean,

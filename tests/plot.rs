@@ -609,8 +609,8 @@ fn run_figures_say_the_scene_mark_global_slip_and_reach_one_on_the_load_axis() {
                 .clone(),
         )
     };
-    // The title names the scene of `scene()` (40 x 5 x 20 mm, 700 N, rod at 4 mm, seed 3),
-    // not the directory; `F_N` typeset: `N` a text of its own, smaller.
+    // The title names the scene of `scene()` (40 x 5 x 20 mm, 700 N, rod at 4 mm, seed 3,
+    // 1 mm cells), not the directory; `F_N` typeset: `N` a text of its own, smaller.
     let title: Vec<String> = texts("precursor_length.svg")
         .iter()
         .take(3)
@@ -621,7 +621,7 @@ fn run_figures_say_the_scene_mark_global_slip_and_reach_one_on_the_load_axis() {
         [
             "Precursor length: 40 x 5 x 20 mm, F",
             "N",
-            "= 700 N, rod at h = 4 mm, seed 3"
+            "= 700 N, rod at h = 4 mm, seed 3, 40 x 5 cells of 1 mm"
         ]
     );
     // Global slip: the load of events.csv's last row over μF_N (μ = 0.5, F_N = 700 N).
@@ -680,13 +680,16 @@ fn figures_take_the_size_asked_for_within_limits() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// The statistics figures show what the run's tables give: `avalanche_sizes` the power
-/// law fitted to the sizes of `per_avalanche.csv` (read here, the spanning avalanche and
-/// those after it left out) with its exponent and interval in the legend, on logarithmic axes
-/// labelled at the powers of ten; `fronts` both fronts.
+/// The statistics figures show what the run's tables give: `avalanche_sizes` the log-binned
+/// sizes of `per_avalanche.csv` (read here, the spanning avalanche and those after it
+/// left out) with a counting error bar on every non-empty bin, and the power law with
+/// `n_tail`, its goodness p and the preferred model in the legend: computed as `stats`
+/// would with its defaults while the directory has no `power_laws.csv`, `stats`' own
+/// numbers once it has (read here from the table); on logarithmic axes labelled at the
+/// powers of ten; `fronts` both fronts.
 #[test]
 fn statistics_figures_show_the_runs_fit_and_fronts() {
-    use precursors::statistics::{fit_power_law, PowerLawOptions, Support};
+    use precursors::statistics::{compare_alternatives, PowerLawOptions, Support};
     let dir = scratch("statistics");
     let scene = SceneBuilder::from_json_file(Path::new("examples/scenes/calibration.json"))
         .unwrap()
@@ -718,19 +721,32 @@ fn statistics_figures_show_the_runs_fit_and_fronts() {
         .iter()
         .map(|r| r[column("ruptures")].parse().unwrap())
         .collect();
-    let options = PowerLawOptions::default().goodness_samples(0);
-    let fit = fit_power_law(&sizes, Support::Discrete, &options).unwrap();
-    let texts: Vec<String> = svg_texts(&dir.join("avalanche_sizes.svg"))
-        .into_iter()
-        .map(|(_, t)| t)
-        .collect();
+    // No power_laws.csv: the fits `stats` would write with its default options.
+    let c = compare_alternatives(&sizes, Support::Discrete, &PowerLawOptions::default()).unwrap();
+    let fit = &c.power_law;
+    let p = fit.p_value.unwrap();
+    let texts = svg_words(&dir.join("avalanche_sizes.svg"));
+    let joined = squash(&texts.concat());
+    let status = if p <= 0.1 {
+        format!("(rejected, p = {p:.2})")
+    } else {
+        format!(", p = {p:.2}")
+    };
     let legend = format!(
-        "power law above {}: α = {:.2} [{:.2}, {:.2}] (95 %)",
-        fit.x_min, fit.alpha, fit.alpha_low, fit.alpha_high
+        "power law, S ≥ {}: α = {:.2} [{:.2}, {:.2}], n_{{tail}} = {}{status}",
+        fit.x_min, fit.alpha, fit.alpha_low, fit.alpha_high, fit.tail
     );
     assert!(
-        texts.iter().any(|t| t == &legend),
+        joined.contains(&squash(&legend.replace("_{tail}", "tail"))),
         "{legend} not in {texts:?}"
+    );
+    assert!(
+        joined.contains("fitscomputedherewiththedefaultsofstats"),
+        "{texts:?}"
+    );
+    assert!(
+        texts.iter().any(|t| t.starts_with("preferred: ")),
+        "{texts:?}"
     );
     assert!(texts
         .iter()
@@ -738,6 +754,92 @@ fn statistics_figures_show_the_runs_fit_and_fronts() {
     assert!(texts
         .iter()
         .any(|t| t.starts_with("Distribution of avalanche sizes")));
+    // `stats` run (few resamples, to be quick): the figure shows its table's numbers.
+    let options = precursors::sweep::StatsOptions::default().fit(
+        PowerLawOptions::default()
+            .bootstrap(30)
+            .goodness_samples(60)
+            .seed(5),
+    );
+    precursors::sweep::statistics(&dir, &options).unwrap();
+    draw(&dir, &[Format::Svg]).unwrap();
+    let table = read_csv(&dir.join("power_laws.csv"));
+    let row = table
+        .iter()
+        .find(|r| r["observable"] == "avalanche_ruptures")
+        .unwrap();
+    let cell = |name: &str| row[name].parse::<f64>().unwrap();
+    let p = cell("p_value");
+    let rejected = p <= 0.1;
+    let status = if rejected {
+        format!("(rejected, p = {p:.2})")
+    } else {
+        format!(", p = {p:.2}")
+    };
+    let legend = format!(
+        "power law, S ≥ {}: α = {:.2} [{:.2}, {:.2}], ntail = {}{status}",
+        cell("x_min"),
+        cell("alpha"),
+        cell("alpha_low"),
+        cell("alpha_high"),
+        row["tail"]
+    );
+    let svg_path = dir.join("avalanche_sizes.svg");
+    let texts = svg_words(&svg_path);
+    let joined = squash(&texts.concat());
+    assert!(
+        joined.contains(&squash(&legend)),
+        "{legend} not in {texts:?}"
+    );
+    assert!(!joined.contains("fitscomputedhere"), "{texts:?}");
+    // The preferred model: none that a test of the verdict column says another beats.
+    let preferred = texts
+        .iter()
+        .find_map(|t| t.strip_prefix("preferred: "))
+        .unwrap_or_else(|| panic!("no preferred model in {texts:?}"));
+    let verdict = &row["verdict"];
+    for model in ["power law", "exponential", "log-normal", "cut-off law"] {
+        if preferred.contains(model) && !preferred.starts_with("none") {
+            assert!(
+                !verdict.contains(&format!("preferred over {model}")),
+                "{preferred} against {verdict}"
+            );
+        }
+    }
+    if rejected {
+        assert!(!preferred.contains("power law"), "{preferred}");
+    }
+    // The solid curves (2 px, many vertices) in the series' colour: the power law unless
+    // rejected (then dashed: short pieces), the cut-off law where it is preferred.
+    let svg = std::fs::read_to_string(&svg_path).unwrap();
+    let blue = "#1F77B4";
+    let curves = svg_polylines(&svg, 2)
+        .iter()
+        .filter(|(stroke, v)| stroke == blue && v.len() > 20)
+        .count();
+    let cutoff_drawn = preferred.contains("cut-off law") && !row["cutoff_scale"].is_empty();
+    assert_eq!(
+        curves,
+        usize::from(!rejected) + usize::from(cutoff_drawn),
+        "{preferred}"
+    );
+    assert_eq!(joined.contains("cut-offlaw:α="), cutoff_drawn, "{texts:?}");
+    // One error bar (a vertical 1 px line in the series' colour) per non-empty bin of
+    // stats' distributions.csv.
+    let bins = read_csv(&dir.join("distributions.csv"))
+        .iter()
+        .filter(|r| r["observable"] == "avalanche_ruptures" && r["count"] != "0")
+        .count();
+    let bars = svg_polylines(&svg, 1)
+        .iter()
+        .filter(|(stroke, v)| stroke == blue && v.len() == 2 && v[0].0 == v[1].0)
+        .count();
+    assert!(bins > 3);
+    assert_eq!(bars, bins);
+    assert!(
+        joined.contains("errorbars:P(1±1/√count),thePoissoncountingerror"),
+        "{texts:?}"
+    );
     // Log axes: the y axis (the densities span more than two decades) labelled at every
     // power of ten between the binned densities, written 10⁻ⁿ; no "log" in any label.
     let densities: Vec<f64> = precursors::statistics::log_binned(&sizes, Support::Discrete, 5)
@@ -913,6 +1015,37 @@ fn spring_run(dir: &Path) {
         .unwrap()
         .run_to_slip(&mut driver, None, |_, _| {})
         .unwrap();
+}
+
+/// `text` without its spaces (an SVG text's leading space is an advance, not a character).
+fn squash(text: &str) -> String {
+    text.replace(' ', "")
+}
+
+/// A CSV table's rows as maps from its header's names to the cells (a quoted cell, with
+/// commas or `""` in it, read whole).
+fn read_csv(path: &Path) -> Vec<std::collections::HashMap<String, String>> {
+    let split = |line: &str| {
+        let mut cells = vec![String::new()];
+        let mut quoted = false;
+        let mut previous = ' ';
+        for c in line.chars() {
+            match c {
+                '"' if quoted && previous == '"' => {}
+                '"' => quoted = !quoted,
+                ',' if !quoted => cells.push(String::new()),
+                c => cells.last_mut().unwrap().push(c),
+            }
+            previous = c;
+        }
+        cells
+    };
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = split(lines.next().unwrap());
+    lines
+        .map(|l| header.iter().cloned().zip(split(l)).collect())
+        .collect()
 }
 
 /// The texts of an SVG, without their attributes.
@@ -1621,4 +1754,215 @@ fn a_png_has_the_pixels_of_its_resolution() {
         std::fs::read(dir.join("precursor_length.svg")).unwrap()
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The colours of an SVG's markers (`<circle>` fills), in order, each once.
+fn marker_colours(svg: &str) -> Vec<String> {
+    let mut colours: Vec<String> = Vec::new();
+    for tag in svg.split("<circle").skip(1) {
+        let Some(fill) = tag
+            .split_once("fill=\"")
+            .map(|t| t.1.split_once('"').unwrap().0)
+        else {
+            continue;
+        };
+        if fill != "none" && !colours.iter().any(|c| c == fill) {
+            colours.push(fill.to_string());
+        }
+    }
+    colours
+}
+
+/// Error bars of an SVG: vertical 1 px lines in a markers' colour.
+fn error_bars(svg: &str) -> usize {
+    let colours = marker_colours(svg);
+    svg_polylines(svg, 1)
+        .iter()
+        .filter(|(stroke, v)| colours.contains(stroke) && v.len() == 2 && v[0].0 == v[1].0)
+        .count()
+}
+
+/// The figures of `stats`' tables on a spring-driven sweep over `Lx` (three lengths, four
+/// runs each; the sweep of tests/statistics.rs' collapse): `drop_against_size` and
+/// `potency_against_size` carry each point's binned means with their intervals as error
+/// bars (one per row of `binned_means.csv` with an interval) and the exponent of
+/// `scaling.csv` with its interval in the legend; `collapse` the `τ` and `D` of
+/// `collapse.csv` with their intervals, and one error bar per bin of `distributions.csv`
+/// holding 3 avalanches or more; `fronts` of a sweep the median and quartiles of ℓ and
+/// of the damage front for each point. The title names the grid (`Δx = 1 mm`: `Lx` is
+/// the axis). Before these figures, the names were unknown and a sweep had no `fronts`.
+#[test]
+fn stats_tables_give_the_relation_collapse_and_ensemble_figures() {
+    use precursors::plot::{draw_with_options, DrawOptions};
+    use precursors::statistics::PowerLawOptions;
+    use precursors::sweep::{statistics, StatsOptions, Sweep, SweepOptions};
+    let dir = scratch("relations");
+    let sweep = Sweep::from_json_str(
+        r#"{
+        "base": { "block": { "lx": 0.02, "ly": 0.004, "lz": 0.01 },
+                  "cells": { "kind": "size", "dx": 0.001, "dy": 0.001 },
+                  "normal_load": 100.0,
+                  "drive": { "kind": "spring", "stiffness": 4e6, "lateral": { "kind": "side" } } },
+        "axes": [ { "keys": ["block.lx", "normal_load"],
+                    "values": [[0.02, 100.0], [0.04, 200.0], [0.08, 400.0]] } ],
+        "realizations": 4,
+        "seed": 9
+    }"#,
+    )
+    .unwrap();
+    sweep.execute(&dir, &SweepOptions::new(), |_| {}).unwrap();
+    let options = DrawOptions::default().formats(&[Format::Svg]).figures([
+        "drop_against_size",
+        "potency_against_size",
+        "collapse",
+        "fronts",
+    ]);
+    // Before `stats`: the tables' figures cannot be drawn, and say why.
+    let e = draw_with_options(&dir, &options).unwrap_err();
+    assert!(e.to_string().contains("precursors stats"), "{e}");
+    let fit = PowerLawOptions::default()
+        .bootstrap(10)
+        .goodness_samples(0)
+        .min_tail(5);
+    statistics(&dir, &StatsOptions::default().fit(fit)).unwrap();
+    let drawn = draw_with_options(&dir, &options).unwrap();
+    assert_eq!(drawn.files.len(), 4, "{:?}", drawn.notes);
+    let means = read_csv(&dir.join("binned_means.csv"));
+    let scaling = read_csv(&dir.join("scaling.csv"));
+    for (figure, relation) in [
+        ("drop_against_size", "force_drop_N_against_ruptures"),
+        ("potency_against_size", "potency_m3_against_ruptures"),
+    ] {
+        let path = dir.join(format!("{figure}.svg"));
+        let svg = std::fs::read_to_string(&path).unwrap();
+        let joined = squash(&svg_words(&path).concat());
+        let with_interval = means
+            .iter()
+            .filter(|r| r["relation"] == relation && !r["mean_high"].is_empty())
+            .count();
+        assert!(with_interval > 3, "{figure}");
+        assert_eq!(error_bars(&svg), with_interval, "{figure}");
+        for row in scaling.iter().filter(|r| r["relation"] == relation) {
+            let v = |c: &str| row[c].parse::<f64>().unwrap();
+            let legend = format!(
+                "β = {:.2} [{:.2}, {:.2}] (95 %), {} avalanches",
+                v("exponent"),
+                v("exponent_low"),
+                v("exponent_high"),
+                row["pairs"]
+            );
+            assert!(
+                joined.contains(&squash(&legend)),
+                "{figure}: {legend} not in {joined}"
+            );
+        }
+        assert!(joined.contains("Δx=1mm"), "{figure}: {joined}");
+    }
+    let collapse = read_csv(&dir.join("collapse.csv"));
+    let row = collapse
+        .iter()
+        .find(|r| r["observable"] == "avalanche_ruptures")
+        .unwrap();
+    let v = |c: &str| row[c].parse::<f64>().unwrap();
+    let legend = format!(
+        "τ = {:.2} [{:.2}, {:.2}], D = {:.2} [{:.2}, {:.2}] (95 %, collapse.csv)",
+        v("tau"),
+        v("tau_low"),
+        v("tau_high"),
+        v("d"),
+        v("d_low"),
+        v("d_high")
+    );
+    let path = dir.join("collapse.svg");
+    let svg = std::fs::read_to_string(&path).unwrap();
+    let words = svg_words(&path);
+    assert!(words.contains(&legend), "{legend} not in {words:?}");
+    let bins = read_csv(&dir.join("distributions.csv"))
+        .iter()
+        .filter(|r| {
+            r["observable"] == "avalanche_ruptures" && r["count"].parse::<usize>().unwrap() >= 3
+        })
+        .count();
+    assert!(bins > 3);
+    assert_eq!(error_bars(&svg), bins);
+    // The points (F_N typeset: `N` a subscript of its own).
+    let points = [
+        "Lx=20mm,FN=100N(4runs)",
+        "Lx=40mm,FN=200N(4runs)",
+        "Lx=80mm,FN=400N(4runs)",
+    ];
+    let joined = squash(&words.concat());
+    for point in points {
+        assert!(joined.contains(point), "{point} not in {words:?}");
+    }
+    // The ensemble fronts: both bands of each point.
+    let fronts = squash(&svg_words(&dir.join("fronts.svg")).concat());
+    for point in points {
+        for front in ["ℓ/Lx", "xD/Lx"] {
+            let entry = format!("{front},medianandquartiles:{point}");
+            assert!(fronts.contains(&entry), "{entry} not in {fronts}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The paper's Fig. 7 on its own set-up (`examples/scenes/fig7.json`: 200 x 7 x 100 mm,
+/// 1 mm cells, `F_N` = 6.25 kN, rod and top sheared together, `F_top = F_lat`): the
+/// profiles it records are those of its last stable state before `ℓ` first exceeds 5 mm
+/// (the rule of `examples/fig7_stresses`), found here from the run's `curve.csv`; and
+/// `coulomb_profiles` is titled with that set-up and load.
+#[test]
+fn the_fig7_scene_records_the_stresses_just_before_the_first_precursor() {
+    let dir = scratch("fig7");
+    let path = Path::new("examples/scenes/fig7.json");
+    let builder = SceneBuilder::from_json_file(path).unwrap();
+    let scene = builder.build().unwrap();
+    let mut driver = scene.driver().unwrap();
+    RunTables::create(&dir, &driver)
+        .unwrap()
+        .run_to_slip(&mut driver, None, |_, _| {})
+        .unwrap();
+    let curve = read_csv(&dir.join("curve.csv"));
+    let load = |r: &std::collections::HashMap<String, String>| -> f64 {
+        r["force_over_mu_FN"].parse().unwrap()
+    };
+    let first = curve
+        .iter()
+        .position(|r| r["precursor_length_m"].parse::<f64>().unwrap() > 5e-3)
+        .unwrap();
+    // The stable states before the first precursor: rows with ℓ (stable states).
+    let before = curve[..first]
+        .iter()
+        .rfind(|r| !r["precursor_length_m"].is_empty())
+        .unwrap();
+    let (low, high) = (load(before), load(&curve[first]));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let recorded = json["profiles"]["loads"][0].as_f64().unwrap();
+    assert!(
+        low <= recorded && recorded < high,
+        "record at a load in [{low}, {high}), not {recorded}"
+    );
+    draw_with(&dir, "coulomb_profiles");
+    let words = squash(&svg_words(&dir.join("coulomb_profiles.svg")).concat());
+    for part in [
+        "200x7x100mm",
+        "FN=6.25kN",
+        "topandrodath=6mmshear,n=1",
+        "seed1",
+        "200x7cellsof1mm",
+        "zP=2mm",
+    ] {
+        assert!(words.contains(part), "{part} not in {words}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Draws the figure `name` of `dir` as SVG.
+fn draw_with(dir: &Path, name: &str) {
+    use precursors::plot::{draw_with_options, DrawOptions};
+    let options = DrawOptions::default()
+        .formats(&[Format::Svg])
+        .figures([name]);
+    draw_with_options(dir, &options).unwrap();
 }

@@ -45,8 +45,14 @@ pub(crate) const STICK_SLIP_FIGURE: &str = "stick_slip";
 /// The figure of a sweep's real contact area at zero shear against the normal load
 /// (paper Fig. 2a).
 pub(crate) const ARCHARD_FIGURE: &str = "archard";
+/// The mean force drop against the avalanche size, from `stats`' tables.
+pub(crate) const DROP_SIZE_FIGURE: &str = "drop_against_size";
+/// The mean potency against the avalanche size, from `stats`' tables.
+pub(crate) const POTENCY_SIZE_FIGURE: &str = "potency_against_size";
+/// The finite-size collapse of the avalanche sizes, from `stats`' tables.
+pub(crate) const COLLAPSE_FIGURE: &str = "collapse";
 /// The figures `plot` draws (the names `plot --figure` takes).
-pub(crate) const FIGURES: [&str; 12] = [
+pub(crate) const FIGURES: [&str; 15] = [
     PRECURSOR_FIGURE,
     AREA_FIGURE,
     MAP_FIGURE,
@@ -59,6 +65,9 @@ pub(crate) const FIGURES: [&str; 12] = [
     SHEAR_PROFILES_FIGURE,
     NORMAL_PROFILES_FIGURE,
     COULOMB_PROFILES_FIGURE,
+    DROP_SIZE_FIGURE,
+    POTENCY_SIZE_FIGURE,
+    COLLAPSE_FIGURE,
 ];
 /// The extensions of the figures.
 pub(crate) const FIGURE_EXTENSIONS: [&str; 2] = ["png", "svg"];

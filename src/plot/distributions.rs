@@ -4,14 +4,19 @@
 //! its exponent), `force_drops` (the same for a driving spring's force drops, when there
 //! are any) and, for a run, `fronts` (`ℓ/Lx` and the damage front `x_D/Lx` against the
 //! load). The samples are derived from the checked tables, as `precursors stats` derives
-//! them; the goodness of fit is `stats`' (it is not drawn).
+//! them; the fits are `stats`' (`power_laws.csv`, read by `plot/tables.rs`), or computed
+//! here as `stats` would where the directory has none of these samples.
 
 use super::selection::Selection;
+use super::tables::{preferred, Fits, Table};
 use super::{point_order, series_colour, short, Canvas, Colours, Corner, PlotError, Style};
+use crate::error::Error;
 use crate::output::derived::derive;
+use crate::output::layout::POWER_LAWS;
 use crate::output::layout::{DROPS_FIGURE, FRONTS_FIGURE, SIZES_FIGURE};
-use crate::statistics::{fit_power_law, log_binned, PowerLawOptions, Support};
+use crate::statistics::{compare_alternatives, cutoff_density, fit_power_law, log_binned, Support};
 use crate::sweep::stats::{points, samples};
+use crate::sweep::StatsOptions;
 use std::path::{Path, PathBuf};
 
 /// What [`draw_statistics`] drew, and what it left out and why.
@@ -24,8 +29,10 @@ pub(super) struct Statistics {
 /// A sweep point's name in a legend, from its axes' values and its runs.
 pub(super) type PointLabel = fn(&[(String, String)], usize) -> String;
 
-/// One point's series of a distribution: its label and samples.
+/// One point's series of a distribution: its place among the directory's points (the
+/// `point` column of `stats`' tables), its label and samples.
 struct Pooled {
+    point: usize,
     label: String,
     samples: Vec<f64>,
 }
@@ -58,7 +65,7 @@ pub(super) fn draw_statistics(
     let (colours, order) = point_order(&points.iter().map(|p| &p.values[..]).collect::<Vec<_>>());
     let mut sizes = Vec::new();
     let mut drops = Vec::new();
-    for point in order.iter().map(|&k| &points[k]).filter(|_| pooled) {
+    for (index, point) in order.iter().map(|&k| (k, &points[k])).filter(|_| pooled) {
         let (mut s, mut d) = (Vec::new(), Vec::new());
         point.for_each_record(|run_dir, record| {
             // The samples `stats` pools by default (the spanning avalanche left out).
@@ -73,10 +80,12 @@ pub(super) fn draw_statistics(
             label(&point.values, point.runs())
         };
         sizes.push(Pooled {
+            point: index,
             label: name.clone(),
             samples: s,
         });
         drops.push(Pooled {
+            point: index,
             label: name,
             samples: d,
         });
@@ -92,7 +101,7 @@ pub(super) fn draw_statistics(
             extensions,
             canvas,
             (SIZES_FIGURE, title, sizes_axes),
-            (&sizes, Support::Discrete),
+            (&sizes, Support::Discrete, "avalanche_ruptures"),
             &mut drawn,
         )?;
     }
@@ -111,7 +120,7 @@ pub(super) fn draw_statistics(
             extensions,
             canvas,
             (DROPS_FIGURE, title, drops_axes),
-            (&drops, Support::Continuous),
+            (&drops, Support::Continuous, "force_drop_N"),
             &mut drawn,
         )?;
     }
@@ -129,17 +138,22 @@ pub(super) fn draw_statistics(
     Ok(drawn)
 }
 
-/// A log-log figure of the log-binned density of each point's samples, with its fit.
+/// A log-log figure of the log-binned density of each point's samples with its counting
+/// error bars, and its fits: `power_laws.csv`'s row for the point and observable (the
+/// fits `precursors stats` wrote), or where the directory has none of these samples
+/// the same fits computed here with `stats`' default options. The power law is drawn
+/// solid, dashed and marked "rejected" where its goodness test rules it out; the cut-off
+/// law where the tests leave it unbeaten ([`preferred`]); the legend gives `n_tail`, the
+/// goodness p and the preferred model.
 fn distribution(
     dir: &Path,
     extensions: &[&str],
     canvas: Canvas,
     (name, title, (x_label, y_label, what)): (&str, &str, (&str, &str, &str)),
-    (family, support): (&Family, Support),
+    (family, support, observable): (&Family, Support, &str),
     drawn: &mut Statistics,
 ) -> Result<(), PlotError> {
-    // The interval from the bootstrap; the goodness of fit is `stats`' to compute.
-    let options = PowerLawOptions::default().goodness_samples(0);
+    let table = Table::read(&dir.join(POWER_LAWS))?;
     let mut chart = canvas
         .chart(
             &format!("Distribution of {what}: {title}"),
@@ -149,19 +163,29 @@ fn distribution(
         .log_x()
         .log_y()
         .legend(Corner::LowerLeft);
+    let symbol = x_label.split_whitespace().next().unwrap_or("x");
     let pooled = &family.pooled;
+    let mut computed = Vec::new();
     for (k, p) in pooled.iter().enumerate() {
-        // The markers and the fit of a point in one colour.
+        // The markers and the fits of a point in one colour.
         let colour = series_colour(family.colours, k, pooled.len());
         let style = Style::new().colour(colour.0, colour.1, colour.2);
         let positive = p.samples.iter().filter(|x| **x > 0.0).count();
         if positive == 0 {
             continue;
         }
-        let bins: Vec<(f64, f64)> = log_binned(&p.samples, support, 5)?
+        let bins: Vec<(f64, f64, f64, f64)> = log_binned(&p.samples, support, 5)?
             .iter()
             .filter(|b| b.count > 0)
-            .map(|b| (b.center, b.density))
+            .map(|b| {
+                let relative = 1.0 / (b.count as f64).sqrt();
+                (
+                    b.center,
+                    b.density,
+                    b.density * (1.0 - relative),
+                    b.density * (1.0 + relative),
+                )
+            })
             .collect();
         let prefix = if p.label.is_empty() {
             String::new()
@@ -169,35 +193,77 @@ fn distribution(
             format!("{}: ", p.label)
         };
         chart = chart
-            .markers(&format!("{prefix}{positive} {what}"), &bins)
+            .error_bars(&format!("{prefix}{positive} {what}"), &bins)
             .style(style);
-        match fit_power_law(&p.samples, support, &options) {
-            Ok(fit) => {
-                let top = p.samples.iter().copied().fold(fit.x_min, f64::max);
-                let line: Vec<(f64, f64)> = (0..=40)
-                    .map(|i| fit.x_min * (top / fit.x_min).powf(f64::from(i) / 40.0))
-                    .map(|x| (x, fit.density(x)))
-                    .collect();
+        let row = match &table {
+            Some(t) => Fits::read(t, p.point, observable)?,
+            None => None,
+        };
+        let fits = match row {
+            Some((n, fits)) if n == positive => fits,
+            _ => {
+                computed.push(p.label.clone());
+                fits_here(&p.samples, support)?
+            }
+        };
+        let Some(fits) = fits else {
+            drawn.notes.push(format!(
+                "{name}: {prefix}no power law fitted ({positive} samples)"
+            ));
+            continue;
+        };
+        let top = p.samples.iter().copied().fold(fits.x_min, f64::max);
+        let share = fits.tail as f64 / fits.samples.max(1) as f64;
+        let curve = |law: (f64, f64, f64)| -> Vec<(f64, f64)> {
+            (0..=40)
+                .map(|i| fits.x_min * (top / fits.x_min).powf(f64::from(i) / 40.0))
+                .map(|x| (x, cutoff_density(support, law, share, x)))
+                .collect()
+        };
+        let (alpha, low, high) = fits.alpha;
+        let verdict = match fits.p {
+            Some(p) if fits.rejected() => format!(" (rejected, p = {})", p_text(p)),
+            Some(p) => format!(", p = {}", p_text(p)),
+            None => " (goodness not tested)".to_string(),
+        };
+        let label = format!(
+            "{prefix}power law, {symbol} ≥ {}: α = {alpha:.2} [{low:.2}, {high:.2}], n_{{tail}} = \
+             {}{verdict}",
+            short(fits.x_min),
+            fits.tail
+        );
+        let line_style = if fits.p.is_some() && !fits.rejected() {
+            style
+        } else {
+            style.dashed()
+        };
+        chart = chart
+            .line(&label, &curve((alpha, 0.0, fits.x_min)))
+            .style(line_style);
+        let best = preferred(&fits);
+        if let Some(((a, a_low, a_high), [Some(scale), scale_low, scale_high])) = fits.cutoff {
+            if best.contains("cut-off law") {
+                let end = |v: Option<f64>| v.map_or("∞".to_string(), short);
                 chart = chart
                     .line(
                         &format!(
-                            "power law above {}: α = {:.2} [{:.2}, {:.2}] (95 %)",
-                            short(fit.x_min),
-                            fit.alpha,
-                            fit.alpha_low,
-                            fit.alpha_high
+                            "{prefix}cut-off law: α = {a:.2} [{a_low:.2}, {a_high:.2}], scale {} \
+                             [{}, {}]",
+                            short(scale),
+                            end(scale_low),
+                            end(scale_high)
                         ),
-                        &line,
+                        &curve((a, 1.0 / scale, fits.x_min)),
                     )
-                    .style(style.dashed());
+                    .style(style);
             }
-            Err(crate::error::Error::TooFewSamples { count, needed, .. }) => {
-                drawn.notes.push(format!(
-                    "{name}: {prefix}no power law fitted ({count} samples, {needed} needed)"
-                ));
-            }
-            Err(e) => return Err(e.into()),
         }
+        chart = chart.note(&format!("{prefix}preferred: {best}"));
+    }
+    chart = chart.note("error bars: P (1 ± 1/√count), the Poisson counting error of each bin");
+    if !computed.is_empty() {
+        chart = chart
+            .note("fits computed here with the defaults of stats (it wrote none of these samples)");
     }
     for extension in extensions {
         let path = dir.join(format!("{name}.{extension}"));
@@ -205,6 +271,37 @@ fn distribution(
         drawn.files.push(path);
     }
     Ok(())
+}
+
+/// A p-value in a legend: two decimals, or two digits below 0.01.
+fn p_text(p: f64) -> String {
+    if p >= 0.01 || p == 0.0 {
+        format!("{p:.2}")
+    } else {
+        format!("{p:.1e}")
+    }
+}
+
+/// The fits `precursors stats` would write for `samples` with its default options: the
+/// power law and its alternatives, the power law alone where the alternatives fail (as
+/// `stats` does), none where the samples are too few.
+fn fits_here(samples: &[f64], support: Support) -> Result<Option<Fits>, PlotError> {
+    let options = StatsOptions::default().fit;
+    match compare_alternatives(samples, support, &options) {
+        Ok(c) => return Ok(Some(Fits::of(&c))),
+        Err(Error::TooFewSamples { .. }) => return Ok(None),
+        Err(_) => {}
+    }
+    match fit_power_law(samples, support, &options) {
+        Ok(f) => Ok(Some(Fits::of_power_law(&f))),
+        Err(
+            Error::TooFewSamples { .. }
+            | Error::InvalidParameter {
+                name: "samples", ..
+            },
+        ) => Ok(None),
+        Err(e) => Err(e.into()),
+    }
 }
 
 /// `ℓ/Lx` and the damage front `x_D/Lx` of a run against the load, as staircases.

@@ -18,8 +18,10 @@
 //! that the directory allows them.
 
 use super::distributions::draw_statistics;
+use super::fronts::ensemble_fronts;
 use super::paper::{draw_archard, draw_stick_slip};
 use super::profiles::draw_profiles;
+use super::relations::draw_relations;
 use super::selection::{Selection, NORMAL_LOAD};
 use super::PlotError;
 use super::{point_order, short, Canvas, Chart, Colours, Corner, Map, Palette};
@@ -27,7 +29,8 @@ use crate::error::{Error, Result};
 use crate::output::check::RunRecord;
 use crate::output::derived::derive;
 use crate::output::layout::{
-    ARCHARD_FIGURE, AREA_FIGURE, FIGURES, MAP_FIGURE, PRECURSOR_FIGURE, STICK_SLIP_FIGURE,
+    ARCHARD_FIGURE, AREA_FIGURE, FIGURES, FRONTS_FIGURE, MAP_FIGURE, PRECURSOR_FIGURE,
+    STICK_SLIP_FIGURE,
 };
 use crate::output::MAP_STEP;
 use crate::sweep::{merge, MergeSummary, MEDIAN_BAND_RUNS, SWEEP_FILE};
@@ -211,7 +214,9 @@ pub struct DrawOptions {
     /// The names of the figures to draw (`precursor_length`, `contact_area`,
     /// `contact_map`, `stick_slip`, `archard`, `fronts`, `avalanche_sizes`,
     /// `force_drops`, `slip_profiles`, `shear_profiles`, `normal_profiles`,
-    /// `coulomb_profiles`); empty (the default): every figure the directory allows.
+    /// `coulomb_profiles`, and from `precursors stats`' tables `drop_against_size`,
+    /// `potency_against_size`, `collapse`); empty (the default): every figure the
+    /// directory allows.
     pub figures: Vec<String>,
 }
 
@@ -370,6 +375,16 @@ pub fn draw_with_options(dir: &Path, options: &DrawOptions) -> Result<Drawn, Plo
     let statistics = draw_statistics(dir, &extensions, canvas, (&title, point_label), &selection)?;
     drawn.files.extend(statistics.files);
     drawn.notes.extend(statistics.notes);
+    if sweep && selection.wants(FRONTS_FIGURE) {
+        // The fronts' medians and quartiles over each point's runs.
+        let (_, points, _) = crate::sweep::stats::points(dir)?;
+        let fronts = ensemble_fronts(dir, &extensions, canvas, (&title, point_label), &points)?;
+        drawn.files.extend(fronts.files);
+        drawn.notes.extend(fronts.notes);
+    }
+    let relations = draw_relations(dir, &extensions, canvas, (&title, point_label), &selection)?;
+    drawn.files.extend(relations.files);
+    drawn.notes.extend(relations.notes);
     drawn.notes.extend(skipped);
     Ok(drawn)
 }
@@ -494,7 +509,54 @@ fn describe(keys: &[(String, String)]) -> String {
     if let Some(seed) = get("heights.seed") {
         parts.push(format!("seed {seed}"));
     }
+    if let Some(grid) = grid(keys) {
+        parts.push(grid);
+    }
     parts.join(", ")
+}
+
+/// A scene's grid in words, so that two scenes on different grids never share a title:
+/// `140 x 7 cells of 1 mm` (`of 1 x 0.5 mm` for cells not square), `Δx = 0.5 mm` where
+/// the block's length is a sweep's axis (and so left out of its title), `20 x 4 cells`
+/// where the block is.
+fn grid(keys: &[(String, String)]) -> Option<String> {
+    let get = |k: &str| {
+        keys.iter()
+            .find(|(key, _)| key == k)
+            .map(|(_, v)| v.as_str())
+    };
+    let num = |k: &str| get(k).and_then(|v| v.parse::<f64>().ok());
+    let (lx, ly) = (num("block.lx"), num("block.ly"));
+    let side = |dx: f64, dy: f64| {
+        if (dx - dy).abs() <= 1e-9 * dx.abs().max(dy.abs()) {
+            format!("{} mm", short(dx * 1e3))
+        } else {
+            format!("{} x {} mm", short(dx * 1e3), short(dy * 1e3))
+        }
+    };
+    match get("cells.kind")? {
+        "size" => {
+            let (dx, dy) = (num("cells.dx")?, num("cells.dy").or(num("cells.dx"))?);
+            Some(match (lx, ly) {
+                (Some(lx), Some(ly)) => format!(
+                    "{} x {} cells of {}",
+                    (lx / dx).round(),
+                    (ly / dy).round(),
+                    side(dx, dy)
+                ),
+                _ if (dx - dy).abs() <= 1e-9 * dx => format!("Δx = {} mm", short(dx * 1e3)),
+                _ => format!("Δx = {} mm, Δy = {} mm", short(dx * 1e3), short(dy * 1e3)),
+            })
+        }
+        "count" => {
+            let (nx, ny) = (num("cells.nx")?, num("cells.ny")?);
+            Some(match (lx, ly) {
+                (Some(lx), Some(ly)) => format!("{nx} x {ny} cells of {}", side(lx / nx, ly / ny)),
+                _ => format!("{nx} x {ny} cells"),
+            })
+        }
+        _ => None,
+    }
 }
 
 /// A sweep axis's value in the user's words and units: `Ly = 7 mm` for `block.ly =
@@ -984,6 +1046,62 @@ mod tests {
         assert_eq!(
             describe(&spring),
             "Lx = 30 mm, F_N = 750 N, spring K_S = 4e6 N/m on the side"
+        );
+    }
+
+    /// docs/statistics.md's two surface studies differ in their cells alone: their titles
+    /// say so (they were the same before the grid was named).
+    #[test]
+    fn scenes_on_different_grids_get_different_titles() {
+        let keys = |dx: &str| -> Vec<(String, String)> {
+            [
+                ("block.lx", "0.14"),
+                ("block.ly", "0.007"),
+                ("block.lz", "0.075"),
+                ("cells.kind", "size"),
+                ("cells.dx", dx),
+                ("cells.dy", dx),
+                ("normal_load", "3500.0"),
+                ("drive.kind", "rod"),
+                ("drive.height", "0.006"),
+                ("heights.correlation_length", "0.003"),
+            ]
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect()
+        };
+        let coarse = describe(&keys("0.001"));
+        let fine = describe(&keys("0.0005"));
+        assert_eq!(
+            coarse,
+            "140 x 7 x 75 mm, F_N = 3.5 kN, rod at h = 6 mm, ξ = 3 mm, 140 x 7 cells of 1 mm"
+        );
+        assert_eq!(
+            fine,
+            "140 x 7 x 75 mm, F_N = 3.5 kN, rod at h = 6 mm, ξ = 3 mm, 280 x 14 cells of 0.5 mm"
+        );
+        // A sweep over the length: the cell size alone.
+        let mut over_lx = keys("0.001");
+        over_lx.retain(|(k, _)| k != "block.lx");
+        assert!(
+            describe(&over_lx).ends_with("ξ = 3 mm, Δx = 1 mm"),
+            "{}",
+            describe(&over_lx)
+        );
+        let count: Vec<(String, String)> = [
+            ("block.lx", "0.02"),
+            ("block.ly", "0.004"),
+            ("block.lz", "0.01"),
+            ("cells.kind", "count"),
+            ("cells.nx", "20"),
+            ("cells.ny", "8"),
+        ]
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+        assert_eq!(
+            describe(&count),
+            "20 x 4 x 10 mm, 20 x 8 cells of 1 x 0.5 mm"
         );
     }
 

@@ -1056,7 +1056,7 @@ fn read_recording(dir: &Path) -> Result<Recording> {
     let block = grid.block();
     // The directory's name as written: its underscores are no subscripts.
     let mut scene = format!(
-        "{}: {}, {nx} x {ny} cells",
+        "{}: {}",
         super::figures::name(dir).replace('_', "\\_"),
         super::figures::run_title(dir)
     );

@@ -4,7 +4,7 @@
 
 use super::PlotError;
 use crate::output::layout::{
-    ARCHARD_FIGURE, COULOMB_PROFILES_FIGURE, DROPS_FIGURE, FIGURES, FRONTS_FIGURE, MAP_FIGURE,
+    ARCHARD_FIGURE, COLLAPSE_FIGURE, COULOMB_PROFILES_FIGURE, DROPS_FIGURE, FIGURES, MAP_FIGURE,
     NORMAL_PROFILES_FIGURE, SHEAR_PROFILES_FIGURE, SLIP_PROFILES_FIGURE, STICK_SLIP_FIGURE,
 };
 use crate::sweep::SWEEP_FILE;
@@ -85,6 +85,17 @@ impl Selection {
         }
         notes.push(format!("no {figure} figure: {reason}"));
         Ok(())
+    }
+
+    /// `figure` cannot be drawn, found from the tables: an error when it was named, else
+    /// left out without a word (the figures of `stats`' tables before `stats` ran).
+    pub(super) fn skip_quietly(
+        &self,
+        figure: &str,
+        dir: &Path,
+        reason: String,
+    ) -> Result<(), PlotError> {
+        self.skip(figure, dir, reason, &mut Vec::new())
     }
 }
 
@@ -185,7 +196,24 @@ impl Facts {
                 Leave::WithNote,
             )),
             (MAP_FIGURE, true) => Some((run_only("the contact map"), Leave::Silently)),
-            (FRONTS_FIGURE, true) => Some((run_only("the fronts' figure"), Leave::Silently)),
+            (COLLAPSE_FIGURE, false) => Some((
+                format!(
+                    "a sweep's figure (the avalanche sizes of its lengths collapsed), and {} is \
+                     a run's directory: plot the sweep's",
+                    dir.display()
+                ),
+                Leave::Silently,
+            )),
+            (COLLAPSE_FIGURE, true) => match &self.keys {
+                Some(keys) if !keys.iter().any(|k| k == "block.lx" || k == "block.ly") => Some((
+                    "the sweep has no axis block.lx or block.ly: the collapse needs points at \
+                     several lengths"
+                        .into(),
+                    Leave::Silently,
+                )),
+                // Whether `stats` wrote the collapse: the tables tell.
+                _ => None,
+            },
             (STICK_SLIP_FIGURE, true) => Some((
                 run_only("stick-slip"),
                 if self.spring == Some(true) {

@@ -437,6 +437,35 @@ fn cutoff_ln_pdf(tail: &Tail, law: Cutoff) -> impl Fn(f64) -> f64 + '_ {
     move |x| -law.alpha * (x / x_min).ln() - law.mu * ((x - x_min) / x_min) - norm
 }
 
+/// The cut-off law `x^(-α) e^(-λx)` on `x ≥ x_min` as a density of all the samples, of
+/// which the tail is the share `share` (the unit of [`super::LogBin::density`], as
+/// [`super::PowerLawFit::density`]): `share · p(x)`, 0 below `x_min` and for parameters
+/// that are not a law (`α ≤ 1` at `λ = 0`). The figures draw the fitted law with it.
+pub(crate) fn cutoff_density(
+    support: Support,
+    (alpha, lambda, x_min): (f64, f64, f64),
+    share: f64,
+    x: f64,
+) -> f64 {
+    let law = Cutoff {
+        alpha,
+        mu: lambda * x_min,
+    };
+    // NaN anywhere fails a comparison: no law there.
+    let within = x >= x_min && x_min > 0.0 && lambda >= 0.0;
+    if !within {
+        return 0.0;
+    }
+    let norm = match support {
+        Support::Discrete => cutoff_discrete_sum(law.alpha, lambda, x_min).ln(),
+        _ => ln_expint(law.alpha, law.mu) + law.mu + x_min.ln(),
+    };
+    if !norm.is_finite() {
+        return 0.0;
+    }
+    share * (-law.alpha * (x / x_min).ln() - law.mu * ((x - x_min) / x_min) - norm).exp()
+}
+
 /// The cut-off law on the tail by maximum likelihood: [`nelder_mead`] in `(α, ln μ)`,
 /// `α ∈ [0, 20]`, `μ ⟨x/x_min - 1⟩ ∈ [1e-12, 1e6]`, from two starts; then the boundary
 /// `λ = 0` (the pure power law, nested) wins when its likelihood is at least as high. The
@@ -645,6 +674,37 @@ mod tests {
                 (s - brute).abs() <= 1e-12 * brute,
                 "α {alpha}, λ {lambda}: {s} vs {brute}"
             );
+        }
+    }
+
+    /// The drawn cut-off law carries the tail's share of the samples: its masses over the
+    /// integers from `x_min` (brute-force sum) and its density over the reals (trapezoids
+    /// on a log grid) add up to `share`.
+    #[test]
+    fn the_cutoff_density_holds_the_tails_share() {
+        let share = 0.3;
+        for (alpha, lambda, x_min) in [(1.5, 0.02, 7.0), (2.4, 0.003, 9.0)] {
+            let law = (alpha, lambda, x_min);
+            let masses: f64 = (0..200_000u32)
+                .rev()
+                .map(|j| cutoff_density(Support::Discrete, law, share, x_min + f64::from(j)))
+                .sum();
+            assert!((masses - share).abs() < 1e-9, "{law:?}: {masses}");
+            assert_eq!(
+                cutoff_density(Support::Discrete, law, share, x_min - 1.0),
+                0.0
+            );
+            let xs: Vec<f64> = (0..=400_000)
+                .map(|i| x_min * 10f64.powf(f64::from(i) * 6.0 / 400_000.0))
+                .collect();
+            let integral: f64 = xs
+                .windows(2)
+                .map(|w| {
+                    let f = |x| cutoff_density(Support::Continuous, law, share, x);
+                    0.5 * (f(w[0]) + f(w[1])) * (w[1] - w[0])
+                })
+                .sum();
+            assert!((integral - share).abs() < 1e-6, "{law:?}: {integral}");
         }
     }
 

@@ -1,0 +1,306 @@
+//! The figures of `precursors stats`' relations and finite-size collapse, drawn from its
+//! tables (`plot/tables.rs` reads them): `drop_against_size` and `potency_against_size`
+//! (the binned means of `binned_means.csv` with their intervals, the least-squares power
+//! law of `scaling.csv` with its exponent and interval in the legend) and, for a sweep
+//! over a block length, `collapse` (`P(S) S^τ` against `S/L^D` from `distributions.csv`
+//! at `collapse.csv`'s `τ` and `D`, their intervals in the legend).
+
+use super::distributions::{PointLabel, Statistics};
+use super::selection::Selection;
+use super::tables::Table;
+use super::{point_order, series_colour, short, Canvas, Corner, PlotError, Style};
+use crate::output::layout::{
+    BINNED_MEANS, COLLAPSE, COLLAPSE_FIGURE, DISTRIBUTIONS, DROP_SIZE_FIGURE, POTENCY_SIZE_FIGURE,
+    SCALING,
+};
+use crate::sweep::stats::points;
+use std::path::Path;
+
+/// The fewest avalanches a bin needs to enter the collapse (`fit_collapse`'s rule).
+const COLLAPSE_MIN_COUNT: f64 = 3.0;
+
+/// Draws the figures of `stats`' relations and collapse that `selection` wants, from the
+/// tables `stats` wrote into `dir`; a figure whose table is missing or holds no rows for
+/// it is left out (without a word: `stats` has not run; an error where it was named).
+pub(super) fn draw_relations(
+    dir: &Path,
+    extensions: &[&str],
+    canvas: Canvas,
+    (title, label): (&str, PointLabel),
+    selection: &Selection,
+) -> Result<Statistics, PlotError> {
+    let mut drawn = Statistics::default();
+    let wanted = [DROP_SIZE_FIGURE, POTENCY_SIZE_FIGURE, COLLAPSE_FIGURE];
+    if !wanted.iter().any(|f| selection.wants(f)) {
+        return Ok(drawn);
+    }
+    let (_, points, _) = points(dir)?;
+    let values: Vec<&[(String, String)]> = points.iter().map(|p| &p.values[..]).collect();
+    let (colours, order) = point_order(&values);
+    let names: Vec<String> = points
+        .iter()
+        .map(|p| {
+            if points.len() == 1 && p.values.is_empty() {
+                String::new()
+            } else {
+                label(&p.values, p.runs())
+            }
+        })
+        .collect();
+    let family = Family {
+        names: &names,
+        order: &order,
+        colours,
+    };
+    let relations = [
+        (
+            DROP_SIZE_FIGURE,
+            "force_drop_N_against_ruptures",
+            ("Force drop against avalanche size", "ΔF (N)", "ΔF"),
+        ),
+        (
+            POTENCY_SIZE_FIGURE,
+            "potency_m3_against_ruptures",
+            ("Potency against avalanche size", "potency (m³)", "P"),
+        ),
+    ];
+    for (figure, relation, words) in relations {
+        if selection.wants(figure) {
+            relation_figure(
+                dir,
+                extensions,
+                canvas,
+                (figure, relation, title, words),
+                &family,
+                selection,
+                &mut drawn,
+            )?;
+        }
+    }
+    if selection.wants(COLLAPSE_FIGURE) {
+        collapse_figure(
+            dir, extensions, canvas, title, &family, selection, &mut drawn,
+        )?;
+    }
+    Ok(drawn)
+}
+
+/// The points' names in a legend, the order they are drawn in and their colours.
+struct Family<'a> {
+    names: &'a [String],
+    order: &'a [usize],
+    colours: super::Colours,
+}
+
+impl Family<'_> {
+    fn prefix(&self, point: usize) -> String {
+        match self.names.get(point) {
+            Some(n) if !n.is_empty() => format!("{n}: "),
+            _ => String::new(),
+        }
+    }
+}
+
+/// A relation's figure: each point's binned means of `y` against the size with their
+/// intervals as error bars, and its fitted power law `y = c S^β`.
+fn relation_figure(
+    dir: &Path,
+    extensions: &[&str],
+    canvas: Canvas,
+    (figure, relation, title, (what, y_label, symbol)): (&str, &str, &str, (&str, &str, &str)),
+    family: &Family<'_>,
+    selection: &Selection,
+    drawn: &mut Statistics,
+) -> Result<(), PlotError> {
+    let (Some(means), Some(fits)) = (
+        Table::read(&dir.join(BINNED_MEANS))?,
+        Table::read(&dir.join(SCALING))?,
+    ) else {
+        let reason = format!("no {BINNED_MEANS} or {SCALING}: run `precursors stats` first");
+        return selection.skip_quietly(figure, dir, reason);
+    };
+    let mut chart = canvas
+        .chart(
+            &format!("{what}: {title}, binned means"),
+            "S (ruptures of an avalanche)",
+            y_label,
+        )
+        .log_x()
+        .log_y()
+        .legend(Corner::UpperLeft);
+    let mut any = false;
+    for (k, &point) in family.order.iter().enumerate() {
+        let rows = means.rows_of(point, ("relation", relation))?;
+        if rows.is_empty() {
+            continue;
+        }
+        any = true;
+        let colour = series_colour(family.colours, k, family.order.len());
+        let style = Style::new().colour(colour.0, colour.1, colour.2);
+        let mut bars = Vec::new();
+        let mut avalanches = 0;
+        for row in &rows {
+            let number = |name: &str| means.number(row, name).map(|v| v.unwrap_or(f64::NAN));
+            avalanches += number("count")? as usize;
+            bars.push((
+                number("x_mean")?,
+                number("mean")?,
+                number("mean_low")?,
+                number("mean_high")?,
+            ));
+        }
+        let prefix = family.prefix(point);
+        chart = chart
+            .error_bars(
+                &format!("{prefix}mean per bin of S, 95 % interval ({avalanches} avalanches)"),
+                &bars,
+            )
+            .style(style);
+        let fit = fits.rows_of(point, ("relation", relation))?;
+        let Some(row) = fit.first() else { continue };
+        let number = |name: &str| fits.number(row, name);
+        if let (Some(beta), Some(low), Some(high), Some(c)) = (
+            number("exponent")?,
+            number("exponent_low")?,
+            number("exponent_high")?,
+            number("prefactor")?,
+        ) {
+            let xs = bars
+                .iter()
+                .map(|b| b.0)
+                .filter(|x| x.is_finite() && *x > 0.0);
+            let (lo, hi) = xs.fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
+            let line: Vec<(f64, f64)> = (0..=20)
+                .map(|i| lo * (hi / lo).powf(f64::from(i) / 20.0))
+                .map(|x| (x, c * x.powf(beta)))
+                .collect();
+            chart = chart
+                .line(
+                    &format!(
+                        "{prefix}{symbol} ∝ S^β: β = {beta:.2} [{low:.2}, {high:.2}] (95 %), {} \
+                         avalanches",
+                        row[fits.column("pairs")?]
+                    ),
+                    &line,
+                )
+                .style(style.dashed());
+        }
+    }
+    if !any {
+        let reason = format!("{BINNED_MEANS} has no rows of {relation}");
+        return selection.skip_quietly(figure, dir, reason);
+    }
+    chart = chart.note("dashed: least squares of ln y on ln S over every avalanche (scaling.csv)");
+    for extension in extensions {
+        let path = dir.join(format!("{figure}.{extension}"));
+        chart.save(&path)?;
+        drawn.files.push(path);
+    }
+    Ok(())
+}
+
+/// The collapse figure of a sweep over a block length: each length's log-binned sizes
+/// (bins of at least 3 avalanches, as the fit) as `P(S) S^τ` against `S/L^D`, `L` in mm,
+/// with their counting error bars.
+fn collapse_figure(
+    dir: &Path,
+    extensions: &[&str],
+    canvas: Canvas,
+    title: &str,
+    family: &Family<'_>,
+    selection: &Selection,
+    drawn: &mut Statistics,
+) -> Result<(), PlotError> {
+    let (Some(collapse), Some(bins)) = (
+        Table::read(&dir.join(COLLAPSE))?,
+        Table::read(&dir.join(DISTRIBUTIONS))?,
+    ) else {
+        let reason = format!(
+            "no {COLLAPSE}: `precursors stats` writes it for a sweep over block.lx or block.ly"
+        );
+        return selection.skip_quietly(COLLAPSE_FIGURE, dir, reason);
+    };
+    let observable = "avalanche_ruptures";
+    let row = collapse
+        .rows
+        .iter()
+        .find(|r| r.get(collapse.column("observable").unwrap_or(0)) == Some(&observable.into()));
+    let fit = match row {
+        Some(row) => {
+            let n = |name: &str| collapse.number(row, name);
+            match (n("tau")?, n("d")?) {
+                (Some(tau), Some(d)) => Some((row, tau, d)),
+                _ => None,
+            }
+        }
+        None => None,
+    };
+    let Some((row, tau, d)) = fit else {
+        let reason = format!("{COLLAPSE} holds no collapse of {observable} (too few samples)");
+        return selection.skip_quietly(COLLAPSE_FIGURE, dir, reason);
+    };
+    let axis = row[collapse.column("axis")?].clone();
+    let n = |name: &str| collapse.number(row, name).map(|v| v.unwrap_or(f64::NAN));
+    let symbol = if axis == "block.ly" { "Ly" } else { "Lx" };
+    let mut chart = canvas
+        .chart(
+            &format!("Collapse of avalanche sizes over {symbol}: {title}"),
+            &format!("S/({symbol}/mm)^D"),
+            "P(S) S^τ",
+        )
+        .log_x()
+        .log_y()
+        .legend(Corner::LowerLeft);
+    for (k, &point) in family.order.iter().enumerate() {
+        let rows = bins.rows_of(point, ("observable", observable))?;
+        let Some(first) = rows.first() else { continue };
+        let length_mm = 1e3 * bins.number(first, &axis)?.unwrap_or(f64::NAN);
+        let mut points = Vec::new();
+        for row in &rows {
+            let number = |name: &str| bins.number(row, name).map(|v| v.unwrap_or(f64::NAN));
+            let (s, count, density) = (number("bin_center")?, number("count")?, number("density")?);
+            if count < COLLAPSE_MIN_COUNT {
+                continue;
+            }
+            let y = density * s.powf(tau);
+            let relative = 1.0 / count.sqrt();
+            points.push((
+                s / length_mm.powf(d),
+                y,
+                y * (1.0 - relative),
+                y * (1.0 + relative),
+            ));
+        }
+        let colour = series_colour(family.colours, k, family.order.len());
+        let label = family.prefix(point);
+        let label = label.trim_end_matches(": ");
+        chart = chart
+            .error_bars(
+                if label.is_empty() {
+                    "one length"
+                } else {
+                    label
+                },
+                &points,
+            )
+            .style(Style::new().colour(colour.0, colour.1, colour.2));
+    }
+    chart = chart
+        .note(&format!(
+            "τ = {:.2} [{:.2}, {:.2}], D = {:.2} [{:.2}, {:.2}] ({} %, collapse.csv)",
+            tau,
+            n("tau_low")?,
+            n("tau_high")?,
+            d,
+            n("d_low")?,
+            n("d_high")?,
+            short(100.0 * n("confidence")?)
+        ))
+        .note("bins of 3 avalanches or more; error bars: 1 ± 1/√count");
+    for extension in extensions {
+        let path = dir.join(format!("{COLLAPSE_FIGURE}.{extension}"));
+        chart.save(&path)?;
+        drawn.files.push(path);
+    }
+    Ok(())
+}
