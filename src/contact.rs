@@ -384,9 +384,11 @@ impl ContactRule {
         match self {
             ContactRule::Paper => (0..breaking.len())
                 .find(|&i| states[i] == SiteState::Attached && paper_over(breaking[i], force)),
-            ContactRule::Anchored | ContactRule::Rejuvenation { .. } => (0..breaking.len()).find(
-                |&i| states[i] == SiteState::Attached && anchored_over(breaking[i], low[i], force),
-            ),
+            ContactRule::Anchored | ContactRule::Rejuvenation { .. } => {
+                (0..breaking.len()).find(|&i| {
+                    states[i] == SiteState::Attached && anchored_over(breaking[i], low[i], force)
+                })
+            }
         }
     }
 

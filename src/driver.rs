@@ -911,8 +911,12 @@ impl Driver {
             self.shear_displacement.clone()
         } else {
             let clock = std::time::Instant::now();
-            let unit = self.solver.solve_tangential(&others, u_z, &self.unit_load)?;
-            let zero = self.solver.solve_tangential_anchor(&others, u_z, &anchors)?;
+            let unit = self
+                .solver
+                .solve_tangential(&others, u_z, &self.unit_load)?;
+            let zero = self
+                .solver
+                .solve_tangential_anchor(&others, u_z, &anchors)?;
             self.stats.tangential_seconds += clock.elapsed().as_secs_f64();
             self.stats.tangential_solves += 2;
             self.stats.tangential_iterations +=

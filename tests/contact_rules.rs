@@ -111,7 +111,10 @@ fn every_state_balances_its_loads_under_each_rule() {
                 }
             }
         });
-        assert!(attaches > 0, "{name}: no site attached: the anchors untested");
+        assert!(
+            attaches > 0,
+            "{name}: no site attached: the anchors untested"
+        );
     }
 }
 
@@ -129,7 +132,10 @@ fn shear_at_attachment(scene: &Scene) -> f64 {
     let mut worst = 0.0_f64;
     run(scene, |event, driver| {
         let attached = |d: &Driver| -> Vec<bool> {
-            d.site_states().iter().map(|s| *s == SiteState::Attached).collect()
+            d.site_states()
+                .iter()
+                .map(|s| *s == SiteState::Attached)
+                .collect()
         };
         match *event {
             Event::Attach { site } | Event::Detach { site } => {
@@ -161,10 +167,16 @@ fn an_anchored_site_carries_no_shear_when_it_attaches() {
     for seed in [1, 4] {
         for contact in [ANCHORED, REJUVENATION] {
             let ratio = shear_at_attachment(&scene(contact, seed));
-            assert!(ratio <= 1e-9, "{contact}, seed {seed}: |φ_i|/max|φ| = {ratio:e}");
+            assert!(
+                ratio <= 1e-9,
+                "{contact}, seed {seed}: |φ_i|/max|φ| = {ratio:e}"
+            );
         }
         let ratio = shear_at_attachment(&spring(ANCHORED, seed));
-        assert!(ratio <= 1e-9, "spring, seed {seed}: |φ_i|/max|φ| = {ratio:e}");
+        assert!(
+            ratio <= 1e-9,
+            "spring, seed {seed}: |φ_i|/max|φ| = {ratio:e}"
+        );
         // The paper's springs, anchored at 0, attach loaded: the check sees it.
         let paper = shear_at_attachment(&scene(PAPER, seed));
         assert!(paper > 1e-3, "paper, seed {seed}: {paper:e}");
@@ -188,7 +200,11 @@ fn reformations(scene: &Scene) -> (Vec<(usize, u64, f64)>, usize) {
                 last_stable_force = load.force;
             }
             Event::Rupture { site, load, .. } => {
-                assert!(broke[site.index].is_none(), "site {} broke twice", site.index);
+                assert!(
+                    broke[site.index].is_none(),
+                    "site {} broke twice",
+                    site.index
+                );
                 broke[site.index] = Some((stable, load.force));
                 ruptures += 1;
             }
@@ -235,7 +251,10 @@ fn broken_sites_re_form_only_under_rejuvenation_and_only_when_due() {
         assert!(!reformed.is_empty(), "seed {seed}: nothing re-formed");
         assert!(ruptures > 64, "seed {seed}: {ruptures} ruptures");
         for (site, states, load) in reformed {
-            assert!(states >= 3, "site {site} re-formed after {states} stable states");
+            assert!(
+                states >= 3,
+                "site {site} re-formed after {states} stable states"
+            );
             assert!(load >= 0.02, "site {site} re-formed after {load} μF_N");
         }
     }
@@ -282,11 +301,18 @@ fn rejuvenation_is_refused_where_it_cannot_run() {
     // The paper's rule leaves no key in the scene's JSON (1.x files and digests).
     let json = builder(PAPER, 0).to_json().unwrap();
     assert!(!json.contains("contact"), "{json}");
-    assert!(builder(ANCHORED, 0).to_json().unwrap().contains("\"anchored\""));
+    assert!(builder(ANCHORED, 0)
+        .to_json()
+        .unwrap()
+        .contains("\"anchored\""));
 }
 
 /// The events of a run on `backend`: kinds and sites, and the loads (N).
-fn events_on(contact: &str, seed: u64, backend: Backend) -> Vec<(&'static str, Option<usize>, f64)> {
+fn events_on(
+    contact: &str,
+    seed: u64,
+    backend: Backend,
+) -> Vec<(&'static str, Option<usize>, f64)> {
     let options = SolverOptions::default().with_backend(backend).unwrap();
     let scene = builder(contact, seed)
         .block(0.012, 0.002, 0.010)
@@ -328,9 +354,9 @@ proptest! {
 
 /// A run cut after a checkpoint and resumed ends with the tables of the uninterrupted
 /// run, byte for byte, under each rule (the anchored ones' checkpoints are of layout 5,
-/// the paper's stay 4). It fails when a checkpoint drops the anchors or the rupture
-/// times (shown by resuming with them zeroed: the tables differ or the resume is
-/// refused).
+/// the paper's stay 4). A checkpoint whose anchors were zeroed (the paper's springs) is
+/// refused by the resume's check of the anchors' equilibrium; a resume that lost them
+/// would run the paper's springs and write other tables.
 #[cfg(feature = "serde")]
 #[test]
 fn a_resumed_run_writes_the_uninterrupted_runs_tables_under_each_rule() {
@@ -347,8 +373,39 @@ fn a_resumed_run_writes_the_uninterrupted_runs_tables_under_each_rule() {
         let cut = scratch("contact-cut");
         let checkpoint = killed_after_checkpoint(&scene, &cut, 12, 9);
         let text = checkpoint.to_json().unwrap();
-        assert!(text.starts_with(&format!("{{\"format\":{format},")), "{contact}");
+        assert!(
+            text.starts_with(&format!("{{\"format\":{format},")),
+            "{contact}"
+        );
         let checkpoint = precursors::Checkpoint::from_json_str(&text).unwrap();
+        if format == 5 {
+            // Its anchors zeroed (the paper's springs), signed again: the resume's check
+            // of the anchors' equilibrium refuses it.
+            let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
+            let anchors = &mut value["contact"]["state"]["anchors"];
+            let moved = anchors
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|a| a.as_f64() != Some(0.0));
+            assert!(moved, "{contact}: no anchor off 0 at the checkpoint");
+            *anchors = serde_json::json!(vec![0.0; scene.grid().len()]);
+            value.as_object_mut().unwrap().remove("digest");
+            let edited = crate::checkpoint::json::resigned(&format!(
+                "{},\"digest\":\"0000000000000000\"}}",
+                serde_json::to_string(&value)
+                    .unwrap()
+                    .strip_suffix('}')
+                    .unwrap()
+            ));
+            let edited = precursors::Checkpoint::from_json_str(&edited).unwrap();
+            let refused = scene.resume(&edited);
+            assert!(
+                matches!(&refused, Err(precursors::Error::InvalidCheckpoint { reason })
+                    if reason.contains("anchors' equilibrium")),
+                "{contact}: {refused:?}"
+            );
+        }
         let mut driver = scene.resume(&checkpoint).unwrap();
         RunTables::resume(&cut, &driver)
             .unwrap()

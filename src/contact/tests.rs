@@ -69,9 +69,18 @@ fn weakest_and_over_threshold_look_at_attached_sites_only() {
     );
     // A tie keeps the first site.
     assert_eq!(rule.weakest(&states, &[3.0, 1.0, 3.0, 2.0]), Some((0, 3.0)));
-    assert_eq!(rule.first_over_threshold(&states, &breaking, &[], 2.9), None);
-    assert_eq!(rule.first_over_threshold(&states, &breaking, &[], 3.0), Some(2));
-    assert_eq!(rule.first_over_threshold(&states, &breaking, &[], 10.0), Some(0));
+    assert_eq!(
+        rule.first_over_threshold(&states, &breaking, &[], 2.9),
+        None
+    );
+    assert_eq!(
+        rule.first_over_threshold(&states, &breaking, &[], 3.0),
+        Some(2)
+    );
+    assert_eq!(
+        rule.first_over_threshold(&states, &breaking, &[], 10.0),
+        Some(0)
+    );
 }
 
 /// The next rupture is the site over threshold (or forced) of largest energy
@@ -93,14 +102,30 @@ fn the_site_of_largest_energy_breaks_first() {
     // At F = 1 N sites 0-2 are over; site 2's compliance is e times larger, so 1.5² e =
     // 6.1 beats 2² = 4: site 2. Site 3 carries the most but is under its threshold.
     let (i, e) = rule
-        .next_rupture(&interface, (&breaking, &[]), 1.0, None, (&traction, &[]), &u_z, cell)
+        .next_rupture(
+            &interface,
+            (&breaking, &[]),
+            1.0,
+            None,
+            (&traction, &[]),
+            &u_z,
+            cell,
+        )
         .unwrap()
         .unwrap();
     assert_eq!(i, 2);
     assert!((e / energy(2, 1.0) - 1.0).abs() < 1e-12, "{e} J");
     // Forced in, site 3 (16 against 6.1) breaks first.
     let (i, _) = rule
-        .next_rupture(&interface, (&breaking, &[]), 1.0, Some(3), (&traction, &[]), &u_z, cell)
+        .next_rupture(
+            &interface,
+            (&breaking, &[]),
+            1.0,
+            Some(3),
+            (&traction, &[]),
+            &u_z,
+            cell,
+        )
         .unwrap()
         .unwrap();
     assert_eq!(i, 3);
@@ -109,9 +134,25 @@ fn the_site_of_largest_energy_breaks_first() {
         .set_states(&[Attached, Detached, Attached, Attached])
         .unwrap();
     interface.break_site(2).unwrap();
-    let next = rule.next_rupture(&interface, (&breaking, &[]), 1.0, None, (&traction, &[]), &u_z, cell);
+    let next = rule.next_rupture(
+        &interface,
+        (&breaking, &[]),
+        1.0,
+        None,
+        (&traction, &[]),
+        &u_z,
+        cell,
+    );
     assert_eq!(next.unwrap().map(|(i, _)| i), Some(0));
-    let next = rule.next_rupture(&interface, (&breaking, &[]), 0.4, None, (&traction, &[]), &u_z, cell);
+    let next = rule.next_rupture(
+        &interface,
+        (&breaking, &[]),
+        0.4,
+        None,
+        (&traction, &[]),
+        &u_z,
+        cell,
+    );
     assert_eq!(next.unwrap(), None);
 }
 
@@ -176,19 +217,38 @@ fn an_anchored_site_holds_inside_its_window() {
     assert_eq!(high, vec![40.0, 150.0, f64::NEG_INFINITY, f64::INFINITY]);
     assert_eq!(low, vec![-60.0, -100.0, f64::INFINITY, f64::NEG_INFINITY]);
     let states = [Attached; 4];
-    assert_eq!(rule.first_over_threshold(&states, &high, &low, 30.0), Some(2));
+    assert_eq!(
+        rule.first_over_threshold(&states, &high, &low, 30.0),
+        Some(2)
+    );
     let states = [Attached, Attached, Detached, Attached];
     assert_eq!(rule.first_over_threshold(&states, &high, &low, 30.0), None);
-    assert_eq!(rule.first_over_threshold(&states, &high, &low, -60.0), Some(0));
-    assert_eq!(rule.first_over_threshold(&states, &high, &low, 40.0), Some(0));
+    assert_eq!(
+        rule.first_over_threshold(&states, &high, &low, -60.0),
+        Some(0)
+    );
+    assert_eq!(
+        rule.first_over_threshold(&states, &high, &low, 40.0),
+        Some(0)
+    );
     assert_eq!(rule.weakest(&states, &high), Some((0, 40.0)));
     // No anchor shear: the paper's loads, bit for bit.
-    let (high, _) = rule.thresholds(&interface, &f, &g1, &[0.0; 4], 0.5).unwrap();
-    let paper = ContactRule::Paper.breaking_loads(&interface, &f, &g1, 0.5).unwrap();
-    assert!(high.iter().zip(&paper).all(|(a, b)| a.to_bits() == b.to_bits()));
+    let (high, _) = rule
+        .thresholds(&interface, &f, &g1, &[0.0; 4], 0.5)
+        .unwrap();
+    let paper = ContactRule::Paper
+        .breaking_loads(&interface, &f, &g1, 0.5)
+        .unwrap();
+    assert!(high
+        .iter()
+        .zip(&paper)
+        .all(|(a, b)| a.to_bits() == b.to_bits()));
     assert!(matches!(
         rule.thresholds(&interface, &f, &g1, &g0[..2], 0.5),
-        Err(Error::LengthMismatch { name: "anchor_traction", .. })
+        Err(Error::LengthMismatch {
+            name: "anchor_traction",
+            ..
+        })
     ));
 }
 
@@ -204,9 +264,17 @@ fn an_anchored_rupture_counts_the_anchors_shear() {
     let over = [0.5, 0.5, f64::INFINITY, f64::INFINITY];
     let low = [f64::NEG_INFINITY; 4];
     let next = |rule: ContactRule, anchor: &[f64]| {
-        rule.next_rupture(&interface, (&over, &low), 1.0, None, (&traction, anchor), &u_z, cell)
-            .unwrap()
-            .unwrap()
+        rule.next_rupture(
+            &interface,
+            (&over, &low),
+            1.0,
+            None,
+            (&traction, anchor),
+            &u_z,
+            cell,
+        )
+        .unwrap()
+        .unwrap()
     };
     // Paper: site 1 (2e6 against 1e6). Anchored: site 0 carries 4e6.
     assert_eq!(next(ContactRule::Paper, &[]).0, 1);
@@ -279,5 +347,7 @@ fn the_clock_re_forms_sites_when_due() {
     assert!(state.check(rule, &[Broken, Detached]).is_ok());
     state.anchors[1] = 1e-9;
     assert!(state.check(rule, &[Broken, Detached]).is_err()); // an anchor off contact
-    assert!(state.check(ContactRule::Anchored, &[Broken, Attached]).is_err());
+    assert!(state
+        .check(ContactRule::Anchored, &[Broken, Attached])
+        .is_err());
 }

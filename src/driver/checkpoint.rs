@@ -9,9 +9,9 @@
 //! build, same CPU features: the FFT kernels are chosen at run time).
 
 use super::{Driver, Phase};
+use crate::contact::ContactState;
 use crate::driver::Event;
 use crate::error::{Error, Result};
-use crate::contact::ContactState;
 use crate::interface::SiteState;
 use crate::scene::{file, Scene, SceneBuilder};
 use crate::solver::{AnchorResponse, NormalEquilibrium, SolverState, TangentialResponse};
@@ -626,9 +626,7 @@ impl Scene {
         }
         // Version 5 holds an anchored rule's state, and only it; the paper's rule writes 4.
         let anchored = self.contact_rule().anchors();
-        if checkpoint.contact.is_some() != anchored
-            || (checkpoint.format == FORMAT) != anchored
-        {
+        if checkpoint.contact.is_some() != anchored || (checkpoint.format == FORMAT) != anchored {
             return bad(format!(
                 "layout version {} {} the state of an anchored contact rule, and the scene's \
                  rule is {:?} (its checkpoints are of version {})",
@@ -713,7 +711,11 @@ impl Scene {
                     "after {} events it {} the anchors' response (a driver solves it, with {n} \
                      finite values, for its first event)",
                     checkpoint.events,
-                    if contact.anchor.is_some() { "holds" } else { "lacks" }
+                    if contact.anchor.is_some() {
+                        "holds"
+                    } else {
+                        "lacks"
+                    }
                 ));
             }
         }
