@@ -1448,6 +1448,39 @@ impl Scene {
     }
 }
 
+/// Refuses a contact rule the protocol cannot run: a re-forming rule's delay out of
+/// range, or re-forming sites under a spring drive (its force drops at each rupture, so
+/// sites may re-form for ever and the run never reach global slip).
+fn check_contact_rule(rule: ContactRule, drive: Drive) -> Result<()> {
+    let Some(delay) = rule.delay() else {
+        return Ok(());
+    };
+    if delay.stable_states == 0 {
+        return Err(Error::InvalidCount {
+            name: "contact.delay.stable_states",
+            value: 0,
+            reason: "a broken site re-forms at a later stable state: the delay is >= 1",
+        });
+    }
+    if !(delay.load.is_finite() && delay.load >= 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "contact.delay.load",
+            value: delay.load,
+            reason: "the load a broken site waits for, in units of mu F_N, is finite and >= 0",
+        });
+    }
+    if let Drive::Spring { .. } = drive {
+        return Err(Error::InvalidChoice {
+            name: "contact.rule",
+            value: "rejuvenation",
+            reason: "under a spring drive the force drops at each rupture and re-formed sites \
+                     may hold it below global slip for ever: drive by force (drive.kind \
+                     \"force\"), or use the rule \"anchored\"",
+        });
+    }
+    Ok(())
+}
+
 /// "Leave out what a given scene does not need" (docs/architecture.md, "What a scene leaves
 /// out"): what a built scene holds follows its drive and its probes.
 #[cfg(test)]
@@ -1553,37 +1586,4 @@ mod leaves_out {
         while driver.interface().broken_count() == 0 && driver.step().unwrap().is_some() {}
         assert!(driver.solver_holds_preconditioners());
     }
-}
-
-/// Refuses a contact rule the protocol cannot run: a re-forming rule's delay out of
-/// range, or re-forming sites under a spring drive (its force drops at each rupture, so
-/// sites may re-form for ever and the run never reach global slip).
-fn check_contact_rule(rule: ContactRule, drive: Drive) -> Result<()> {
-    let Some(delay) = rule.delay() else {
-        return Ok(());
-    };
-    if delay.stable_states == 0 {
-        return Err(Error::InvalidCount {
-            name: "contact.delay.stable_states",
-            value: 0,
-            reason: "a broken site re-forms at a later stable state: the delay is >= 1",
-        });
-    }
-    if !(delay.load.is_finite() && delay.load >= 0.0) {
-        return Err(Error::InvalidParameter {
-            name: "contact.delay.load",
-            value: delay.load,
-            reason: "the load a broken site waits for, in units of mu F_N, is finite and >= 0",
-        });
-    }
-    if let Drive::Spring { .. } = drive {
-        return Err(Error::InvalidChoice {
-            name: "contact.rule",
-            value: "rejuvenation",
-            reason: "under a spring drive the force drops at each rupture and re-formed sites \
-                     may hold it below global slip for ever: drive by force (drive.kind \
-                     \"force\"), or use the rule \"anchored\"",
-        });
-    }
-    Ok(())
 }
