@@ -20,14 +20,174 @@
 use crate::error::{check_slice, Error, Result};
 use crate::interface::{Interface, SiteState};
 
-/// The rule of a run's site transitions. Only the paper's for now.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// The rule of a run's site transitions (the scene key `contact`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub(crate) enum ContactRule {
     /// The paper's: the Coulomb threshold `|φ_x| = μ φ_z` of a spring anchored at
     /// `u_x = 0`; among the sites over threshold the one of largest elastic energy
     /// breaks first; a broken site never re-forms.
     #[default]
     Paper,
+    /// The paper's threshold and order, with each spring anchored where its site
+    /// attached: `φ_x = -k_x (u_x - a)`, `a` the site's `u_x` when it attached, so that
+    /// a site carries no shear at its attachment. A broken site never re-forms.
+    Anchored,
+    /// [`ContactRule::Anchored`], and a broken site re-forms (broken → detached, then
+    /// the normal equilibrium decides whether it touches) once its [`Delay`] has passed,
+    /// at the move from a stable state to the next load.
+    Rejuvenation {
+        /// How long a broken site stays broken.
+        delay: Delay,
+    },
+}
+
+/// How long a broken site stays broken under [`ContactRule::Rejuvenation`], in the
+/// protocol's quasi-static clock: both must have passed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Delay {
+    /// Stable states reached since the rupture (`>= 1`).
+    pub(crate) stable_states: u64,
+    /// Increase of the shear force since the rupture, in units of `μ F_N` (`>= 0`).
+    pub(crate) load: f64,
+}
+
+impl Default for Delay {
+    fn default() -> Self {
+        Self {
+            stable_states: 1,
+            load: 0.0,
+        }
+    }
+}
+
+impl Delay {
+    /// Whether a site broken at `since` may re-form at the clock tick `clock` under the
+    /// force `force` (N); `load_scale` is `μ F_N` (N), `slack` (N) what the force may
+    /// fall short by (rounding of a table's written forces).
+    fn due(self, since: BrokenSince, clock: u64, force: f64, load_scale: f64, slack: f64) -> bool {
+        clock.saturating_sub(since.clock) >= self.stable_states
+            && force - since.force + slack >= self.load * load_scale
+    }
+}
+
+/// When a site broke: the clock tick (stable states passed) and the force (N).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub(crate) struct BrokenSince {
+    /// The clock tick of its avalanche.
+    pub(crate) clock: u64,
+    /// The shear force at the rupture (N).
+    pub(crate) force: f64,
+}
+
+/// What an anchored rule carries from one event to the next (none under the paper's):
+/// the anchors, and for re-forming sites the clock and when each broken site broke.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub(crate) struct ContactState {
+    /// Per site, the `u_x` (m) at which its spring carries no shear: the site's `u_x` when
+    /// it attached; `0` off the attached sites.
+    pub(crate) anchors: Vec<f64>,
+    /// The quasi-static clock: moves from a stable state to the next load made.
+    pub(crate) clock: u64,
+    /// Per site (re-forming rules only, else empty), when it broke if it is broken.
+    pub(crate) broken_since: Vec<Option<BrokenSince>>,
+}
+
+impl ContactState {
+    /// The state at the start of a run of `sites` sites under `rule`: every spring
+    /// anchored at 0 (the contact forms at zero shear); `None` under the paper's rule.
+    pub(crate) fn new(rule: ContactRule, sites: usize) -> Option<Self> {
+        match rule {
+            ContactRule::Paper => None,
+            ContactRule::Anchored => Some(Self {
+                anchors: vec![0.0; sites],
+                clock: 0,
+                broken_since: Vec::new(),
+            }),
+            ContactRule::Rejuvenation { .. } => Some(Self {
+                anchors: vec![0.0; sites],
+                clock: 0,
+                broken_since: vec![None; sites],
+            }),
+        }
+    }
+
+    /// Records the rupture of `site` under the force `force` (N), at the current tick.
+    pub(crate) fn broke(&mut self, site: usize, force: f64) {
+        self.anchors[site] = 0.0;
+        if let Some(slot) = self.broken_since.get_mut(site) {
+            *slot = Some(BrokenSince {
+                clock: self.clock,
+                force,
+            });
+        }
+    }
+
+    /// The next tick of the clock (a move from a stable state to the next load) under the
+    /// force `force` (N): the broken sites whose delay has passed, which re-form now
+    /// (forgotten here). None but under [`ContactRule::Rejuvenation`].
+    pub(crate) fn tick(&mut self, rule: ContactRule, force: f64, load_scale: f64) -> Vec<usize> {
+        self.clock += 1;
+        let ContactRule::Rejuvenation { delay } = rule else {
+            return Vec::new();
+        };
+        let clock = self.clock;
+        let mut due = Vec::new();
+        for (i, slot) in self.broken_since.iter_mut().enumerate() {
+            if let Some(since) = *slot {
+                if delay.due(since, clock, force, load_scale, 0.0) {
+                    *slot = None;
+                    due.push(i);
+                }
+            }
+        }
+        due
+    }
+
+    /// Whether the state fits `states` under `rule` on `sites` sites: its lengths, finite
+    /// anchors zero off the attached sites, and a rupture time for each broken site and
+    /// for it alone (re-forming rules). `Err(reason)` otherwise.
+    pub(crate) fn check(
+        &self,
+        rule: ContactRule,
+        states: &[SiteState],
+    ) -> std::result::Result<(), String> {
+        let n = states.len();
+        if self.anchors.len() != n {
+            return Err(format!("{} anchors for {n} sites", self.anchors.len()));
+        }
+        if let Some(i) = (0..n).find(|&i| {
+            !self.anchors[i].is_finite()
+                || (states[i] != SiteState::Attached && self.anchors[i] != 0.0)
+        }) {
+            return Err(format!(
+                "site {i} is {:?} with the anchor {:e} m (finite, and 0 unless attached)",
+                states[i], self.anchors[i]
+            ));
+        }
+        let reforms = matches!(rule, ContactRule::Rejuvenation { .. });
+        if self.broken_since.len() != if reforms { n } else { 0 } {
+            return Err(format!(
+                "{} rupture times for {n} sites under the rule {rule:?}",
+                self.broken_since.len()
+            ));
+        }
+        if let Some(i) = (0..self.broken_since.len()).find(|&i| {
+            (states[i] == SiteState::Broken) != self.broken_since[i].is_some()
+                || self.broken_since[i]
+                    .is_some_and(|b| b.clock > self.clock || !b.force.is_finite())
+        }) {
+            return Err(format!(
+                "site {i} is {:?} with the rupture time {:?} (one for each broken site, at \
+                 or before the clock {})",
+                states[i], self.broken_since[i], self.clock
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// A change of one site's state, as the events `rupture`, `detach` and `attach` record it.
@@ -58,6 +218,12 @@ fn paper_over(breaking: f64, force: f64) -> bool {
     breaking <= force
 }
 
+/// An anchored site's threshold test: the load is out of its window, above or below.
+#[inline]
+fn anchored_over(high: f64, low: f64, force: f64) -> bool {
+    high <= force || force <= low
+}
+
 /// The paper's breaking load of one site (N): the threshold `μ φ_z` (Pa) over the shear
 /// traction per newton `|g|` (Pa/N), `+∞` where the site carries no shear. One
 /// expression for every caller: `(μ f) / |g|`, in that order, gives the same bits as
@@ -69,6 +235,43 @@ fn paper_breaking_load(friction_coefficient: f64, f: f64, g: f64) -> f64 {
     } else {
         friction_coefficient * f / g.abs()
     }
+}
+
+/// The window of loads (N) inside which an anchored site holds, `(λ_high, λ_low)`: its
+/// shear `φ_x = F g1 + g0` (Pa, `g1` per newton, `g0` the anchors') reaches the threshold
+/// `τ = μ φ_z` at `F = (±τ - g0 sgn g1)/|g1|`. A site that carries no shear per newton
+/// holds at every load (`(+∞, -∞)`) or at none (`(-∞, +∞)`).
+#[inline]
+fn anchored_window(friction_coefficient: f64, f: f64, g1: f64, g0: f64) -> (f64, f64) {
+    let tau = friction_coefficient * f;
+    if g1 == 0.0 {
+        return match g0 != 0.0 && g0.abs() >= tau {
+            true => (f64::NEG_INFINITY, f64::INFINITY),
+            false => (f64::INFINITY, f64::NEG_INFINITY),
+        };
+    }
+    let shift = g0 * g1.signum();
+    ((tau - shift) / g1.abs(), (-tau - shift) / g1.abs())
+}
+
+/// The checks of [`ContactRule::breaking_loads`]' input.
+fn check_threshold_inputs(
+    interface: &Interface,
+    normal_traction: &[f64],
+    shear_per_newton: &[f64],
+    friction_coefficient: f64,
+) -> Result<()> {
+    let n = interface.states().len();
+    check_slice("normal_traction", normal_traction, n)?;
+    check_slice("shear_per_newton", shear_per_newton, n)?;
+    if !(friction_coefficient.is_finite() && friction_coefficient >= 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "friction_coefficient",
+            value: friction_coefficient,
+            reason: "the friction coefficient must be finite and >= 0",
+        });
+    }
+    Ok(())
 }
 
 impl ContactRule {
@@ -87,56 +290,105 @@ impl ContactRule {
         shear_per_newton: &[f64],
         friction_coefficient: f64,
     ) -> Result<Vec<f64>> {
-        let n = interface.states().len();
-        check_slice("normal_traction", normal_traction, n)?;
-        check_slice("shear_per_newton", shear_per_newton, n)?;
-        if !(friction_coefficient.is_finite() && friction_coefficient >= 0.0) {
-            return Err(Error::InvalidParameter {
-                name: "friction_coefficient",
-                value: friction_coefficient,
-                reason: "the friction coefficient must be finite and >= 0",
-            });
+        check_threshold_inputs(
+            interface,
+            normal_traction,
+            shear_per_newton,
+            friction_coefficient,
+        )?;
+        // The anchored rules' window starts from the same checks; its loads are
+        // [`ContactRule::thresholds`]'.
+        Ok(shear_per_newton
+            .iter()
+            .zip(normal_traction)
+            .map(|(g, f)| paper_breaking_load(friction_coefficient, *f, *g))
+            .collect())
+    }
+
+    /// Whether the rule anchors springs where their sites attach (all but the paper's).
+    pub(crate) fn anchors(self) -> bool {
+        !matches!(self, ContactRule::Paper)
+    }
+
+    /// The loads (N) at which each site reaches its threshold, `(λ_high, λ_low)`: the
+    /// site holds for `λ_low < F < λ_high`. Under the paper's rule
+    /// [`ContactRule::breaking_loads`] and no `λ_low` (empty: a spring anchored at 0
+    /// under `F >= 0` has none); under an anchored rule the window of each site from its
+    /// shear per newton `g1` and its anchors' shear `g0` (Pa).
+    ///
+    /// # Errors
+    /// As [`ContactRule::breaking_loads`]; `anchor_traction` of the wrong length or not
+    /// finite (anchored rules).
+    pub(crate) fn thresholds(
+        self,
+        interface: &Interface,
+        normal_traction: &[f64],
+        shear_per_newton: &[f64],
+        anchor_traction: &[f64],
+        friction_coefficient: f64,
+    ) -> Result<(Vec<f64>, Vec<f64>)> {
+        if self == ContactRule::Paper {
+            let high = self.breaking_loads(
+                interface,
+                normal_traction,
+                shear_per_newton,
+                friction_coefficient,
+            )?;
+            return Ok((high, Vec::new()));
         }
-        Ok(match self {
-            ContactRule::Paper => shear_per_newton
-                .iter()
-                .zip(normal_traction)
-                .map(|(g, f)| paper_breaking_load(friction_coefficient, *f, *g))
-                .collect(),
-        })
+        check_threshold_inputs(
+            interface,
+            normal_traction,
+            shear_per_newton,
+            friction_coefficient,
+        )?;
+        let n = normal_traction.len();
+        check_slice("anchor_traction", anchor_traction, n)?;
+        Ok((0..n)
+            .map(|i| {
+                anchored_window(
+                    friction_coefficient,
+                    normal_traction[i],
+                    shear_per_newton[i],
+                    anchor_traction[i],
+                )
+            })
+            .unzip())
     }
 
     /// The attached site with the smallest finite breaking load, and that load (N): the
     /// threshold a stable state's load is raised to. `None` when no attached site
     /// carries shear.
+    /// Every rule raises the load (`F` grows with the control under both drives), so
+    /// the next threshold is the smallest `λ_high`.
     pub(crate) fn weakest(self, states: &[SiteState], breaking: &[f64]) -> Option<(usize, f64)> {
-        match self {
-            ContactRule::Paper => {
-                let mut best: Option<(usize, f64)> = None;
-                for (i, &b) in breaking.iter().enumerate() {
-                    if states[i] == SiteState::Attached
-                        && b.is_finite()
-                        && best.is_none_or(|(_, v)| b < v)
-                    {
-                        best = Some((i, b));
-                    }
-                }
-                best
+        let mut best: Option<(usize, f64)> = None;
+        for (i, &b) in breaking.iter().enumerate() {
+            if states[i] == SiteState::Attached && b.is_finite() && best.is_none_or(|(_, v)| b < v)
+            {
+                best = Some((i, b));
             }
         }
+        best
     }
 
     /// The first attached site over its threshold under the shear force `force` (N):
-    /// what a stable state may not hold.
+    /// what a stable state may not hold. `low` is [`ContactRule::thresholds`]' `λ_low`.
     pub(crate) fn first_over_threshold(
         self,
         states: &[SiteState],
         breaking: &[f64],
+        low: &[f64],
         force: f64,
     ) -> Option<usize> {
         match self {
             ContactRule::Paper => (0..breaking.len())
                 .find(|&i| states[i] == SiteState::Attached && paper_over(breaking[i], force)),
+            ContactRule::Anchored | ContactRule::Rejuvenation { .. } => {
+                (0..breaking.len()).find(|&i| {
+                    states[i] == SiteState::Attached && anchored_over(breaking[i], low[i], force)
+                })
+            }
         }
     }
 
@@ -144,9 +396,10 @@ impl ContactRule {
     /// its elastic energy (J): among the attached sites over threshold (and `forced`, the
     /// site whose threshold the load was raised to, over it by construction though
     /// rounding may say otherwise), the one of largest energy `½ φ_x² ΔA / k_x`, with
-    /// `φ_x = F g` from the shear tractions per newton `traction` (Pa/N) at the normal
-    /// displacements `u_z` (m); `cell` is `ΔA` (m²). `None` when no site is over
-    /// threshold: the avalanche has ended.
+    /// `φ_x = F g + g0` from the shear tractions per newton `traction` (Pa/N) and those of
+    /// the anchors `anchor_traction` (Pa; empty under the paper's rule, and `low` with
+    /// them) at the normal displacements `u_z` (m); `cell` is `ΔA` (m²). `None` when no
+    /// site is over threshold: the avalanche has ended.
     ///
     /// # Errors
     /// [`Error::NonFinite`] when the chosen site's compliance overflows.
@@ -154,32 +407,40 @@ impl ContactRule {
     pub(crate) fn next_rupture(
         self,
         interface: &Interface,
-        breaking: &[f64],
+        (breaking, low): (&[f64], &[f64]),
         force: f64,
         forced: Option<usize>,
-        traction: &[f64],
+        (traction, anchor_traction): (&[f64], &[f64]),
         u_z: &[f64],
         cell: f64,
     ) -> Result<Option<(usize, f64)>> {
         let best = match self {
-            ContactRule::Paper => {
-                largest_energy(interface, breaking, force, forced, traction, u_z, cell)
-            }
+            ContactRule::Paper => largest_energy(
+                interface,
+                |i| paper_over(breaking[i], force) || forced == Some(i),
+                |i| force * traction[i],
+                u_z,
+                cell,
+            ),
+            ContactRule::Anchored | ContactRule::Rejuvenation { .. } => largest_energy(
+                interface,
+                |i| anchored_over(breaking[i], low[i], force) || forced == Some(i),
+                |i| force * traction[i] + anchor_traction[i],
+                u_z,
+                cell,
+            ),
         };
-        match best {
-            Some(i) => {
-                let phi = force * traction[i];
-                Ok(Some((i, interface.rupture_energy(i, u_z[i], phi, cell)?)))
-            }
-            None => Ok(None),
-        }
+        Ok(match best {
+            Some((i, phi)) => Some((i, interface.rupture_energy(i, u_z[i], phi, cell)?)),
+            None => None,
+        })
     }
 
     /// Whether the interface slides as a whole: every spring broke.
     pub(crate) fn global_slip(self, interface: &Interface) -> bool {
-        match self {
-            ContactRule::Paper => interface.broken_count() == interface.states().len(),
-        }
+        // Every rule: a re-forming site re-forms only at a stable state, never inside
+        // the avalanche that breaks the last spring.
+        interface.broken_count() == interface.states().len()
     }
 
     /// The attach and detach events of a new normal equilibrium, in site order: `emit`
@@ -192,15 +453,12 @@ impl ContactRule {
         after: &[SiteState],
         mut emit: impl FnMut(usize, bool),
     ) {
-        match self {
-            ContactRule::Paper => {
-                for (i, (old, new)) in before.iter().zip(after).enumerate() {
-                    match (old, new) {
-                        (SiteState::Attached, SiteState::Detached) => emit(i, false),
-                        (SiteState::Detached, SiteState::Attached) => emit(i, true),
-                        _ => {}
-                    }
-                }
+        // Every rule: a re-formed site is detached before its equilibrium.
+        for (i, (old, new)) in before.iter().zip(after).enumerate() {
+            match (old, new) {
+                (SiteState::Attached, SiteState::Detached) => emit(i, false),
+                (SiteState::Detached, SiteState::Attached) => emit(i, true),
+                _ => {}
             }
         }
     }
@@ -209,102 +467,150 @@ impl ContactRule {
     /// `states`: each broke a site that is still broken (no site re-forms inside an
     /// avalanche).
     pub(crate) fn avalanche_ruptures_bound(self, states: &[SiteState]) -> usize {
-        match self {
-            ContactRule::Paper => states.iter().filter(|s| **s == SiteState::Broken).count(),
-        }
+        // Every rule: sites re-form between avalanches only.
+        states.iter().filter(|s| **s == SiteState::Broken).count()
     }
 
-    /// Whether a site that broke may change again (re-form).
-    fn reforms(self) -> bool {
+    /// The delay after which a broken site re-forms; `None` when it never does.
+    pub(crate) fn delay(self) -> Option<Delay> {
         match self {
-            ContactRule::Paper => false,
+            ContactRule::Paper | ContactRule::Anchored => None,
+            ContactRule::Rejuvenation { delay } => Some(delay),
         }
     }
 }
 
-/// The paper's choice of the next rupture ([`ContactRule::next_rupture`]): its index.
-/// The order key is `ln` of the energy ([`Interface::log_rupture_energy`]), which
-/// neither underflow nor overflow can tie; ties keep the first site.
+/// The choice of the next rupture ([`ContactRule::next_rupture`]): among the attached
+/// sites `over` threshold the one of largest energy under its shear `phi` (Pa); its index
+/// and shear. The order key is `ln` of the energy ([`Interface::log_rupture_energy`]),
+/// which neither underflow nor overflow can tie; ties keep the first site.
 fn largest_energy(
     interface: &Interface,
-    breaking: &[f64],
-    force: f64,
-    forced: Option<usize>,
-    traction: &[f64],
+    over: impl Fn(usize) -> bool,
+    phi: impl Fn(usize) -> f64,
     u_z: &[f64],
     cell: f64,
-) -> Option<usize> {
+) -> Option<(usize, f64)> {
     let states = interface.states();
-    let mut best: Option<(usize, f64)> = None;
+    let mut best: Option<(usize, f64, f64)> = None;
     for i in 0..states.len() {
         if states[i] != SiteState::Attached {
             continue;
         }
-        if paper_over(breaking[i], force) || forced == Some(i) {
-            let phi = force * traction[i];
+        if over(i) {
+            let phi = phi(i);
             let key = interface.log_rupture_energy(i, u_z[i], phi, cell);
-            if best.is_none_or(|(_, k)| key > k) {
-                best = Some((i, key));
+            if best.is_none_or(|(_, k, _)| key > k) {
+                best = Some((i, key, phi));
             }
         }
     }
-    best.map(|(i, _)| i)
+    best.map(|(i, _, phi)| (i, phi))
 }
 
 /// The site states a run's site events leave, replayed in order under a rule: the
 /// resume's check of a checkpoint's states against its `events.csv`. Each change is
-/// tagged (with its line in the table) so that a refusal names where it happened.
+/// tagged (with its line in the table) so that a refusal names where it happened. The
+/// stable states keep the quasi-static clock of a re-forming rule
+/// ([`Replay::stable`]): a broken site may change again only by attaching when its
+/// delay has passed, and is broken at the end unless its delay passed.
 pub(crate) struct Replay {
     rule: ContactRule,
+    /// `μ F_N` (N): the unit of a [`Delay`]'s load.
+    load_scale: f64,
     /// Per site: the state its last change left and that change's tag.
     last: Vec<Option<(SiteState, usize)>>,
+    /// Per site: when its last rupture happened (clock tick, force in N).
+    broke: Vec<Option<BrokenSince>>,
+    /// Stable states so far, and the forces (N) of the last two.
+    stable: u64,
+    forces: [f64; 2],
 }
 
 impl Replay {
-    /// No change yet on `sites` sites.
-    pub(crate) fn new(rule: ContactRule, sites: usize) -> Self {
+    /// No change yet on `sites` sites; `load_scale` is `μ F_N` (N).
+    pub(crate) fn new(rule: ContactRule, sites: usize, load_scale: f64) -> Self {
         Self {
             rule,
+            load_scale,
             last: vec![None; sites],
+            broke: vec![None; sites],
+            stable: 0,
+            forces: [0.0; 2],
         }
     }
 
-    /// Applies `change` of site `index` (tagged `tag`). `Err(tag of the rupture)` when
-    /// the rule forbids it: under the paper's rule, any change of a broken site. A site
-    /// beyond the grid is ignored (the row checks refuse it).
+    /// A stable state at the force `force` (N): the driver's next move ticks the clock
+    /// (and re-forms the sites then due).
+    pub(crate) fn stable(&mut self, force: f64) {
+        self.stable += 1;
+        self.forces = [self.forces[1], force];
+    }
+
+    /// Whether a site broken at `since` was due at the move after the `back`-th last
+    /// stable state (0: the last). The table's forces are written to 13 digits: a due
+    /// load may fall short of the delay's by their rounding.
+    fn due(&self, since: BrokenSince, back: usize) -> bool {
+        let Some(delay) = self.rule.delay() else {
+            return false;
+        };
+        let clock = self.stable.saturating_sub(back as u64);
+        let force = self.forces[1 - back];
+        let slack = 1e-11 * (force.abs() + since.force.abs() + self.load_scale);
+        clock > since.clock && delay.due(since, clock, force, self.load_scale, slack)
+    }
+
+    /// Applies `change` of site `index` (tagged `tag`) under the force `force` (N, the
+    /// rupture's). `Err(tag of the rupture)` when the rule forbids it: any change of a
+    /// broken site but its attachment once its delay has passed (a re-forming rule). A
+    /// site beyond the grid is ignored (the row checks refuse it).
     pub(crate) fn apply(
         &mut self,
         index: usize,
         change: SiteChange,
         tag: usize,
+        force: f64,
     ) -> Result<(), usize> {
-        let reforms = self.rule.reforms();
-        let Some(slot) = self.last.get_mut(index) else {
+        let Some(slot) = self.last.get(index).copied() else {
             return Ok(());
         };
-        if let Some((SiteState::Broken, broke)) = *slot {
-            if !reforms {
+        if let Some((SiteState::Broken, broke)) = slot {
+            let reformed = change == SiteChange::Attach
+                && self.broke[index].is_some_and(|since| self.due(since, 0));
+            if !reformed {
                 return Err(broke);
             }
         }
-        *slot = Some((change.to(), tag));
+        if change == SiteChange::Rupture {
+            self.broke[index] = Some(BrokenSince {
+                clock: self.stable,
+                force,
+            });
+        }
+        self.last[index] = Some((change.to(), tag));
         Ok(())
     }
 
     /// The state the changes so far leave site `index` in when `state` is not one of
     /// them, with the tag of its last change (`None` without one); `None` when `state`
     /// fits. A site no change touched may be attached or detached (the normal
-    /// equilibrium at zero shear chose), never broken: only a rupture breaks a site.
+    /// equilibrium at zero shear chose), never broken: only a rupture breaks a site. A
+    /// site a rupture left broken is detached, and only detached, once its delay passed
+    /// (by the move after the last-but-one stable state: the replay ends at a stable
+    /// state, before its move).
     pub(crate) fn mismatch(
         &self,
         index: usize,
         state: SiteState,
     ) -> Option<(SiteState, Option<usize>)> {
-        let (expected, tag) = match self.last.get(index).copied().flatten() {
+        let (mut expected, tag) = match self.last.get(index).copied().flatten() {
             Some((s, tag)) => (s, Some(tag)),
             None if state == SiteState::Broken => (SiteState::Attached, None),
             None => return None,
         };
+        if expected == SiteState::Broken && self.broke[index].is_some_and(|b| self.due(b, 1)) {
+            expected = SiteState::Detached;
+        }
         (expected != state).then_some((expected, tag))
     }
 }

@@ -37,13 +37,13 @@
 //! # Ok::<(), precursors::Error>(())
 //! ```
 
-use crate::contact::ContactRule;
+use crate::contact::{ContactRule, ContactState};
 use crate::error::{Error, Result};
 use crate::geometry::Grid;
-use crate::interface::{Interface, Material};
+use crate::interface::{Interface, Material, SiteState};
 use crate::probe::StressProbe;
 use crate::scene::{Drive, Scene};
-use crate::solver::{EquilibriumSolver, NormalEquilibrium, TangentialResponse};
+use crate::solver::{AnchorResponse, EquilibriumSolver, NormalEquilibrium, TangentialResponse};
 use std::collections::VecDeque;
 use std::ops::ControlFlow;
 
@@ -257,8 +257,12 @@ impl Event {
 enum Phase {
     /// Before the first normal equilibrium.
     Start,
-    /// Stable: the next step raises the load.
+    /// Stable: the next step raises the load (a re-forming rule first re-forms the
+    /// sites whose delay has passed).
     Stable,
+    /// Stable, with the sites due re-formed and their equilibrium solved: the next step
+    /// raises the load.
+    Reformed,
     /// At fixed load, possibly with sites over threshold (`forced`: the site that set
     /// the threshold, over it by definition whatever the rounding).
     Avalanche { forced: Option<usize> },
@@ -325,12 +329,20 @@ pub struct Driver {
     solver: EquilibriumSolver,
     normal: Option<NormalEquilibrium>,
     response: Option<TangentialResponse>,
-    /// `φ_x = F g` (Pa) of the current state (empty before the first equilibrium).
+    /// The anchored rules' state (`None` under the paper's rule).
+    contact: Option<ContactState>,
+    /// The anchored rules' shear at zero load, `g0` (`None` under the paper's rule and
+    /// before the first equilibrium).
+    anchor: Option<AnchorResponse>,
+    /// `φ_x = F g + g0` (Pa) of the current state (empty before the first equilibrium).
     shear_traction: Vec<f64>,
-    /// `u_x = F u_x/F` (m) of the current state (empty before the first equilibrium).
+    /// `u_x = F u_x/F + u0` (m) of the current state (empty before the first equilibrium).
     shear_displacement: Vec<f64>,
     /// Breaking load `λ_i` (N) of each site in the current state (`+∞` off contact).
     breaking: Vec<f64>,
+    /// The anchored rules' lower breaking load of each site (N): the site also breaks
+    /// once the load falls to it ([`ContactRule::thresholds`]); empty under the paper's.
+    breaking_low: Vec<f64>,
     initial_columns: Vec<f64>,
     /// Control parameter: `F` (N) under force control, `U_S` (m) under a spring.
     control: f64,
@@ -495,9 +507,12 @@ impl Scene {
             solver,
             normal: None,
             response: None,
+            contact: ContactState::new(self.contact_rule(), n),
+            anchor: None,
             shear_traction: Vec::new(),
             shear_displacement: Vec::new(),
             breaking: vec![f64::INFINITY; n],
+            breaking_low: Vec::new(),
             initial_columns: Vec::new(),
             control: 0.0,
             pending: VecDeque::new(),
@@ -630,21 +645,26 @@ impl Driver {
     }
 
     /// Recomputes the shear fields of the current state (`F` times the response per
-    /// newton) after the load or the response changed.
+    /// newton, plus the anchors' response under an anchored rule) after the load or the
+    /// response changed.
     pub(crate) fn refresh_shear(&mut self) {
         let f = self.force();
-        match &self.response {
-            Some(r) => {
-                self.shear_traction.clear();
+        self.shear_traction.clear();
+        self.shear_displacement.clear();
+        match (&self.response, &self.anchor) {
+            (Some(r), None) => {
                 self.shear_traction.extend(r.traction.iter().map(|g| f * g));
-                self.shear_displacement.clear();
                 self.shear_displacement
                     .extend(r.displacement.iter().map(|u| f * u));
             }
-            None => {
-                self.shear_traction.clear();
-                self.shear_displacement.clear();
+            (Some(r), Some(a)) => {
+                let affine = |g: &[f64], g0: &[f64]| -> Vec<f64> {
+                    g.iter().zip(g0).map(|(g, g0)| f * g + g0).collect()
+                };
+                self.shear_traction = affine(&r.traction, &a.traction);
+                self.shear_displacement = affine(&r.displacement, &a.displacement);
             }
+            (None, _) => {}
         }
     }
 
@@ -661,28 +681,24 @@ impl Driver {
                 self.phase = Phase::Stable;
             }
             Phase::Stable => {
-                let (site, threshold) = self.weakest()?;
-                self.control = match self.scene.drive() {
-                    Drive::Spring { stiffness, .. } => {
-                        // F = K_S U_S / (1 + K_S Û): invert for the U_S that makes F = λ.
-                        threshold * (1.0 + stiffness * self.response()?.offset_per_newton)
-                            / stiffness
-                    }
-                    Drive::Force(_) => threshold,
-                };
-                self.pending
-                    .push_back(Event::LoadRaised { load: self.load() });
-                self.avalanche_ruptures = 0;
-                self.phase = Phase::Avalanche { forced: Some(site) };
+                if self.reform()? {
+                    self.phase = Phase::Reformed;
+                    return Ok(());
+                }
+                self.raise(false)?;
             }
+            Phase::Reformed => self.raise(true)?,
             Phase::Avalanche { forced } => {
                 let force = self.force();
                 let best = self.contact_rule().next_rupture(
                     &self.interface,
-                    &self.breaking,
+                    (&self.breaking, &self.breaking_low),
                     force,
                     forced,
-                    &self.response()?.traction,
+                    (
+                        &self.response()?.traction,
+                        self.anchor.as_ref().map_or(&[][..], |a| &a.traction),
+                    ),
                     &self.normal()?.displacement,
                     self.grid().cell_area(),
                 )?;
@@ -703,6 +719,9 @@ impl Driver {
                         });
                         self.avalanche_ruptures += 1;
                         self.interface.break_site(i)?;
+                        if let Some(contact) = &mut self.contact {
+                            contact.broke(i, load.force);
+                        }
                         if self.contact_rule().global_slip(&self.interface) {
                             self.pending.push_back(Event::GlobalSlip { load });
                             self.phase = Phase::Done;
@@ -718,6 +737,55 @@ impl Driver {
         Ok(())
     }
 
+    /// The move from a stable state to the next load: the load raised to the next
+    /// threshold (after re-formed sites, never lowered: a site they overload may be over
+    /// threshold already).
+    fn raise(&mut self, reformed: bool) -> Result<()> {
+        let (site, threshold) = self.weakest()?;
+        let control = match self.scene.drive() {
+            Drive::Spring { stiffness, .. } => {
+                // F = K_S (U_S - Û0) / (1 + K_S Û): invert for the U_S that makes F = λ.
+                let u_s =
+                    threshold * (1.0 + stiffness * self.response()?.offset_per_newton) / stiffness;
+                match &self.anchor {
+                    Some(a) => u_s + a.offset,
+                    None => u_s,
+                }
+            }
+            Drive::Force(_) => threshold,
+        };
+        self.control = match reformed {
+            true => control.max(self.control),
+            false => control,
+        };
+        self.pending
+            .push_back(Event::LoadRaised { load: self.load() });
+        self.avalanche_ruptures = 0;
+        self.phase = Phase::Avalanche { forced: Some(site) };
+        Ok(())
+    }
+
+    /// A re-forming rule's tick of the quasi-static clock at a stable state: the broken
+    /// sites whose delay has passed become detached, and the equilibrium of the new site
+    /// set is solved (queueing the sites that attach, anchored). Whether any re-formed.
+    fn reform(&mut self) -> Result<bool> {
+        let rule = self.contact_rule();
+        let force = self.force();
+        let load_scale = self.friction_coefficient() * self.normal_load();
+        let Some(contact) = &mut self.contact else {
+            return Ok(false);
+        };
+        let due = contact.tick(rule, force, load_scale);
+        if due.is_empty() {
+            return Ok(false);
+        }
+        for i in due {
+            self.interface.set_state(i, SiteState::Detached);
+        }
+        self.equilibrate()?;
+        Ok(true)
+    }
+
     /// Normal then tangential equilibrium of the current site set; queues the sites that
     /// detached or attached.
     fn equilibrate(&mut self) -> Result<()> {
@@ -731,18 +799,26 @@ impl Driver {
         self.stats.normal_solves += 1;
         self.stats.normal_active_set_iterations += normal.report.active_set_iterations;
         self.stats.normal_iterations += normal.report.linear_iterations;
+        let mut attached_now = Vec::new();
         if self.normal.is_some() {
             let grid = self.scene.grid();
             let pending = &mut self.pending;
+            let anchors = self.contact.is_some();
             self.scene
                 .contact_rule()
                 .changes(&before, self.interface.states(), |i, attached| {
                     let site = Site::new(grid, i);
+                    if attached && anchors {
+                        attached_now.push(i);
+                    }
                     pending.push_back(match attached {
                         true => Event::Attach { site },
                         false => Event::Detach { site },
                     })
                 });
+        }
+        if self.contact.is_some() {
+            self.anchor_new_sites(&normal.displacement, &attached_now)?;
         }
         let clock = std::time::Instant::now();
         let response =
@@ -751,6 +827,35 @@ impl Driver {
         self.stats.tangential_seconds += clock.elapsed().as_secs_f64();
         self.stats.tangential_solves += 1;
         self.stats.tangential_iterations += response.report.linear_iterations;
+        self.check_spring(&response)?;
+        match self.contact.as_ref().map(|c| c.anchors.clone()) {
+            None => {
+                self.breaking = self.contact_rule().breaking_loads(
+                    &self.interface,
+                    &normal.traction,
+                    &response.traction,
+                    self.friction_coefficient(),
+                )?;
+            }
+            Some(anchors) => {
+                let anchor = self.solve_anchor(&normal.displacement, &anchors)?;
+                (self.breaking, self.breaking_low) = self.contact_rule().thresholds(
+                    &self.interface,
+                    &normal.traction,
+                    &response.traction,
+                    &anchor.traction,
+                    self.friction_coefficient(),
+                )?;
+                self.anchor = Some(anchor);
+            }
+        }
+        self.normal = Some(normal);
+        self.response = Some(response);
+        Ok(())
+    }
+
+    /// Refuses a response under which the driving spring cannot load the block.
+    fn check_spring(&self, response: &TangentialResponse) -> Result<()> {
         if let Drive::Spring { stiffness, .. } = self.scene.drive() {
             let denominator = 1.0 + stiffness * response.offset_per_newton;
             if denominator.is_nan() || denominator <= 0.0 {
@@ -762,14 +867,73 @@ impl Driver {
                 });
             }
         }
-        self.breaking = self.contact_rule().breaking_loads(
-            &self.interface,
-            &normal.traction,
-            &response.traction,
-            self.friction_coefficient(),
-        )?;
-        self.normal = Some(normal);
-        self.response = Some(response);
+        Ok(())
+    }
+
+    /// The anchors' response `g0` at the normal displacements `u_z` (m), counted with
+    /// the tangential solves.
+    fn solve_anchor(&mut self, u_z: &[f64], anchors: &[f64]) -> Result<AnchorResponse> {
+        let clock = std::time::Instant::now();
+        let anchor = self
+            .solver
+            .solve_tangential_anchor(&self.interface, u_z, anchors)?;
+        self.stats.tangential_seconds += clock.elapsed().as_secs_f64();
+        self.stats.tangential_solves += 1;
+        self.stats.tangential_iterations += anchor.report.linear_iterations;
+        Ok(anchor)
+    }
+
+    /// Anchors the springs of the sites that just attached (`attached_now`) where they
+    /// carry no shear at the current load: at their `u_x` in the equilibrium of the other
+    /// attached sites at that load (normal displacements `u_z`, m), which inserting them
+    /// then leaves as it is. Springs off the attached set lose their anchors.
+    fn anchor_new_sites(&mut self, u_z: &[f64], attached_now: &[usize]) -> Result<()> {
+        let Some(contact) = &mut self.contact else {
+            return Ok(());
+        };
+        let states = self.interface.states();
+        for (a, s) in contact.anchors.iter_mut().zip(states) {
+            if *s != SiteState::Attached {
+                *a = 0.0;
+            }
+        }
+        if attached_now.is_empty() {
+            return Ok(());
+        }
+        let mut others = self.interface.clone();
+        for &i in attached_now {
+            others.set_state(i, SiteState::Detached);
+            contact.anchors[i] = 0.0;
+        }
+        let anchors = contact.anchors.clone();
+        let u_x: Vec<f64> = if others.attached_count() == 0 {
+            // No other site holds the block: the new ones attach where it stood.
+            self.shear_displacement.clone()
+        } else {
+            let clock = std::time::Instant::now();
+            let unit = self
+                .solver
+                .solve_tangential(&others, u_z, &self.unit_load)?;
+            let zero = self
+                .solver
+                .solve_tangential_anchor(&others, u_z, &anchors)?;
+            self.stats.tangential_seconds += clock.elapsed().as_secs_f64();
+            self.stats.tangential_solves += 2;
+            self.stats.tangential_iterations +=
+                unit.report.linear_iterations + zero.report.linear_iterations;
+            self.check_spring(&unit)?;
+            let force = self.drive_force(unit.offset_per_newton, zero.offset);
+            unit.displacement
+                .iter()
+                .zip(&zero.displacement)
+                .map(|(u1, u0)| force * u1 + u0)
+                .collect()
+        };
+        if let Some(contact) = &mut self.contact {
+            for &i in attached_now {
+                contact.anchors[i] = u_x.get(i).copied().unwrap_or(0.0);
+            }
+        }
         Ok(())
     }
 
@@ -802,12 +966,26 @@ impl Driver {
 
     /// The shear force `F` (N) in the current state.
     pub fn force(&self) -> f64 {
+        match (self.scene.drive(), &self.response) {
+            (Drive::Force(_), _) => self.control,
+            (Drive::Spring { .. }, Some(r)) => self.drive_force(
+                r.offset_per_newton,
+                self.anchor.as_ref().map_or(0.0, |a| a.offset),
+            ),
+            (Drive::Spring { .. }, None) => 0.0,
+        }
+    }
+
+    /// The shear force (N) of the current control in a state whose block moves by
+    /// `per_newton` (m/N) per newton plus `offset` (m, the anchors'):
+    /// `K_S (U_S - Û0) / (1 + K_S Û)` under a spring drive, the control under force.
+    fn drive_force(&self, per_newton: f64, offset: f64) -> f64 {
         match self.scene.drive() {
             Drive::Force(_) => self.control,
-            Drive::Spring { stiffness, .. } => match &self.response {
-                Some(r) => stiffness * self.control / (1.0 + stiffness * r.offset_per_newton),
-                None => 0.0,
-            },
+            // `U_S - 0` is `U_S` bit for bit (`-0 - 0` is `-0`): the paper's expression.
+            Drive::Spring { stiffness, .. } => {
+                stiffness * (self.control - offset) / (1.0 + stiffness * per_newton)
+            }
         }
     }
 

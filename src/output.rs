@@ -614,6 +614,7 @@ impl RunTables {
         }
         resume::check_site_states(
             driver.contact_rule(),
+            driver.friction_coefficient() * driver.normal_load(),
             &plan.site_events,
             driver.site_states(),
             &read[0],

@@ -762,6 +762,8 @@ pub struct SceneBuilder {
     max_cells: usize,
     run: RunOptions,
     confirm_metres: bool,
+    /// The rule of the site transitions (scene-file key `contact`).
+    contact: ContactRule,
 }
 
 impl PartialEq for SceneBuilder {
@@ -786,6 +788,7 @@ impl PartialEq for SceneBuilder {
             && self.max_cells == other.max_cells
             && self.run == other.run
             && self.confirm_metres == other.confirm_metres
+            && self.contact == other.contact
     }
 }
 
@@ -806,6 +809,7 @@ impl Default for SceneBuilder {
             max_cells: crate::green::DEFAULT_MAX_CELLS,
             run: RunOptions::default(),
             confirm_metres: false,
+            contact: ContactRule::Paper,
         }
     }
 }
@@ -928,6 +932,14 @@ impl SceneBuilder {
     /// ```
     pub fn confirm_metres(mut self, confirm: bool) -> Self {
         self.confirm_metres = confirm;
+        self
+    }
+
+    /// The rule of the site transitions (scene-file key `contact`; default the paper's).
+    /// Checked by [`SceneBuilder::check`]. (Crate-private until the rules are public.)
+    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
+    pub(crate) fn contact_rule(mut self, rule: ContactRule) -> Self {
+        self.contact = rule;
         self
     }
 
@@ -1112,6 +1124,7 @@ impl SceneBuilder {
             "use fewer cells (or fewer probes), or a machine with more memory",
         )?;
         check_tolerance(self.plan_tolerance)?;
+        check_contact_rule(self.contact, self.drive)?;
         if !(self.normal_load.is_finite() && self.normal_load > 0.0) {
             return Err(Error::InvalidParameter {
                 name: "normal_load",
@@ -1394,10 +1407,9 @@ impl Scene {
         self.inner.probe.as_ref()
     }
 
-    /// The rule of the site transitions ([`crate::contact`]): the paper's, the only one
-    /// so far (a scene key will choose).
+    /// The rule of the site transitions ([`crate::contact`]; scene-file key `contact`).
     pub(crate) fn contact_rule(&self) -> ContactRule {
-        ContactRule::Paper
+        self.inner.builder.contact
     }
 
     /// The lateral load of the drive, if any (the probes' lateral stress term).
@@ -1434,6 +1446,39 @@ impl Scene {
             (None, _) => vec![0.0; self.inner.grid.len()],
         }
     }
+}
+
+/// Refuses a contact rule the protocol cannot run: a re-forming rule's delay out of
+/// range, or re-forming sites under a spring drive (its force drops at each rupture, so
+/// sites may re-form for ever and the run never reach global slip).
+fn check_contact_rule(rule: ContactRule, drive: Drive) -> Result<()> {
+    let Some(delay) = rule.delay() else {
+        return Ok(());
+    };
+    if delay.stable_states == 0 {
+        return Err(Error::InvalidCount {
+            name: "contact.delay.stable_states",
+            value: 0,
+            reason: "a broken site re-forms at a later stable state: the delay is >= 1",
+        });
+    }
+    if !(delay.load.is_finite() && delay.load >= 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "contact.delay.load",
+            value: delay.load,
+            reason: "the load a broken site waits for, in units of mu F_N, is finite and >= 0",
+        });
+    }
+    if let Drive::Spring { .. } = drive {
+        return Err(Error::InvalidChoice {
+            name: "contact.rule",
+            value: "rejuvenation",
+            reason: "under a spring drive the force drops at each rupture and re-formed sites \
+                     may hold it below global slip for ever: drive by force (drive.kind \
+                     \"force\"), or use the rule \"anchored\"",
+        });
+    }
+    Ok(())
 }
 
 /// "Leave out what a given scene does not need" (docs/architecture.md, "What a scene leaves

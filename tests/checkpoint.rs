@@ -728,15 +728,23 @@ pub(crate) mod json {
         assert!(reason.contains("EOF"), "{reason}");
         // Another layout version, newer or older (older ones carry no digest): refused,
         // saying which.
-        for (version, words) in [(5, "layout version 5"), (2, "layout version 2")] {
+        for (version, words) in [(6, "layout version 6"), (2, "layout version 2")] {
             let other = text.replacen("\"format\":4", &format!("\"format\":{version}"), 1);
             assert_ne!(other, text);
             let reason = refused(&other);
             assert!(
-                reason.contains(words) && reason.contains("reads versions 3 to 4"),
+                reason.contains(words) && reason.contains("reads versions 3 to 5"),
                 "{reason}"
             );
         }
+        // Version 5 is an anchored contact rule's: the paper's state under it, signed
+        // again, is read but not resumed.
+        let five = resigned(&text.replacen("\"format\":4", "\"format\":5", 1));
+        let resumed = scene.resume(&Checkpoint::from_json_str(&five).unwrap());
+        assert!(
+            matches!(&resumed, Err(Error::InvalidCheckpoint { reason }) if reason.contains("layout version 5 without")),
+            "{resumed:?}"
+        );
         // Edits and damage: the event count, a site's state, a key this build does not
         // know (at the top, inside), a flipped byte, a missing or altered digest.
         let states = text.find("\"states\":[").unwrap();

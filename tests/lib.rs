@@ -5,6 +5,7 @@ mod api;
 mod calibration;
 mod checkpoint;
 mod common;
+mod contact_rules;
 #[cfg(feature = "cli")]
 mod damage;
 mod driver;

@@ -69,9 +69,18 @@ fn weakest_and_over_threshold_look_at_attached_sites_only() {
     );
     // A tie keeps the first site.
     assert_eq!(rule.weakest(&states, &[3.0, 1.0, 3.0, 2.0]), Some((0, 3.0)));
-    assert_eq!(rule.first_over_threshold(&states, &breaking, 2.9), None);
-    assert_eq!(rule.first_over_threshold(&states, &breaking, 3.0), Some(2));
-    assert_eq!(rule.first_over_threshold(&states, &breaking, 10.0), Some(0));
+    assert_eq!(
+        rule.first_over_threshold(&states, &breaking, &[], 2.9),
+        None
+    );
+    assert_eq!(
+        rule.first_over_threshold(&states, &breaking, &[], 3.0),
+        Some(2)
+    );
+    assert_eq!(
+        rule.first_over_threshold(&states, &breaking, &[], 10.0),
+        Some(0)
+    );
 }
 
 /// The next rupture is the site over threshold (or forced) of largest energy
@@ -93,14 +102,30 @@ fn the_site_of_largest_energy_breaks_first() {
     // At F = 1 N sites 0-2 are over; site 2's compliance is e times larger, so 1.5² e =
     // 6.1 beats 2² = 4: site 2. Site 3 carries the most but is under its threshold.
     let (i, e) = rule
-        .next_rupture(&interface, &breaking, 1.0, None, &traction, &u_z, cell)
+        .next_rupture(
+            &interface,
+            (&breaking, &[]),
+            1.0,
+            None,
+            (&traction, &[]),
+            &u_z,
+            cell,
+        )
         .unwrap()
         .unwrap();
     assert_eq!(i, 2);
     assert!((e / energy(2, 1.0) - 1.0).abs() < 1e-12, "{e} J");
     // Forced in, site 3 (16 against 6.1) breaks first.
     let (i, _) = rule
-        .next_rupture(&interface, &breaking, 1.0, Some(3), &traction, &u_z, cell)
+        .next_rupture(
+            &interface,
+            (&breaking, &[]),
+            1.0,
+            Some(3),
+            (&traction, &[]),
+            &u_z,
+            cell,
+        )
         .unwrap()
         .unwrap();
     assert_eq!(i, 3);
@@ -109,9 +134,25 @@ fn the_site_of_largest_energy_breaks_first() {
         .set_states(&[Attached, Detached, Attached, Attached])
         .unwrap();
     interface.break_site(2).unwrap();
-    let next = rule.next_rupture(&interface, &breaking, 1.0, None, &traction, &u_z, cell);
+    let next = rule.next_rupture(
+        &interface,
+        (&breaking, &[]),
+        1.0,
+        None,
+        (&traction, &[]),
+        &u_z,
+        cell,
+    );
     assert_eq!(next.unwrap().map(|(i, _)| i), Some(0));
-    let next = rule.next_rupture(&interface, &breaking, 0.4, None, &traction, &u_z, cell);
+    let next = rule.next_rupture(
+        &interface,
+        (&breaking, &[]),
+        0.4,
+        None,
+        (&traction, &[]),
+        &u_z,
+        cell,
+    );
     assert_eq!(next.unwrap(), None);
 }
 
@@ -141,16 +182,16 @@ fn global_slip_and_the_changes_of_an_equilibrium() {
 fn a_broken_site_never_changes_again() {
     let rule = ContactRule::Paper;
     for change in [SiteChange::Rupture, SiteChange::Detach, SiteChange::Attach] {
-        let mut replay = Replay::new(rule, 3);
-        replay.apply(0, SiteChange::Detach, 10).unwrap();
-        replay.apply(0, SiteChange::Attach, 11).unwrap();
-        replay.apply(0, SiteChange::Rupture, 12).unwrap();
-        assert_eq!(replay.apply(0, change, 13), Err(12));
+        let mut replay = Replay::new(rule, 3, 1.0);
+        replay.apply(0, SiteChange::Detach, 10, 0.0).unwrap();
+        replay.apply(0, SiteChange::Attach, 11, 0.0).unwrap();
+        replay.apply(0, SiteChange::Rupture, 12, 0.0).unwrap();
+        assert_eq!(replay.apply(0, change, 13, 0.0), Err(12));
     }
-    let mut replay = Replay::new(rule, 3);
-    replay.apply(0, SiteChange::Rupture, 5).unwrap();
-    replay.apply(1, SiteChange::Detach, 6).unwrap();
-    replay.apply(7, SiteChange::Rupture, 8).unwrap(); // beyond the grid: the row checks'
+    let mut replay = Replay::new(rule, 3, 1.0);
+    replay.apply(0, SiteChange::Rupture, 5, 0.0).unwrap();
+    replay.apply(1, SiteChange::Detach, 6, 0.0).unwrap();
+    replay.apply(7, SiteChange::Rupture, 8, 0.0).unwrap(); // beyond the grid: the row checks'
     assert_eq!(replay.mismatch(0, Broken), None);
     assert_eq!(replay.mismatch(0, Attached), Some((Broken, Some(5))));
     assert_eq!(replay.mismatch(1, Detached), None);
@@ -158,4 +199,155 @@ fn a_broken_site_never_changes_again() {
     assert_eq!(replay.mismatch(2, Attached), None);
     assert_eq!(replay.mismatch(2, Detached), None);
     assert_eq!(replay.mismatch(2, Broken), Some((Attached, None)));
+}
+
+/// An anchored site holds inside its window `λ_low < F < λ_high`, the roots of
+/// `|F g1 + g0| = μ f` worked out here; with no anchor shear its `λ_high` is the paper's
+/// load bit for bit; a site without shear per newton holds always or never.
+#[test]
+fn an_anchored_site_holds_inside_its_window() {
+    let interface = interface();
+    let rule = ContactRule::Anchored;
+    let f = [1e3, 1e3, 1e3, 1e3];
+    let g1 = [10.0, -4.0, 0.0, 0.0];
+    let g0 = [100.0, 100.0, 600.0, 100.0];
+    let (high, low) = rule.thresholds(&interface, &f, &g1, &g0, 0.5).unwrap();
+    // τ = 500 Pa. Site 0: 10 F + 100 = ±500 at F = 40, -60. Site 1: -4 F + 100 = -500 at
+    // F = 150, = 500 at F = -100. Site 2: |600| ≥ 500 at any load; site 3: never.
+    assert_eq!(high, vec![40.0, 150.0, f64::NEG_INFINITY, f64::INFINITY]);
+    assert_eq!(low, vec![-60.0, -100.0, f64::INFINITY, f64::NEG_INFINITY]);
+    let states = [Attached; 4];
+    assert_eq!(
+        rule.first_over_threshold(&states, &high, &low, 30.0),
+        Some(2)
+    );
+    let states = [Attached, Attached, Detached, Attached];
+    assert_eq!(rule.first_over_threshold(&states, &high, &low, 30.0), None);
+    assert_eq!(
+        rule.first_over_threshold(&states, &high, &low, -60.0),
+        Some(0)
+    );
+    assert_eq!(
+        rule.first_over_threshold(&states, &high, &low, 40.0),
+        Some(0)
+    );
+    assert_eq!(rule.weakest(&states, &high), Some((0, 40.0)));
+    // No anchor shear: the paper's loads, bit for bit.
+    let (high, _) = rule
+        .thresholds(&interface, &f, &g1, &[0.0; 4], 0.5)
+        .unwrap();
+    let paper = ContactRule::Paper
+        .breaking_loads(&interface, &f, &g1, 0.5)
+        .unwrap();
+    assert!(high
+        .iter()
+        .zip(&paper)
+        .all(|(a, b)| a.to_bits() == b.to_bits()));
+    assert!(matches!(
+        rule.thresholds(&interface, &f, &g1, &g0[..2], 0.5),
+        Err(Error::LengthMismatch {
+            name: "anchor_traction",
+            ..
+        })
+    ));
+}
+
+/// Under an anchored rule the energy is that of the shear `F g1 + g0`: the anchors' shear
+/// can make a site of smaller `g1` the one that breaks.
+#[test]
+fn an_anchored_rupture_counts_the_anchors_shear() {
+    let interface = interface();
+    let cell = 1e-6;
+    let u_z = [0.0; 4];
+    let traction = [1e6, 2e6, 0.0, 0.0];
+    let anchor = [3e6, 0.0, 0.0, 0.0];
+    let over = [0.5, 0.5, f64::INFINITY, f64::INFINITY];
+    let low = [f64::NEG_INFINITY; 4];
+    let next = |rule: ContactRule, anchor: &[f64]| {
+        rule.next_rupture(
+            &interface,
+            (&over, &low),
+            1.0,
+            None,
+            (&traction, anchor),
+            &u_z,
+            cell,
+        )
+        .unwrap()
+        .unwrap()
+    };
+    // Paper: site 1 (2e6 against 1e6). Anchored: site 0 carries 4e6.
+    assert_eq!(next(ContactRule::Paper, &[]).0, 1);
+    let (i, e) = next(ContactRule::Anchored, &anchor);
+    assert_eq!(i, 0);
+    let expected = 0.5 * 4e6 * 4e6 * cell / SpringLaw::default().c_x();
+    assert!((e / expected - 1.0).abs() < 1e-12);
+}
+
+/// The re-forming rule's replay: a broken site attaches again only once both delays
+/// have passed (stable states counted from its rupture's, load in `μ F_N`), never
+/// detaches or breaks while broken, and at the end is detached exactly when it was due
+/// at the last move.
+#[test]
+fn a_re_forming_site_waits_for_its_delay() {
+    let rule = ContactRule::Rejuvenation {
+        delay: Delay {
+            stable_states: 2,
+            load: 0.1,
+        },
+    };
+    // μ F_N = 10 N: the load delay is 1 N.
+    let mut replay = Replay::new(rule, 2, 10.0);
+    replay.stable(0.0);
+    replay.apply(0, SiteChange::Rupture, 3, 5.0).unwrap(); // at tick 1
+    replay.stable(5.0);
+    assert_eq!(replay.apply(0, SiteChange::Attach, 5, 0.0), Err(3)); // 1 tick
+    replay.stable(5.5);
+    assert_eq!(replay.apply(0, SiteChange::Attach, 7, 0.0), Err(3)); // 0.5 N
+    assert_eq!(replay.mismatch(0, Broken), None);
+    replay.stable(6.0);
+    assert_eq!(replay.apply(0, SiteChange::Detach, 9, 0.0), Err(3));
+    assert_eq!(replay.apply(0, SiteChange::Rupture, 9, 6.0), Err(3));
+    // Not yet due at the move after the stable state at 5.5 N; due at the one at 6 N.
+    assert_eq!(replay.mismatch(0, Detached), Some((Broken, Some(3))));
+    replay.stable(6.0);
+    assert_eq!(replay.mismatch(0, Detached), None);
+    assert_eq!(replay.mismatch(0, Broken), Some((Detached, Some(3))));
+    replay.apply(0, SiteChange::Attach, 11, 0.0).unwrap();
+    assert_eq!(replay.mismatch(0, Attached), None);
+    // The paper's rule: never.
+    let mut paper = Replay::new(ContactRule::Paper, 1, 10.0);
+    paper.apply(0, SiteChange::Rupture, 1, 5.0).unwrap();
+    for k in 0..10 {
+        paper.stable(100.0 * k as f64);
+    }
+    assert_eq!(paper.apply(0, SiteChange::Attach, 2, 0.0), Err(1));
+}
+
+/// The re-forming rule's clock: a site re-forms at the first tick where both delays have
+/// passed, and a state that does not fit its sites is refused with the reason.
+#[test]
+fn the_clock_re_forms_sites_when_due() {
+    let delay = Delay {
+        stable_states: 2,
+        load: 0.1,
+    };
+    let rule = ContactRule::Rejuvenation { delay };
+    let mut state = ContactState::new(rule, 2).unwrap();
+    assert!(ContactState::new(ContactRule::Paper, 2).is_none());
+    assert!(state.tick(rule, 0.0, 10.0).is_empty()); // tick 1
+    state.broke(1, 5.0);
+    assert!(state.tick(rule, 9.0, 10.0).is_empty()); // 1 tick
+    assert!(state.tick(rule, 5.5, 10.0).is_empty()); // 0.5 N
+    assert_eq!(state.tick(rule, 6.0, 10.0), vec![1]);
+    assert_eq!(state.broken_since, vec![None, None]);
+    assert!(state.check(rule, &[Attached, Detached]).is_ok());
+    state.broke(0, 6.0);
+    assert!(state.check(rule, &[Attached, Detached]).is_err()); // 0 is not broken
+    assert!(state.check(rule, &[Broken, Detached]).is_ok());
+    state.anchors[1] = 1e-9;
+    assert!(state.check(rule, &[Broken, Detached]).is_err()); // an anchor off contact
+    assert!(state
+        .check(ContactRule::Anchored, &[Broken, Attached])
+        .is_err());
 }

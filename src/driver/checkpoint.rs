@@ -9,17 +9,23 @@
 //! build, same CPU features: the FFT kernels are chosen at run time).
 
 use super::{Driver, Phase};
+use crate::contact::ContactState;
 use crate::driver::Event;
 use crate::error::{Error, Result};
 use crate::interface::SiteState;
 use crate::scene::{file, Scene, SceneBuilder};
-use crate::solver::{NormalEquilibrium, SolverState, TangentialResponse};
+use crate::solver::{AnchorResponse, NormalEquilibrium, SolverState, TangentialResponse};
 
 /// Version of the checkpoint layout; a checkpoint of another version is refused.
 /// Version 2: the scene digest; the dense backend's one factor. Version 3: the JSON form
 /// ends with a digest of its whole content; unknown keys are refused. Version 4: the
-/// digests of the table rows it covers (`tables`).
-const FORMAT: u32 = 4;
+/// digests of the table rows it covers (`tables`). Version 5: the state of an anchored
+/// contact rule (`contact`), written only under such a rule: the paper's rule still
+/// writes version 4, byte for byte, and versions 3 and 4 resume under it.
+const FORMAT: u32 = 5;
+
+/// The layout the paper's contact rule writes ([`FORMAT`]'s version 4).
+const PAPER_FORMAT: u32 = 4;
 
 /// The oldest layout still read: version 3 (1.x) has no table digests, and its tables are
 /// checked as before them (row by row and against each other).
@@ -278,10 +284,27 @@ pub struct Checkpoint {
     avalanche_ruptures: usize,
     events: usize,
     solver: SolverState,
+    /// An anchored rule's state and its anchors' response (layout version 5; none under
+    /// the paper's rule).
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Option::is_none")
+    )]
+    contact: Option<ContactCheckpoint>,
     /// The digests of the table rows it covers, when taken by
     /// [`crate::output::RunTables::checkpoint`] (none in layout version 3).
     #[cfg_attr(feature = "serde", serde(default))]
     tables: Option<Vec<TableDigest>>,
+}
+
+/// What a checkpoint holds of an anchored contact rule.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+struct ContactCheckpoint {
+    state: ContactState,
+    /// The anchors' response `g0` (none before the first event).
+    anchor: Option<AnchorResponse>,
 }
 
 impl Checkpoint {
@@ -401,7 +424,7 @@ fn verified(text: &str) -> std::result::Result<Checkpoint, Refusal> {
             return Err(reason(format!(
                 "layout version {v}, this build reads versions {OLDEST_FORMAT} to {FORMAT} \
                  (version 3 added a digest of the whole content, version 4 the digests of \
-                 the table rows): resume it with the precursors version that wrote it, or \
+                 the table rows, version 5 the state of an anchored contact rule): resume it with the precursors version that wrote it, or \
                  start the run again"
             )))
         }
@@ -440,8 +463,15 @@ impl Driver {
     /// A snapshot of the driver as it stands (between two events); [`Scene::resume`]
     /// continues from it with exactly the events this driver would return.
     pub fn checkpoint(&self) -> Checkpoint {
+        let contact = self.contact.as_ref().map(|state| ContactCheckpoint {
+            state: state.clone(),
+            anchor: self.anchor.clone(),
+        });
         Checkpoint {
-            format: FORMAT,
+            format: match contact {
+                Some(_) => FORMAT,
+                None => PAPER_FORMAT,
+            },
             scene: self.scene.to_builder(),
             scene_digest: digest(&self.scene.to_builder()),
             states: self.interface.states().to_vec(),
@@ -454,6 +484,7 @@ impl Driver {
             avalanche_ruptures: self.avalanche_ruptures,
             events: self.events,
             solver: self.solver.state(),
+            contact,
             tables: None,
         }
     }
@@ -495,11 +526,18 @@ impl Scene {
         driver.solver.restore(checkpoint.solver.clone(), started)?;
         // λ is a function of the two equilibria: recomputed rather than stored (it holds
         // infinities, which JSON cannot).
+        if let Some(contact) = &checkpoint.contact {
+            driver.contact = Some(contact.state.clone());
+            driver.anchor = contact.anchor.clone();
+        }
         if let (Some(normal), Some(response)) = (&checkpoint.normal, &checkpoint.response) {
-            driver.breaking = driver.contact_rule().breaking_loads(
+            let rule = driver.contact_rule();
+            let anchor = driver.anchor.as_ref().map_or(&[][..], |a| &a.traction);
+            (driver.breaking, driver.breaking_low) = rule.thresholds(
                 &driver.interface,
                 &normal.traction,
                 &response.traction,
+                anchor,
                 driver.friction_coefficient(),
             )?;
         }
@@ -528,6 +566,7 @@ impl Scene {
             if let Some(i) = driver.contact_rule().first_over_threshold(
                 driver.interface.states(),
                 &driver.breaking,
+                &driver.breaking_low,
                 force,
             ) {
                 return Err(Error::InvalidCheckpoint {
@@ -553,7 +592,7 @@ impl Scene {
             ));
         }
         if let Some(tables) = &checkpoint.tables {
-            if checkpoint.format < FORMAT {
+            if checkpoint.format < PAPER_FORMAT {
                 return bad(format!(
                     "layout version {} holds no table digests, this one does",
                     checkpoint.format
@@ -584,6 +623,21 @@ impl Scene {
             "the scene resumed on",
         ) {
             return Err(e);
+        }
+        // Version 5 holds an anchored rule's state, and only it; the paper's rule writes 4.
+        let anchored = self.contact_rule().anchors();
+        if checkpoint.contact.is_some() != anchored || (checkpoint.format == FORMAT) != anchored {
+            return bad(format!(
+                "layout version {} {} the state of an anchored contact rule, and the scene's \
+                 rule is {:?} (its checkpoints are of version {})",
+                checkpoint.format,
+                match checkpoint.contact {
+                    Some(_) => "with",
+                    None => "without",
+                },
+                self.contact_rule(),
+                if anchored { FORMAT } else { PAPER_FORMAT }
+            ));
         }
         Ok(())
     }
@@ -642,6 +696,29 @@ impl Scene {
                 if started { "lacks" } else { "holds" }
             ));
         }
+        if let Some(contact) = &checkpoint.contact {
+            if let Err(reason) = contact.state.check(self.contact_rule(), &checkpoint.states) {
+                return bad(format!("its contact rule's state: {reason}"));
+            }
+            let anchor_ok = match &contact.anchor {
+                Some(a) => {
+                    lengths_ok(&a.traction) && lengths_ok(&a.displacement) && a.offset.is_finite()
+                }
+                None => true,
+            };
+            if contact.anchor.is_some() != started || !anchor_ok {
+                return bad(format!(
+                    "after {} events it {} the anchors' response (a driver solves it, with {n} \
+                     finite values, for its first event)",
+                    checkpoint.events,
+                    if contact.anchor.is_some() {
+                        "holds"
+                    } else {
+                        "lacks"
+                    }
+                ));
+            }
+        }
         self.check_checkpoint_protocol(checkpoint, started)?;
         self.check_checkpoint_equilibria(checkpoint)?;
         if !checkpoint.control.is_finite() {
@@ -668,7 +745,10 @@ impl Scene {
             return Ok(());
         };
         // Done or failed: the last rupture or solve left the equilibria behind the states.
-        if !matches!(checkpoint.phase, Phase::Stable | Phase::Avalanche { .. }) {
+        if !matches!(
+            checkpoint.phase,
+            Phase::Stable | Phase::Reformed | Phase::Avalanche { .. }
+        ) {
             return Ok(());
         }
         let states = &checkpoint.states;
@@ -706,7 +786,7 @@ impl Scene {
         let zero = vec![0.0; n];
         let unit_load = self.unit_load_displacement();
         let tolerance = RESIDUAL_FACTOR * self.solver_options().tolerance();
-        let checks = [
+        let mut checks = vec![
             Equilibrium {
                 name: "normal",
                 traction: &normal.traction,
@@ -728,6 +808,23 @@ impl Scene {
                 total: -1.0,
             },
         ];
+        // An anchored rule's springs at zero load: anchored at `a`, no net force.
+        if let Some((state, Some(anchor))) = checkpoint
+            .contact
+            .as_ref()
+            .map(|c| (&c.state, c.anchor.as_ref()))
+        {
+            checks.push(Equilibrium {
+                name: "anchors'",
+                traction: &anchor.traction,
+                displacement: &anchor.displacement,
+                product: product(&anchor.traction)?,
+                applied: &zero,
+                compliance: &tangential_compliance,
+                rest: &state.anchors,
+                total: 0.0,
+            });
+        }
         for check in checks {
             if let Some(reason) = check.violation(&attached, cell, tolerance) {
                 return Err(Error::InvalidCheckpoint {
@@ -862,7 +959,12 @@ impl Equilibrium<'_> {
             ));
         }
         let carried = cell * self.traction.iter().sum::<f64>();
-        if (carried - self.total).abs() > tolerance * self.total.abs() {
+        // No net load (the anchors'): against the tractions' own size.
+        let load = match self.total {
+            0.0 => cell * self.traction.iter().map(|t| t.abs()).sum::<f64>(),
+            total => total.abs(),
+        };
+        if (carried - self.total).abs() > tolerance * load {
             return Some(format!(
                 "the tractions carry {carried:e} N, the load is {:e} N",
                 self.total

@@ -113,7 +113,12 @@ impl Driver {
     /// [`Error::NotSolved`] before the first event ([`Driver::event_count`] 0), never
     /// after it.
     pub fn mean_shear_displacement(&self) -> Result<f64> {
-        Ok(self.force() * self.response()?.offset_per_newton)
+        let mean = self.force() * self.response()?.offset_per_newton;
+        // No `+ 0.0` under the paper's rule: it would turn a `-0` into `+0`.
+        Ok(match &self.anchor {
+            Some(a) => mean + a.offset,
+            None => mean,
+        })
     }
 
     /// The interface's slip per newton of shear load at the current attached set

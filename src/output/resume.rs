@@ -220,7 +220,12 @@ impl Cut<'_> {
                 stable.push(index);
                 stable_forces.push(e.force_text);
             }
-            if let Event::Rupture { .. } | Event::Detach { .. } | Event::Attach { .. } = e.event {
+            // The stable states keep the replay's clock (a re-forming rule's).
+            if let Event::Rupture { .. }
+            | Event::Detach { .. }
+            | Event::Attach { .. }
+            | Event::Stable { .. } = e.event
+            {
                 site_events.push((line, e.event));
             }
             if index == k {
@@ -554,35 +559,46 @@ pub(super) fn fields_continuation(
 }
 
 /// Refuses a resumed driver whose site states (`states`, from its checkpoint) are not
-/// those the kept events of `events.csv` (`site_events`, read from `path`) leave under
-/// the run's contact rule (`rule`, [`Replay`]): under the paper's, every site a rupture
-/// broke is broken and none broke twice, no other site is broken, and a site's last
-/// detachment or attachment left it detached or attached. A checkpoint forged with a
+/// those the kept events of `events.csv` (`site_events`, read from `path`: the site
+/// events and the stable states) leave under the run's contact rule (`rule`, [`Replay`];
+/// `load_scale` is `μ F_N`, N): every site a rupture broke is broken and none broke
+/// twice, no other site is broken, and a site's last detachment or attachment left it
+/// detached or attached; under a re-forming rule a broken site attaches again, or is
+/// detached, once its delay has passed, and only then. A checkpoint forged with a
 /// recomputed digest (a broken site set back to attached) would otherwise run on and
 /// break a site twice.
 pub(super) fn check_site_states(
     rule: ContactRule,
+    load_scale: f64,
     site_events: &[(usize, Event)],
     states: &[SiteState],
     path: &Path,
 ) -> Result<()> {
-    let mut replay = Replay::new(rule, states.len());
+    let mut replay = Replay::new(rule, states.len(), load_scale);
     for &(line, event) in site_events {
-        let (site, change) = match event {
-            Event::Rupture { site, .. } => (site, SiteChange::Rupture),
-            Event::Detach { site } => (site, SiteChange::Detach),
-            Event::Attach { site } => (site, SiteChange::Attach),
+        let (site, change, force) = match event {
+            Event::Rupture { site, load, .. } => (site, SiteChange::Rupture, load.force),
+            Event::Detach { site } => (site, SiteChange::Detach, 0.0),
+            Event::Attach { site } => (site, SiteChange::Attach, 0.0),
+            Event::Stable { load, .. } => {
+                replay.stable(load.force);
+                continue;
+            }
             _ => continue,
         };
-        if let Err(broke) = replay.apply(site.index, change, line) {
+        if let Err(broke) = replay.apply(site.index, change, line, force) {
             return Err(Error::CorruptTable {
                 path: Some(path.to_path_buf()),
                 reason: format!(
                     "line {line}: a {} of site ({}, {}), which broke on line {broke}: a broken \
-                     site never changes again",
+                     site never changes again{}",
                     event.kind(),
                     site.ix,
-                    site.iy
+                    site.iy,
+                    match rule.delay() {
+                        Some(_) => " but by attaching once its delay has passed",
+                        None => "",
+                    }
                 ),
             });
         }

@@ -9,6 +9,7 @@
 
 use super::schema::{schema_enum, schema_leaf, schema_struct, Schema, Walk};
 use super::{Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder};
+use crate::contact::{ContactRule, Delay};
 use crate::interface::AreaLaw;
 use crate::probe::ProbeSpec;
 use crate::solver::{Backend, Parallelism, SolverOptions};
@@ -40,6 +41,10 @@ schema_struct! {
         drive: DriveSpec,
         solver: SolverSpec,
         plan_tolerance: f64,
+        /// Written only when it is not the paper's rule, so files (and the checkpoints'
+        /// identities) of other scenes stay as they were.
+        #[cfg_attr(feature = "serde", serde(skip_serializing_if = "ContactSpec::is_paper"))]
+        contact: ContactSpec,
         // The observers (`[observer]`: not in the identity) are the run options' keys
         // (`RunOptions`), which 1.x scene files keep carrying.
         [observer] probes: ProbesSpec,
@@ -61,6 +66,152 @@ schema_struct! {
         /// Written only when it is not the default.
         #[cfg_attr(feature = "serde", serde(skip_serializing_if = "is_default_max_output_bytes"))]
         [observer] max_output_bytes: f64,
+    }
+}
+
+/// `contact`: the rule of the site transitions (`docs/scene-format.md`). The paper's
+/// rule is the default and leaves no key, in the file or in a checkpoint's identity
+/// (every 1.x checkpoint's digest has none).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+struct ContactSpec {
+    rule: RuleSpec,
+    /// Only for the rule `rejuvenation`.
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
+    delay: Option<DelaySpec>,
+}
+
+/// `contact.rule`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+enum RuleSpec {
+    #[default]
+    Paper,
+    Anchored,
+    Rejuvenation,
+}
+
+/// `contact.delay`: both must pass before a broken site re-forms.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+struct DelaySpec {
+    stable_states: u64,
+    load: f64,
+}
+
+impl Default for DelaySpec {
+    fn default() -> Self {
+        let delay = Delay::default();
+        Self {
+            stable_states: delay.stable_states,
+            load: delay.load,
+        }
+    }
+}
+
+impl ContactSpec {
+    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
+    fn is_paper(&self) -> bool {
+        *self == ContactSpec::default()
+    }
+
+    /// The rule; a delay given to a rule that does not re-form is refused.
+    #[cfg(feature = "serde")]
+    fn into_rule(self) -> Result<ContactRule> {
+        Ok(match (self.rule, self.delay) {
+            (RuleSpec::Paper, None) => ContactRule::Paper,
+            (RuleSpec::Anchored, None) => ContactRule::Anchored,
+            (RuleSpec::Rejuvenation, delay) => {
+                let delay = delay.unwrap_or_default();
+                ContactRule::Rejuvenation {
+                    delay: Delay {
+                        stable_states: delay.stable_states,
+                        load: delay.load,
+                    },
+                }
+            }
+            (rule, Some(_)) => {
+                return Err(Error::InvalidChoice {
+                    name: "contact.delay",
+                    value: match rule {
+                        RuleSpec::Paper => "paper",
+                        _ => "anchored",
+                    },
+                    reason: "only the rule \"rejuvenation\" re-forms broken sites and takes a \
+                             delay",
+                })
+            }
+        })
+    }
+}
+
+impl From<ContactRule> for ContactSpec {
+    fn from(rule: ContactRule) -> Self {
+        match rule {
+            ContactRule::Paper => ContactSpec::default(),
+            ContactRule::Anchored => ContactSpec {
+                rule: RuleSpec::Anchored,
+                delay: None,
+            },
+            ContactRule::Rejuvenation { delay } => ContactSpec {
+                rule: RuleSpec::Rejuvenation,
+                delay: Some(DelaySpec {
+                    stable_states: delay.stable_states,
+                    load: delay.load,
+                }),
+            },
+        }
+    }
+}
+
+impl Schema for ContactSpec {
+    /// No key for the paper's rule (the default): 1.x identities have none.
+    fn keys(&self, path: &str, walk: Walk, out: &mut Vec<(String, String)>) {
+        use super::schema::join;
+        if self.is_paper() {
+            return;
+        }
+        let rule = match self.rule {
+            RuleSpec::Paper => "paper",
+            RuleSpec::Anchored => "anchored",
+            RuleSpec::Rejuvenation => "rejuvenation",
+        };
+        out.push((join(path, "rule"), rule.to_string()));
+        if let Some(delay) = &self.delay {
+            let at = join(path, "delay");
+            delay
+                .stable_states
+                .keys(&join(&at, "stable_states"), walk, out);
+            delay.load.keys(&join(&at, "load"), walk, out);
+        }
+    }
+
+    #[cfg(feature = "serde")]
+    fn set(&mut self, at: &str, rest: &[&str], value: &serde_json::Value) -> Result<(), KeyError> {
+        use super::schema::{join, replace};
+        match rest {
+            [] => replace(self, value),
+            ["rule"] => replace(&mut self.rule, value),
+            ["delay"] => replace(&mut self.delay, value),
+            ["delay", "stable_states"] => {
+                replace(&mut self.delay.get_or_insert_default().stable_states, value)
+            }
+            ["delay", "load"] => replace(&mut self.delay.get_or_insert_default().load, value),
+            ["delay", segment, ..] => Err(KeyError::not_a_key(
+                &join(at, "delay"),
+                segment,
+                &["stable_states", "load"],
+            )),
+            [segment, ..] => Err(KeyError::not_a_key(at, segment, &["rule", "delay"])),
+        }
+    }
+
+    #[cfg(feature = "serde")]
+    fn object_at(rest: &[&str]) -> bool {
+        matches!(rest, [] | ["delay"])
     }
 }
 
@@ -558,6 +709,7 @@ impl From<&SceneBuilder> for SceneFile {
             max_cells,
             run,
             confirm_metres,
+            contact,
         } = b;
         SceneFile {
             block: BlockSpec {
@@ -601,6 +753,7 @@ impl From<&SceneBuilder> for SceneFile {
             },
             confirm_metres: *confirm_metres,
             max_output_bytes: run.output_limit(),
+            contact: (*contact).into(),
         }
     }
 }
@@ -708,6 +861,7 @@ impl SceneFile {
             profiles,
             confirm_metres,
             max_output_bytes,
+            contact,
         } = self;
         let material = Material::new(
             material.young_modulus,
@@ -736,7 +890,9 @@ impl SceneFile {
                 .record_profiles(&profiles.loads, &profiles.planes)
                 .max_output_bytes(max_output_bytes),
             confirm_metres,
-        })
+            contact: Default::default(),
+        }
+        .contact_rule(contact.into_rule()?))
     }
 }
 

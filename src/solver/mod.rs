@@ -46,6 +46,7 @@ mod set;
 mod spectral;
 mod system;
 mod tangential;
+pub(crate) use tangential::AnchorResponse;
 
 #[cfg(feature = "cuda")]
 pub use cuda::{cuda_device, record_cuda_phase_times, CudaDevice, CudaPhaseTimes};

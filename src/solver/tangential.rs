@@ -19,7 +19,8 @@ use crate::interface::{Interface, SiteState};
 /// of the solve: the tractions (Pa), the displacements (m) and the block's mean
 /// displacement `U0` (m). Adds to `F` times [`TangentialResponse`].
 #[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(not(test), allow(dead_code))] // the anchored rules' (issue 55), not yet wired in
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub(crate) struct AnchorResponse {
     /// `φ_x` (Pa) per cell; zero off the attached set.
     pub(crate) traction: Vec<f64>,
@@ -95,7 +96,6 @@ impl EquilibriumSolver {
     /// # Errors
     /// As [`EquilibriumSolver::solve_tangential`]; [`Error::NonFinite`] for an anchor that
     /// is not finite.
-    #[cfg_attr(not(test), allow(dead_code))] // the anchored rules' (issue 55), not yet wired in
     pub(crate) fn solve_tangential_anchor(
         &mut self,
         interface: &Interface,
