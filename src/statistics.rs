@@ -40,6 +40,7 @@ mod alternatives;
 mod scaling;
 mod special;
 
+#[cfg(feature = "plot")]
 pub(crate) use alternatives::cutoff_density;
 pub use alternatives::LikelihoodRatio;
 pub use scaling::{

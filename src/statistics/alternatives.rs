@@ -441,6 +441,7 @@ fn cutoff_ln_pdf(tail: &Tail, law: Cutoff) -> impl Fn(f64) -> f64 + '_ {
 /// which the tail is the share `share` (the unit of [`super::LogBin::density`], as
 /// [`super::PowerLawFit::density`]): `share · p(x)`, 0 below `x_min` and for parameters
 /// that are not a law (`α ≤ 1` at `λ = 0`). The figures draw the fitted law with it.
+#[cfg_attr(not(feature = "plot"), allow(dead_code))] // drawn by `plot` alone
 pub(crate) fn cutoff_density(
     support: Support,
     (alpha, lambda, x_min): (f64, f64, f64),
