@@ -358,6 +358,22 @@ impl DamageFront {
     /// spring breaks), an attachment when it was not; at global slip every spring broke,
     /// so every site has one.
     ///
+    /// ```
+    /// use precursors::{DamageFront, Scene};
+    /// let scene = Scene::builder().block(0.012, 0.002, 0.010).normal_load(50.0).seed(0).build()?;
+    /// let mut driver = scene.driver()?;
+    /// // The first event is the stable state at zero shear.
+    /// let mut events = vec![driver.next().unwrap()?];
+    /// let at_zero_shear = driver.site_states().to_vec();
+    /// for event in driver.by_ref() {
+    ///     events.push(event?); // to global slip
+    /// }
+    /// assert_eq!(DamageFront::zero_shear_states(scene.grid(), &events)?, at_zero_shear);
+    /// // A run cut short is not a whole run.
+    /// assert!(DamageFront::zero_shear_states(scene.grid(), &events[..3]).is_err());
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
     /// # Errors
     /// [`Error::LengthMismatch`] naming `events` when they do not end in global slip or a
     /// site has no event (not the whole run of a scene on `grid`).

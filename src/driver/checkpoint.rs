@@ -508,7 +508,7 @@ impl Scene {
 
     /// [`Scene::resume`] with the driver observed as `options` ask (probes, threads: as
     /// [`Scene::driver_with`]); give [`crate::output::RunTables::resume_with`] the same
-    /// options.
+    /// options (its example resumes a run this way).
     ///
     /// # Errors
     /// As [`Scene::resume`] and [`Scene::driver_with`].

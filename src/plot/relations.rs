@@ -177,7 +177,7 @@ fn relation_figure(
             chart = chart
                 .line(
                     &format!(
-                        "{prefix}{symbol} ∝ S^β: β = {beta:.2} [{low:.2}, {high:.2}] (95 %), {} \
+                        "{prefix}{symbol} = c S^β: β = {beta:.2} [{low:.2}, {high:.2}] (95 %), {} \
                          avalanches",
                         row[fits.column("pairs")?]
                     ),
@@ -190,7 +190,10 @@ fn relation_figure(
         let reason = format!("{BINNED_MEANS} has no rows of {relation}");
         return selection.skip_quietly(figure, dir, reason);
     }
-    chart = chart.note("dashed: least squares of ln y on ln S over every avalanche (scaling.csv)");
+    chart = chart.note(
+        "dashed: least squares of ln y on ln S over every avalanche (scaling.csv): \
+         their geometric mean, below the markers' arithmetic means",
+    );
     for extension in extensions {
         let path = dir.join(format!("{figure}.{extension}"));
         chart.save(&path)?;
