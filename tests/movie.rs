@@ -611,7 +611,7 @@ fn a_coulomb_frame_ends_at_the_block_and_says_its_saturation_aspect_and_scene() 
         stretch > 1.05 && texts.iter().any(|t| t.contains(&expected)),
         "{expected} {texts:?}"
     );
-    // The scene line: the directory, the block, F_N typeset, the cells.
+    // The scene line: the directory, the block, F_N typeset, the cells and their size.
     let name = dir.file_name().unwrap().to_string_lossy().into_owned();
     let scene = texts
         .iter()
@@ -619,7 +619,7 @@ fn a_coulomb_frame_ends_at_the_block_and_says_its_saturation_aspect_and_scene() 
         .unwrap_or_else(|| panic!("{texts:?}"));
     assert_eq!(texts[scene + 1], "N");
     assert!(
-        texts[scene + 2].ends_with(", 10 x 4 cells, 2 planes"),
+        texts[scene + 2].ends_with(", 10 x 4 cells of 1 mm, 2 planes"),
         "{texts:?}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
