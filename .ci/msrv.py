@@ -2,7 +2,7 @@
 """Fails when a resolved package needs a newer rustc than the crate's `rust-version`.
 
 Reads `cargo metadata --format-version 1` on stdin. Every resolved package counts,
-dev-dependencies included: the README promises `cargo test --all-features` too.
+dev-dependencies included: the README promises `cargo test --release --all-features` too.
 """
 import json
 import sys

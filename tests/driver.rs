@@ -559,7 +559,7 @@ fn driver_follows_the_naive_protocol() {
 }
 
 /// The stiff and extreme cases of docs/stability.md's table against the naive protocol;
-/// `cargo test --all-features --test lib extreme_cases -- --nocapture` prints the table.
+/// `cargo test --release --all-features --test lib extreme_cases -- --nocapture` prints the table.
 #[test]
 fn extreme_cases_follow_the_naive_protocol() {
     let base = Case::small("", 20.0);

@@ -65,9 +65,9 @@ fn states(builder: SceneBuilder) -> (Vec<State>, f64) {
                     event: driver.event_count(),
                     load: load.force / mu_fn,
                     rows: vec![
-                        ("slip_m", 0.0, slip.slip),
-                        ("shear_traction_Pa", 0.0, slip.shear_traction),
-                        ("normal_traction_Pa", 0.0, slip.normal_traction),
+                        ("slip_m", 0.0, slip.slip().to_vec()),
+                        ("shear_traction_Pa", 0.0, slip.shear_traction().to_vec()),
+                        ("normal_traction_Pa", 0.0, slip.normal_traction().to_vec()),
                         ("shear_Pa", PLANE, p.shear().to_vec()),
                         ("normal_Pa", PLANE, p.normal().to_vec()),
                         ("coulomb_of_means_Pa", PLANE, p.coulomb_of_means().to_vec()),

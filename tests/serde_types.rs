@@ -309,7 +309,7 @@ fn results_of_a_run_round_trip() {
             round_trip(&plane.at(3, 1).unwrap());
             round_trip(&stresses.points[0]);
             let slip = driver.slip_profile().unwrap();
-            assert!(slip.slip.iter().any(|&u| u != 0.0));
+            assert!(slip.slip().iter().any(|&u| u != 0.0));
             round_trip(&slip);
         }
         if matches!(event, Event::GlobalSlip { .. }) {

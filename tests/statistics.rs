@@ -706,8 +706,8 @@ fn slip_profiles_balance_the_loads() {
     while let Some(event) = driver.step().unwrap() {
         if let Event::Stable { load, .. } = event {
             let p = driver.slip_profile().unwrap();
-            let normal: f64 = p.normal_traction.iter().sum::<f64>() * dx * ly;
-            let shear: f64 = p.shear_traction.iter().sum::<f64>() * dx * ly;
+            let normal: f64 = p.normal_traction().iter().sum::<f64>() * dx * ly;
+            let shear: f64 = p.shear_traction().iter().sum::<f64>() * dx * ly;
             assert!((normal - 3500.0).abs() < 1e-6 * 3500.0, "{normal}");
             assert!(
                 (shear + load.force).abs() < 1e-6 * 3500.0,
@@ -716,7 +716,7 @@ fn slip_profiles_balance_the_loads() {
             );
             // The rod pushes +x: every column has moved forward.
             if load.force > 0.0 {
-                assert!(p.slip.iter().all(|u| *u > 0.0));
+                assert!(p.slip().iter().all(|u| *u > 0.0));
             }
             checked += 1;
             if checked == 40 {

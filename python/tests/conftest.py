@@ -1,8 +1,8 @@
 """Shared fixtures: the calibration scene, the `precursors` program and its run of it.
 
 The program is the independent side of several tests: `.ci/run` passes the one the Rust
-tests built (`PRECURSORS_BIN=target/debug/precursors`); without the variable the tests use
-that path and build the program there first if it is missing."""
+tests built (`PRECURSORS_BIN=target/release/precursors`, the README's build); without the
+variable the tests use that path and build the program there first if it is missing."""
 
 import os
 import subprocess
@@ -18,17 +18,16 @@ CALIBRATION = ROOT / "examples" / "scenes" / "calibration.json"
 
 def program() -> Path:
     given = os.environ.get("PRECURSORS_BIN")
-    path = Path(given) if given else ROOT / "target" / "debug" / "precursors"
+    path = Path(given) if given else ROOT / "target" / "release" / "precursors"
     if not given and not path.is_file():
         subprocess.run(
-            ["cargo", "build", "--quiet", "--profile", "test", "--features", "cli",
-             "--bin", "precursors"],
+            ["cargo", "build", "--quiet", "--release", "--all-features", "--bin", "precursors"],
             cwd=ROOT, check=True, env={**os.environ, "CARGO_TARGET_DIR": str(ROOT / "target")},
         )
     if not path.is_file():
         raise FileNotFoundError(
             f"the precursors program is not at {path}: build it with "
-            "`cargo build --profile test --features cli --bin precursors` or set PRECURSORS_BIN"
+            "`cargo build --release --all-features --bin precursors` or set PRECURSORS_BIN"
         )
     return path
 

@@ -15,17 +15,60 @@ use crate::scene::Drive;
 const NOMINAL_AREA_SLACK: f64 = 1e-9;
 
 /// The interface along `x`, averaged over `y` ([`Driver::slip_profile`]): one value per
-/// column `ix`, from the trailing edge.
+/// column `ix`, from the trailing edge. Read it through its methods, as [`crate::Profile`]
+/// (the fields stay readable through 1.x).
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct SlipProfile {
     /// `⟨u_x⟩_y`, the shear displacement of the bottom face (m).
+    #[deprecated(since = "1.2.0", note = "use the method `SlipProfile::slip()`")]
     pub slip: Vec<f64>,
     /// `⟨φ_x⟩_y`, the shear traction (Pa; negative where the springs resist `+x`).
+    #[deprecated(
+        since = "1.2.0",
+        note = "use the method `SlipProfile::shear_traction()`"
+    )]
     pub shear_traction: Vec<f64>,
     /// `⟨φ_z⟩_y`, the normal traction (Pa; compressive positive).
+    #[deprecated(
+        since = "1.2.0",
+        note = "use the method `SlipProfile::normal_traction()`"
+    )]
     pub normal_traction: Vec<f64>,
+    /// The columns' centres `(ix + 1/2)·Δx` (m); empty for a profile read from a serde
+    /// value written before 1.2 (a field added later has a default:
+    /// docs/compatibility.md).
+    #[cfg_attr(feature = "serde", serde(default))]
+    x: Vec<f64>,
+}
+
+// The fields stay readable through 1.x; the crate itself reads them only here.
+#[allow(deprecated)]
+impl SlipProfile {
+    /// The centre `x = (ix + 1/2)·Δx` of each column `ix` (m), from `x = 0` at the
+    /// trailing face: the abscissa of the other three. Empty only for a profile read from
+    /// a serde value written before 1.2.
+    pub fn x(&self) -> &[f64] {
+        &self.x
+    }
+
+    /// `⟨u_x⟩_y`, the shear displacement of the bottom face in each column (m).
+    pub fn slip(&self) -> &[f64] {
+        &self.slip
+    }
+
+    /// `⟨φ_x⟩_y`, the shear traction of each column (Pa; negative where the springs resist
+    /// `+x`; a detached or broken cell counts with zero).
+    pub fn shear_traction(&self) -> &[f64] {
+        &self.shear_traction
+    }
+
+    /// `⟨φ_z⟩_y`, the normal traction of each column (Pa; compressive positive; a detached
+    /// or broken cell counts with zero).
+    pub fn normal_traction(&self) -> &[f64] {
+        &self.normal_traction
+    }
 }
 
 /// The interface's slip per newton of shear load at the current attached set
@@ -196,9 +239,10 @@ impl Driver {
     ///     }
     /// }
     /// let profile = driver.slip_profile()?;
-    /// assert_eq!(profile.slip.len(), 20);
+    /// assert_eq!(profile.slip().len(), 20);
+    /// assert_eq!(profile.x()[3], 3.5e-3);             // 1 mm columns: centre of column 3 (m)
     /// // The column averages carry the load: Σ ⟨φ_z⟩_y Δx Ly = F_N (N).
-    /// let carried: f64 = profile.normal_traction.iter().sum::<f64>() * 0.001 * 0.004;
+    /// let carried: f64 = profile.normal_traction().iter().sum::<f64>() * 0.001 * 0.004;
     /// assert!((carried - 80.0).abs() < 1e-6 * 80.0);
     /// # Ok::<(), precursors::Error>(())
     /// ```
@@ -217,7 +261,10 @@ impl Driver {
             columns.iter_mut().for_each(|c| *c /= ny);
             columns
         };
+        let dx = self.grid().dx();
+        #[allow(deprecated)] // the fields stay filled through 1.x
         Ok(SlipProfile {
+            x: (0..nx).map(|ix| (ix as f64 + 0.5) * dx).collect(),
             slip: average(self.shear_displacement()?),
             shear_traction: average(self.shear_traction()?),
             normal_traction: average(self.normal_traction()?),

@@ -230,9 +230,9 @@ impl ProfilesTable {
             rows.push(text);
         };
         let slip = driver.slip_profile()?;
-        row(INTERFACE_FIELDS[0], 0.0, &slip.slip);
-        row(INTERFACE_FIELDS[1], 0.0, &slip.shear_traction);
-        row(INTERFACE_FIELDS[2], 0.0, &slip.normal_traction);
+        row(INTERFACE_FIELDS[0], 0.0, slip.slip());
+        row(INTERFACE_FIELDS[1], 0.0, slip.shear_traction());
+        row(INTERFACE_FIELDS[2], 0.0, slip.normal_traction());
         if let Some(probe) = &self.probe {
             let stresses = driver.stresses_at(std::slice::from_ref(&probe.0))?;
             for (plane, &z) in stresses.planes.iter().zip(&self.planes) {
