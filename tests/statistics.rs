@@ -918,6 +918,30 @@ fn the_finite_size_study_files_are_the_documented_study() {
     }
 }
 
+#[test]
+fn the_contact_rules_study_files_pair_the_rod_study() {
+    // docs/contact-rules.md: each rule's sweep is the rod study's (examples/sweeps/
+    // statistics/rod.json) with only `contact` changed, so realization r has the same
+    // heights under every rule and the paper rule's rows are the rod study's.
+    use precursors::sweep::Sweep;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/sweeps");
+    let rod = Sweep::from_json_file(root.join("statistics/rod.json")).unwrap();
+    let json = |sweep: &Sweep, r: usize| -> serde_json::Value {
+        serde_json::from_str(&sweep.runs()[r].scene().to_json().unwrap()).unwrap()
+    };
+    for (name, rule) in [("anchored", "anchored"), ("rejuvenation", "rejuvenation")] {
+        let path = root.join(format!("contact-rules/{name}.json"));
+        let sweep = Sweep::from_json_file(&path).unwrap_or_else(|e| panic!("{path:?}: {e}"));
+        assert_eq!(sweep.runs().len(), rod.runs().len(), "{name}");
+        for r in [0, 17, 49] {
+            let mut scene = json(&sweep, r);
+            assert_eq!(scene["contact"]["rule"], rule, "{name}");
+            scene.as_object_mut().unwrap().remove("contact");
+            assert_eq!(scene, json(&rod, r), "{name}: realization {r}");
+        }
+    }
+}
+
 /// The fixture of tests/data/statistics/make_lr_fixtures.py: each case's samples and the
 /// values scipy computed on them.
 fn lr_fixture() -> Vec<(String, Vec<f64>, HashMap<String, f64>)> {
