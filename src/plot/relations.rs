@@ -48,11 +48,14 @@ pub(super) fn draw_relations(
     // (a sweep still running when `stats` ran): the legends and the title count those.
     let pooled = Table::read(&dir.join(POWER_LAWS))?;
     let mut entered = Vec::with_capacity(points.len());
+    // A table written before its column `runs` cannot say which runs it pooled.
+    let mut unknown = false;
     for (k, p) in points.iter().enumerate() {
         let runs = match &pooled {
             Some(table) => runs_pooled(table, k)?,
             None => None,
         };
+        unknown |= pooled.is_some() && runs.is_none();
         entered.push(runs.unwrap_or(p.runs()));
     }
     let title = match retitle {
@@ -105,6 +108,13 @@ pub(super) fn draw_relations(
         collapse_figure(
             dir, extensions, canvas, title, &family, selection, &mut drawn,
         )?;
+    }
+    if !drawn.files.is_empty() && unknown {
+        drawn.notes.push(format!(
+            "{POWER_LAWS} names no runs (written before its column `runs`): the figures of \
+             stats' tables count the runs complete now, which may not be those it pooled; run \
+             `precursors stats` again"
+        ));
     }
     let now: Vec<usize> = points.iter().map(|p| p.runs()).collect();
     if !drawn.files.is_empty() && entered != now {
