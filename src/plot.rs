@@ -46,6 +46,7 @@ use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
+use std::ops::Range;
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -80,7 +81,8 @@ trait Draw {
     ) -> std::result::Result<(), String>;
 }
 
-/// The corner of the plotting area that holds a chart's legend.
+/// The corner of the plotting area a chart's legend is asked to go in ([`Chart::legend`]:
+/// it goes elsewhere rather than cover data).
 ///
 /// ```
 /// use precursors::plot::{Chart, Corner};
@@ -567,12 +569,42 @@ impl Chart {
     /// A line of text under the legend's entries (no glyph): what holds for several
     /// series, said once instead of in each entry ("no interval below 6 runs"). Notes
     /// are drawn in the order given, in the legend's box (with no entries, alone in it).
+    ///
+    /// ```
+    /// use precursors::plot::Chart;
+    /// let dir = std::env::temp_dir().join(format!("precursors-doc-note-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// // ℓ/Lx of two seeds, rising as the load to the fourth power.
+    /// let seed = |s: f64| -> Vec<(f64, f64)> {
+    ///     (0..=10).map(|k| (k as f64 / 10.0, s * (k as f64 / 10.0).powi(4))).collect()
+    /// };
+    /// Chart::new("Precursor length", "F/(μF_N)", "ℓ/Lx")
+    ///     .line("seed 1", &seed(1.0))
+    ///     .line("seed 2", &seed(0.8))
+    ///     .note("no interval below 6 runs")
+    ///     .save(dir.join("note.svg"))?;
+    /// let svg = std::fs::read_to_string(dir.join("note.svg"))?;
+    /// // The note comes after the entries, in the same box...
+    /// let at = |text: &str| svg.find(text).unwrap_or_else(|| panic!("{text} not drawn"));
+    /// assert!(at("seed 2") < at("no interval below 6 runs"));
+    /// // ...and has no glyph: two sample lines (3 pixels wide), the entries'.
+    /// assert_eq!(svg.matches("stroke-width=\"3\"").count(), 2);
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn note(mut self, text: &str) -> Self {
         self.notes.push(text.into());
         self
     }
 
-    /// Where the legend goes.
+    /// Where the legend goes: in `corner` of the plotting area, unless its box would cover
+    /// drawn data there (a line or a staircase, the edge of a band, a marker, an error
+    /// bar, within 3 pixels of their drawn width); then in the first corner, in the order
+    /// upper left, upper right, lower left, lower right, where it covers none. Where it
+    /// would cover data in every corner, it goes below the plotting area (under the x
+    /// axis's label, the plotting area shrunk to make room) as long as the plotting area
+    /// keeps half its height; else in the corner where it covers the least (`corner` on
+    /// ties).
     pub fn legend(mut self, corner: Corner) -> Self {
         self.legend = corner;
         self
@@ -633,11 +665,17 @@ impl Chart {
     /// use precursors::plot::Chart;
     /// let dir = std::env::temp_dir().join(format!("precursors-doc-bars-{}", std::process::id()));
     /// std::fs::create_dir_all(&dir)?;
+    /// // P(S) at two sizes with the counting interval P (1 ± 1/√count): 25 and 1 samples.
     /// let rows = [(1.0, 0.5, 0.4, 0.6), (10.0, 0.01, 0.0, 0.02)];
     /// Chart::new("P(S)", "S", "P(S)").log_x().log_y().error_bars("counts", &rows)
     ///     .save(dir.join("bars.svg"))?;
     /// let svg = std::fs::read_to_string(dir.join("bars.svg"))?;
     /// assert!(svg.contains("counts"));
+    /// // Two markers (radius 3) and, in their colour, one pixel wide: two bars, two caps
+    /// // on the first and one on the second (its lower end, 0, is off the log axis).
+    /// assert_eq!(svg.matches("r=\"3\"").count(), 2);
+    /// let thin = svg.matches("stroke=\"#1F77B4\" stroke-width=\"1\"").count();
+    /// assert_eq!(thin, 2 + 3);
     /// std::fs::remove_dir_all(&dir)?;
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
@@ -805,7 +843,25 @@ impl Draw for ChartDrawing<'_> {
         root: &DrawingArea<DB, Shift>,
     ) -> std::result::Result<(), String> {
         let (me, x, y) = (self.chart, self.x, self.y);
-        let mut chart = axes(root, &me.title, x, y)?;
+        // The legend's place is settled on the plotting area before anything is drawn
+        // (building the coordinates draws nothing): a legend put below it shrinks it.
+        let top = measured_title_room(root, &me.title)?;
+        let (columns, rows) = frame(root, top, x, y, 0)?.plotting_area().get_pixel_range();
+        let entries = me.legend_entries();
+        let layout = legend_layout(root, columns.end - columns.start, &entries, &me.notes)?;
+        let placement = match &layout {
+            Some(layout) => {
+                let ink = me.ink(((x, y), (&columns, &rows)));
+                place(me.legend, layout.size, (&columns, &rows), &ink)
+            }
+            None => Placement::Corner(me.legend),
+        };
+        let below = match (&layout, placement) {
+            (Some(layout), Placement::Below) => (layout.size.1 + 2 * LEGEND_GAP) as u32,
+            _ => 0,
+        };
+        typeset_title(root, &me.title)?;
+        let mut chart = frame(root, top, x, y, below)?;
         draw_axes(
             root,
             &mut chart,
@@ -813,7 +869,6 @@ impl Draw for ChartDrawing<'_> {
             (&me.y_label, y),
             (true, self.log),
         )?;
-        let mut legend = Vec::new();
         for (k, s) in me.series.iter().enumerate() {
             let colour = me.colour(k);
             for run in finite_runs(&s.band, |b| [b.0, b.1, b.2]) {
@@ -827,19 +882,7 @@ impl Draw for ChartDrawing<'_> {
                     .map_err(|e| e.to_string())?;
             }
             let style = colour.stroke_width(2);
-            let markers = s.kind == Kind::Markers;
-            let dashed = s.style.dashed;
-            if !s.label.is_empty() {
-                let glyph = if markers {
-                    Glyph::Marker
-                } else if dashed {
-                    Glyph::Dashed
-                } else {
-                    Glyph::Line
-                };
-                legend.push((s.label.clone(), glyph, colour));
-            }
-            if markers {
+            if s.kind == Kind::Markers {
                 let points = s
                     .points
                     .iter()
@@ -856,7 +899,7 @@ impl Draw for ChartDrawing<'_> {
                 } else {
                     run.to_vec()
                 };
-                if dashed {
+                if s.style.dashed {
                     chart.draw_series(DashedLineSeries::new(line, DASH, GAP, style))
                 } else {
                     chart.draw_series(LineSeries::new(line, style))
@@ -864,14 +907,213 @@ impl Draw for ChartDrawing<'_> {
                 .map_err(|e| e.to_string())?;
             }
         }
-        draw_legend(
-            &chart.plotting_area().strip_coord_spec(),
-            &legend,
-            &me.notes,
-            me.legend,
-        )?;
+        if let Some(layout) = layout {
+            let (columns, rows) = chart.plotting_area().get_pixel_range();
+            let at = match placement {
+                Placement::Corner(corner) => corner_box(corner, layout.size, (&columns, &rows)).0,
+                Placement::Below => (columns.start, rows.end + X_LABEL_AREA + LEGEND_GAP),
+            };
+            draw_legend(root, &layout, at)?;
+        }
         Ok(())
     }
+}
+
+impl Chart {
+    /// The legend's entries: each labelled series' label, glyph and colour.
+    fn legend_entries(&self) -> Vec<(String, Glyph, RGBColor)> {
+        self.series
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| !s.label.is_empty())
+            .map(|(k, s)| {
+                let glyph = if s.kind == Kind::Markers {
+                    Glyph::Marker
+                } else if s.style.dashed {
+                    Glyph::Dashed
+                } else {
+                    Glyph::Line
+                };
+                (s.label.clone(), glyph, self.colour(k))
+            })
+            .collect()
+    }
+
+    /// What a legend must not cover ([`Ink`]) of this chart's series (in their drawn
+    /// units: `log10` of the data on a logarithmic axis) on a plotting area of pixels
+    /// `columns` x `rows` showing the ranges `x` x `y`: each line's and staircase's
+    /// segments, the edges of each band, each marker and error bar.
+    fn ink(&self, ((x, y), (columns, rows)): (Ranges, (&Range<i32>, &Range<i32>))) -> Vec<Ink> {
+        let (left, width) = (
+            f64::from(columns.start),
+            f64::from(columns.end - columns.start),
+        );
+        let (bottom, height) = (f64::from(rows.end), f64::from(rows.end - rows.start));
+        let at = |(u, v): (f64, f64)| {
+            (
+                left + (u - x.0) / (x.1 - x.0) * width,
+                bottom - (v - y.0) / (y.1 - y.0) * height,
+            )
+        };
+        let mut ink = Vec::new();
+        let polyline = |points: &[(f64, f64)], half: f64, ink: &mut Vec<Ink>| {
+            for pair in points.windows(2) {
+                ink.push((at(pair[0]), at(pair[1]), half));
+            }
+        };
+        for s in &self.series {
+            for run in finite_runs(&s.band, |b| [b.0, b.1, b.2]) {
+                let upper: Vec<(f64, f64)> = run.iter().map(|b| (b.0, b.2)).collect();
+                let lower: Vec<(f64, f64)> = run.iter().map(|b| (b.0, b.1)).collect();
+                polyline(&upper, 1.0, &mut ink);
+                polyline(&lower, 1.0, &mut ink);
+            }
+            if s.kind == Kind::Markers {
+                for &p in s
+                    .points
+                    .iter()
+                    .filter(|p| p.0.is_finite() && p.1.is_finite())
+                {
+                    ink.push((at(p), at(p), 3.0));
+                }
+                for &(u, lower, upper) in s
+                    .errors
+                    .iter()
+                    .filter(|e| e.0.is_finite() && e.2.is_finite())
+                {
+                    let low = if lower.is_finite() { lower } else { y.0 };
+                    ink.push((at((u, low)), at((u, upper)), f64::from(CAP)));
+                }
+                continue;
+            }
+            for run in finite_runs(&s.points, |p| [p.0, p.1]) {
+                let line = if s.kind == Kind::Steps {
+                    staircase(run)
+                } else {
+                    run.to_vec()
+                };
+                polyline(&line, 1.0, &mut ink);
+            }
+        }
+        ink
+    }
+}
+
+/// A chart's axis ranges `(x, y)` in drawn units.
+type Ranges = ((f64, f64), (f64, f64));
+
+/// A piece of drawn data in the picture's pixels: a segment (a marker: one of zero
+/// length) and the half width it is drawn with.
+type Ink = ((f64, f64), (f64, f64), f64);
+
+/// Where a legend goes ([`place`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Placement {
+    /// In a corner of the plotting area.
+    Corner(Corner),
+    /// Under the plotting area and its x label, the plotting area shrunk to make room.
+    Below,
+}
+
+/// The pixels a legend keeps clear of drawn data around its box.
+const LEGEND_CLEARANCE: f64 = 3.0;
+/// The gap (pixels) above and below a legend put under the plotting area, and the inset
+/// of a legend from its corner of the plotting area.
+const LEGEND_GAP: i32 = 5;
+
+/// The top left corner and the far corner of a legend box of `size` in `corner` of the
+/// plotting area of pixels `columns` x `rows`.
+fn corner_box(
+    corner: Corner,
+    size: (i32, i32),
+    (columns, rows): (&Range<i32>, &Range<i32>),
+) -> ((i32, i32), (i32, i32)) {
+    let left = match corner {
+        Corner::UpperLeft | Corner::LowerLeft => columns.start + LEGEND_GAP,
+        Corner::UpperRight | Corner::LowerRight => columns.end - size.0 - LEGEND_GAP,
+    };
+    let top = match corner {
+        Corner::UpperLeft | Corner::UpperRight => rows.start + LEGEND_GAP,
+        Corner::LowerLeft | Corner::LowerRight => rows.end - size.1 - LEGEND_GAP,
+    };
+    ((left, top), (left + size.0, top + size.1))
+}
+
+/// How many pieces of `ink` a legend box from `a` to `b` would cover (within
+/// [`LEGEND_CLEARANCE`] of their drawn width).
+fn covered(ink: &[Ink], (a, b): ((i32, i32), (i32, i32))) -> usize {
+    ink.iter()
+        .filter(|&&(p, q, half)| {
+            let pad = half + LEGEND_CLEARANCE;
+            let rect = [
+                f64::from(a.0) - pad,
+                f64::from(a.1) - pad,
+                f64::from(b.0) + pad,
+                f64::from(b.1) + pad,
+            ];
+            crosses(p, q, rect)
+        })
+        .count()
+}
+
+/// Whether the segment from `p` to `q` meets the rectangle `[x0, y0, x1, y1]`
+/// (Liang-Barsky clipping: the segment's parameter interval inside each slab).
+fn crosses(p: (f64, f64), q: (f64, f64), [x0, y0, x1, y1]: [f64; 4]) -> bool {
+    let (dx, dy) = (q.0 - p.0, q.1 - p.1);
+    let (mut enter, mut leave) = (0.0f64, 1.0f64);
+    for (along, room) in [
+        (-dx, p.0 - x0),
+        (dx, x1 - p.0),
+        (-dy, p.1 - y0),
+        (dy, y1 - p.1),
+    ] {
+        if along == 0.0 {
+            if room < 0.0 {
+                return false;
+            }
+        } else if along < 0.0 {
+            enter = enter.max(room / along);
+        } else {
+            leave = leave.min(room / along);
+        }
+    }
+    enter <= leave
+}
+
+/// Where a legend box of `size` goes on the plotting area `plot` that shows `ink`: the
+/// corner `asked` where it covers none of it, else the first corner that covers none in
+/// the order upper left, upper right, lower left, lower right; where every corner would
+/// cover data, below the plotting area, when the plotting area keeps at least half its
+/// height; else the corner that covers the fewest pieces (`asked` first on ties).
+fn place(
+    asked: Corner,
+    size: (i32, i32),
+    plot: (&Range<i32>, &Range<i32>),
+    ink: &[Ink],
+) -> Placement {
+    let mut order = vec![asked];
+    for corner in [
+        Corner::UpperLeft,
+        Corner::UpperRight,
+        Corner::LowerLeft,
+        Corner::LowerRight,
+    ] {
+        if !order.contains(&corner) {
+            order.push(corner);
+        }
+    }
+    let counts: Vec<usize> = order
+        .iter()
+        .map(|&c| covered(ink, corner_box(c, size, plot)))
+        .collect();
+    if let Some(k) = counts.iter().position(|&n| n == 0) {
+        return Placement::Corner(order[k]);
+    }
+    if 2 * (size.1 + 2 * LEGEND_GAP) <= plot.1.end - plot.1.start {
+        return Placement::Below;
+    }
+    let fewest = (0..order.len()).min_by_key(|&k| counts[k]).unwrap_or(0);
+    Placement::Corner(order[fewest])
 }
 
 /// The half width of an error bar's cap, in 1/150 inch.
@@ -1424,7 +1666,16 @@ fn axes<'a, DB: DrawingBackend>(
 {
     // The title typeset by hand (plotters' caption has no subscripts), on one line or two,
     // above the plotting area.
-    let mut builder = ChartBuilder::on(area);
+    let top = typeset_title(area, title)?;
+    frame(area, top, x, y, 0)
+}
+
+/// Typesets `title` above the plotting area (one line or two, [`title_lines`]) and
+/// returns the room it takes ([`title_room`]).
+fn typeset_title<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+) -> std::result::Result<u32, String> {
     let (width, _) = area.dim_in_pixel();
     let (lines, size) = title_lines(area, title, width as i32 - 16)?;
     let line_height = (1.25 * size) as i32;
@@ -1433,9 +1684,34 @@ fn axes<'a, DB: DrawingBackend>(
         let top = TITLE_TOP + k as i32 * line_height;
         typeset(area, line, (left, top), size, Reading::Across)?;
     }
-    builder
+    Ok(title_room(lines.len(), size))
+}
+
+/// The room above the plotting area the title of `area` will take (measured, not drawn).
+fn measured_title_room<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+) -> std::result::Result<u32, String> {
+    let (width, _) = area.dim_in_pixel();
+    let (lines, size) = title_lines(area, title, width as i32 - 16)?;
+    Ok(title_room(lines.len(), size))
+}
+
+/// The chart's coordinates on `area`: `top` pixels above the plotting area for the title,
+/// the tick values' and labels' areas, and `below` more pixels under them (a legend put
+/// below the plotting area). Draws nothing: it can be built to measure the plotting area.
+fn frame<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    top: u32,
+    x: (f64, f64),
+    y: (f64, f64),
+    below: u32,
+) -> std::result::Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String>
+{
+    ChartBuilder::on(area)
         .margin(16)
-        .margin_top(title_room(lines.len(), size))
+        .margin_top(top)
+        .margin_bottom(16 + below)
         .x_label_area_size(X_LABEL_AREA)
         .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(x.0..x.1, y.0..y.1)
@@ -1720,61 +1996,79 @@ enum Glyph {
     Marker,
 }
 
-/// Draws a legend of `entries` (label, glyph, colour) and, under them, `notes` (text
-/// without a glyph) in `corner` of `area` (a chart's plotting area): a framed, almost
-/// opaque box as plotters draws its own, with the labels typeset (plotters' legend draws
-/// them as plain text), each shortened with `…` where the area is too narrow for it.
-fn draw_legend<DB: DrawingBackend>(
+/// A legend laid out ([`legend_layout`]): its entries (label as it fits, glyph,
+/// colour), its notes as they fit, and its box's size in pixels.
+struct LegendLayout {
+    entries: Vec<(String, Glyph, RGBColor)>,
+    notes: Vec<String>,
+    size: (i32, i32),
+}
+
+/// The size of a legend's text (pixels).
+const LEGEND_TEXT: f64 = 15.0;
+/// The margin inside a legend's frame (pixels).
+const LEGEND_MARGIN: i32 = 10;
+/// The room of an entry's glyph before its label (pixels).
+const GLYPH_ROOM: i32 = 30;
+
+/// The legend of `entries` (label, glyph, colour) and, under them, `notes` (text without
+/// a glyph) on a plotting area `width` pixels wide: each text shortened with `…` where
+/// the area is too narrow for it; `None` with neither.
+fn legend_layout<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
+    width: i32,
     entries: &[(String, Glyph, RGBColor)],
     notes: &[String],
-    corner: Corner,
-) -> std::result::Result<(), String> {
-    const SIZE: f64 = 15.0;
-    const MARGIN: i32 = 10;
-    const GLYPH_ROOM: i32 = 30;
-    // A row holds a letter and its lowered subscript.
-    let row = (1.5 * SIZE) as i32;
+) -> std::result::Result<Option<LegendLayout>, String> {
     if entries.is_empty() && notes.is_empty() {
-        return Ok(());
+        return Ok(None);
     }
-    let (area_width, area_height) = area.dim_in_pixel();
-    let room = area_width as i32 - 10 - 2 * MARGIN;
-    let mut labels = Vec::with_capacity(entries.len());
-    for (label, _, _) in entries {
-        labels.push(abbreviated(area, label, SIZE, room - GLYPH_ROOM)?);
+    // A row holds a letter and its lowered subscript.
+    let row = (1.5 * LEGEND_TEXT) as i32;
+    let room = width - 10 - 2 * LEGEND_MARGIN;
+    let mut widest = 0;
+    let mut fitted = Vec::with_capacity(entries.len());
+    for (label, glyph, colour) in entries {
+        let label = abbreviated(area, label, LEGEND_TEXT, room - GLYPH_ROOM)?;
+        widest = widest.max(GLYPH_ROOM + typeset_width(area, &label, LEGEND_TEXT)?);
+        fitted.push((label, *glyph, *colour));
     }
     let mut lines = Vec::with_capacity(notes.len());
     for note in notes {
-        lines.push(abbreviated(area, note, SIZE, room)?);
+        let line = abbreviated(area, note, LEGEND_TEXT, room)?;
+        widest = widest.max(typeset_width(area, &line, LEGEND_TEXT)?);
+        lines.push(line);
     }
-    let mut widest = 0;
-    for label in &labels {
-        widest = widest.max(GLYPH_ROOM + typeset_width(area, label, SIZE)?);
-    }
-    for line in &lines {
-        widest = widest.max(typeset_width(area, line, SIZE)?);
-    }
-    let width = widest + 2 * MARGIN;
-    let height = (labels.len() + lines.len()) as i32 * row + 2 * MARGIN;
-    let left = match corner {
-        Corner::UpperLeft | Corner::LowerLeft => 5,
-        Corner::UpperRight | Corner::LowerRight => area_width as i32 - width - 5,
-    };
-    let top = match corner {
-        Corner::UpperLeft | Corner::UpperRight => 5,
-        Corner::LowerLeft | Corner::LowerRight => area_height as i32 - height - 5,
-    };
-    let frame = [(left, top), (left + width, top + height)];
+    let height = (fitted.len() + lines.len()) as i32 * row + 2 * LEGEND_MARGIN;
+    Ok(Some(LegendLayout {
+        entries: fitted,
+        notes: lines,
+        size: (widest + 2 * LEGEND_MARGIN, height),
+    }))
+}
+
+/// Draws `legend` on `area` with its box's top left corner at `(left, top)`: a framed,
+/// almost opaque box as plotters draws its own, with the labels typeset (plotters'
+/// legend draws them as plain text).
+fn draw_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    legend: &LegendLayout,
+    (left, top): (i32, i32),
+) -> std::result::Result<(), String> {
+    let row = (1.5 * LEGEND_TEXT) as i32;
+    let frame = [(left, top), (left + legend.size.0, top + legend.size.1)];
     area.draw(&Rectangle::new(frame, WHITE.mix(0.85).filled()))
         .map_err(|e| e.to_string())?;
     area.draw(&Rectangle::new(frame, RGBColor(160, 160, 160)))
         .map_err(|e| e.to_string())?;
     let (_, letter) = area
-        .estimate_text_size("0", &piece_font(SIZE, false, Reading::Across))
+        .estimate_text_size("0", &piece_font(LEGEND_TEXT, false, Reading::Across))
         .map_err(|e| e.to_string())?;
-    for (k, (label, (_, glyph, colour))) in labels.iter().zip(entries).enumerate() {
-        let (x, y) = (left + MARGIN, top + MARGIN + k as i32 * row + row / 2);
+    for (k, (label, glyph, colour)) in legend.entries.iter().enumerate() {
+        let (x, y) = (
+            left + LEGEND_MARGIN,
+            top + LEGEND_MARGIN + k as i32 * row + row / 2,
+        );
         let drawn = match glyph {
             Glyph::Marker => area.draw(&Circle::new((x + 11, y), 4, colour.filled())),
             Glyph::Dashed => area.draw(&DashedPathElement::new(
@@ -1790,15 +2084,15 @@ fn draw_legend<DB: DrawingBackend>(
         };
         drawn.map_err(|e| e.to_string())?;
         let start = (x + GLYPH_ROOM, y - letter as i32 / 2);
-        typeset(area, label, start, SIZE, Reading::Across)?;
+        typeset(area, label, start, LEGEND_TEXT, Reading::Across)?;
     }
-    for (k, line) in lines.iter().enumerate() {
-        let y = top + MARGIN + (labels.len() + k) as i32 * row + row / 2;
+    for (k, line) in legend.notes.iter().enumerate() {
+        let y = top + LEGEND_MARGIN + (legend.entries.len() + k) as i32 * row + row / 2;
         typeset(
             area,
             line,
-            (left + MARGIN, y - letter as i32 / 2),
-            SIZE,
+            (left + LEGEND_MARGIN, y - letter as i32 / 2),
+            LEGEND_TEXT,
             Reading::Across,
         )?;
     }

@@ -34,6 +34,13 @@ const SWEEP: &str = r#"{ "base": { "block": { "lx": 0.03, "ly": 0.005, "lz": 0.0
     "heights": { "kind": "gaussian", "seed": 0 }, "normal_load": 500.0 },
     "axes": [], "realizations": 2, "seed": 5 }"#;
 
+/// A sweep of the tiny scene over the block's length (30 and 60 mm), two realizations.
+const SWEEP_LX: &str = r#"{ "base": { "block": { "lx": 0.03, "ly": 0.005, "lz": 0.02 },
+    "cells": { "kind": "size", "dx": 0.001, "dy": 0.001 },
+    "heights": { "kind": "gaussian", "seed": 0 }, "normal_load": 500.0 },
+    "axes": [ { "key": "block.lx", "values": [0.03, 0.06] } ],
+    "realizations": 2, "seed": 5 }"#;
+
 /// The program with `args`, killed after 60 s: `None` when it had to be (it hung).
 fn bounded(args: &[&str]) -> Option<Output> {
     let mut child = command(args)
@@ -108,6 +115,31 @@ fn finished_sweep(dir: &Path) -> PathBuf {
     ];
     let o = precursors(&args);
     assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
+    sweep
+}
+
+/// A sweep of two block lengths (two runs each) in `dir/lx`, with its `stats` tables and
+/// its figures (the collapse among them).
+fn lx_sweep(dir: &Path) -> PathBuf {
+    let sweep_file = dir.join("lx-in.json");
+    std::fs::write(&sweep_file, SWEEP_LX).unwrap();
+    let sweep = dir.join("lx");
+    for args in [
+        vec![
+            "sweep",
+            path(&sweep_file),
+            "--out",
+            path(&sweep),
+            "-q",
+            "--jobs",
+            "1",
+        ],
+        vec!["stats", path(&sweep), "--bootstrap", "5", "--goodness", "5"],
+        vec!["plot", path(&sweep)],
+    ] {
+        let o = precursors(&args);
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
+    }
     sweep
 }
 
@@ -606,6 +638,10 @@ fn a_symbolic_link_at_any_path_of_a_directory_is_refused_and_its_target_kept() {
                 "contact_area.svg",
                 "contact_map.png",
                 "fronts.svg",
+                // The tables of `stats` the statistics figures read (issue 54).
+                "power_laws.csv",
+                "binned_means.csv",
+                "scaling.csv",
             ],
         ),
         (
@@ -699,8 +735,15 @@ fn a_symbolic_link_at_any_path_of_a_directory_is_refused_and_its_target_kept() {
                 ".precursors.lock",
                 "sweep.json",
                 "curves.csv",
+                "slip.csv",
+                "avalanches.csv",
+                "runs.csv",
+                "power_laws.csv",
+                "binned_means.csv",
+                "scaling.csv",
                 "precursor_length.png",
                 "avalanche_sizes.png",
+                "potency_against_size.png",
                 "p0000-r0001/done",
                 "p0000-r0001/curve.csv",
             ],
@@ -733,6 +776,11 @@ fn a_symbolic_link_at_any_path_of_a_directory_is_refused_and_its_target_kept() {
             });
         }
     }
+    // A sweep over the block's length: `plot` reads the collapse's tables.
+    let lengths = lx_sweep(&dir);
+    for name in ["collapse.csv", "distributions.csv", "collapse.png"] {
+        cases.check(&lengths, name, |d| vec!["plot".into(), s(d)]);
+    }
     // A cut run of the sweep (no marker): `sweep` runs it again, and refuses a link at
     // its lock, its scene record or a table rather than remove it or write through it.
     let cut = dir.join("cut");
@@ -759,6 +807,48 @@ fn a_symbolic_link_at_any_path_of_a_directory_is_refused_and_its_target_kept() {
     }
     assert!(cases.cases > 60, "{} cases", cases.cases);
     assert!(cases.failures.is_empty(), "{:#?}", cases.failures);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Issue 54, item 7: a table of `stats` gone after the figures were drawn. `plot --figure`
+/// of a figure drawn from it is refused (code 2) naming the table, and the figure already
+/// there keeps its bytes; `plot` of every figure draws the others and says that the one
+/// left in the directory is from an earlier plot, not from these tables (before: not a
+/// word, the old figure passed for a new one).
+#[test]
+fn a_missing_statistics_table_is_said_and_its_old_figure_not_passed_off() {
+    let dir = scratch("missing-tables");
+    let lengths = lx_sweep(&dir);
+    let cases = [
+        ("collapse", "collapse.csv"),
+        ("collapse", "distributions.csv"),
+        ("potency_against_size", "binned_means.csv"),
+        ("potency_against_size", "scaling.csv"),
+    ];
+    for (k, (figure, table)) in cases.into_iter().enumerate() {
+        let copy = dir.join(format!("case{k}"));
+        copy_dir(&lengths, &copy);
+        let png = copy.join(format!("{figure}.png"));
+        let old = std::fs::read(&png).unwrap_or_else(|e| panic!("{figure} not drawn: {e}"));
+        std::fs::remove_file(copy.join(table)).unwrap();
+        let o = precursors(&["plot", path(&copy), "--figure", figure]);
+        let text = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{figure} without {table}: {text}");
+        assert!(
+            text.contains(&format!("no {table}")) && text.contains("precursors stats"),
+            "{figure} without {table}: {text}"
+        );
+        assert_eq!(std::fs::read(&png).unwrap(), old);
+        let o = precursors(&["plot", path(&copy)]);
+        let text = stderr(&o);
+        assert_eq!(o.status.code(), Some(0), "{text}");
+        let note = format!("{figure}.png in the directory is from an earlier plot");
+        assert!(
+            text.contains(&note) && text.contains(&format!("no {table}")),
+            "{figure} without {table}: {text}"
+        );
+        assert!(text.contains("precursor_length.png"), "{text}");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

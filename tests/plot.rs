@@ -745,7 +745,7 @@ fn statistics_figures_show_the_runs_fit_and_fronts() {
         "{texts:?}"
     );
     assert!(
-        texts.iter().any(|t| t.starts_with("preferred: ")),
+        texts.iter().any(|t| t.starts_with("pure power law ")),
         "{texts:?}"
     );
     assert!(texts
@@ -792,23 +792,38 @@ fn statistics_figures_show_the_runs_fit_and_fronts() {
         "{legend} not in {texts:?}"
     );
     assert!(!joined.contains("fitscomputedhere"), "{texts:?}");
-    // The preferred model: none that a test of the verdict column says another beats.
-    let preferred = texts
-        .iter()
-        .find_map(|t| t.strip_prefix("preferred: "))
-        .unwrap_or_else(|| panic!("no preferred model in {texts:?}"));
+    // The verdict, a clause a line: the goodness test, then each law preferred over
+    // others, each as the verdict column's tests say (which the figure does not read).
     let verdict = &row["verdict"];
-    for model in ["power law", "exponential", "log-normal", "cut-off law"] {
-        if preferred.contains(model) && !preferred.starts_with("none") {
-            assert!(
-                !verdict.contains(&format!("preferred over {model}")),
-                "{preferred} against {verdict}"
-            );
+    let goodness = if rejected { "rejected" } else { "not rejected" };
+    let p_shown = if p >= 0.01 || p == 0.0 {
+        format!("{p:.2}")
+    } else {
+        format!("{p:.1e}")
+    };
+    assert!(
+        texts.contains(&format!("pure power law {goodness} (p = {p_shown})")),
+        "{texts:?}"
+    );
+    let mut preferred = Vec::new();
+    for clause in texts.iter().filter(|t| t.contains(" preferred over ")) {
+        let (winner, losers) = clause.trim().split_once(" preferred over ").unwrap();
+        for loser in losers.split(" and ") {
+            let loser = loser.split(" (p = ").next().unwrap();
+            let said = format!("{winner} preferred over {loser}");
+            assert!(verdict.contains(&said), "{said} against {verdict}");
         }
+        preferred.push(winner.to_string());
     }
     if rejected {
-        assert!(!preferred.contains("power law"), "{preferred}");
+        assert!(!preferred.contains(&"power law".to_string()), "{texts:?}");
     }
+    // The laws the tests cannot tell apart from a preferred one are drawn with it.
+    let untold = texts
+        .iter()
+        .find(|t| t.contains("the tests cannot tell "))
+        .cloned()
+        .unwrap_or_default();
     // The solid curves (2 px, many vertices) in the series' colour: the power law unless
     // rejected (then dashed: short pieces), the cut-off law where it is preferred.
     let svg = std::fs::read_to_string(&svg_path).unwrap();
@@ -817,11 +832,13 @@ fn statistics_figures_show_the_runs_fit_and_fronts() {
         .iter()
         .filter(|(stroke, v)| stroke == blue && v.len() > 20)
         .count();
-    let cutoff_drawn = preferred.contains("cut-off law") && !row["cutoff_scale"].is_empty();
+    let cutoff_drawn = (preferred.contains(&"cut-off law".to_string())
+        || !preferred.is_empty() && untold.contains("cut-off law"))
+        && !row["cutoff_scale"].is_empty();
     assert_eq!(
         curves,
         usize::from(!rejected) + usize::from(cutoff_drawn),
-        "{preferred}"
+        "{texts:?}"
     );
     assert_eq!(joined.contains("cut-offlaw:α="), cutoff_drawn, "{texts:?}");
     // One error bar (a vertical 1 px line in the series' colour) per non-empty bin of
@@ -867,7 +884,9 @@ fn statistics_figures_show_the_runs_fit_and_fronts() {
         let label = superscript(n);
         assert!(texts.contains(&label), "{label} not in {texts:?}");
     }
-    assert!(texts.iter().all(|t| !t.contains("log")));
+    assert!(texts
+        .iter()
+        .all(|t| !t.replace("log-normal", "").contains("log")));
     let fronts: Vec<String> = svg_texts(&dir.join("fronts.svg"))
         .into_iter()
         .map(|(_, t)| t)
@@ -1782,6 +1801,136 @@ fn error_bars(svg: &str) -> usize {
         .count()
 }
 
+/// The legend's box of an SVG chart (its grey frame): left, top, right, bottom.
+fn legend_box(svg: &str) -> (f64, f64, f64, f64) {
+    let tag = svg
+        .split("<rect")
+        .skip(1)
+        .map(|t| t.split_once("/>").unwrap().0)
+        .find(|t| t.contains("fill=\"none\" stroke=\"#A0A0A0\""))
+        .expect("a legend's frame");
+    let (x, y) = (attribute(tag, "x"), attribute(tag, "y"));
+    (
+        x,
+        y,
+        x + attribute(tag, "width"),
+        y + attribute(tag, "height"),
+    )
+}
+
+/// The data of an SVG chart drawn in the rectangle `(left, top, right, bottom)`: its
+/// markers (circles of radius 3, by their extent), its lines (polylines 2 pixels wide,
+/// sampled along each segment) and its error bars (vertical 1-pixel polylines in a
+/// marker's colour), each said with where it is.
+fn data_under(svg: &str, (left, top, right, bottom): (f64, f64, f64, f64)) -> Vec<String> {
+    let inside = |(x, y): (f64, f64), pad: f64| {
+        (left - pad..=right + pad).contains(&x) && (top - pad..=bottom + pad).contains(&y)
+    };
+    let mut found = Vec::new();
+    for tag in svg.split("<circle").skip(1) {
+        let tag = tag.split_once("/>").unwrap().0;
+        if attribute(tag, "r") != 3.0 {
+            continue; // a legend's marker glyph is 4 wide
+        }
+        let centre = (attribute(tag, "cx"), attribute(tag, "cy"));
+        if inside(centre, 3.0) {
+            found.push(format!("marker at {centre:?}"));
+        }
+    }
+    let colours = marker_colours(svg);
+    let bars = svg_polylines(svg, 1)
+        .into_iter()
+        .filter(|(stroke, v)| colours.contains(stroke) && v.len() == 2 && v[0].0 == v[1].0);
+    for (stroke, vertices) in svg_polylines(svg, 2).into_iter().chain(bars) {
+        for pair in vertices.windows(2) {
+            let hit = (0..=20).map(|k| k as f64 / 20.0).find_map(|t| {
+                let at = (
+                    pair[0].0 + t * (pair[1].0 - pair[0].0),
+                    pair[0].1 + t * (pair[1].1 - pair[0].1),
+                );
+                inside(at, 0.0).then_some(at)
+            });
+            if let Some(at) = hit {
+                found.push(format!("{stroke} line at {at:?}"));
+                break;
+            }
+        }
+    }
+    found
+}
+
+/// Issue 54, item 7: a legend never covers data. Markers over the left half of a chart
+/// send a legend asked for in the upper left corner to the upper right, clear of them;
+/// markers over the whole chart send it below the plotting area, which shrinks to keep
+/// them all above it. Read back from the SVGs: the legend's frame against every marker,
+/// line and error bar. Before, the legend stayed where it was asked to go, over the
+/// markers.
+#[test]
+fn a_legend_goes_where_it_covers_no_data() {
+    let dir = scratch("legend-place");
+    // 21 x 21 markers over x in [0, x_max], y in [0, 1], with error bars.
+    let grid = |x_max: f64| -> Vec<(f64, f64, f64, f64)> {
+        (0..=20)
+            .flat_map(|i| {
+                (0..=20).map(move |j| {
+                    let y = j as f64 / 20.0;
+                    (x_max * i as f64 / 20.0, y, y - 0.01, y + 0.01)
+                })
+            })
+            .collect()
+    };
+    let draw = |name: &str, x_max: f64| -> String {
+        let path = dir.join(name);
+        Chart::new("Legend placement", "x", "y")
+            .x_range(0.0, 1.0)
+            .y_range(0.0, 1.0)
+            .error_bars("samples", &grid(x_max))
+            .line("a line", &[(0.0, 0.0), (x_max, 0.4)])
+            .note("a note under the entries")
+            .legend(Corner::UpperLeft)
+            .save(&path)
+            .unwrap();
+        std::fs::read_to_string(&path).unwrap()
+    };
+    let markers = |svg: &str| -> Vec<(f64, f64)> {
+        svg.split("<circle")
+            .skip(1)
+            .map(|t| t.split_once("/>").unwrap().0)
+            .filter(|t| attribute(t, "r") == 3.0)
+            .map(|t| (attribute(t, "cx"), attribute(t, "cy")))
+            .collect()
+    };
+    // The left half taken: the upper right corner, right of every marker.
+    let svg = draw("left.svg", 0.45);
+    let frame = legend_box(&svg);
+    assert_eq!(data_under(&svg, frame), Vec::<String>::new(), "{frame:?}");
+    let points = markers(&svg);
+    assert_eq!(points.len(), 21 * 21);
+    let rightmost = points.iter().map(|p| p.0).fold(f64::MIN, f64::max);
+    let highest = points.iter().map(|p| p.1).fold(f64::MAX, f64::min);
+    assert!(frame.0 > rightmost, "{frame:?} left of {rightmost}");
+    assert!(frame.1 < highest + 10.0, "{frame:?}: not the upper corner");
+    // The whole chart taken: below every marker, within the picture.
+    let svg = draw("full.svg", 1.0);
+    let frame = legend_box(&svg);
+    assert_eq!(data_under(&svg, frame), Vec::<String>::new(), "{frame:?}");
+    let points = markers(&svg);
+    let lowest = points.iter().map(|p| p.1).fold(f64::MIN, f64::max);
+    assert!(frame.1 > lowest, "{frame:?} above the marker at {lowest}");
+    assert!(frame.3 <= 560.0, "{frame:?} off the picture");
+    // The x label stays between the plotting area and the legend.
+    let label = svg_texts(&dir.join("full.svg"))
+        .into_iter()
+        .find(|(_, t)| t == "x")
+        .map(|(a, _)| attribute(&a, "y"))
+        .unwrap();
+    assert!(
+        lowest < label && label < frame.1,
+        "{lowest} {label} {frame:?}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// The figures of `stats`' tables on a spring-driven sweep over `Lx` (three lengths, four
 /// runs each; the sweep of tests/statistics.rs' collapse): `drop_against_size` and
 /// `potency_against_size` carry each point's binned means with their intervals as error
@@ -1824,7 +1973,7 @@ fn stats_tables_give_the_relation_collapse_and_ensemble_figures() {
         .bootstrap(10)
         .goodness_samples(0)
         .min_tail(5);
-    statistics(&dir, &StatsOptions::default().fit(fit)).unwrap();
+    statistics(&dir, &StatsOptions::default().fit(fit.clone())).unwrap();
     let drawn = draw_with_options(&dir, &options).unwrap();
     assert_eq!(drawn.files.len(), 4, "{:?}", drawn.notes);
     let means = read_csv(&dir.join("binned_means.csv"));
@@ -1902,6 +2051,73 @@ fn stats_tables_give_the_relation_collapse_and_ensemble_figures() {
             let entry = format!("{front},medianandquartiles:{point}");
             assert!(fronts.contains(&entry), "{entry} not in {fronts}");
         }
+    }
+    // Issue 54, item 7: no legend covers data (on the finite-size study, those of the
+    // collapse and of the relations covered their points).
+    let figures = ["drop_against_size", "potency_against_size", "collapse"];
+    for figure in figures {
+        let svg = std::fs::read_to_string(dir.join(format!("{figure}.svg"))).unwrap();
+        let under = data_under(&svg, legend_box(&svg));
+        assert!(under.is_empty(), "{figure}: {under:?}");
+    }
+    // A run of the longest block cut after `stats` ran (no completion marker, no record,
+    // as a killed run's): the figures of stats' tables still count the 4 runs it pooled
+    // there (they said 3, the runs complete now), and a note says so.
+    let cut = dir.join("p0002-r0003");
+    std::fs::remove_file(cut.join("done")).unwrap();
+    std::fs::remove_file(cut.join("meta.json")).unwrap();
+    let drawn = draw_with_options(&dir, &options).unwrap();
+    for figure in figures {
+        let words = squash(&svg_words(&dir.join(format!("{figure}.svg"))).concat());
+        assert!(words.contains("Δx=1mm,4realizations"), "{figure}: {words}");
+        assert!(
+            words.contains("Lx=80mm,FN=400N(4runs)"),
+            "{figure}: {words}"
+        );
+    }
+    assert!(
+        drawn
+            .notes
+            .iter()
+            .any(|n| n.contains("(4, 4, 4 a point); 4, 4, 3 are complete now")),
+        "{:?}",
+        drawn.notes
+    );
+    // Tables written before power_laws.csv's `runs`: the runs complete now, said so.
+    let fits_path = dir.join("power_laws.csv");
+    let with_runs = std::fs::read_to_string(&fits_path).unwrap();
+    let without: String = with_runs
+        .lines()
+        .map(|l| format!("{}\n", &l[..l.rfind(',').unwrap()]))
+        .collect();
+    std::fs::write(&fits_path, without).unwrap();
+    let drawn = draw_with_options(&dir, &options).unwrap();
+    assert!(
+        drawn
+            .notes
+            .iter()
+            .any(|n| n.contains("power_laws.csv names no runs")),
+        "{:?}",
+        drawn.notes
+    );
+    // `stats` again pools the 3 complete ones: the titles say 3 to 4 of the 4
+    // realizations (they said 4 realizations, the sweep's plan), the legend 3 runs.
+    statistics(&dir, &StatsOptions::default().fit(fit)).unwrap();
+    draw_with_options(&dir, &options).unwrap();
+    for figure in figures {
+        let words = squash(&svg_words(&dir.join(format!("{figure}.svg"))).concat());
+        assert!(
+            words.contains("3-4of4realizationsperpoint"),
+            "{figure}: {words}"
+        );
+        assert!(
+            words.contains("Lx=80mm,FN=400N(3runs)"),
+            "{figure}: {words}"
+        );
+        assert!(
+            words.contains("Lx=20mm,FN=100N(4runs)"),
+            "{figure}: {words}"
+        );
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -445,7 +445,7 @@ fn stats_pool_each_points_realizations() {
     ));
     assert!(
         header.ends_with(
-            ",lr_cutoff_vs_lognormal_p,verdict,classes_excluded,cutoff_classes_excluded"
+            ",lr_cutoff_vs_lognormal_p,verdict,classes_excluded,cutoff_classes_excluded,runs"
         ),
         "{header}"
     );

@@ -8,7 +8,7 @@
 //! here as `stats` would where the directory has none of these samples.
 
 use super::selection::Selection;
-use super::tables::{preferred, Fits, Table};
+use super::tables::{p_text, preferred, Fits, Table};
 use super::{point_order, series_colour, short, Canvas, Colours, Corner, PlotError, Style};
 use crate::error::Error;
 use crate::output::derived::derive;
@@ -144,7 +144,7 @@ pub(super) fn draw_statistics(
 /// the same fits computed here with `stats`' default options. The power law is drawn
 /// solid, dashed and marked "rejected" where its goodness test rules it out; the cut-off
 /// law where the tests leave it unbeaten ([`preferred`]); the legend gives `n_tail`, the
-/// goodness p and the preferred model.
+/// goodness p and the tests' verdict (which law they prefer, over which, at which p).
 fn distribution(
     dir: &Path,
     extensions: &[&str],
@@ -240,9 +240,9 @@ fn distribution(
         chart = chart
             .line(&label, &curve((alpha, 0.0, fits.x_min)))
             .style(line_style);
-        let best = preferred(&fits);
+        let verdict = preferred(&fits);
         if let Some(((a, a_low, a_high), [Some(scale), scale_low, scale_high])) = fits.cutoff {
-            if best.contains("cut-off law") {
+            if verdict.preferred.contains(&"cut-off law") {
                 let end = |v: Option<f64>| v.map_or("∞".to_string(), short);
                 chart = chart
                     .line(
@@ -258,7 +258,14 @@ fn distribution(
                     .style(style);
             }
         }
-        chart = chart.note(&format!("{prefix}preferred: {best}"));
+        // The verdict a clause a line, the point's name on the first.
+        for (k, clause) in verdict.clauses.iter().enumerate() {
+            chart = chart.note(&if k == 0 {
+                format!("{prefix}{clause}")
+            } else {
+                format!("  {clause}")
+            });
+        }
     }
     chart = chart.note("error bars: P (1 ± 1/√count), the Poisson counting error of each bin");
     if !computed.is_empty() {
@@ -271,15 +278,6 @@ fn distribution(
         drawn.files.push(path);
     }
     Ok(())
-}
-
-/// A p-value in a legend: two decimals, or two digits below 0.01.
-fn p_text(p: f64) -> String {
-    if p >= 0.01 || p == 0.0 {
-        format!("{p:.2}")
-    } else {
-        format!("{p:.1e}")
-    }
 }
 
 /// The fits `precursors stats` would write for `samples` with its default options: the

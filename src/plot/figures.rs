@@ -382,7 +382,14 @@ pub fn draw_with_options(dir: &Path, options: &DrawOptions) -> Result<Drawn, Plo
         drawn.files.extend(fronts.files);
         drawn.notes.extend(fronts.notes);
     }
-    let relations = draw_relations(dir, &extensions, canvas, (&title, point_label), &selection)?;
+    let retitle = sweep.then_some(sweep_title_over as super::relations::Retitle);
+    let relations = draw_relations(
+        dir,
+        &extensions,
+        canvas,
+        (&title, point_label, retitle),
+        &selection,
+    )?;
     drawn.files.extend(relations.files);
     drawn.notes.extend(relations.notes);
     drawn.notes.extend(skipped);
@@ -420,8 +427,19 @@ pub(super) fn run_title(dir: &Path) -> String {
 }
 
 /// The scene of a sweep in a few words: its first run's keys but the axes' and the seed,
-/// and the realizations; the directory's name when the sweep file cannot be read.
+/// and the realizations whose runs are complete ([`realizations`]); the directory's name
+/// when the sweep file cannot be read.
 fn sweep_title(dir: &Path) -> String {
+    let complete: Vec<usize> = match crate::sweep::stats::points(dir) {
+        Ok((_, points, _)) => points.iter().map(|p| p.runs()).collect(),
+        Err(_) => Vec::new(),
+    };
+    sweep_title_over(dir, &complete)
+}
+
+/// [`sweep_title`] for a figure drawn over `runs[k]` runs of point `k` (the runs `stats`
+/// pooled, for the figures of its tables).
+fn sweep_title_over(dir: &Path, runs: &[usize]) -> String {
     let Ok(sweep) = crate::sweep::Sweep::from_json_file(dir.join(SWEEP_FILE)) else {
         return name(dir);
     };
@@ -432,8 +450,23 @@ fn sweep_title(dir: &Path) -> String {
     keys.retain(|(key, _)| {
         key != "heights.seed" && !first.values().iter().any(|(axis, _)| axis == key)
     });
-    let realizations = sweep.runs().len() / sweep.points().max(1);
-    format!("{}, {realizations} realizations", describe(&keys))
+    let planned = sweep.runs().len() / sweep.points().max(1);
+    format!("{}, {}", describe(&keys), realizations(runs, planned))
+}
+
+/// The realizations of a sweep's points in words, from each point's runs that enter a
+/// figure (`complete`) and the realizations the sweep plans (`planned`): `50 realizations` when
+/// every point has them all, `41 of 50 realizations` when every point has as many, and
+/// `11-50 of 50 realizations per point` otherwise (each point's legend entry gives its
+/// own).
+fn realizations(complete: &[usize], planned: usize) -> String {
+    match (complete.iter().min(), complete.iter().max()) {
+        (Some(&low), Some(&high)) if low != high => {
+            format!("{low}-{high} of {planned} realizations per point")
+        }
+        (Some(&n), _) if n != planned => format!("{n} of {planned} realizations"),
+        _ => format!("{planned} realizations"),
+    }
 }
 
 /// `v` clipped to `[low, high]`; a `NaN` (no band: fewer than two runs) stays `NaN`.
@@ -1103,6 +1136,19 @@ mod tests {
             describe(&count),
             "20 x 4 x 10 mm, 20 x 8 cells of 1 x 0.5 mm"
         );
+    }
+
+    /// The lx sweep of the finite-size study: 50 realizations planned, 11 complete at
+    /// its longest block.
+    #[test]
+    fn a_title_counts_the_complete_runs_of_each_point() {
+        assert_eq!(
+            realizations(&[50, 50, 50, 50, 11], 50),
+            "11-50 of 50 realizations per point"
+        );
+        assert_eq!(realizations(&[41, 41], 50), "41 of 50 realizations");
+        assert_eq!(realizations(&[50, 50], 50), "50 realizations");
+        assert_eq!(realizations(&[], 50), "50 realizations");
     }
 
     #[test]

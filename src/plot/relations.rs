@@ -3,15 +3,17 @@
 //! (the binned means of `binned_means.csv` with their intervals, the least-squares power
 //! law of `scaling.csv` with its exponent and interval in the legend) and, for a sweep
 //! over a block length, `collapse` (`P(S) S^τ` against `S/L^D` from `distributions.csv`
-//! at `collapse.csv`'s `τ` and `D`, their intervals in the legend).
+//! at `collapse.csv`'s `τ` and `D`, their intervals in the legend). Their legends and
+//! titles count the runs `stats` pooled (`power_laws.csv`'s `runs`), not those complete
+//! now.
 
 use super::distributions::{PointLabel, Statistics};
 use super::selection::Selection;
-use super::tables::Table;
+use super::tables::{runs_pooled, Table};
 use super::{point_order, series_colour, short, Canvas, Corner, PlotError, Style};
 use crate::output::layout::{
     BINNED_MEANS, COLLAPSE, COLLAPSE_FIGURE, DISTRIBUTIONS, DROP_SIZE_FIGURE, POTENCY_SIZE_FIGURE,
-    SCALING,
+    POWER_LAWS, SCALING,
 };
 use crate::sweep::stats::points;
 use std::path::Path;
@@ -19,14 +21,19 @@ use std::path::Path;
 /// The fewest avalanches a bin needs to enter the collapse (`fit_collapse`'s rule).
 const COLLAPSE_MIN_COUNT: f64 = 3.0;
 
+/// A sweep's title over `runs[k]` runs of each point `k` (the runs `stats` pooled).
+pub(super) type Retitle = fn(&Path, &[usize]) -> String;
+
 /// Draws the figures of `stats`' relations and collapse that `selection` wants, from the
 /// tables `stats` wrote into `dir`; a figure whose table is missing or holds no rows for
-/// it is left out (without a word: `stats` has not run; an error where it was named).
+/// it is left out (an error where it was named; a note where an earlier plot's file of it
+/// is in the directory, [`Selection::skip_quietly`]). `retitle` gives a sweep's title
+/// over the runs `stats` pooled (`None`: a run's, `title`).
 pub(super) fn draw_relations(
     dir: &Path,
     extensions: &[&str],
     canvas: Canvas,
-    (title, label): (&str, PointLabel),
+    (title, label, retitle): (&str, PointLabel, Option<Retitle>),
     selection: &Selection,
 ) -> Result<Statistics, PlotError> {
     let mut drawn = Statistics::default();
@@ -37,13 +44,33 @@ pub(super) fn draw_relations(
     let (_, points, _) = points(dir)?;
     let values: Vec<&[(String, String)]> = points.iter().map(|p| &p.values[..]).collect();
     let (colours, order) = point_order(&values);
+    // The runs that entered `stats`' tables, which may be fewer than those complete now
+    // (a sweep still running when `stats` ran): the legends and the title count those.
+    let pooled = Table::read(&dir.join(POWER_LAWS))?;
+    let mut entered = Vec::with_capacity(points.len());
+    // A table written before its column `runs` cannot say which runs it pooled.
+    let mut unknown = false;
+    for (k, p) in points.iter().enumerate() {
+        let runs = match &pooled {
+            Some(table) => runs_pooled(table, k)?,
+            None => None,
+        };
+        unknown |= pooled.is_some() && runs.is_none();
+        entered.push(runs.unwrap_or(p.runs()));
+    }
+    let title = match retitle {
+        Some(retitle) => retitle(dir, &entered),
+        None => title.to_string(),
+    };
+    let title = title.as_str();
     let names: Vec<String> = points
         .iter()
-        .map(|p| {
+        .zip(&entered)
+        .map(|(p, &runs)| {
             if points.len() == 1 && p.values.is_empty() {
                 String::new()
             } else {
-                label(&p.values, p.runs())
+                label(&p.values, runs)
             }
         })
         .collect();
@@ -82,6 +109,28 @@ pub(super) fn draw_relations(
             dir, extensions, canvas, title, &family, selection, &mut drawn,
         )?;
     }
+    if !drawn.files.is_empty() && unknown {
+        drawn.notes.push(format!(
+            "{POWER_LAWS} names no runs (written before its column `runs`): the figures of \
+             stats' tables count the runs complete now, which may not be those it pooled; run \
+             `precursors stats` again"
+        ));
+    }
+    let now: Vec<usize> = points.iter().map(|p| p.runs()).collect();
+    if !drawn.files.is_empty() && entered != now {
+        let list = |runs: &[usize]| {
+            runs.iter()
+                .map(|n| n.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        drawn.notes.push(format!(
+            "the figures of stats' tables are drawn over the runs it pooled ({} a point); {} \
+             are complete now: run `precursors stats` again",
+            list(&entered),
+            list(&now)
+        ));
+    }
     Ok(drawn)
 }
 
@@ -112,12 +161,14 @@ fn relation_figure(
     selection: &Selection,
     drawn: &mut Statistics,
 ) -> Result<(), PlotError> {
-    let (Some(means), Some(fits)) = (
+    let (means, fits) = (
         Table::read(&dir.join(BINNED_MEANS))?,
         Table::read(&dir.join(SCALING))?,
-    ) else {
-        let reason = format!("no {BINNED_MEANS} or {SCALING}: run `precursors stats` first");
-        return selection.skip_quietly(figure, dir, reason);
+    );
+    let missing = missing(&[(BINNED_MEANS, means.is_some()), (SCALING, fits.is_some())]);
+    let (Some(means), Some(fits)) = (means, fits) else {
+        let reason = format!("no {missing}: run `precursors stats` first");
+        return selection.skip_quietly(figure, dir, reason, &mut drawn.notes);
     };
     let mut chart = canvas
         .chart(
@@ -150,21 +201,34 @@ fn relation_figure(
             ));
         }
         let prefix = family.prefix(point);
-        chart = chart
-            .error_bars(
-                &format!("{prefix}mean per bin of S, 95 % interval ({avalanches} avalanches)"),
-                &bars,
-            )
-            .style(style);
+        // One entry a point: its markers, named with its fit (the dashed line in its
+        // colour, unlabelled), to keep the legend small enough to leave the data clear.
         let fit = fits.rows_of(point, ("relation", relation))?;
-        let Some(row) = fit.first() else { continue };
-        let number = |name: &str| fits.number(row, name);
-        if let (Some(beta), Some(low), Some(high), Some(c)) = (
-            number("exponent")?,
-            number("exponent_low")?,
-            number("exponent_high")?,
-            number("prefactor")?,
-        ) {
+        let law = match fit.first() {
+            Some(row) => {
+                let number = |name: &str| fits.number(row, name);
+                match (
+                    number("exponent")?,
+                    number("exponent_low")?,
+                    number("exponent_high")?,
+                    number("prefactor")?,
+                ) {
+                    (Some(beta), Some(low), Some(high), Some(c)) => {
+                        Some((beta, low, high, c, row[fits.column("pairs")?].clone()))
+                    }
+                    _ => None,
+                }
+            }
+            None => None,
+        };
+        let label = match &law {
+            Some((beta, low, high, _, pairs)) => {
+                format!("{prefix}β = {beta:.2} [{low:.2}, {high:.2}] (95 %), {pairs} avalanches")
+            }
+            None => format!("{prefix}no fit, {avalanches} avalanches"),
+        };
+        chart = chart.error_bars(&label, &bars).style(style);
+        if let Some((beta, _, _, c, _)) = law {
             let xs = bars
                 .iter()
                 .map(|b| b.0)
@@ -174,32 +238,31 @@ fn relation_figure(
                 .map(|i| lo * (hi / lo).powf(f64::from(i) / 20.0))
                 .map(|x| (x, c * x.powf(beta)))
                 .collect();
-            chart = chart
-                .line(
-                    &format!(
-                        "{prefix}{symbol} = c S^β: β = {beta:.2} [{low:.2}, {high:.2}] (95 %), {} \
-                         avalanches",
-                        row[fits.column("pairs")?]
-                    ),
-                    &line,
-                )
-                .style(style.dashed());
+            chart = chart.line("", &line).style(style.dashed());
         }
     }
     if !any {
         let reason = format!("{BINNED_MEANS} has no rows of {relation}");
-        return selection.skip_quietly(figure, dir, reason);
+        return selection.skip_quietly(figure, dir, reason, &mut drawn.notes);
     }
-    chart = chart.note(
-        "dashed: least squares of ln y on ln S over every avalanche (scaling.csv): \
-         their geometric mean, below the markers' arithmetic means",
-    );
+    chart = chart
+        .note("markers: the mean of each bin of S, its 95 % interval")
+        .note(&format!(
+            "dashed: {symbol} = c S^β, least squares of ln {symbol} on ln S over every"
+        ))
+        .note("avalanche (scaling.csv): the geometric mean, below the arithmetic one");
     for extension in extensions {
         let path = dir.join(format!("{figure}.{extension}"));
         chart.save(&path)?;
         drawn.files.push(path);
     }
     Ok(())
+}
+
+/// The names of the tables not found among `tables` (name, found), joined by `and`.
+fn missing(tables: &[(&str, bool)]) -> String {
+    let names: Vec<&str> = tables.iter().filter(|t| !t.1).map(|t| t.0).collect();
+    names.join(" and ")
 }
 
 /// The collapse figure of a sweep over a block length: each length's log-binned sizes
@@ -214,14 +277,20 @@ fn collapse_figure(
     selection: &Selection,
     drawn: &mut Statistics,
 ) -> Result<(), PlotError> {
-    let (Some(collapse), Some(bins)) = (
+    let (collapse, bins) = (
         Table::read(&dir.join(COLLAPSE))?,
         Table::read(&dir.join(DISTRIBUTIONS))?,
-    ) else {
+    );
+    let missing = missing(&[
+        (COLLAPSE, collapse.is_some()),
+        (DISTRIBUTIONS, bins.is_some()),
+    ]);
+    let (Some(collapse), Some(bins)) = (collapse, bins) else {
         let reason = format!(
-            "no {COLLAPSE}: `precursors stats` writes it for a sweep over block.lx or block.ly"
+            "no {missing}: `precursors stats` writes {COLLAPSE} and {DISTRIBUTIONS} for a sweep \
+             over block.lx or block.ly"
         );
-        return selection.skip_quietly(COLLAPSE_FIGURE, dir, reason);
+        return selection.skip_quietly(COLLAPSE_FIGURE, dir, reason, &mut drawn.notes);
     };
     let observable = "avalanche_ruptures";
     let row = collapse
@@ -240,7 +309,7 @@ fn collapse_figure(
     };
     let Some((row, tau, d)) = fit else {
         let reason = format!("{COLLAPSE} holds no collapse of {observable} (too few samples)");
-        return selection.skip_quietly(COLLAPSE_FIGURE, dir, reason);
+        return selection.skip_quietly(COLLAPSE_FIGURE, dir, reason, &mut drawn.notes);
     };
     let axis = row[collapse.column("axis")?].clone();
     let n = |name: &str| collapse.number(row, name).map(|v| v.unwrap_or(f64::NAN));

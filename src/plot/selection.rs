@@ -4,8 +4,9 @@
 
 use super::PlotError;
 use crate::output::layout::{
-    ARCHARD_FIGURE, COLLAPSE_FIGURE, COULOMB_PROFILES_FIGURE, DROPS_FIGURE, FIGURES, MAP_FIGURE,
-    NORMAL_PROFILES_FIGURE, SHEAR_PROFILES_FIGURE, SLIP_PROFILES_FIGURE, STICK_SLIP_FIGURE,
+    ARCHARD_FIGURE, COLLAPSE_FIGURE, COULOMB_PROFILES_FIGURE, DROPS_FIGURE, FIGURES,
+    FIGURE_EXTENSIONS, MAP_FIGURE, NORMAL_PROFILES_FIGURE, SHEAR_PROFILES_FIGURE,
+    SLIP_PROFILES_FIGURE, STICK_SLIP_FIGURE,
 };
 use crate::sweep::SWEEP_FILE;
 use std::path::Path;
@@ -88,14 +89,33 @@ impl Selection {
     }
 
     /// `figure` cannot be drawn, found from the tables: an error when it was named, else
-    /// left out without a word (the figures of `stats`' tables before `stats` ran).
+    /// left out without a word (the figures of `stats`' tables before `stats` ran), but
+    /// where the directory holds a file of that figure from an earlier plot: a note in
+    /// `notes` then says that it no longer matches the tables.
     pub(super) fn skip_quietly(
         &self,
         figure: &str,
         dir: &Path,
         reason: String,
+        notes: &mut Vec<String>,
     ) -> Result<(), PlotError> {
-        self.skip(figure, dir, reason, &mut Vec::new())
+        let mut earlier = Vec::new();
+        for extension in FIGURE_EXTENSIONS {
+            let name = format!("{figure}.{extension}");
+            if crate::files::is_file(&dir.join(&name), "examining an earlier figure")? {
+                earlier.push(name);
+            }
+        }
+        if earlier.is_empty() || self.named {
+            return self.skip(figure, dir, reason, &mut Vec::new());
+        }
+        notes.push(format!(
+            "no {figure} figure: {reason}; {} in the directory {} from an earlier plot, \
+             not from these tables",
+            earlier.join(" and "),
+            if earlier.len() == 1 { "is" } else { "are" }
+        ));
+        Ok(())
     }
 }
 

@@ -1,7 +1,7 @@
 //! The tables `precursors stats` writes (`power_laws.csv`, `binned_means.csv`,
 //! `scaling.csv`, `collapse.csv`; module [`crate::sweep::stats`]) read back for the
-//! figures, by their header's names; and the model the likelihood-ratio tests prefer
-//! ([`preferred`]).
+//! figures, by their header's names; the runs `stats` pooled ([`runs_pooled`]); and what
+//! the likelihood-ratio tests say ([`preferred`]).
 
 use crate::error::{Error, Result};
 use crate::statistics::{Comparison, PowerLawFit, LR_SIGNIFICANCE};
@@ -101,6 +101,23 @@ impl Table {
             .map(|r| r.as_slice())
             .collect())
     }
+}
+
+/// The complete runs `stats` pooled at point `point` (`power_laws.csv`'s `runs`, `table`):
+/// `None` for a table written before that column, or without a row of the point.
+///
+/// # Errors
+/// [`Error::CorruptTable`] for a damaged cell.
+pub(super) fn runs_pooled(table: &Table, point: usize) -> Result<Option<usize>> {
+    if !table.header.iter().any(|h| h == "runs") {
+        return Ok(None);
+    }
+    let column = table.column("point")?;
+    let point = point.to_string();
+    let Some(row) = table.rows.iter().find(|r| r[column] == point) else {
+        return Ok(None);
+    };
+    Ok(table.number(row, "runs")?.map(|v| v as usize))
 }
 
 /// A CSV line's cells, a quoted cell unquoted (`"a, b"` is one cell, `""` a quote).
@@ -278,51 +295,135 @@ impl Fits {
     }
 }
 
-/// The model the tests prefer, in words: of the pure power law, the exponential, the
-/// log-normal and the power law with cut-off, the ones that lose no test, a test counting
-/// where its p-value is below [`LR_SIGNIFICANCE`] (the sign of `R` says who wins) and the
-/// power law losing where its goodness test rejects it (`p ≤ 0.1`). One such model: its
-/// name; several: `A or B (not distinguished)` (no test separates them: the cut-off law
-/// and the exponential are never compared); where none of them wins a test, that the
-/// tests do not decide. A cut-off law fitted at `λ = 0` is the power law itself. Without the alternatives: the power law's goodness alone.
-pub(super) fn preferred(fits: &Fits) -> String {
-    const NAMES: [&str; 4] = ["power law", "exponential", "log-normal", "cut-off law"];
+/// The laws a distribution's tests compare, in the order of [`Fits::tests`]' pairs.
+const MODELS: [&str; 4] = ["power law", "exponential", "log-normal", "cut-off law"];
+
+/// The laws each test of [`Fits::tests`] compares: power law against exponential,
+/// log-normal and cut-off law; cut-off law against log-normal.
+const PAIRS: [(usize, usize); 4] = [(0, 1), (0, 2), (0, 3), (3, 2)];
+
+/// What the tests of a distribution's fits say ([`preferred`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Verdict {
+    /// The laws that lose no test, where one of them wins one (none where no law does).
+    pub preferred: Vec<&'static str>,
+    /// The verdict in clauses, each a line of a legend.
+    pub clauses: Vec<String>,
+}
+
+/// What the tests say, in clauses that follow them (Clauset et al.; a test counts where its
+/// p-value is below [`LR_SIGNIFICANCE`], the sign of `R` saying who wins):
+///
+/// 1. the goodness test of the pure power law: `pure power law rejected (p = …)` (`p ≤
+///    0.1`), `… not rejected (p = …)`, or `power law's goodness not tested`;
+/// 2. for each law that wins a test and loses none, in the order power law, exponential,
+///    log-normal, cut-off law: `A preferred over B (p = …) and C (p = …)`;
+/// 3. where several laws lose no test and one of them wins one: that the tests cannot tell
+///    them apart, with the p of the test between two of them or `never compared` (the
+///    exponential is compared with the power law only);
+/// 4. where no law wins a test: `the likelihood-ratio tests cannot tell the laws apart
+///    (every p ≥ 0.1)`; where each law that wins one loses another: `no law preferred: each
+///    that wins a test loses another`.
+///
+/// A cut-off law fitted at `λ = 0` is the power law itself (said so; its tests are the
+/// power law's). Without the alternatives: the goodness test and `no alternative fitted`.
+pub(super) fn preferred(fits: &Fits) -> Verdict {
+    let mut clauses = vec![match fits.p {
+        Some(p) if p <= GOODNESS_REJECTS => format!("pure power law rejected (p = {})", p_text(p)),
+        Some(p) => format!("pure power law not rejected (p = {})", p_text(p)),
+        None => "power law's goodness not tested".to_string(),
+    }];
     let Some(tests) = fits.tests else {
-        return match fits.p {
-            Some(p) if p <= GOODNESS_REJECTS => "none: power law rejected, no alternative fitted",
-            Some(_) => "power law (not rejected; no alternative fitted)",
-            None => "not tested",
-        }
-        .to_string();
+        clauses.push("no alternative fitted".into());
+        return Verdict {
+            preferred: Vec::new(),
+            clauses,
+        };
     };
-    let (mut wins, mut losses) = ([0; 4], [0; 4]);
+    // At λ = 0 the cut-off law is the pure power law (nested): its tests are the power
+    // law's own, and it is left out.
+    let same = fits.cutoff.is_some_and(|(_, scale)| scale[0].is_none());
+    let laws: &[usize] = if same { &[0, 1, 2] } else { &[0, 1, 2, 3] };
+    let mut losses = [0; 4];
     if fits.rejected() {
         losses[0] += 1;
     }
-    // (first, second) of each test: power law against exponential, log-normal, cut-off
-    // law; cut-off law against log-normal.
-    for ((a, b), t) in [(0, 1), (0, 2), (0, 3), (3, 2)].into_iter().zip(tests) {
+    // (winner, loser, p) of each test that decides.
+    let mut decided = Vec::new();
+    for (&(a, b), t) in PAIRS.iter().zip(tests) {
+        if !(laws.contains(&a) && laws.contains(&b)) {
+            continue;
+        }
         if t.p < LR_SIGNIFICANCE && t.log_ratio != 0.0 {
             let (w, l) = if t.log_ratio > 0.0 { (a, b) } else { (b, a) };
-            wins[w] += 1;
             losses[l] += 1;
+            decided.push((w, l, t.p));
         }
     }
-    // At λ = 0 the cut-off law is the pure power law (nested): one model.
-    let same = fits.cutoff.is_some_and(|(_, scale)| scale[0].is_none());
+    let unbeaten: Vec<usize> = laws.iter().copied().filter(|&m| losses[m] == 0).collect();
+    let winners: Vec<usize> = unbeaten
+        .iter()
+        .copied()
+        .filter(|&m| decided.iter().any(|d| d.0 == m))
+        .collect();
     if same {
-        wins[0] += wins[3];
-        losses[0] += losses[3];
+        clauses.push("cut-off law fitted at λ = 0: the power law itself".into());
     }
-    let models = if same { 0..3 } else { 0..4 };
-    let unbeaten: Vec<usize> = models.filter(|&m| losses[m] == 0).collect();
-    if unbeaten.iter().all(|&m| wins[m] == 0) {
-        return "none: the tests do not decide".to_string();
+    if decided.is_empty() {
+        clauses.push(format!(
+            "the likelihood-ratio tests cannot tell the laws apart (every p ≥ {LR_SIGNIFICANCE})"
+        ));
+    } else if winners.is_empty() {
+        clauses.push("no law preferred: each that wins a test loses another".into());
     }
-    let names: Vec<&str> = unbeaten.iter().map(|&m| NAMES[m]).collect();
-    match names.as_slice() {
-        [one] => one.to_string(),
-        many => format!("{} (not distinguished)", many.join(" or ")),
+    for &w in &winners {
+        let beaten: Vec<String> = decided
+            .iter()
+            .filter(|d| d.0 == w)
+            .map(|&(_, l, p)| format!("{} (p = {})", MODELS[l], p_text(p)))
+            .collect();
+        clauses.push(format!(
+            "{} preferred over {}",
+            MODELS[w],
+            beaten.join(" and ")
+        ));
+    }
+    if !winners.is_empty() && unbeaten.len() > 1 {
+        let names: Vec<&str> = unbeaten.iter().map(|&m| MODELS[m]).collect();
+        clauses.push(match unbeaten.as_slice() {
+            [a, b] => {
+                let (a, b) = (*a, *b);
+                let test = PAIRS
+                    .iter()
+                    .zip(tests)
+                    .find(|(pair, _)| **pair == (a, b) || **pair == (b, a));
+                let p = match test {
+                    Some((_, t)) => format!("p = {}", p_text(t.p)),
+                    None => "never compared".into(),
+                };
+                format!("the tests cannot tell {} from {} ({p})", names[0], names[1])
+            }
+            _ => format!(
+                "the tests cannot tell {} and {} apart",
+                names[..names.len() - 1].join(", "),
+                names[names.len() - 1]
+            ),
+        });
+    }
+    let preferred = if winners.is_empty() {
+        Vec::new()
+    } else {
+        unbeaten.iter().map(|&m| MODELS[m]).collect()
+    };
+    Verdict { preferred, clauses }
+}
+
+/// A p-value in a legend: two decimals, or two digits below 0.01.
+pub(super) fn p_text(p: f64) -> String {
+    if p >= 0.01 || p == 0.0 {
+        format!("{p:.2}")
+    } else {
+        format!("{p:.1e}")
     }
 }
 
@@ -342,66 +443,141 @@ mod tests {
         }
     }
 
+    /// The verdict's clauses.
+    fn says(fits: &Fits) -> Vec<String> {
+        preferred(fits).clauses
+    }
+
     /// Rows of docs/statistics.md's study table (R of the power law against the
-    /// exponential made up: the table leaves it out).
+    /// exponential made up: the table leaves it out); each expected clause read off the
+    /// tests by hand: a test decides at p < 0.1, for the law its R's sign favours.
     #[test]
-    fn the_preferred_model_is_the_one_that_loses_no_test_and_wins_one() {
-        // rod, avalanche_ruptures: PL rejected (0.07), cut-off over PL (0.02), cut-off
-        // over log-normal (R 0.3, p 0.06).
+    fn the_verdict_says_what_each_test_decides() {
+        // rod, avalanche_ruptures: PL rejected (0.07); PL over exponential (0.01),
+        // cut-off over PL (0.02), cut-off over log-normal (R 0.3, p 0.06); PL against
+        // log-normal undecided (0.15). The cut-off law alone loses nothing.
         let rod = fits(
             Some(0.07),
             [(5.0, 0.01), (-2.4, 0.15), (-3.0, 0.02), (0.3, 0.06)],
         );
-        assert_eq!(preferred(&rod), "cut-off law");
-        // spring, avalanche_ruptures: nothing decides.
+        assert_eq!(
+            says(&rod),
+            [
+                "pure power law rejected (p = 0.07)",
+                "cut-off law preferred over power law (p = 0.02) and log-normal (p = 0.06)",
+            ]
+        );
+        assert_eq!(preferred(&rod).preferred, ["cut-off law"]);
+        // spring, avalanche_ruptures: no test decides.
         let spring = fits(
             Some(0.26),
             [(0.5, 0.6), (-0.4, 0.52), (-0.6, 0.25), (0.3, 0.67)],
         );
-        assert_eq!(preferred(&spring), "none: the tests do not decide");
-        // surface 0.5 mm, precursor leaps: cut-off over PL, cut-off and log-normal alike.
+        assert_eq!(
+            says(&spring),
+            [
+                "pure power law not rejected (p = 0.26)",
+                "the likelihood-ratio tests cannot tell the laws apart (every p ≥ 0.1)",
+            ]
+        );
+        assert!(preferred(&spring).preferred.is_empty());
+        // surface 0.5 mm, precursor leaps: cut-off over PL; cut-off against log-normal
+        // undecided (0.91), log-normal against PL undecided (0.22): both unbeaten.
         let both = fits(
             Some(0.0),
             [(9.0, 0.0), (-2.7, 0.22), (-2.0, 0.02), (-0.1, 0.91)],
         );
         assert_eq!(
-            preferred(&both),
-            "log-normal or cut-off law (not distinguished)"
+            says(&both),
+            [
+                "pure power law rejected (p = 0.00)",
+                "cut-off law preferred over power law (p = 0.02)",
+                "the tests cannot tell log-normal from cut-off law (p = 0.91)",
+            ]
         );
-        // The exponential is compared with the power law only.
+        assert_eq!(preferred(&both).preferred, ["log-normal", "cut-off law"]);
+        // The rod sweep's case: the exponential is compared with the power law only,
+        // which it does not beat (0.5): it and the cut-off law are both unbeaten.
         let exponential = fits(
             Some(0.0),
-            [(-1.0, 0.5), (-2.7, 0.02), (-2.0, 0.02), (0.1, 0.01)],
+            [(-1.0, 0.5), (-2.7, 0.02), (-2.0, 0.02), (0.1, 0.004)],
         );
         assert_eq!(
-            preferred(&exponential),
-            "exponential or cut-off law (not distinguished)"
+            says(&exponential),
+            [
+                "pure power law rejected (p = 0.00)",
+                "cut-off law preferred over power law (p = 0.02) and log-normal (p = 4.0e-3)",
+                "the tests cannot tell exponential from cut-off law (never compared)",
+            ]
         );
-        // A power law not rejected that beats every alternative.
+        assert_eq!(
+            preferred(&exponential).preferred,
+            ["exponential", "cut-off law"]
+        );
+        // A power law not rejected that beats the exponential and the log-normal: the
+        // nested test cannot favour it over the cut-off law (R = 0).
         let power = fits(
             Some(0.5),
             [(4.0, 0.01), (3.0, 0.05), (0.0, 1.0), (0.1, 0.9)],
         );
         assert_eq!(
-            preferred(&power),
-            "power law or cut-off law (not distinguished)",
-            "the nested test cannot favour the power law"
+            says(&power),
+            [
+                "pure power law not rejected (p = 0.50)",
+                "power law preferred over exponential (p = 0.01) and log-normal (p = 0.05)",
+                "the tests cannot tell power law from cut-off law (p = 1.00)",
+            ]
         );
         let alone = fits(
             Some(0.5),
             [(4.0, 0.01), (3.0, 0.05), (-2.0, 0.5), (0.3, 0.05)],
         );
         assert_eq!(
-            preferred(&alone),
-            "power law or cut-off law (not distinguished)"
+            says(&alone),
+            [
+                "pure power law not rejected (p = 0.50)",
+                "power law preferred over exponential (p = 0.01) and log-normal (p = 0.05)",
+                "cut-off law preferred over log-normal (p = 0.05)",
+                "the tests cannot tell power law from cut-off law (p = 0.50)",
+            ]
         );
-        // rod, precursor leaps: the cut-off law at λ = 0 is the rejected power law.
+        // rod, precursor leaps: the cut-off law at λ = 0 is the rejected power law; the
+        // log-normal beats it (0.02), which beats the exponential (0.05).
         let mut leaps = fits(
             Some(0.03),
             [(2.0, 0.05), (-0.3, 0.02), (0.0, 1.0), (-0.3, 0.02)],
         );
         leaps.cutoff = Some(((3.97, 3.3, 4.4), [None, Some(18.5), None]));
-        assert_eq!(preferred(&leaps), "log-normal");
+        assert_eq!(
+            says(&leaps),
+            [
+                "pure power law rejected (p = 0.03)",
+                "cut-off law fitted at λ = 0: the power law itself",
+                "log-normal preferred over power law (p = 0.02)",
+            ]
+        );
+        assert_eq!(preferred(&leaps).preferred, ["log-normal"]);
+        // A cycle: the power law beats the log-normal, which beats the cut-off law,
+        // which beats the power law.
+        let cycle = fits(
+            Some(0.5),
+            [(0.0, 1.0), (2.0, 0.01), (-2.0, 0.01), (-2.0, 0.01)],
+        );
+        assert_eq!(
+            says(&cycle)[1],
+            "no law preferred: each that wins a test loses another"
+        );
+        assert!(preferred(&cycle).preferred.is_empty());
+        // Without the alternatives: the goodness test alone.
+        let mut bare = fits(Some(0.05), [(0.0, 1.0); 4]);
+        bare.tests = None;
+        assert_eq!(
+            says(&bare),
+            [
+                "pure power law rejected (p = 0.05)",
+                "no alternative fitted"
+            ]
+        );
     }
 
     #[test]

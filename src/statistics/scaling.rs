@@ -565,6 +565,36 @@ pub fn fit_collapse(
 
 /// How the cut-off scale of the size distribution grows with the system's size
 /// ([`fit_cutoff_scaling`]): `s_c ≈ c L^β`.
+///
+/// ```
+/// use precursors::statistics::{compare_alternatives, fit_cutoff_scaling, PowerLawOptions, Support};
+/// // Sizes spread as S^-1.5 e^(-S/s_c), s_c = 2000 L^1.5 (37 and 296 ruptures).
+/// let draw = |s_c: f64| -> Vec<f64> {
+///     let mut out = Vec::new();
+///     for i in 1..3000u32 {
+///         let u = ((i as f64) * 0.618034).fract();
+///         let x = (1.0 - u).powf(-1.0 / 0.5); // Pareto with τ = 1.5
+///         if ((i as f64) * 0.414214).fract() < (-x / s_c).exp() { out.push(x.floor()); }
+///     }
+///     out
+/// };
+/// // No bootstrap: the cut-offs' intervals are degenerate, the lengths weigh alike.
+/// let options = PowerLawOptions::default().bootstrap(0).goodness_samples(0);
+/// let lengths = [0.07f64, 0.28];
+/// let fits: Vec<_> = lengths.iter()
+///     .map(|&l| compare_alternatives(&draw(2000.0 * l * l.sqrt()), Support::Discrete, &options)
+///         .map(|c| c.cutoff))
+///     .collect::<Result<_, _>>()?;
+/// let s = fit_cutoff_scaling(&lengths, &fits, 0.95)?;
+/// // Two lengths: the line through both cut-offs, slope ln(s_c2/s_c1) / ln 4.
+/// let slope = (fits[1].cutoff / fits[0].cutoff).ln() / 4f64.ln();
+/// assert_eq!(s.lengths, 2);
+/// assert!((s.exponent - slope).abs() < 1e-9, "{s:?}");
+/// assert_eq!((s.exponent_low, s.exponent_high), (s.exponent, s.exponent));
+/// assert!((s.prefactor * 0.07f64.powf(s.exponent) / fits[0].cutoff - 1.0).abs() < 1e-9);
+/// assert!(s.chi2_per_dof.is_none()); // no degree of freedom left
+/// # Ok::<(), precursors::Error>(())
+/// ```
 #[non_exhaustive]
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]

@@ -491,10 +491,12 @@ pub(crate) fn points(dir: &Path) -> Result<(Vec<String>, Vec<Point>, usize), Swe
 ///   exponential_lambda,lognormal_mu,lognormal_sigma,lr_exponential,
 ///   lr_exponential_normalized,lr_exponential_p,lr_lognormal,lr_lognormal_normalized,
 ///   lr_lognormal_p,lr_cutoff,lr_cutoff_normalized,lr_cutoff_p,lr_cutoff_vs_lognormal,
-///   lr_cutoff_vs_lognormal_normalized,lr_cutoff_vs_lognormal_p,verdict` (docs/statistics.md
-///   defines them; an infinite value, such as the cut-off scale `1/λ` at `λ = 0`, is an
-///   empty cell); the fit's cells are empty where the samples are too few (fewer than
-///   `min_tail` positive ones);
+///   lr_cutoff_vs_lognormal_normalized,lr_cutoff_vs_lognormal_p,verdict,classes_excluded,
+///   cutoff_classes_excluded,runs` (docs/statistics.md defines them; `runs` is the
+///   complete runs pooled at the point, which the figures of these tables name; an
+///   infinite value, such as the cut-off scale `1/λ` at `λ = 0`, is an empty cell); the
+///   fit's cells are empty where the samples are too few (fewer than `min_tail` positive
+///   ones);
 /// * `distributions.csv`: per point and observable, the log-binned density
 ///   ([`log_binned`]), header `point,<axis keys>,observable,bin_low,bin_high,
 ///   bin_center,count,density`.
@@ -571,7 +573,7 @@ pub fn statistics_with_progress(
     let mut fits = format!(
         "point,{key_header}observable,support,samples,tail,x_min,alpha,alpha_std_error,\
          alpha_low,alpha_high,x_min_low,x_min_high,ks_distance,p_value,confidence,\
-         {ALTERNATIVES_HEADER},classes_excluded,cutoff_classes_excluded\n"
+         {ALTERNATIVES_HEADER},classes_excluded,cutoff_classes_excluded,runs\n"
     );
     let mut verdicts = Vec::new();
     let mut classes = Vec::new();
@@ -662,11 +664,12 @@ pub fn statistics_with_progress(
             let excluded = class_cells(fit.as_ref());
             let _ = writeln!(
                 fits,
-                "{index},{values}{name},{support_name},{positive},{},{},{},{}",
+                "{index},{values}{name},{support_name},{positive},{},{},{},{},{}",
                 fit_cells(fit.as_ref(), options.fit.confidence),
                 alternative_cells(fit.as_ref()),
                 cell(&excluded[0]),
                 cell(&excluded[1]),
+                point.runs(),
             );
             if let Some(Fit::Compared(c)) = &fit {
                 verdicts.push(format!("point {index}, {name}: {}", c.verdict()));
