@@ -453,12 +453,14 @@ impl ContactLaw for Restated {
 }
 
 /// Slip weakening: a site whose spring broke before holds `μ_d φ_z` (Pa) once it holds
-/// again, `μ_d < μ`; anchored springs; a broken site re-forms `after` stable states
-/// after its rupture.
+/// again, `μ_d < μ`; anchored springs; a broken site re-forms `after` stable states and
+/// a load increase `load` (N) after its rupture (without the load, re-formed sites may
+/// break again at the same load for ever).
 #[derive(Debug)]
 struct SlipWeakening {
     dynamic: f64,
     after: u64,
+    load: f64,
 }
 
 impl ContactLaw for SlipWeakening {
@@ -475,8 +477,12 @@ impl ContactLaw for SlipWeakening {
         true
     }
     fn reforms(&self, site: &SiteView) -> bool {
-        site.rupture_stable_states
-            .is_some_and(|at| site.stable_states >= at + self.after)
+        match (site.rupture_stable_states, site.rupture_force) {
+            (Some(at), Some(force)) => {
+                site.stable_states >= at + self.after && site.force - force >= self.load
+            }
+            _ => false,
+        }
     }
 }
 
@@ -576,6 +582,7 @@ fn a_slip_weakening_rule_balances_its_loads_and_differs_from_the_papers() {
         .contact_rule(ContactRule::custom(SlipWeakening {
             dynamic: mu / 2.0,
             after: 2,
+            load: 0.02 * mu * base.normal_load(),
         }))
         .build()
         .unwrap();
@@ -627,6 +634,8 @@ fn custom_events_on(seed: u64, backend: Backend) -> Vec<(&'static str, Option<us
         .contact_rule(ContactRule::custom(SlipWeakening {
             dynamic: 0.5 * precursors::Material::default().friction_coefficient(),
             after: 2,
+            // 2 % of μ F_N (F_N = 40 N).
+            load: 0.02 * precursors::Material::default().friction_coefficient() * 40.0,
         }))
         .build()
         .unwrap();
@@ -682,6 +691,7 @@ fn a_custom_rule_is_refused_where_only_built_in_rules_go() {
         .contact_rule(ContactRule::custom(SlipWeakening {
             dynamic: 0.3,
             after: 2,
+            load: 0.6,
         }))
         .build()
         .unwrap();

@@ -35,8 +35,9 @@ use std::sync::Arc;
 /// [`RunTables`](crate::output::RunTables) refuse it with
 /// [`Error::CustomContactRule`](crate::Error::CustomContactRule); sweeps and the Python
 /// bindings, which read scene files, cannot name one. A custom rule that re-forms sites
-/// under a spring drive may never reach global slip (the built-in re-forming rule is
-/// refused there): bound such a run yourself.
+/// without a load delay, or under a spring drive, may never reach global slip (re-formed
+/// sites can break again at the same load for ever; the built-in re-forming rule is
+/// refused under a spring): bound such a run yourself.
 ///
 /// A law is shared by the scene's drivers, across threads: it is `Send + Sync` (and
 /// `RefUnwindSafe`, as the scene and driver that hold it are), and answers from its
@@ -46,9 +47,11 @@ use std::sync::Arc;
 /// use precursors::{ContactLaw, ContactRule, Event, Scene, SiteView};
 ///
 /// /// Slip weakening: a site whose spring broke before holds only μ_d φ_z (Pa) once it
-/// /// re-forms, two stable states after its rupture, anchored where it attaches.
+/// /// re-forms, two stable states and a load increase `load` (N) after its rupture,
+/// /// anchored where it attaches. (Without a load delay re-formed sites could break
+/// /// again at the same load for ever under force control.)
 /// #[derive(Debug)]
-/// struct Weakening { dynamic: f64 }
+/// struct Weakening { dynamic: f64, load: f64 }
 ///
 /// impl ContactLaw for Weakening {
 ///     fn name(&self) -> &str { "slip-weakening" }
@@ -58,8 +61,12 @@ use std::sync::Arc;
 ///     }
 ///     fn anchors(&self) -> bool { true }
 ///     fn reforms(&self, site: &SiteView) -> bool {
-///         // Two stable states after its rupture.
-///         site.rupture_stable_states.is_some_and(|at| site.stable_states >= at + 2)
+///         match (site.rupture_stable_states, site.rupture_force) {
+///             (Some(at), Some(force)) => {
+///                 site.stable_states >= at + 2 && site.force - force >= self.load
+///             }
+///             _ => false,
+///         }
 ///     }
 /// }
 ///
@@ -68,7 +75,8 @@ use std::sync::Arc;
 ///     .cells(12, 2)
 ///     .normal_load(40.0)
 ///     .seed(1)
-///     .contact_rule(ContactRule::custom(Weakening { dynamic: 0.3 })) // μ_s = 0.5
+///     // μ_s = 0.5, μ F_N = 20 N: re-formation after 2 % of it.
+///     .contact_rule(ContactRule::custom(Weakening { dynamic: 0.3, load: 0.4 }))
 ///     .build()?;
 /// assert_eq!(scene.contact_rule().name(), "slip-weakening");
 /// let events: Vec<Event> = scene.driver()?.collect::<Result<_, _>>()?;

@@ -8,13 +8,16 @@ use precursors::{ContactLaw, ContactRule, Error, Event, ProbeSpec, Scene, SiteSt
 
 /// Slip weakening, written here as a user would: a site holds the static threshold
 /// `μ_s φ_z` (Pa) until its spring first breaks; it re-forms (anchored, no shear at its
-/// attachment) two stable states later and then holds only `μ_d φ_z`, `μ_d < μ_s`. The
-/// threshold depends on the site's state and history only, never on the load, so it is
-/// fixed between events (the trait's contract).
+/// attachment) two stable states and a load increase `load` later, and then holds only
+/// `μ_d φ_z`, `μ_d < μ_s`. The threshold depends on the site's state and history only,
+/// never on the load, so it is fixed between events (the trait's contract); the load
+/// delay bounds the run (re-formed sites cannot break again at one load for ever).
 #[derive(Debug)]
 struct SlipWeakening {
     /// `μ_d` (dimensionless).
     dynamic: f64,
+    /// The load increase (N) a broken site waits for.
+    load: f64,
 }
 
 impl ContactLaw for SlipWeakening {
@@ -32,8 +35,12 @@ impl ContactLaw for SlipWeakening {
         true
     }
     fn reforms(&self, site: &SiteView) -> bool {
-        site.rupture_stable_states
-            .is_some_and(|at| site.stable_states >= at + 2)
+        match (site.rupture_stable_states, site.rupture_force) {
+            (Some(at), Some(force)) => {
+                site.stable_states >= at + 2 && site.force - force >= self.load
+            }
+            _ => false,
+        }
     }
 }
 
@@ -125,7 +132,10 @@ fn main() -> Result<(), Error> {
     let paper = builder.clone().build()?;
     let mu = paper.material().friction_coefficient();
     let weakening = builder
-        .contact_rule(ContactRule::custom(SlipWeakening { dynamic: 0.5 * mu }))
+        .contact_rule(ContactRule::custom(SlipWeakening {
+            dynamic: 0.5 * mu,
+            load: 0.02 * mu * paper.normal_load(),
+        }))
         .build()?;
     assert_eq!(weakening.contact_rule().name(), "slip-weakening");
     let (paper_events, paper_twice) = checked_run(&paper)?;
