@@ -17,41 +17,68 @@
 //! per-site loops: the paper's rule costs what the code it replaced cost, and gives the
 //! same bits.
 
+mod law;
+
+pub use law::{ContactLaw, CustomRule, SiteView};
+
 use crate::error::{check_slice, Error, Result};
 use crate::interface::{Interface, SiteState};
+use std::sync::Arc;
 
-/// The rule of a run's site transitions (the scene key `contact`).
-// Only scene files (feature `serde`) choose a rule other than the paper's until the rule
-// is public (issue 55): without that feature those variants are never built.
-#[cfg_attr(not(feature = "serde"), allow(dead_code))]
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub(crate) enum ContactRule {
-    /// The paper's: the Coulomb threshold `|φ_x| = μ φ_z` of a spring anchored at
-    /// `u_x = 0`; among the sites over threshold the one of largest elastic energy
-    /// breaks first; a broken site never re-forms.
+/// The rule of a run's site transitions ([`SceneBuilder::contact_rule`](crate::SceneBuilder::contact_rule),
+/// scene-file key `contact`, `docs/scene-format.md`; the physics in `docs/model.md`).
+/// The built-in rules are scene-file values; a downstream crate writes its own as a
+/// [`ContactLaw`] ([`ContactRule::custom`]).
+///
+/// ```
+/// use precursors::{ContactRule, Delay, Scene};
+/// let rule = ContactRule::Rejuvenation { delay: Delay::new(3, 0.02)? };
+/// let scene = Scene::builder()
+///     .block(0.012, 0.002, 0.010)
+///     .normal_load(40.0)
+///     .contact_rule(rule.clone())
+///     .build()?;
+/// assert_eq!(scene.contact_rule(), &rule);
+/// assert_eq!(rule.name(), "rejuvenation");
+/// let default = Scene::builder().block(0.012, 0.002, 0.010).normal_load(40.0).build()?;
+/// assert_eq!(default.contact_rule(), &ContactRule::Paper);
+/// # Ok::<(), precursors::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
+pub enum ContactRule {
+    /// The paper's (the default): the Coulomb threshold `|φ_x| = μ φ_z` (Pa) of a spring
+    /// anchored at `u_x = 0`; among the sites over threshold the one of largest elastic
+    /// energy breaks first; a broken site never re-forms.
     #[default]
     Paper,
     /// The paper's threshold and order, with each spring anchored where its site
-    /// attached: `φ_x = -k_x (u_x - a)`, `a` the site's `u_x` when it attached, so that
-    /// a site carries no shear at its attachment. A broken site never re-forms.
+    /// attached: `φ_x = -k_x (u_x - a)`, `a` the site's `u_x` (m) when it attached, so
+    /// that a site carries no shear at its attachment. A broken site never re-forms.
     Anchored,
     /// [`ContactRule::Anchored`], and a broken site re-forms (broken → detached, then
     /// the normal equilibrium decides whether it touches) once its [`Delay`] has passed,
-    /// at the move from a stable state to the next load.
+    /// at the move from a stable state to the next load. Refused under a spring drive.
     Rejuvenation {
         /// How long a broken site stays broken.
         delay: Delay,
     },
+    /// A rule written outside the crate ([`ContactLaw`], made by [`ContactRule::custom`]).
+    /// Not a scene-file value: what it gives up is in [`ContactLaw`]'s documentation.
+    Custom(CustomRule),
 }
 
 /// How long a broken site stays broken under [`ContactRule::Rejuvenation`], in the
-/// protocol's quasi-static clock: both must have passed.
+/// protocol's quasi-static clock: both must have passed. Made by [`Delay::new`]; the
+/// default is one stable state and no load.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Delay {
+#[non_exhaustive]
+pub struct Delay {
     /// Stable states reached since the rupture (`>= 1`).
-    pub(crate) stable_states: u64,
-    /// Increase of the shear force since the rupture, in units of `μ F_N` (`>= 0`).
-    pub(crate) load: f64,
+    pub stable_states: u64,
+    /// Increase of the shear force since the rupture, in units of `μ F_N`
+    /// (dimensionless, finite, `>= 0`).
+    pub load: f64,
 }
 
 impl Default for Delay {
@@ -64,6 +91,40 @@ impl Default for Delay {
 }
 
 impl Delay {
+    /// A delay of `stable_states` stable states (`>= 1`) and a shear-force increase of
+    /// `load` times `μ F_N` (dimensionless, finite, `>= 0`), both since the rupture.
+    ///
+    /// # Errors
+    /// [`Error::InvalidCount`] for no stable state, [`Error::InvalidParameter`] for a load
+    /// that is negative or not finite; each names its scene-file key
+    /// (`contact.delay.*`).
+    pub fn new(stable_states: u64, load: f64) -> Result<Self> {
+        Self {
+            stable_states,
+            load,
+        }
+        .check()
+    }
+
+    /// The delay if it is valid ([`Delay::new`]'s checks).
+    pub(crate) fn check(self) -> Result<Self> {
+        if self.stable_states == 0 {
+            return Err(Error::InvalidCount {
+                name: "contact.delay.stable_states",
+                value: 0,
+                reason: "a broken site re-forms at a later stable state: the delay is >= 1",
+            });
+        }
+        if !(self.load.is_finite() && self.load >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "contact.delay.load",
+                value: self.load,
+                reason: "the load a broken site waits for, in units of mu F_N, is finite and >= 0",
+            });
+        }
+        Ok(self)
+    }
+
     /// Whether a site broken at `since` may re-form at the clock tick `clock` under the
     /// force `force` (N); `load_scale` is `μ F_N` (N), `slack` (N) what the force may
     /// fall short by (rounding of a table's written forces).
@@ -84,38 +145,61 @@ pub(crate) struct BrokenSince {
     pub(crate) force: f64,
 }
 
-/// What an anchored rule carries from one event to the next (none under the paper's):
-/// the anchors, and for re-forming sites the clock and when each broken site broke.
+/// What a rule other than the paper's carries from one event to the next (none under
+/// the paper's): the anchors, and for re-forming sites the clock and when each broken
+/// site broke; under a custom rule also how often each site broke.
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub(crate) struct ContactState {
     /// Per site, the `u_x` (m) at which its spring carries no shear: the site's `u_x` when
-    /// it attached; `0` off the attached sites.
+    /// it attached; `0` off the attached sites (and always, under a custom rule that
+    /// does not anchor).
     pub(crate) anchors: Vec<f64>,
     /// The quasi-static clock: moves from a stable state to the next load made.
     pub(crate) clock: u64,
     /// Per site (re-forming rules only, else empty), when it broke if it is broken.
     pub(crate) broken_since: Vec<Option<BrokenSince>>,
+    /// Per site, its ruptures so far (custom rules only, else empty). Never in a
+    /// checkpoint: a custom rule has none.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub(crate) ruptures: Vec<u64>,
+}
+
+/// The fields of the current equilibrium a [`SiteView`] shows, as the driver holds them.
+pub(crate) struct Fields<'a> {
+    /// The site states.
+    pub(crate) states: &'a [SiteState],
+    /// `φ_z` (Pa) per site.
+    pub(crate) normal_traction: &'a [f64],
+    /// `u_z` (m) per site.
+    pub(crate) normal_displacement: &'a [f64],
+    /// `μ` (dimensionless).
+    pub(crate) friction_coefficient: f64,
+    /// `F` (N).
+    pub(crate) force: f64,
 }
 
 impl ContactState {
     /// The state at the start of a run of `sites` sites under `rule`: every spring
     /// anchored at 0 (the contact forms at zero shear); `None` under the paper's rule.
-    pub(crate) fn new(rule: ContactRule, sites: usize) -> Option<Self> {
-        match rule {
-            ContactRule::Paper => None,
-            ContactRule::Anchored => Some(Self {
-                anchors: vec![0.0; sites],
-                clock: 0,
-                broken_since: Vec::new(),
-            }),
-            ContactRule::Rejuvenation { .. } => Some(Self {
-                anchors: vec![0.0; sites],
-                clock: 0,
-                broken_since: vec![None; sites],
-            }),
-        }
+    pub(crate) fn new(rule: &ContactRule, sites: usize) -> Option<Self> {
+        let (reforms, counts) = match rule {
+            ContactRule::Paper => return None,
+            ContactRule::Anchored => (false, false),
+            ContactRule::Rejuvenation { .. } => (true, false),
+            ContactRule::Custom(_) => (true, true),
+        };
+        Some(Self {
+            anchors: vec![0.0; sites],
+            clock: 0,
+            broken_since: if reforms {
+                vec![None; sites]
+            } else {
+                Vec::new()
+            },
+            ruptures: if counts { vec![0; sites] } else { Vec::new() },
+        })
     }
 
     /// Records the rupture of `site` under the force `force` (N), at the current tick.
@@ -127,27 +211,99 @@ impl ContactState {
                 force,
             });
         }
+        if let Some(count) = self.ruptures.get_mut(site) {
+            *count += 1;
+        }
     }
 
-    /// The next tick of the clock (a move from a stable state to the next load) under the
-    /// force `force` (N): the broken sites whose delay has passed, which re-form now
-    /// (forgotten here). None but under [`ContactRule::Rejuvenation`].
-    pub(crate) fn tick(&mut self, rule: ContactRule, force: f64, load_scale: f64) -> Vec<usize> {
+    /// What a custom law sees of site `i` in the equilibrium `fields`.
+    fn view(&self, i: usize, fields: &Fields) -> SiteView {
+        let since = self.broken_since.get(i).copied().flatten();
+        SiteView {
+            index: i,
+            state: fields.states[i],
+            normal_traction: fields.normal_traction[i],
+            normal_displacement: fields.normal_displacement[i],
+            friction_coefficient: fields.friction_coefficient,
+            anchor: self.anchors[i],
+            ruptures: self.ruptures.get(i).copied().unwrap_or(0),
+            stable_states: self.clock,
+            rupture_stable_states: since.map(|b| b.clock),
+            rupture_force: since.map(|b| b.force),
+            force: fields.force,
+        }
+    }
+
+    /// The next tick of the clock (a move from a stable state to the next load) in the
+    /// stable state `fields` (its force `F`, N): the broken sites whose delay has passed,
+    /// or that a custom law re-forms, which re-form now (forgotten here); `load_scale` is
+    /// `μ F_N` (N). None under [`ContactRule::Anchored`].
+    pub(crate) fn tick(
+        &mut self,
+        rule: &ContactRule,
+        fields: &Fields,
+        load_scale: f64,
+    ) -> Vec<usize> {
         self.clock += 1;
-        let ContactRule::Rejuvenation { delay } = rule else {
-            return Vec::new();
-        };
         let clock = self.clock;
         let mut due = Vec::new();
-        for (i, slot) in self.broken_since.iter_mut().enumerate() {
-            if let Some(since) = *slot {
-                if delay.due(since, clock, force, load_scale, 0.0) {
-                    *slot = None;
-                    due.push(i);
+        match rule {
+            ContactRule::Rejuvenation { delay } => {
+                for (i, slot) in self.broken_since.iter_mut().enumerate() {
+                    if let Some(since) = *slot {
+                        if delay.due(since, clock, fields.force, load_scale, 0.0) {
+                            *slot = None;
+                            due.push(i);
+                        }
+                    }
                 }
             }
+            ContactRule::Custom(custom) => {
+                due = (0..self.broken_since.len())
+                    .filter(|&i| {
+                        self.broken_since[i].is_some()
+                            && custom.law().reforms(&self.view(i, fields))
+                    })
+                    .collect();
+                for &i in &due {
+                    self.broken_since[i] = None;
+                }
+            }
+            ContactRule::Paper | ContactRule::Anchored => {}
         }
         due
+    }
+
+    /// The Coulomb threshold `τ_i` (Pa) a custom law gives each site of the equilibrium
+    /// `fields` (0 off the attached sites, which carry no shear); `None` under a built-in
+    /// rule (whose threshold is `μ φ_z`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidThreshold`] for a threshold that is negative or not finite.
+    pub(crate) fn custom_thresholds(
+        &self,
+        rule: &ContactRule,
+        fields: &Fields,
+    ) -> Result<Option<Vec<f64>>> {
+        let ContactRule::Custom(custom) = rule else {
+            return Ok(None);
+        };
+        let law = custom.law();
+        let mut taus = vec![0.0; fields.states.len()];
+        for (i, tau) in taus.iter_mut().enumerate() {
+            if fields.states[i] != SiteState::Attached {
+                continue;
+            }
+            *tau = law.threshold(&self.view(i, fields));
+            if !(tau.is_finite() && *tau >= 0.0) {
+                return Err(Error::InvalidThreshold {
+                    rule: law.name().to_string(),
+                    site: i,
+                    value: *tau,
+                });
+            }
+        }
+        Ok(Some(taus))
     }
 
     /// Whether the state fits `states` under `rule` on `sites` sites: its lengths, finite
@@ -155,7 +311,7 @@ impl ContactState {
     /// for it alone (re-forming rules). `Err(reason)` otherwise.
     pub(crate) fn check(
         &self,
-        rule: ContactRule,
+        rule: &ContactRule,
         states: &[SiteState],
     ) -> std::result::Result<(), String> {
         let n = states.len();
@@ -171,7 +327,10 @@ impl ContactState {
                 states[i], self.anchors[i]
             ));
         }
-        let reforms = matches!(rule, ContactRule::Rejuvenation { .. });
+        let reforms = matches!(
+            rule,
+            ContactRule::Rejuvenation { .. } | ContactRule::Custom(_)
+        );
         if self.broken_since.len() != if reforms { n } else { 0 } {
             return Err(format!(
                 "{} rupture times for {n} sites under the rule {rule:?}",
@@ -227,26 +386,25 @@ fn anchored_over(high: f64, low: f64, force: f64) -> bool {
     high <= force || force <= low
 }
 
-/// The paper's breaking load of one site (N): the threshold `μ φ_z` (Pa) over the shear
-/// traction per newton `|g|` (Pa/N), `+∞` where the site carries no shear. One
-/// expression for every caller: `(μ f) / |g|`, in that order, gives the same bits as
-/// the 1.x code.
+/// The breaking load of one site (N) of a spring anchored at 0: the threshold `τ` (Pa)
+/// over the shear traction per newton `|g|` (Pa/N), `+∞` where the site carries no
+/// shear. One expression for every caller: `τ / |g|` with the paper's `τ = μ f` gives
+/// the same bits as the 1.x code's `(μ f) / |g|`.
 #[inline]
-fn paper_breaking_load(friction_coefficient: f64, f: f64, g: f64) -> f64 {
+fn breaking_load(tau: f64, g: f64) -> f64 {
     if g == 0.0 {
         f64::INFINITY
     } else {
-        friction_coefficient * f / g.abs()
+        tau / g.abs()
     }
 }
 
 /// The window of loads (N) inside which an anchored site holds, `(λ_high, λ_low)`: its
 /// shear `φ_x = F g1 + g0` (Pa, `g1` per newton, `g0` the anchors') reaches the threshold
-/// `τ = μ φ_z` at `F = (±τ - g0 sgn g1)/|g1|`. A site that carries no shear per newton
+/// `τ` (Pa) at `F = (±τ - g0 sgn g1)/|g1|`. A site that carries no shear per newton
 /// holds at every load (`(+∞, -∞)`) or at none (`(-∞, +∞)`).
 #[inline]
-fn anchored_window(friction_coefficient: f64, f: f64, g1: f64, g0: f64) -> (f64, f64) {
-    let tau = friction_coefficient * f;
+fn anchored_window(tau: f64, g1: f64, g0: f64) -> (f64, f64) {
     if g1 == 0.0 {
         return match g0 != 0.0 && g0.abs() >= tau {
             true => (f64::NEG_INFINITY, f64::INFINITY),
@@ -278,6 +436,38 @@ fn check_threshold_inputs(
 }
 
 impl ContactRule {
+    /// A rule of a downstream crate's `law` (see [`ContactLaw`] for its contract and
+    /// what it gives up).
+    pub fn custom(law: impl ContactLaw + 'static) -> Self {
+        ContactRule::Custom(CustomRule::new(Arc::new(law)))
+    }
+
+    /// The rule's name: its scene-file value (`"paper"`, `"anchored"`,
+    /// `"rejuvenation"`) or the custom law's [`ContactLaw::name`].
+    pub fn name(&self) -> &str {
+        match self {
+            ContactRule::Paper => "paper",
+            ContactRule::Anchored => "anchored",
+            ContactRule::Rejuvenation { .. } => "rejuvenation",
+            ContactRule::Custom(custom) => custom.law().name(),
+        }
+    }
+
+    /// Refuses a custom rule where only a built-in one goes: `operation` records the
+    /// scene by its scene-file keys (a checkpoint, a scene file, a run directory).
+    ///
+    /// # Errors
+    /// [`Error::CustomContactRule`] under [`ContactRule::Custom`].
+    pub(crate) fn built_in(&self, operation: &'static str) -> Result<()> {
+        match self {
+            ContactRule::Custom(custom) => Err(Error::CustomContactRule {
+                rule: custom.law().name().to_string(),
+                operation,
+            }),
+            _ => Ok(()),
+        }
+    }
+
     /// The shear load (N) at which each site reaches its threshold, from the normal
     /// tractions (Pa), the shear tractions per newton of load (Pa/N) and the friction
     /// coefficient; `+∞` for sites that carry no shear.
@@ -287,7 +477,7 @@ impl ContactRule {
     /// with a value that is not finite; [`Error::InvalidParameter`] for a friction
     /// coefficient that is negative or not finite.
     pub(crate) fn breaking_loads(
-        self,
+        &self,
         interface: &Interface,
         normal_traction: &[f64],
         shear_per_newton: &[f64],
@@ -304,33 +494,40 @@ impl ContactRule {
         Ok(shear_per_newton
             .iter()
             .zip(normal_traction)
-            .map(|(g, f)| paper_breaking_load(friction_coefficient, *f, *g))
+            .map(|(g, f)| breaking_load(friction_coefficient * f, *g))
             .collect())
     }
 
-    /// Whether the rule anchors springs where their sites attach (all but the paper's).
-    pub(crate) fn anchors(self) -> bool {
-        !matches!(self, ContactRule::Paper)
+    /// Whether the rule anchors springs where their sites attach (all but the paper's,
+    /// and custom rules that do not).
+    pub(crate) fn anchors(&self) -> bool {
+        match self {
+            ContactRule::Paper => false,
+            ContactRule::Anchored | ContactRule::Rejuvenation { .. } => true,
+            ContactRule::Custom(custom) => custom.anchors(),
+        }
     }
 
     /// The loads (N) at which each site reaches its threshold, `(λ_high, λ_low)`: the
     /// site holds for `λ_low < F < λ_high`. Under the paper's rule
     /// [`ContactRule::breaking_loads`] and no `λ_low` (empty: a spring anchored at 0
     /// under `F >= 0` has none); under an anchored rule the window of each site from its
-    /// shear per newton `g1` and its anchors' shear `g0` (Pa).
+    /// shear per newton `g1` and its anchors' shear `g0` (Pa, `anchor_traction`; `None`
+    /// when the rule does not anchor). The threshold is `μ φ_z`, or a custom law's
+    /// `taus` (Pa, [`ContactState::custom_thresholds`]).
     ///
     /// # Errors
     /// As [`ContactRule::breaking_loads`]; `anchor_traction` of the wrong length or not
     /// finite (anchored rules).
     pub(crate) fn thresholds(
-        self,
+        &self,
         interface: &Interface,
-        normal_traction: &[f64],
-        shear_per_newton: &[f64],
-        anchor_traction: &[f64],
+        (normal_traction, shear_per_newton): (&[f64], &[f64]),
+        anchor_traction: Option<&[f64]>,
         friction_coefficient: f64,
+        taus: Option<&[f64]>,
     ) -> Result<(Vec<f64>, Vec<f64>)> {
-        if self == ContactRule::Paper {
+        if matches!(self, ContactRule::Paper) {
             let high = self.breaking_loads(
                 interface,
                 normal_traction,
@@ -346,16 +543,23 @@ impl ContactRule {
             friction_coefficient,
         )?;
         let n = normal_traction.len();
+        if let Some(taus) = taus {
+            check_slice("thresholds", taus, n)?;
+        }
+        let tau = |i: usize| match taus {
+            Some(taus) => taus[i],
+            None => friction_coefficient * normal_traction[i],
+        };
+        let Some(anchor_traction) = anchor_traction else {
+            // A custom rule that does not anchor: the paper's springs, its threshold.
+            let high = (0..n)
+                .map(|i| breaking_load(tau(i), shear_per_newton[i]))
+                .collect();
+            return Ok((high, Vec::new()));
+        };
         check_slice("anchor_traction", anchor_traction, n)?;
         Ok((0..n)
-            .map(|i| {
-                anchored_window(
-                    friction_coefficient,
-                    normal_traction[i],
-                    shear_per_newton[i],
-                    anchor_traction[i],
-                )
-            })
+            .map(|i| anchored_window(tau(i), shear_per_newton[i], anchor_traction[i]))
             .unzip())
     }
 
@@ -364,7 +568,7 @@ impl ContactRule {
     /// carries shear.
     /// Every rule raises the load (`F` grows with the control under both drives), so
     /// the next threshold is the smallest `λ_high`.
-    pub(crate) fn weakest(self, states: &[SiteState], breaking: &[f64]) -> Option<(usize, f64)> {
+    pub(crate) fn weakest(&self, states: &[SiteState], breaking: &[f64]) -> Option<(usize, f64)> {
         let mut best: Option<(usize, f64)> = None;
         for (i, &b) in breaking.iter().enumerate() {
             if states[i] == SiteState::Attached && b.is_finite() && best.is_none_or(|(_, v)| b < v)
@@ -378,20 +582,20 @@ impl ContactRule {
     /// The first attached site over its threshold under the shear force `force` (N):
     /// what a stable state may not hold. `low` is [`ContactRule::thresholds`]' `λ_low`.
     pub(crate) fn first_over_threshold(
-        self,
+        &self,
         states: &[SiteState],
         breaking: &[f64],
         low: &[f64],
         force: f64,
     ) -> Option<usize> {
-        match self {
-            ContactRule::Paper => (0..breaking.len())
+        // The paper's springs (anchored at 0) under the paper's rule and a custom rule
+        // that does not anchor; the window under the others.
+        match self.anchors() {
+            false => (0..breaking.len())
                 .find(|&i| states[i] == SiteState::Attached && paper_over(breaking[i], force)),
-            ContactRule::Anchored | ContactRule::Rejuvenation { .. } => {
-                (0..breaking.len()).find(|&i| {
-                    states[i] == SiteState::Attached && anchored_over(breaking[i], low[i], force)
-                })
-            }
+            true => (0..breaking.len()).find(|&i| {
+                states[i] == SiteState::Attached && anchored_over(breaking[i], low[i], force)
+            }),
         }
     }
 
@@ -408,7 +612,7 @@ impl ContactRule {
     /// [`Error::NonFinite`] when the chosen site's compliance overflows.
     #[allow(clippy::too_many_arguments)] // the state of one avalanche step, as the driver holds it
     pub(crate) fn next_rupture(
-        self,
+        &self,
         interface: &Interface,
         (breaking, low): (&[f64], &[f64]),
         force: f64,
@@ -417,15 +621,15 @@ impl ContactRule {
         u_z: &[f64],
         cell: f64,
     ) -> Result<Option<(usize, f64)>> {
-        let best = match self {
-            ContactRule::Paper => largest_energy(
+        let best = match self.anchors() {
+            false => largest_energy(
                 interface,
                 |i| paper_over(breaking[i], force) || forced == Some(i),
                 |i| force * traction[i],
                 u_z,
                 cell,
             ),
-            ContactRule::Anchored | ContactRule::Rejuvenation { .. } => largest_energy(
+            true => largest_energy(
                 interface,
                 |i| anchored_over(breaking[i], low[i], force) || forced == Some(i),
                 |i| force * traction[i] + anchor_traction[i],
@@ -440,7 +644,7 @@ impl ContactRule {
     }
 
     /// Whether the interface slides as a whole: every spring broke.
-    pub(crate) fn global_slip(self, interface: &Interface) -> bool {
+    pub(crate) fn global_slip(&self, interface: &Interface) -> bool {
         // Every rule: a re-forming site re-forms only at a stable state, never inside
         // the avalanche that breaks the last spring.
         interface.broken_count() == interface.states().len()
@@ -451,7 +655,7 @@ impl ContactRule {
     /// (`true`, an attach) or out of it (`false`, a detach). A rupture is the protocol's
     /// own event, never a change of an equilibrium.
     pub(crate) fn changes(
-        self,
+        &self,
         before: &[SiteState],
         after: &[SiteState],
         mut emit: impl FnMut(usize, bool),
@@ -469,16 +673,17 @@ impl ContactRule {
     /// The most ruptures the avalanche under way can have had in the site states
     /// `states`: each broke a site that is still broken (no site re-forms inside an
     /// avalanche).
-    pub(crate) fn avalanche_ruptures_bound(self, states: &[SiteState]) -> usize {
+    pub(crate) fn avalanche_ruptures_bound(&self, states: &[SiteState]) -> usize {
         // Every rule: sites re-form between avalanches only.
         states.iter().filter(|s| **s == SiteState::Broken).count()
     }
 
-    /// The delay after which a broken site re-forms; `None` when it never does.
-    pub(crate) fn delay(self) -> Option<Delay> {
+    /// The delay after which a broken site re-forms; `None` when it never does (or a
+    /// custom law decides).
+    pub(crate) fn delay(&self) -> Option<Delay> {
         match self {
-            ContactRule::Paper | ContactRule::Anchored => None,
-            ContactRule::Rejuvenation { delay } => Some(delay),
+            ContactRule::Paper | ContactRule::Anchored | ContactRule::Custom(_) => None,
+            ContactRule::Rejuvenation { delay } => Some(*delay),
         }
     }
 }

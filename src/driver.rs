@@ -37,7 +37,7 @@
 //! # Ok::<(), precursors::Error>(())
 //! ```
 
-use crate::contact::{ContactRule, ContactState};
+use crate::contact::{ContactRule, ContactState, Fields};
 use crate::error::{Error, Result};
 use crate::geometry::Grid;
 use crate::interface::{Interface, Material, SiteState};
@@ -769,13 +769,23 @@ impl Driver {
     /// sites whose delay has passed become detached, and the equilibrium of the new site
     /// set is solved (queueing the sites that attach, anchored). Whether any re-formed.
     fn reform(&mut self) -> Result<bool> {
-        let rule = self.contact_rule();
         let force = self.force();
         let load_scale = self.friction_coefficient() * self.normal_load();
+        let friction_coefficient = self.friction_coefficient();
         let Some(contact) = &mut self.contact else {
             return Ok(false);
         };
-        let due = contact.tick(rule, force, load_scale);
+        let normal = self.normal.as_ref().ok_or(Error::NotSolved {
+            what: "the normal equilibrium",
+        })?;
+        let fields = Fields {
+            states: self.interface.states(),
+            normal_traction: &normal.traction,
+            normal_displacement: &normal.displacement,
+            friction_coefficient,
+            force,
+        };
+        let due = contact.tick(self.scene.contact_rule(), &fields, load_scale);
         if due.is_empty() {
             return Ok(false);
         }
@@ -800,10 +810,10 @@ impl Driver {
         self.stats.normal_active_set_iterations += normal.report.active_set_iterations;
         self.stats.normal_iterations += normal.report.linear_iterations;
         let mut attached_now = Vec::new();
+        let anchors = self.scene.contact_rule().anchors();
         if self.normal.is_some() {
             let grid = self.scene.grid();
             let pending = &mut self.pending;
-            let anchors = self.contact.is_some();
             self.scene
                 .contact_rule()
                 .changes(&before, self.interface.states(), |i, attached| {
@@ -817,7 +827,7 @@ impl Driver {
                     })
                 });
         }
-        if self.contact.is_some() {
+        if anchors {
             self.anchor_new_sites(&normal.displacement, &attached_now)?;
         }
         let clock = std::time::Instant::now();
@@ -837,16 +847,41 @@ impl Driver {
                     self.friction_coefficient(),
                 )?;
             }
-            Some(anchors) => {
-                let anchor = self.solve_anchor(&normal.displacement, &anchors)?;
-                (self.breaking, self.breaking_low) = self.contact_rule().thresholds(
+            Some(anchor_at) => {
+                let anchor = match anchors {
+                    true => Some(self.solve_anchor(&normal.displacement, &anchor_at)?),
+                    false => None,
+                };
+                let rule = self.scene.contact_rule();
+                let taus = match rule {
+                    ContactRule::Custom(_) => {
+                        let force = self.drive_force(
+                            response.offset_per_newton,
+                            anchor.as_ref().map_or(0.0, |a| a.offset),
+                        );
+                        let fields = Fields {
+                            states: self.interface.states(),
+                            normal_traction: &normal.traction,
+                            normal_displacement: &normal.displacement,
+                            friction_coefficient: self.friction_coefficient(),
+                            force,
+                        };
+                        self.contact
+                            .as_ref()
+                            .map(|c| c.custom_thresholds(rule, &fields))
+                            .transpose()?
+                            .flatten()
+                    }
+                    _ => None,
+                };
+                (self.breaking, self.breaking_low) = rule.thresholds(
                     &self.interface,
-                    &normal.traction,
-                    &response.traction,
-                    &anchor.traction,
+                    (&normal.traction, &response.traction),
+                    anchor.as_ref().map(|a| &a.traction[..]),
                     self.friction_coefficient(),
+                    taus.as_deref(),
                 )?;
-                self.anchor = Some(anchor);
+                self.anchor = anchor;
             }
         }
         self.normal = Some(normal);
@@ -948,7 +983,7 @@ impl Driver {
     }
 
     /// The rule of the site transitions ([`crate::contact`]): the scene's.
-    pub(crate) fn contact_rule(&self) -> ContactRule {
+    pub(crate) fn contact_rule(&self) -> &ContactRule {
         self.scene.contact_rule()
     }
 

@@ -800,6 +800,38 @@ pub enum Error {
         /// The largest ratio accepted.
         limit: f64,
     },
+    /// A custom contact rule (`ContactRule::Custom`, a downstream crate's `ContactLaw`)
+    /// where only a built-in rule goes: what records a scene by its scene-file keys (a
+    /// scene's JSON, a checkpoint written or resumed, a run directory's tables) cannot
+    /// name Rust code. Run such a scene with `Scene::driver` alone.
+    #[error(
+        "{operation} refused: the contact rule \"{}\" is a custom one (Rust code), which \
+         scene files, checkpoints and run directories cannot record; only the built-in rules \
+         (paper, anchored, rejuvenation) can",
+        Bounded(rule)
+    )]
+    CustomContactRule {
+        /// The custom law's name (`ContactLaw::name`).
+        rule: String,
+        /// What was refused (`"writing a checkpoint"`, ...).
+        operation: &'static str,
+    },
+    /// A custom contact law (`ContactLaw::threshold`) gave a site a Coulomb threshold that
+    /// is negative or not finite; the driver fails at that step.
+    #[error(
+        "the contact rule \"{}\" gave site {site} the threshold {} Pa: a threshold is finite \
+         and >= 0",
+        Bounded(rule),
+        Num(*value)
+    )]
+    InvalidThreshold {
+        /// The custom law's name.
+        rule: String,
+        /// The site's index (cell order `iy·Nx + ix`).
+        site: usize,
+        /// The threshold given (Pa).
+        value: f64,
+    },
 }
 
 /// `error` and its causes ([`std::error::Error::source`]) joined by ": ", as `anyhow`

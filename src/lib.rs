@@ -20,7 +20,9 @@
 //!   gives a [`Driver`], an iterator of [`Event`]s (ruptures, detachments, attachments,
 //!   load steps, stable states, global slip) with the observables between them (real
 //!   contact area, precursor length, tractions, [`Stresses`] on planes and at points) and
-//!   [`Checkpoint`]s; one [`Error`] type for all of it.
+//!   [`Checkpoint`]s; one [`Error`] type for all of it. The [`ContactRule`] of the site
+//!   transitions is the paper's by default; a downstream crate writes its own as a
+//!   [`ContactLaw`].
 //! * [`green`]: the box's Neumann Green function (`G` and `∂G/∂z` at points, the load
 //!   terms) and the Galerkin influence operator of a grid, planned once per geometry and
 //!   applied matrix-free through the 2-D DCT.
@@ -130,6 +132,7 @@ mod surface;
 pub mod sweep;
 
 pub use avalanche::{Avalanche, Avalanches, DamageFront};
+pub use contact::{ContactLaw, ContactRule, CustomRule, Delay, SiteView};
 pub use cost::GridCost;
 pub use driver::{
     Checkpoint, Driver, Event, Load, RunState, Site, SlipPerNewton, SlipProfile, SolveStats,

@@ -416,8 +416,10 @@ impl RunTables {
     /// ```
     ///
     /// # Errors
-    /// [`Error::OutOfRange`] for options the scene cannot record, naming the key;
-    /// [`Error::DirectoryLocked`] when another process writes the directory;
+    /// [`Error::CustomContactRule`] for a driver under a custom contact rule
+    /// ([`crate::ContactLaw`]); [`Error::OutOfRange`] for options the scene cannot
+    /// record, naming the key; [`Error::DirectoryLocked`] when another process writes the
+    /// directory;
     /// [`Error::Io`] when a file cannot be written or removed.
     pub fn create_with(dir: &Path, driver: &Driver, options: &RunOptions) -> Result<Self> {
         check_options(driver, options)?;
@@ -550,6 +552,7 @@ impl RunTables {
     /// ```
     ///
     /// # Errors
+    /// [`Error::CustomContactRule`] for a driver under a custom contact rule;
     /// [`Error::OutOfRange`] for options the scene cannot record;
     /// [`Error::RunDirectory`] for a missing directory or (feature `serde`) one without
     /// its scene record; [`Error::CheckpointSceneMismatch`], naming the first differing
@@ -1181,6 +1184,12 @@ fn read_old(partial: &Path, path: &Path) -> Result<(Option<String>, PathBuf)> {
 
 /// Refuses run options that `driver`'s scene cannot record, naming the key.
 fn check_options(driver: &Driver, options: &RunOptions) -> Result<()> {
+    // The tables are checked against a built-in rule (the friction limit μF_N, the
+    // replay of the site events) and the directory records the scene's keys.
+    driver
+        .scene()
+        .contact_rule()
+        .built_in("recording a run directory")?;
     let probes = options.probe_spec().unwrap_or(driver.scene().probes());
     crate::scene::check_run_options(options, driver.grid(), probes.tolerance())
 }

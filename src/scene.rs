@@ -935,12 +935,30 @@ impl SceneBuilder {
         self
     }
 
-    /// The rule of the site transitions (scene-file key `contact`; default the paper's).
-    /// Checked by [`SceneBuilder::check`]. (Crate-private until the rules are public.)
-    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
-    pub(crate) fn contact_rule(mut self, rule: ContactRule) -> Self {
+    /// The rule of the site transitions (scene-file key `contact`; default
+    /// [`ContactRule::Paper`]): a built-in rule, or a downstream crate's
+    /// ([`ContactRule::custom`], which gives up scene files and checkpoints:
+    /// [`crate::ContactLaw`]). Checked by [`SceneBuilder::check`]: a re-forming built-in
+    /// rule needs a valid [`crate::Delay`] and a force drive.
+    ///
+    /// ```
+    /// use precursors::{ContactRule, Error, Scene};
+    /// let anchored = Scene::builder()
+    ///     .block(0.010, 0.004, 0.010)
+    ///     .normal_load(100.0)
+    ///     .contact_rule(ContactRule::Anchored)
+    ///     .build()?;
+    /// assert_eq!(anchored.contact_rule(), &ContactRule::Anchored);
+    /// # Ok::<(), Error>(())
+    /// ```
+    pub fn contact_rule(mut self, rule: ContactRule) -> Self {
         self.contact = rule;
         self
+    }
+
+    /// The rule of the site transitions given ([`SceneBuilder::contact_rule`]).
+    pub(crate) fn contact(&self) -> &ContactRule {
+        &self.contact
     }
 
     /// The plan tolerance (scene-file key `plan_tolerance`): the largest relative error
@@ -1124,7 +1142,7 @@ impl SceneBuilder {
             "use fewer cells (or fewer probes), or a machine with more memory",
         )?;
         check_tolerance(self.plan_tolerance)?;
-        check_contact_rule(self.contact, self.drive)?;
+        check_contact_rule(&self.contact, self.drive)?;
         if !(self.normal_load.is_finite() && self.normal_load > 0.0) {
             return Err(Error::InvalidParameter {
                 name: "normal_load",
@@ -1407,9 +1425,10 @@ impl Scene {
         self.inner.probe.as_ref()
     }
 
-    /// The rule of the site transitions ([`crate::contact`]; scene-file key `contact`).
-    pub(crate) fn contact_rule(&self) -> ContactRule {
-        self.inner.builder.contact
+    /// The rule of the site transitions ([`SceneBuilder::contact_rule`]; scene-file key
+    /// `contact`).
+    pub fn contact_rule(&self) -> &ContactRule {
+        &self.inner.builder.contact
     }
 
     /// The lateral load of the drive, if any (the probes' lateral stress term).
@@ -1451,24 +1470,11 @@ impl Scene {
 /// Refuses a contact rule the protocol cannot run: a re-forming rule's delay out of
 /// range, or re-forming sites under a spring drive (its force drops at each rupture, so
 /// sites may re-form for ever and the run never reach global slip).
-fn check_contact_rule(rule: ContactRule, drive: Drive) -> Result<()> {
+fn check_contact_rule(rule: &ContactRule, drive: Drive) -> Result<()> {
     let Some(delay) = rule.delay() else {
         return Ok(());
     };
-    if delay.stable_states == 0 {
-        return Err(Error::InvalidCount {
-            name: "contact.delay.stable_states",
-            value: 0,
-            reason: "a broken site re-forms at a later stable state: the delay is >= 1",
-        });
-    }
-    if !(delay.load.is_finite() && delay.load >= 0.0) {
-        return Err(Error::InvalidParameter {
-            name: "contact.delay.load",
-            value: delay.load,
-            reason: "the load a broken site waits for, in units of mu F_N, is finite and >= 0",
-        });
-    }
+    delay.check()?;
     if let Drive::Spring { .. } = drive {
         return Err(Error::InvalidChoice {
             name: "contact.rule",

@@ -778,6 +778,7 @@ impl Sweep {
             "slip_force_N": slip,
             "slip_over_mu_FN": slip.map(|f| f / mu_fn),
             "backend": driver.backend().to_string(),
+            "contact_rule": driver.scene().contact_rule().name(),
             "seconds": { "build": built, "total": seconds },
             "scene": &run.scene,
         });

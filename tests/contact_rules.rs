@@ -2,11 +2,15 @@
 //! where their sites attach, and broken sites that re-form after a delay. References:
 //! the physics each state must satisfy (force balance, the Coulomb bound, no shear at an
 //! attachment), the rules' own definitions replayed from the events, the other backend,
-//! and the uninterrupted run.
+//! and the uninterrupted run. A downstream crate's rules (`ContactLaw`) against the
+//! built-in rules they restate.
 
 use crate::common::scratch;
 use precursors::solver::{Backend, SolverOptions};
-use precursors::{Drive, Driver, Event, Lateral, Scene, SceneBuilder, SiteState};
+use precursors::{
+    ContactLaw, ContactRule, Delay, Drive, Driver, Error, Event, Lateral, Scene, SceneBuilder,
+    SiteState, SiteView,
+};
 use proptest::prelude::*;
 
 const PAPER: &str = r#"{"rule": "paper"}"#;
@@ -419,4 +423,319 @@ fn a_resumed_run_writes_the_uninterrupted_runs_tables_under_each_rule() {
         std::fs::remove_dir_all(&whole).unwrap();
         std::fs::remove_dir_all(&cut).unwrap();
     }
+}
+
+/// A built-in rule restated as a custom law through the public trait: the default
+/// threshold (the paper's `μ φ_z`), springs anchored or not, and a broken site re-formed
+/// after `delay` (stable states, and a load in N), as `ContactRule::Rejuvenation`'s
+/// definition says (docs/model.md).
+#[derive(Debug)]
+struct Restated {
+    anchors: bool,
+    delay: Option<(u64, f64)>,
+}
+
+impl ContactLaw for Restated {
+    fn name(&self) -> &str {
+        "restated"
+    }
+    fn anchors(&self) -> bool {
+        self.anchors
+    }
+    fn reforms(&self, site: &SiteView) -> bool {
+        match (self.delay, site.rupture_stable_states, site.rupture_force) {
+            (Some((states, load)), Some(at), Some(force)) => {
+                site.stable_states - at >= states && site.force - force >= load
+            }
+            _ => false,
+        }
+    }
+}
+
+/// Slip weakening: a site whose spring broke before holds `μ_d φ_z` (Pa) once it holds
+/// again, `μ_d < μ`; anchored springs; a broken site re-forms `after` stable states and
+/// a load increase `load` (N) after its rupture (without the load, re-formed sites may
+/// break again at the same load for ever).
+#[derive(Debug)]
+struct SlipWeakening {
+    dynamic: f64,
+    after: u64,
+    load: f64,
+}
+
+impl ContactLaw for SlipWeakening {
+    fn name(&self) -> &str {
+        "slip-weakening"
+    }
+    fn threshold(&self, site: &SiteView) -> f64 {
+        match site.ruptures {
+            0 => site.friction_coefficient * site.normal_traction,
+            _ => self.dynamic * site.normal_traction,
+        }
+    }
+    fn anchors(&self) -> bool {
+        true
+    }
+    fn reforms(&self, site: &SiteView) -> bool {
+        match (site.rupture_stable_states, site.rupture_force) {
+            (Some(at), Some(force)) => {
+                site.stable_states >= at + self.after && site.force - force >= self.load
+            }
+            _ => false,
+        }
+    }
+}
+
+/// The events of a run, each with the force (N) and the shear tractions (Pa) after it,
+/// as text: `{:?}` of an `f64` is its shortest round trip, so equal texts are equal bits.
+fn exact_events(scene: &Scene) -> Vec<String> {
+    run(scene, |_, d| {
+        format!("{:?} {:?}", d.force(), d.shear_traction().ok())
+    })
+    .into_iter()
+    .map(|(e, seen)| format!("{e:?} {seen}"))
+    .collect()
+}
+
+/// A custom rule that restates a built-in one gives exactly its events, loads and
+/// fields, bit for bit: the paper's threshold through the trait is the paper's, under
+/// the paper's springs (rod and spring drives), anchored ones, and re-formation after
+/// the delay of `REJUVENATION` (three stable states, 2 % of `μ F_N`). It fails when the
+/// custom path computes the threshold in another order (`(μ f)/|g|` against `μ (f/|g|)`
+/// changes the last bits), or re-forms, anchors or ticks the clock otherwise than the
+/// built-in rules (shown with `site.stable_states - at >= states - 1`).
+#[test]
+fn a_custom_rule_restating_a_built_in_one_gives_its_events_exactly() {
+    let restate =
+        |b: SceneBuilder, law: Restated| b.contact_rule(ContactRule::custom(law)).build().unwrap();
+    for seed in [1, 2] {
+        let paper = scene(PAPER, seed);
+        let restated = restate(
+            builder(PAPER, seed),
+            Restated {
+                anchors: false,
+                delay: None,
+            },
+        );
+        assert_eq!(restated.contact_rule().name(), "restated");
+        assert_eq!(exact_events(&paper), exact_events(&restated), "seed {seed}");
+        let paper_spring = spring(PAPER, seed);
+        let spring_builder = builder(PAPER, seed).drive(Drive::Spring {
+            stiffness: 4e6,
+            lateral: Lateral::Side,
+        });
+        let restated = restate(
+            spring_builder,
+            Restated {
+                anchors: false,
+                delay: None,
+            },
+        );
+        assert_eq!(exact_events(&paper_spring), exact_events(&restated));
+        let anchored = restate(
+            builder(PAPER, seed),
+            Restated {
+                anchors: true,
+                delay: None,
+            },
+        );
+        assert_eq!(
+            exact_events(&scene(ANCHORED, seed)),
+            exact_events(&anchored)
+        );
+        let rejuvenation = scene(REJUVENATION, seed);
+        let mu_f_n = rejuvenation.material().friction_coefficient() * rejuvenation.normal_load();
+        let re_forming = restate(
+            builder(PAPER, seed),
+            Restated {
+                anchors: true,
+                delay: Some((3, 0.02 * mu_f_n)),
+            },
+        );
+        let expected = exact_events(&rejuvenation);
+        assert!(
+            expected.iter().filter(|e| e.starts_with("Attach")).count()
+                > exact_events(&scene(ANCHORED, seed))
+                    .iter()
+                    .filter(|e| e.starts_with("Attach"))
+                    .count(),
+            "seed {seed}: no site re-formed: the re-formation untested"
+        );
+        assert_eq!(expected, exact_events(&re_forming), "seed {seed}");
+    }
+    // The same rule built from the public `Delay` is the scene file's.
+    let delay = Delay::new(3, 0.02).unwrap();
+    assert_eq!(
+        scene(REJUVENATION, 1).contact_rule(),
+        &ContactRule::Rejuvenation { delay }
+    );
+}
+
+/// A custom slip-weakening rule (re-formed sites hold `μ_d φ_z`, `μ_d = μ/2`) balances
+/// its loads after every event and holds `|φ_x| <= μ φ_z` at its stable states; its
+/// sites re-form, and its events are not the paper's (it re-forms and weakens).
+#[test]
+fn a_slip_weakening_rule_balances_its_loads_and_differs_from_the_papers() {
+    let base = scene(PAPER, 1);
+    let mu = base.material().friction_coefficient();
+    let scene = builder(PAPER, 1)
+        .contact_rule(ContactRule::custom(SlipWeakening {
+            dynamic: mu / 2.0,
+            after: 2,
+            load: 0.02 * mu * base.normal_load(),
+        }))
+        .build()
+        .unwrap();
+    let cell = scene.grid().cell_area();
+    let f_n = scene.normal_load();
+    let events = run(&scene, |event, driver| {
+        if matches!(event, Event::GlobalSlip { .. }) {
+            return;
+        }
+        let force = driver.force();
+        let phi_x = driver.shear_traction().unwrap();
+        let phi_z = driver.normal_traction().unwrap();
+        let scale: f64 = cell * phi_x.iter().map(|p| p.abs()).sum::<f64>() + force.abs();
+        let carried: f64 = cell * phi_x.iter().sum::<f64>();
+        assert!(
+            (carried + force).abs() <= 1e-9 * scale + 1e-12,
+            "{event:?}: ΔA Σφ_x = {carried:e}, F = {force:e}"
+        );
+        let normal: f64 = cell * phi_z.iter().sum::<f64>();
+        assert!((normal - f_n).abs() <= 1e-9 * f_n, "{normal} N");
+        if let Event::Stable { .. } = event {
+            for (i, s) in driver.site_states().iter().enumerate() {
+                if *s == SiteState::Attached {
+                    assert!(phi_x[i].abs() <= mu * phi_z[i] * (1.0 + 1e-9), "site {i}");
+                }
+            }
+        }
+    });
+    let ruptures = events
+        .iter()
+        .filter(|(e, _)| matches!(e, Event::Rupture { .. }))
+        .count();
+    assert!(
+        ruptures > 64,
+        "{ruptures} ruptures: no site re-formed and broke again"
+    );
+    assert_ne!(exact_events(&base), exact_events(&scene));
+}
+
+/// The events of a run of `rule` on `backend`: kinds and sites, and the loads (N).
+fn custom_events_on(seed: u64, backend: Backend) -> Vec<(&'static str, Option<usize>, f64)> {
+    let options = SolverOptions::default().with_backend(backend).unwrap();
+    let scene = Scene::builder()
+        .block(0.012, 0.002, 0.010)
+        .cells(12, 2)
+        .normal_load(40.0)
+        .seed(seed)
+        .solver_options(options)
+        .contact_rule(ContactRule::custom(SlipWeakening {
+            dynamic: 0.5 * precursors::Material::default().friction_coefficient(),
+            after: 2,
+            // 2 % of μ F_N (F_N = 40 N).
+            load: 0.02 * precursors::Material::default().friction_coefficient() * 40.0,
+        }))
+        .build()
+        .unwrap();
+    run(&scene, |_, d| d.force())
+        .into_iter()
+        .map(|(e, force)| {
+            let site = match e {
+                Event::Rupture { site, .. } | Event::Attach { site } | Event::Detach { site } => {
+                    Some(site.index)
+                }
+                _ => None,
+            };
+            (e.kind(), site, force)
+        })
+        .collect()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3))]
+    /// The dense and the spectral backends give the same events, in order, with the same
+    /// loads (to 1e-8), under a custom slip-weakening rule; small scenes, random seeds.
+    #[test]
+    fn dense_and_spectral_agree_on_a_custom_rule(seed in 0u64..10_000) {
+        let dense = custom_events_on(seed, Backend::Dense);
+        let spectral = custom_events_on(seed, Backend::Spectral);
+        prop_assert_eq!(dense.len(), spectral.len());
+        for (d, s) in dense.iter().zip(&spectral) {
+            prop_assert_eq!((d.0, d.1), (s.0, s.1));
+            prop_assert!((d.2 - s.2).abs() <= 1e-8 * d.2.abs().max(1e-6), "{:?} {:?}", d, s);
+        }
+    }
+}
+
+/// A law whose threshold is negative.
+#[derive(Debug)]
+struct Negative;
+
+impl ContactLaw for Negative {
+    fn name(&self) -> &str {
+        "negative"
+    }
+    fn threshold(&self, _: &SiteView) -> f64 {
+        -1.0
+    }
+}
+
+/// What a custom rule gives up is a typed error where it is asked for: a resume of its
+/// checkpoint, a run directory, and (feature `serde`) its scene's JSON and its
+/// checkpoint's; a threshold out of range fails the driver's step with the site.
+#[test]
+fn a_custom_rule_is_refused_where_only_built_in_rules_go() {
+    let weakening = builder(PAPER, 1)
+        .contact_rule(ContactRule::custom(SlipWeakening {
+            dynamic: 0.3,
+            after: 2,
+            load: 0.6,
+        }))
+        .build()
+        .unwrap();
+    let custom = |e: &Error, what: &str| {
+        matches!(e, Error::CustomContactRule { rule, operation }
+            if rule == "slip-weakening" && operation.contains(what))
+    };
+    let mut driver = weakening.driver().unwrap();
+    for _ in 0..5 {
+        driver.step().unwrap();
+    }
+    let checkpoint = driver.checkpoint();
+    let refused = weakening.resume(&checkpoint).unwrap_err();
+    assert!(custom(&refused, "checkpoint"), "{refused}");
+    // Neither can a built-in scene resume it (its scene names another rule).
+    let refused = scene(PAPER, 1).resume(&checkpoint).unwrap_err();
+    assert!(custom(&refused, "checkpoint"), "{refused}");
+    let dir = scratch("contact-custom");
+    let refused = precursors::output::RunTables::create(&dir, &driver).unwrap_err();
+    assert!(custom(&refused, "run directory"), "{refused}");
+    assert!(
+        std::fs::read_dir(&dir).unwrap().next().is_none(),
+        "a refused run directory was written"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    #[cfg(feature = "serde")]
+    {
+        let refused = weakening.to_builder().to_json().unwrap_err();
+        assert!(custom(&refused, "JSON"), "{refused}");
+        let refused = checkpoint.to_json().unwrap_err();
+        assert!(custom(&refused, "checkpoint"), "{refused}");
+        assert!(serde_json::to_string(&weakening.to_builder()).is_err());
+    }
+    let mut driver = builder(PAPER, 1)
+        .contact_rule(ContactRule::custom(Negative))
+        .build()
+        .unwrap()
+        .driver()
+        .unwrap();
+    let failed = driver.step().unwrap_err();
+    assert!(
+        matches!(&failed, Error::InvalidThreshold { rule, value, .. }
+            if rule == "negative" && *value == -1.0),
+        "{failed}"
+    );
+    assert!(matches!(driver.step(), Err(Error::DriverFailed { .. })));
 }

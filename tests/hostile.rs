@@ -1680,6 +1680,13 @@ fn check_merged(
                 if keys.contains(column) || cell.is_empty() {
                     continue;
                 }
+                if column == "contact_rule" {
+                    // A name: one of the built-in rules (a sweep names no other).
+                    if !["paper", "anchored", "rejuvenation"].contains(&cell.as_str()) {
+                        return Err(format!("{name} line {}: contact rule {cell:?}", k + 2));
+                    }
+                    continue;
+                }
                 let at = format!("{name} line {} `{column}`", k + 2);
                 let x = finite(cell, &at)?;
                 let within = |lo: f64, hi: f64| {

@@ -794,6 +794,40 @@ fn info_says_whether_a_gpu_is_usable() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `info` names the scene's contact rule (with a re-forming rule's delay) and lists the
+/// rules the key takes.
+#[test]
+fn info_names_the_contact_rule() {
+    let dir = scratch("info-contact");
+    let scene = dir.join("scene.json");
+    let rejuvenation = BASE.replacen(
+        "{ \"block\"",
+        r#"{ "contact": { "rule": "rejuvenation", "delay": { "stable_states": 3, "load": 0.02 } }, "block""#,
+        1,
+    );
+    for (text, expected) in [
+        (BASE, "contact    paper "),
+        (
+            rejuvenation.as_str(),
+            "contact    rejuvenation (delay 3 stable states and 0.02 μF_N) ",
+        ),
+    ] {
+        std::fs::write(&scene, text).unwrap();
+        let o = precursors(&["info", path(&scene)]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let out = String::from_utf8(o.stdout).unwrap();
+        let line = out
+            .lines()
+            .find(|l| l.starts_with("contact "))
+            .unwrap_or_else(|| panic!("no contact line: {out}"));
+        assert!(
+            line.starts_with(expected) && line.ends_with("paper, anchored, rejuvenation)"),
+            "{line}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A scene asking for the CUDA backend where it cannot run ends with code 6 and the
 /// reason (docs/cli.md), from `run` and `info` alike, with nothing written.
 #[test]

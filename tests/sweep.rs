@@ -251,6 +251,36 @@ fn a_linked_sweep_merges_with_a_column_per_key() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A sweep over the contact rule: `runs.csv` names each run's rule (read from its scene
+/// record; the axis column gives the value as the sweep file wrote it), and so does its
+/// `meta.json`. A run whose recorded scene is the paper's could not pass for an anchored
+/// one: the rule columns differ.
+#[test]
+fn runs_csv_names_the_contact_rule() {
+    let sweep = Sweep::from_json_str(&sweep_text(
+        r#"{ "key": "contact.rule", "values": ["paper", "anchored"] }"#,
+        1,
+    ))
+    .unwrap();
+    let dir = scratch("contact-rule");
+    sweep.execute(&dir, &SweepOptions::new(), |_| {}).unwrap();
+    merge(&dir).unwrap();
+    let runs = std::fs::read_to_string(dir.join("runs.csv")).unwrap();
+    let mut lines = runs.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "run,point,realization,seed,contact.rule,stable_states,slip_over_mu_FN,contact_rule"
+    );
+    for (line, rule) in lines.zip(["paper", "anchored"]) {
+        // The axis' cell: the JSON text `"paper"`, quoted as CSV.
+        assert!(line.contains(&format!(",\"\"\"{rule}\"\"\",")), "{line}");
+        assert!(line.ends_with(&format!(",{rule}")), "{line}");
+    }
+    let meta = std::fs::read_to_string(dir.join("p0001-r0000").join("meta.json")).unwrap();
+    assert!(meta.contains("\"contact_rule\": \"anchored\""), "{meta}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn seeds_are_derived_stably_from_the_base_seed_and_the_coordinates() {
     // Pinned values: changing the derivation changes every sweep's heights.

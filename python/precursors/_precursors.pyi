@@ -46,6 +46,9 @@ class Scene:
         profile_planes: Optional[Sequence[float]] = ...,
         confirm_metres: Optional[bool] = ...,
         max_output_bytes: Optional[float] = ...,
+        contact_rule: Optional[str] = ...,
+        delay_stable_states: Optional[int] = ...,
+        delay_load: Optional[float] = ...,
     ) -> None: ...
     @staticmethod
     def from_file(path: _Path) -> Scene: ...

@@ -164,6 +164,9 @@ class SurfaceSpectrum:
 # The drives a string names (the others are dicts in the scene-file format).
 _DRIVES = ("rod", "top", "side")
 
+# The built-in contact rules (the scene file's `contact.rule`; a custom rule is Rust only).
+_CONTACT_RULES = ("paper", "anchored", "rejuvenation")
+
 
 def scene_dict(
     *,
@@ -190,6 +193,9 @@ def scene_dict(
     profile_planes: Optional[Sequence[float]] = None,
     confirm_metres: Optional[bool] = None,
     max_output_bytes: Optional[float] = None,
+    contact_rule: Optional[str] = None,
+    delay_stable_states: Optional[int] = None,
+    delay_load: Optional[float] = None,
 ) -> Dict[str, Any]:
     """The scene-file dict of the keywords of ``precursors.Scene(...)``; a keyword left
     out is a key left out (the calibration scene's value)."""
@@ -328,4 +334,21 @@ def scene_dict(
         scene["confirm_metres"] = confirm_metres
     if max_output_bytes is not None:
         scene["max_output_bytes"] = _number("max_output_bytes", max_output_bytes)
+    if contact_rule is not None:
+        _choice("contact_rule", contact_rule, _CONTACT_RULES)
+    delay: Dict[str, Any] = {}
+    if delay_stable_states is not None:
+        delay["stable_states"] = _count("delay_stable_states", delay_stable_states)
+    if delay_load is not None:
+        delay["load"] = _number("delay_load", delay_load)
+    if delay and contact_rule != "rejuvenation":
+        raise TypeError(
+            "delay_stable_states= and delay_load= go with contact_rule='rejuvenation' "
+            "(the only rule whose broken sites re-form)"
+        )
+    if contact_rule is not None:
+        contact: Dict[str, Any] = {"rule": contact_rule}
+        if delay:
+            contact["delay"] = delay
+        scene["contact"] = contact
     return scene

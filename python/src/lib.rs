@@ -303,7 +303,11 @@ fn build(py: Python<'_>, builder: precursors::SceneBuilder) -> PyResult<Scene> {
 /// profile_loads=[F/(μF_N), ...], profile_planes=[z, ...] (m); confirm_metres=True for a
 /// block of a metre or more under a mean pressure below 1e-6 E (refused otherwise as
 /// millimetres typed as metres); max_output_bytes (B, default 1e10) bounds the estimated
-/// size of the recorded profiles (refused above it, before the run).
+/// size of the recorded profiles (refused above it, before the run);
+/// contact_rule='paper' | 'anchored' | 'rejuvenation' (the site transitions, default the
+/// paper's), with 'rejuvenation' delay_stable_states (int >= 1, default 1) and delay_load
+/// (F/(μF_N) >= 0, default 0) before a broken site re-forms. A custom rule (the crate's
+/// `ContactLaw`) is Rust only.
 #[pyclass(module = "precursors", frozen)]
 struct Scene {
     inner: precursors::Scene,
@@ -323,7 +327,8 @@ impl Scene {
                           c_x=None, c_z=None, drive=None, rod=None, backend=None, \
                           threads=None, probe_planes=None, probe_points=None, \
                           profile_loads=None, profile_planes=None, confirm_metres=None, \
-                          max_output_bytes=None)"
+                          max_output_bytes=None, contact_rule=None, \
+                          delay_stable_states=None, delay_load=None)"
     )]
     fn new(py: Python<'_>, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
         let dict = py
@@ -398,7 +403,8 @@ impl Scene {
     }
 
     /// The grid and its estimated cost (the crate's `GridCost`): `nx`, `ny`, `cells`,
-    /// `dx`, `dy` (m), `block` (m), `normal_load` (N), `backend`, `memory_bytes`,
+    /// `dx`, `dy` (m), `block` (m), `normal_load` (N), `backend`, `contact_rule` (the
+    /// rule's name: `"paper"`, `"anchored"`, `"rejuvenation"`), `memory_bytes`,
     /// `plan_seconds` and `solve_seconds` (one cold normal + tangential solve, one
     /// thread; estimates).
     fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -414,6 +420,7 @@ impl Scene {
         d.set_item("block", (block.lx(), block.ly(), block.lz()))?;
         d.set_item("normal_load", self.inner.normal_load())?;
         d.set_item("backend", self.inner.solver_options().backend().to_string())?;
+        d.set_item("contact_rule", self.inner.contact_rule().name())?;
         d.set_item("memory_bytes", cost.memory_bytes)?;
         d.set_item("plan_seconds", cost.plan_seconds)?;
         d.set_item("solve_seconds", cost.solve_seconds)?;

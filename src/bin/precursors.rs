@@ -910,6 +910,17 @@ fn info(path: &Path) -> Result<(), Failure> {
         other => other,
     };
     let block = grid.block();
+    let contact = match (file["contact"]["rule"].as_str(), &file["contact"]["delay"]) {
+        (Some(rule), serde_json::Value::Object(delay)) => format!(
+            "{rule} (delay {} stable states and {} μF_N)",
+            delay
+                .get("stable_states")
+                .unwrap_or(&serde_json::Value::Null),
+            delay.get("load").unwrap_or(&serde_json::Value::Null)
+        ),
+        (Some(rule), _) => rule.to_string(),
+        (None, _) => "paper".to_string(),
+    };
     // Fitted to documented runs to global slip on one thread (release build,
     // docs/performance.md): the calibration scene, 980 cells, 0.84 s; N = 1e4, about 70 s;
     // above, the growth from N = 1e4 to 1e5 measured on one machine (115 s to about
@@ -924,6 +935,8 @@ fn info(path: &Path) -> Result<(), Failure> {
          block      {} x {} x {} m\n\
          cells      {} x {} = {n} (cell {} x {} m)\n\
          backend    {resolved}, solver threads {}\n\
+         contact    {contact} (the rules of key contact.rule: paper, anchored, \
+         rejuvenation)\n\
          memory     ~{} (estimate)\n\
          plan       ~{} (estimate, one thread)\n\
          equilibrium ~{} per cold normal + tangential solve (estimate, one thread)\n\

@@ -182,7 +182,7 @@ fn global_slip_and_the_changes_of_an_equilibrium() {
 fn a_broken_site_never_changes_again() {
     let rule = ContactRule::Paper;
     for change in [SiteChange::Rupture, SiteChange::Detach, SiteChange::Attach] {
-        let mut replay = Replay::new(rule, 3, 1.0);
+        let mut replay = Replay::new(rule.clone(), 3, 1.0);
         replay.apply(0, SiteChange::Detach, 10, 0.0).unwrap();
         replay.apply(0, SiteChange::Attach, 11, 0.0).unwrap();
         replay.apply(0, SiteChange::Rupture, 12, 0.0).unwrap();
@@ -211,7 +211,9 @@ fn an_anchored_site_holds_inside_its_window() {
     let f = [1e3, 1e3, 1e3, 1e3];
     let g1 = [10.0, -4.0, 0.0, 0.0];
     let g0 = [100.0, 100.0, 600.0, 100.0];
-    let (high, low) = rule.thresholds(&interface, &f, &g1, &g0, 0.5).unwrap();
+    let (high, low) = rule
+        .thresholds(&interface, (&f, &g1), Some(&g0[..]), 0.5, None)
+        .unwrap();
     // τ = 500 Pa. Site 0: 10 F + 100 = ±500 at F = 40, -60. Site 1: -4 F + 100 = -500 at
     // F = 150, = 500 at F = -100. Site 2: |600| ≥ 500 at any load; site 3: never.
     assert_eq!(high, vec![40.0, 150.0, f64::NEG_INFINITY, f64::INFINITY]);
@@ -234,7 +236,7 @@ fn an_anchored_site_holds_inside_its_window() {
     assert_eq!(rule.weakest(&states, &high), Some((0, 40.0)));
     // No anchor shear: the paper's loads, bit for bit.
     let (high, _) = rule
-        .thresholds(&interface, &f, &g1, &[0.0; 4], 0.5)
+        .thresholds(&interface, (&f, &g1), Some(&[0.0; 4][..]), 0.5, None)
         .unwrap();
     let paper = ContactRule::Paper
         .breaking_loads(&interface, &f, &g1, 0.5)
@@ -244,7 +246,7 @@ fn an_anchored_site_holds_inside_its_window() {
         .zip(&paper)
         .all(|(a, b)| a.to_bits() == b.to_bits()));
     assert!(matches!(
-        rule.thresholds(&interface, &f, &g1, &g0[..2], 0.5),
+        rule.thresholds(&interface, (&f, &g1), Some(&g0[..2]), 0.5, None),
         Err(Error::LengthMismatch {
             name: "anchor_traction",
             ..
@@ -333,21 +335,162 @@ fn the_clock_re_forms_sites_when_due() {
         load: 0.1,
     };
     let rule = ContactRule::Rejuvenation { delay };
-    let mut state = ContactState::new(rule, 2).unwrap();
-    assert!(ContactState::new(ContactRule::Paper, 2).is_none());
-    assert!(state.tick(rule, 0.0, 10.0).is_empty()); // tick 1
+    let mut state = ContactState::new(&rule, 2).unwrap();
+    assert!(ContactState::new(&ContactRule::Paper, 2).is_none());
+    let (states, zero) = ([Attached; 2], [0.0; 2]);
+    let at = |force: f64| Fields {
+        states: &states,
+        normal_traction: &zero,
+        normal_displacement: &zero,
+        friction_coefficient: 0.5,
+        force,
+    };
+    assert!(state.tick(&rule, &at(0.0), 10.0).is_empty()); // tick 1
     state.broke(1, 5.0);
-    assert!(state.tick(rule, 9.0, 10.0).is_empty()); // 1 tick
-    assert!(state.tick(rule, 5.5, 10.0).is_empty()); // 0.5 N
-    assert_eq!(state.tick(rule, 6.0, 10.0), vec![1]);
+    assert!(state.tick(&rule, &at(9.0), 10.0).is_empty()); // 1 tick
+    assert!(state.tick(&rule, &at(5.5), 10.0).is_empty()); // 0.5 N
+    assert_eq!(state.tick(&rule, &at(6.0), 10.0), vec![1]);
     assert_eq!(state.broken_since, vec![None, None]);
-    assert!(state.check(rule, &[Attached, Detached]).is_ok());
+    assert!(state.check(&rule, &[Attached, Detached]).is_ok());
     state.broke(0, 6.0);
-    assert!(state.check(rule, &[Attached, Detached]).is_err()); // 0 is not broken
-    assert!(state.check(rule, &[Broken, Detached]).is_ok());
+    assert!(state.check(&rule, &[Attached, Detached]).is_err()); // 0 is not broken
+    assert!(state.check(&rule, &[Broken, Detached]).is_ok());
     state.anchors[1] = 1e-9;
-    assert!(state.check(rule, &[Broken, Detached]).is_err()); // an anchor off contact
+    assert!(state.check(&rule, &[Broken, Detached]).is_err()); // an anchor off contact
     assert!(state
-        .check(ContactRule::Anchored, &[Broken, Attached])
+        .check(&ContactRule::Anchored, &[Broken, Attached])
         .is_err());
+}
+
+/// A law that gives `scale` times the paper's threshold (`NaN` at `bad`, if any), and
+/// re-forms a broken site two ticks after its rupture.
+#[derive(Debug)]
+struct Scaled {
+    scale: f64,
+    bad: Option<usize>,
+}
+
+impl ContactLaw for Scaled {
+    fn name(&self) -> &str {
+        "scaled"
+    }
+    fn threshold(&self, site: &SiteView) -> f64 {
+        match self.bad == Some(site.index) {
+            true => f64::NAN,
+            false => self.scale * site.friction_coefficient * site.normal_traction,
+        }
+    }
+    fn reforms(&self, site: &SiteView) -> bool {
+        site.rupture_stable_states
+            .is_some_and(|at| site.stable_states >= at + 2)
+    }
+}
+
+/// A custom law's thresholds: asked for the attached sites only (0 elsewhere), its
+/// breaking loads `τ / |g|`; the paper's threshold gives the paper's loads bit for bit,
+/// twice the threshold twice the loads; a threshold that is not finite fails with the
+/// site; the law re-forms a site when it says so, and the view counts its ruptures.
+#[test]
+fn a_custom_law_sets_the_threshold_and_the_re_formations() {
+    let interface = interface();
+    let states = [Attached, Attached, Detached, Attached];
+    let (f, g) = ([1e3, 2e3, 0.0, 5.0], [10.0, -4.0, 0.0, -0.0]);
+    let u_z = [0.0; 4];
+    let fields = |force: f64| Fields {
+        states: &states,
+        normal_traction: &f,
+        normal_displacement: &u_z,
+        friction_coefficient: 0.5,
+        force,
+    };
+    let paper = ContactRule::Paper
+        .breaking_loads(&interface, &f, &g, 0.5)
+        .unwrap();
+    for (scale, expected) in [(1.0, [50.0, 250.0]), (2.0, [100.0, 500.0])] {
+        let rule = ContactRule::custom(Scaled { scale, bad: None });
+        assert!(!rule.anchors());
+        assert_eq!(rule.name(), "scaled");
+        let state = ContactState::new(&rule, 4).unwrap();
+        let taus = state
+            .custom_thresholds(&rule, &fields(0.0))
+            .unwrap()
+            .unwrap();
+        assert_eq!(taus, vec![500.0 * scale, 1000.0 * scale, 0.0, 2.5 * scale]);
+        let (high, low) = rule
+            .thresholds(&interface, (&f, &g), None, 0.5, Some(taus.as_slice()))
+            .unwrap();
+        assert!(low.is_empty());
+        assert_eq!(&high[..2], &expected);
+        assert_eq!(high[3], f64::INFINITY);
+        if scale == 1.0 {
+            assert!(high
+                .iter()
+                .zip(&paper)
+                .all(|(a, b)| a.to_bits() == b.to_bits()));
+        }
+    }
+    let rule = ContactRule::custom(Scaled {
+        scale: 1.0,
+        bad: Some(1),
+    });
+    let state = ContactState::new(&rule, 4).unwrap();
+    assert!(matches!(
+        state.custom_thresholds(&rule, &fields(0.0)),
+        Err(Error::InvalidThreshold { site: 1, ref rule, .. }) if rule == "scaled"
+    ));
+    // Built-in rules have no custom thresholds.
+    let anchored = ContactState::new(&ContactRule::Anchored, 4).unwrap();
+    assert_eq!(
+        anchored
+            .custom_thresholds(&ContactRule::Anchored, &fields(0.0))
+            .unwrap(),
+        None
+    );
+    // Re-formation: site 3 breaks at tick 1 and re-forms at tick 3.
+    let rule = ContactRule::custom(Scaled {
+        scale: 1.0,
+        bad: None,
+    });
+    let mut state = ContactState::new(&rule, 4).unwrap();
+    assert!(state.tick(&rule, &fields(1.0), 1.0).is_empty());
+    state.broke(3, 1.0);
+    assert_eq!(state.view(3, &fields(1.0)).ruptures, 1);
+    assert_eq!(state.view(3, &fields(1.0)).rupture_force, Some(1.0));
+    assert!(state.tick(&rule, &fields(2.0), 1.0).is_empty());
+    assert_eq!(state.tick(&rule, &fields(3.0), 1.0), vec![3]);
+    assert_eq!(state.view(3, &fields(3.0)).rupture_stable_states, None);
+    assert_eq!(state.view(3, &fields(3.0)).ruptures, 1);
+    // What a custom rule gives up is a typed error naming it and the operation.
+    assert!(matches!(
+        rule.built_in("writing a checkpoint"),
+        Err(Error::CustomContactRule {
+            operation: "writing a checkpoint",
+            ..
+        })
+    ));
+    assert!(ContactRule::Anchored
+        .built_in("writing a checkpoint")
+        .is_ok());
+}
+
+/// `Delay::new` refuses what the scene file refuses, naming the key.
+#[test]
+fn a_delay_is_checked() {
+    assert_eq!(Delay::new(1, 0.0).unwrap(), Delay::default());
+    assert!(matches!(
+        Delay::new(0, 0.0),
+        Err(Error::InvalidCount {
+            name: "contact.delay.stable_states",
+            ..
+        })
+    ));
+    for load in [-0.1, f64::NAN, f64::INFINITY] {
+        assert!(matches!(
+            Delay::new(1, load),
+            Err(Error::InvalidParameter {
+                name: "contact.delay.load",
+                ..
+            })
+        ));
+    }
 }

@@ -329,10 +329,13 @@ impl Checkpoint {
     /// that is of the checkpoint's compact JSON without its digest.
     ///
     /// # Errors
+    /// [`Error::CustomContactRule`] for a checkpoint of a driver under a custom contact
+    /// rule ([`crate::ContactLaw`]: a scene file cannot name it);
     /// [`Error::InvalidCheckpoint`] if serialisation fails (it does not for a checkpoint
-    /// taken by [`Driver::checkpoint`]).
+    /// taken by [`Driver::checkpoint`] under a built-in rule).
     #[cfg(feature = "serde")]
     pub fn to_json(&self) -> Result<String> {
+        self.scene.contact().built_in("writing a checkpoint")?;
         let body = serde_json::to_string(self).map_err(|e| Error::InvalidCheckpoint {
             reason: format!("cannot be written as JSON: {e}"),
         })?;
@@ -461,7 +464,9 @@ fn verified(text: &str) -> std::result::Result<Checkpoint, Refusal> {
 
 impl Driver {
     /// A snapshot of the driver as it stands (between two events); [`Scene::resume`]
-    /// continues from it with exactly the events this driver would return.
+    /// continues from it with exactly the events this driver would return. Under a custom
+    /// contact rule ([`crate::ContactLaw`]) the snapshot can be neither resumed nor
+    /// written ([`Error::CustomContactRule`]).
     pub fn checkpoint(&self) -> Checkpoint {
         let contact = self.contact.as_ref().map(|state| ContactCheckpoint {
             state: state.clone(),
@@ -501,7 +506,9 @@ impl Scene {
     /// [`Error::CheckpointSceneMismatch`], naming the first differing option by its
     /// scene-file key, when the checkpoint was taken on another scene or its stored
     /// scene was edited since (the digest differs); [`Error::InvalidCheckpoint`] when it
-    /// is of another layout version or inconsistent; those of [`Scene::driver`].
+    /// is of another layout version or inconsistent; [`Error::CustomContactRule`] under a
+    /// custom contact rule ([`crate::ContactLaw`]: its state is not recorded); those of
+    /// [`Scene::driver`].
     pub fn resume(&self, checkpoint: &Checkpoint) -> Result<Driver> {
         self.resume_with(checkpoint, self.run_options())
     }
@@ -532,13 +539,16 @@ impl Scene {
         }
         if let (Some(normal), Some(response)) = (&checkpoint.normal, &checkpoint.response) {
             let rule = driver.contact_rule();
-            let anchor = driver.anchor.as_ref().map_or(&[][..], |a| &a.traction);
+            let anchor = match rule.anchors() {
+                true => Some(driver.anchor.as_ref().map_or(&[][..], |a| &a.traction[..])),
+                false => None,
+            };
             (driver.breaking, driver.breaking_low) = rule.thresholds(
                 &driver.interface,
-                &normal.traction,
-                &response.traction,
+                (&normal.traction, &response.traction),
                 anchor,
                 driver.friction_coefficient(),
+                None,
             )?;
         }
         driver.normal = checkpoint.normal.clone();
@@ -584,6 +594,12 @@ impl Scene {
     /// Refuses a checkpoint of another layout, or whose scene was edited or is not this
     /// one ([`Scene::resume`]'s first checks).
     fn check_checkpoint_scene(&self, checkpoint: &Checkpoint) -> Result<()> {
+        // A custom rule's state is not recorded, nor its checks written.
+        self.contact_rule().built_in("resuming a checkpoint")?;
+        checkpoint
+            .scene
+            .contact()
+            .built_in("resuming a checkpoint")?;
         let bad = |reason: String| Err(Error::InvalidCheckpoint { reason });
         if !(OLDEST_FORMAT..=FORMAT).contains(&checkpoint.format) {
             return bad(format!(

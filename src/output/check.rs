@@ -627,6 +627,8 @@ pub(crate) struct RunRecord {
     /// What the run recorded beside its tables (from its scene record).
     #[cfg_attr(not(feature = "plot"), allow(dead_code))] // the figures read it
     pub options: crate::recording::RunOptions,
+    /// The run's contact rule (from its scene record, key `contact`).
+    pub contact: crate::contact::ContactRule,
 }
 
 #[cfg(feature = "serde")]
@@ -679,7 +681,9 @@ impl RunRecord {
             None
         };
         let options = scene.current_run().clone();
+        let contact = scene.contact().clone();
         Ok(RunRecord {
+            contact,
             bounds,
             grid,
             events,

@@ -568,13 +568,13 @@ pub(super) fn fields_continuation(
 /// recomputed digest (a broken site set back to attached) would otherwise run on and
 /// break a site twice.
 pub(super) fn check_site_states(
-    rule: ContactRule,
+    rule: &ContactRule,
     load_scale: f64,
     site_events: &[(usize, Event)],
     states: &[SiteState],
     path: &Path,
 ) -> Result<()> {
-    let mut replay = Replay::new(rule, states.len(), load_scale);
+    let mut replay = Replay::new(rule.clone(), states.len(), load_scale);
     for &(line, event) in site_events {
         let (site, change, force) = match event {
             Event::Rupture { site, load, .. } => (site, SiteChange::Rupture, load.force),

@@ -91,6 +91,10 @@ enum RuleSpec {
     Paper,
     Anchored,
     Rejuvenation,
+    /// A custom rule ([`ContactRule::Custom`]): in a scene's identity, never in a file
+    /// (writing it is an error, reading it an unknown value).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    Custom,
 }
 
 /// `contact.delay`: both must pass before a broken site re-forms.
@@ -133,6 +137,14 @@ impl ContactSpec {
                     },
                 }
             }
+            (RuleSpec::Custom, _) => {
+                return Err(Error::InvalidChoice {
+                    name: "contact.rule",
+                    value: "custom",
+                    reason: "a custom rule is Rust code (ContactRule::custom), not a scene-file \
+                             value",
+                })
+            }
             (rule, Some(_)) => {
                 return Err(Error::InvalidChoice {
                     name: "contact.delay",
@@ -148,8 +160,8 @@ impl ContactSpec {
     }
 }
 
-impl From<ContactRule> for ContactSpec {
-    fn from(rule: ContactRule) -> Self {
+impl From<&ContactRule> for ContactSpec {
+    fn from(rule: &ContactRule) -> Self {
         match rule {
             ContactRule::Paper => ContactSpec::default(),
             ContactRule::Anchored => ContactSpec {
@@ -162,6 +174,12 @@ impl From<ContactRule> for ContactSpec {
                     stable_states: delay.stable_states,
                     load: delay.load,
                 }),
+            },
+            // Its identity names it a custom rule; writing it is refused
+            // (`ContactRule::built_in`).
+            ContactRule::Custom(_) => ContactSpec {
+                rule: RuleSpec::Custom,
+                delay: None,
             },
         }
     }
@@ -178,6 +196,7 @@ impl Schema for ContactSpec {
             RuleSpec::Paper => "paper",
             RuleSpec::Anchored => "anchored",
             RuleSpec::Rejuvenation => "rejuvenation",
+            RuleSpec::Custom => "custom",
         };
         out.push((join(path, "rule"), rule.to_string()));
         if let Some(delay) = &self.delay {
@@ -753,7 +772,7 @@ impl From<&SceneBuilder> for SceneFile {
             },
             confirm_metres: *confirm_metres,
             max_output_bytes: run.output_limit(),
-            contact: (*contact).into(),
+            contact: contact.into(),
         }
     }
 }
@@ -1198,8 +1217,11 @@ impl SceneBuilder {
     /// builder: floats round-trip exactly.
     ///
     /// # Errors
-    /// [`Error::SceneFile`] if serialisation fails (it does not for a builder's values).
+    /// [`Error::CustomContactRule`] under a custom contact rule ([`crate::ContactLaw`]: a
+    /// scene file cannot name it); [`Error::SceneFile`] if serialisation fails (it does
+    /// not for a builder's values).
     pub fn to_json(&self) -> Result<String> {
+        self.contact().built_in("writing the scene as JSON")?;
         serde_json::to_string_pretty(&SceneFile::from(self)).map_err(|e| json_error(None, e))
     }
 }
@@ -1210,6 +1232,9 @@ impl Serialize for SceneBuilder {
         &self,
         serializer: S,
     ) -> std::result::Result<S::Ok, S::Error> {
+        self.contact()
+            .built_in("serialising the scene")
+            .map_err(serde::ser::Error::custom)?;
         SceneFile::from(self).serialize(serializer)
     }
 }

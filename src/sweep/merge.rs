@@ -177,6 +177,8 @@ struct RunData {
     avalanches: Vec<usize>,
     /// `F/(μF_N)` of global slip.
     slip: Option<f64>,
+    /// The name of its contact rule (its scene record's key `contact.rule`).
+    contact_rule: String,
 }
 
 /// The complete run in `dir`, read and checked ([`RunRecord::read`]): its tables whole,
@@ -193,6 +195,7 @@ fn read_run(dir: &Path, run: &SweepRun) -> Result<RunData> {
             .collect(),
         avalanches: record.ruptures,
         slip: Some(record.slip),
+        contact_rule: record.contact.name().to_string(),
     })
 }
 
@@ -356,7 +359,7 @@ pub(crate) fn ensemble_curves(dir: &Path, grid: &[f64]) -> Result<Vec<EnsembleCu
 ///   size ≥ 1; stable states reached without a rupture are not counted), pooled over the
 ///   realizations: size, count, fraction;
 /// * `runs.csv`: one row per run: its point, realization, seed, stable states and slip
-///   load (empty for a run not complete).
+///   load (empty for a run not complete), and the name of its contact rule.
 ///
 /// Runs without their completion marker are left out and counted.
 ///
@@ -450,7 +453,10 @@ impl Tables {
                  last_stable_over_mu_FN_max\n"
             ),
             avalanches: format!("point,{key_header}ruptures,count,fraction\n"),
-            runs: format!("run,point,realization,seed,{key_header}stable_states,slip_over_mu_FN\n"),
+            runs: format!(
+                "run,point,realization,seed,{key_header}stable_states,slip_over_mu_FN,\
+                 contact_rule\n"
+            ),
         }
     }
 
@@ -462,20 +468,23 @@ impl Tables {
             let run_dir = dir.join(&run.dir_name);
             let (point, realization, seed) = (run.point, run.realization, run.seed);
             if !crate::files::is_file(&run_dir.join(DONE), "examining the run directory")? {
+                // Its rule as the sweep gives it (no scene record to read yet).
                 let _ = writeln!(
                     self.runs,
-                    "{},{point},{realization},{seed},{values},,",
-                    run.index
+                    "{},{point},{realization},{seed},{values},,{}",
+                    run.index,
+                    run.scene.contact().name()
                 );
                 continue;
             }
             let d = read_run(&run_dir, run)?;
             let _ = writeln!(
                 self.runs,
-                "{},{point},{realization},{seed},{values}{},{}",
+                "{},{point},{realization},{seed},{values}{},{},{}",
                 run.index,
                 d.curve.len(),
-                d.slip.map(num).unwrap_or_default()
+                d.slip.map(num).unwrap_or_default(),
+                d.contact_rule
             );
             data.push(d);
         }
