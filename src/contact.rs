@@ -280,7 +280,8 @@ fn check_threshold_inputs(
 impl ContactRule {
     /// The shear load (N) at which each site reaches its threshold, from the normal
     /// tractions (Pa), the shear tractions per newton of load (Pa/N) and the friction
-    /// coefficient; `+∞` for sites that carry no shear.
+    /// coefficient (each site's from the interface's friction map where it has one);
+    /// `+∞` for sites that carry no shear.
     ///
     /// # Errors
     /// [`Error::LengthMismatch`] or [`Error::NonFinite`] for slices of the wrong length or
@@ -300,12 +301,17 @@ impl ContactRule {
             friction_coefficient,
         )?;
         // The anchored rules' window starts from the same checks; its loads are
-        // [`ContactRule::thresholds`]'.
-        Ok(shear_per_newton
-            .iter()
-            .zip(normal_traction)
-            .map(|(g, f)| paper_breaking_load(friction_coefficient, *f, *g))
-            .collect())
+        // [`ContactRule::thresholds`]'. A friction map is matched outside the loop.
+        let loads = shear_per_newton.iter().zip(normal_traction);
+        Ok(match interface.friction_map() {
+            None => loads
+                .map(|(g, f)| paper_breaking_load(friction_coefficient, *f, *g))
+                .collect(),
+            Some(mu) => loads
+                .zip(mu)
+                .map(|((g, f), mu)| paper_breaking_load(*mu, *f, *g))
+                .collect(),
+        })
     }
 
     /// Whether the rule anchors springs where their sites attach (all but the paper's).
@@ -347,10 +353,11 @@ impl ContactRule {
         )?;
         let n = normal_traction.len();
         check_slice("anchor_traction", anchor_traction, n)?;
+        let map = interface.friction_map();
         Ok((0..n)
             .map(|i| {
                 anchored_window(
-                    friction_coefficient,
+                    map.map_or(friction_coefficient, |mu| mu[i]),
                     normal_traction[i],
                     shear_per_newton[i],
                     anchor_traction[i],
@@ -623,7 +630,9 @@ impl Interface {
     /// `|φ_x| = μ φ_z`, `λ_i = μ φ_z,i / |φ_x,i(1)|` (paper Eq. lambda_Amonton_dscrt), from
     /// the normal tractions (Pa) and the shear tractions per newton of load (Pa/N,
     /// [`crate::solver::TangentialResponse::traction`]). `+∞` for sites that carry no shear
-    /// (detached, broken, or exactly unloaded).
+    /// (detached, broken, or exactly unloaded). On an interface with a friction map
+    /// ([`Interface::with_friction_map`]) each site's `μ_i` takes the place of
+    /// `friction_coefficient`, which is still checked.
     ///
     /// # Errors
     /// [`Error::LengthMismatch`] for slices of the wrong length;
