@@ -336,7 +336,7 @@ fn a_resumed_run_with_maps_writes_the_uninterrupted_runs_tables() {
     let mut slip = 0.0;
     RunTables::create(&whole, &driver)
         .unwrap()
-        .run_to_slip(&mut driver, None, |_, event| {
+        .run_to_slip(&mut driver, None, |event, _| {
             if let Event::GlobalSlip { load } = event {
                 slip = load.force;
             }
