@@ -575,13 +575,16 @@ fn refuse_map(builder: &SceneBuilder, k: usize) -> Result<()> {
             name: ["maps.friction_coefficient", "maps.c_x", "maps.c_z"][k],
             value: "a map",
             reason: match k {
-                1 => "fit_tangential_stiffness fits the scalar c_x, which the scene's map of \
-                      c_x replaces: fit on the scene without the map",
-                _ => "fit_normal_stiffness fits the scalar c_z, which the scene's map of c_z \
-                      replaces: fit on the scene without the map",
+                1 => {
+                    "fit_tangential_stiffness fits the scalar c_x, which the scene's map of \
+                      c_x replaces: fit on the scene without the map"
+                }
+                _ => {
+                    "fit_normal_stiffness fits the scalar c_z, which the scene's map of c_z \
+                      replaces: fit on the scene without the map"
+                }
             },
         });
     }
     Ok(())
 }
-

@@ -20,9 +20,9 @@ use crate::error::{check_slice, Error, Result};
 use crate::geometry::Grid;
 use crate::surface::{Plan, SurfaceSpectrum, Truncated};
 use rand::rngs::Xoshiro256PlusPlus;
-use std::sync::Arc;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
+use std::sync::Arc;
 
 /// Bulk and friction properties of the block. Defaults: the paper's PMMA.
 ///
@@ -876,7 +876,12 @@ impl Interface {
     pub fn normal_stiffness(&self) -> Vec<f64> {
         match &self.c_z {
             None => self.heights().iter().map(|h| self.law.c_z / h).collect(),
-            Some(c_z) => self.heights().iter().zip(c_z.iter()).map(|(h, c)| c / h).collect(),
+            Some(c_z) => self
+                .heights()
+                .iter()
+                .zip(c_z.iter())
+                .map(|(h, c)| c / h)
+                .collect(),
         }
     }
 
@@ -884,7 +889,12 @@ impl Interface {
     pub fn normal_compliance(&self) -> Vec<f64> {
         match &self.c_z {
             None => self.heights().iter().map(|h| h / self.law.c_z).collect(),
-            Some(c_z) => self.heights().iter().zip(c_z.iter()).map(|(h, c)| h / c).collect(),
+            Some(c_z) => self
+                .heights()
+                .iter()
+                .zip(c_z.iter())
+                .map(|(h, c)| h / c)
+                .collect(),
         }
     }
 

@@ -84,7 +84,11 @@ fn a_uniform_map_gives_the_scalar_scenes_events() {
         // Other constants, as scalars and as maps.
         let other = builder
             .clone()
-            .material(precursors::Material::default().with_friction_coefficient(0.7).unwrap())
+            .material(
+                precursors::Material::default()
+                    .with_friction_coefficient(0.7)
+                    .unwrap(),
+            )
             .springs(SpringLaw::new(4e11, 3e8).unwrap());
         let scalar = events(&other.build().unwrap());
         let mapped = events(&uniform(builder, 0.7, 4e11, 3e8).build().unwrap());
@@ -227,7 +231,10 @@ fn every_state_balances_its_loads_and_holds_each_sites_bound() {
             assert!((normal - f_n).abs() <= 1e-9 * f_n, "{name}: {normal} N");
             if let Event::Stable { load, .. } = event {
                 stable += 1;
-                assert!(load.force <= driver.friction_limit() * (1.0 + 1e-9), "{name}");
+                assert!(
+                    load.force <= driver.friction_limit() * (1.0 + 1e-9),
+                    "{name}"
+                );
                 for (i, s) in driver.site_states().iter().enumerate() {
                     if *s == SiteState::Attached {
                         assert!(
@@ -306,8 +313,12 @@ proptest! {
 /// the material's μF_N), c_x drawn, c_z given.
 fn mapped_scene() -> Scene {
     let n = 64;
-    let mu: Vec<f64> = (0..n).map(|i| 0.4 + 0.5 * ((i * 13) % 7) as f64 / 6.0).collect();
-    let c_z: Vec<f64> = (0..n).map(|i| 1.65e8 * (1.0 + 0.5 * (i % 3) as f64)).collect();
+    let mu: Vec<f64> = (0..n)
+        .map(|i| 0.4 + 0.5 * ((i * 13) % 7) as f64 / 6.0)
+        .collect();
+    let c_z: Vec<f64> = (0..n)
+        .map(|i| 1.65e8 * (1.0 + 0.5 * (i % 3) as f64))
+        .collect();
     base(Drive::top(), 4)
         .friction_map(SiteMap::Values(mu))
         .c_x_map(SiteMap::Surface {
@@ -343,15 +354,17 @@ fn a_resumed_run_with_maps_writes_the_uninterrupted_runs_tables() {
         })
         .unwrap();
     let material = scene.material().friction_coefficient() * scene.normal_load();
-    assert!(slip > material, "slip at {slip} N, not beyond μF_N = {material} N");
+    assert!(
+        slip > material,
+        "slip at {slip} N, not beyond μF_N = {material} N"
+    );
     let recorded = SceneBuilder::from_json_file(whole.join("scene.json")).unwrap();
     assert!(recorded == scene.to_builder(), "scene.json lost the maps");
     let text = std::fs::read_to_string(whole.join("scene.json")).unwrap();
     assert!(text.contains("\"maps\"") && text.contains("gaussian_surface"));
     let cut = scratch("maps-cut");
     let checkpoint = killed_after_checkpoint(&scene, &cut, 6, 5);
-    let checkpoint =
-        precursors::Checkpoint::from_json_str(&checkpoint.to_json().unwrap()).unwrap();
+    let checkpoint = precursors::Checkpoint::from_json_str(&checkpoint.to_json().unwrap()).unwrap();
     let mut driver = scene.resume(&checkpoint).unwrap();
     RunTables::resume(&cut, &driver)
         .unwrap()
@@ -383,25 +396,56 @@ fn bad_maps_are_refused_naming_the_key_and_the_site() {
     let err = |builder: SceneBuilder| builder.build().unwrap_err();
     let e = err(b.clone().friction_map(SiteMap::Values(vec![0.5; 63])));
     assert!(
-        matches!(e, Error::LengthMismatch { name: "maps.friction_coefficient", expected: 64, found: 63 }),
+        matches!(
+            e,
+            Error::LengthMismatch {
+                name: "maps.friction_coefficient",
+                expected: 64,
+                found: 63
+            }
+        ),
         "{e}"
     );
     let mut values = vec![1.65e12; 64];
     values[9] = 1e30;
     let e = err(b.clone().c_x_map(SiteMap::Values(values.clone())));
     assert!(
-        matches!(e, Error::MapValue { key: "maps.c_x", index: 9, .. }),
+        matches!(
+            e,
+            Error::MapValue {
+                key: "maps.c_x",
+                index: 9,
+                ..
+            }
+        ),
         "{e}"
     );
     assert!(e.to_string().contains("maps.c_x[9]"), "{e}");
     values[9] = f64::NAN;
     let e = err(b.clone().c_x_map(SiteMap::Values(values)));
-    assert!(matches!(e, Error::MapValue { key: "maps.c_x", index: 9, .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            Error::MapValue {
+                key: "maps.c_x",
+                index: 9,
+                ..
+            }
+        ),
+        "{e}"
+    );
     let mut mu = vec![0.5; 64];
     mu[63] = 0.0;
     let e = err(b.clone().friction_map(SiteMap::Values(mu)));
     assert!(
-        matches!(e, Error::MapValue { key: "maps.friction_coefficient", index: 63, .. }),
+        matches!(
+            e,
+            Error::MapValue {
+                key: "maps.friction_coefficient",
+                index: 63,
+                ..
+            }
+        ),
         "{e}"
     );
     let surface = |mean, std_dev| SiteMap::Surface {
@@ -411,10 +455,25 @@ fn bad_maps_are_refused_naming_the_key_and_the_site() {
         seed: 1,
     };
     let e = err(b.clone().c_z_map(surface(-1.0, 1.0)));
-    assert!(matches!(e, Error::OutOfRange { key: "maps.c_z.mean", .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            Error::OutOfRange {
+                key: "maps.c_z.mean",
+                ..
+            }
+        ),
+        "{e}"
+    );
     let e = err(b.clone().friction_map(surface(0.5, -0.1)));
     assert!(
-        matches!(e, Error::OutOfRange { key: "maps.friction_coefficient.std_dev", .. }),
+        matches!(
+            e,
+            Error::OutOfRange {
+                key: "maps.friction_coefficient.std_dev",
+                ..
+            }
+        ),
         "{e}"
     );
     // A drawn map whose values leave the range (half of them above μ = 1e3): refused when
@@ -429,19 +488,38 @@ fn bad_maps_are_refused_naming_the_key_and_the_site() {
     let mut c_z = vec![1.65e8; 64];
     c_z[5] = 1.0;
     let e = err(b.clone().c_z_map(SiteMap::Values(c_z)));
-    assert!(matches!(e, Error::OutOfRange { key: "normal_load", .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            Error::OutOfRange {
+                key: "normal_load",
+                ..
+            }
+        ),
+        "{e}"
+    );
     // The interface's own maps.
     let grid = Grid::new(Block::new(0.002, 0.001, 0.005).unwrap(), 2, 1).unwrap();
-    let interface =
-        Interface::new(grid, Heights::from_values(&grid, vec![1e-6; 2]).unwrap(), SpringLaw::default())
-            .unwrap();
+    let interface = Interface::new(
+        grid,
+        Heights::from_values(&grid, vec![1e-6; 2]).unwrap(),
+        SpringLaw::default(),
+    )
+    .unwrap();
     assert!(matches!(
         interface.clone().with_c_z_map(vec![1e8]),
-        Err(Error::LengthMismatch { name: "maps.c_z", .. })
+        Err(Error::LengthMismatch {
+            name: "maps.c_z",
+            ..
+        })
     ));
     assert!(matches!(
         interface.with_friction_map(vec![0.5, f64::INFINITY]),
-        Err(Error::MapValue { key: "maps.friction_coefficient", index: 1, .. })
+        Err(Error::MapValue {
+            key: "maps.friction_coefficient",
+            index: 1,
+            ..
+        })
     ));
     // A calibration of a scalar that a map replaces.
     let e = precursors::calibration::fit_normal_stiffness(
@@ -451,7 +529,16 @@ fn bad_maps_are_refused_naming_the_key_and_the_site() {
         &Default::default(),
     )
     .unwrap_err();
-    assert!(matches!(e, Error::InvalidChoice { name: "maps.c_z", .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            Error::InvalidChoice {
+                name: "maps.c_z",
+                ..
+            }
+        ),
+        "{e}"
+    );
 }
 
 /// The scene file's `maps`: every kind reads to its map; a map file's values are read
@@ -461,7 +548,9 @@ fn bad_maps_are_refused_naming_the_key_and_the_site() {
 #[test]
 fn the_scene_files_maps() {
     let dir = scratch("maps-file");
-    let lines: String = (0..8).map(|i| format!("{}\n", 1e12 + 1e11 * i as f64)).collect();
+    let lines: String = (0..8)
+        .map(|i| format!("{}\n", 1e12 + 1e11 * i as f64))
+        .collect();
     std::fs::write(dir.join("cx.txt"), format!("# c_x (N/m³)\n\n{lines}")).unwrap();
     let scene = |maps: &str| {
         format!(
@@ -508,7 +597,12 @@ fn the_scene_files_maps() {
         std::fs::write(dir.join("cx.txt"), text).unwrap();
         let e = SceneBuilder::from_json_file(&path).unwrap_err();
         match &e {
-            Error::MapFile { key: "maps.c_x", path, line: l, reason } => {
+            Error::MapFile {
+                key: "maps.c_x",
+                path,
+                line: l,
+                reason,
+            } => {
                 assert!(path.ends_with("cx.txt") && *l == line, "{e}");
                 assert!(reason.contains(what), "{e}");
             }
@@ -522,7 +616,10 @@ fn the_scene_files_maps() {
         r#"{"c_x": {"kind": "values", "values": [1e12], "seed": 3}}"#,
     ] {
         assert!(
-            matches!(SceneBuilder::from_json_str(&scene(maps)), Err(Error::SceneFile { .. })),
+            matches!(
+                SceneBuilder::from_json_str(&scene(maps)),
+                Err(Error::SceneFile { .. })
+            ),
             "{maps}"
         );
     }
@@ -552,7 +649,11 @@ fn each_site_takes_its_own_values() {
         .with_c_z_map(c_z.to_vec())
         .unwrap();
     interface
-        .set_states(&[SiteState::Attached, SiteState::Attached, SiteState::Detached])
+        .set_states(&[
+            SiteState::Attached,
+            SiteState::Attached,
+            SiteState::Detached,
+        ])
         .unwrap();
     let u_z = [0.2e-6, -0.4e-6, 0.0];
     let k_z = interface.normal_stiffness();
@@ -562,7 +663,11 @@ fn each_site_takes_its_own_values() {
         .unwrap();
     for i in 0..3 {
         assert!((k_z[i] / (c_z[i] / u0[i]) - 1.0).abs() < 1e-15, "k_z {i}");
-        let expected = if i < 2 { c_x[i] * (-u_z[i] / u0[i]).exp() } else { 0.0 };
+        let expected = if i < 2 {
+            c_x[i] * (-u_z[i] / u0[i]).exp()
+        } else {
+            0.0
+        };
         assert!((k_x[i] - expected).abs() <= 1e-15 * expected, "k_x {i}");
     }
     assert!((lambda[0] - 0.3 * 1e3 / 10.0).abs() < 1e-12);

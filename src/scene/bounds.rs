@@ -568,7 +568,11 @@ pub(super) fn map_values(k: usize, values: &[f64], sites: usize) -> Result<()> {
             key,
             index,
             value,
-            range: format!("[{}, {}]{unit} (the range of the scalar)", End(min, true), End(max, false)),
+            range: format!(
+                "[{}, {}]{unit} (the range of the scalar)",
+                End(min, true),
+                End(max, false)
+            ),
         });
     }
     Ok(())

@@ -8,7 +8,9 @@
 //! fall back to a default.
 
 use super::schema::{schema_enum, schema_leaf, schema_struct, Schema, Walk};
-use super::{Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder, SiteMap, SiteMaps, MAP_KEYS};
+use super::{
+    Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder, SiteMap, SiteMaps, MAP_KEYS,
+};
 use crate::contact::{ContactRule, Delay};
 use crate::interface::AreaLaw;
 use crate::probe::ProbeSpec;
@@ -1681,9 +1683,15 @@ mod tests {
         ] {
             assert!(keys.iter().any(|k| k == key), "{key}: {keys:?}");
         }
-        assert_eq!(first_difference(&a, &b).as_deref(), Some("maps.friction_coefficient.kind"));
+        assert_eq!(
+            first_difference(&a, &b).as_deref(),
+            Some("maps.friction_coefficient.kind")
+        );
         let c = a.clone().friction_map(map(4));
-        assert_eq!(first_difference(&b, &c).as_deref(), Some("maps.friction_coefficient.seed"));
+        assert_eq!(
+            first_difference(&b, &c).as_deref(),
+            Some("maps.friction_coefficient.seed")
+        );
         let d = a.c_x_map(SiteMap::Values(vec![1e12; 980]));
         assert_eq!(first_difference(&d, &b).as_deref(), Some("maps.c_x.kind"));
     }
