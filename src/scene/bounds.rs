@@ -523,9 +523,18 @@ pub(super) fn load_exponent(builder: &SceneBuilder, grid: &Grid, c_z: f64) -> Re
     Ok(())
 }
 
+/// A map's key, range, unit, and keys of a random map's mean and standard deviation.
+type MapBounds = (
+    &'static str,
+    (f64, f64),
+    &'static str,
+    &'static str,
+    &'static str,
+);
+
 /// The maps' keys ([`super::MAP_KEYS`] under `maps`), their ranges (the scalars') and
 /// units, and the keys of a random map's mean and standard deviation.
-const MAPS: [(&str, (f64, f64), &str, &str, &str); 3] = [
+const MAPS: [MapBounds; 3] = [
     (
         "maps.friction_coefficient",
         FRICTION,
