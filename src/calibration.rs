@@ -260,7 +260,8 @@ fn normal_area_with(
 /// # Errors
 /// [`Error::InvalidParameter`] for a target area that is not finite and `> 0`, a bracket
 /// that is not `0 < low < high` or does not enclose the target; [`Error::FitNotConverged`]
-/// past `max_evaluations`; those of [`normal_contact_area`].
+/// past `max_evaluations`; those of [`normal_contact_area`]; [`Error::InvalidChoice`]
+/// (`maps.c_z`) for a scene with a map of `c_z`, which the scalar fitted would not change.
 pub fn fit_normal_stiffness(
     builder: &SceneBuilder,
     target_area: f64,
@@ -268,6 +269,7 @@ pub fn fit_normal_stiffness(
     options: &FitOptions,
 ) -> Result<Fit> {
     check_bracket("c_z bracket (N/m²)", bracket)?;
+    refuse_map(builder, 2)?;
     if !(target_area.is_finite() && target_area > 0.0) {
         return Err(Error::InvalidParameter {
             name: "target_area (m²)",
@@ -487,7 +489,8 @@ fn misfit_with(
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for a bracket that is not `0 < low < high`; those of
-/// [`precursor_misfit`].
+/// [`precursor_misfit`]; [`Error::InvalidChoice`] (`maps.c_x`) for a scene with a map of
+/// `c_x`, which the scalar fitted would not change.
 pub fn fit_tangential_stiffness(
     builder: &SceneBuilder,
     targets: &[(f64, f64)],
@@ -495,6 +498,7 @@ pub fn fit_tangential_stiffness(
     options: &FitOptions,
 ) -> Result<Fit> {
     check_bracket("c_x bracket (N/m³)", bracket)?;
+    refuse_map(builder, 1)?;
     check_targets(targets)?;
     let mut evaluations = 0;
     let planner = Planner::new(); // every evaluation shares the geometry's plan
@@ -561,4 +565,26 @@ pub fn fit_tangential_stiffness(
         misfit: best_f,
         evaluations,
     })
+}
+
+/// Refuses a fit of the scalar that the builder's map `k` (the order of the scene's
+/// `maps`: μ, `c_x`, `c_z`) replaces: every evaluation would give the same scene.
+fn refuse_map(builder: &SceneBuilder, k: usize) -> Result<()> {
+    if builder.current_maps().0[k].is_some() {
+        return Err(Error::InvalidChoice {
+            name: ["maps.friction_coefficient", "maps.c_x", "maps.c_z"][k],
+            value: "a map",
+            reason: match k {
+                1 => {
+                    "fit_tangential_stiffness fits the scalar c_x, which the scene's map of \
+                      c_x replaces: fit on the scene without the map"
+                }
+                _ => {
+                    "fit_normal_stiffness fits the scalar c_z, which the scene's map of c_z \
+                      replaces: fit on the scene without the map"
+                }
+            },
+        });
+    }
+    Ok(())
 }

@@ -174,8 +174,10 @@ pub(crate) struct Fields<'a> {
     pub(crate) normal_traction: &'a [f64],
     /// `u_z` (m) per site.
     pub(crate) normal_displacement: &'a [f64],
-    /// `μ` (dimensionless).
+    /// `μ` (dimensionless) of the material.
     pub(crate) friction_coefficient: f64,
+    /// `μ_i` per site where the scene has a friction map (it replaces the material's).
+    pub(crate) friction_map: Option<&'a [f64]>,
     /// `F` (N).
     pub(crate) force: f64,
 }
@@ -224,7 +226,9 @@ impl ContactState {
             state: fields.states[i],
             normal_traction: fields.normal_traction[i],
             normal_displacement: fields.normal_displacement[i],
-            friction_coefficient: fields.friction_coefficient,
+            friction_coefficient: fields
+                .friction_map
+                .map_or(fields.friction_coefficient, |mu| mu[i]),
             anchor: self.anchors[i],
             ruptures: self.ruptures.get(i).copied().unwrap_or(0),
             stable_states: self.clock,
@@ -470,7 +474,8 @@ impl ContactRule {
 
     /// The shear load (N) at which each site reaches its threshold, from the normal
     /// tractions (Pa), the shear tractions per newton of load (Pa/N) and the friction
-    /// coefficient; `+∞` for sites that carry no shear.
+    /// coefficient (each site's from the interface's friction map where it has one);
+    /// `+∞` for sites that carry no shear.
     ///
     /// # Errors
     /// [`Error::LengthMismatch`] or [`Error::NonFinite`] for slices of the wrong length or
@@ -490,12 +495,17 @@ impl ContactRule {
             friction_coefficient,
         )?;
         // The anchored rules' window starts from the same checks; its loads are
-        // [`ContactRule::thresholds`]'.
-        Ok(shear_per_newton
-            .iter()
-            .zip(normal_traction)
-            .map(|(g, f)| breaking_load(friction_coefficient * f, *g))
-            .collect())
+        // [`ContactRule::thresholds`]'. A friction map is matched outside the loop.
+        let loads = shear_per_newton.iter().zip(normal_traction);
+        Ok(match interface.friction_map() {
+            None => loads
+                .map(|(g, f)| breaking_load(friction_coefficient * f, *g))
+                .collect(),
+            Some(mu) => loads
+                .zip(mu)
+                .map(|((g, f), mu)| breaking_load(mu * f, *g))
+                .collect(),
+        })
     }
 
     /// Whether the rule anchors springs where their sites attach (all but the paper's,
@@ -546,9 +556,10 @@ impl ContactRule {
         if let Some(taus) = taus {
             check_slice("thresholds", taus, n)?;
         }
+        let map = interface.friction_map();
         let tau = |i: usize| match taus {
             Some(taus) => taus[i],
-            None => friction_coefficient * normal_traction[i],
+            None => map.map_or(friction_coefficient, |mu| mu[i]) * normal_traction[i],
         };
         let Some(anchor_traction) = anchor_traction else {
             // A custom rule that does not anchor: the paper's springs, its threshold.
@@ -828,7 +839,9 @@ impl Interface {
     /// `|φ_x| = μ φ_z`, `λ_i = μ φ_z,i / |φ_x,i(1)|` (paper Eq. lambda_Amonton_dscrt), from
     /// the normal tractions (Pa) and the shear tractions per newton of load (Pa/N,
     /// [`crate::solver::TangentialResponse::traction`]). `+∞` for sites that carry no shear
-    /// (detached, broken, or exactly unloaded).
+    /// (detached, broken, or exactly unloaded). On an interface with a friction map
+    /// ([`Interface::with_friction_map`]) each site's `μ_i` takes the place of
+    /// `friction_coefficient`, which is still checked.
     ///
     /// # Errors
     /// [`Error::LengthMismatch`] for slices of the wrong length;

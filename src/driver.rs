@@ -770,7 +770,7 @@ impl Driver {
     /// set is solved (queueing the sites that attach, anchored). Whether any re-formed.
     fn reform(&mut self) -> Result<bool> {
         let force = self.force();
-        let load_scale = self.friction_coefficient() * self.normal_load();
+        let load_scale = self.friction_limit();
         let friction_coefficient = self.friction_coefficient();
         let Some(contact) = &mut self.contact else {
             return Ok(false);
@@ -783,6 +783,7 @@ impl Driver {
             normal_traction: &normal.traction,
             normal_displacement: &normal.displacement,
             friction_coefficient,
+            friction_map: self.interface.friction_map(),
             force,
         };
         let due = contact.tick(self.scene.contact_rule(), &fields, load_scale);
@@ -864,6 +865,7 @@ impl Driver {
                             normal_traction: &normal.traction,
                             normal_displacement: &normal.displacement,
                             friction_coefficient: self.friction_coefficient(),
+                            friction_map: self.interface.friction_map(),
                             force,
                         };
                         self.contact
@@ -1073,9 +1075,36 @@ impl Driver {
     }
 
     /// The local friction coefficient `μ` (dimensionless) of the Coulomb rule, for
-    /// instance for [`crate::PlaneStress::profile`].
+    /// instance for [`crate::PlaneStress::profile`]: the material's. With a friction map
+    /// ([`crate::SceneBuilder::friction_map`]) each site has its own (the interface's
+    /// [`crate::Interface::friction_map`]) and this one stays the reference of the
+    /// probes' Coulomb stress.
     pub fn friction_coefficient(&self) -> f64 {
         self.scene.material().friction_coefficient()
+    }
+
+    /// The friction limit `μF_N` (N): the largest shear force a stable state can carry
+    /// (every attached site holds `|φ_x,i| ≤ μ_i φ_z,i`), and the unit of the loads
+    /// `F/(μF_N)` of the run's tables. `μ` is the material's
+    /// ([`Driver::friction_coefficient`]), or the largest value of the scene's friction
+    /// map ([`crate::SceneBuilder::friction_map`]) where that is larger.
+    ///
+    /// ```
+    /// use precursors::{Drive, Scene, SiteMap};
+    /// let base = Scene::builder()
+    ///     .block(0.010, 0.004, 0.010)
+    ///     .cells(10, 4)
+    ///     .normal_load(40.0)                // F_N (N)
+    ///     .drive(Drive::top());
+    /// assert_eq!(base.clone().build()?.driver()?.friction_limit(), 0.5 * 40.0);
+    /// let mu: Vec<f64> = (0..40).map(|i| if i == 7 { 0.8 } else { 0.3 }).collect();
+    /// let driver = base.friction_map(SiteMap::Values(mu)).build()?.driver()?;
+    /// assert_eq!(driver.friction_limit(), 0.8 * 40.0);              // the largest μ_i
+    /// assert_eq!(driver.friction_coefficient(), 0.5);               // the material's
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    pub fn friction_limit(&self) -> f64 {
+        self.scene.limit_friction_coefficient() * self.normal_load()
     }
 
     /// Cumulative solver work since this driver was created or resumed (counts and wall

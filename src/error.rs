@@ -499,6 +499,34 @@ pub enum Error {
         /// What is wrong with it.
         reason: String,
     },
+    /// A map's file has a line that is not a value of its key in range
+    /// (`SiteMap::from_file`, a scene file's `maps.KEY` of kind `file`).
+    #[error("{key}: {}, line {line}: {}", path.display(), Bounded(reason))]
+    MapFile {
+        /// The scene-file key of the map (`maps.friction_coefficient`, `maps.c_x`,
+        /// `maps.c_z`; `maps` for [`crate::SiteMap::from_file`]).
+        key: &'static str,
+        /// The file.
+        path: PathBuf,
+        /// Line number (1-based; 0 for the file as a whole).
+        line: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// A site's value of a map is not finite or outside its key's range (a scene's
+    /// `maps`, `Interface::with_friction_map`, `with_c_x_map`, `with_c_z_map`).
+    #[error("{key}[{index}] = {} is out of range: the valid range is {range}", Num(*value))]
+    MapValue {
+        /// The scene-file key of the map (`maps.friction_coefficient`, `maps.c_x`,
+        /// `maps.c_z`).
+        key: &'static str,
+        /// Cell index (paper order `iy * Nx + ix`).
+        index: usize,
+        /// The value given or generated.
+        value: f64,
+        /// The valid range, with its unit.
+        range: String,
+    },
     /// A scene file is not valid JSON, not UTF-8 text, or does not follow
     /// `docs/scene-format.md` (feature `serde`: `SceneBuilder::from_json_file`,
     /// `from_json_str`).

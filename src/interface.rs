@@ -8,6 +8,13 @@
 //! may re-attach), and [`SiteState::Broken`] once it slipped under the Coulomb rule (never
 //! re-attaches). The solvers ([`crate::solver`]) work with compliances `1/k` (m³/N),
 //! which stay finite when springs are stiff (`u0 → 0`).
+//!
+//! `μ`, `c_x` and `c_z` are the scalars of the material and the spring law unless the
+//! interface has a map of them ([`Interface::with_friction_map`],
+//! [`Interface::with_c_x_map`], [`Interface::with_c_z_map`]; a scene's key `maps`): one
+//! value per site. Without a map the scalar code runs as before, bit for bit; a map with
+//! every value equal to the scalar gives the same bits (the same expressions, the value
+//! read from the map).
 
 use crate::error::{check_slice, Error, Result};
 use crate::geometry::Grid;
@@ -15,6 +22,7 @@ use crate::surface::{Plan, SurfaceSpectrum, Truncated};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
+use std::sync::Arc;
 
 /// Bulk and friction properties of the block. Defaults: the paper's PMMA.
 ///
@@ -650,6 +658,35 @@ pub struct Interface {
     heights: Heights,
     law: SpringLaw,
     states: Vec<SiteState>,
+    /// Per-site `μ`, `c_x` (N/m³), `c_z` (N/m²): `None` takes the scalar (shared: a
+    /// driver's interface is a clone of its scene's).
+    friction: Option<Arc<[f64]>>,
+    c_x: Option<Arc<[f64]>>,
+    c_z: Option<Arc<[f64]>>,
+}
+
+/// The checks of a map's values: one per site, each finite and `> 0`.
+fn site_map(key: &'static str, grid: &Grid, values: Vec<f64>) -> Result<Option<Arc<[f64]>>> {
+    if values.len() != grid.len() {
+        return Err(Error::LengthMismatch {
+            name: key,
+            expected: grid.len(),
+            found: values.len(),
+        });
+    }
+    if let Some((index, &value)) = values
+        .iter()
+        .enumerate()
+        .find(|(_, v)| !(v.is_finite() && **v > 0.0))
+    {
+        return Err(Error::MapValue {
+            key,
+            index,
+            value,
+            range: "finite and > 0".into(),
+        });
+    }
+    Ok(Some(values.into()))
 }
 
 impl Interface {
@@ -671,7 +708,84 @@ impl Interface {
             grid,
             heights,
             law,
+            friction: None,
+            c_x: None,
+            c_z: None,
         })
+    }
+
+    /// The same interface with a friction coefficient per site (dimensionless, in cell
+    /// order `i = iy·Nx + ix`) in place of the scalar `μ` of the Coulomb rule: site `i`
+    /// breaks at `|φ_x,i| = μ_i φ_z,i` ([`Interface::breaking_loads`] then ignores its
+    /// scalar argument but for its checks).
+    ///
+    /// ```
+    /// use precursors::{Block, Grid, Heights, Interface, SpringLaw};
+    /// let grid = Grid::new(Block::new(0.002, 0.001, 0.005)?, 2, 1)?;   // two cells
+    /// let heights = Heights::from_values(&grid, vec![1e-6; 2])?;
+    /// let interface = Interface::new(grid, heights, SpringLaw::default())?
+    ///     .with_friction_map(vec![0.4, 0.8])?
+    ///     .with_c_z_map(vec![1.65e8, 3.3e8])?;                       // N/m²
+    /// // λ_i = μ_i φ_z / |φ_x(1 N)|: 0.4 · 1e3 / 10 and 0.8 · 1e3 / 10 (N).
+    /// assert_eq!(interface.breaking_loads(&[1e3; 2], &[10.0; 2], 0.5)?, vec![40.0, 80.0]);
+    /// assert_eq!(interface.normal_stiffness(), vec![1.65e8 / 1e-6, 3.3e8 / 1e-6]); // N/m³
+    /// assert!(interface.c_x_map().is_none());                       // the scalar c_x
+    /// assert!(Interface::new(grid, Heights::from_values(&grid, vec![1e-6; 2])?,
+    ///     SpringLaw::default())?.with_friction_map(vec![0.5]).is_err()); // one per site
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] for a count other than the grid's; [`Error::MapValue`]
+    /// for a value that is not finite and `> 0`.
+    pub fn with_friction_map(mut self, values: Vec<f64>) -> Result<Self> {
+        self.friction = site_map("maps.friction_coefficient", &self.grid, values)?;
+        Ok(self)
+    }
+
+    /// The same interface with `c_x` (N/m³) per site in place of the spring law's:
+    /// `k_x,i = c_x,i exp(-u_z,i/u0_i)`.
+    ///
+    /// # Errors
+    /// As [`Interface::with_friction_map`].
+    pub fn with_c_x_map(mut self, values: Vec<f64>) -> Result<Self> {
+        self.c_x = site_map("maps.c_x", &self.grid, values)?;
+        Ok(self)
+    }
+
+    /// The same interface with `c_z` (N/m²) per site in place of the spring law's:
+    /// `k_z,i = c_z,i / u0_i`.
+    ///
+    /// # Errors
+    /// As [`Interface::with_friction_map`].
+    pub fn with_c_z_map(mut self, values: Vec<f64>) -> Result<Self> {
+        self.c_z = site_map("maps.c_z", &self.grid, values)?;
+        Ok(self)
+    }
+
+    /// The friction coefficient of every site (cell order), `None` when every site has
+    /// the material's scalar `μ`.
+    pub fn friction_map(&self) -> Option<&[f64]> {
+        self.friction.as_deref()
+    }
+
+    /// `c_x` (N/m³) of every site, `None` when every site has the spring law's.
+    pub fn c_x_map(&self) -> Option<&[f64]> {
+        self.c_x.as_deref()
+    }
+
+    /// `c_z` (N/m²) of every site, `None` when every site has the spring law's.
+    pub fn c_z_map(&self) -> Option<&[f64]> {
+        self.c_z.as_deref()
+    }
+
+    /// `c_x` (N/m³) of site `index`.
+    #[inline]
+    fn c_x_at(&self, index: usize) -> f64 {
+        match &self.c_x {
+            None => self.law.c_x,
+            Some(map) => map[index],
+        }
     }
 
     /// The grid.
@@ -760,18 +874,34 @@ impl Interface {
     /// Normal stiffness per unit area `k_z = c_z / u0` (N/m³) of every site (the value
     /// while attached; a detached or broken site exerts no force).
     pub fn normal_stiffness(&self) -> Vec<f64> {
-        self.heights().iter().map(|h| self.law.c_z / h).collect()
+        match &self.c_z {
+            None => self.heights().iter().map(|h| self.law.c_z / h).collect(),
+            Some(c_z) => self
+                .heights()
+                .iter()
+                .zip(c_z.iter())
+                .map(|(h, c)| c / h)
+                .collect(),
+        }
     }
 
     /// Normal compliance `1 / k_z = u0 / c_z` (m³/N) of every site.
     pub fn normal_compliance(&self) -> Vec<f64> {
-        self.heights().iter().map(|h| h / self.law.c_z).collect()
+        match &self.c_z {
+            None => self.heights().iter().map(|h| h / self.law.c_z).collect(),
+            Some(c_z) => self
+                .heights()
+                .iter()
+                .zip(c_z.iter())
+                .map(|(h, c)| h / c)
+                .collect(),
+        }
     }
 
     /// Tangential compliance `1 / k_x = exp(u_z / u0) / c_x` (m³/N) of attached site
     /// `i` at normal displacement `u_z` (m). Finite whenever `u_z ≤ u0` (attached).
     pub(crate) fn tangential_compliance_at(&self, index: usize, u_z: f64) -> Result<f64> {
-        let value = (u_z / self.heights()[index]).exp() / self.law.c_x;
+        let value = (u_z / self.heights()[index]).exp() / self.c_x_at(index);
         if value.is_finite() {
             Ok(value)
         } else {
@@ -808,7 +938,8 @@ impl Interface {
     /// the candidates of a rupture, which neither underflow (energies below 1e-308 J at the
     /// corners of the valid ranges) nor overflow can tie. `-∞` for a zero traction.
     pub(crate) fn log_rupture_energy(&self, index: usize, u_z: f64, phi: f64, cell: f64) -> f64 {
-        2.0 * phi.abs().ln() + (0.5 * cell).ln() + u_z / self.heights()[index] - self.law.c_x.ln()
+        2.0 * phi.abs().ln() + (0.5 * cell).ln() + u_z / self.heights()[index]
+            - self.c_x_at(index).ln()
     }
 
     /// Tangential stiffness per unit area (N/m³) at the normal displacements `u_z` (m):
@@ -831,7 +962,7 @@ impl Interface {
         if self.states[index] != SiteState::Attached {
             return Ok(0.0);
         }
-        let value = self.law.c_x * (-u_z / self.heights()[index]).exp();
+        let value = self.c_x_at(index) * (-u_z / self.heights()[index]).exp();
         if value.is_finite() {
             Ok(value)
         } else {

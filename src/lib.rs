@@ -146,7 +146,7 @@ pub use probe::{
     CellStress, PlaneStress, PointStress, ProbeInput, ProbeSpec, Profile, StressProbe, Stresses,
 };
 pub use recording::{ObserverCost, RunOptions};
-pub use scene::{Drive, ForceLoad, HeightSource, Lateral, Scene, SceneBuilder};
+pub use scene::{Drive, ForceLoad, HeightSource, Lateral, Scene, SceneBuilder, SiteMap};
 pub use surface::SurfaceSpectrum;
 
 /// The `nalgebra` this crate converts to and from (feature `nalgebra`): heights from an

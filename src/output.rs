@@ -617,7 +617,7 @@ impl RunTables {
         }
         resume::check_site_states(
             driver.contact_rule(),
-            driver.friction_coefficient() * driver.normal_load(),
+            driver.friction_limit(),
             &plan.site_events,
             driver.site_states(),
             &read[0],
@@ -680,7 +680,7 @@ impl RunTables {
             .map_err(|e| Error::io("writing table", &self.partials[0], e))?;
         if let Event::Stable { load, .. } = *event {
             self.stable_states += 1;
-            let mu_fn = driver.friction_coefficient() * driver.normal_load();
+            let mu_fn = driver.friction_limit();
             let (broken, attached) = counts(driver.site_states());
             let ell = driver.precursor_length()?;
             let slip = driver.slip_per_newton()?;
@@ -718,7 +718,7 @@ impl RunTables {
             if let Some(profiles) = &mut self.profiles {
                 profiles.reach(driver, index, load.force, false)?;
             }
-            let mu_fn = driver.friction_coefficient() * driver.normal_load();
+            let mu_fn = driver.friction_limit();
             self.map_rows_below(load.force / mu_fn, false)?;
             self.slipped = true;
         }

@@ -600,86 +600,269 @@ impl HeightSource {
     /// must fit in the memory available.
     pub(crate) fn read_file(path: &std::path::Path, cells: Option<usize>) -> Result<HeightSource> {
         let name = path.display().to_string();
-        // 1 MiB of comments and 256 bytes a height. Checked on the length reported (a
-        // long file is refused unread) and on the bytes read (a device reports 0).
-        let limit = cells.map(|c| (1u64 << 20).saturating_add((c as u64).saturating_mul(256)));
-        let too_long = |size: &str| Error::HeightsFile {
-            path: name.clone(),
-            line: 0,
-            reason: format!(
-                "the file has {size} bytes, more than the {} bytes that {} heights (one per \
+        read_values(
+            path,
+            cells,
+            "reading heights file",
+            ("height", "heights"),
+            |value| {
+                (!(value.is_finite() && value > 0.0))
+                    .then(|| format!("{value} m is not a height: heights must be finite and > 0"))
+            },
+            |line, reason| Error::HeightsFile {
+                path: name.clone(),
+                line,
+                reason,
+            },
+        )
+        .map(HeightSource::Values)
+    }
+}
+
+/// The values of a text file of one value per line in the paper's cell order
+/// `i = iy·Nx + ix` (blank lines and lines starting with `#` skipped), for a grid of
+/// `cells` cells when known: a file longer than such a grid's values can be (1 MiB of
+/// comments and 256 bytes a value), or holding more values, is refused before it is read
+/// whole; without a grid, the file must fit in the memory available. `noun` names a value
+/// and the values in messages, `invalid` says why a value is refused (`None`: valid),
+/// `error` makes the error of a line (0: the file as a whole) and its reason.
+fn read_values(
+    path: &std::path::Path,
+    cells: Option<usize>,
+    operation: &'static str,
+    (one, many): (&str, &str),
+    invalid: impl Fn(f64) -> Option<String>,
+    error: impl Fn(usize, String) -> Error,
+) -> Result<Vec<f64>> {
+    // 1 MiB of comments and 256 bytes a value. Checked on the length reported (a long
+    // file is refused unread) and on the bytes read (a device reports 0).
+    let limit = cells.map(|c| (1u64 << 20).saturating_add((c as u64).saturating_mul(256)));
+    let too_long = |size: &str| {
+        error(
+            0,
+            format!(
+                "the file has {size} bytes, more than the {} bytes that {} {many} (one per \
                  cell) and their comments may take",
                 limit.unwrap_or_default(),
                 cells.unwrap_or_default()
             ),
-        };
-        let size = std::fs::metadata(path)
-            .map_err(|e| Error::io("reading heights file", path, e))?
-            .len();
-        if limit.is_some_and(|l| size > l) {
-            return Err(too_long(&size.to_string()));
-        }
-        // The text and the values (8 bytes each, from at least 2 bytes of text) within the
-        // memory available.
-        let bytes = crate::files::read_bytes(path, "reading heights file")?;
-        if limit.is_some_and(|l| bytes.len() as u64 > l) {
-            return Err(too_long(&format!("at least {}", bytes.len())));
-        }
-        let text = match std::str::from_utf8(&bytes) {
-            Ok(text) => text,
-            Err(e) => {
-                let prefix = &bytes[..e.valid_up_to()];
-                let line = prefix.iter().filter(|b| **b == b'\n').count() + 1;
-                return Err(Error::HeightsFile {
-                    path: name,
-                    line,
-                    reason: format!(
-                        "the file is not UTF-8 text: byte {} (0x{:02x}) is not valid UTF-8",
-                        e.valid_up_to(),
-                        bytes[e.valid_up_to()]
-                    ),
-                });
-            }
-        };
-        let mut values = Vec::new();
-        for (number, line) in text.lines().enumerate() {
-            let line = line.trim();
-            if line.is_empty() || line.starts_with('#') {
-                continue;
-            }
-            let bad = |reason: String| Error::HeightsFile {
-                path: name.clone(),
-                line: number + 1,
-                reason,
-            };
-            if cells.is_some_and(|cells| values.len() == cells) {
-                return Err(bad(format!(
-                    "one height more than the grid's {} cells",
-                    values.len()
-                )));
-            }
-            let value: f64 = line.parse().map_err(|e| {
-                // A line may be megabytes long: its start says enough.
-                let start: String = line.chars().take(40).collect();
-                let cut = if start.len() < line.len() { "..." } else { "" };
-                bad(format!("{start:?}{cut} is not a number ({e})"))
-            })?;
-            if !(value.is_finite() && value > 0.0) {
-                return Err(bad(format!(
-                    "{value} m is not a height: heights must be finite and > 0"
-                )));
-            }
-            values.push(value);
-        }
-        if values.is_empty() {
-            return Err(Error::HeightsFile {
-                path: name,
-                line: 0,
-                reason: "the file holds no heights".into(),
-            });
-        }
-        Ok(HeightSource::Values(values))
+        )
+    };
+    let size = std::fs::metadata(path)
+        .map_err(|e| Error::io(operation, path, e))?
+        .len();
+    if limit.is_some_and(|l| size > l) {
+        return Err(too_long(&size.to_string()));
     }
+    // The text and the values (8 bytes each, from at least 2 bytes of text) within the
+    // memory available.
+    let bytes = crate::files::read_bytes(path, operation)?;
+    if limit.is_some_and(|l| bytes.len() as u64 > l) {
+        return Err(too_long(&format!("at least {}", bytes.len())));
+    }
+    let text = match std::str::from_utf8(&bytes) {
+        Ok(text) => text,
+        Err(e) => {
+            let prefix = &bytes[..e.valid_up_to()];
+            let line = prefix.iter().filter(|b| **b == b'\n').count() + 1;
+            return Err(error(
+                line,
+                format!(
+                    "the file is not UTF-8 text: byte {} (0x{:02x}) is not valid UTF-8",
+                    e.valid_up_to(),
+                    bytes[e.valid_up_to()]
+                ),
+            ));
+        }
+    };
+    let mut values = Vec::new();
+    for (number, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let bad = |reason: String| error(number + 1, reason);
+        if cells.is_some_and(|cells| values.len() == cells) {
+            return Err(bad(format!(
+                "one {one} more than the grid's {} cells",
+                values.len()
+            )));
+        }
+        let value: f64 = line.parse().map_err(|e| {
+            // A line may be megabytes long: its start says enough.
+            let start: String = line.chars().take(40).collect();
+            let cut = if start.len() < line.len() { "..." } else { "" };
+            bad(format!("{start:?}{cut} is not a number ({e})"))
+        })?;
+        if let Some(reason) = invalid(value) {
+            return Err(bad(reason));
+        }
+        values.push(value);
+    }
+    if values.is_empty() {
+        return Err(error(0, format!("the file holds no {many}")));
+    }
+    Ok(values)
+}
+
+/// Where a map of per-site values comes from: a friction coefficient (dimensionless),
+/// `c_x` (N/m³) or `c_z` (N/m²) per site in place of the scalar of the material or the
+/// spring law ([`SceneBuilder::friction_map`], [`SceneBuilder::c_x_map`],
+/// [`SceneBuilder::c_z_map`]; the scene-file key `maps`, docs/scene-format.md). Each value
+/// must lie in its scalar's range (docs/scene-format.md, "Valid ranges"); the scene refuses
+/// others naming the key and the site ([`Error::MapValue`]).
+///
+/// ```
+/// use precursors::{Drive, Scene, SiteMap, SurfaceSpectrum};
+/// let base = Scene::builder()
+///     .block(0.010, 0.004, 0.010)       // Lx, Ly, Lz (m)
+///     .cells(10, 4)                     // 1 mm cells: 40 sites
+///     .normal_load(40.0)                // F_N (N)
+///     .drive(Drive::top());
+/// // μ from 0.4 to 0.6 along x, one value per cell in the order i = iy·Nx + ix.
+/// let mu: Vec<f64> = (0..40).map(|i| 0.4 + 0.2 * (i % 10) as f64 / 9.0).collect();
+/// let scene = base.clone().friction_map(SiteMap::Values(mu.clone())).build()?;
+/// assert_eq!(scene.interface().friction_map(), Some(&mu[..]));
+/// // c_x from the surface generator: ξ = 2 mm, mean 1.65e12 N/m³, sd 20 %, its own seed.
+/// let c_x = SiteMap::Surface {
+///     spectrum: SurfaceSpectrum::gaussian(2e-3)?,
+///     mean: 1.65e12,
+///     std_dev: 0.33e12,
+///     seed: 9,
+/// };
+/// let scene = base.clone().c_x_map(c_x).build()?;
+/// assert!(scene.interface().c_x_map().unwrap().iter().all(|&c| c > 0.0));
+/// // A map of the wrong size, or with a value out of its scalar's range, is refused.
+/// assert!(base.clone().friction_map(SiteMap::Values(vec![0.5; 39])).build().is_err());
+/// assert!(base.friction_map(SiteMap::Values(vec![1e9; 40])).build().is_err());
+/// # Ok::<(), precursors::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "file::MapSpec", into = "file::MapSpec")
+)]
+#[non_exhaustive]
+pub enum SiteMap {
+    /// One value per site, in the paper's cell order `i = iy·Nx + ix` (in the unit of
+    /// the scalar it replaces).
+    Values(Vec<f64>),
+    /// A random map from the heights' generator ([`Heights::random_surface`]) with its
+    /// own seed: a Gaussian field of the spectrum's correlation, mapped onto a Gaussian
+    /// of `mean` and `std_dev` truncated at 0, averaged over each cell. The same seed
+    /// gives the same map at every cell size and, bit for bit, on every machine (a test
+    /// pins values); with the heights' seed and spectrum it is the heights' field (fully
+    /// correlated with them). Scene-file kinds `gaussian_surface` and
+    /// `self_affine_surface`.
+    Surface {
+        /// The power spectrum of the field.
+        spectrum: SurfaceSpectrum,
+        /// Mean of the Gaussian before truncation at 0 (in the scalar's unit; within the
+        /// scalar's range).
+        mean: f64,
+        /// Standard deviation of the Gaussian before truncation (`>= 0`; `0`: every
+        /// site the mean).
+        std_dev: f64,
+        /// Seed of the field's Fourier coefficients.
+        seed: u64,
+    },
+}
+
+impl SiteMap {
+    /// A map read from a text file: one value per line in the paper's cell order
+    /// `i = iy·Nx + ix`; blank lines and lines starting with `#` are skipped. Each value
+    /// must be finite and `> 0`; the count and the ranges are checked against the scene
+    /// at [`SceneBuilder::build`].
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be read (with its path); [`Error::MapFile`]
+    /// (key `maps`) for a line that is not a finite value `> 0`, or no value at all.
+    pub fn from_file(path: impl AsRef<std::path::Path>) -> Result<SiteMap> {
+        Self::read_file(path.as_ref(), None, "maps", (0.0, f64::INFINITY), "")
+    }
+
+    /// [`SiteMap::from_file`] for the scene-file key `key` on a grid of `cells` cells
+    /// (when known: a longer file is refused before it is read whole): each value within
+    /// `range` (in `unit`).
+    pub(crate) fn read_file(
+        path: &std::path::Path,
+        cells: Option<usize>,
+        key: &'static str,
+        (min, max): (f64, f64),
+        unit: &str,
+    ) -> Result<SiteMap> {
+        read_values(
+            path,
+            cells,
+            "reading map file",
+            ("value", "values"),
+            |value| {
+                let valid = value.is_finite() && value > 0.0 && (min..=max).contains(&value);
+                (!valid).then(|| {
+                    format!(
+                        "{value}{}{unit} is not a value of {key}: finite and > 0{}",
+                        if unit.is_empty() { "" } else { " " },
+                        if max.is_finite() {
+                            format!(", within [{min:e}, {max:e}]")
+                        } else {
+                            String::new()
+                        }
+                    )
+                })
+            },
+            |line, reason| Error::MapFile {
+                key,
+                path: path.to_path_buf(),
+                line,
+                reason,
+            },
+        )
+        .map(SiteMap::Values)
+    }
+
+    /// The map's values on `grid` (drawn for a random map: `O(N)` work and more).
+    ///
+    /// # Errors
+    /// Those of the surface generator ([`Error::SurfaceTooLarge`], [`Error::OutOfMemory`]).
+    pub(crate) fn values(&self, grid: &Grid) -> Result<Vec<f64>> {
+        match self {
+            SiteMap::Values(values) => Ok(values.clone()),
+            SiteMap::Surface {
+                spectrum,
+                mean,
+                std_dev,
+                seed,
+            } => crate::surface::Plan::new(grid, spectrum)?.cell_averages(
+                grid,
+                &crate::surface::Truncated::new(*mean, *std_dev),
+                *seed,
+            ),
+        }
+    }
+}
+
+impl From<Vec<f64>> for SiteMap {
+    /// One value per site in cell order `i = iy·Nx + ix` ([`SiteMap::Values`]), validated
+    /// at [`SceneBuilder::build`].
+    fn from(values: Vec<f64>) -> Self {
+        SiteMap::Values(values)
+    }
+}
+
+/// The maps a scene gives, by key ([`MAP_KEYS`]): `None` takes the scalar.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct SiteMaps(pub(crate) [Option<SiteMap>; 3]);
+
+/// The keys of the maps, in the order of [`SiteMaps`]: the friction coefficient, `c_x`,
+/// `c_z`.
+pub(crate) const MAP_KEYS: [&str; 3] = ["friction_coefficient", "c_x", "c_z"];
+
+/// The friction coefficient that normalises the loads `F/(μF_N)` and bounds a stable
+/// state's `F ≤ μF_N`: the material's `μ`, or the friction map's largest value where it
+/// is larger (docs/model.md, "Maps").
+pub(crate) fn friction_limit(mu: f64, map: Option<&[f64]>) -> f64 {
+    map.map_or(mu, |m| m.iter().fold(mu, |a, &b| a.max(b)))
 }
 
 impl From<Vec<f64>> for HeightSource {
@@ -764,6 +947,8 @@ pub struct SceneBuilder {
     confirm_metres: bool,
     /// The rule of the site transitions (scene-file key `contact`).
     contact: ContactRule,
+    /// Per-site maps of μ, c_x, c_z (scene-file key `maps`).
+    maps: SiteMaps,
 }
 
 impl PartialEq for SceneBuilder {
@@ -789,6 +974,7 @@ impl PartialEq for SceneBuilder {
             && self.run == other.run
             && self.confirm_metres == other.confirm_metres
             && self.contact == other.contact
+            && self.maps == other.maps
     }
 }
 
@@ -810,6 +996,7 @@ impl Default for SceneBuilder {
             run: RunOptions::default(),
             confirm_metres: false,
             contact: ContactRule::Paper,
+            maps: SiteMaps::default(),
         }
     }
 }
@@ -961,6 +1148,73 @@ impl SceneBuilder {
         &self.contact
     }
 
+    /// A friction coefficient per site in place of the material's `μ` (scene-file key
+    /// `maps.friction_coefficient`; default none): site `i` breaks at
+    /// `|φ_x,i| = μ_i φ_z,i`. The material's `μ` stays the scene's reference: the loads
+    /// `F/(μF_N)` of the tables are normalised by the larger of it and the map's largest
+    /// value, the friction limit no stable state exceeds ([`crate::Driver::friction_limit`]);
+    /// the stress probes' Coulomb stress and a rejuvenation delay's load use it. Each value
+    /// within the scalar's range ([`SiteMap`]); checked at [`SceneBuilder::check`] (given
+    /// values) and [`SceneBuilder::build`] (drawn ones).
+    pub fn friction_map(mut self, map: SiteMap) -> Self {
+        self.maps.0[0] = Some(map);
+        self
+    }
+
+    /// `c_x` (N/m³) per site in place of the spring law's (scene-file key `maps.c_x`;
+    /// default none): `k_x,i = c_x,i exp(-u_z,i/u0_i)`. Checked as
+    /// [`SceneBuilder::friction_map`].
+    pub fn c_x_map(mut self, map: SiteMap) -> Self {
+        self.maps.0[1] = Some(map);
+        self
+    }
+
+    /// `c_z` (N/m²) per site in place of the spring law's (scene-file key `maps.c_z`;
+    /// default none): `k_z,i = c_z,i / u0_i`. Checked as [`SceneBuilder::friction_map`];
+    /// the normal load's bound `F_N ≤ 650 ΔA c_z` takes the map's smallest value.
+    pub fn c_z_map(mut self, map: SiteMap) -> Self {
+        self.maps.0[2] = Some(map);
+        self
+    }
+
+    /// The friction coefficient that normalises the loads of the scene's tables
+    /// ([`friction_limit`]): the material's `μ`, or the friction map's largest value
+    /// (drawn for a random map) where larger.
+    ///
+    /// # Errors
+    /// Those of [`SceneBuilder::grid`] and of the surface generator, for a random map.
+    pub(crate) fn limit_friction_coefficient(&self) -> Result<f64> {
+        let mu = self.material.friction_coefficient();
+        match &self.maps.0[0] {
+            None => Ok(mu),
+            Some(map) => Ok(friction_limit(mu, Some(&map.values(&self.grid()?)?))),
+        }
+    }
+
+    /// The maps set so far (see [`SceneBuilder::current_springs`]).
+    pub(crate) fn current_maps(&self) -> &SiteMaps {
+        &self.maps
+    }
+
+    /// `interface` with the scene's maps, drawn and checked: each value in its scalar's
+    /// range, and the normal load within the bound of the smallest `c_z`.
+    fn with_maps(&self, mut interface: Interface, grid: &Grid) -> Result<Interface> {
+        for (k, map) in self.maps.0.iter().enumerate() {
+            let Some(map) = map else { continue };
+            let values = map.values(grid)?;
+            bounds::map_values(k, &values, grid.len())?;
+            interface = match k {
+                0 => interface.with_friction_map(values)?,
+                1 => interface.with_c_x_map(values)?,
+                _ => interface.with_c_z_map(values)?,
+            };
+        }
+        if let Some(c_z) = interface.c_z_map() {
+            bounds::load_exponent(self, grid, c_z.iter().fold(f64::INFINITY, |a, &b| a.min(b)))?;
+        }
+        Ok(interface)
+    }
+
     /// The plan tolerance (scene-file key `plan_tolerance`): the largest relative error
     /// accepted on the influence operator's eigenvalues (dimensionless, default `1e-8`, as
     /// [`crate::green::InfluencePlanBuilder::plan_tolerance`]; not the solver's linear
@@ -1054,12 +1308,6 @@ impl SceneBuilder {
     /// name on the builder).
     pub(crate) fn current_springs(&self) -> SpringLaw {
         self.law
-    }
-
-    /// The material set so far (see [`SceneBuilder::current_springs`]).
-    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
-    pub(crate) fn current_material(&self) -> Material {
-        self.material
     }
 
     /// The normal load set so far (N; see [`SceneBuilder::current_springs`]).
@@ -1262,7 +1510,11 @@ impl SceneBuilder {
                 Some(cells)
             }
         };
-        let interface = Interface::new(grid, heights, self.law)?;
+        let interface = self.with_maps(Interface::new(grid, heights, self.law)?, &grid)?;
+        let limit_mu = friction_limit(
+            self.material.friction_coefficient(),
+            interface.friction_map(),
+        );
         // The seed is in the heights now: `to_builder` then takes given values.
         self.seed = None;
         let probe = plan_probes(&plan, self.effective_probes(), rod.as_ref())?;
@@ -1274,6 +1526,7 @@ impl SceneBuilder {
                 interface,
                 plan,
                 lateral_response,
+                limit_mu,
                 builder: self,
             }),
         })
@@ -1335,6 +1588,8 @@ struct Built {
     rod: Option<RodLoad>,
     /// The default probes, planned at build.
     probe: Option<StressProbe>,
+    /// The friction coefficient of the friction limit ([`friction_limit`]).
+    limit_mu: f64,
 }
 
 impl Scene {
@@ -1423,6 +1678,12 @@ impl Scene {
     /// The default probes as planned at build (`None` when there are none).
     pub(crate) fn stress_probe(&self) -> Option<&StressProbe> {
         self.inner.probe.as_ref()
+    }
+
+    /// The friction coefficient of the friction limit `μF_N` ([`friction_limit`]): the
+    /// material's `μ` unless the friction map has a larger value.
+    pub(crate) fn limit_friction_coefficient(&self) -> f64 {
+        self.inner.limit_mu
     }
 
     /// The rule of the site transitions ([`SceneBuilder::contact_rule`]; scene-file key

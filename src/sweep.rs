@@ -760,7 +760,7 @@ impl Sweep {
         }
         tables.finish()?;
         let seconds = started.elapsed().as_secs_f64();
-        let mu_fn = driver.friction_coefficient() * driver.normal_load();
+        let mu_fn = driver.friction_limit();
         let meta = serde_json::json!({
             "crate_version": env!("CARGO_PKG_VERSION"),
             "run": run.index,
@@ -1017,10 +1017,19 @@ fn check_size(axes: &[Axis], realizations: usize, base: &SceneBuilder) -> Result
             })
         }
     };
+    let values = |v: &[f64]| 8 * v.len();
     let heights = match base.current_heights() {
-        HeightSource::Values(v) => 8 * v.len(),
+        HeightSource::Values(v) => values(v),
         _ => 0,
-    };
+    } + base
+        .current_maps()
+        .0
+        .iter()
+        .map(|m| match m {
+            Some(crate::scene::SiteMap::Values(v)) => values(v),
+            _ => 0,
+        })
+        .sum::<usize>();
     // Each run holds its scene, heights included, its values as text and its
     // coordinates; twice that while it is built.
     let text: usize = axes

@@ -67,12 +67,13 @@ fn an_axis_that_is_not_a_scene_key_is_an_axis_error() {
     // before issue 27, without `fields`) in the list: the one scene schema
     // (scene/schema.rs) lists every top-level key of the scene format
     // (docs/scene-format.md), `max_cells`, `fields`, `profiles`, `confirm_metres`,
-    // `max_output_bytes` and `contact` included.
+    // `max_output_bytes`, `contact` and `maps` included.
     assert_eq!(
         e.to_string(),
         "sweep axis `normal_lod`: not a scene key: the scene has no `normal_lod` (it has: \
-         block, cells, confirm_metres, contact, drive, fields, heights, material, max_cells, \
-         max_output_bytes, normal_load, plan_tolerance, probes, profiles, solver, springs)"
+         block, cells, confirm_metres, contact, drive, fields, heights, maps, material, \
+         max_cells, max_output_bytes, normal_load, plan_tolerance, probes, profiles, solver, \
+         springs)"
     );
 }
 

@@ -19,6 +19,7 @@ mod interface;
 mod invariants;
 mod laws;
 mod loads;
+mod maps;
 #[cfg(feature = "nalgebra")]
 mod matrix;
 #[cfg(feature = "cli")]

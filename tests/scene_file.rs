@@ -284,7 +284,7 @@ fn documented_scenes_are_valid() {
         b.build().unwrap_or_else(|e| panic!("{e}\n{text}"));
         blocks += 1;
     }
-    assert_eq!(blocks, 3);
+    assert_eq!(blocks, 4);
     let mut files = 0;
     for entry in std::fs::read_dir(root.join("examples/scenes")).unwrap() {
         let path = entry.unwrap().path();

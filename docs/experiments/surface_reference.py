@@ -9,7 +9,8 @@ crate's (so the reference is the exact cell average to about 1e-15).
 
     python3 docs/experiments/surface_reference.py          # needs mpmath (1.3)
 
-prints the values pinned in tests/surfaces.rs (`pinned_*`) and in src/surface.rs
+prints the values pinned in tests/surfaces.rs (`pinned_*`), tests/maps.rs
+(`pinned_drawn_maps`: a map is the heights' generator with its own marginal) and in src/surface.rs
 (`the_copula_is_the_truncated_gaussian_quantile`).
 """
 import math
@@ -156,4 +157,10 @@ if __name__ == "__main__":
     print("pinned_self_affine_surface (8 x 4 mm, 4 x 2 cells, H 0.7, 3 / 0.6 / 5 mm, seed 11,"
           " mean 2 um, sd 1 um):")
     for v in heights(0.008, 0.004, 4, 2, self_affine(0.7, 3e-3, 0.6e-3, 5e-3), 2e-6, 1e-6, 11, 64):
+        print(f"    {v!r},")
+    print("pinned_drawn_maps, mu (8 x 4 mm, 4 x 2 cells, xi = 2 mm, seed 13, mean 0.5, sd 0.1):")
+    for v in heights(0.008, 0.004, 4, 2, gaussian(2e-3), 0.5, 0.1, 13, 16):
+        print(f"    {v!r},")
+    print("pinned_drawn_maps, c_x (xi = 1.5 mm, seed 21, mean 1.65e12, sd 0.5e12 N/m^3):")
+    for v in heights(0.008, 0.004, 4, 2, gaussian(1.5e-3), 1.65e12, 0.5e12, 21, 16):
         print(f"    {v!r},")

@@ -36,6 +36,9 @@ class Scene:
         friction_coefficient: Optional[float] = ...,
         c_x: Optional[float] = ...,
         c_z: Optional[float] = ...,
+        friction_map: Union[npt.ArrayLike, Mapping[str, Any], None] = ...,
+        c_x_map: Union[npt.ArrayLike, Mapping[str, Any], None] = ...,
+        c_z_map: Union[npt.ArrayLike, Mapping[str, Any], None] = ...,
         drive: Union[str, Mapping[str, Any], None] = ...,
         rod: Optional[Tuple[float, float]] = ...,
         backend: Optional[str] = ...,
@@ -137,6 +140,8 @@ class Driver:
     def normal_load(self) -> float: ...
     @property
     def friction_coefficient(self) -> float: ...
+    @property
+    def friction_limit(self) -> float: ...
     @property
     def nominal_area(self) -> float: ...
     @property

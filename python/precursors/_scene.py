@@ -105,6 +105,29 @@ def _heights(value: Any) -> np.ndarray:
     return array
 
 
+def _map(name: str, value: Any) -> Dict[str, Any]:
+    """A map's scene-file object: a dict as given (the scene file's ``maps.KEY``), or an
+    array of numbers of shape (Ny, Nx), each finite and > 0, as ``values`` in cell order
+    (its shape is checked against the grid by ``Scene``, its ranges by the crate)."""
+    if isinstance(value, dict):
+        return value
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(
+            f"{name} must be an array of numbers (float) of shape (Ny, Nx) or a dict in "
+            f"the scene-file form (maps), not {type(value).__name__}"
+        ) from None
+    bad = np.argwhere(~(np.isfinite(array) & (array > 0.0)))
+    if len(bad):
+        at = tuple(int(i) for i in bad[0])
+        place = ", ".join(str(i) for i in at)
+        raise _value_error(
+            "MapValue", f"{name}[{place}] = {array[at]} is invalid: it must be finite and > 0"
+        )
+    return {"kind": "values", "values": array.ravel(order="C")}
+
+
 class SurfaceSpectrum:
     """The power spectrum of a Gaussian random surface (the crate's ``SurfaceSpectrum``;
     docs/model.md section 3.1): heights with a length scale, the same surface at every
@@ -183,6 +206,9 @@ def scene_dict(
     friction_coefficient: Optional[float] = None,
     c_x: Optional[float] = None,
     c_z: Optional[float] = None,
+    friction_map: Any = None,
+    c_x_map: Any = None,
+    c_z_map: Any = None,
     drive: Union[str, Dict[str, Any], None] = None,
     rod: Optional[Tuple[float, float]] = None,
     backend: Optional[str] = None,
@@ -276,6 +302,17 @@ def scene_dict(
     springs = {k: v for k, v in (("c_x", c_x), ("c_z", c_z)) if v is not None}
     if springs:
         scene["springs"] = springs
+    maps = {
+        key: _map(name, value)
+        for key, name, value in (
+            ("friction_coefficient", "friction_map", friction_map),
+            ("c_x", "c_x_map", c_x_map),
+            ("c_z", "c_z_map", c_z_map),
+        )
+        if value is not None
+    }
+    if maps:
+        scene["maps"] = maps
     if isinstance(drive, str) and drive not in _DRIVES:
         raise _value_error(
             "InvalidChoice",

@@ -86,6 +86,8 @@ fn core_class(e: &precursors::Error) -> Class {
         | E::NoProbes
         | E::SceneFile { .. }
         | E::HeightsFile { .. }
+        | E::MapFile { .. }
+        | E::MapValue { .. }
         | E::CheckpointFile { .. }
         | E::CheckpointSceneMismatch { .. }
         | E::InvalidCheckpoint { .. }
@@ -297,6 +299,9 @@ fn build(py: Python<'_>, builder: precursors::SceneBuilder) -> PyResult<Scene> {
 /// normal_load (N); seed (int) of random heights, heights=array of shape (Ny, Nx) (m),
 /// surface=SurfaceSpectrum, height_distribution=(mean, std_dev) (m);
 /// young_modulus (Pa), poisson_ratio, friction_coefficient; c_x, c_z (springs);
+/// friction_map, c_x_map, c_z_map: per-site values in their place, an array of shape
+/// (Ny, Nx) or a dict in the scene-file form (`maps`: values, file, gaussian_surface,
+/// self_affine_surface);
 /// drive='rod' | 'top' | 'side' or a scene-file dict, rod=(height, half_width) (m);
 /// backend='auto' | 'dense' | 'spectral', threads (int, 'all', 'current');
 /// probe_planes=[z, ...], probe_points=[(x, y, z), ...] (m);
@@ -324,7 +329,8 @@ impl Scene {
         text_signature = "(*, block=None, cells=None, cell_size=None, normal_load=None, \
                           seed=None, heights=None, surface=None, height_distribution=None, \
                           young_modulus=None, poisson_ratio=None, friction_coefficient=None, \
-                          c_x=None, c_z=None, drive=None, rod=None, backend=None, \
+                          c_x=None, c_z=None, friction_map=None, c_x_map=None, \
+                          c_z_map=None, drive=None, rod=None, backend=None, \
                           threads=None, probe_planes=None, probe_points=None, \
                           profile_loads=None, profile_planes=None, confirm_metres=None, \
                           max_output_bytes=None, contact_rule=None, \
@@ -337,16 +343,19 @@ impl Scene {
             .call((), kwargs)?;
         let text = dumps(py, &dict)?;
         let builder = precursors::SceneBuilder::from_json_str(&text).map_err(keyword_error)?;
-        let heights = match kwargs {
-            Some(k) => k.get_item("heights")?.filter(|h| !h.is_none()),
-            None => None,
-        };
-        if let Some(heights) = heights {
+        for name in ["heights", "friction_map", "c_x_map", "c_z_map"] {
+            let array = match kwargs {
+                Some(k) => k
+                    .get_item(name)?
+                    .filter(|h| !h.is_none() && !h.is_instance_of::<PyDict>()),
+                None => None,
+            };
+            let Some(array) = array else { continue };
             // The array's shape, which the scene file's flat values no longer carry: a
             // transposed or flat array is refused, not read row by row.
             let shape: Vec<usize> = py
                 .import("numpy")?
-                .call_method1("shape", (heights,))?
+                .call_method1("shape", (array,))?
                 .extract()?;
             let grid = builder.grid().or_raise()?;
             if shape != [grid.ny(), grid.nx()] {
@@ -356,7 +365,7 @@ impl Scene {
                     class: Class::Value,
                     kind: "ShapeMismatch".into(),
                     message: format!(
-                        "heights has shape ({}{comma}), the grid needs (Ny, Nx) = ({}, {}): \
+                        "{name} has shape ({}{comma}), the grid needs (Ny, Nx) = ({}, {}): \
                          row iy, column ix",
                         given.join(", "),
                         grid.ny(),
@@ -736,6 +745,13 @@ impl Driver {
     #[getter]
     fn friction_coefficient(&self) -> f64 {
         self.inner.friction_coefficient()
+    }
+
+    /// The friction limit `μF_N` (N): the unit of the tables' loads `F/(μF_N)`, with `μ`
+    /// the material's or, where larger, the friction map's largest value.
+    #[getter]
+    fn friction_limit(&self) -> f64 {
+        self.inner.friction_limit()
     }
 
     /// `Lx·Ly` (m²).

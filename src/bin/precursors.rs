@@ -781,7 +781,7 @@ fn run(
         scene.normal_load(),
         scene.normal_load() / (block.lx() * block.ly())
     );
-    let mu_fn = driver.friction_coefficient() * driver.normal_load();
+    let mu_fn = driver.friction_limit();
     let first_event = driver.event_count();
     let mut bar = Progress::new(progress);
     let line = |driver: &Driver, elapsed: f64| {

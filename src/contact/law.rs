@@ -135,7 +135,8 @@ pub struct SiteView {
     pub normal_traction: f64,
     /// The normal displacement `u_z` (m) of the block's bottom at the site.
     pub normal_displacement: f64,
-    /// The local friction coefficient `μ` (dimensionless) of the scene's material.
+    /// The site's friction coefficient `μ` (dimensionless): the scene's friction map at
+    /// the site where it has one (`SceneBuilder::friction_map`), else the material's.
     pub friction_coefficient: f64,
     /// The `u_x` (m) at which the site's spring carries no shear: where it attached under
     /// an anchoring rule, 0 otherwise (and off the attached sites).

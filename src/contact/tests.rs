@@ -343,6 +343,7 @@ fn the_clock_re_forms_sites_when_due() {
         normal_traction: &zero,
         normal_displacement: &zero,
         friction_coefficient: 0.5,
+        friction_map: None,
         force,
     };
     assert!(state.tick(&rule, &at(0.0), 10.0).is_empty()); // tick 1
@@ -401,6 +402,7 @@ fn a_custom_law_sets_the_threshold_and_the_re_formations() {
         normal_traction: &f,
         normal_displacement: &u_z,
         friction_coefficient: 0.5,
+        friction_map: None,
         force,
     };
     let paper = ContactRule::Paper

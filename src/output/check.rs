@@ -88,7 +88,7 @@ pub(crate) struct Bounds {
     pub ny: usize,
     /// The block's length (m).
     pub lx: f64,
-    /// `μF_N` (N).
+    /// `μF_N` (N): the friction limit (`Driver::friction_limit`).
     pub mu_fn: f64,
 }
 
@@ -100,7 +100,7 @@ impl Bounds {
             nx: grid.nx(),
             ny: grid.ny(),
             lx: grid.block().lx(),
-            mu_fn: driver.friction_coefficient() * driver.normal_load(),
+            mu_fn: driver.friction_limit(),
         }
     }
 }
@@ -660,7 +660,7 @@ impl RunRecord {
             nx: grid.nx(),
             ny: grid.ny(),
             lx: grid.block().lx(),
-            mu_fn: scene.current_material().friction_coefficient() * scene.current_normal_load(),
+            mu_fn: scene.limit_friction_coefficient()? * scene.current_normal_load(),
         };
         let path = |t: usize| dir.join(TABLES[t]);
         let corrupt = |t: usize, bad: Bad| bad.at(&path(t));

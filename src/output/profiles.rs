@@ -220,7 +220,7 @@ impl ProfilesTable {
 
     /// The profiles of `driver`'s state (event `event`, load `force` N).
     fn state(&self, driver: &Driver, event: usize, force: f64) -> Result<State> {
-        let mu_fn = driver.friction_coefficient() * driver.normal_load();
+        let mu_fn = driver.friction_limit();
         let mut rows = Vec::with_capacity(group_len(self.planes.len()));
         let mut row = |field: &str, z: f64, values: &[f64]| {
             let mut text = format!("{field},{z:.12e}");
@@ -263,7 +263,7 @@ impl ProfilesTable {
         force: f64,
         stable: bool,
     ) -> Result<()> {
-        let mu_fn = driver.friction_coefficient() * driver.normal_load();
+        let mu_fn = driver.friction_limit();
         // As `events.csv` and `curve.csv` write it, so that a check reads the same load.
         let x = if stable {
             written(force / mu_fn).1

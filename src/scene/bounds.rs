@@ -12,7 +12,7 @@
 //! zeros (`block.ly = 1e308`), a load ratio of `+∞` (`drive.stiffness = 1e-306`) or
 //! garbage (`solver.tolerance = 1`).
 
-use super::{Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder};
+use super::{Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder, SiteMap};
 use crate::error::{Error, Num, Result};
 use crate::geometry::Grid;
 use crate::probe::ProbeSpec;
@@ -468,6 +468,7 @@ pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
     within("normal_load", builder.normal_load, NORMAL_LOAD, "N", HUGE)?;
     millimetres(builder)?;
     heights(&builder.heights)?;
+    maps(builder, grid)?;
     drive(builder)?;
     let o = builder.solver;
     within(
@@ -495,19 +496,129 @@ pub(super) fn physics(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
     // with in their place).
     probes(&builder.probes, grid)?;
     run_options(&builder.run, grid, builder.effective_probes().tolerance())?;
-    // The last site attached carries the whole normal load: its tangential stiffness and
-    // area grow like e^{F_N/(ΔA c_z)}.
-    let exponent = builder.normal_load / (grid.cell_area() * builder.law.c_z());
+    // A drawn c_z map is checked when it is drawn (`SceneBuilder::build`).
+    let c_z = match &builder.maps.0[2] {
+        None => builder.law.c_z(),
+        Some(SiteMap::Values(v)) => v.iter().fold(f64::INFINITY, |a, &b| a.min(b)),
+        Some(SiteMap::Surface { .. }) => f64::INFINITY,
+    };
+    load_exponent(builder, grid, c_z)
+}
+
+/// The normal load against the smallest `c_z` (N/m²): the last site attached carries the
+/// whole normal load, and its tangential stiffness and area grow like `e^{F_N/(ΔA c_z)}`.
+pub(super) fn load_exponent(builder: &SceneBuilder, grid: &Grid, c_z: f64) -> Result<()> {
+    let exponent = builder.normal_load / (grid.cell_area() * c_z);
     if exponent.is_nan() || exponent > MAX_EXPONENT {
         return Err(out_of_range(
             "normal_load",
             builder.normal_load,
             NORMAL_LOAD.0,
-            MAX_EXPONENT * grid.cell_area() * builder.law.c_z(),
-            "N (at most 650 ΔA c_z)",
+            MAX_EXPONENT * grid.cell_area() * c_z,
+            "N (at most 650 ΔA c_z, with a map of c_z its smallest value)",
             "the last site attached carries the whole normal load, and its stiffness \
              c_x·exp(F_N/(ΔA c_z) - 1) and contact area overflow beyond 650 ΔA c_z",
         ));
+    }
+    Ok(())
+}
+
+/// A map's key, range, unit, and keys of a random map's mean and standard deviation.
+type MapBounds = (
+    &'static str,
+    (f64, f64),
+    &'static str,
+    &'static str,
+    &'static str,
+);
+
+/// The maps' keys ([`super::MAP_KEYS`] under `maps`), their ranges (the scalars') and
+/// units, and the keys of a random map's mean and standard deviation.
+const MAPS: [MapBounds; 3] = [
+    (
+        "maps.friction_coefficient",
+        FRICTION,
+        "",
+        "maps.friction_coefficient.mean",
+        "maps.friction_coefficient.std_dev",
+    ),
+    ("maps.c_x", C_X, "N/m³", "maps.c_x.mean", "maps.c_x.std_dev"),
+    ("maps.c_z", C_Z, "N/m²", "maps.c_z.mean", "maps.c_z.std_dev"),
+];
+
+/// The range of the map `k`'s values (in the order of [`super::MAP_KEYS`]) and its unit.
+#[cfg_attr(not(feature = "serde"), allow(dead_code))]
+pub(crate) fn map_range(k: usize) -> (f64, f64, &'static str) {
+    let (_, (min, max), unit, _, _) = MAPS[k];
+    (min, max, unit)
+}
+
+/// The values of the map `k`: one per site, each within its scalar's range.
+pub(super) fn map_values(k: usize, values: &[f64], sites: usize) -> Result<()> {
+    let (key, (min, max), unit, _, _) = MAPS[k];
+    if values.len() != sites {
+        return Err(Error::LengthMismatch {
+            name: key,
+            expected: sites,
+            found: values.len(),
+        });
+    }
+    if let Some((index, &value)) = values
+        .iter()
+        .enumerate()
+        .find(|(_, v)| !(min..=max).contains(*v))
+    {
+        let unit = if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {unit}")
+        };
+        return Err(Error::MapValue {
+            key,
+            index,
+            value,
+            range: format!(
+                "[{}, {}]{unit} (the range of the scalar)",
+                End(min, true),
+                End(max, false)
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The maps of a scene: given values (count and range), a random map's mean and
+/// standard deviation (within the scalar's range) and its spectrum on the grid.
+fn maps(builder: &SceneBuilder, grid: &Grid) -> Result<()> {
+    for (k, map) in builder.maps.0.iter().enumerate() {
+        let (_, range, unit, mean_key, std_key) = MAPS[k];
+        match map {
+            None => {}
+            Some(SiteMap::Values(v)) => map_values(k, v, grid.len())?,
+            Some(SiteMap::Surface {
+                spectrum,
+                mean,
+                std_dev,
+                ..
+            }) => {
+                within(
+                    mean_key,
+                    *mean,
+                    range,
+                    unit,
+                    "a map's mean lies in the range of the scalar it replaces",
+                )?;
+                within(
+                    std_key,
+                    *std_dev,
+                    (0.0, range.1),
+                    unit,
+                    "a map's standard deviation is finite, >= 0 and within the range of \
+                     the scalar it replaces",
+                )?;
+                crate::surface::Plan::new(grid, spectrum)?;
+            }
+        }
     }
     Ok(())
 }
@@ -565,7 +676,13 @@ fn resolution(builder: &SceneBuilder) -> Result<()> {
     // p = F_N/(Lx Ly c_z) under the mean pressure; resolved to tolerance·R of the height,
     // its relative error is about tolerance·R/p. With springs far stiffer than the load
     // (p of 1e-14 at c_z = 1e19 N/m²) the areas were rounding noise written with exit 0.
-    let p = builder.normal_load / (lx * ly * builder.law.c_z());
+    // With a map of c_z, its mean (of the values, or of a random map's Gaussian).
+    let c_z = match &builder.maps.0[2] {
+        None => builder.law.c_z(),
+        Some(SiteMap::Values(v)) => v.iter().sum::<f64>() / v.len().max(1) as f64,
+        Some(SiteMap::Surface { mean, .. }) => *mean,
+    };
+    let p = builder.normal_load / (lx * ly * c_z);
     if (tolerance * r / p).is_nan() || tolerance * r > MAX_AREA_ERROR * p {
         let most = MAX_AREA_ERROR * p / r;
         if most >= SOLVER_TOLERANCE.0 {

@@ -8,7 +8,9 @@
 //! fall back to a default.
 
 use super::schema::{schema_enum, schema_leaf, schema_struct, Schema, Walk};
-use super::{Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder};
+use super::{
+    Cells, Drive, ForceLoad, HeightSource, Lateral, SceneBuilder, SiteMap, SiteMaps, MAP_KEYS,
+};
 use crate::contact::{ContactRule, Delay};
 use crate::interface::AreaLaw;
 use crate::probe::ProbeSpec;
@@ -37,6 +39,10 @@ schema_struct! {
         material: MaterialSpec,
         springs: SpringsSpec,
         heights: HeightsSpec,
+        /// Written only when the scene has a map, so files (and the checkpoints'
+        /// identities) of other scenes stay as they were.
+        #[cfg_attr(feature = "serde", serde(skip_serializing_if = "MapsSpec::is_empty"))]
+        maps: MapsSpec,
         normal_load: f64,
         drive: DriveSpec,
         solver: SolverSpec,
@@ -231,6 +237,254 @@ impl Schema for ContactSpec {
     #[cfg(feature = "serde")]
     fn object_at(rest: &[&str]) -> bool {
         matches!(rest, [] | ["delay"])
+    }
+}
+
+/// `maps`: per-site values in place of the scalars `material.friction_coefficient`,
+/// `springs.c_x`, `springs.c_z` (`docs/scene-format.md`). A scene without maps leaves no
+/// key, in the file or in a checkpoint's identity (every 1.x checkpoint's digest has none).
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+struct MapsSpec {
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
+    friction_coefficient: Option<MapSpec>,
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
+    c_x: Option<MapSpec>,
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
+    c_z: Option<MapSpec>,
+}
+
+schema_enum! {
+    /// `maps.KEY`: where a map's values come from.
+    #[derive(Debug, Clone, PartialEq)]
+    #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+    #[cfg_attr(feature = "serde", serde(tag = "kind", deny_unknown_fields))]
+    // Map files are read by the file format only (feature `serde`).
+    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
+    pub(super) enum MapSpec {
+        Values = "values" {
+            values: Vec<f64>,
+        },
+        File = "file" {
+            path: PathBuf,
+        },
+        GaussianSurface = "gaussian_surface" {
+            correlation_length: f64,
+            mean: f64,
+            std_dev: f64,
+            #[cfg_attr(feature = "serde", serde(default = "default_seed"))]
+            seed: u64,
+        },
+        SelfAffineSurface = "self_affine_surface" {
+            hurst: f64,
+            roll_off: f64,
+            short_cutoff: f64,
+            long_cutoff: f64,
+            mean: f64,
+            std_dev: f64,
+            #[cfg_attr(feature = "serde", serde(default = "default_seed"))]
+            seed: u64,
+        },
+    }
+}
+
+impl MapsSpec {
+    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
+    fn is_empty(&self) -> bool {
+        *self == MapsSpec::default()
+    }
+
+    /// The maps in the order of [`MAP_KEYS`].
+    fn fields(&self) -> [&Option<MapSpec>; 3] {
+        [&self.friction_coefficient, &self.c_x, &self.c_z]
+    }
+
+    #[cfg(feature = "serde")]
+    fn field_mut(&mut self, name: &str) -> Option<&mut Option<MapSpec>> {
+        match name {
+            "friction_coefficient" => Some(&mut self.friction_coefficient),
+            "c_x" => Some(&mut self.c_x),
+            "c_z" => Some(&mut self.c_z),
+            _ => None,
+        }
+    }
+
+    /// The maps; a map file is read relative to `base`, bounded by `grid_cells` (asked
+    /// only for a file).
+    #[cfg(feature = "serde")]
+    fn into_maps(self, base: &Path, grid_cells: impl Fn() -> Option<usize>) -> Result<SiteMaps> {
+        let mut maps = SiteMaps::default();
+        for (k, spec) in [self.friction_coefficient, self.c_x, self.c_z]
+            .into_iter()
+            .enumerate()
+        {
+            maps.0[k] = match spec {
+                None => None,
+                Some(spec) => Some(spec.into_map(k, base, &grid_cells)?),
+            };
+        }
+        Ok(maps)
+    }
+}
+
+#[cfg(feature = "serde")]
+impl MapSpec {
+    /// The map of the key `MAP_KEYS[k]`.
+    fn into_map(
+        self,
+        k: usize,
+        base: &Path,
+        grid_cells: &impl Fn() -> Option<usize>,
+    ) -> Result<SiteMap> {
+        Ok(match self {
+            MapSpec::Values { values } => SiteMap::Values(values),
+            MapSpec::File { path } => {
+                const KEYS: [&str; 3] = ["maps.friction_coefficient", "maps.c_x", "maps.c_z"];
+                let (min, max, unit) = super::bounds::map_range(k);
+                SiteMap::read_file(&base.join(path), grid_cells(), KEYS[k], (min, max), unit)?
+            }
+            MapSpec::GaussianSurface {
+                correlation_length,
+                mean,
+                std_dev,
+                seed,
+            } => SiteMap::Surface {
+                spectrum: SurfaceSpectrum::gaussian(correlation_length)?,
+                mean,
+                std_dev,
+                seed,
+            },
+            MapSpec::SelfAffineSurface {
+                hurst,
+                roll_off,
+                short_cutoff,
+                long_cutoff,
+                mean,
+                std_dev,
+                seed,
+            } => SiteMap::Surface {
+                spectrum: SurfaceSpectrum::self_affine(hurst, roll_off, short_cutoff, long_cutoff)?,
+                mean,
+                std_dev,
+                seed,
+            },
+        })
+    }
+}
+
+impl From<&SiteMap> for MapSpec {
+    fn from(map: &SiteMap) -> Self {
+        match map {
+            SiteMap::Values(values) => MapSpec::Values {
+                values: values.clone(),
+            },
+            SiteMap::Surface {
+                spectrum,
+                mean,
+                std_dev,
+                seed,
+            } => match *spectrum {
+                SurfaceSpectrum::Gaussian { correlation_length } => MapSpec::GaussianSurface {
+                    correlation_length,
+                    mean: *mean,
+                    std_dev: *std_dev,
+                    seed: *seed,
+                },
+                SurfaceSpectrum::SelfAffine {
+                    hurst,
+                    roll_off,
+                    short_cutoff,
+                    long_cutoff,
+                } => MapSpec::SelfAffineSurface {
+                    hurst,
+                    roll_off,
+                    short_cutoff,
+                    long_cutoff,
+                    mean: *mean,
+                    std_dev: *std_dev,
+                    seed: *seed,
+                },
+            },
+        }
+    }
+}
+
+impl From<SiteMap> for MapSpec {
+    fn from(map: SiteMap) -> Self {
+        MapSpec::from(&map)
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<MapSpec> for SiteMap {
+    type Error = Error;
+
+    /// A map as serde reads it: the scene file's kinds but `file` (a map holds values,
+    /// not a path).
+    fn try_from(spec: MapSpec) -> Result<Self> {
+        if let MapSpec::File { .. } = spec {
+            return Err(Error::InvalidChoice {
+                name: "kind",
+                value: "file",
+                reason: "a map holds its values, not a path: read the file with \
+                         SiteMap::from_file",
+            });
+        }
+        spec.into_map(0, Path::new("."), &|| None)
+    }
+}
+
+impl From<&SiteMaps> for MapsSpec {
+    fn from(maps: &SiteMaps) -> Self {
+        let [friction_coefficient, c_x, c_z] = &maps.0;
+        MapsSpec {
+            friction_coefficient: friction_coefficient.as_ref().map(MapSpec::from),
+            c_x: c_x.as_ref().map(MapSpec::from),
+            c_z: c_z.as_ref().map(MapSpec::from),
+        }
+    }
+}
+
+impl Schema for MapsSpec {
+    /// The keys of the maps given; none without maps (1.x identities have none).
+    fn keys(&self, path: &str, walk: Walk, out: &mut Vec<(String, String)>) {
+        use super::schema::join;
+        for (name, map) in MAP_KEYS.iter().zip(self.fields()) {
+            if let Some(map) = map {
+                map.keys(&join(path, name), walk, out);
+            }
+        }
+    }
+
+    #[cfg(feature = "serde")]
+    fn set(&mut self, at: &str, rest: &[&str], value: &serde_json::Value) -> Result<(), KeyError> {
+        use super::schema::{join, replace};
+        match rest {
+            [] => replace(self, value),
+            [name, rest @ ..] => {
+                let Some(field) = self.field_mut(name) else {
+                    return Err(KeyError::not_a_key(at, name, &MAP_KEYS));
+                };
+                let here = join(at, name);
+                match (rest, field) {
+                    ([], field) => replace(field, value),
+                    ([segment, ..], None) => Err(KeyError::NotAnObject {
+                        at: here,
+                        segment: segment.to_string(),
+                    }),
+                    (rest, Some(map)) => map.set(&here, rest, value),
+                }
+            }
+        }
+    }
+
+    #[cfg(feature = "serde")]
+    fn object_at(rest: &[&str]) -> bool {
+        match rest {
+            [] => true,
+            [name, rest @ ..] => MAP_KEYS.contains(name) && MapSpec::object_at(rest),
+        }
     }
 }
 
@@ -729,6 +983,7 @@ impl From<&SceneBuilder> for SceneFile {
             run,
             confirm_metres,
             contact,
+            maps,
         } = b;
         SceneFile {
             block: BlockSpec {
@@ -748,6 +1003,7 @@ impl From<&SceneBuilder> for SceneFile {
                 area_law: law.area_law(),
             },
             heights: heights.into(),
+            maps: maps.into(),
             normal_load: *normal_load,
             drive: (*drive).into(),
             // The run options' probes and threads, where given, are those the scene's
@@ -870,6 +1126,7 @@ impl SceneFile {
             material,
             springs,
             heights,
+            maps,
             normal_load,
             drive,
             solver,
@@ -889,6 +1146,7 @@ impl SceneFile {
         )?;
         let law = SpringLaw::new(springs.c_x, springs.c_z)?.with_area_law(springs.area_law);
         let heights = heights.into_source(base, || grid_cells(block, cells, max_cells))?;
+        let maps = maps.into_maps(base, || grid_cells(block, cells, max_cells))?;
         let solver = solver.into_options()?;
         let probes = probes.to_spec()?;
         Ok(SceneBuilder {
@@ -910,6 +1168,7 @@ impl SceneFile {
                 .max_output_bytes(max_output_bytes),
             confirm_metres,
             contact: Default::default(),
+            maps,
         }
         .contact_rule(contact.into_rule()?))
     }
@@ -1335,6 +1594,20 @@ mod tests {
                 distribution: crate::interface::HeightDistribution::default(),
                 seed: 6,
             }),
+            base.clone()
+                .friction_map(SiteMap::Surface {
+                    spectrum: SurfaceSpectrum::gaussian(2e-3).unwrap(),
+                    mean: 0.5,
+                    std_dev: 0.1,
+                    seed: 3,
+                })
+                .c_z_map(SiteMap::Values(vec![1.65e8; 80])),
+            base.clone().c_x_map(SiteMap::Surface {
+                spectrum: SurfaceSpectrum::self_affine(0.7, 3e-3, 0.6e-3, 8e-3).unwrap(),
+                mean: 1e12,
+                std_dev: 2e11,
+                seed: 4,
+            }),
             base.solver_options(
                 SolverOptions::default()
                     .with_parallelism(Parallelism::Threads(3))
@@ -1412,6 +1685,42 @@ mod tests {
         assert_eq!(first_difference(&top, &a).as_deref(), Some("drive.kind"));
     }
 
+    /// A scene's maps are in its identity, key by key; a scene without maps has no key of
+    /// them (the pinned identity of the default scene is a 1.x checkpoint's).
+    #[test]
+    fn the_maps_are_in_the_identity_only_when_given() {
+        let a = SceneBuilder::default();
+        assert!(identity(&a).iter().all(|(k, _)| !k.starts_with("maps")));
+        let map = |seed| SiteMap::Surface {
+            spectrum: SurfaceSpectrum::gaussian(2e-3).unwrap(),
+            mean: 0.5,
+            std_dev: 0.1,
+            seed,
+        };
+        let b = a.clone().friction_map(map(3));
+        let keys: Vec<String> = identity(&b).into_iter().map(|(k, _)| k).collect();
+        for key in [
+            "maps.friction_coefficient.kind",
+            "maps.friction_coefficient.correlation_length",
+            "maps.friction_coefficient.mean",
+            "maps.friction_coefficient.std_dev",
+            "maps.friction_coefficient.seed",
+        ] {
+            assert!(keys.iter().any(|k| k == key), "{key}: {keys:?}");
+        }
+        assert_eq!(
+            first_difference(&a, &b).as_deref(),
+            Some("maps.friction_coefficient.kind")
+        );
+        let c = a.clone().friction_map(map(4));
+        assert_eq!(
+            first_difference(&b, &c).as_deref(),
+            Some("maps.friction_coefficient.seed")
+        );
+        let d = a.c_x_map(SiteMap::Values(vec![1e12; 980]));
+        assert_eq!(first_difference(&d, &b).as_deref(), Some("maps.c_x.kind"));
+    }
+
     /// `cuda` solves the `spectral` rule: one identity, so a checkpoint resumes across the
     /// two; `dense` is another rule.
     #[test]
@@ -1441,6 +1750,8 @@ mod tests {
             "",
             "block",
             "cells",
+            "maps",
+            "maps.c_x",
             "heights",
             "drive",
             "drive.lateral",
@@ -1451,6 +1762,8 @@ mod tests {
         }
         for path in [
             "normal_load",
+            "maps.mu",
+            "maps.c_x.mean",
             "block.lx",
             "drive.height",
             "probes.points",

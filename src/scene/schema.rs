@@ -238,14 +238,14 @@ macro_rules! schema_struct {
 macro_rules! schema_enum {
     (
         $(#[$meta:meta])*
-        enum $name:ident {
+        $vis:vis enum $name:ident {
             $( $variant:ident = $kind:literal {
                 $( $(#[$field_meta:meta])* $field:ident : $ty:ty ),* $(,)?
             } ),* $(,)?
         }
     ) => {
         $(#[$meta])*
-        enum $name {
+        $vis enum $name {
             $(
                 #[cfg_attr(feature = "serde", serde(rename = $kind))]
                 $variant { $( $(#[$field_meta])* $field: $ty ),* }
