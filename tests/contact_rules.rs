@@ -311,6 +311,12 @@ fn rejuvenation_is_refused_where_it_cannot_run() {
         .contains("\"anchored\""));
 }
 
+/// The loads' scale in `events_on`'s scenes, `μ F_N` = 0.5 x 40 N: the backends' solves
+/// agree to their tolerance relative to it, so a load far below it (an early threshold
+/// of a few mN) is compared to 1e-8 of it, not of itself (seed 9470 differed by 1.1e-8
+/// of 1.8 mN, 1e-12 of `μ F_N`).
+const MU_FN: f64 = 20.0;
+
 /// The events of a run on `backend`: kinds and sites, and the loads (N).
 fn events_on(
     contact: &str,
@@ -342,7 +348,7 @@ fn events_on(
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(3))]
     /// The dense and the spectral backends give the same events, in order, with the
-    /// same loads (to 1e-8), under the anchored rules; small scenes, random seeds.
+    /// same loads (to 1e-8 of the larger of the load and `μ F_N`), under the anchored rules; small scenes, random seeds.
     #[test]
     fn dense_and_spectral_agree_event_by_event(seed in 0u64..10_000, rejuvenate in any::<bool>()) {
         let contact = if rejuvenate { REJUVENATION } else { ANCHORED };
@@ -351,7 +357,7 @@ proptest! {
         prop_assert_eq!(dense.len(), spectral.len());
         for (d, s) in dense.iter().zip(&spectral) {
             prop_assert_eq!((d.0, d.1), (s.0, s.1));
-            prop_assert!((d.2 - s.2).abs() <= 1e-8 * d.2.abs().max(1e-6), "{:?} {:?}", d, s);
+            prop_assert!((d.2 - s.2).abs() <= 1e-8 * d.2.abs().max(MU_FN), "{:?} {:?}", d, s);
         }
     }
 }
@@ -656,7 +662,7 @@ fn custom_events_on(seed: u64, backend: Backend) -> Vec<(&'static str, Option<us
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(3))]
     /// The dense and the spectral backends give the same events, in order, with the same
-    /// loads (to 1e-8), under a custom slip-weakening rule; small scenes, random seeds.
+    /// loads (to 1e-8 of the larger of the load and `μ F_N`), under a custom slip-weakening rule; small scenes, random seeds.
     #[test]
     fn dense_and_spectral_agree_on_a_custom_rule(seed in 0u64..10_000) {
         let dense = custom_events_on(seed, Backend::Dense);
@@ -664,7 +670,7 @@ proptest! {
         prop_assert_eq!(dense.len(), spectral.len());
         for (d, s) in dense.iter().zip(&spectral) {
             prop_assert_eq!((d.0, d.1), (s.0, s.1));
-            prop_assert!((d.2 - s.2).abs() <= 1e-8 * d.2.abs().max(1e-6), "{:?} {:?}", d, s);
+            prop_assert!((d.2 - s.2).abs() <= 1e-8 * d.2.abs().max(MU_FN), "{:?} {:?}", d, s);
         }
     }
 }

@@ -311,7 +311,7 @@ fn build(py: Python<'_>, builder: precursors::SceneBuilder) -> PyResult<Scene> {
 /// size of the recorded profiles (refused above it, before the run);
 /// contact_rule='paper' | 'anchored' | 'rejuvenation' (the site transitions, default the
 /// paper's), with 'rejuvenation' delay_stable_states (int >= 1, default 1) and delay_load
-/// (F/(μF_N) >= 0, default 0) before a broken site re-forms. A custom rule (the crate's
+/// (F/(μF_N) > 0, default 0.01) before a broken site re-forms. A custom rule (the crate's
 /// `ContactLaw`) is Rust only.
 #[pyclass(module = "precursors", frozen)]
 struct Scene {

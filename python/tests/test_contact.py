@@ -31,7 +31,7 @@ def test_the_keywords_are_the_scene_files_contact_key():
     }
     # The defaults of the delay: one stable state and no load.
     default = precursors.Scene(**SMALL, contact_rule="rejuvenation").to_dict()
-    assert default["contact"]["delay"] == {"stable_states": 1, "load": 0.0}
+    assert default["contact"]["delay"] == {"stable_states": 1, "load": 0.01}
 
 
 def test_only_re_formed_sites_break_again():
