@@ -1183,6 +1183,7 @@ impl SceneBuilder {
     ///
     /// # Errors
     /// Those of [`SceneBuilder::grid`] and of the surface generator, for a random map.
+    #[cfg(feature = "serde")] // the row checks of a run directory read it
     pub(crate) fn limit_friction_coefficient(&self) -> Result<f64> {
         let mu = self.material.friction_coefficient();
         match &self.maps.0[0] {
