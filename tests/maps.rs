@@ -295,7 +295,7 @@ fn events_on(seed: u64, backend: Backend) -> Vec<(&'static str, Option<usize>, f
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(3))]
     /// The dense and the spectral backends give the same events, in order, with the
-    /// same loads (to 1e-8), on heterogeneous maps of μ, c_x and c_z; small scenes,
+    /// same loads (to 1e-8 of `μ F_N`), on heterogeneous maps of μ, c_x and c_z; small scenes,
     /// random seeds.
     #[test]
     fn dense_and_spectral_agree_event_by_event(seed in 0u64..10_000) {
@@ -304,7 +304,10 @@ proptest! {
         prop_assert_eq!(dense.len(), spectral.len());
         for (d, s) in dense.iter().zip(&spectral) {
             prop_assert_eq!((d.0, d.1), (s.0, s.1));
-            prop_assert!((d.2 - s.2).abs() <= 1e-8 * d.2.abs().max(1e-6), "{:?} {:?}", d, s);
+            // To 1e-8 of the larger of the load and the material's μF_N = 20 N: the solves
+            // agree to their tolerance relative to the loads' scale, not to an early
+            // threshold of a few mN (as tests/contact_rules.rs).
+            prop_assert!((d.2 - s.2).abs() <= 1e-8 * d.2.abs().max(20.0), "{:?} {:?}", d, s);
         }
     }
 }
