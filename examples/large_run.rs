@@ -1,6 +1,6 @@
 //! The N = 1e4 scene of the performance target (issue 4: zero shear to global slip in
-//! under a minute; docs/performance.md's table at the top, last measured 2026-11-26 on a
-//! 2-core VM: 69-84 s with two solver threads, 109-117 s with one, the target not met
+//! under a minute; docs/performance.md's table at the top, last measured 2026-11-29 on a
+//! 2-core VM: 78-86 s with two solver threads, 90-114 s with one, the target not met
 //! there): a 200 x 50 x 75 mm block on 1 mm cells, 3.5 MPa normal
 //! pressure, rod drive (defaults), force control, seed 1. Spectral backend (Auto).
 //!
