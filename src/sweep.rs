@@ -91,7 +91,14 @@ struct SweepSpec {
     realizations: usize,
     #[serde(default)]
     seed: u64,
+    /// Drawn maps whose seed each realization derives too (`docs/sweep-format.md`); not
+    /// written when empty, so the copy of an older sweep is unchanged.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    reseed_maps: Vec<String>,
 }
+
+/// The maps a sweep may reseed, in the order their seeds are derived.
+const MAP_KEYS: [&str; 3] = ["friction_coefficient", "c_x", "c_z"];
 
 fn empty_object() -> Value {
     Value::Object(serde_json::Map::new())
@@ -630,10 +637,11 @@ impl Sweep {
             SceneFile::from_value(&spec.base, base_dir).map_err(|e| base_error(chain(&e)))?;
         spec.base = base.to_value().map_err(|e| base_error(chain(&e)))?;
         let base_builder = base.to_builder().map_err(|e| base_error(chain(&e)))?;
-        let random = check_realizations(spec.realizations, &base_builder)?;
+        let random = check_realizations(spec.realizations, &base_builder, &spec.reseed_maps)?;
         let axes = read_axes(&spec, |reason| file_error(path, reason))?;
         check_size(&axes, spec.realizations, &base_builder)?;
         check_axes(&axes, &base)?;
+        check_reseed_maps(&spec, &axes, |reason| file_error(path, reason))?;
         let points = axes.iter().map(|a| a.steps.len()).product::<usize>();
         let runs = runs_of(&spec, &axes, &base, random)?;
         Ok(Sweep {
@@ -971,8 +979,12 @@ fn empty_but_lock(dir: &Path) -> Result<()> {
 ///
 /// # Errors
 /// [`Error::InvalidCount`] for zero realizations, or several with heights that are not
-/// random.
-fn check_realizations(realizations: usize, base: &SceneBuilder) -> Result<bool> {
+/// random and no map reseeded.
+fn check_realizations(
+    realizations: usize,
+    base: &SceneBuilder,
+    reseed_maps: &[String],
+) -> Result<bool> {
     if realizations == 0 {
         return Err(Error::InvalidCount {
             name: "realizations",
@@ -982,16 +994,70 @@ fn check_realizations(realizations: usize, base: &SceneBuilder) -> Result<bool> 
         .into());
     }
     let random = base.current_heights().is_random();
-    if realizations > 1 && !random {
+    if realizations > 1 && !random && reseed_maps.is_empty() {
         return Err(Error::InvalidCount {
             name: "realizations",
             value: realizations as u64,
-            reason: "realizations differ by the seed of random heights, but the base \
-                     scene's heights are values (give one realization)",
+            reason: "realizations differ by the seed of random heights (or of the maps in \
+                     `reseed_maps`), but the base scene's heights are values (give one \
+                     realization)",
         }
         .into());
     }
     Ok(random)
+}
+
+/// `reseed_maps` names each of `MAP_KEYS` at most once, each a map of the base scene drawn
+/// from a seed (`gaussian_surface`, `self_affine_surface`), whose seed no axis sets.
+///
+/// # Errors
+/// [`SweepError::File`] naming the map and why.
+fn check_reseed_maps(
+    spec: &SweepSpec,
+    axes: &[Axis],
+    file_error: impl Fn(String) -> SweepError,
+) -> Result<()> {
+    for (i, name) in spec.reseed_maps.iter().enumerate() {
+        let refuse = |reason: String| Err(file_error(format!("reseed_maps: `{name}` {reason}")));
+        if !MAP_KEYS.contains(&name.as_str()) {
+            return refuse(format!(
+                "is not a map (the maps are {})",
+                MAP_KEYS.join(", ")
+            ));
+        }
+        if spec.reseed_maps[..i].contains(name) {
+            return refuse("is named twice".to_string());
+        }
+        let kind = spec.base["maps"][name.as_str()]["kind"].as_str();
+        if !matches!(kind, Some("gaussian_surface" | "self_affine_surface")) {
+            return refuse(match kind {
+                None => format!("is not in the base scene (give `maps.{name}`)"),
+                Some(kind) => format!(
+                    "is a `{kind}` map: only a map drawn from a seed (`gaussian_surface`, \
+                     `self_affine_surface`) can be reseeded"
+                ),
+            });
+        }
+        let seed_key = format!("maps.{name}.seed");
+        if let Some(key) = axes
+            .iter()
+            .flat_map(|a| &a.keys)
+            .find(|k| overlap(k, &seed_key))
+        {
+            return refuse(format!(
+                "has its seed set by the axis `{key}`: either the axis or the realizations \
+                 choose it"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The seed of map `MAP_KEYS[map]` in the run whose heights' seed is `seed`: derived
+/// from both, so that it differs from the heights' (a map with the heights' spectrum and
+/// seed would be their field) and from the other maps'.
+fn map_seed(seed: u64, map: usize) -> u64 {
+    splitmix64(seed ^ splitmix64(0x6d61_7073_0000_0000 | map as u64))
 }
 
 /// The size of the sweep, before any scene is checked or any run built: at most
@@ -1179,6 +1245,11 @@ fn runs_of(
             };
             if random {
                 set_key(&mut scene, "heights.seed", &Value::from(seed), invalid)?;
+            }
+            for name in &spec.reseed_maps {
+                let map = MAP_KEYS.iter().position(|k| k == name).unwrap_or(0);
+                let key = format!("maps.{name}.seed");
+                set_key(&mut scene, &key, &Value::from(map_seed(seed, map)), invalid)?;
             }
             let builder = scene.to_builder().map_err(|e| invalid(chain(&e)))?;
             if realization == 0 {

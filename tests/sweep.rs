@@ -807,3 +807,121 @@ fn a_stopped_sweep_marks_only_complete_runs_and_ends_as_an_uninterrupted_one() {
     std::fs::remove_dir_all(&dir).unwrap();
     std::fs::remove_dir_all(&whole).unwrap();
 }
+
+/// An independent restatement of docs/sweep-format.md's derivation of a reseeded map's
+/// seed: `splitmix64(s ^ splitmix64(0x6d61707300000000 + m))`, `s` the run's heights'
+/// seed, `m` the map's place in (friction_coefficient, c_x, c_z).
+fn documented_map_seed(s: u64, m: u64) -> u64 {
+    fn splitmix64(x: u64) -> u64 {
+        let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    splitmix64(s ^ splitmix64(0x6d61_7073_0000_0000 + m))
+}
+
+const MAPPED_BASE: &str = r#"{ "block": { "lx": 0.03, "ly": 0.005, "lz": 0.02 },
+    "cells": { "kind": "size", "dx": 0.001, "dy": 0.001 },
+    "heights": { "kind": "gaussian", "seed": 0 },
+    "normal_load": 500.0,
+    "drive": { "kind": "top" },
+    "maps": {
+      "friction_coefficient": { "kind": "gaussian_surface", "correlation_length": 0.004,
+                                "mean": 0.5, "std_dev": 0.1, "seed": 3 },
+      "c_z": { "kind": "gaussian_surface", "correlation_length": 0.004,
+               "mean": 1.65e8, "std_dev": 2e7, "seed": 3 } } }"#;
+
+fn friction_map_of(scene: &precursors::SceneBuilder) -> Vec<f64> {
+    let scene = scene.clone().build().unwrap();
+    scene.interface().friction_map().unwrap().to_vec()
+}
+
+#[test]
+fn realizations_reseed_the_maps_named_in_reseed_maps() {
+    let text = format!(
+        r#"{{ "base": {MAPPED_BASE}, "axes": [], "realizations": 3, "seed": 11,
+             "reseed_maps": ["friction_coefficient"] }}"#
+    );
+    let sweep = Sweep::from_json_str(&text).unwrap();
+    let maps: Vec<Vec<f64>> = sweep
+        .runs()
+        .iter()
+        .map(|r| friction_map_of(r.scene()))
+        .collect();
+    assert_ne!(maps[0], maps[1]);
+    assert_ne!(maps[1], maps[2]);
+    for run in sweep.runs() {
+        // The documented seed, and a map other than the heights' seed would draw.
+        let expected = documented_map_seed(run.seed(), 0);
+        let scene = |seed: u64| {
+            let map = format!(
+                r#""maps": {{ "friction_coefficient": {{ "kind": "gaussian_surface",
+                    "correlation_length": 0.004, "mean": 0.5, "std_dev": 0.1,
+                    "seed": {seed} }} }}"#
+            );
+            let text = MAPPED_BASE.split(r#""maps""#).next().unwrap().to_string() + &map + "}";
+            precursors::SceneBuilder::from_json_str(&text).unwrap()
+        };
+        let map = friction_map_of(run.scene());
+        assert_eq!(map, friction_map_of(&scene(expected)));
+        assert_ne!(map, friction_map_of(&scene(run.seed())));
+    }
+    // A map not named keeps the base's seed in every run.
+    let c_z: Vec<Vec<f64>> = sweep
+        .runs()
+        .iter()
+        .map(|r| {
+            r.scene()
+                .clone()
+                .build()
+                .unwrap()
+                .interface()
+                .c_z_map()
+                .unwrap()
+                .to_vec()
+        })
+        .collect();
+    assert_eq!(c_z[0], c_z[1]);
+    // Without the key, the realizations share the map (as 1.x sweeps do).
+    let plain =
+        format!(r#"{{ "base": {MAPPED_BASE}, "axes": [], "realizations": 2, "seed": 11 }}"#);
+    let plain = Sweep::from_json_str(&plain).unwrap();
+    assert_eq!(
+        friction_map_of(plain.runs()[0].scene()),
+        friction_map_of(plain.runs()[1].scene())
+    );
+    assert!(!plain.to_json().unwrap().contains("reseed_maps"));
+    assert!(sweep.to_json().unwrap().contains("reseed_maps"));
+}
+
+#[test]
+fn reseed_maps_refuses_what_it_cannot_reseed() {
+    let err = |reseed: &str, axes: &str| {
+        let text = format!(
+            r#"{{ "base": {MAPPED_BASE}, "axes": [{axes}], "realizations": 2, "seed": 11,
+                 "reseed_maps": {reseed} }}"#
+        );
+        crate::common::chain(&Sweep::from_json_str(&text).unwrap_err())
+    };
+    let e = err(r#"["mu"]"#, "");
+    assert!(e.contains("`mu` is not a map"), "{e}");
+    let e = err(r#"["c_z", "c_z"]"#, "");
+    assert!(e.contains("named twice"), "{e}");
+    let e = err(r#"["c_x"]"#, "");
+    assert!(e.contains("`c_x` is not in the base scene"), "{e}");
+    let e = err(
+        r#"["friction_coefficient"]"#,
+        r#"{ "key": "maps.friction_coefficient.seed", "values": [1, 2] }"#,
+    );
+    assert!(e.contains("axis `maps.friction_coefficient.seed`"), "{e}");
+    // A map of values has no seed.
+    let values = vec!["0.5"; 150].join(", ");
+    let text = format!(
+        r#"{{ "base": {{ "block": {{ "lx": 0.03, "ly": 0.005, "lz": 0.02 }},
+             "maps": {{ "friction_coefficient": {{ "kind": "values", "values": [{values}] }} }} }},
+             "realizations": 1, "reseed_maps": ["friction_coefficient"] }}"#
+    );
+    let e = crate::common::chain(&Sweep::from_json_str(&text).unwrap_err());
+    assert!(e.contains("is a `values` map"), "{e}");
+}
