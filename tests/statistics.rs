@@ -942,6 +942,55 @@ fn the_contact_rules_study_files_pair_the_rod_study() {
     }
 }
 
+#[test]
+fn the_friction_map_study_files_are_the_documented_ensembles() {
+    // docs/contact-rules.md, "Heterogeneous friction under a top load": the calibration
+    // block under the top drive, without a map (20 runs) and with a Gaussian friction map
+    // of mean 0.5 and spread 0.05, 0.1, 0.2 at five correlation lengths, 20 maps each.
+    use precursors::sweep::Sweep;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/sweeps/contact-rules");
+    let json = |sweep: &Sweep, r: usize| -> serde_json::Value {
+        serde_json::from_str(&sweep.runs()[r].scene().to_json().unwrap()).unwrap()
+    };
+    let uniform = Sweep::from_json_file(root.join("friction_map_uniform.json")).unwrap();
+    assert_eq!(uniform.runs().len(), 20);
+    let scene = json(&uniform, 0);
+    assert_eq!(scene["drive"]["kind"], "top");
+    assert!(scene.get("maps").is_none());
+    for spread in [0.05, 0.1, 0.2] {
+        let name = format!("friction_map_{spread}.json");
+        let sweep =
+            Sweep::from_json_file(root.join(&name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(sweep.runs().len(), 100, "{name}");
+        let lengths: Vec<f64> = (0..5)
+            .map(|p| {
+                json(&sweep, 20 * p)["maps"]["friction_coefficient"]["correlation_length"]
+                    .as_f64()
+                    .unwrap()
+            })
+            .collect();
+        assert_eq!(lengths, [0.002, 0.005, 0.01, 0.02, 0.04], "{name}");
+        for r in [0, 1, 57] {
+            let scene = json(&sweep, r);
+            assert_eq!(scene["drive"]["kind"], "top", "{name}");
+            let map = &scene["maps"]["friction_coefficient"];
+            assert_eq!(
+                (map["mean"].as_f64(), map["std_dev"].as_f64()),
+                (Some(0.5), Some(spread))
+            );
+            assert_eq!(scene["block"], json(&uniform, 0)["block"], "{name}");
+            assert_eq!(
+                scene["normal_load"],
+                json(&uniform, 0)["normal_load"],
+                "{name}"
+            );
+        }
+        // Each realization draws its own map.
+        let seed = |r: usize| json(&sweep, r)["maps"]["friction_coefficient"]["seed"].clone();
+        assert_ne!(seed(0), seed(1), "{name}");
+    }
+}
+
 /// The fixture of tests/data/statistics/make_lr_fixtures.py: each case's samples and the
 /// values scipy computed on them.
 fn lr_fixture() -> Vec<(String, Vec<f64>, HashMap<String, f64>)> {
