@@ -15,6 +15,9 @@ runs of:
            the longest such patch anywhere on the interface, over Lx, at the stable
            state in effect at 0.5 and 0.9 of the slip load;
   ell90    the paper's precursor length l/Lx (curve.csv), from the trailing edge, there;
+  jumps    the arrested events: stable states (before global slip) at which the longest
+           detached patch grew by 5 mm or more in one avalanche, and the largest such
+           growth over Lx (jump);
   biggest  the largest avalanche before the spanning one, in ruptures, and its extent
            over Lx (per_avalanche.csv's extent_m).
 
@@ -73,6 +76,9 @@ def analyse_run(d):
                 last = s
         return last
 
+    min_cols = round(0.005 / (lx / nx))
+    growth = [b[1] - a[1] for a, b in zip(states, states[1:])]
+    jumps = [g for g in growth if g >= min_cols]
     onset = next((s[0] for s in states if s[1] >= round(0.005 / (lx / nx))), slip) / slip
     av = list(csv.DictReader(open(os.path.join(d, "per_avalanche.csv"))))
     before = [a for a in av if a["spanning"] == "0" and a["after_spanning"] == "0"
@@ -84,13 +90,16 @@ def analyse_run(d):
         "patch50": at(0.5, states)[1] / nx,
         "patch90": at(0.9, states)[1] / nx,
         "ell90": at(0.9, curve)[1],
+        "jumps": len(jumps),
+        "jump": max(jumps, default=0) / nx,
         "biggest": int(big["ruptures"]) if big else 0,
         "biggest_extent": float(big["extent_m"]) / lx if big else 0.0,
     }
 
 
 def main():
-    keys = ["slip", "onset", "patch50", "patch90", "ell90", "biggest", "biggest_extent"]
+    keys = ["slip", "onset", "patch50", "patch90", "ell90", "jumps", "jump", "biggest",
+            "biggest_extent"]
     print("| sweep | correlation length (mm) | runs | " + " | ".join(keys) + " |")
     print("|---" * (len(keys) + 3) + "|")
     for arg in sys.argv[1:]:
@@ -106,7 +115,7 @@ def main():
             cells = []
             for k in keys:
                 lo, med, hi = quartiles([r[k] for r in rs])
-                fmt = "%.0f" if k == "biggest" else "%.3f"
+                fmt = "%.0f" if k in ("biggest", "jumps") else "%.3f"
                 cells.append((fmt + " [" + fmt + ", " + fmt + "]") % (med, lo, hi))
             xi_mm = "%g" % (float(xi) * 1e3) if xi else "(no map)"
             print("| %s | %s | %d | %s |" % (name, xi_mm, len(rs), " | ".join(cells)))

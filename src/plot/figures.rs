@@ -539,6 +539,37 @@ fn describe(keys: &[(String, String)]) -> String {
     if let Some(xi) = mm("heights.correlation_length") {
         parts.push(format!("ξ = {xi} mm"));
     }
+    // A rule or a map other than the paper's scalars changes the physics: two studies that
+    // differ only by them must not share a title.
+    if let Some(rule) = get("contact.rule").filter(|&r| r != "paper") {
+        parts.push(format!("{rule} rule"));
+    }
+    for (map, symbol) in [
+        ("friction_coefficient", "μ"),
+        ("c_x", "c_x"),
+        ("c_z", "c_z"),
+    ] {
+        let key = |k: &str| format!("maps.{map}.{k}");
+        if get(&key("kind")).is_none() {
+            continue;
+        }
+        let mut text = format!("{symbol} map");
+        let stats: Vec<String> = [("mean", "mean"), ("std_dev", "sd")]
+            .iter()
+            .filter_map(|(k, name)| num(&key(k)).map(|v| format!("{name} {}", short(v))))
+            .collect();
+        if !stats.is_empty() {
+            text = format!("{text} ({})", stats.join(", "));
+        }
+        if let Some(xi) = mm(&key("correlation_length")) {
+            let xi_of = match map {
+                "friction_coefficient" => "ξ_μ".to_string(),
+                _ => format!("ξ({symbol})"),
+            };
+            text = format!("{text}, {xi_of} = {xi} mm");
+        }
+        parts.push(text);
+    }
     if let Some(seed) = get("heights.seed") {
         parts.push(format!("seed {seed}"));
     }
@@ -595,8 +626,10 @@ fn grid(keys: &[(String, String)]) -> Option<String> {
 /// A sweep axis's value in the user's words and units: `Ly = 7 mm` for `block.ly =
 /// 0.007`, `F_N = 3.5 kN` for `normal_load = 3500`; other keys as written.
 fn axis_value(key: &str, value: &str) -> String {
+    // A key's underscores are its own, not the figures' subscript marks.
+    let literal = |text: &str| text.replace('_', "\\_");
     let Ok(v) = value.parse::<f64>() else {
-        return format!("{key} = {value}");
+        return format!("{} = {}", literal(key), literal(value));
     };
     let length = |symbol: &str| format!("{symbol} = {} mm", short(v * 1e3));
     match key {
@@ -618,7 +651,12 @@ fn axis_value(key: &str, value: &str) -> String {
         "material.poisson_ratio" => format!("ν = {}", short(v)),
         "springs.c_x" => format!("c_x = {} N/m³", short(v)),
         "springs.c_z" => format!("c_z = {} N/m²", short(v)),
-        _ => format!("{key} = {value}"),
+        "maps.friction_coefficient.correlation_length" => length("ξ_μ"),
+        "maps.friction_coefficient.mean" => format!("mean μ = {}", short(v)),
+        "maps.friction_coefficient.std_dev" => format!("sd μ = {}", short(v)),
+        "maps.c_x.correlation_length" => length("ξ(c_x)"),
+        "maps.c_z.correlation_length" => length("ξ(c_z)"),
+        _ => format!("{} = {value}", literal(key)),
     }
 }
 
@@ -1157,5 +1195,53 @@ mod tests {
         assert_eq!(clip(1.3, 0.0, 1.0), 1.0);
         assert_eq!(clip(0.4, 0.0, 1.0), 0.4);
         assert!(clip(f64::NAN, 0.0, 1.0).is_nan());
+    }
+
+    #[test]
+    fn axis_keys_keep_their_underscores_in_legends() {
+        // Drawn as written: no piece of the label is a subscript.
+        let plain = |label: String| {
+            let pieces = super::super::subscripts(&label);
+            assert!(pieces.iter().all(|(_, sub)| !sub), "{label}: {pieces:?}");
+            pieces.into_iter().map(|(t, _)| t).collect::<String>()
+        };
+        assert_eq!(
+            plain(axis_value("maps.friction_coefficient.seed", "7")),
+            "maps.friction_coefficient.seed = 7"
+        );
+        assert_eq!(
+            plain(axis_value("contact.rule", "\"anchored_x\"")),
+            "contact.rule = \"anchored_x\""
+        );
+        assert_eq!(
+            axis_value("maps.friction_coefficient.correlation_length", "0.005"),
+            "ξ_μ = 5 mm"
+        );
+    }
+
+    #[test]
+    fn titles_name_the_contact_rule_and_the_maps() {
+        let keys = |pairs: &[(&str, &str)]| -> Vec<(String, String)> {
+            pairs
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect()
+        };
+        let base = [("drive.kind", "top"), ("contact.rule", "paper")];
+        assert_eq!(describe(&keys(&base)), "top shear");
+        let anchored = [("drive.kind", "top"), ("contact.rule", "anchored")];
+        assert_eq!(describe(&keys(&anchored)), "top shear, anchored rule");
+        let mapped = [
+            ("drive.kind", "top"),
+            ("maps.friction_coefficient.kind", "gaussian_surface"),
+            ("maps.friction_coefficient.correlation_length", "0.005"),
+            ("maps.friction_coefficient.mean", "0.5"),
+            ("maps.friction_coefficient.std_dev", "0.2"),
+            ("maps.c_z.kind", "values"),
+        ];
+        assert_eq!(
+            describe(&keys(&mapped)),
+            "top shear, μ map (mean 0.5, sd 0.2), ξ_μ = 5 mm, c_z map"
+        );
     }
 }
