@@ -46,6 +46,7 @@ use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
+use std::borrow::Cow;
 use std::ops::Range;
 use std::path::Path;
 use std::sync::OnceLock;
@@ -724,6 +725,12 @@ impl Chart {
     /// file is left under its name).
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = path.as_ref();
+        render(path, (self.size, self.dpi), &self.settled(path)?)
+    }
+
+    /// The chart checked and ready to draw ([`Chart::save`]'s refusals, `path` naming
+    /// the figure in them): on logarithmic axes, its data in `log10`.
+    fn settled(&self, path: &Path) -> Result<ChartDrawing<'_>> {
         let refuse = |reason: String| PlotError::Figure {
             path: Some(path.to_path_buf()),
             reason,
@@ -775,28 +782,20 @@ impl Chart {
                     .for_each(|b| *b = (lx(b.0), ly(b.1), ly(b.2)));
             }
             let (x, y) = drawn.ranges(path)?;
-            return render(
-                path,
-                (self.size, self.dpi),
-                &ChartDrawing {
-                    chart: &drawn,
-                    x,
-                    y,
-                    log: self.log,
-                },
-            );
-        }
-        let (x, y) = self.ranges(path)?;
-        render(
-            path,
-            (self.size, self.dpi),
-            &ChartDrawing {
-                chart: self,
+            return Ok(ChartDrawing {
+                chart: Cow::Owned(drawn),
                 x,
                 y,
-                log: (false, false),
-            },
-        )
+                log: self.log,
+            });
+        }
+        let (x, y) = self.ranges(path)?;
+        Ok(ChartDrawing {
+            chart: Cow::Borrowed(self),
+            x,
+            y,
+            log: (false, false),
+        })
     }
 
     /// The axis ranges: given, or fitted to the data.
@@ -830,7 +829,7 @@ fn axis_map(log: bool) -> fn(f64) -> f64 {
 
 /// A chart with its axis ranges settled.
 struct ChartDrawing<'a> {
-    chart: &'a Chart,
+    chart: Cow<'a, Chart>,
     x: (f64, f64),
     y: (f64, f64),
     /// Whether the axes show `log10` of the data (their ticks then print `10^v`).
@@ -842,7 +841,7 @@ impl Draw for ChartDrawing<'_> {
         &self,
         root: &DrawingArea<DB, Shift>,
     ) -> std::result::Result<(), String> {
-        let (me, x, y) = (self.chart, self.x, self.y);
+        let (me, x, y) = (&*self.chart, self.x, self.y);
         // The legend's place is settled on the plotting area before anything is drawn
         // (building the coordinates draws nothing): a legend put below it shrinks it.
         let top = measured_title_room(root, &me.title)?;
@@ -913,7 +912,97 @@ impl Draw for ChartDrawing<'_> {
                 Placement::Corner(corner) => corner_box(corner, layout.size, (&columns, &rows)).0,
                 Placement::Below => (columns.start, rows.end + X_LABEL_AREA + LEGEND_GAP),
             };
-            draw_legend(root, &layout, at)?;
+            // The pixel ranges are the picture's; the legend is drawn on `root`, a
+            // panel's area away from the picture's origin.
+            let (base_x, base_y) = root.get_base_pixel();
+            draw_legend(root, &layout, (at.0 - base_x, at.1 - base_y))?;
+        }
+        Ok(())
+    }
+}
+
+/// Charts side by side under one title and its notes: a grid of panels, each a chart
+/// with its own title, axes and legend, as many columns as `⌈√n⌉` for `n` charts, the
+/// rows filled left to right. A sweep's distributions (`plot/distributions.rs`) take it
+/// for many points, whose curves and legends one chart cannot hold.
+#[derive(Debug, Clone)]
+struct Panels {
+    title: String,
+    /// Lines under the title: what holds for every panel.
+    notes: Vec<String>,
+    charts: Vec<Chart>,
+    /// A panel's size (1/150 inch), as a chart's ([`Chart::size`]): shrunk where the
+    /// grid would pass the largest picture.
+    panel: (u32, u32),
+    dpi: u32,
+}
+
+impl Panels {
+    /// The grid's columns and rows.
+    fn grid(&self) -> (usize, usize) {
+        let n = self.charts.len().max(1);
+        let columns = (1..=n).find(|c| c * c >= n).unwrap_or(n);
+        (columns, n.div_ceil(columns))
+    }
+
+    /// The room above the panels (1/150 inch): the title on one line or two, the notes.
+    fn head(&self) -> u32 {
+        title_room(1, TITLE_SIZE).max(title_room(2, WRAPPED_TITLE_SIZE))
+            + self.notes.len() as u32 * NOTE_LINE
+    }
+
+    /// Writes the figure to `path` as [`Chart::save`] does (its refusals for each panel).
+    fn save(&self, path: &Path) -> Result<()> {
+        let (columns, rows) = self.grid();
+        let head = self.head();
+        // The largest side the resolution allows, in 1/150 inch.
+        let largest = (u64::from(LARGEST_SIDE) * u64::from(DEFAULT_DPI)
+            / u64::from(self.dpi.max(DEFAULT_DPI))) as u32;
+        let panel = (
+            self.panel.0.min(largest / columns as u32),
+            self.panel.1.min(largest.saturating_sub(head) / rows as u32),
+        );
+        let panels = self
+            .charts
+            .iter()
+            .map(|c| c.settled(path))
+            .collect::<Result<Vec<_>>>()?;
+        let size = (panel.0 * columns as u32, panel.1 * rows as u32 + head);
+        render(
+            path,
+            (size, self.dpi),
+            &PanelsDrawing {
+                title: &self.title,
+                notes: &self.notes,
+                panels,
+                grid: (columns, rows),
+                head,
+            },
+        )
+    }
+}
+
+/// Panels with their charts settled.
+struct PanelsDrawing<'a> {
+    title: &'a str,
+    notes: &'a [String],
+    panels: Vec<ChartDrawing<'a>>,
+    grid: (usize, usize),
+    head: u32,
+}
+
+impl Draw for PanelsDrawing<'_> {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+    ) -> std::result::Result<(), String> {
+        let room = typeset_title(root, self.title)?;
+        let (head, body) = root.split_vertically(self.head);
+        let (_, notes) = head.split_vertically(room.min(self.head));
+        draw_notes(&notes, self.notes)?;
+        let areas = body.split_evenly((self.grid.1, self.grid.0));
+        for (panel, area) in self.panels.iter().zip(&areas) {
+            panel.draw(area)?;
         }
         Ok(())
     }

@@ -821,11 +821,28 @@ impl SiteMap {
         .map(SiteMap::Values)
     }
 
-    /// The map's values on `grid` (drawn for a random map: `O(N)` work and more).
+    /// The map's values on `grid`, one per site in cell order `i = iy·Nx + ix`: given
+    /// ones as they are, a random map's drawn (`O(N log N)` work), as a scene on `grid`
+    /// takes them (`precursors info` prints their mean, spread and extremes). Neither
+    /// their count nor their range is checked here ([`SceneBuilder::build`] does).
+    ///
+    /// ```
+    /// use precursors::{Block, Grid, SiteMap, SurfaceSpectrum};
+    /// let grid = Grid::new(Block::new(0.010, 0.004, 0.010)?, 10, 4)?;
+    /// let map = SiteMap::Surface {
+    ///     spectrum: SurfaceSpectrum::gaussian(2e-3)?,      // ξ = 2 mm
+    ///     mean: 0.5,
+    ///     std_dev: 0.0,                                    // no spread: the mean everywhere
+    ///     seed: 7,
+    /// };
+    /// assert!(map.values(&grid)?.iter().all(|&mu| (mu - 0.5).abs() < 1e-12));
+    /// assert_eq!(SiteMap::Values(vec![0.4; 40]).values(&grid)?, vec![0.4; 40]);
+    /// # Ok::<(), precursors::Error>(())
+    /// ```
     ///
     /// # Errors
     /// Those of the surface generator ([`Error::SurfaceTooLarge`], [`Error::OutOfMemory`]).
-    pub(crate) fn values(&self, grid: &Grid) -> Result<Vec<f64>> {
+    pub fn values(&self, grid: &Grid) -> Result<Vec<f64>> {
         match self {
             SiteMap::Values(values) => Ok(values.clone()),
             SiteMap::Surface {

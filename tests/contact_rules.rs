@@ -5,8 +5,8 @@
 //! and the uninterrupted run. A downstream crate's rules (`ContactLaw`) against the
 //! built-in rules they restate.
 
+use crate::common::events::{backends_agree, run};
 use crate::common::scratch;
-use precursors::solver::{Backend, SolverOptions};
 use precursors::{
     ContactLaw, ContactRule, Delay, Drive, Driver, Error, Event, Lateral, Scene, SceneBuilder,
     SiteState, SiteView,
@@ -41,20 +41,6 @@ fn spring(contact: &str, seed: u64) -> Scene {
         })
         .build()
         .unwrap()
-}
-
-/// The events of a run to global slip, each with what `look` reads of the state right
-/// after it; at most 20 000 events (a run that does not end fails).
-fn run<T>(scene: &Scene, mut look: impl FnMut(&Event, &Driver) -> T) -> Vec<(Event, T)> {
-    let mut driver = scene.driver().unwrap();
-    let mut out = Vec::new();
-    while let Some(event) = driver.step().unwrap() {
-        let seen = look(&event, &driver);
-        out.push((event, seen));
-        assert!(out.len() < 20_000, "no global slip after 20 000 events");
-    }
-    assert!(matches!(out.last(), Some((Event::GlobalSlip { .. }, _))));
-    out
 }
 
 /// After every event (but global slip, which solves nothing), the state balances its
@@ -311,39 +297,19 @@ fn rejuvenation_is_refused_where_it_cannot_run() {
         .contains("\"anchored\""));
 }
 
-/// The loads' scale in `events_on`'s scenes, `μ F_N` = 0.5 x 40 N: the backends' solves
+/// A 12 x 2 scene of random heights under the rule `contact`, for the backends' agreement.
+fn small(contact: &str, seed: u64) -> SceneBuilder {
+    builder(contact, seed)
+        .block(0.012, 0.002, 0.010)
+        .cells(12, 2)
+        .normal_load(40.0)
+}
+
+/// The loads' scale in the backends' scenes, `μ F_N` = 0.5 x 40 N: the backends' solves
 /// agree to their tolerance relative to it, so a load far below it (an early threshold
 /// of a few mN) is compared to 1e-8 of it, not of itself (seed 9470 differed by 1.1e-8
 /// of 1.8 mN, 1e-12 of `μ F_N`).
 const MU_FN: f64 = 20.0;
-
-/// The events of a run on `backend`: kinds and sites, and the loads (N).
-fn events_on(
-    contact: &str,
-    seed: u64,
-    backend: Backend,
-) -> Vec<(&'static str, Option<usize>, f64)> {
-    let options = SolverOptions::default().with_backend(backend).unwrap();
-    let scene = builder(contact, seed)
-        .block(0.012, 0.002, 0.010)
-        .cells(12, 2)
-        .normal_load(40.0)
-        .solver_options(options)
-        .build()
-        .unwrap();
-    run(&scene, |_, d| d.force())
-        .into_iter()
-        .map(|(e, force)| {
-            let site = match e {
-                Event::Rupture { site, .. } | Event::Attach { site } | Event::Detach { site } => {
-                    Some(site.index)
-                }
-                _ => None,
-            };
-            (e.kind(), site, force)
-        })
-        .collect()
-}
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(3))]
@@ -352,13 +318,7 @@ proptest! {
     #[test]
     fn dense_and_spectral_agree_event_by_event(seed in 0u64..10_000, rejuvenate in any::<bool>()) {
         let contact = if rejuvenate { REJUVENATION } else { ANCHORED };
-        let dense = events_on(contact, seed, Backend::Dense);
-        let spectral = events_on(contact, seed, Backend::Spectral);
-        prop_assert_eq!(dense.len(), spectral.len());
-        for (d, s) in dense.iter().zip(&spectral) {
-            prop_assert_eq!((d.0, d.1), (s.0, s.1));
-            prop_assert!((d.2 - s.2).abs() <= 1e-8 * d.2.abs().max(MU_FN), "{:?} {:?}", d, s);
-        }
+        backends_agree(small(contact, seed), MU_FN)?;
     }
 }
 
@@ -628,35 +588,19 @@ fn a_slip_weakening_rule_balances_its_loads_and_differs_from_the_papers() {
     assert_ne!(exact_events(&base), exact_events(&scene));
 }
 
-/// The events of a run of `rule` on `backend`: kinds and sites, and the loads (N).
-fn custom_events_on(seed: u64, backend: Backend) -> Vec<(&'static str, Option<usize>, f64)> {
-    let options = SolverOptions::default().with_backend(backend).unwrap();
-    let scene = Scene::builder()
+/// A small scene under a custom slip-weakening rule.
+fn custom_scene(seed: u64) -> SceneBuilder {
+    Scene::builder()
         .block(0.012, 0.002, 0.010)
         .cells(12, 2)
         .normal_load(40.0)
         .seed(seed)
-        .solver_options(options)
         .contact_rule(ContactRule::custom(SlipWeakening {
             dynamic: 0.5 * precursors::Material::default().friction_coefficient(),
             after: 2,
             // 2 % of μ F_N (F_N = 40 N).
             load: 0.02 * precursors::Material::default().friction_coefficient() * 40.0,
         }))
-        .build()
-        .unwrap();
-    run(&scene, |_, d| d.force())
-        .into_iter()
-        .map(|(e, force)| {
-            let site = match e {
-                Event::Rupture { site, .. } | Event::Attach { site } | Event::Detach { site } => {
-                    Some(site.index)
-                }
-                _ => None,
-            };
-            (e.kind(), site, force)
-        })
-        .collect()
 }
 
 proptest! {
@@ -665,13 +609,7 @@ proptest! {
     /// loads (to 1e-8 of the larger of the load and `μ F_N`), under a custom slip-weakening rule; small scenes, random seeds.
     #[test]
     fn dense_and_spectral_agree_on_a_custom_rule(seed in 0u64..10_000) {
-        let dense = custom_events_on(seed, Backend::Dense);
-        let spectral = custom_events_on(seed, Backend::Spectral);
-        prop_assert_eq!(dense.len(), spectral.len());
-        for (d, s) in dense.iter().zip(&spectral) {
-            prop_assert_eq!((d.0, d.1), (s.0, s.1));
-            prop_assert!((d.2 - s.2).abs() <= 1e-8 * d.2.abs().max(MU_FN), "{:?} {:?}", d, s);
-        }
+        backends_agree(custom_scene(seed), MU_FN)?;
     }
 }
 

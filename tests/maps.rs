@@ -5,11 +5,11 @@
 //! same tables, and bad maps are refused with typed errors naming the key, the site or
 //! the file's line.
 
+use crate::common::events::{backends_agree, run};
 use crate::common::scratch;
-use precursors::solver::{Backend, SolverOptions};
 use precursors::{
-    Block, Drive, Driver, Error, Event, Grid, Heights, Interface, Scene, SceneBuilder, SiteMap,
-    SiteState, SpringLaw, SurfaceSpectrum,
+    Block, Drive, Error, Event, Grid, Heights, Interface, Scene, SceneBuilder, SiteMap, SiteState,
+    SpringLaw, SurfaceSpectrum,
 };
 use proptest::prelude::*;
 
@@ -21,20 +21,6 @@ fn base(drive: Drive, seed: u64) -> SceneBuilder {
         .normal_load(60.0)
         .drive(drive)
         .seed(seed)
-}
-
-/// Every event of a run to global slip, each with what `look` reads of the state right
-/// after it; at most 20 000 events.
-fn run<T>(scene: &Scene, mut look: impl FnMut(&Event, &Driver) -> T) -> Vec<(Event, T)> {
-    let mut driver = scene.driver().unwrap();
-    let mut out = Vec::new();
-    while let Some(event) = driver.step().unwrap() {
-        let seen = look(&event, &driver);
-        out.push((event, seen));
-        assert!(out.len() < 20_000, "no global slip after 20 000 events");
-    }
-    assert!(matches!(out.last(), Some((Event::GlobalSlip { .. }, _))));
-    out
 }
 
 fn events(scene: &Scene) -> Vec<Event> {
@@ -257,17 +243,15 @@ fn every_state_balances_its_loads_and_holds_each_sites_bound() {
     }
 }
 
-/// The events of a run on `backend` with heterogeneous maps drawn from `seed`: kinds,
-/// sites and loads (N).
-fn events_on(seed: u64, backend: Backend) -> Vec<(&'static str, Option<usize>, f64)> {
-    let options = SolverOptions::default().with_backend(backend).unwrap();
+/// A small scene with heterogeneous maps of μ, c_x and c_z drawn from `seed`.
+fn heterogeneous_maps(seed: u64) -> SceneBuilder {
     let drawn = |mean: f64, spread: f64, seed: u64| SiteMap::Surface {
         spectrum: SurfaceSpectrum::gaussian(2e-3).unwrap(),
         mean,
         std_dev: spread * mean,
         seed,
     };
-    let scene = Scene::builder()
+    Scene::builder()
         .block(0.012, 0.002, 0.010)
         .cells(12, 2)
         .normal_load(40.0)
@@ -275,21 +259,6 @@ fn events_on(seed: u64, backend: Backend) -> Vec<(&'static str, Option<usize>, f
         .friction_map(drawn(0.5, 0.3, seed + 1))
         .c_x_map(drawn(1.65e12, 0.3, seed + 2))
         .c_z_map(drawn(1.65e8, 0.3, seed + 3))
-        .solver_options(options)
-        .build()
-        .unwrap();
-    run(&scene, |_, d| d.force())
-        .into_iter()
-        .map(|(e, force)| {
-            let site = match e {
-                Event::Rupture { site, .. } | Event::Attach { site } | Event::Detach { site } => {
-                    Some(site.index)
-                }
-                _ => None,
-            };
-            (e.kind(), site, force)
-        })
-        .collect()
 }
 
 proptest! {
@@ -299,16 +268,8 @@ proptest! {
     /// random seeds.
     #[test]
     fn dense_and_spectral_agree_event_by_event(seed in 0u64..10_000) {
-        let dense = events_on(seed, Backend::Dense);
-        let spectral = events_on(seed, Backend::Spectral);
-        prop_assert_eq!(dense.len(), spectral.len());
-        for (d, s) in dense.iter().zip(&spectral) {
-            prop_assert_eq!((d.0, d.1), (s.0, s.1));
-            // To 1e-8 of the larger of the load and the material's μF_N = 20 N: the solves
-            // agree to their tolerance relative to the loads' scale, not to an early
-            // threshold of a few mN (as tests/contact_rules.rs).
-            prop_assert!((d.2 - s.2).abs() <= 1e-8 * d.2.abs().max(20.0), "{:?} {:?}", d, s);
-        }
+        // The material's μF_N = 20 N: the loads' scale (as tests/contact_rules.rs).
+        backends_agree(heterogeneous_maps(seed), 20.0)?;
     }
 }
 

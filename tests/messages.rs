@@ -534,6 +534,103 @@ fn info_refuses_what_run_refuses_and_writes_lengths_plainly() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `info` prints one line per map the scene gives (docs/cli.md): its key and unit, its
+/// kind (a file's path, a random map's correlation length in mm and seed) and its values'
+/// mean, standard deviation (over the sites, 1/N), smallest and largest, to the four
+/// digits printed. References: a `file` map of `c_x` = 1e12 + i·1e9 N/m³ (i = 0..149:
+/// mean 1.0745e12, std 1e9·√((150² − 1)/12)), a `values` map of `c_z` =
+/// 1.65e8·(1 + 0.5·(i mod 3)) N/m² (50 sites each of 1.65e8, 2.475e8, 3.3e8: mean
+/// 2.475e8, std 0.825e8·√(2/3)), and a drawn μ against the built scene's map, its
+/// moments computed here. A scene without maps has no such line.
+#[test]
+fn info_describes_the_scenes_maps() {
+    let dir = scratch("info-maps");
+    let sites = 150;
+    let c_x: String = (0..sites)
+        .map(|i| format!("{}\n", 1e12 + f64::from(i) * 1e9))
+        .collect();
+    std::fs::write(dir.join("c_x.txt"), c_x).unwrap();
+    let c_z: Vec<String> = (0..sites)
+        .map(|i| format!("{}", 1.65e8 * (1.0 + 0.5 * f64::from(i % 3))))
+        .collect();
+    let maps = format!(
+        r#""maps": {{
+            "friction_coefficient": {{ "kind": "gaussian_surface", "correlation_length": 0.005,
+                                       "mean": 0.5, "std_dev": 0.1, "seed": 7 }},
+            "c_x": {{ "kind": "file", "path": "c_x.txt" }},
+            "c_z": {{ "kind": "values", "values": [{}] }} }},
+        "normal_load""#,
+        c_z.join(", ")
+    );
+    let scene = dir.join("maps.json");
+    std::fs::write(&scene, BASE.replace(r#""normal_load""#, &maps)).unwrap();
+    let o = precursors(&["info", path(&scene)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let text = String::from_utf8(o.stdout).unwrap();
+    let line = |start: &str| -> &str {
+        let found: Vec<&str> = text.lines().filter(|l| l.starts_with(start)).collect();
+        assert_eq!(found.len(), 1, "{start} in {text}");
+        found[0]
+    };
+    // The mean, std, min and max a line gives.
+    let moments = |line: &str| -> [f64; 4] {
+        let after = |word: &str| -> f64 {
+            let tail = line.split_once(&format!(" {word} ")).unwrap().1;
+            tail.split([',', ' ']).next().unwrap().parse().unwrap()
+        };
+        [after("mean"), after("std"), after("min"), after("max")]
+    };
+    let close = |found: [f64; 4], expected: [f64; 4], what: &str| {
+        for (f, e) in found.iter().zip(expected) {
+            // Four significant digits: within 5e-4 relative.
+            assert!(
+                (f - e).abs() <= 5e-4 * e.abs(),
+                "{what}: {found:?} vs {expected:?}"
+            );
+        }
+    };
+    let c_x = line("map        c_x (N/m³): file c_x.txt; over 150 sites mean ");
+    let spread = 1e9 * ((150.0f64 * 150.0 - 1.0) / 12.0).sqrt();
+    close(moments(c_x), [1.0745e12, spread, 1e12, 1.149e12], "c_x");
+    let c_z = line("map        c_z (N/m²): values; over 150 sites mean ");
+    let spread = 0.825e8 * (2.0f64 / 3.0).sqrt();
+    close(moments(c_z), [2.475e8, spread, 1.65e8, 3.3e8], "c_z");
+    let mu = line(
+        "map        friction_coefficient (dimensionless): gaussian_surface (ξ = 5 mm, seed 7); \
+         over 150 sites mean ",
+    );
+    let built = SceneBuilder::from_json_file(&scene)
+        .unwrap()
+        .build()
+        .unwrap();
+    let values = built.interface().friction_map().unwrap();
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let std = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt();
+    let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let max = values.iter().copied().fold(0.0, f64::max);
+    assert!(std > 0.01, "{values:?}");
+    close(moments(mu), [mean, std, min, max], "μ");
+    // The maps' lines between the contact rule's and the memory's.
+    let order: Vec<&str> = text
+        .lines()
+        .map(|l| l.split_whitespace().next().unwrap_or(""))
+        .collect();
+    let at = |key: &str| order.iter().position(|k| *k == key).unwrap();
+    assert_eq!(
+        (at("contact") + 1, at("memory") - 3),
+        (at("map"), at("map")),
+        "{text}"
+    );
+    // No maps, no such line.
+    let plain = dir.join("plain.json");
+    std::fs::write(&plain, BASE).unwrap();
+    let o = precursors(&["info", path(&plain)]);
+    let text = String::from_utf8(o.stdout).unwrap();
+    assert!(!text.lines().any(|l| l.starts_with("map ")), "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn every_without_checkpoint_is_a_command_line_error() {
     let dir = scratch("every");

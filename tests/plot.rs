@@ -1803,19 +1803,25 @@ fn error_bars(svg: &str) -> usize {
 
 /// The legend's box of an SVG chart (its grey frame): left, top, right, bottom.
 fn legend_box(svg: &str) -> (f64, f64, f64, f64) {
-    let tag = svg
-        .split("<rect")
+    *legend_boxes(svg).first().expect("a legend's frame")
+}
+
+/// The legends' boxes of an SVG figure (their grey frames), in the order drawn.
+fn legend_boxes(svg: &str) -> Vec<(f64, f64, f64, f64)> {
+    svg.split("<rect")
         .skip(1)
         .map(|t| t.split_once("/>").unwrap().0)
-        .find(|t| t.contains("fill=\"none\" stroke=\"#A0A0A0\""))
-        .expect("a legend's frame");
-    let (x, y) = (attribute(tag, "x"), attribute(tag, "y"));
-    (
-        x,
-        y,
-        x + attribute(tag, "width"),
-        y + attribute(tag, "height"),
-    )
+        .filter(|t| t.contains("fill=\"none\" stroke=\"#A0A0A0\""))
+        .map(|tag| {
+            let (x, y) = (attribute(tag, "x"), attribute(tag, "y"));
+            (
+                x,
+                y,
+                x + attribute(tag, "width"),
+                y + attribute(tag, "height"),
+            )
+        })
+        .collect()
 }
 
 /// The data of an SVG chart drawn in the rectangle `(left, top, right, bottom)`: its
@@ -1857,6 +1863,147 @@ fn data_under(svg: &str, (left, top, right, bottom): (f64, f64, f64, f64)) -> Ve
         }
     }
     found
+}
+
+/// A sweep of more than four points draws `avalanche_sizes` one panel a point
+/// (docs/statistics.md): a grid of 3 x 2 panels of the figure's size for 6 points, in the
+/// points' order, each titled by its point and with its own legend in its panel, clear of
+/// its data: the point's avalanche count and its power law's `α`, interval and `n_tail`
+/// (fitted here from the runs' `per_avalanche.csv`, as `stats` pools them) and the
+/// goodness test's verdict. Four points keep one chart with one legend. Before, every
+/// point's entries went into one legend, taller than the figure for many points.
+#[test]
+fn many_points_get_a_panel_each() {
+    use precursors::plot::{draw_with_options, DrawOptions};
+    use precursors::statistics::{compare_alternatives, PowerLawOptions, Support};
+    use precursors::sweep::{Sweep, SweepOptions};
+    let base = r#"{ "block": { "lx": 0.04, "ly": 0.005, "lz": 0.02 },
+        "cells": { "kind": "size", "dx": 0.001, "dy": 0.001 }, "normal_load": 700.0,
+        "drive": { "kind": "rod", "height": 0.004, "half_width": 0.001 } }"#;
+    let heights = [2, 3, 4, 5, 6, 7];
+    let (width, height) = (800.0, 560.0);
+    for count in [4, 6] {
+        let dir = scratch(&format!("panels-{count}"));
+        let values: Vec<String> = heights[..count]
+            .iter()
+            .map(|h| format!("{}", f64::from(*h) * 1e-3))
+            .collect();
+        let sweep = Sweep::from_json_str(&format!(
+            r#"{{ "base": {base}, "axes": [ {{ "key": "drive.height",
+                  "values": [{}] }} ], "realizations": 2, "seed": 3 }}"#,
+            values.join(", ")
+        ))
+        .unwrap();
+        sweep.execute(&dir, &SweepOptions::new(), |_| {}).unwrap();
+        let options = DrawOptions::default()
+            .formats(&[Format::Svg])
+            .figures(["avalanche_sizes"]);
+        let drawn = draw_with_options(&dir, &options).unwrap();
+        let path = dir.join("avalanche_sizes.svg");
+        let svg = std::fs::read_to_string(&path).unwrap();
+        let svg_tag = svg.split_once("<svg").unwrap().1.split_once('>').unwrap().0;
+        let size = (attribute(svg_tag, "width"), attribute(svg_tag, "height"));
+        let frames = legend_boxes(&svg);
+        let texts = svg_texts(&path);
+        let at = |a: &str| (attribute(a, "x"), attribute(a, "y"));
+        if count == 4 {
+            assert_eq!(size, (width, height));
+            assert_eq!(frames.len(), 1, "{frames:?}");
+            // The points named in the legend's entries.
+            let named = texts
+                .iter()
+                .filter(|(_, t)| t.starts_with("h = ") && t.ends_with("avalanche sizes"))
+                .count();
+            assert_eq!(named, 4, "{texts:?}");
+            std::fs::remove_dir_all(&dir).unwrap();
+            continue;
+        }
+        // Three columns, two rows, under the title and its notes.
+        assert_eq!(size.0, 3.0 * width);
+        let head = size.1 - 2.0 * height;
+        assert!((50.0..150.0).contains(&head), "{size:?}");
+        assert_eq!(frames.len(), 6, "{frames:?}");
+        let cell = |(x, y): (f64, f64)| ((x / width) as usize, ((y - head) / height) as usize);
+        let mut fitted = 0;
+        for (k, h) in heights.iter().enumerate() {
+            let name = format!("h = {h} mm (2 runs)");
+            let titles: Vec<(f64, f64)> = texts
+                .iter()
+                .filter(|(_, t)| *t == name)
+                .map(|(a, _)| at(a))
+                .collect();
+            assert_eq!(titles.len(), 1, "{name}: {texts:?}");
+            let panel = cell(titles[0]);
+            assert_eq!(panel, (k % 3, k / 3), "{name}");
+            let frame = frames
+                .iter()
+                .copied()
+                .find(|f| cell((f.0, f.1)) == panel)
+                .unwrap_or_else(|| panic!("{name}: no legend in its panel"));
+            assert_eq!(cell((frame.2, frame.3)), panel, "{name}: {frame:?}");
+            assert!(titles[0].1 < frame.1, "{name}: the title under the legend");
+            let under = data_under(&svg, frame);
+            assert!(under.is_empty(), "{name}: {under:?}");
+            let inside = |(x, y): (f64, f64)| {
+                (frame.0..=frame.2).contains(&x) && (frame.1..=frame.3).contains(&y)
+            };
+            let legend: Vec<&str> = texts
+                .iter()
+                .filter(|(a, _)| inside(at(a)))
+                .map(|(_, t)| t.as_str())
+                .collect();
+            let joined = squash(&legend.concat());
+            // The point's sizes as `stats` pools them: each run's avalanches before the
+            // spanning one.
+            let mut sizes = Vec::new();
+            for run in 0..2 {
+                let table = dir.join(format!("p{k:04}-r{run:04}/per_avalanche.csv"));
+                for row in read_csv(&table) {
+                    if row["spanning"] == "0" && row["after_spanning"] == "0" {
+                        sizes.push(row["ruptures"].parse::<f64>().unwrap());
+                    }
+                }
+            }
+            assert!(
+                legend.contains(&format!("{} avalanche sizes", sizes.len()).as_str()),
+                "{name}: {legend:?}"
+            );
+            match compare_alternatives(&sizes, Support::Discrete, &PowerLawOptions::default()) {
+                Ok(c) => {
+                    let fit = &c.power_law;
+                    let entry = format!(
+                        "α = {:.2} [{:.2}, {:.2}], ntail = {}",
+                        fit.alpha, fit.alpha_low, fit.alpha_high, fit.tail
+                    );
+                    assert!(
+                        joined.contains(&squash(&entry)),
+                        "{name}: {entry} not in {legend:?}"
+                    );
+                    assert!(
+                        legend.iter().any(|t| t.starts_with("pure power law ")),
+                        "{name}: {legend:?}"
+                    );
+                    fitted += 1;
+                }
+                Err(_) => assert!(
+                    drawn
+                        .notes
+                        .iter()
+                        .any(|n| n.contains(&name) && n.contains("no power law fitted")),
+                    "{name}: {:?}",
+                    drawn.notes
+                ),
+            }
+        }
+        assert!(fitted >= 3, "{fitted} of 6 points fitted");
+        // What holds for every panel is said once, under the title.
+        let notes = texts
+            .iter()
+            .filter(|(_, t)| t.starts_with("error bars: P"))
+            .count();
+        assert_eq!(notes, 1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
 
 /// Issue 54, item 7: a legend never covers data. Markers over the left half of a chart

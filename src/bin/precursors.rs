@@ -882,6 +882,11 @@ const INFO_BUILDS_BELOW: usize = 100_000;
 fn info(path: &Path) -> Result<(), Failure> {
     let builder = SceneBuilder::from_json_file(path)?;
     let file: serde_json::Value = serde_json::from_str(&builder.to_json()?).unwrap_or_default();
+    // The file as written, for what the builder's JSON does not keep (a map file's path).
+    let raw: serde_json::Value = std::fs::read_to_string(path)
+        .ok()
+        .and_then(|text| serde_json::from_str(&text).ok())
+        .unwrap_or_default();
     // What `run` refuses, `info` refuses: every check of `build` but the plan (memory
     // included); and the whole scene is built when that is quick, which also plans.
     let grid = builder.check()?;
@@ -930,6 +935,7 @@ fn info(path: &Path) -> Result<(), Failure> {
     } else {
         0.84 * (1e4_f64 / 980.0).powf(1.9) * (n as f64 / 1e4).powf(2.1)
     };
+    let maps = map_lines(&raw, &file, &grid)?;
     let text = format!(
         "scene      {}\n\
          block      {} x {} x {} m\n\
@@ -937,6 +943,7 @@ fn info(path: &Path) -> Result<(), Failure> {
          backend    {resolved}, solver threads {}\n\
          contact    {contact} (the rules of key contact.rule: paper, anchored, \
          rejuvenation)\n\
+         {maps}\
          memory     ~{} (estimate)\n\
          plan       ~{} (estimate, one thread)\n\
          equilibrium ~{} per cold normal + tangential solve (estimate, one thread)\n\
@@ -1028,12 +1035,86 @@ fn print_out(text: &str) -> Result<(), Failure> {
 /// A length with six significant digits, as a person writes it: `0.0007`, not the
 /// `0.0007000000000000001` that `0.007 / 10` is in binary; `1e-9`, not 0.000000001.
 fn metres(m: f64) -> String {
-    let rounded: f64 = format!("{m:.5e}").parse().unwrap_or(m);
+    significant(m, 6)
+}
+
+/// `x` with `digits` significant digits (at least 1), as a person writes it: `0.5012`,
+/// `1.65e12`, `1e-9`; plainly from 1e-4 to 1e6, else with an exponent.
+fn significant(x: f64, digits: usize) -> String {
+    let rounded: f64 = format!("{:.*e}", digits.max(1) - 1, x).parse().unwrap_or(x);
     if rounded == 0.0 || (1e-4..1e6).contains(&rounded.abs()) {
         format!("{rounded}")
     } else {
         format!("{rounded:e}")
     }
+}
+
+/// The scene file's maps (key `maps`), one line each: the key and the unit of its
+/// values, the map's kind (a file's path; a random map's correlation length in mm where
+/// its spectrum has one, and its seed) and its values over the sites, drawn for a random
+/// map: their mean, standard deviation (over the `N` sites, `1/N`), smallest and
+/// largest, four significant digits. `raw` is the file as written (a map file's path),
+/// `file` the scene as the builder reads it (a map file's values).
+fn map_lines(
+    raw: &serde_json::Value,
+    file: &serde_json::Value,
+    grid: &precursors::Grid,
+) -> Result<String, Failure> {
+    const MAPS: [(&str, &str); 3] = [
+        ("friction_coefficient", "dimensionless"),
+        ("c_x", "N/m³"),
+        ("c_z", "N/m²"),
+    ];
+    let mut lines = String::new();
+    for (key, unit) in MAPS {
+        let spec = &file["maps"][key];
+        if spec.is_null() {
+            continue;
+        }
+        let written = &raw["maps"][key];
+        let mut kind = written["kind"]
+            .as_str()
+            .or(spec["kind"].as_str())
+            .unwrap_or("values")
+            .to_string();
+        if let Some(path) = written["path"].as_str() {
+            kind = format!("{kind} {path}");
+        }
+        let mut about = Vec::new();
+        if let Some(xi) = spec["correlation_length"].as_f64() {
+            about.push(format!("ξ = {} mm", significant(1e3 * xi, 4)));
+        }
+        if let Some(seed) = spec["seed"].as_u64() {
+            about.push(format!("seed {seed}"));
+        }
+        if !about.is_empty() {
+            kind = format!("{kind} ({})", about.join(", "));
+        }
+        // The builder's own JSON of the map: it reads back (a file's as its values).
+        let map: precursors::SiteMap =
+            serde_json::from_value(spec.clone()).map_err(|e| Failure {
+                error: format!("reading back the map maps.{key}: {e}").into(),
+                code: 1,
+            })?;
+        let values = map.values(grid)?;
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let std = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt();
+        let (min, max) = values
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        lines.push_str(&format!(
+            "map        {key} ({unit}): {kind}; over {} sites mean {}, std {}, min {}, max {}\n",
+            values.len(),
+            significant(mean, 4),
+            significant(std, 4),
+            significant(min, 4),
+            significant(max, 4),
+        ));
+    }
+    Ok(lines)
 }
 
 fn run_sweep(

@@ -9,7 +9,9 @@
 
 use super::selection::Selection;
 use super::tables::{p_text, preferred, Fits, Table};
-use super::{point_order, series_colour, short, Canvas, Colours, Corner, PlotError, Style};
+use super::{
+    point_order, series_colour, short, Canvas, Chart, Colours, Corner, Panels, PlotError, Style,
+};
 use crate::error::Error;
 use crate::output::derived::derive;
 use crate::output::layout::POWER_LAWS;
@@ -138,6 +140,10 @@ pub(super) fn draw_statistics(
     Ok(drawn)
 }
 
+/// The most points a distribution figure draws on one chart: above, one panel a point
+/// ([`Panels`]), each with its own legend (docs/statistics.md).
+const ONE_CHART_POINTS: usize = 4;
+
 /// A log-log figure of the log-binned density of each point's samples with its counting
 /// error bars, and its fits: `power_laws.csv`'s row for the point and observable (the
 /// fits `precursors stats` wrote), or where the directory has none of these samples
@@ -145,6 +151,8 @@ pub(super) fn draw_statistics(
 /// solid, dashed and marked "rejected" where its goodness test rules it out; the cut-off
 /// law where the tests leave it unbeaten ([`preferred`]); the legend gives `n_tail`, the
 /// goodness p and the tests' verdict (which law they prefer, over which, at which p).
+/// Up to [`ONE_CHART_POINTS`] points share one chart, their legend entries named by
+/// their points; more are drawn one a panel, titled by their points.
 fn distribution(
     dir: &Path,
     extensions: &[&str],
@@ -154,25 +162,113 @@ fn distribution(
     drawn: &mut Statistics,
 ) -> Result<(), PlotError> {
     let table = Table::read(&dir.join(POWER_LAWS))?;
-    let mut chart = canvas
-        .chart(
-            &format!("Distribution of {what}: {title}"),
-            x_label,
-            y_label,
-        )
-        .log_x()
-        .log_y()
-        .legend(Corner::LowerLeft);
-    let symbol = x_label.split_whitespace().next().unwrap_or("x");
+    let heading = format!("Distribution of {what}: {title}");
+    let empty = |title: &str| {
+        canvas
+            .chart(title, x_label, y_label)
+            .log_x()
+            .log_y()
+            .legend(Corner::LowerLeft)
+    };
+    let fitting = Fitting {
+        table: table.as_ref(),
+        support,
+        observable,
+        what,
+        symbol: x_label.split_whitespace().next().unwrap_or("x"),
+        figure: name,
+    };
     let pooled = &family.pooled;
-    let mut computed = Vec::new();
+    let panels = pooled.len() > ONE_CHART_POINTS;
+    let mut chart = empty(&heading);
+    let mut charts = Vec::new();
+    let mut computed = false;
     for (k, p) in pooled.iter().enumerate() {
         // The markers and the fits of a point in one colour.
         let colour = series_colour(family.colours, k, pooled.len());
         let style = Style::new().colour(colour.0, colour.1, colour.2);
+        if panels {
+            let panel = fitting.point(empty(&p.label), p, (false, style), drawn)?;
+            computed |= panel.1;
+            charts.push(panel.0);
+        } else {
+            let one = fitting.point(chart, p, (true, style), drawn)?;
+            computed |= one.1;
+            chart = one.0;
+        }
+    }
+    let mut notes =
+        vec!["error bars: P (1 ± 1/√count), the Poisson counting error of each bin".to_string()];
+    if computed {
+        notes.push(
+            "fits computed here with the defaults of stats (it wrote none of these samples)".into(),
+        );
+    }
+    let figure = Panels {
+        title: heading,
+        notes: notes.clone(),
+        charts,
+        panel: canvas.size,
+        dpi: canvas.dpi,
+    };
+    for note in &notes {
+        chart = chart.note(note);
+    }
+    for extension in extensions {
+        let path = dir.join(format!("{name}.{extension}"));
+        if panels {
+            figure.save(&path)?;
+        } else {
+            chart.save(&path)?;
+        }
+        drawn.files.push(path);
+    }
+    Ok(())
+}
+
+/// What the fits of one figure's points are drawn from.
+struct Fitting<'a> {
+    /// `power_laws.csv`, where the directory has it.
+    table: Option<&'a Table>,
+    support: Support,
+    /// The observable's name in `power_laws.csv`.
+    observable: &'a str,
+    /// The samples, in words (`avalanche sizes`).
+    what: &'a str,
+    /// The samples' symbol in the legend (`S`).
+    symbol: &'a str,
+    /// The figure's name, in notes.
+    figure: &'a str,
+}
+
+impl Fitting<'_> {
+    /// `chart` with the point `p`'s binned density (markers with error bars), its fits and
+    /// the tests' verdict in `style`, its legend entries named by the point where `named`
+    /// (a chart of several points); and whether the fits were computed here (`stats`
+    /// wrote none of these samples). A point without a fit is said in `drawn`'s notes.
+    fn point(
+        &self,
+        mut chart: Chart,
+        p: &Pooled,
+        (named, style): (bool, Style),
+        drawn: &mut Statistics,
+    ) -> Result<(Chart, bool), PlotError> {
+        let (support, what, symbol) = (self.support, self.what, self.symbol);
+        let prefix = if p.label.is_empty() {
+            String::new()
+        } else {
+            format!("{}: ", p.label)
+        };
+        let entry = if named { prefix.as_str() } else { "" };
         let positive = p.samples.iter().filter(|x| **x > 0.0).count();
         if positive == 0 {
-            continue;
+            // A panel says why it is empty; a shared chart has the others' series.
+            let chart = if named {
+                chart
+            } else {
+                chart.note(&format!("no {what}"))
+            };
+            return Ok((chart, false));
         }
         let bins: Vec<(f64, f64, f64, f64)> = log_binned(&p.samples, support, 5)?
             .iter()
@@ -187,30 +283,23 @@ fn distribution(
                 )
             })
             .collect();
-        let prefix = if p.label.is_empty() {
-            String::new()
-        } else {
-            format!("{}: ", p.label)
-        };
         chart = chart
-            .error_bars(&format!("{prefix}{positive} {what}"), &bins)
+            .error_bars(&format!("{entry}{positive} {what}"), &bins)
             .style(style);
-        let row = match &table {
-            Some(t) => Fits::read(t, p.point, observable)?,
+        let row = match self.table {
+            Some(t) => Fits::read(t, p.point, self.observable)?,
             None => None,
         };
-        let fits = match row {
-            Some((n, fits)) if n == positive => fits,
-            _ => {
-                computed.push(p.label.clone());
-                fits_here(&p.samples, support)?
-            }
+        let (fits, computed) = match row {
+            Some((n, fits)) if n == positive => (fits, false),
+            _ => (fits_here(&p.samples, support)?, true),
         };
         let Some(fits) = fits else {
             drawn.notes.push(format!(
-                "{name}: {prefix}no power law fitted ({positive} samples)"
+                "{}: {prefix}no power law fitted ({positive} samples)",
+                self.figure
             ));
-            continue;
+            return Ok((chart, computed));
         };
         let top = p.samples.iter().copied().fold(fits.x_min, f64::max);
         let share = fits.tail as f64 / fits.samples.max(1) as f64;
@@ -227,7 +316,7 @@ fn distribution(
             None => " (goodness not tested)".to_string(),
         };
         let label = format!(
-            "{prefix}power law, {symbol} ≥ {}: α = {alpha:.2} [{low:.2}, {high:.2}], n_{{tail}} = \
+            "{entry}power law, {symbol} ≥ {}: α = {alpha:.2} [{low:.2}, {high:.2}], n_{{tail}} = \
              {}{verdict}",
             short(fits.x_min),
             fits.tail
@@ -247,7 +336,7 @@ fn distribution(
                 chart = chart
                     .line(
                         &format!(
-                            "{prefix}cut-off law: α = {a:.2} [{a_low:.2}, {a_high:.2}], scale {} \
+                            "{entry}cut-off law: α = {a:.2} [{a_low:.2}, {a_high:.2}], scale {} \
                              [{}, {}]",
                             short(scale),
                             end(scale_low),
@@ -261,23 +350,13 @@ fn distribution(
         // The verdict a clause a line, the point's name on the first.
         for (k, clause) in verdict.clauses.iter().enumerate() {
             chart = chart.note(&if k == 0 {
-                format!("{prefix}{clause}")
+                format!("{entry}{clause}")
             } else {
                 format!("  {clause}")
             });
         }
+        Ok((chart, computed))
     }
-    chart = chart.note("error bars: P (1 ± 1/√count), the Poisson counting error of each bin");
-    if !computed.is_empty() {
-        chart = chart
-            .note("fits computed here with the defaults of stats (it wrote none of these samples)");
-    }
-    for extension in extensions {
-        let path = dir.join(format!("{name}.{extension}"));
-        chart.save(&path)?;
-        drawn.files.push(path);
-    }
-    Ok(())
 }
 
 /// The fits `precursors stats` would write for `samples` with its default options: the

@@ -1,6 +1,7 @@
 //! Shared test helpers: Gauss–Legendre quadrature (the independent reference for cell
 //! averages and face integrals) and relative comparison.
 
+pub mod events;
 #[cfg(feature = "cli")]
 pub mod program;
 
