@@ -2329,3 +2329,72 @@ fn draw_with(dir: &Path, name: &str) {
         .figures([name]);
     draw_with_options(dir, &options).unwrap();
 }
+
+/// A sweep's `fronts` of more than 4 points: one panel a point, titled by it, each with its
+/// own legend clear of its bands (the one-chart legend of 5 points and up had ten entries
+/// and covered the data); 4 points keep one chart.
+#[test]
+fn ensemble_fronts_of_many_points_get_a_panel_each() {
+    use precursors::plot::{draw_with_options, DrawOptions};
+    use precursors::sweep::{Sweep, SweepOptions};
+    let base = r#"{ "block": { "lx": 0.04, "ly": 0.005, "lz": 0.02 },
+        "cells": { "kind": "size", "dx": 0.001, "dy": 0.001 }, "normal_load": 700.0,
+        "drive": { "kind": "rod", "height": 0.004, "half_width": 0.001 } }"#;
+    let heights = [2, 3, 4, 5, 6, 7];
+    let (width, height) = (800.0, 560.0);
+    for count in [4, 6] {
+        let dir = scratch(&format!("fronts-panels-{count}"));
+        let values: Vec<String> = heights[..count]
+            .iter()
+            .map(|h| format!("{}", f64::from(*h) * 1e-3))
+            .collect();
+        let sweep = Sweep::from_json_str(&format!(
+            r#"{{ "base": {base}, "axes": [ {{ "key": "drive.height",
+                  "values": [{}] }} ], "realizations": 2, "seed": 3 }}"#,
+            values.join(", ")
+        ))
+        .unwrap();
+        sweep.execute(&dir, &SweepOptions::new(), |_| {}).unwrap();
+        let options = DrawOptions::default()
+            .formats(&[Format::Svg])
+            .figures(["fronts"]);
+        draw_with_options(&dir, &options).unwrap();
+        let path = dir.join("fronts.svg");
+        let svg = std::fs::read_to_string(&path).unwrap();
+        let svg_tag = svg.split_once("<svg").unwrap().1.split_once('>').unwrap().0;
+        let size = (attribute(svg_tag, "width"), attribute(svg_tag, "height"));
+        let frames = legend_boxes(&svg);
+        let texts = svg_texts(&path);
+        let at = |a: &str| (attribute(a, "x"), attribute(a, "y"));
+        if count == 4 {
+            assert_eq!(size, (width, height));
+            assert_eq!(frames.len(), 1, "{frames:?}");
+            std::fs::remove_dir_all(&dir).unwrap();
+            continue;
+        }
+        assert_eq!(size.0, 3.0 * width);
+        let head = size.1 - 2.0 * height;
+        assert!((30.0..150.0).contains(&head), "{size:?}");
+        assert_eq!(frames.len(), 6, "{frames:?}");
+        let cell = |(x, y): (f64, f64)| ((x / width) as usize, ((y - head) / height) as usize);
+        for (k, h) in heights.iter().enumerate() {
+            let name = format!("h = {h} mm (2 runs)");
+            let titles: Vec<(f64, f64)> = texts
+                .iter()
+                .filter(|(_, t)| *t == name)
+                .map(|(a, _)| at(a))
+                .collect();
+            assert_eq!(titles.len(), 1, "{name}: {texts:?}");
+            let panel = cell(titles[0]);
+            assert_eq!(panel, (k % 3, k / 3), "{name}");
+            let frame = frames
+                .iter()
+                .copied()
+                .find(|f| cell((f.0, f.1)) == panel)
+                .unwrap_or_else(|| panic!("{name}: no legend in its panel"));
+            let under = data_under(&svg, frame);
+            assert!(under.is_empty(), "{name}: {under:?}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -140,9 +140,9 @@ pub(super) fn draw_statistics(
     Ok(drawn)
 }
 
-/// The most points a distribution figure draws on one chart: above, one panel a point
-/// ([`Panels`]), each with its own legend (docs/statistics.md).
-const ONE_CHART_POINTS: usize = 4;
+/// The most points a distribution figure, or a sweep's fronts, draws on one chart: above,
+/// one panel a point ([`Panels`]), each with its own legend (docs/statistics.md).
+pub(super) const ONE_CHART_POINTS: usize = 4;
 
 /// A log-log figure of the log-binned density of each point's samples with its counting
 /// error bars, and its fits: `power_laws.csv`'s row for the point and observable (the

@@ -3,8 +3,8 @@
 //! each run at its last stable state at or below the load (its whole length from its
 //! global slip on), next to one run's staircases (the point's first complete run).
 
-use super::distributions::{PointLabel, Statistics};
-use super::{point_order, series_colour, Canvas, Corner, PlotError, Style};
+use super::distributions::{PointLabel, Statistics, ONE_CHART_POINTS};
+use super::{point_order, series_colour, Canvas, Chart, Corner, Panels, PlotError, Style};
 use crate::output::check::RunRecord;
 use crate::output::derived::derive;
 use crate::output::layout::FRONTS_FIGURE;
@@ -82,7 +82,9 @@ fn bands(runs: &[Fronts]) -> (Band, Band) {
 }
 
 /// Draws `fronts` of the sweep in `dir` from its `points`: each point's bands, and for a
-/// sweep of one point its first run's staircases beside them.
+/// sweep of one point its first run's staircases beside them. Up to
+/// [`ONE_CHART_POINTS`] points share one chart; more are drawn one a panel ([`Panels`]),
+/// titled by their points, so that the legend never outgrows the figure.
 pub(super) fn ensemble_fronts(
     dir: &Path,
     extensions: &[&str],
@@ -92,15 +94,17 @@ pub(super) fn ensemble_fronts(
 ) -> Result<Statistics, PlotError> {
     let mut drawn = Statistics::default();
     let (colours, order) = point_order(&points.iter().map(|p| &p.values[..]).collect::<Vec<_>>());
-    let mut chart = canvas
-        .chart(
-            &format!("Precursor and damage fronts: {title}, median and interquartile range"),
-            "F/(μF_N)",
-            "x/Lx",
-        )
-        .x_range(0.0, 1.0)
-        .y_range(0.0, 1.0)
-        .legend(Corner::UpperLeft);
+    let heading = format!("Precursor and damage fronts: {title}, median and interquartile range");
+    let empty = |title: &str| -> Chart {
+        canvas
+            .chart(title, "F/(μF_N)", "x/Lx")
+            .x_range(0.0, 1.0)
+            .y_range(0.0, 1.0)
+            .legend(Corner::UpperLeft)
+    };
+    let panels = points.len() > ONE_CHART_POINTS;
+    let mut chart = empty(&heading);
+    let mut charts = Vec::new();
     let mut drew = false;
     for (k, point) in order.iter().map(|&k| &points[k]).enumerate() {
         let mut runs = Vec::with_capacity(point.runs());
@@ -120,6 +124,16 @@ pub(super) fn ensemble_fronts(
             label(&point.values, point.runs())
         };
         let (ell, front) = bands(&runs);
+        if panels {
+            charts.push(
+                empty(&name)
+                    .band("ℓ/Lx, median and quartiles", &ell)
+                    .style(style)
+                    .band("x_D/Lx, median and quartiles", &front)
+                    .style(style.dashed()),
+            );
+            continue;
+        }
         chart = chart
             .band(&format!("ℓ/Lx, median and quartiles: {name}"), &ell)
             .style(style)
@@ -148,11 +162,22 @@ pub(super) fn ensemble_fronts(
         ));
         return Ok(drawn);
     }
-    chart = chart
-        .note("ℓ: columns below their zero-shear area; x_D: columns with half their contacts lost");
+    let note = "ℓ: columns below their zero-shear area; x_D: columns with half their contacts lost";
+    let figure = Panels {
+        title: heading,
+        notes: vec![note.to_string()],
+        charts,
+        panel: canvas.size,
+        dpi: canvas.dpi,
+    };
+    let chart = chart.note(note);
     for extension in extensions {
         let path = dir.join(format!("{FRONTS_FIGURE}.{extension}"));
-        chart.save(&path)?;
+        if panels {
+            figure.save(&path)?;
+        } else {
+            chart.save(&path)?;
+        }
         drawn.files.push(path);
     }
     Ok(drawn)
