@@ -1865,6 +1865,104 @@ fn data_under(svg: &str, (left, top, right, bottom): (f64, f64, f64, f64)) -> Ve
     found
 }
 
+/// A sweep of `count` points (the rod at 2, 3, ... mm, two realizations each) run in a
+/// scratch directory named `name`, and its `figure` drawn as SVG and read back: the panel
+/// figures' tests.
+struct PanelFigure {
+    dir: std::path::PathBuf,
+    drawn: precursors::plot::Drawn,
+    svg: String,
+    /// The SVG's width and height.
+    size: (f64, f64),
+    /// The legend boxes `(left, top, right, bottom)`.
+    frames: Vec<(f64, f64, f64, f64)>,
+    texts: Vec<(String, String)>,
+}
+
+/// A panel's size, and the default figure's (1/150 inch at 150 dpi: SVG units).
+const PANEL: (f64, f64) = (800.0, 560.0);
+/// The rod heights (mm) of the panel sweeps' points, in order.
+const PANEL_HEIGHTS: [u32; 6] = [2, 3, 4, 5, 6, 7];
+
+fn panel_figure(name: &str, count: usize, figure: &str) -> PanelFigure {
+    use precursors::plot::{draw_with_options, DrawOptions};
+    use precursors::sweep::{Sweep, SweepOptions};
+    let base = r#"{ "block": { "lx": 0.04, "ly": 0.005, "lz": 0.02 },
+        "cells": { "kind": "size", "dx": 0.001, "dy": 0.001 }, "normal_load": 700.0,
+        "drive": { "kind": "rod", "height": 0.004, "half_width": 0.001 } }"#;
+    let dir = scratch(&format!("{name}-{count}"));
+    let values: Vec<String> = PANEL_HEIGHTS[..count]
+        .iter()
+        .map(|h| format!("{}", f64::from(*h) * 1e-3))
+        .collect();
+    let sweep = Sweep::from_json_str(&format!(
+        r#"{{ "base": {base}, "axes": [ {{ "key": "drive.height",
+              "values": [{}] }} ], "realizations": 2, "seed": 3 }}"#,
+        values.join(", ")
+    ))
+    .unwrap();
+    sweep.execute(&dir, &SweepOptions::new(), |_| {}).unwrap();
+    let options = DrawOptions::default()
+        .formats(&[Format::Svg])
+        .figures([figure]);
+    let drawn = draw_with_options(&dir, &options).unwrap();
+    let path = dir.join(format!("{figure}.svg"));
+    let svg = std::fs::read_to_string(&path).unwrap();
+    let svg_tag = svg.split_once("<svg").unwrap().1.split_once('>').unwrap().0;
+    let size = (attribute(svg_tag, "width"), attribute(svg_tag, "height"));
+    let frames = legend_boxes(&svg);
+    let texts = svg_texts(&path);
+    PanelFigure {
+        dir,
+        drawn,
+        svg,
+        size,
+        frames,
+        texts,
+    }
+}
+
+impl PanelFigure {
+    /// For a figure of six points: three columns of panels, two rows, under the title
+    /// and its notes; point `k`'s title (`h = … mm (2 runs)`) once, in panel `k` in the
+    /// points' order, above its own legend, which lies in the panel and covers no data.
+    /// Each point's name and legend box.
+    fn six_panels(&self) -> Vec<(String, (f64, f64, f64, f64))> {
+        let (width, height) = PANEL;
+        assert_eq!(self.size.0, 3.0 * width);
+        let head = self.size.1 - 2.0 * height;
+        assert!((30.0..150.0).contains(&head), "{:?}", self.size);
+        assert_eq!(self.frames.len(), 6, "{:?}", self.frames);
+        let cell = |(x, y): (f64, f64)| ((x / width) as usize, ((y - head) / height) as usize);
+        let at = |a: &str| (attribute(a, "x"), attribute(a, "y"));
+        let mut panels = Vec::new();
+        for (k, h) in PANEL_HEIGHTS.iter().enumerate() {
+            let name = format!("h = {h} mm (2 runs)");
+            let titles: Vec<(f64, f64)> = self
+                .texts
+                .iter()
+                .filter(|(_, t)| *t == name)
+                .map(|(a, _)| at(a))
+                .collect();
+            assert_eq!(titles.len(), 1, "{name}: {:?}", self.texts);
+            let panel = cell(titles[0]);
+            assert_eq!(panel, (k % 3, k / 3), "{name}");
+            let frame = self
+                .frames
+                .iter()
+                .copied()
+                .find(|f| cell((f.0, f.1)) == panel)
+                .unwrap_or_else(|| panic!("{name}: no legend in its panel"));
+            assert_eq!(cell((frame.2, frame.3)), panel, "{name}: {frame:?}");
+            assert!(titles[0].1 < frame.1, "{name}: the title under the legend");
+            let under = data_under(&self.svg, frame);
+            assert!(under.is_empty(), "{name}: {under:?}");
+            panels.push((name, frame));
+        }
+        panels
+    }
+}
+
 /// A sweep of more than four points draws `avalanche_sizes` one panel a point
 /// (docs/statistics.md): a grid of 3 x 2 panels of the figure's size for 6 points, in the
 /// points' order, each titled by its point and with its own legend in its panel, clear of
@@ -1874,76 +1972,25 @@ fn data_under(svg: &str, (left, top, right, bottom): (f64, f64, f64, f64)) -> Ve
 /// point's entries went into one legend, taller than the figure for many points.
 #[test]
 fn many_points_get_a_panel_each() {
-    use precursors::plot::{draw_with_options, DrawOptions};
     use precursors::statistics::{compare_alternatives, PowerLawOptions, Support};
-    use precursors::sweep::{Sweep, SweepOptions};
-    let base = r#"{ "block": { "lx": 0.04, "ly": 0.005, "lz": 0.02 },
-        "cells": { "kind": "size", "dx": 0.001, "dy": 0.001 }, "normal_load": 700.0,
-        "drive": { "kind": "rod", "height": 0.004, "half_width": 0.001 } }"#;
-    let heights = [2, 3, 4, 5, 6, 7];
-    let (width, height) = (800.0, 560.0);
     for count in [4, 6] {
-        let dir = scratch(&format!("panels-{count}"));
-        let values: Vec<String> = heights[..count]
-            .iter()
-            .map(|h| format!("{}", f64::from(*h) * 1e-3))
-            .collect();
-        let sweep = Sweep::from_json_str(&format!(
-            r#"{{ "base": {base}, "axes": [ {{ "key": "drive.height",
-                  "values": [{}] }} ], "realizations": 2, "seed": 3 }}"#,
-            values.join(", ")
-        ))
-        .unwrap();
-        sweep.execute(&dir, &SweepOptions::new(), |_| {}).unwrap();
-        let options = DrawOptions::default()
-            .formats(&[Format::Svg])
-            .figures(["avalanche_sizes"]);
-        let drawn = draw_with_options(&dir, &options).unwrap();
-        let path = dir.join("avalanche_sizes.svg");
-        let svg = std::fs::read_to_string(&path).unwrap();
-        let svg_tag = svg.split_once("<svg").unwrap().1.split_once('>').unwrap().0;
-        let size = (attribute(svg_tag, "width"), attribute(svg_tag, "height"));
-        let frames = legend_boxes(&svg);
-        let texts = svg_texts(&path);
+        let figure = panel_figure("panels", count, "avalanche_sizes");
+        let (texts, dir) = (&figure.texts, &figure.dir);
         let at = |a: &str| (attribute(a, "x"), attribute(a, "y"));
         if count == 4 {
-            assert_eq!(size, (width, height));
-            assert_eq!(frames.len(), 1, "{frames:?}");
+            assert_eq!(figure.size, PANEL);
+            assert_eq!(figure.frames.len(), 1, "{:?}", figure.frames);
             // The points named in the legend's entries.
             let named = texts
                 .iter()
                 .filter(|(_, t)| t.starts_with("h = ") && t.ends_with("avalanche sizes"))
                 .count();
             assert_eq!(named, 4, "{texts:?}");
-            std::fs::remove_dir_all(&dir).unwrap();
+            std::fs::remove_dir_all(dir).unwrap();
             continue;
         }
-        // Three columns, two rows, under the title and its notes.
-        assert_eq!(size.0, 3.0 * width);
-        let head = size.1 - 2.0 * height;
-        assert!((50.0..150.0).contains(&head), "{size:?}");
-        assert_eq!(frames.len(), 6, "{frames:?}");
-        let cell = |(x, y): (f64, f64)| ((x / width) as usize, ((y - head) / height) as usize);
         let mut fitted = 0;
-        for (k, h) in heights.iter().enumerate() {
-            let name = format!("h = {h} mm (2 runs)");
-            let titles: Vec<(f64, f64)> = texts
-                .iter()
-                .filter(|(_, t)| *t == name)
-                .map(|(a, _)| at(a))
-                .collect();
-            assert_eq!(titles.len(), 1, "{name}: {texts:?}");
-            let panel = cell(titles[0]);
-            assert_eq!(panel, (k % 3, k / 3), "{name}");
-            let frame = frames
-                .iter()
-                .copied()
-                .find(|f| cell((f.0, f.1)) == panel)
-                .unwrap_or_else(|| panic!("{name}: no legend in its panel"));
-            assert_eq!(cell((frame.2, frame.3)), panel, "{name}: {frame:?}");
-            assert!(titles[0].1 < frame.1, "{name}: the title under the legend");
-            let under = data_under(&svg, frame);
-            assert!(under.is_empty(), "{name}: {under:?}");
+        for (k, (name, frame)) in figure.six_panels().into_iter().enumerate() {
             let inside = |(x, y): (f64, f64)| {
                 (frame.0..=frame.2).contains(&x) && (frame.1..=frame.3).contains(&y)
             };
@@ -1986,12 +2033,13 @@ fn many_points_get_a_panel_each() {
                     fitted += 1;
                 }
                 Err(_) => assert!(
-                    drawn
+                    figure
+                        .drawn
                         .notes
                         .iter()
                         .any(|n| n.contains(&name) && n.contains("no power law fitted")),
                     "{name}: {:?}",
-                    drawn.notes
+                    figure.drawn.notes
                 ),
             }
         }
@@ -2002,7 +2050,7 @@ fn many_points_get_a_panel_each() {
             .filter(|(_, t)| t.starts_with("error bars: P"))
             .count();
         assert_eq!(notes, 1);
-        std::fs::remove_dir_all(&dir).unwrap();
+        std::fs::remove_dir_all(dir).unwrap();
     }
 }
 
@@ -2335,66 +2383,14 @@ fn draw_with(dir: &Path, name: &str) {
 /// and covered the data); 4 points keep one chart.
 #[test]
 fn ensemble_fronts_of_many_points_get_a_panel_each() {
-    use precursors::plot::{draw_with_options, DrawOptions};
-    use precursors::sweep::{Sweep, SweepOptions};
-    let base = r#"{ "block": { "lx": 0.04, "ly": 0.005, "lz": 0.02 },
-        "cells": { "kind": "size", "dx": 0.001, "dy": 0.001 }, "normal_load": 700.0,
-        "drive": { "kind": "rod", "height": 0.004, "half_width": 0.001 } }"#;
-    let heights = [2, 3, 4, 5, 6, 7];
-    let (width, height) = (800.0, 560.0);
     for count in [4, 6] {
-        let dir = scratch(&format!("fronts-panels-{count}"));
-        let values: Vec<String> = heights[..count]
-            .iter()
-            .map(|h| format!("{}", f64::from(*h) * 1e-3))
-            .collect();
-        let sweep = Sweep::from_json_str(&format!(
-            r#"{{ "base": {base}, "axes": [ {{ "key": "drive.height",
-                  "values": [{}] }} ], "realizations": 2, "seed": 3 }}"#,
-            values.join(", ")
-        ))
-        .unwrap();
-        sweep.execute(&dir, &SweepOptions::new(), |_| {}).unwrap();
-        let options = DrawOptions::default()
-            .formats(&[Format::Svg])
-            .figures(["fronts"]);
-        draw_with_options(&dir, &options).unwrap();
-        let path = dir.join("fronts.svg");
-        let svg = std::fs::read_to_string(&path).unwrap();
-        let svg_tag = svg.split_once("<svg").unwrap().1.split_once('>').unwrap().0;
-        let size = (attribute(svg_tag, "width"), attribute(svg_tag, "height"));
-        let frames = legend_boxes(&svg);
-        let texts = svg_texts(&path);
-        let at = |a: &str| (attribute(a, "x"), attribute(a, "y"));
+        let figure = panel_figure("fronts-panels", count, "fronts");
         if count == 4 {
-            assert_eq!(size, (width, height));
-            assert_eq!(frames.len(), 1, "{frames:?}");
-            std::fs::remove_dir_all(&dir).unwrap();
-            continue;
+            assert_eq!(figure.size, PANEL);
+            assert_eq!(figure.frames.len(), 1, "{:?}", figure.frames);
+        } else {
+            figure.six_panels();
         }
-        assert_eq!(size.0, 3.0 * width);
-        let head = size.1 - 2.0 * height;
-        assert!((30.0..150.0).contains(&head), "{size:?}");
-        assert_eq!(frames.len(), 6, "{frames:?}");
-        let cell = |(x, y): (f64, f64)| ((x / width) as usize, ((y - head) / height) as usize);
-        for (k, h) in heights.iter().enumerate() {
-            let name = format!("h = {h} mm (2 runs)");
-            let titles: Vec<(f64, f64)> = texts
-                .iter()
-                .filter(|(_, t)| *t == name)
-                .map(|(a, _)| at(a))
-                .collect();
-            assert_eq!(titles.len(), 1, "{name}: {texts:?}");
-            let panel = cell(titles[0]);
-            assert_eq!(panel, (k % 3, k / 3), "{name}");
-            let frame = frames
-                .iter()
-                .copied()
-                .find(|f| cell((f.0, f.1)) == panel)
-                .unwrap_or_else(|| panic!("{name}: no legend in its panel"));
-            let under = data_under(&svg, frame);
-            assert!(under.is_empty(), "{name}: {under:?}");
-        }
-        std::fs::remove_dir_all(&dir).unwrap();
+        std::fs::remove_dir_all(&figure.dir).unwrap();
     }
 }
