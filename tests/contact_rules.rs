@@ -5,7 +5,7 @@
 //! and the uninterrupted run. A downstream crate's rules (`ContactLaw`) against the
 //! built-in rules they restate.
 
-use crate::common::events::{backends_agree, run};
+use crate::common::events::{assert_balanced, backends_agree, run};
 use crate::common::scratch;
 use precursors::{
     ContactLaw, ContactRule, Delay, Drive, Driver, Error, Event, Lateral, Scene, SceneBuilder,
@@ -68,18 +68,9 @@ fn every_state_balances_its_loads_under_each_rule() {
                 return;
             }
             attaches += matches!(event, Event::Attach { .. }) as usize;
-            let force = driver.force();
-            let phi_x = driver.shear_traction().unwrap();
-            let phi_z = driver.normal_traction().unwrap();
-            let scale: f64 = cell * phi_x.iter().map(|p| p.abs()).sum::<f64>() + force.abs();
-            let carried: f64 = cell * phi_x.iter().sum::<f64>();
-            assert!(
-                (carried + force).abs() <= 1e-9 * scale + 1e-12,
-                "{name}: {event:?}: ΔA Σφ_x = {carried:e}, F = {force:e}"
-            );
-            let normal: f64 = cell * phi_z.iter().sum::<f64>();
-            assert!((normal - f_n).abs() <= 1e-9 * f_n, "{name}: {normal} N");
+            let (phi_x, phi_z) = assert_balanced(driver, event, (cell, f_n), &name);
             if let Some(u_s) = driver.load().drive_displacement {
+                let force = driver.force();
                 let mean = driver.mean_shear_displacement().unwrap();
                 let spring = 4e6 * (u_s - mean);
                 assert!(
@@ -558,17 +549,7 @@ fn a_slip_weakening_rule_balances_its_loads_and_differs_from_the_papers() {
         if matches!(event, Event::GlobalSlip { .. }) {
             return;
         }
-        let force = driver.force();
-        let phi_x = driver.shear_traction().unwrap();
-        let phi_z = driver.normal_traction().unwrap();
-        let scale: f64 = cell * phi_x.iter().map(|p| p.abs()).sum::<f64>() + force.abs();
-        let carried: f64 = cell * phi_x.iter().sum::<f64>();
-        assert!(
-            (carried + force).abs() <= 1e-9 * scale + 1e-12,
-            "{event:?}: ΔA Σφ_x = {carried:e}, F = {force:e}"
-        );
-        let normal: f64 = cell * phi_z.iter().sum::<f64>();
-        assert!((normal - f_n).abs() <= 1e-9 * f_n, "{normal} N");
+        let (phi_x, phi_z) = assert_balanced(driver, event, (cell, f_n), "rejuvenation");
         if let Event::Stable { .. } = event {
             for (i, s) in driver.site_states().iter().enumerate() {
                 if *s == SiteState::Attached {

@@ -5,7 +5,7 @@
 //! same tables, and bad maps are refused with typed errors naming the key, the site or
 //! the file's line.
 
-use crate::common::events::{backends_agree, run};
+use crate::common::events::{assert_balanced, backends_agree, run};
 use crate::common::scratch;
 use precursors::{
     Block, Drive, Error, Event, Grid, Heights, Interface, Scene, SceneBuilder, SiteMap, SiteState,
@@ -204,17 +204,7 @@ fn every_state_balances_its_loads_and_holds_each_sites_bound() {
             if matches!(event, Event::GlobalSlip { .. }) {
                 return;
             }
-            let force = driver.force();
-            let phi_x = driver.shear_traction().unwrap();
-            let phi_z = driver.normal_traction().unwrap();
-            let scale: f64 = cell * phi_x.iter().map(|p| p.abs()).sum::<f64>() + force.abs();
-            let carried: f64 = cell * phi_x.iter().sum::<f64>();
-            assert!(
-                (carried + force).abs() <= 1e-9 * scale + 1e-12,
-                "{name}: {event:?}: ΔA Σφ_x = {carried:e}, F = {force:e}"
-            );
-            let normal: f64 = cell * phi_z.iter().sum::<f64>();
-            assert!((normal - f_n).abs() <= 1e-9 * f_n, "{name}: {normal} N");
+            let (phi_x, phi_z) = assert_balanced(driver, event, (cell, f_n), &name);
             if let Event::Stable { load, .. } = event {
                 stable += 1;
                 assert!(

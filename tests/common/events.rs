@@ -61,3 +61,28 @@ pub fn backends_agree(builder: SceneBuilder, scale: f64) -> Result<(), TestCaseE
     }
     Ok(())
 }
+
+/// Force balance in the state right after `event` (`what` names the case in failures):
+/// the springs' shear tractions carry the load, `ΔA Σ φ_x = -F` to 1e-9 of the terms'
+/// size, and their normal tractions the normal load, `ΔA Σ φ_z = F_N` to 1e-9 (`cell`
+/// the cell area ΔA in m², `f_n` in N). The tractions `(φ_x, φ_z)` in Pa are returned for
+/// the caller's own checks.
+pub fn assert_balanced(
+    driver: &Driver,
+    event: &Event,
+    (cell, f_n): (f64, f64),
+    what: &str,
+) -> (Vec<f64>, Vec<f64>) {
+    let force = driver.force();
+    let phi_x = driver.shear_traction().unwrap().to_vec();
+    let phi_z = driver.normal_traction().unwrap().to_vec();
+    let scale: f64 = cell * phi_x.iter().map(|p| p.abs()).sum::<f64>() + force.abs();
+    let carried: f64 = cell * phi_x.iter().sum::<f64>();
+    assert!(
+        (carried + force).abs() <= 1e-9 * scale + 1e-12,
+        "{what}: {event:?}: ΔA Σφ_x = {carried:e}, F = {force:e}"
+    );
+    let normal: f64 = cell * phi_z.iter().sum::<f64>();
+    assert!((normal - f_n).abs() <= 1e-9 * f_n, "{what}: {normal} N");
+    (phi_x, phi_z)
+}
