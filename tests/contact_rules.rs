@@ -68,7 +68,7 @@ fn every_state_balances_its_loads_under_each_rule() {
                 return;
             }
             attaches += matches!(event, Event::Attach { .. }) as usize;
-            let (phi_x, phi_z) = assert_balanced(driver, event, (cell, f_n), &name);
+            let (phi_x, phi_z) = assert_balanced(driver, event, (cell, f_n), name);
             if let Some(u_s) = driver.load().drive_displacement {
                 let force = driver.force();
                 let mean = driver.mean_shear_displacement().unwrap();

@@ -204,7 +204,7 @@ fn every_state_balances_its_loads_and_holds_each_sites_bound() {
             if matches!(event, Event::GlobalSlip { .. }) {
                 return;
             }
-            let (phi_x, phi_z) = assert_balanced(driver, event, (cell, f_n), &name);
+            let (phi_x, phi_z) = assert_balanced(driver, event, (cell, f_n), name);
             if let Event::Stable { load, .. } = event {
                 stable += 1;
                 assert!(
